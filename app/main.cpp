@@ -1,0 +1,43 @@
+/// fieldpath: collision-free 5-axis ball-end paths through a repulsive field, and their proof.
+#include <cstdio>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.h"
+#include "errors.h"
+
+#ifndef FIELDPATH_VERSION
+#define FIELDPATH_VERSION "unknown"
+#endif
+
+int main(int argc, char** argv) {
+  using namespace fieldpath::app;
+  CLI::App app{"fieldpath: collision-free 5-axis ball-end milling paths (repulsive field), "
+               "clearance check and Z-buffer machining simulation"};
+  app.set_version_flag("--version", std::string("fieldpath ") + FIELDPATH_VERSION);
+  app.require_subcommand(1);
+  GlobalOptions global;
+  app.add_flag("--quiet", global.quiet, "No progress lines on stderr");
+
+  addToolCommand(app, global);
+  addSimulateCommand(app, global);
+  addFieldCommand(app, global);
+  addGenerateCommand(app, global);
+  addCheckCommand(app, global);
+  addStudyCommand(app, global);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);  // prints help / version / the usage error
+    return code == 0 ? 0 : 1;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "fieldpath: error: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fieldpath: internal error: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,24 @@
+#pragma once
+#include <cmath>
+/// Settings of the tool-axis dynamics (scene `dynamics:` block). Defaults documented here, once.
+
+namespace fieldpath::dynamics {
+
+enum class Integrator { Bdf, Erk };  ///< CVODE BDF (default) or ARKODE ERK (explicit reference)
+
+struct DynamicsParams {
+  double inertia = 1.0;     ///< J
+  double damping = -1.0;    ///< c; negative = critical, 2·sqrt(k·J)
+  double stiffness = 1.0;   ///< k
+  double feed_mm_per_min = 1000.0;
+  double rtol = 1.0e-6;
+  double atol = 1.0e-9;
+  double max_tilt_deg = 35.0;
+  double max_lead_deg = 20.0;
+  Integrator integrator = Integrator::Bdf;
+
+  /// c, with the critical default resolved.
+  double effectiveDamping() const { return damping >= 0.0 ? damping : 2.0 * std::sqrt(stiffness * inertia); }
+};
+
+}  // namespace fieldpath::dynamics

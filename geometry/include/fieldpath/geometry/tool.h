@@ -1,0 +1,26 @@
+#pragma once
+/// Cutting tool and holder descriptions (tool frame: tip at origin, axis +z, mm).
+/// The meshing and node generation live beside this in tool_model.h.
+#include <utility>
+#include <vector>
+
+namespace fieldpath::geometry {
+
+enum class ToolShape { Ball, Torus, Flat };
+
+/// A milling tool with a cylindrical shank closed by a flat top at `length_mm`.
+struct ToolSpec {
+  ToolShape shape = ToolShape::Ball;
+  double radius_mm = 3.0;         ///< R, tool radius
+  double corner_radius_mm = 0.0;  ///< r, torus only (0 < r <= R)
+  double length_mm = 12.0;        ///< L, from the tip to the top of the cutting body
+};
+
+/// Holder: (z from the tip, radius) stations, mm, z strictly increasing; revolved about +z.
+struct HolderStation {
+  double z_mm;
+  double radius_mm;
+};
+using HolderProfile = std::vector<HolderStation>;
+
+}  // namespace fieldpath::geometry

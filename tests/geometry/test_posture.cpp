@@ -1,0 +1,85 @@
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "fieldpath/geometry/posture.h"
+
+using namespace fieldpath::geometry;
+
+namespace {
+
+void expectProperRotationMappingZTo(const Eigen::Matrix3d& r, const Vec3& axis) {
+  EXPECT_LT((r.transpose() * r - Eigen::Matrix3d::Identity()).norm(), 1e-14);
+  EXPECT_NEAR(r.determinant(), 1.0, 1e-14);
+  EXPECT_LT((r * Vec3::UnitZ() - axis.normalized()).norm(), 1e-14);
+}
+
+Vec3 randomUnit(std::mt19937_64& rng) {
+  std::normal_distribution<double> n;
+  return Vec3(n(rng), n(rng), n(rng)).normalized();
+}
+
+}  // namespace
+
+TEST(Posture, RandomAxesGiveProperRotations) {
+  std::mt19937_64 rng(1);
+  for (int t = 0; t < 2000; ++t) {
+    const Vec3 a = randomUnit(rng);
+    expectProperRotationMappingZTo(rotationFromZ(a), a);
+  }
+}
+
+TEST(Posture, AxesNearPlusZ) {
+  std::mt19937_64 rng(2);
+  for (double eps : {1e-9, 1e-12, 1e-15, 0.0}) {
+    for (int t = 0; t < 100; ++t) {
+      const Vec3 d = randomUnit(rng);
+      const Vec3 a = (Vec3::UnitZ() + eps * Vec3(d.x(), d.y(), 0)).normalized();
+      const Eigen::Matrix3d r = rotationFromZ(a);
+      expectProperRotationMappingZTo(r, a);
+      // Minimal rotation: near identity when the axis is near +z.
+      EXPECT_LT((r - Eigen::Matrix3d::Identity()).norm(), 10 * eps + 1e-15);
+    }
+  }
+}
+
+TEST(Posture, AxesNearMinusZ) {
+  std::mt19937_64 rng(3);
+  for (double eps : {1e-6, 1e-9, 1e-12, 0.0}) {
+    for (int t = 0; t < 100; ++t) {
+      const Vec3 d = randomUnit(rng);
+      const Vec3 a = (-Vec3::UnitZ() + eps * Vec3(d.x(), d.y(), 0)).normalized();
+      expectProperRotationMappingZTo(rotationFromZ(a), a);
+    }
+  }
+  const Eigen::Matrix3d r = rotationFromZ(-Vec3::UnitZ());
+  expectProperRotationMappingZTo(r, -Vec3::UnitZ());
+}
+
+TEST(Posture, MinimalRotationFixesTheCommonPerpendicular) {
+  // The rotation is about e_z × a, so that vector is left unchanged.
+  std::mt19937_64 rng(4);
+  for (int t = 0; t < 200; ++t) {
+    const Vec3 a = randomUnit(rng);
+    const Vec3 w = Vec3::UnitZ().cross(a);
+    if (w.norm() < 1e-6) continue;
+    EXPECT_LT((rotationFromZ(a) * w - w).norm(), 1e-14);
+  }
+}
+
+TEST(Posture, TransformRoundTripsPoints) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-100, 100);
+  for (int t = 0; t < 500; ++t) {
+    Posture p;
+    p.tip_mm = Vec3(u(rng), u(rng), u(rng));
+    p.axis = randomUnit(rng);
+    const Eigen::Isometry3d m = toolToWorld(p);
+    const Vec3 x(u(rng), u(rng), u(rng));
+    EXPECT_LT((m.inverse() * (m * x) - x).norm(), 1e-12);
+    EXPECT_LT((m * Vec3::Zero() - p.tip_mm).norm(), 1e-12);
+    const Posture back = postureFromTransform(m);
+    EXPECT_LT((back.tip_mm - p.tip_mm).norm(), 1e-12);
+    EXPECT_LT((back.axis - p.axis).norm(), 1e-14);
+  }
+}
