@@ -1,0 +1,30 @@
+#pragma once
+/// The CLI's progress line on stderr (for work over a second; silenced by --quiet).
+#include <chrono>
+#include <cstdio>
+#include <string>
+
+#include "fieldpath/common/progress.h"
+
+namespace fieldpath::app {
+
+/// Makes a Progress hook that redraws one stderr line at most 10 times a second, and only once
+/// the work has run for a second. Quiet → a hook that never prints.
+inline common::Progress makeProgressLine(bool quiet) {
+  if (quiet) return [](double, std::string_view) { return true; };
+  const auto start = std::chrono::steady_clock::now();
+  auto last = start;
+  return [start, last](double fraction, std::string_view what) mutable {
+    const auto now = std::chrono::steady_clock::now();
+    const double elapsed_s = std::chrono::duration<double>(now - start).count();
+    if (elapsed_s < 1.0 || (now - last < std::chrono::milliseconds(100) && fraction < 1.0))
+      return true;
+    last = now;
+    std::fprintf(stderr, "\r%-24.*s %5.1f%%  %6.1f s%s", static_cast<int>(what.size()), what.data(),
+                 100.0 * fraction, elapsed_s, fraction >= 1.0 ? "\n" : "");
+    std::fflush(stderr);
+    return true;
+  };
+}
+
+}  // namespace fieldpath::app
