@@ -1,5 +1,7 @@
 #pragma once
 /// Indexed triangle meshes (mm). Orientation: counter-clockwise seen from outside (outward normals).
+#include <cstddef>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -10,5 +12,27 @@ struct TriangleMesh {
   std::vector<Eigen::Vector3d> vertices;   ///< mm
   std::vector<Eigen::Vector3i> triangles;  ///< vertex indices, CCW from outside
 };
+
+/// Counts of what is wrong with a mesh (nothing is repaired). Edges are undirected vertex-index pairs.
+struct MeshReport {
+  std::size_t vertices = 0;
+  std::size_t triangles = 0;
+  std::size_t non_finite_vertices = 0;
+  std::size_t degenerate_triangles = 0;  ///< repeated index, index out of range, or zero area
+  std::size_t open_edges = 0;            ///< used by one triangle
+  std::size_t non_manifold_edges = 0;    ///< used by more than two triangles
+  std::size_t inconsistent_edges = 0;    ///< two triangles traverse it the same way
+  /// Closed and consistently oriented: non-empty, no open, non-manifold or inconsistent edge,
+  /// no degenerate triangle, every vertex finite.
+  bool closed() const;
+  /// One line, e.g. "1200 vertices, 2396 triangles, closed".
+  std::string summary() const;
+};
+
+MeshReport validateMesh(const TriangleMesh& mesh);
+/// Total triangle area, mm².
+double meshArea(const TriangleMesh& mesh);
+/// Signed enclosed volume (divergence theorem), mm³; positive for outward orientation of a closed mesh.
+double meshVolume(const TriangleMesh& mesh);
 
 }  // namespace fieldpath::geometry

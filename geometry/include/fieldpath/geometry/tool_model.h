@@ -1,0 +1,49 @@
+#pragma once
+/// Tool and holder as revolved profiles → closed meshes and surface nodes, in the tool frame
+/// (tip at the origin, axis +z, mm). See tool.h for the descriptions.
+#include <string_view>
+#include <vector>
+
+#include "fieldpath/geometry/mesh.h"
+#include "fieldpath/geometry/posture.h"
+#include "fieldpath/geometry/tool.h"
+
+namespace fieldpath::geometry {
+
+/// "ball:R[:L]" | "torus:R:r[:L]" | "flat:R[:L]" (mm); L defaults to 4R. Throws common::InputError.
+ToolSpec parseToolSpec(std::string_view text);
+
+/// "z0:r0,z1:r1,..." (mm, z from the tip, strictly increasing; r > 0). Empty text → empty profile.
+/// Throws common::InputError.
+HolderProfile parseHolderProfile(std::string_view text);
+
+/// Throws common::InputError if the tool is not meshable (R <= 0, r outside (0, R] for a torus,
+/// L below the cutting end, non-finite values).
+void validateToolSpec(const ToolSpec& tool);
+/// Throws common::InputError unless z strictly increases and every radius is finite and > 0.
+void validateHolderProfile(const HolderProfile& holder);
+
+/// Closed, outward-oriented mesh of tool body (cutting end + cylindrical shank to L) and holder,
+/// every point within `chord_tol_mm` of the analytic surface. Angular steps come from the sagitta
+/// formula; the tip lies on the axis with no degenerate triangles there. The holder (may be empty)
+/// is joined to the top of the tool: the profile runs tip → L → holder stations → top on the axis.
+TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double chord_tol_mm);
+
+enum class NodePart { Tool, Holder };
+
+/// A point on the surface of tool or holder (tool frame, mm) with its outward unit normal.
+struct SurfaceNode {
+  Vec3 position_mm;
+  Vec3 normal;
+  NodePart part;
+};
+
+/// Nodes spread over the revolved surface about `spacing_mm` apart (along the profile and around
+/// the axis), including the tip, and the flat top (tool only) or the holder's end faces.
+std::vector<SurfaceNode> surfaceNodes(const ToolSpec& tool, const HolderProfile& holder, double spacing_mm);
+
+/// |distance| (mm) from a point in the tool frame to the analytic surface of the tool body
+/// (cutting end, shank cylinder and flat top at L).
+double toolSurfaceDistance(const ToolSpec& tool, const Vec3& point_tool_frame_mm);
+
+}  // namespace fieldpath::geometry
