@@ -1,0 +1,79 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/pathgen/clearance.h"
+
+using namespace fieldpath;
+using geometry::Posture;
+using geometry::TriangleMesh;
+using geometry::Vec3;
+
+namespace {
+
+/// Closed axis-aligned box [lo, hi], outward triangles.
+TriangleMesh box(const Vec3& lo, const Vec3& hi) {
+  TriangleMesh m;
+  for (int i = 0; i < 8; ++i)
+    m.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+  const int f[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                        {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  for (const auto& t : f) m.triangles.emplace_back(t[0], t[1], t[2]);
+  return m;
+}
+
+/// A wall: the plane x = x0 as two triangles, large.
+TriangleMesh wall(double x0) {
+  TriangleMesh m;
+  m.vertices = {{x0, -100, -100}, {x0, 100, -100}, {x0, 100, 100}, {x0, -100, 100}};
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return m;
+}
+
+}  // namespace
+
+// Closed form: a 2 × 2 × 10 "tool" (tool frame, tip at the origin) beside the wall x = 5.
+TEST(Clearance, BoxToolBesideAWallClosedForm) {
+  const TriangleMesh tool = box(Vec3(-1, -1, 0), Vec3(1, 1, 10));
+  const std::vector<TriangleMesh> obstacles = {wall(5.0), wall(-20.0)};
+  const pathgen::ClearanceChecker checker(tool, obstacles);
+  Posture upright;
+  EXPECT_NEAR(checker.clearance(upright), 4.0, 1e-9);
+
+  // Tilted towards +x by θ about y: the top far corner comes to x = 10 sin θ + cos θ.
+  const double theta = 0.3;
+  Posture tilted;
+  tilted.axis = Vec3(std::sin(theta), 0, std::cos(theta));
+  int nearest = -1;
+  EXPECT_NEAR(checker.clearance(tilted, &nearest), 5.0 - (10 * std::sin(theta) + std::cos(theta)), 1e-9);
+  EXPECT_EQ(nearest, 0);
+
+  Posture crossing;
+  crossing.tip_mm = Vec3(4.5, 0, 0);  // box spans x ∈ [3.5, 5.5]: it crosses the wall
+  Posture beyond;
+  beyond.tip_mm = Vec3(-17, 0, 0);  // 2 mm from the second wall
+  const std::vector<Posture> postures = {upright, tilted, crossing, beyond, crossing};
+  const auto result = checker.check(postures, pathgen::ClearanceRequest{.per_posture = true, .batch = 2});
+  EXPECT_EQ(result.postures, 5u);
+  EXPECT_EQ(result.colliding, 2u);
+  EXPECT_EQ(result.first_colliding, 2u);
+  EXPECT_EQ(result.min_index, 2u);
+  EXPECT_EQ(result.min_clearance_mm, 0.0);
+  ASSERT_EQ(result.clearance_mm.size(), 5u);
+  EXPECT_NEAR(result.clearance_mm[3], 2.0, 1e-9);
+  EXPECT_NEAR(result.clearance_mm[0], 4.0, 1e-9);
+
+  const std::vector<Posture> safe = {upright, beyond};
+  const auto ok = checker.check(safe);
+  EXPECT_EQ(ok.colliding, 0u);
+  EXPECT_NEAR(ok.min_clearance_mm, 2.0, 1e-9);
+  EXPECT_EQ(ok.min_index, 1u);
+  EXPECT_EQ(ok.min_obstacle, 1);
+}
+
+TEST(Clearance, EmptyMeshIsBadInput) {
+  const std::vector<TriangleMesh> obstacles = {TriangleMesh{}};
+  EXPECT_THROW(pathgen::ClearanceChecker(box(Vec3(-1, -1, 0), Vec3(1, 1, 1)), obstacles),
+               common::InputError);
+}

@@ -1,0 +1,88 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "fieldpath/common/errors.h"
+#include "fixtures.h"
+#include "fieldpath/pathgen/passes.h"
+
+using namespace fieldpath;
+using namespace fieldpath::pathgen;
+
+// Closed form first: on a flat straight channel a pass is the straight line z = R, y = const.
+TEST(Passes, FlatChannelGivesStraightLinesAtBallHeight) {
+  ImpellerParams p = test::flatChannel();
+  p.passes_v = {0.25, 0.75};
+  const Impeller imp(p);
+  PathParams path;
+  path.passes = 3;
+  path.step_mm = 0.7;
+  const auto passes = impellerPasses(imp, path, 3.0);
+  ASSERT_EQ(passes.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    const Pass& pass = passes[k];
+    EXPECT_NEAR(pass.length_mm, 72.0, 1e-9);
+    ASSERT_EQ(pass.samples.size(), 104u);  // ceil(72 / 0.7) = 103 intervals
+    for (const PassSample& s : pass.samples) {
+      EXPECT_NEAR(s.centre_mm.z(), 3.0, 1e-12);
+      EXPECT_NEAR(s.centre_mm.y(), -5.0 + 5.0 * k, 1e-12);
+      EXPECT_NEAR(s.centre_mm.x(), s.s_mm, 1e-9);
+      EXPECT_NEAR((s.feed - Vec3::UnitX()).norm(), 0, 1e-9);
+      EXPECT_NEAR((s.binormal - Vec3::UnitY()).norm(), 0, 1e-9);
+    }
+  }
+  const geometry::Posture tip = ballPosture(Vec3(1, 2, 3), Vec3::UnitZ(), 3.0);
+  EXPECT_NEAR((tip.tip_mm - Vec3(1, 2, 0)).norm(), 0, 1e-15);
+  // Lead turns n about b towards f.
+  const Vec3 a = nominalAxis(passes[0].samples[5], M_PI / 6);
+  EXPECT_NEAR((a - Vec3(0.5, 0, std::sqrt(0.75))).norm(), 0, 1e-9);
+}
+
+TEST(Passes, OffsetCurvesAreArcLengthSteppedWithOrthonormalFrames) {
+  const Impeller imp{ImpellerParams{}};
+  const PathParams path;  // 7 passes, 0.5 mm
+  const double r = 3.0;
+  const auto passes = impellerPasses(imp, path, r);
+  ASSERT_EQ(passes.size(), 7u);
+  double total_mm = 0;
+  for (const Pass& pass : passes) {
+    total_mm += pass.length_mm;
+    const double step = pass.samples[1].s_mm - pass.samples[0].s_mm;
+    EXPECT_LE(step, path.step_mm + 1e-12);
+    EXPECT_GT(step, path.step_mm * 0.98);
+    for (size_t i = 0; i < pass.samples.size(); ++i) {
+      const PassSample& s = pass.samples[i];
+      // C = S + R n: the ball touches the hub at S(u, v).
+      EXPECT_NEAR((s.centre_mm - r * s.normal - imp.hub(s.u, pass.v)).norm(), 0, 1e-9);
+      EXPECT_NEAR(s.feed.norm(), 1, 1e-12);
+      EXPECT_NEAR(s.feed.dot(s.normal), 0, 1e-9);
+      EXPECT_NEAR((s.binormal - s.normal.cross(s.feed)).norm(), 0, 1e-12);
+      if (i > 0) {  // chord between stations = arc-length step (flat enough at 0.5 mm)
+        const double chord = (s.centre_mm - pass.samples[i - 1].centre_mm).norm();
+        EXPECT_NEAR(chord, step, 1e-4);
+        EXPECT_GT(s.feed.dot(s.centre_mm - pass.samples[i - 1].centre_mm), 0);
+      }
+    }
+  }
+  EXPECT_NEAR(total_mm, 500.0, 25.0);  // seed 004: 7 passes ≈ 500 mm
+}
+
+TEST(Passes, EmptyPassAndBadPathValuesNameThePassOrKey) {
+  ImpellerParams p;
+  p.u_range = {0.5, 0.5};
+  const Impeller imp(p);
+  try {
+    impellerPasses(imp, PathParams{}, 3.0);
+    FAIL();
+  } catch (const common::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("pass 1"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("empty"), std::string::npos) << e.what();
+  }
+  const Impeller good{ImpellerParams{}};
+  PathParams path;
+  path.passes = 0;
+  EXPECT_THROW(impellerPasses(good, path, 3.0), common::InputError);
+  path = {};
+  path.step_mm = 0;
+  EXPECT_THROW(impellerPasses(good, path, 3.0), common::InputError);
+}
