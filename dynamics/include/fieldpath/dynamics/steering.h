@@ -1,0 +1,109 @@
+#pragma once
+/// Spring-damper steering of the tool axis along one pass (seed 004 §1.2, DESIGN.md "The dynamics"):
+/// the ball centre follows the pass exactly, the axis turns under the moment of the repulsive field
+/// at the tool and holder nodes, and a spring-damper pulls it back to the nominal angles:
+///
+///   J θ'' + c θ' + k (θ - θ0(s)) = τ(θ),   θ = (lead, tilt),   s = v t,
+///   τ = [ M·b, M·f ],   M = Σ (x_i - C) × F(x_i)   (world frame, about the ball centre C).
+///
+/// Integrated in time with CVODE (BDF, dense Newton, difference-quotient Jacobian) or, for
+/// comparison, ARKODE's explicit ERK, which reports SolverFailed when stiffness outruns its budget.
+#include <functional>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "fieldpath/common/progress.h"
+#include "fieldpath/dynamics/frame.h"
+#include "fieldpath/dynamics/params.h"
+#include "fieldpath/field/force_field.h"
+#include "fieldpath/geometry/posture.h"
+
+namespace fieldpath::dynamics {
+
+/// The programmed pass: ball-centre curve with its frame as a function of arc length s in
+/// [0, length_mm]. Called at arbitrary s (solver stages), so it must be cheap and deterministic.
+struct Pass {
+  double length_mm = 0.0;
+  std::function<PassFrame(double s_mm)> frameAt;
+};
+
+/// What to do when an output sample leaves the configured limits.
+enum class LimitPolicy {
+  Report,  ///< stop; status TiltLimit / RateLimit and a message naming the arc length
+  Clamp,   ///< hold the angle at the limit (rate zeroed, solver restarted); the sample is flagged
+};
+
+struct SteeringRequest {
+  const field::ForceField* field = nullptr;   ///< not owned; null = no field (free response)
+  std::span<const Vec3> nodes_tool_frame_mm;  ///< tool + holder nodes, tool frame (tip at 0, axis +z)
+  double ball_radius_mm = 3.0;                ///< R: the ball centre is at (0, 0, R) in the tool frame
+  DynamicsParams params;
+  double step_mm = 0.5;  ///< arc length between output samples (the last one lands on length_mm)
+  std::optional<double> initial_lead_rad;  ///< default: nominal θ0(0)
+  std::optional<double> initial_tilt_rad;  ///< default: nominal θ0(0)
+  double initial_lead_rate_rad_per_s = 0.0;
+  double initial_tilt_rate_rad_per_s = 0.0;
+  LimitPolicy on_limit = LimitPolicy::Report;
+  double max_angle_change_deg_per_mm = 0.0;  ///< between output samples, either angle; 0 = unchecked
+  long max_steps_per_output = 500;           ///< solver step budget per output interval
+  /// Optional: distance (mm) from the placed nodes (world frame) to the obstacles, stored in each
+  /// sample (pathgen passes an FCL or point query). NaN in the samples when unset.
+  std::function<double(std::span<const Vec3> nodes_world_mm)> clearance;
+  common::Progress progress;
+};
+
+/// One output sample, every `step_mm` along the pass.
+struct PostureSample {
+  double s_mm = 0.0;
+  double lead_rad = 0.0, tilt_rad = 0.0;
+  double lead_rate_rad_per_s = 0.0, tilt_rate_rad_per_s = 0.0;
+  double lead_torque = 0.0, tilt_torque = 0.0;  ///< τ = [M·b, M·f]
+  Vec3 moment = Vec3::Zero();                   ///< M about the ball centre, world frame
+  double clearance_mm = 0.0;                    ///< from SteeringRequest::clearance, else NaN
+  geometry::Posture posture;                    ///< tip = C - R a, axis a
+  bool limited = false;                         ///< clamped (LimitPolicy::Clamp) or rate over limit
+};
+
+/// Solver counters, summed over restarts (clamps).
+struct SolverStats {
+  long steps = 0;
+  long rhs_evals = 0;             ///< all right-hand-side evaluations, Jacobian ones included
+  long jacobian_evals = 0;        ///< dense difference-quotient Jacobians (BDF only)
+  long error_test_failures = 0;
+  long convergence_failures = 0;  ///< nonlinear (Newton) convergence failures (BDF only)
+  long restarts = 0;              ///< re-initialisations after a clamp
+};
+
+enum class Status {
+  Ok,
+  TiltLimit,     ///< an angle left [-max, max] (LimitPolicy::Report)
+  RateLimit,     ///< an angle changed faster than max_angle_change_deg_per_mm (Report)
+  SolverFailed,  ///< the integrator gave up (step budget, convergence, non-finite moment)
+};
+const char* toString(Status status);
+
+struct SteeringResult {
+  std::vector<PostureSample> samples;  ///< s = 0, step, 2 step, ..., length (up to a failure)
+  SolverStats stats;
+  Status status = Status::Ok;
+  std::string message;  ///< empty when Ok; otherwise names the arc length (mm) and the cause
+  int clamped_samples = 0;
+};
+
+/// Integrates one pass. Throws common::InputError for bad settings (naming the `dynamics.` key) and
+/// common::Interrupted when the progress hook asks to stop; numerical outcomes are in `status`.
+SteeringResult steerPass(const Pass& pass, const SteeringRequest& request);
+
+/// The moment of the field on the nodes placed at axis angles (lead, tilt) at one pass frame, about
+/// the ball centre: τ = [M·b, M·f]. Used by steerPass and by callers that want the static moment.
+struct AxisMoment {
+  Vec3 moment = Vec3::Zero();
+  double lead_torque = 0.0, tilt_torque = 0.0;
+};
+AxisMoment axisMoment(const field::ForceField& field, std::span<const Vec3> nodes_tool_frame_mm,
+                      double ball_radius_mm, const LocalFrame& frame, const Vec3& centre_mm,
+                      double lead_rad, double tilt_rad);
+
+}  // namespace fieldpath::dynamics

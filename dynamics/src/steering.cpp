@@ -1,0 +1,285 @@
+#include "fieldpath/dynamics/steering.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+#include "fieldpath/common/errors.h"
+#include "sundials_support.h"
+
+namespace fieldpath::dynamics {
+namespace {
+
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+constexpr int kStateSize = 4;  ///< lead, tilt (rad), lead rate, tilt rate (rad/s)
+
+/// Places the nodes (offsets from the ball centre, tool frame) at axis a and sums their moment.
+AxisMoment momentOfNodes(const field::ForceField& field, std::span<const Vec3> offsets_mm,
+                         const LocalFrame& frame, const Vec3& centre_mm, double lead_rad, double tilt_rad,
+                         std::vector<Vec3>& nodes_mm, std::vector<Vec3>& forces) {
+  const Eigen::Matrix3d rotation = geometry::rotationFromZ(axisFromAngles(frame, lead_rad, tilt_rad));
+  nodes_mm.resize(offsets_mm.size());
+  forces.resize(offsets_mm.size());
+  for (std::size_t i = 0; i < offsets_mm.size(); ++i) nodes_mm[i] = centre_mm + rotation * offsets_mm[i];
+  field.evaluate(nodes_mm, forces);
+  AxisMoment out;
+  for (std::size_t i = 0; i < offsets_mm.size(); ++i) out.moment += (nodes_mm[i] - centre_mm).cross(forces[i]);
+  out.lead_torque = out.moment.dot(frame.b);
+  out.tilt_torque = out.moment.dot(frame.f);
+  return out;
+}
+
+/// Node offsets from the ball centre in the tool frame: x - (0, 0, R).
+std::vector<Vec3> offsetsFromCentre(std::span<const Vec3> nodes_tool_frame_mm, double ball_radius_mm) {
+  std::vector<Vec3> out(nodes_tool_frame_mm.begin(), nodes_tool_frame_mm.end());
+  for (Vec3& p : out) p.z() -= ball_radius_mm;
+  return out;
+}
+
+void requireThat(bool ok, const char* key, const char* condition, double value) {
+  if (ok) return;
+  std::ostringstream msg;
+  msg << key << " must be " << condition << " (got " << value << ")";
+  throw common::InputError(msg.str());
+}
+
+void validate(const Pass& pass, const SteeringRequest& request) {
+  const DynamicsParams& p = request.params;
+  requireThat(std::isfinite(p.inertia) && p.inertia > 0.0, "dynamics.inertia", "> 0", p.inertia);
+  requireThat(!std::isnan(p.damping) && std::isfinite(p.effectiveDamping()), "dynamics.damping",
+              ">= 0 (negative = critical)", p.damping);
+  requireThat(std::isfinite(p.stiffness) && p.stiffness >= 0.0, "dynamics.stiffness", ">= 0", p.stiffness);
+  requireThat(std::isfinite(p.feed_mm_per_min) && p.feed_mm_per_min > 0.0, "dynamics.feed", "> 0",
+              p.feed_mm_per_min);
+  requireThat(std::isfinite(p.rtol) && p.rtol > 0.0, "dynamics.rtol", "> 0", p.rtol);
+  requireThat(std::isfinite(p.atol) && p.atol > 0.0, "dynamics.atol", "> 0", p.atol);
+  requireThat(p.max_tilt_deg > 0.0 && p.max_tilt_deg <= 90.0, "dynamics.max_tilt_deg", "in (0, 90]",
+              p.max_tilt_deg);
+  requireThat(p.max_lead_deg > 0.0 && p.max_lead_deg <= 90.0, "dynamics.max_lead_deg", "in (0, 90]",
+              p.max_lead_deg);
+  requireThat(std::isfinite(request.step_mm) && request.step_mm > 0.0, "path.step", "> 0", request.step_mm);
+  requireThat(std::isfinite(request.ball_radius_mm) && request.ball_radius_mm > 0.0, "tool.radius", "> 0",
+              request.ball_radius_mm);
+  requireThat(std::isfinite(pass.length_mm) && pass.length_mm >= 0.0, "pass length (mm)", ">= 0",
+              pass.length_mm);
+  requireThat(request.max_angle_change_deg_per_mm >= 0.0, "max angle change (deg/mm)", ">= 0",
+              request.max_angle_change_deg_per_mm);
+  requireThat(request.max_steps_per_output > 0, "max steps per output", "> 0",
+              static_cast<double>(request.max_steps_per_output));
+  if (!pass.frameAt) throw common::InputError("pass: no frame function (frameAt is empty)");
+}
+
+/// J θ'' + c θ' + k (θ - θ0(s)) = τ(θ), first-order form, time in s, s = v t.
+class SteeringSystem final : public detail::OdeSystem {
+ public:
+  SteeringSystem(const Pass& pass, const SteeringRequest& request)
+      : pass_(pass),
+        request_(request),
+        offsets_mm_(offsetsFromCentre(request.nodes_tool_frame_mm, request.ball_radius_mm)),
+        feed_mm_per_s_(request.params.feed_mm_per_min / 60.0),
+        inertia_(request.params.inertia),
+        damping_(request.params.effectiveDamping()),
+        stiffness_(request.params.stiffness) {}
+
+  double feedMmPerS() const { return feed_mm_per_s_; }
+
+  /// Arc length at time t, kept on the pass (solver stages may look slightly past the end).
+  double arcLength(double t_s) const { return std::clamp(feed_mm_per_s_ * t_s, 0.0, pass_.length_mm); }
+
+  int rhs(double t_s, const double* y, double* ydot) override {
+    const double s_mm = arcLength(t_s);
+    const PassFrame pass_frame = pass_.frameAt(s_mm);
+    const AxisMoment m = moment(pass_frame, y[0], y[1]);
+    ydot[0] = y[2];
+    ydot[1] = y[3];
+    ydot[2] = (m.lead_torque - damping_ * y[2] - stiffness_ * (y[0] - pass_frame.lead0_rad)) / inertia_;
+    ydot[3] = (m.tilt_torque - damping_ * y[3] - stiffness_ * (y[1] - pass_frame.tilt0_rad)) / inertia_;
+    const bool finite = std::isfinite(ydot[2]) && std::isfinite(ydot[3]);
+    return finite ? 0 : 1;  // recoverable: the solver retries a shorter step, then gives up
+  }
+
+  /// The sample at arc length s for state y; also leaves the placed nodes in nodes_mm_.
+  PostureSample sample(double s_mm, const std::array<double, kStateSize>& y) {
+    const PassFrame pass_frame = pass_.frameAt(s_mm);
+    const AxisMoment m = moment(pass_frame, y[0], y[1]);
+    PostureSample out;
+    out.s_mm = s_mm;
+    out.lead_rad = y[0];
+    out.tilt_rad = y[1];
+    out.lead_rate_rad_per_s = y[2];
+    out.tilt_rate_rad_per_s = y[3];
+    out.lead_torque = m.lead_torque;
+    out.tilt_torque = m.tilt_torque;
+    out.moment = m.moment;
+    const Vec3 axis = axisFromAngles(localFrame(pass_frame), y[0], y[1]);
+    out.posture.axis = axis;
+    out.posture.tip_mm = pass_frame.centre_mm - request_.ball_radius_mm * axis;
+    out.clearance_mm = std::numeric_limits<double>::quiet_NaN();
+    if (request_.clearance) {
+      if (!request_.field) placeNodes(pass_frame, axis);
+      out.clearance_mm = request_.clearance(nodes_mm_);
+    }
+    return out;
+  }
+
+ private:
+  AxisMoment moment(const PassFrame& pass_frame, double lead_rad, double tilt_rad) {
+    if (!request_.field) return {};
+    return momentOfNodes(*request_.field, offsets_mm_, localFrame(pass_frame), pass_frame.centre_mm, lead_rad,
+                         tilt_rad, nodes_mm_, forces_);
+  }
+
+  void placeNodes(const PassFrame& pass_frame, const Vec3& axis) {
+    const Eigen::Matrix3d rotation = geometry::rotationFromZ(axis);
+    nodes_mm_.resize(offsets_mm_.size());
+    for (std::size_t i = 0; i < offsets_mm_.size(); ++i)
+      nodes_mm_[i] = pass_frame.centre_mm + rotation * offsets_mm_[i];
+  }
+
+  const Pass& pass_;
+  const SteeringRequest& request_;
+  std::vector<Vec3> offsets_mm_;
+  double feed_mm_per_s_, inertia_, damping_, stiffness_;
+  std::vector<Vec3> nodes_mm_, forces_;  // scratch, reused by every evaluation
+};
+
+std::string at(double s_mm) {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(3);
+  out << "s = " << s_mm << " mm: ";
+  return out.str();
+}
+
+/// Limit checks on one sample; returns the violation (empty if none) and, with Clamp, clamps y.
+struct LimitCheck {
+  Status status = Status::Ok;
+  std::string what;
+  bool clamped = false;
+};
+
+LimitCheck checkAngles(const DynamicsParams& p, LimitPolicy policy, std::array<double, kStateSize>& y) {
+  LimitCheck out;
+  const struct {
+    const char* name;
+    const char* key;
+    double max_deg;
+    int index;
+  } angles[] = {{"lead", "dynamics.max_lead_deg", p.max_lead_deg, 0},
+                {"tilt", "dynamics.max_tilt_deg", p.max_tilt_deg, 1}};
+  for (const auto& a : angles) {
+    const double max_rad = a.max_deg / kDegPerRad;
+    if (std::abs(y[a.index]) <= max_rad) continue;
+    if (policy == LimitPolicy::Clamp) {
+      y[a.index] = std::copysign(max_rad, y[a.index]);
+      y[a.index + 2] = 0.0;  // the stop absorbs the motion
+      out.clamped = true;
+      continue;
+    }
+    std::ostringstream msg;
+    msg.precision(4);
+    msg << a.name << " " << y[a.index] * kDegPerRad << "° exceeds " << a.key << " = " << a.max_deg << "°";
+    out.status = Status::TiltLimit;
+    out.what = msg.str();
+    return out;
+  }
+  return out;
+}
+
+}  // namespace
+
+const char* toString(Status status) {
+  switch (status) {
+    case Status::Ok: return "ok";
+    case Status::TiltLimit: return "tilt limit";
+    case Status::RateLimit: return "angle change limit";
+    case Status::SolverFailed: return "solver failed";
+  }
+  return "?";
+}
+
+AxisMoment axisMoment(const field::ForceField& field, std::span<const Vec3> nodes_tool_frame_mm,
+                      double ball_radius_mm, const LocalFrame& frame, const Vec3& centre_mm, double lead_rad,
+                      double tilt_rad) {
+  std::vector<Vec3> nodes_mm, forces;
+  return momentOfNodes(field, offsetsFromCentre(nodes_tool_frame_mm, ball_radius_mm), frame, centre_mm,
+                       lead_rad, tilt_rad, nodes_mm, forces);
+}
+
+SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
+  validate(pass, request);
+  SteeringSystem system(pass, request);
+  const double v = system.feedMmPerS();
+
+  const PassFrame start = pass.frameAt(0.0);
+  std::array<double, kStateSize> y = {request.initial_lead_rad.value_or(start.lead0_rad),
+                                      request.initial_tilt_rad.value_or(start.tilt0_rad),
+                                      request.initial_lead_rate_rad_per_s, request.initial_tilt_rate_rad_per_s};
+  for (double value : y)
+    requireThat(std::isfinite(value), "initial axis state", "finite", value);
+
+  detail::IntegratorSettings settings;
+  settings.rtol = request.params.rtol;
+  settings.atol = request.params.atol;
+  settings.max_step_s = request.step_mm / v;  // never step over a feature longer than one output step
+  settings.max_steps = request.max_steps_per_output;
+  std::unique_ptr<detail::Integrator> integrator =
+      request.params.integrator == Integrator::Erk
+          ? detail::makeArkodeErk(system, kStateSize, 0.0, y.data(), settings)
+          : detail::makeCvodeBdf(system, kStateSize, 0.0, y.data(), settings);
+
+  SteeringResult result;
+  const auto intervals = static_cast<long>(std::ceil(pass.length_mm / request.step_mm - 1e-9));
+  result.samples.reserve(static_cast<std::size_t>(intervals) + 1);
+  const double max_change_rad_per_mm = request.max_angle_change_deg_per_mm / kDegPerRad;
+  const long report_every = std::max(1L, intervals / 100);
+
+  for (long k = 0; k <= intervals; ++k) {
+    const double s_mm = std::min(static_cast<double>(k) * request.step_mm, pass.length_mm);
+    if (k > 0) {
+      const int flag = integrator->advance(s_mm / v, y.data());
+      if (flag < 0) {
+        result.status = Status::SolverFailed;
+        result.message = at(s_mm) + (request.params.integrator == Integrator::Erk ? "ARKODE ERK" : "CVODE BDF") +
+                          " failed (" + integrator->flagName(flag) + "): " + integrator->lastError();
+        break;
+      }
+    }
+    LimitCheck check = checkAngles(request.params, request.on_limit, y);
+    if (check.clamped) integrator->restart(s_mm / v, y.data());
+    PostureSample sample = system.sample(s_mm, y);
+    sample.limited = check.clamped;
+    if (check.status == Status::Ok && max_change_rad_per_mm > 0.0 && !result.samples.empty()) {
+      const PostureSample& prev = result.samples.back();
+      const double ds_mm = s_mm - prev.s_mm;
+      const double change = std::max(std::abs(sample.lead_rad - prev.lead_rad), std::abs(sample.tilt_rad - prev.tilt_rad));
+      if (ds_mm > 0.0 && change > max_change_rad_per_mm * ds_mm) {
+        sample.limited = true;
+        if (request.on_limit == LimitPolicy::Report) {
+          std::ostringstream msg;
+          msg.precision(4);
+          msg << "axis turned " << change / ds_mm * kDegPerRad << "°/mm, over the limit of "
+              << request.max_angle_change_deg_per_mm << "°/mm";
+          check.status = Status::RateLimit;
+          check.what = msg.str();
+        }
+      }
+    }
+    result.clamped_samples += check.clamped ? 1 : 0;
+    result.samples.push_back(sample);
+    if (check.status != Status::Ok) {
+      result.status = check.status;
+      result.message = at(s_mm) + check.what;
+      break;
+    }
+    if (k % report_every == 0)
+      common::report(request.progress, intervals > 0 ? static_cast<double>(k) / intervals : 1.0, "dynamics");
+  }
+  result.stats = integrator->stats();
+  return result;
+}
+
+}  // namespace fieldpath::dynamics
