@@ -14,7 +14,7 @@ using pathgen::Vec3;
 
 // Closed form first: a straight, flat, parallel channel is a plane strip between vertical walls.
 TEST(Impeller, FlatChannelIsClosedForm) {
-  ImpellerParams p = test::flatChannel();
+  ImpellerParams p = pathgen::test::flatChannel();
   const Impeller imp(p);
   EXPECT_NEAR((imp.hub(0.5, 0.25) - Vec3(36, -5, 0)).norm(), 0, 1e-12);
   EXPECT_NEAR((imp.hubNormal(0.3, 0.7) - Vec3::UnitZ()).norm(), 0, 1e-12);
