@@ -6,6 +6,8 @@
 #include <map>
 #include <utility>
 
+#include <Eigen/Geometry>
+
 namespace fieldpath::geometry {
 
 bool MeshReport::closed() const {

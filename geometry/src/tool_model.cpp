@@ -1,28 +1,323 @@
 #include "fieldpath/geometry/tool_model.h"
 
-#include <stdexcept>
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <numbers>
+#include <string>
 
 #include "fieldpath/common/errors.h"
 
 namespace fieldpath::geometry {
+namespace {
+
+using common::InputError;
+using Vec2 = Eigen::Vector2d;  ///< meridian half-plane: (rho = distance from the axis, z), mm
+
+constexpr double kPi = std::numbers::pi;
+
+/// One piece of a revolved profile: a straight segment, or a circular arc about `centre` from
+/// `start_rad` to `end_rad` (counter-clockwise in the (rho, z) plane). `from`/`to` are exact end
+/// points, so the tip and the top lie exactly on the axis.
+struct ProfileSegment {
+  Vec2 from, to;
+  bool is_arc = false;
+  Vec2 centre = Vec2::Zero();
+  double radius_mm = 0, start_rad = 0, end_rad = 0;
+  NodePart part = NodePart::Tool;
+
+  double length() const { return is_arc ? radius_mm * (end_rad - start_rad) : (to - from).norm(); }
+  /// Point at parameter t in [0, 1].
+  Vec2 at(double t) const {
+    if (t <= 0) return from;
+    if (t >= 1) return to;
+    if (!is_arc) return from + t * (to - from);
+    const double a = start_rad + t * (end_rad - start_rad);
+    return centre + radius_mm * Vec2(std::cos(a), std::sin(a));
+  }
+  /// Outward unit normal at parameter t. The profile runs tip → top with the solid on its left,
+  /// so outward is the travel direction turned clockwise.
+  Vec2 normal(double t) const {
+    if (is_arc) return (at(t) - centre).normalized();
+    const Vec2 d = (to - from).normalized();
+    return Vec2(d.y(), -d.x());
+  }
+  double distance(const Vec2& q) const {
+    if (is_arc) {
+      const Vec2 d = q - centre;
+      const double a = std::atan2(d.y(), d.x());
+      if (a >= start_rad && a <= end_rad) return std::abs(d.norm() - radius_mm);
+      return std::min((q - from).norm(), (q - to).norm());
+    }
+    const Vec2 d = to - from;
+    const double t = std::clamp((q - from).dot(d) / d.squaredNorm(), 0.0, 1.0);
+    return (q - (from + t * d)).norm();
+  }
+};
+
+using Profile = std::vector<ProfileSegment>;
+
+ProfileSegment line(Vec2 from, Vec2 to, NodePart part = NodePart::Tool) {
+  ProfileSegment s;
+  s.from = from;
+  s.to = to;
+  s.part = part;
+  return s;
+}
+
+/// Quarter arc of the cutting corner: from the bottom (angle -π/2) to the side (angle 0).
+ProfileSegment cornerArc(Vec2 centre, double radius_mm) {
+  ProfileSegment s;
+  s.is_arc = true;
+  s.centre = centre;
+  s.radius_mm = radius_mm;
+  s.start_rad = -kPi / 2;
+  s.end_rad = 0.0;
+  s.from = Vec2(centre.x(), centre.y() - radius_mm);
+  s.to = Vec2(centre.x() + radius_mm, centre.y());
+  return s;
+}
+
+/// Tip → side of the shank at (R, L): cutting end then shank cylinder. No top.
+Profile toolSide(const ToolSpec& tool) {
+  const double big_r = tool.radius_mm, len = tool.length_mm;
+  Profile p;
+  double side_start_z = 0.0;
+  switch (tool.shape) {
+    case ToolShape::Ball:
+      p.push_back(cornerArc(Vec2(0.0, big_r), big_r));
+      p.back().from = Vec2(0.0, 0.0);
+      side_start_z = big_r;
+      break;
+    case ToolShape::Torus: {
+      const double r = tool.corner_radius_mm;
+      if (big_r - r > 0) p.push_back(line(Vec2(0.0, 0.0), Vec2(big_r - r, 0.0)));
+      p.push_back(cornerArc(Vec2(big_r - r, r), r));
+      if (big_r - r <= 0) p.back().from = Vec2(0.0, 0.0);
+      side_start_z = r;
+      break;
+    }
+    case ToolShape::Flat:
+      p.push_back(line(Vec2(0.0, 0.0), Vec2(big_r, 0.0)));
+      break;
+  }
+  if (len > side_start_z) p.push_back(line(Vec2(big_r, side_start_z), Vec2(big_r, len)));
+  return p;
+}
+
+/// The whole closed profile from the tip to the top on the axis: tool side, then either the flat
+/// top at L, or the holder stations (the shank runs on up to the first station if it starts above
+/// L) and the holder's top face.
+Profile fullProfile(const ToolSpec& tool, const HolderProfile& holder) {
+  Profile p = toolSide(tool);
+  const auto add = [&p](Vec2 to, NodePart part) {
+    if ((to - p.back().to).norm() > 0) p.push_back(line(p.back().to, to, part));
+  };
+  if (holder.empty()) {
+    add(Vec2(0.0, tool.length_mm), NodePart::Tool);
+    return p;
+  }
+  add(Vec2(tool.radius_mm, holder.front().z_mm), NodePart::Tool);
+  for (const HolderStation& s : holder) add(Vec2(s.radius_mm, s.z_mm), NodePart::Holder);
+  add(Vec2(0.0, holder.back().z_mm), NodePart::Holder);
+  return p;
+}
+
+/// Angular step (rad) whose chord on a circle of `radius_mm` stays within `sagitta_mm`.
+double angularStep(double radius_mm, double sagitta_mm) {
+  if (sagitta_mm >= radius_mm) return kPi / 2;
+  return 2.0 * std::acos(1.0 - sagitta_mm / radius_mm);
+}
+
+double parseNumberField(std::string_view token, std::string_view what, std::string_view text) {
+  double value = 0;
+  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+  if (token.empty() || ec != std::errc() || end != token.data() + token.size() || !std::isfinite(value))
+    throw InputError(std::string(what) + " '" + std::string(text) + "': '" + std::string(token) +
+                     "' is not a finite number");
+  return value;
+}
+
+std::vector<std::string_view> split(std::string_view text, char separator) {
+  std::vector<std::string_view> parts;
+  for (std::size_t start = 0;;) {
+    const auto end = text.find(separator, start);
+    parts.push_back(text.substr(start, end == std::string_view::npos ? std::string_view::npos : end - start));
+    if (end == std::string_view::npos) return parts;
+    start = end + 1;
+  }
+}
+
+}  // namespace
 
 ToolSpec parseToolSpec(std::string_view text) {
-  throw common::InputError("tool shape '" + std::string(text) + "': not implemented yet");
+  const auto fields = split(text, ':');
+  const std::string_view name = fields[0];
+  ToolSpec tool;
+  std::size_t needed;
+  if (name == "ball") {
+    tool.shape = ToolShape::Ball;
+    needed = 2;
+  } else if (name == "torus") {
+    tool.shape = ToolShape::Torus;
+    needed = 3;
+  } else if (name == "flat") {
+    tool.shape = ToolShape::Flat;
+    needed = 2;
+  } else {
+    throw InputError("tool shape '" + std::string(text) + "': expected ball:R[:L], torus:R:r[:L] or flat:R[:L]");
+  }
+  if (fields.size() != needed && fields.size() != needed + 1)
+    throw InputError("tool shape '" + std::string(text) + "': expected " +
+                     (needed == 3 ? "torus:R:r[:L]" : std::string(name) + ":R[:L]"));
+  tool.radius_mm = parseNumberField(fields[1], "tool shape", text);
+  tool.corner_radius_mm = needed == 3 ? parseNumberField(fields[2], "tool shape", text) : 0.0;
+  tool.length_mm = fields.size() > needed ? parseNumberField(fields[needed], "tool shape", text) : 4.0 * tool.radius_mm;
+  try {
+    validateToolSpec(tool);
+  } catch (const InputError& e) {
+    throw InputError("tool shape '" + std::string(text) + "': " + e.what());
+  }
+  return tool;
 }
+
 HolderProfile parseHolderProfile(std::string_view text) {
-  if (text.empty()) return {};
-  throw common::InputError("holder '" + std::string(text) + "': not implemented yet");
+  HolderProfile holder;
+  if (text.empty()) return holder;
+  for (std::string_view station : split(text, ',')) {
+    const auto zr = split(station, ':');
+    if (zr.size() != 2)
+      throw InputError("holder '" + std::string(text) + "': station '" + std::string(station) + "' is not z:r");
+    holder.push_back({parseNumberField(zr[0], "holder", text), parseNumberField(zr[1], "holder", text)});
+  }
+  try {
+    validateHolderProfile(holder);
+  } catch (const InputError& e) {
+    throw InputError("holder '" + std::string(text) + "': " + e.what());
+  }
+  return holder;
 }
-void validateToolSpec(const ToolSpec&) {}
-void validateHolderProfile(const HolderProfile&) {}
-TriangleMesh toolMesh(const ToolSpec&, const HolderProfile&, double) {
-  throw std::logic_error("toolMesh: not implemented yet");
+
+void validateToolSpec(const ToolSpec& tool) {
+  if (!std::isfinite(tool.radius_mm) || !(tool.radius_mm > 0)) throw InputError("tool radius must be > 0");
+  if (tool.shape == ToolShape::Torus &&
+      !(tool.corner_radius_mm > 0 && tool.corner_radius_mm <= tool.radius_mm))
+    throw InputError("corner radius must be in (0, R]");
+  const double end_mm = tool.shape == ToolShape::Ball    ? tool.radius_mm
+                        : tool.shape == ToolShape::Torus ? tool.corner_radius_mm
+                                                         : 0.0;
+  if (!std::isfinite(tool.length_mm) || !(tool.length_mm >= end_mm) || !(tool.length_mm > 0))
+    throw InputError("tool length must cover the cutting end (>= " + std::to_string(end_mm) + " mm)");
 }
-std::vector<SurfaceNode> surfaceNodes(const ToolSpec&, const HolderProfile&, double) {
-  throw std::logic_error("surfaceNodes: not implemented yet");
+
+void validateHolderProfile(const HolderProfile& holder) {
+  for (std::size_t i = 0; i < holder.size(); ++i) {
+    const HolderStation& s = holder[i];
+    if (!std::isfinite(s.z_mm) || !std::isfinite(s.radius_mm) || !(s.radius_mm > 0))
+      throw InputError("station " + std::to_string(i) + ": z must be finite and radius > 0");
+    if (i > 0 && !(s.z_mm > holder[i - 1].z_mm) &&
+        !(s.z_mm == holder[i - 1].z_mm && s.radius_mm != holder[i - 1].radius_mm))
+      throw InputError("station " + std::to_string(i) +
+                       ": z must increase (equal z only for a step to another radius)");
+  }
+  if (holder.size() == 1) throw InputError("a holder needs at least two stations");
+  if (!holder.empty() && !(holder.back().z_mm > holder.front().z_mm))
+    throw InputError("holder has no height");
 }
-double toolSurfaceDistance(const ToolSpec&, const Vec3&) {
-  throw std::logic_error("toolSurfaceDistance: not implemented yet");
+
+TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double chord_tol_mm) {
+  validateToolSpec(tool);
+  validateHolderProfile(holder);
+  if (!std::isfinite(chord_tol_mm) || !(chord_tol_mm > 0))
+    throw InputError("chordal tolerance must be a finite number > 0 mm");
+  if (!holder.empty() && holder.front().z_mm < tool.length_mm)
+    throw InputError("holder starts at z " + std::to_string(holder.front().z_mm) +
+                     " mm, below the tool length " + std::to_string(tool.length_mm) + " mm");
+  const Profile profile = fullProfile(tool, holder);
+
+  // A triangle spanning a profile step and a circumferential step deviates from the surface by
+  // about the sum of both sagittas (to leading order), so each gets under half the tolerance.
+  const double sagitta_mm = 0.45 * chord_tol_mm;
+  double max_rho_mm = 0;
+  for (const auto& s : profile) max_rho_mm = std::max({max_rho_mm, s.from.x(), s.to.x()});
+  const int sectors = std::max(8, static_cast<int>(std::ceil(2 * kPi / angularStep(max_rho_mm, sagitta_mm))));
+
+  // Profile points from the tip to the top; arcs subdivided, straight pieces left whole.
+  std::vector<Vec2> points{profile.front().from};
+  for (const auto& s : profile) {
+    const int pieces =
+        s.is_arc ? std::max(1, static_cast<int>(std::ceil((s.end_rad - s.start_rad) / angularStep(s.radius_mm, sagitta_mm))))
+                 : 1;
+    for (int i = 1; i <= pieces; ++i) points.push_back(s.at(static_cast<double>(i) / pieces));
+  }
+
+  TriangleMesh mesh;
+  std::vector<double> cos_j(sectors), sin_j(sectors);
+  for (int j = 0; j < sectors; ++j) {
+    cos_j[j] = std::cos(2 * kPi * j / sectors);
+    sin_j[j] = std::sin(2 * kPi * j / sectors);
+  }
+  // ring[k] = first vertex index of profile point k; on the axis a ring is a single vertex.
+  std::vector<int> ring(points.size());
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    ring[k] = static_cast<int>(mesh.vertices.size());
+    const Vec2& q = points[k];
+    if (q.x() == 0.0) {
+      mesh.vertices.emplace_back(0.0, 0.0, q.y());
+    } else {
+      for (int j = 0; j < sectors; ++j) mesh.vertices.emplace_back(q.x() * cos_j[j], q.x() * sin_j[j], q.y());
+    }
+  }
+  const auto vertex = [&](std::size_t k, int j) { return points[k].x() == 0.0 ? ring[k] : ring[k] + j % sectors; };
+  for (std::size_t k = 0; k + 1 < points.size(); ++k) {
+    for (int j = 0; j < sectors; ++j) {
+      const int a = vertex(k, j), b = vertex(k, j + 1), c = vertex(k + 1, j + 1), d = vertex(k + 1, j);
+      if (a != b) mesh.triangles.emplace_back(a, b, c);  // lower edge not collapsed on the axis
+      if (c != d) mesh.triangles.emplace_back(a, c, d);  // upper edge not collapsed on the axis
+    }
+  }
+  return mesh;
+}
+
+std::vector<SurfaceNode> surfaceNodes(const ToolSpec& tool, const HolderProfile& holder, double spacing_mm) {
+  validateToolSpec(tool);
+  validateHolderProfile(holder);
+  if (!std::isfinite(spacing_mm) || !(spacing_mm > 0)) throw InputError("node spacing must be a finite number > 0 mm");
+  if (!holder.empty() && holder.front().z_mm < tool.length_mm)
+    throw InputError("holder starts below the tool length");
+  const Profile profile = fullProfile(tool, holder);
+
+  std::vector<SurfaceNode> nodes;
+  const auto addRing = [&](const ProfileSegment& s, double t, int ring_index) {
+    const Vec2 q = s.at(t), n = s.normal(t);
+    if (q.x() == 0.0) {
+      nodes.push_back({Vec3(0.0, 0.0, q.y()), Vec3(0.0, 0.0, n.y()), s.part});
+      return;
+    }
+    const int count = std::max(1, static_cast<int>(std::ceil(2 * kPi * q.x() / spacing_mm)));
+    const double phase = 0.5 * (ring_index % 2);  // staggered rings cover the surface more evenly
+    for (int j = 0; j < count; ++j) {
+      const double a = 2 * kPi * (j + phase) / count;
+      const Vec3 radial(std::cos(a), std::sin(a), 0.0);
+      nodes.push_back({Vec3(q.x() * radial.x(), q.x() * radial.y(), q.y()),
+                       Vec3(n.x() * radial.x(), n.x() * radial.y(), n.y()).normalized(), s.part});
+    }
+  };
+  int ring_index = 0;
+  for (const auto& s : profile) {
+    const int pieces = std::max(1, static_cast<int>(std::ceil(s.length() / spacing_mm)));
+    for (int i = 0; i < pieces; ++i) addRing(s, static_cast<double>(i) / pieces, ring_index++);
+  }
+  addRing(profile.back(), 1.0, ring_index);
+  return nodes;
+}
+
+double toolSurfaceDistance(const ToolSpec& tool, const Vec3& point_tool_frame_mm) {
+  const Profile profile = fullProfile(tool, {});
+  const Vec2 q(std::hypot(point_tool_frame_mm.x(), point_tool_frame_mm.y()), point_tool_frame_mm.z());
+  double distance_mm = std::numeric_limits<double>::infinity();
+  for (const auto& s : profile) distance_mm = std::min(distance_mm, s.distance(q));
+  return distance_mm;
 }
 
 }  // namespace fieldpath::geometry

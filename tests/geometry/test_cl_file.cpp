@@ -1,0 +1,165 @@
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/geometry/cl_file.h"
+#include "temp_files.h"
+
+using namespace fieldpath::geometry;
+using fieldpath::common::InputError;
+using namespace fieldpath::geometry::test_files;
+namespace fs = std::filesystem;
+
+namespace {
+
+bool bitwiseEqual(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+void expectSame(const std::vector<Posture>& a, const std::vector<Posture>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_TRUE(bitwiseEqual(a[i].tip_mm[c], b[i].tip_mm[c])) << i << " " << a[i].tip_mm[c] << " " << b[i].tip_mm[c];
+      EXPECT_TRUE(bitwiseEqual(a[i].axis[c], b[i].axis[c])) << i << " " << a[i].axis[c] << " " << b[i].axis[c];
+    }
+    EXPECT_EQ(a[i].has_spindle, b[i].has_spindle);
+    EXPECT_TRUE(bitwiseEqual(a[i].spindle_rad, b[i].spindle_rad));
+  }
+}
+
+std::vector<Posture> randomPostures(std::size_t n, bool spindle) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u(-500, 500);
+  std::vector<Posture> out(n);
+  for (auto& p : out) {
+    p.tip_mm = Vec3(u(rng), u(rng), u(rng));
+    p.axis = Vec3(g(rng), g(rng), g(rng)).normalized();
+    p.has_spindle = spindle;
+    p.spindle_rad = spindle ? u(rng) / 100 : 0.0;
+  }
+  // Awkward but valid numbers.
+  out[0].tip_mm = Vec3(-0.0, 1e-300, 1.7976931348623157e308);
+  out[0].axis = Vec3::UnitZ();
+  out[1].tip_mm = Vec3(0.1, 1.0 / 3.0, 5e-324);
+  out[1].axis = -Vec3::UnitZ();
+  return out;
+}
+
+/// Expects readClFile to throw an InputError naming `file:line:` and containing `what`.
+void expectClError(const std::string& text, int line, const std::string& what) {
+  const fs::path p = writeBytes("bad.cl", text);
+  try {
+    readClFile(p);
+    ADD_FAILURE() << "no error for: " << text;
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(p.string() + ":" + std::to_string(line) + ": "), std::string::npos) << msg;
+    EXPECT_NE(msg.find(what), std::string::npos) << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+}
+
+}  // namespace
+
+TEST(ClFile, ClosedFormRead) {
+  const auto p = readClFile(writeBytes("one.cl", "# header\n\n1 2 3 0 0 1   # trailing\n  4\t5 6 0 1 0 0.5\r\n"));
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_EQ(p[0].tip_mm, Vec3(1, 2, 3));
+  EXPECT_EQ(p[0].axis, Vec3::UnitZ());
+  EXPECT_FALSE(p[0].has_spindle);
+  EXPECT_EQ(p[1].axis, Vec3::UnitY());
+  EXPECT_TRUE(p[1].has_spindle);
+  EXPECT_EQ(p[1].spindle_rad, 0.5);
+}
+
+TEST(ClFile, RoundTripsExactly) {
+  for (bool spindle : {false, true}) {
+    const auto postures = randomPostures(1000, spindle);
+    const fs::path p = tempPath("rt.cl");
+    writeClFile(p, postures, "fieldpath test\nsecond line");
+    expectSame(readClFile(p), postures);
+    EXPECT_FALSE(fs::exists(p.string() + ".tmp"));
+  }
+}
+
+TEST(ClFile, NormalisesNearlyUnitAxes) {
+  const auto p = readClFile(writeBytes("near.cl", "0 0 0 0 0 1.0009\n0 0 0 0.6 0.8 0.0001\n"));
+  EXPECT_EQ(p[0].axis, Vec3::UnitZ());
+  EXPECT_NEAR(p[1].axis.norm(), 1.0, 1e-15);
+}
+
+TEST(ClFile, MalformedLinesNameTheLine) {
+  expectClError("0 0 0 0 0 1\nnan 0 0 0 0 1\n", 2, "not finite");
+  expectClError("0 0 0 0 0 1\n0 0 0 0 0 inf\n", 2, "not finite");
+  expectClError("# c\n0 0 0 0 0 1\n\n1 2 3 0 0\n", 4, "short line");
+  expectClError("1 2 3 0 0 0\n", 1, "zero tool axis");
+  expectClError("1 2 3 0 0 1.002\n", 1, "not a unit vector");
+  expectClError("1 2 3 0 0 0.998\n", 1, "not a unit vector");
+  expectClError("1 2 3 0 0 1\n\xff\xfe\x01garbage 2 3 0 0 1\n", 2, "not a number");
+  expectClError("1 2 3 0 0 1\n1 2 3 0 0 1 0 9\n", 2, "too many columns");
+  expectClError("1 2 3 0 0 1x\n", 1, "not a number");
+  expectClError("1,2,3,0,0,1\n", 1, "short line");
+}
+
+TEST(ClFile, EmptyAndMissingFiles) {
+  for (const char* text : {"", "# only a comment\n\n   \n"}) {
+    const fs::path p = writeBytes("empty.cl", text);
+    try {
+      readClFile(p);
+      ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("no postures"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_THROW(readClFile(tempPath("does_not_exist.cl")), InputError);
+  EXPECT_THROW(readClFile(fs::temp_directory_path()), InputError);  // a directory
+}
+
+TEST(AptFile, WritesHeaderAndParsesBackExactly) {
+  const auto postures = randomPostures(200, false);
+  AptHeader header;
+  header.part_name = "IMPELLER";
+  header.tool.shape = ToolShape::Torus;
+  header.tool.radius_mm = 5;
+  header.tool.corner_radius_mm = 1;
+  header.tool.length_mm = 30;
+  header.feed_mm_per_min = 1500;
+  const fs::path p = tempPath("path.apt");
+  writeAptFile(p, postures, header);
+  std::ifstream in(p);
+  std::string l1, l2, l3, l4, l5, l6;
+  std::getline(in, l1), std::getline(in, l2), std::getline(in, l3), std::getline(in, l4), std::getline(in, l5),
+      std::getline(in, l6);
+  EXPECT_EQ(l1, "PARTNO/IMPELLER");
+  EXPECT_EQ(l2, "UNITS/MM");
+  EXPECT_EQ(l3, "MULTAX/ON");
+  EXPECT_EQ(l4, "CUTTER/10,1,4,1,0,0,30");
+  EXPECT_EQ(l5, "FEDRAT/MMPM,1500");
+  EXPECT_EQ(l6.rfind("GOTO/", 0), 0u);
+  std::string last, line;
+  while (std::getline(in, line)) last = line;
+  EXPECT_EQ(last, "FINI");
+
+  auto back = readAptFile(p);
+  for (auto& b : back) b.has_spindle = false;
+  auto expected = postures;
+  expectSame(back, expected);
+}
+
+TEST(AptFile, ReadsContinuationAndRejectsBadGoto) {
+  const auto p = readAptFile(writeBytes("c.apt", "PARTNO/X\nGOTO/1,2,$\n 3,0,0,1\nGOTO/4,5,6\nFINI\n"));
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_EQ(p[0].tip_mm, Vec3(1, 2, 3));
+  EXPECT_EQ(p[1].tip_mm, Vec3(4, 5, 6));
+  EXPECT_EQ(p[1].axis, Vec3::UnitZ());
+  EXPECT_THROW(readAptFile(writeBytes("b.apt", "GOTO/1,2,3,0,0\n")), InputError);
+  EXPECT_THROW(readAptFile(writeBytes("b.apt", "GOTO/1,2,x,0,0,1\n")), InputError);
+  EXPECT_THROW(readAptFile(writeBytes("b.apt", "PARTNO/X\nFINI\n")), InputError);
+}

@@ -1,0 +1,85 @@
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "fieldpath/geometry/mesh.h"
+
+using namespace fieldpath::geometry;
+
+namespace {
+
+/// Unit cube [0,1]³, 12 triangles, outward.
+TriangleMesh unitCube() {
+  TriangleMesh m;
+  for (int i = 0; i < 8; ++i) m.vertices.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    m.triangles.emplace_back(q[0], q[1], q[2]);
+    m.triangles.emplace_back(q[0], q[2], q[3]);
+  }
+  return m;
+}
+
+}  // namespace
+
+TEST(Mesh, CubeClosedForm) {
+  const TriangleMesh cube = unitCube();
+  const MeshReport r = validateMesh(cube);
+  EXPECT_TRUE(r.closed()) << r.summary();
+  EXPECT_EQ(r.vertices, 8u);
+  EXPECT_EQ(r.triangles, 12u);
+  EXPECT_DOUBLE_EQ(meshArea(cube), 6.0);
+  EXPECT_DOUBLE_EQ(meshVolume(cube), 1.0);
+  EXPECT_EQ(r.summary(), "8 vertices, 12 triangles, closed");
+}
+
+TEST(Mesh, InvertedCubeHasNegativeVolume) {
+  TriangleMesh cube = unitCube();
+  for (auto& t : cube.triangles) std::swap(t[1], t[2]);
+  EXPECT_TRUE(validateMesh(cube).closed());
+  EXPECT_DOUBLE_EQ(meshVolume(cube), -1.0);
+}
+
+TEST(Mesh, ReportsEachDefect) {
+  {
+    TriangleMesh m = unitCube();
+    m.triangles.pop_back();
+    const MeshReport r = validateMesh(m);
+    EXPECT_EQ(r.open_edges, 3u);
+    EXPECT_FALSE(r.closed());
+    EXPECT_NE(r.summary().find("3 open edges"), std::string::npos) << r.summary();
+  }
+  {
+    TriangleMesh m = unitCube();
+    std::swap(m.triangles[0][1], m.triangles[0][2]);
+    const MeshReport r = validateMesh(m);
+    EXPECT_EQ(r.inconsistent_edges, 3u);
+    EXPECT_EQ(r.open_edges, 0u);
+    EXPECT_FALSE(r.closed());
+  }
+  {
+    TriangleMesh m = unitCube();
+    m.triangles.push_back(m.triangles[0]);
+    EXPECT_EQ(validateMesh(m).non_manifold_edges, 3u);
+  }
+  {
+    TriangleMesh m = unitCube();
+    m.vertices[7].x() = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_EQ(validateMesh(m).non_finite_vertices, 1u);
+    EXPECT_FALSE(validateMesh(m).closed());
+  }
+  {
+    TriangleMesh m = unitCube();
+    m.triangles.emplace_back(0, 0, 1);   // repeated index
+    m.triangles.emplace_back(0, 1, 99);  // out of range
+    m.vertices.emplace_back(0.5, 0, 0);  // collinear with 0 and 1: zero area
+    m.triangles.emplace_back(0, 1, 8);
+    EXPECT_EQ(validateMesh(m).degenerate_triangles, 3u);
+  }
+  {
+    const MeshReport r = validateMesh(TriangleMesh{});
+    EXPECT_FALSE(r.closed());
+    EXPECT_NE(r.summary().find("empty"), std::string::npos);
+  }
+}

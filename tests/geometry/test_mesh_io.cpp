@@ -1,0 +1,127 @@
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/geometry/mesh_io.h"
+#include "fieldpath/geometry/tool_model.h"
+#include "temp_files.h"
+
+using namespace fieldpath::geometry;
+using fieldpath::common::InputError;
+using namespace fieldpath::geometry::test_files;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Tetrahedron (0,0,0), (1,0,0), (0,1,0), (0,0,1): volume 1/6, outward.
+const char* kAsciiTetra = R"(solid tetra
+facet normal 0 0 -1
+ outer loop
+  vertex 0 0 0
+  vertex 0 1 0
+  vertex 1 0 0
+ endloop
+endfacet
+facet normal 0 -1 0
+ outer loop
+  vertex 0 0 0
+  vertex 1 0 0
+  vertex 0 0 1
+ endloop
+endfacet
+facet normal -1 0 0
+ outer loop
+  vertex 0 0 0
+  vertex 0 0 1
+  vertex 0 1 0
+ endloop
+endfacet
+facet normal 1 1 1
+ outer loop
+  vertex 1 0 0
+  vertex 0 1 0
+  vertex 0 0 1
+ endloop
+endfacet
+endsolid tetra
+)";
+
+void expectInputErrorNamingFile(const fs::path& p) {
+  try {
+    loadMesh(p);
+    ADD_FAILURE() << "no error for " << p;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+
+TEST(MeshIo, AsciiStlClosedForm) {
+  const TriangleMesh m = loadMesh(writeBytes("tetra.stl", kAsciiTetra));
+  EXPECT_EQ(m.vertices.size(), 4u);  // corners joined across facets
+  EXPECT_EQ(m.triangles.size(), 4u);
+  EXPECT_TRUE(validateMesh(m).closed()) << validateMesh(m).summary();
+  EXPECT_NEAR(meshVolume(m), 1.0 / 6.0, 1e-12);
+}
+
+TEST(MeshIo, RoundTripsStlObjPly) {
+  const TriangleMesh tool = toolMesh(parseToolSpec("torus:5:1:20"), parseHolderProfile("20:8,35:8"), 0.01);
+  for (const char* ext : {".stl", ".obj", ".ply", ".STL"}) {
+    SCOPED_TRACE(ext);
+    const fs::path p = tempPath(std::string("tool") + ext);
+    saveMesh(tool, p);
+    EXPECT_FALSE(fs::exists(p.string() + ".tmp"));
+    const TriangleMesh back = loadMesh(p);
+    EXPECT_EQ(back.vertices.size(), tool.vertices.size());
+    ASSERT_EQ(back.triangles.size(), tool.triangles.size());
+    EXPECT_TRUE(validateMesh(back).closed()) << validateMesh(back).summary();
+    EXPECT_NEAR(meshVolume(back), meshVolume(tool), 1e-5 * meshVolume(tool));
+    // Same triangles in the same order, vertices to single precision.
+    for (std::size_t t = 0; t < tool.triangles.size(); t += 97)
+      for (int c = 0; c < 3; ++c)
+        EXPECT_LT((back.vertices[back.triangles[t][c]] - tool.vertices[tool.triangles[t][c]]).norm(), 1e-5);
+  }
+  EXPECT_THROW(saveMesh(tool, tempPath("tool.xyz")), InputError);
+}
+
+TEST(MeshIo, BinaryStlIsBinary) {
+  const TriangleMesh tool = toolMesh(parseToolSpec("ball:3"), {}, 0.05);
+  const fs::path p = tempPath("bin.stl");
+  saveMesh(tool, p);
+  EXPECT_EQ(fs::file_size(p), 84 + 50 * tool.triangles.size());
+}
+
+TEST(MeshIo, BrokenFilesAreInputErrors) {
+  expectInputErrorNamingFile(tempPath("missing.stl"));
+  expectInputErrorNamingFile(writeBytes("empty.stl", ""));
+  expectInputErrorNamingFile(writeBytes("garbage.stl", std::string("\x01\x02\xff garbage", 12)));
+  expectInputErrorNamingFile(writeBytes("garbage.ply", "ply\nformat nonsense\n"));
+  expectInputErrorNamingFile(writeBytes("noface.obj", "v 0 0 0\nv 1 0 0\n"));
+  // Binary STL whose header announces more triangles than the file holds.
+  std::string truncated(80, ' ');
+  const std::uint32_t count = 1000;
+  truncated.append(reinterpret_cast<const char*>(&count), 4);
+  truncated.append(50 * 3, '\0');
+  expectInputErrorNamingFile(writeBytes("truncated.stl", truncated));
+  // Truncated ASCII STL.
+  expectInputErrorNamingFile(writeBytes("cut.stl", std::string(kAsciiTetra).substr(0, 60)));
+}
+
+TEST(MeshIo, DefectiveMeshesLoadAndAreReported) {
+  // Tetrahedron with one facet missing: loads, three open edges.
+  std::string open = kAsciiTetra;
+  open.erase(open.find("facet normal 1 1 1"), open.find("endsolid") - open.find("facet normal 1 1 1"));
+  const TriangleMesh m = loadMesh(writeBytes("open.stl", open));
+  const MeshReport r = validateMesh(m);
+  EXPECT_EQ(r.triangles, 3u);
+  EXPECT_EQ(r.open_edges, 3u);
+  EXPECT_FALSE(r.closed());
+  // OBJ with a face flipped: inconsistent orientation is reported.
+  const TriangleMesh flipped = loadMesh(writeBytes(
+      "flipped.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 3 2 4\n"));
+  EXPECT_GT(validateMesh(flipped).inconsistent_edges, 0u);
+}
