@@ -1,0 +1,95 @@
+#pragma once
+/// The repulsive law of seed 004, eq. 1 (DESIGN.md "The field"), written once for every evaluator
+/// (brute force, direct, voxel nodes). No OpenVDB here.
+///
+/// F(x) = gain · Σ_j w_j φ(r_j) u_j,  r_j = |x - q_j|,  u_j = (x - q_j) / r_j,
+/// φ(r) = (1/r - 1/r0) / r² for r < r0 (0 beyond), held at φ(r_min) for r < r_min.
+///
+/// Surface rule (ours; the seed is silent, DESIGN.md asks for an outward force inside walls): let
+/// q* be the nearest sample within r0, n* its normal and η = (x - q*)·n* the height of x above
+/// its tangent plane (η < 0: inside the obstacle, the seed's normal sign test of §2.1). Where
+/// η < r_min, x gets the field at x'' = x + (r_min - η) n*, the point r_min above the surface:
+/// eq. 1 alone would give a plane's field that falls to zero on the surface (the r_min hold makes
+/// the samples under x pull sideways) and, inside, would push x deeper. So the field is held
+/// at its value r_min off the surface, finite and outward on both sides and continuous through
+/// η = r_min; a point exactly on a sample uses the sample's normal for u.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <optional>
+
+#include "fieldpath/field/params.h"
+#include "fieldpath/geometry/posture.h"
+
+namespace fieldpath::field {
+
+using geometry::Vec3;
+
+/// φ of eq. 1 with the r_min hold; r, r0, r_min in mm, result in 1/mm³.
+inline double phi(double r_mm, double r0_mm, double r_min_mm) {
+  if (r_mm >= r0_mm) return 0.0;
+  const double r = std::max(r_mm, r_min_mm);
+  return (1.0 / r - 1.0 / r0_mm) / (r * r);
+}
+
+/// The contribution of one sample (eq. 1, without the surface rule): gain · w · φ(r) · u, world frame.
+/// u = (x - q)/r, or the sample's unit outward normal where x = q exactly.
+inline Vec3 sampleForce(const Vec3& x_mm, const Vec3& q_mm, const Vec3& normal, double weight,
+                        const FieldParams& params) {
+  const Vec3 d = x_mm - q_mm;
+  const double r2 = d.squaredNorm();
+  if (r2 >= params.r0_mm * params.r0_mm) return Vec3::Zero();
+  const double r = std::sqrt(r2);
+  const Vec3 u = r > 0.0 ? Vec3(d / r) : normal;
+  return params.gain * weight * phi(r, params.r0_mm, params.r_min_mm) * u;
+}
+
+/// Magnitude of the field of an infinite plane of area-weighted samples at distance d (mm) on its
+/// outer side: π·gain·(r0 - d)² / (d·r0²) for r_min <= d < r0 (eq. 1 integrated over the plane).
+inline double planeFieldMagnitude(double d_mm, const FieldParams& params) {
+  if (d_mm >= params.r0_mm) return 0.0;
+  const double r0 = params.r0_mm;
+  return M_PI * params.gain * (r0 - d_mm) * (r0 - d_mm) / (d_mm * r0 * r0);
+}
+
+namespace detail {
+
+/// Eq. 1 summed over candidate samples with the surface rule. `for_each_near(center, radius, fn)`
+/// must call fn(j) at least for every sample j within `radius` of `center` (a superset is fine);
+/// P, N are random-access ranges of Vec3 (points, normals), W of double (weights).
+/// Returns nothing where no sample is within r0 (the field is zero there) or where x is inside an
+/// obstacle deeper than `max_inside_depth_mm` (outside the voxel band).
+template <class ForEachNear, class P, class N, class W>
+std::optional<Vec3> fieldAt(const Vec3& x_mm, ForEachNear&& for_each_near, const P& points,
+                            const N& normals, const W& weights, const FieldParams& params,
+                            double max_inside_depth_mm = HUGE_VAL) {
+  const double r0_sq = params.r0_mm * params.r0_mm;
+  auto sum = [&](const Vec3& at, double* nearest_sq, long* nearest) {
+    Vec3 f = Vec3::Zero();
+    for_each_near(at, params.r0_mm, [&](std::size_t j) {
+      const Vec3 d = at - points[j];
+      const double r2 = d.squaredNorm();
+      if (r2 >= r0_sq) return;
+      const double r = std::sqrt(r2);
+      const Vec3 u = r > 0.0 ? Vec3(d / r) : Vec3(normals[j]);
+      f += (weights[j] * phi(r, params.r0_mm, params.r_min_mm)) * u;
+      if (nearest && r2 < *nearest_sq) {
+        *nearest_sq = r2;
+        *nearest = static_cast<long>(j);
+      }
+    });
+    return f;
+  };
+  double nearest_sq = r0_sq;
+  long nearest = -1;
+  Vec3 f = sum(x_mm, &nearest_sq, &nearest);
+  if (nearest < 0) return std::nullopt;
+  const Vec3& n = normals[nearest];
+  const double height_mm = (x_mm - points[nearest]).dot(n);
+  if (height_mm < -max_inside_depth_mm) return std::nullopt;
+  if (height_mm < params.r_min_mm) f = sum(x_mm + (params.r_min_mm - height_mm) * n, nullptr, nullptr);
+  return Vec3(params.gain * f);
+}
+
+}  // namespace detail
+}  // namespace fieldpath::field

@@ -1,0 +1,40 @@
+#pragma once
+/// Obstacle meshes → sample points q_j with outward normals and weights (DESIGN.md "The field").
+/// The guide surface (the one being machined) is never passed here.
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "fieldpath/field/params.h"
+#include "fieldpath/geometry/mesh.h"
+#include "fieldpath/geometry/posture.h"
+
+namespace fieldpath::field {
+
+using geometry::Vec3;
+
+/// Sample points of the obstacle surfaces, world frame. All vectors have the same size.
+struct ObstacleSamples {
+  std::vector<Vec3> points_mm;  ///< q_j, mm
+  std::vector<Vec3> normals;    ///< unit, outward (CCW triangles seen from outside)
+  std::vector<double> weights;  ///< w_j: the sample's area (mm²) or 1 (Weights::Unit)
+  double area_mm2 = 0.0;        ///< total sampled area; 0 if unknown (sizes the voxel estimate)
+
+  std::size_t size() const { return points_mm.size(); }
+  void add(const Vec3& point_mm, const Vec3& normal, double weight) {
+    points_mm.push_back(point_mm);
+    normals.push_back(normal);
+    weights.push_back(weight);
+  }
+};
+
+/// Each triangle is cut into n² similar sub-triangles (n chosen so that a sub-triangle has area
+/// <= step² and edges <= 1.5·step); one sample at each sub-triangle's centroid, with the
+/// triangle's normal and the sub-triangle's area (Weights::Area, an exact partition of the
+/// surface, so the field does not depend on the density) or 1 (Weights::Unit, the seed's sum).
+/// Degenerate (zero-area) triangles are skipped. Throws common::InputError for step_mm <= 0 or
+/// a non-finite vertex.
+ObstacleSamples sampleObstacles(std::span<const geometry::TriangleMesh> meshes, double step_mm,
+                                Weights weights);
+
+}  // namespace fieldpath::field

@@ -1,0 +1,78 @@
+#pragma once
+/// The field sampled at the nodes of a sparse OpenVDB Vec3SGrid (hidden in the .cpp) and
+/// interpolated between them (DESIGN.md "The field", seed 004 §2).
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "fieldpath/common/progress.h"
+#include "fieldpath/field/direct_field.h"
+
+namespace fieldpath::field {
+
+struct VoxelRequest {
+  double voxel_size_mm = 0.5;  ///< h; nodes at (i h, j h, k h), world frame
+  Interpolation interpolation = Interpolation::Trilinear;
+  /// Depth of the band of nodes kept inside obstacles (where the surface rule of law.h pushes a
+  /// node out); negative: 2 h + r_min, so that every interpolation cell a node r_min deep
+  /// reaches is built.
+  double inside_band_mm = -1.0;
+  /// Only nodes in this world box (mm): the region the tool can reach. Default: everywhere the
+  /// field can be non-zero.
+  std::optional<Eigen::AlignedBox3d> region_mm;
+  /// A build whose estimated memory (estimateVoxelNodes) exceeds this is refused (InputError).
+  std::size_t max_memory_bytes = std::size_t{4} << 30;
+  common::Progress progress;  ///< "field" fraction of leaves built
+};
+
+/// Node counts and costs of a built voxel field.
+struct VoxelStats {
+  std::size_t estimated_nodes = 0;  ///< estimateVoxelNodes, before allocation
+  std::size_t active_nodes = 0;     ///< nodes holding a value (the sparse grid)
+  std::size_t dense_box_nodes = 0;  ///< nodes of a dense grid over the bounding box of the active ones
+  std::size_t memory_bytes = 0;     ///< OpenVDB's memUsage of the grid
+  double build_seconds = 0.0;
+};
+
+/// Upper bound of the nodes a build will make active, from the samples alone (no fine-grid
+/// allocation): the lesser of the dense box (samples padded by r0, clipped to the region) and
+/// the nodes of the coarse cells (edge r0/2) within two cells of a sample. Throws InputError
+/// for h <= 0.
+std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams& params,
+                               const VoxelRequest& request);
+/// Bytes per node of the estimate (a Vec3f per node of leaves that are ~2/3 full).
+inline constexpr double kVoxelBytesPerNode = 18.0;
+
+class VoxelField final : public ForceField {
+ public:
+  /// Builds the nodes from the exact field (node values equal `direct` up to float rounding),
+  /// in parallel. Throws common::InputError for h <= 0 or when the estimate exceeds
+  /// request.max_memory_bytes (the message gives the estimate); common::Interrupted if the
+  /// progress hook asks to stop.
+  VoxelField(const DirectField& direct, const VoxelRequest& request);
+  ~VoxelField() override;
+  VoxelField(VoxelField&&) noexcept;
+  VoxelField& operator=(VoxelField&&) noexcept;
+
+  /// Trilinear (OpenVDB BoxSampler) or quadratic (QuadraticSampler) interpolation; zero outside
+  /// the band.
+  void evaluate(std::span<const Vec3> points_mm, std::span<Vec3> forces) const override;
+
+  const VoxelStats& stats() const;
+  double voxelSizeMm() const;
+  Interpolation interpolation() const;
+  /// World positions (mm) of the active nodes, at most `max_count` of them.
+  std::vector<Vec3> activeNodes(std::size_t max_count = std::size_t(-1)) const;
+  /// Writes the grid (named "force") to a .vdb file atomically; Houdini and Blender open it.
+  void save(const std::filesystem::path& file) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fieldpath::field

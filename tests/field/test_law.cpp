@@ -1,0 +1,214 @@
+/// Eq. 1 against its closed forms: one point, superposition, an area-weighted plane; sampling; the
+/// surface rule; brute force against the indexed direct sum.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/field/direct_field.h"
+#include "fieldpath/field/law.h"
+#include "fieldpath/field/sampling.h"
+#include "fieldpath/geometry/mesh.h"
+#include "meshes.h"
+
+using namespace fieldpath::field;
+using fieldpath::geometry::TriangleMesh;
+
+namespace {
+
+Vec3 randomUnit(std::mt19937_64& rng) {
+  std::normal_distribution<double> n;
+  return Vec3(n(rng), n(rng), n(rng)).normalized();
+}
+
+ObstacleSamples onePoint(const Vec3& q, const Vec3& normal, double weight) {
+  ObstacleSamples s;
+  s.add(q, normal, weight);
+  return s;
+}
+
+/// Eq. 1 written out for one sample, independently of law.h.
+Vec3 eq1(const Vec3& x, const Vec3& q, double w, const FieldParams& p) {
+  const double r = (x - q).norm();
+  if (r >= p.r0_mm) return Vec3::Zero();
+  const double rc = std::max(r, p.r_min_mm);
+  return p.gain * w * (1.0 / rc - 1.0 / p.r0_mm) / (rc * rc) * (x - q) / r;
+}
+
+}  // namespace
+
+TEST(Law, OnePointMatchesEq1AtRandomDistances) {
+  FieldParams p;
+  p.r0_mm = 5.0;
+  p.r_min_mm = 0.25;
+  p.gain = 1.7;
+  const Vec3 q(1.0, -2.0, 3.0), n(0, 0, 1);
+  const DirectField direct(onePoint(q, n, 0.8), p);
+  const BruteForceField brute(onePoint(q, n, 0.8), p);
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> radius(p.r_min_mm, p.r0_mm);
+  for (int t = 0; t < 500; ++t) {
+    const Vec3 u = randomUnit(rng);
+    const Vec3 x = q + radius(rng) * u;
+    if ((x - q).dot(n) < p.r_min_mm) continue;  // the surface rule holds the field below r_min
+    const Vec3 expected = eq1(x, q, 0.8, p);
+    EXPECT_LT((direct.at(x) - expected).norm(), 1e-12 * expected.norm()) << t;
+    EXPECT_LT((brute.at(x) - expected).norm(), 1e-12 * expected.norm()) << t;
+  }
+}
+
+TEST(Law, ZeroBeyondR0) {
+  FieldParams p;
+  const Vec3 q(0, 0, 0);
+  const DirectField direct(onePoint(q, Vec3::UnitZ(), 1.0), p);
+  std::mt19937_64 rng(5);
+  for (int t = 0; t < 200; ++t) {
+    const Vec3 x = q + (p.r0_mm * (1.0 + 1e-9) + 3.0 * t / 200.0) * randomUnit(rng);
+    EXPECT_EQ(direct.at(x), Vec3::Zero());
+  }
+  EXPECT_EQ(phi(p.r0_mm, p.r0_mm, p.r_min_mm), 0.0);
+}
+
+TEST(Law, HeldAtRMinAndFiniteOnTheSample) {
+  FieldParams p;
+  const Vec3 q(0, 0, 0), n(0, 0, 1);
+  const double held = (1.0 / p.r_min_mm - 1.0 / p.r0_mm) / (p.r_min_mm * p.r_min_mm);
+  for (double r : {p.r_min_mm, 0.2, 0.1, 1e-3, 1e-9, 0.0}) {
+    EXPECT_EQ(phi(r, p.r0_mm, p.r_min_mm), held) << r;
+    const Vec3 x = q + r * Vec3(0.6, 0.0, 0.8);
+    const Vec3 f = sampleForce(x, q, n, 1.0, p);
+    EXPECT_NEAR(f.norm(), p.gain * held, 1e-12 * held) << r;
+    EXPECT_NEAR(f.normalized().dot(r > 0 ? Vec3(0.6, 0.0, 0.8) : n), 1.0, 1e-12) << r;
+  }
+  // The whole field near the sample: finite, bounded by the held value, pointing out.
+  const DirectField direct(onePoint(q, n, 1.0), p);
+  for (double r : {0.2, 1e-3, 0.0}) {
+    const Vec3 f = direct.at(q + r * Vec3(0.6, 0.0, 0.8));
+    EXPECT_TRUE(f.allFinite());
+    EXPECT_LE(f.norm(), held * (1 + 1e-12));
+    EXPECT_GT(f.z(), 0.0);
+  }
+  EXPECT_NEAR(direct.at(q).z(), held, 1e-12 * held);  // on the sample: along its normal, r_min off
+}
+
+TEST(Law, Superposition) {
+  FieldParams p;
+  std::mt19937_64 rng(6);
+  std::uniform_real_distribution<double> u(-3.0, 3.0), w(0.2, 2.0);
+  ObstacleSamples all;
+  std::vector<ObstacleSamples> each;
+  for (int j = 0; j < 12; ++j) {  // samples below z = 0, normals +z: queries above are outside
+    const Vec3 q(u(rng), u(rng), -std::abs(u(rng)) / 3.0);
+    const double wj = w(rng);
+    all.add(q, Vec3::UnitZ(), wj);
+    each.push_back(onePoint(q, Vec3::UnitZ(), wj));
+  }
+  const DirectField direct(all, p);
+  for (int t = 0; t < 200; ++t) {
+    const Vec3 x(u(rng), u(rng), 0.3 + std::abs(u(rng)));  // more than r_min above
+    Vec3 sum = Vec3::Zero();
+    for (const auto& s : each) sum += DirectField(s, p).at(x);
+    EXPECT_LT((direct.at(x) - sum).norm(), 1e-12 * (1.0 + sum.norm())) << t;
+  }
+}
+
+TEST(Sampling, AreaWeightsPartitionTheSurfaceWithOutwardNormals) {
+  const TriangleMesh cube = test::box(Vec3(0, 0, 0), Vec3(10, 20, 30));
+  const double area = 2.0 * (10 * 20 + 20 * 30 + 10 * 30);
+  for (double step : {2.0, 1.0, 0.5}) {
+    const ObstacleSamples s = sampleObstacles({&cube, 1}, step, Weights::Area);
+    double total = 0.0;
+    for (std::size_t j = 0; j < s.size(); ++j) {
+      total += s.weights[j];
+      EXPECT_LE(s.weights[j], step * step * (1 + 1e-12));
+      EXPECT_NEAR(s.normals[j].norm(), 1.0, 1e-12);
+      // outward: the normal points away from the box centre
+      EXPECT_GT((s.points_mm[j] - Vec3(5, 10, 15)).dot(s.normals[j]), 0.0);
+    }
+    EXPECT_NEAR(total, area, 1e-9 * area);
+    EXPECT_NEAR(s.area_mm2, area, 1e-9 * area);
+    // about one sample per step² (between 1 and 3 given the n×n split of right triangles)
+    EXPECT_GE(s.size(), area / (step * step));
+    EXPECT_LE(s.size(), 3.0 * area / (step * step));
+  }
+  const ObstacleSamples unit = sampleObstacles({&cube, 1}, 1.0, Weights::Unit);
+  for (double w : unit.weights) EXPECT_EQ(w, 1.0);
+  EXPECT_THROW(sampleObstacles({&cube, 1}, 0.0, Weights::Area), fieldpath::common::InputError);
+}
+
+TEST(Law, PlaneIsIndependentOfSamplingDensityAndMatchesClosedForm) {
+  FieldParams p;  // r0 = 5: a 2×(5+1) mm wide square acts as an infinite plane at its centre
+  const TriangleMesh plane = test::squarePlane(8.0);
+  const DirectField coarse(sampleObstacles({&plane, 1}, 1.0, Weights::Area), p);
+  const DirectField fine(sampleObstacles({&plane, 1}, 0.5, Weights::Area), p);
+  for (double d : {1.0, 1.5, 2.0, 3.0, 4.0, 4.5}) {
+    const Vec3 x(0.3, -0.2, d);
+    const double exact = planeFieldMagnitude(d, p);
+    const Vec3 fc = coarse.at(x), ff = fine.at(x);
+    EXPECT_NEAR(ff.z(), exact, 0.01 * exact) << d;  // quadrature error of the 0.5 mm sampling
+    EXPECT_NEAR(fc.z(), exact, 0.02 * exact) << d;
+    EXPECT_NEAR(fc.z(), ff.z(), 0.02 * exact) << d;
+    EXPECT_LT(ff.head<2>().norm(), 0.01 * exact) << d;  // along the normal
+  }
+}
+
+TEST(Law, InsideAnObstacleTheForceIsFiniteAndOutward) {
+  FieldParams p;
+  const TriangleMesh cube = test::box(Vec3(-5, -5, -5), Vec3(5, 5, 5));
+  const ObstacleSamples samples = sampleObstacles({&cube, 1}, 0.5, Weights::Area);
+  const DirectField direct(samples, p);
+  const BruteForceField brute(samples, p);
+  for (double depth : {1e-6, 0.1, 0.3, 1.0, 2.0}) {
+    const Vec3 x(0.4, -0.3, 5.0 - depth);  // below the top face
+    const Vec3 f = direct.at(x);
+    ASSERT_TRUE(f.allFinite()) << depth;
+    EXPECT_GT(f.z(), 0.9 * f.norm()) << depth;
+    EXPECT_GT(f.norm(), 0.0) << depth;
+    EXPECT_LT((brute.at(x) - f).norm(), 1e-12 * f.norm()) << depth;
+  }
+  // Continuous across the surface: just inside and just outside agree.
+  const Vec3 in = direct.at(Vec3(0.4, -0.3, 5.0 - 1e-7)), out = direct.at(Vec3(0.4, -0.3, 5.0 + 1e-7));
+  EXPECT_LT((in - out).norm(), 1e-4 * out.norm());
+  // Exactly on a sample point: finite and along the outward normal.
+  for (std::size_t j = 0; j < samples.size(); j += 97) {
+    const Vec3 f = direct.at(samples.points_mm[j]);
+    ASSERT_TRUE(f.allFinite());
+    EXPECT_GT(f.dot(samples.normals[j]), 0.0);
+  }
+}
+
+TEST(Law, DirectEqualsBruteForceInParallel) {
+  FieldParams p;
+  const TriangleMesh a = test::box(Vec3(-6, -6, -4), Vec3(-2, 6, 4));
+  const TriangleMesh b = test::box(Vec3(2, -6, -4), Vec3(6, 6, 4));
+  const std::vector<TriangleMesh> walls{a, b};
+  const ObstacleSamples samples = sampleObstacles(walls, 1.0, Weights::Unit);
+  const DirectField direct(samples, p);
+  const BruteForceField brute(samples, p);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-10.0, 10.0);
+  std::vector<Vec3> x(5000);
+  for (auto& v : x) v = Vec3(u(rng), u(rng), u(rng));
+  std::vector<Vec3> fd(x.size()), fb(x.size());
+  direct.evaluate(x, fd);
+  brute.evaluate(x, fb);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    ASSERT_TRUE(fd[i].allFinite());
+    EXPECT_LT((fd[i] - fb[i]).norm(), 1e-9 * (1.0 + fb[i].norm())) << i;
+    if (i % 500 == 0) EXPECT_EQ(direct.at(x[i]), fd[i]);  // one at a time = batched
+  }
+}
+
+TEST(Law, BadParametersAreInputErrors) {
+  const ObstacleSamples s = onePoint(Vec3::Zero(), Vec3::UnitZ(), 1.0);
+  auto with = [](auto change) {
+    FieldParams p;
+    change(p);
+    return p;
+  };
+  using fieldpath::common::InputError;
+  EXPECT_THROW(DirectField(s, with([](FieldParams& p) { p.r0_mm = -1; })), InputError);
+  EXPECT_THROW(DirectField(s, with([](FieldParams& p) { p.r_min_mm = 5; })), InputError);
+  EXPECT_THROW(DirectField(s, with([](FieldParams& p) { p.voxel_size_mm = 0; })), InputError);
+}
