@@ -1,0 +1,376 @@
+/// Z-buffer CPU reference: closed forms first (ball envelope), then an independent double-precision
+/// reference for 5-axis postures, mesh tools against their analytic shape, watertightness, zoom,
+/// order independence, outputs and bad input.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/zbuffer/outputs.h"
+#include "fieldpath/zbuffer/simulator.h"
+#include "fieldpath/zbuffer/tool_mesh.h"
+#include "reference.h"
+
+namespace fieldpath::zbuffer {
+namespace {
+
+constexpr float kStock = 100.f;
+
+SimulationResult runCpu(const Grid& grid, const Tool& tool, const std::vector<Posture>& postures,
+                        Engine engine = Engine::Fast, std::size_t block = 1 << 20) {
+  SimulationRequest req;
+  req.grid = grid;
+  req.tool = tool;
+  req.stock_mm = kStock;
+  req.backend = Backend::Cpu;
+  req.engine = engine;
+  req.block_postures = block;
+  return simulate(req, postures);
+}
+
+Posture pose(double x, double y, double z, double i, double j, double k) {
+  const double n = std::sqrt(i * i + j * j + k * k);
+  return {{float(x), float(y), float(z)}, {float(i / n), float(j / n), float(k / n)}};
+}
+
+test::PlacedTool placed(const Tool& tool, const Posture& p) {
+  const double ax = p.axis.x, ay = p.axis.y, az = p.axis.z,
+               n = std::sqrt(ax * ax + ay * ay + az * az);
+  return {tool.radius_mm,
+          tool.kind == ToolKind::Flat ? 0.0 : double(tool.corner_radius_mm),
+          tool.length_mm,
+          {p.tip_mm.x, p.tip_mm.y, p.tip_mm.z},
+          {ax / n, ay / n, az / n}};
+}
+
+/// Reference height map: min over postures of the reference lowest point, stock elsewhere.
+std::vector<double> referenceHeights(const Grid& g, const Tool& tool,
+                                     const std::vector<Posture>& postures, double dx_off = 0,
+                                     double dy_off = 0) {
+  std::vector<double> h(g.lineCount(), kStock);
+  for (const auto& p : postures) {
+    const auto t = placed(tool, p);
+    for (int iy = 0; iy < g.ny; ++iy)
+      for (int ix = 0; ix < g.nx; ++ix) {
+        const double x = g.x0_mm + (ix + 0.5) * g.dx_mm + dx_off,
+                     y = g.y0_mm + (iy + 0.5) * g.dy_mm + dy_off;
+        const double reach = std::hypot(x - t.tip[0], y - t.tip[1]);
+        if (reach > t.len + t.big_r + 1) continue;
+        if (auto z = test::lowestZ(t, x, y))
+          h[std::size_t(iy) * g.nx + ix] = std::min(h[std::size_t(iy) * g.nx + ix], *z);
+      }
+  }
+  return h;
+}
+
+/// Compares float heights with the reference: equal within tol, or (at a steep wall or a
+/// silhouette) within the reference's range over lines moved by ±delta.
+void expectMatchesReference(const Grid& g, const Tool& tool, const std::vector<Posture>& postures,
+                            const std::vector<float>& got, double tol = 2e-4, double delta = 2e-4) {
+  const auto ref = referenceHeights(g, tool, postures);
+  std::vector<std::vector<double>> moved;
+  int steep = 0, bad = 0;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    if (std::abs(got[i] - ref[i]) <= tol) continue;
+    if (moved.empty())
+      for (auto [ox, oy] : {std::pair{delta, 0.0}, {-delta, 0.0}, {0.0, delta}, {0.0, -delta}})
+        moved.push_back(referenceHeights(g, tool, postures, ox, oy));
+    double lo = ref[i], hi = ref[i];
+    for (const auto& m : moved) {
+      lo = std::min(lo, m[i]);
+      hi = std::max(hi, m[i]);
+    }
+    if (got[i] >= lo - tol && got[i] <= hi + tol) {
+      ++steep;
+      continue;
+    }
+    if (++bad <= 5)
+      ADD_FAILURE() << "line " << i % g.nx << "," << i / g.nx << ": got " << got[i] << " reference "
+                    << ref[i];
+  }
+  EXPECT_EQ(bad, 0);
+  EXPECT_LE(steep, int(ref.size() / 50)) << "too many lines only within the neighbourhood band";
+}
+
+TEST(Rotation, FloatTwinIsOrthonormalAndMapsEz) {
+  std::mt19937 rng(1);
+  std::normal_distribution<double> n;
+  std::vector<Vec3f> axes = {{0, 0, 1},     {0, 0, -1},     {1, 0, 0},
+                             {0, 1e-9f, 1}, {1e-9f, 0, -1}, {0.6f, 0.8f, 0}};
+  for (int k = 0; k < 200; ++k) axes.push_back({float(n(rng)), float(n(rng)), float(n(rng))});
+  for (const auto a : axes) {
+    const Mat3f r = rotationFromZ(a);
+    const double len = std::sqrt(double(a.x) * a.x + double(a.y) * a.y + double(a.z) * a.z);
+    for (int row = 0; row < 3; ++row) {
+      EXPECT_NEAR(r.m[row][2], comp(a, row) / len, 1e-6);  // maps e_z to a
+      for (int col = 0; col < 3; ++col) {
+        double d = 0;
+        for (int k = 0; k < 3; ++k) d += double(r.m[k][row]) * r.m[k][col];
+        EXPECT_NEAR(d, row == col ? 1.0 : 0.0, 1e-6);
+      }
+    }
+    const double det = r.m[0][0] * (r.m[1][1] * r.m[2][2] - r.m[1][2] * r.m[2][1]) -
+                       r.m[0][1] * (r.m[1][0] * r.m[2][2] - r.m[1][2] * r.m[2][0]) +
+                       r.m[0][2] * (r.m[1][0] * r.m[2][1] - r.m[1][1] * r.m[2][0]);
+    EXPECT_NEAR(det, 1.0, 1e-6);
+  }
+}
+
+TEST(Analytic, BallThreeAxisEqualsSphereClosedForm) {
+  const Grid g = Grid::fromRegion(-5, -5, 5, 5, 100, 100);
+  const Tool tool = Tool::ball(3, 12);
+  const std::vector<Posture> postures = {pose(0.37, -0.21, 1.5, 0, 0, 1)};
+  const auto got = runCpu(g, tool, postures).heights_mm;
+  for (int iy = 0; iy < g.ny; ++iy)
+    for (int ix = 0; ix < g.nx; ++ix) {
+      const double x = g.x0_mm + (ix + 0.5) * g.dx_mm - 0.37,
+                   y = g.y0_mm + (iy + 0.5) * g.dy_mm + 0.21;
+      const double rho2 = x * x + y * y;
+      const double want = rho2 <= 9.0 ? 1.5 + 3.0 - std::sqrt(9.0 - rho2) : kStock;
+      const float h = got[std::size_t(iy) * g.nx + ix];
+      if (std::abs(std::sqrt(rho2) - 3.0) < 1e-3) continue;  // the rim itself: vertical wall
+      EXPECT_NEAR(h, want, 2e-5) << ix << "," << iy;
+    }
+}
+
+std::vector<Posture> awkwardPostures(int random_count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Posture> p = {
+      pose(0, 0, 0, 0, 0, 1),                 // vertical
+      pose(3.3, -2.1, 0.4, 1e-9, 0, 1),       // 1e-9 from vertical
+      pose(-3.1, 2.7, -0.3, 0, -1e-9, 1),     //
+      pose(2.2, 3.1, 1.1, 1, 0.05, 1e-3),     // nearly horizontal
+      pose(-2.4, -3.3, 0.7, -0.3, 1, 0.002),  //
+      pose(0.5, -4.0, 2.0, 0.4, 0.3, 1),      // 5-axis tilts
+  };
+  for (int k = 0; k < random_count; ++k) {
+    const bool three_axis = k % 2 == 0;
+    p.push_back(three_axis ? pose(4 * u(rng), 4 * u(rng), u(rng), 0, 0, 1)
+                           : pose(4 * u(rng), 4 * u(rng), u(rng), 0.8 * u(rng), 0.8 * u(rng), 1));
+  }
+  return p;
+}
+
+TEST(Analytic, BallEnvelopeMatchesReferenceFor3And5Axis) {
+  const Grid g = Grid::fromRegion(-6, -6, 6, 6, 48, 48);
+  const Tool tool = Tool::ball(2, 8);
+  const auto postures = awkwardPostures(10, 7);
+  expectMatchesReference(g, tool, postures, runCpu(g, tool, postures).heights_mm);
+}
+
+TEST(Analytic, TorusAndFlatMatchReference) {
+  const Grid g = Grid::fromRegion(-6, -6, 6, 6, 40, 40);
+  const auto postures = awkwardPostures(6, 11);
+  for (const Tool& tool : {Tool::torus(2, 0.6, 8), Tool::flat(1.5, 6)})
+    expectMatchesReference(g, tool, postures, runCpu(g, tool, postures).heights_mm);
+}
+
+TEST(Analytic, OrderAndBlocksDoNotChangeABit) {
+  const Grid g = Grid::fromRegion(-6, -6, 6, 6, 64, 64);
+  const Tool tool = Tool::torus(2, 0.5, 8);
+  auto postures = awkwardPostures(200, 3);
+  const auto a = runCpu(g, tool, postures).heights_mm;
+  std::shuffle(postures.begin(), postures.end(), std::mt19937(5));
+  const auto b = runCpu(g, tool, postures, Engine::Fast, 7).heights_mm;
+  EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(float)));
+}
+
+TEST(Mesh, BallMeshWithinChordalToleranceOfAnalytic) {
+  const Grid g = Grid::fromRegion(-6, -6, 6, 6, 60, 60);
+  const Tool ana = Tool::ball(2, 8);
+  const int around = 64, arc = 16;
+  const Tool mesh = Tool::fromMesh(analyticToolMesh(ana, around, arc));
+  const double eps = analyticToolMeshError(ana, around, arc);
+  ASSERT_LT(eps, 0.05);
+  const auto postures = awkwardPostures(8, 21);
+  // Shrunk solid: radius R-ε about the same ball centre and axis, top at L-ε.
+  std::vector<Posture> shrunk = postures;
+  for (auto& p : shrunk) {
+    const Mat3f r = rotationFromZ(p.axis);
+    p.tip_mm = p.tip_mm + float(eps) * Vec3f{r.m[0][2], r.m[1][2], r.m[2][2]};
+  }
+  const auto h_ana = runCpu(g, ana, postures).heights_mm;
+  const auto h_mesh = runCpu(g, mesh, postures).heights_mm;
+  const auto h_in = runCpu(g, Tool::ball(2 - eps, 8 - 2 * eps), shrunk).heights_mm;
+  const double tol = 1e-4;
+  for (std::size_t i = 0; i < h_ana.size(); ++i) {
+    EXPECT_GE(h_mesh[i], h_ana[i] - tol) << i;  // the mesh lies inside the solid
+    EXPECT_LE(h_mesh[i], h_in[i] + tol) << i;   // and contains the solid shrunk by ε
+  }
+}
+
+TEST(Mesh, FastBvhAgreesWithCoarseRasteriser) {
+  const Grid g = Grid::fromRegion(-6, -6, 6, 6, 64, 64);
+  const Tool mesh = Tool::fromMesh(analyticToolMesh(Tool::torus(2, 0.5, 8), 48, 8));
+  const auto postures = awkwardPostures(20, 9);
+  const auto fast = runCpu(g, mesh, postures, Engine::Fast).heights_mm;
+  const auto coarse = runCpu(g, mesh, postures, Engine::Coarse).heights_mm;
+  int differ = 0;
+  for (std::size_t i = 0; i < fast.size(); ++i) differ += std::abs(fast[i] - coarse[i]) > 1e-3f;
+  EXPECT_LE(differ, int(fast.size() / 200));  // only grazing lines on vertical walls may differ
+}
+
+/// A tool whose bottom is a 4×4 grid of unit squares (two triangles each, diagonals alternating)
+/// at z = 0 closed by a pyramid: every vertex and edge of the bottom lies on grid lines.
+ToolMesh gridBottomTool() {
+  ToolMesh m;
+  for (int y = -2; y <= 2; ++y)
+    for (int x = -2; x <= 2; ++x) m.vertices.push_back({float(x), float(y), 0.f});
+  m.vertices.push_back({0.f, 0.f, 3.f});
+  const auto v = [](int x, int y) { return std::uint32_t((y + 2) * 5 + (x + 2)); };
+  for (int y = -2; y < 2; ++y)
+    for (int x = -2; x < 2; ++x) {
+      // bottom faces point down: clockwise seen from above
+      if ((x + y) % 2 == 0) {
+        m.triangles.push_back({v(x, y), v(x + 1, y + 1), v(x + 1, y)});
+        m.triangles.push_back({v(x, y), v(x, y + 1), v(x + 1, y + 1)});
+      } else {
+        m.triangles.push_back({v(x, y), v(x, y + 1), v(x + 1, y)});
+        m.triangles.push_back({v(x + 1, y), v(x, y + 1), v(x + 1, y + 1)});
+      }
+    }
+  const std::uint32_t apex = 25;
+  for (int k = -2; k < 2; ++k) {
+    m.triangles.push_back({v(k, -2), v(k + 1, -2), apex});
+    m.triangles.push_back({v(2, k), v(2, k + 1), apex});
+    m.triangles.push_back({v(k + 1, 2), v(k, 2), apex});
+    m.triangles.push_back({v(-2, k + 1), v(-2, k), apex});
+  }
+  return m;
+}
+
+TEST(Mesh, LinesThroughSharedVerticesAndEdgesAreNeverMissed) {
+  const Tool tool = Tool::fromMesh(gridBottomTool());
+  // Lines at every quarter unit: through vertices, along edges, through diagonals.
+  const Grid g = Grid::fromRegion(-4.125, -4.125, 4.125, 4.125, 33, 33);
+  for (Engine engine : {Engine::Fast, Engine::Coarse})
+    for (auto shift : {0.0, 0.5, 1.0}) {
+      const std::vector<Posture> postures = {pose(shift, -shift, -1, 0, 0, 1)};
+      const auto h = runCpu(g, tool, postures, engine).heights_mm;
+      for (int iy = 0; iy < g.ny; ++iy)
+        for (int ix = 0; ix < g.nx; ++ix) {
+          const double x = g.x0_mm + (ix + 0.5) * g.dx_mm - shift,
+                       y = g.y0_mm + (iy + 0.5) * g.dy_mm + shift;
+          const bool under = std::abs(x) <= 2 && std::abs(y) <= 2;
+          EXPECT_EQ(h[std::size_t(iy) * g.nx + ix], under ? -1.f : kStock)
+              << "engine " << int(engine) << " line at " << x << "," << y;
+        }
+    }
+}
+
+TEST(Mesh, TiltedSphereMeshHasNoHoles) {
+  // Inside the silhouette (by a margin) every line must be lowered, for random tilts.
+  const Tool ana = Tool::ball(2, 6);  // the shank covers the upper half of the ball
+  const Tool mesh = Tool::fromMesh(analyticToolMesh(ana, 37, 11));
+  const Grid g = Grid::fromRegion(-3, -3, 3, 3, 301, 301);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Posture> p;
+  for (int k = 0; k < 12; ++k) {
+    const Engine engine = k % 2 ? Engine::Coarse : Engine::Fast;
+    if (k % 2 == 0)
+      p = {pose(0.1 * u(rng), 0.1 * u(rng), 0, u(rng), u(rng), 0.2 + std::abs(u(rng)))};
+    const auto h = runCpu(g, mesh, p, engine).heights_mm;
+    const Mat3f r = rotationFromZ(p[0].axis);
+    const Vec3f c = p[0].tip_mm + 2.f * Vec3f{r.m[0][2], r.m[1][2], r.m[2][2]};
+    int holes = 0;
+    for (int iy = 0; iy < g.ny; ++iy)
+      for (int ix = 0; ix < g.nx; ++ix) {
+        const double x = g.x0_mm + (ix + 0.5) * g.dx_mm, y = g.y0_mm + (iy + 0.5) * g.dy_mm;
+        if (std::hypot(x - c.x, y - c.y) < 1.9) holes += h[std::size_t(iy) * g.nx + ix] == kStock;
+      }
+    EXPECT_EQ(holes, 0) << "posture " << k / 2 << " engine " << int(engine);
+  }
+}
+
+TEST(Zoom, ZoomEqualsTheSameLinesOfTheFullRun) {
+  const Grid full = Grid::fromRegion(-8, -8, 8, 8, 128, 128);
+  const int ix0 = 40, iy0 = 70, nx = 30, ny = 20;
+  const Grid zoom = Grid::fromRegion(full.x0_mm + ix0 * full.dx_mm, full.y0_mm + iy0 * full.dy_mm,
+                                     full.x0_mm + (ix0 + nx) * full.dx_mm,
+                                     full.y0_mm + (iy0 + ny) * full.dy_mm, nx, ny);
+  const auto postures = awkwardPostures(300, 13);
+  for (const Tool& tool :
+       {Tool::ball(2, 8), Tool::fromMesh(analyticToolMesh(Tool::torus(2, 0.5, 8), 40, 6))}) {
+    const auto a = runCpu(full, tool, postures);
+    const auto b = runCpu(zoom, tool, postures);
+    EXPECT_GT(b.postures_culled,
+              a.postures_culled);  // the zoom skips postures that do not reach it
+    for (int iy = 0; iy < ny; ++iy)
+      for (int ix = 0; ix < nx; ++ix)
+        ASSERT_EQ(b.heights_mm[std::size_t(iy) * nx + ix],
+                  a.heights_mm[std::size_t(iy + iy0) * full.nx + ix + ix0])
+            << ix << "," << iy;
+  }
+}
+
+TEST(Stock, PartTopIsTheStartingHeight) {
+  const Grid g = Grid::fromRegion(0, 0, 10, 10, 20, 20);
+  // a box 2..8 × 2..8, top at z = 5, bottom at z = 1 (only the top faces up)
+  std::vector<Vec3f> v = {{2, 2, 5}, {8, 2, 5}, {8, 8, 5}, {2, 8, 5},
+                          {2, 2, 1}, {8, 2, 1}, {8, 8, 1}, {2, 8, 1}};
+  std::vector<std::array<std::uint32_t, 3>> t = {{0, 1, 2}, {0, 2, 3}, {4, 6, 5}, {4, 7, 6}};
+  const auto h = stockFromPart(g, v, t);
+  EXPECT_EQ(h[10 * 20 + 10], 5.f);
+  EXPECT_EQ(h[0], 1.f);  // outside the part: its lowest z
+}
+
+TEST(Outputs, NpyJsonStlPngAreWellFormed) {
+  const auto dir = std::filesystem::temp_directory_path() / "fieldpath_zbuffer_outputs";
+  std::filesystem::create_directories(dir);
+  const Grid g = Grid::fromRegion(0, 0, 3, 2, 3, 2);
+  const std::vector<float> h = {1, 2, 3, 4, 5, 6};
+  writeHeightsNpy(dir / "h.npy", g, h);
+  std::ifstream in(dir / "h.npy", std::ios::binary);
+  std::string data((std::istreambuf_iterator<char>(in)), {});
+  ASSERT_EQ(data.substr(0, 6), "\x93NUMPY");
+  const std::size_t header = std::uint8_t(data[8]) | (std::uint8_t(data[9]) << 8);
+  EXPECT_EQ((10 + header) % 64, 0u);
+  EXPECT_NE(data.find("'shape': (2, 3)"), std::string::npos);
+  ASSERT_EQ(data.size(), 10 + header + 6 * 4);
+  float last;
+  std::memcpy(&last, data.data() + data.size() - 4, 4);
+  EXPECT_EQ(last, 6.f);
+  EXPECT_EQ(writeSurfaceStl(dir / "s.stl", g, h), 4u);
+  EXPECT_EQ(std::filesystem::file_size(dir / "s.stl"), 84u + 4 * 50);
+  writeReliefPng(dir / "r.png", g, h);
+  std::ifstream png(dir / "r.png", std::ios::binary);
+  std::string p((std::istreambuf_iterator<char>(png)), {});
+  EXPECT_EQ(p.substr(1, 3), "PNG");
+  EXPECT_EQ(p.substr(p.size() - 8, 4), "IEND");
+  writeHeightsJson(dir / "h.json", g);
+  std::ifstream js(dir / "h.json");
+  std::string j((std::istreambuf_iterator<char>(js)), {});
+  EXPECT_NE(j.find("\"shape\":[2,3]"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(BadInput, RegionGridAndToolAreChecked) {
+  EXPECT_THROW(Grid::fromRegion(0, 0, 0, 5, 10, 10), common::InputError);
+  EXPECT_THROW(Grid::fromRegion(0, 0, 5, 5, 0, 10), common::InputError);
+  EXPECT_THROW(Grid::fromRegion(0, 0, std::nan(""), 5, 10, 10), common::InputError);
+  const Grid huge = Grid::fromRegion(0, 0, 1, 1, 2000000, 2000000);
+  try {
+    checkGridFits(huge);
+    ADD_FAILURE() << "absurd grid accepted";
+  } catch (const common::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("MiB"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(Tool::ball(-1, 4), common::InputError);
+  EXPECT_THROW(Tool::torus(2, 3, 8), common::InputError);
+  EXPECT_THROW(Tool::fromMesh({}), common::InputError);
+  SimulationRequest req;
+  req.grid = Grid::fromRegion(0, 0, 1, 1, 4, 4);
+  req.tool = Tool::ball(1, 4);
+  req.engine = Engine::Coarse;
+  EXPECT_THROW(simulate(req, std::span<const Posture>{}), common::InputError);
+}
+
+}  // namespace
+}  // namespace fieldpath::zbuffer

@@ -1,0 +1,395 @@
+#pragma once
+/// The per-posture, per-line and per-triangle math of the Z-buffer, shared by the CPU reference
+/// (OpenMP) and the CUDA backend. Views here are plain structs of values and non-owning pointers so
+/// that they can be passed to a kernel by value.
+#include <cfloat>
+#include <cstdint>
+
+#include "fieldpath/zbuffer/hd.h"
+
+namespace fieldpath::zbuffer {
+
+/// The lines of a height map: line (ix, iy) stands at x = x0 + (ix+0.5) dx, y = y0 + (iy+0.5) dy
+/// (mm, world). Line coordinates are formed in double and rounded once, so a zoom grid aligned
+/// with a coarser one gives its lines the very same float coordinates.
+struct GridView {
+  double x0_mm = 0, y0_mm = 0, dx_mm = 1, dy_mm = 1;
+  int nx = 0, ny = 0;
+  int tile_shift = 4;  ///< culling tiles of 2^shift × 2^shift lines
+  int tiles_x = 0, tiles_y = 0;
+};
+
+enum class ToolKind : int { Ball = 0, Torus = 1, Flat = 2, Mesh = 3 };
+
+/// Bounding volume hierarchy node (tool frame, mm). Interior: left child at this+1, right child
+/// at `first`, count == 0. Leaf: triangles [first, first+count) of the leaf-ordered array.
+struct BvhNode {
+  float lo[3];
+  float hi[3];
+  std::int32_t first;
+  std::int32_t count;
+};
+
+/// A tool as the kernels see it (tool frame: tip at origin, axis +z, mm).
+struct ToolView {
+  ToolKind kind = ToolKind::Ball;
+  float radius_mm = 0, corner_radius_mm = 0, length_mm = 0;      ///< analytic shapes
+  float hull_radius_mm = 0, hull_zmin_mm = 0, hull_zmax_mm = 0;  ///< bounds the solid (all kinds)
+  // Mesh tools: triangles in BVH leaf order (9 floats each, shared vertices copied bit-exactly).
+  const float* bvh_triangles = nullptr;
+  const BvhNode* bvh_nodes = nullptr;
+  // Mesh tools, coarse engine: the indexed mesh as given.
+  const Vec3f* vertices = nullptr;
+  const std::uint32_t* indices = nullptr;  ///< 3 per triangle, CCW seen from outside
+  std::int32_t triangle_count = 0;
+};
+
+/// Everything a posture needs, computed once per posture.
+struct PreparedPosture {
+  Mat3f rot;  ///< tool → world
+  Vec3f tip_mm;
+  Vec3f dir;          ///< world +z expressed in the tool frame (third row of rot)
+  float lowest_z_mm;  ///< no point of the placed tool is below this (conservative)
+  int ix0, ix1, iy0,
+      iy1;  ///< lines that may meet the tool (inclusive, clipped); empty if ix0 > ix1
+  // Watertight ray/triangle test (Woop, Benthin, Wald 2013): axis permutation and shear.
+  int kx, ky, kz;
+  float sx, sy, sz;
+  Vec3f inv_dir;  ///< 1/dir with zeros replaced by ±1e-30 (no 0·∞ in the slab test)
+};
+
+FIELDPATH_HD float safeInverse(float v) { return 1.f / (v == 0.f ? 1e-30f : v); }
+
+FIELDPATH_HD int clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
+
+/// First / last line index in [0, n-1] at or after / before the fractional index f (clamped in
+/// double before the conversion, so far-away coordinates cannot overflow an int).
+FIELDPATH_HD int firstLine(double f, int n) {
+  return static_cast<int>(ceil(f < 0.0 ? 0.0 : (f > n - 1.0 ? n - 1.0 : f)));
+}
+FIELDPATH_HD int lastLine(double f, int n) {
+  return static_cast<int>(floor(f < 0.0 ? 0.0 : (f > n - 1.0 ? n - 1.0 : f)));
+}
+
+/// Lowest possible world z of the placed tool and its footprint on the grid.
+FIELDPATH_HD PreparedPosture preparePosture(const GridView& g, const ToolView& tool, Posture pose) {
+  PreparedPosture pp;
+  pp.rot = rotationFromZ(pose.axis);
+  pp.tip_mm = pose.tip_mm;
+  const float i = pp.rot.m[0][2], j = pp.rot.m[1][2], k = pp.rot.m[2][2];
+  pp.dir = {pp.rot.m[2][0], pp.rot.m[2][1], pp.rot.m[2][2]};
+  const float s = sqrtf(maxf(0.f, i * i + j * j));
+  const float hull_r = tool.hull_radius_mm, z0 = tool.hull_zmin_mm, z1 = tool.hull_zmax_mm;
+  float lowest = pose.tip_mm.z + minf(z0 * k, z1 * k) - hull_r * s;
+  if (tool.kind != ToolKind::Mesh) {
+    // Analytic: corner piece (disk of radius R-r at height r, swept by a ball of radius r) and
+    // shank cylinder (radius R, z from r to L).
+    const float r = tool.corner_radius_mm, big_r = tool.radius_mm;
+    const float corner = r * k - (big_r - r) * s - r;
+    const float shank = minf(r * k, tool.length_mm * k) - big_r * s;
+    lowest = pose.tip_mm.z + minf(corner, shank);
+  }
+  const float margin = 1e-5f * (absf(pose.tip_mm.z) + hull_r + z1 - z0) + 1e-6f;
+  pp.lowest_z_mm = lowest - margin;
+
+  const float ex = hull_r * sqrtf(maxf(0.f, 1.f - i * i)) + margin;
+  const float ey = hull_r * sqrtf(maxf(0.f, 1.f - j * j)) + margin;
+  const float xa = pose.tip_mm.x + z0 * i, xb = pose.tip_mm.x + z1 * i;
+  const float ya = pose.tip_mm.y + z0 * j, yb = pose.tip_mm.y + z1 * j;
+  const double xmin = minf(xa, xb) - ex, xmax = maxf(xa, xb) + ex;
+  const double ymin = minf(ya, yb) - ey, ymax = maxf(ya, yb) + ey;
+  const double fx0 = (xmin - g.x0_mm) / g.dx_mm - 0.5, fx1 = (xmax - g.x0_mm) / g.dx_mm - 0.5;
+  const double fy0 = (ymin - g.y0_mm) / g.dy_mm - 0.5, fy1 = (ymax - g.y0_mm) / g.dy_mm - 0.5;
+  if (fx1 < 0.0 || fy1 < 0.0 || fx0 > g.nx - 1.0 || fy0 > g.ny - 1.0 || !(fx0 <= fx1) ||
+      !(fy0 <= fy1)) {
+    pp.ix0 = pp.iy0 = 1;
+    pp.ix1 = pp.iy1 = 0;
+  } else {
+    pp.ix0 = firstLine(fx0, g.nx);
+    pp.ix1 = lastLine(fx1, g.nx);
+    pp.iy0 = firstLine(fy0, g.ny);
+    pp.iy1 = lastLine(fy1, g.ny);
+  }
+
+  // Shear constants of the watertight test for rays along pp.dir (tool frame).
+  const float ax = absf(pp.dir.x), ay = absf(pp.dir.y), az = absf(pp.dir.z);
+  pp.kz = (ax > ay) ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+  pp.kx = (pp.kz + 1) % 3;
+  pp.ky = (pp.kx + 1) % 3;
+  const float dkz = comp(pp.dir, pp.kz);
+  if (dkz < 0.f) {
+    const int t = pp.kx;
+    pp.kx = pp.ky;
+    pp.ky = t;
+  }
+  pp.sx = comp(pp.dir, pp.kx) / dkz;
+  pp.sy = comp(pp.dir, pp.ky) / dkz;
+  pp.sz = 1.f / dkz;
+  pp.inv_dir = {safeInverse(pp.dir.x), safeInverse(pp.dir.y), safeInverse(pp.dir.z)};
+  return pp;
+}
+
+/// World coordinates of line (ix, iy) relative to the tip, formed in double, rounded once.
+FIELDPATH_HD void lineOffset(const GridView& g, const PreparedPosture& pp, int ix, int iy,
+                             float& rx, float& ry) {
+  const double xd = g.x0_mm + (ix + 0.5) * g.dx_mm;
+  const double yd = g.y0_mm + (iy + 0.5) * g.dy_mm;
+  rx = static_cast<float>(xd - static_cast<double>(pp.tip_mm.x));
+  ry = static_cast<float>(yd - static_cast<double>(pp.tip_mm.y));
+}
+
+/// Smallest t with o + t d inside the infinite cylinder x²+y² <= R² (tool frame); returns false if
+/// the line misses it. Stable roots (no cancellation), exact for d parallel to the axis.
+FIELDPATH_HD bool cylinderInterval(Vec3f o, Vec3f d, float radius, float& lo, float& hi) {
+  const float a = d.x * d.x + d.y * d.y;
+  const float b = o.x * d.x + o.y * d.y;
+  const float c = o.x * o.x + o.y * o.y - radius * radius;
+  if (a == 0.f) {
+    if (c > 0.f) return false;
+    lo = -FLT_MAX;
+    hi = FLT_MAX;
+    return true;
+  }
+  const float disc = b * b - a * c;
+  if (disc < 0.f) return false;
+  const float q = -(b + (b >= 0.f ? sqrtf(disc) : -sqrtf(disc)));
+  if (q == 0.f) {
+    lo = hi = 0.f;
+    return true;
+  }
+  const float t1 = q / a, t2 = c / q;
+  lo = minf(t1, t2);
+  hi = maxf(t1, t2);
+  return true;
+}
+
+/// Entry parameter of the line o + t d into the slab zlo <= z <= zhi ∩ cylinder of `radius`.
+FIELDPATH_HD float cappedCylinderEntry(Vec3f o, Vec3f d, float radius, float zlo, float zhi) {
+  float lo, hi;
+  if (!cylinderInterval(o, d, radius, lo, hi)) return FLT_MAX;
+  if (d.z == 0.f) {
+    if (o.z < zlo || o.z > zhi) return FLT_MAX;
+  } else {
+    const float ta = (zlo - o.z) / d.z, tb = (zhi - o.z) / d.z;
+    lo = maxf(lo, minf(ta, tb));
+    hi = minf(hi, maxf(ta, tb));
+  }
+  return lo <= hi ? lo : FLT_MAX;
+}
+
+/// Entry into the ball of radius r centred at (0, 0, zc): stable quadratic roots.
+FIELDPATH_HD float ballEntry(Vec3f o, Vec3f d, float r, float zc) {
+  const Vec3f w{o.x, o.y, o.z - zc};
+  const float a = dot(d, d), b = dot(w, d), c = dot(w, w) - r * r;
+  const float disc = b * b - a * c;
+  if (disc < 0.f) return FLT_MAX;
+  const float root = sqrtf(disc);
+  // lower root: (-b - root)/a, computed as c/(-b + root) when b < 0 (no cancellation)
+  if (b >= 0.f) return (-b - root) / a;
+  const float den = -b + root;
+  return den > 0.f ? c / den : 0.f;
+}
+
+/// Entry into the convex corner piece of a torus end mill: the points within r of the disk of
+/// radius rho in the plane z = r. Newton's method on the convex distance function, started at the
+/// entry of the bounding ball: it approaches the root monotonically from below.
+FIELDPATH_HD float torusCornerEntry(Vec3f o, Vec3f d, float rho, float r) {
+  float t = ballEntry(o, d, rho + r, r);
+  if (t == FLT_MAX) return FLT_MAX;
+  const float tol = 1e-7f * (rho + r);
+  for (int it = 0; it < 40; ++it) {
+    const Vec3f q = o + t * d;
+    const float rq = sqrtf(q.x * q.x + q.y * q.y);
+    const float scale = rq > rho ? rho / rq : 1.f;
+    const Vec3f diff{q.x - scale * q.x, q.y - scale * q.y, q.z - r};
+    const float dist = sqrtf(dot(diff, diff));
+    const float g = dist - r;
+    if (g <= tol) return t;
+    const float slope = dist > 0.f ? dot(diff, d) / dist : 0.f;
+    if (slope >= 0.f) return FLT_MAX;  // past the closest approach without reaching the piece
+    const float step = g / slope;
+    t -= step;
+    if (-step <= tol) return t;
+  }
+  return t;
+}
+
+/// Entry parameter of the line o + t d (tool frame) into an analytic tool, FLT_MAX if it misses.
+FIELDPATH_HD float analyticEntry(const ToolView& tool, Vec3f o, Vec3f d) {
+  const float big_r = tool.radius_mm, r = tool.corner_radius_mm;
+  float t = cappedCylinderEntry(o, d, big_r, r, tool.length_mm);
+  if (r > 0.f) {
+    const float rho = big_r - r;
+    t = minf(t, rho > 0.f ? torusCornerEntry(o, d, rho, r) : ballEntry(o, d, r, r));
+  }
+  return t;
+}
+
+/// Slab test of a (padded) box against the ray; returns the entry parameter or FLT_MAX.
+FIELDPATH_HD float boxEntry(const BvhNode& n, Vec3f o, Vec3f inv, float t_max) {
+  const float tx0 = (n.lo[0] - o.x) * inv.x, tx1 = (n.hi[0] - o.x) * inv.x;
+  const float ty0 = (n.lo[1] - o.y) * inv.y, ty1 = (n.hi[1] - o.y) * inv.y;
+  const float tz0 = (n.lo[2] - o.z) * inv.z, tz1 = (n.hi[2] - o.z) * inv.z;
+  const float tnear = maxf(maxf(minf(tx0, tx1), minf(ty0, ty1)), minf(tz0, tz1));
+  const float tfar = minf(minf(maxf(tx0, tx1), maxf(ty0, ty1)), maxf(tz0, tz1));
+  return (tnear <= tfar && tnear <= t_max) ? tnear : FLT_MAX;
+}
+
+/// Watertight ray/triangle test (Woop et al. 2013), only triangles the upward world line enters
+/// (facing down after placement). Edge values of a shared edge are exact negatives in both
+/// triangles, and zero counts as inside, so a line through a shared edge or vertex is never missed.
+FIELDPATH_HD float triangleEntry(const PreparedPosture& pp, const float* v, Vec3f o) {
+  const Vec3f a{v[0] - o.x, v[1] - o.y, v[2] - o.z};
+  const Vec3f b{v[3] - o.x, v[4] - o.y, v[5] - o.z};
+  const Vec3f c{v[6] - o.x, v[7] - o.y, v[8] - o.z};
+  const float az = comp(a, pp.kz), bz = comp(b, pp.kz), cz = comp(c, pp.kz);
+  const float ax = comp(a, pp.kx) - pp.sx * az, ay = comp(a, pp.ky) - pp.sy * az;
+  const float bx = comp(b, pp.kx) - pp.sx * bz, by = comp(b, pp.ky) - pp.sy * bz;
+  const float cx = comp(c, pp.kx) - pp.sx * cz, cy = comp(c, pp.ky) - pp.sy * cz;
+  const float u = cx * by - cy * bx;
+  const float w_v = ax * cy - ay * cx;
+  const float w = bx * ay - by * ax;
+  if (u < 0.f || w_v < 0.f || w < 0.f) return FLT_MAX;
+  const float det = u + w_v + w;
+  if (det == 0.f) return FLT_MAX;
+  const float t_num = u * (pp.sz * az) + w_v * (pp.sz * bz) + w * (pp.sz * cz);
+  return t_num / det;
+}
+
+/// Lowest entry of the line o + t dir into a mesh tool, below t_max, through the BVH (tool frame).
+FIELDPATH_HD float meshEntry(const ToolView& tool, const PreparedPosture& pp, Vec3f o,
+                             float t_max) {
+  int stack[64];
+  int top = 0;
+  float best = FLT_MAX;
+  float limit = t_max;
+  int node = 0;
+  if (boxEntry(tool.bvh_nodes[0], o, pp.inv_dir, limit) == FLT_MAX) return FLT_MAX;
+  for (;;) {
+    const BvhNode& n = tool.bvh_nodes[node];
+    if (n.count > 0) {
+      for (int t = n.first; t < n.first + n.count; ++t) {
+        const float th = triangleEntry(pp, tool.bvh_triangles + 9 * t, o);
+        if (th < best) {
+          best = th;
+          limit = minf(limit, th);
+        }
+      }
+    } else {
+      const int left = node + 1, right = n.first;
+      const float tl = boxEntry(tool.bvh_nodes[left], o, pp.inv_dir, limit);
+      const float tr = boxEntry(tool.bvh_nodes[right], o, pp.inv_dir, limit);
+      if (tl != FLT_MAX && tr != FLT_MAX) {
+        const bool left_first = tl <= tr;
+        stack[top++] = left_first ? right : left;
+        node = left_first ? left : right;
+        continue;
+      }
+      if (tl != FLT_MAX) {
+        node = left;
+        continue;
+      }
+      if (tr != FLT_MAX) {
+        node = right;
+        continue;
+      }
+    }
+    // pop, skipping boxes that can no longer hold a lower hit
+    bool found = false;
+    while (top > 0) {
+      node = stack[--top];
+      if (boxEntry(tool.bvh_nodes[node], o, pp.inv_dir, limit) != FLT_MAX) {
+        found = true;
+        break;
+      }
+    }
+    if (!found) return best;
+  }
+}
+
+/// The height the posture would give line (ix, iy), or FLT_MAX if it cannot lower it below
+/// `current_mm`. Analytic and mesh tools; -0 folded to +0 so that both backends store equal bits.
+FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
+                           int ix, int iy, float current_mm) {
+  float rx, ry;
+  lineOffset(g, pp, ix, iy, rx, ry);
+  const Vec3f o = mulTransposed(pp.rot, Vec3f{rx, ry, 0.f});
+  float t;
+  if (tool.kind == ToolKind::Mesh) {
+    const float slack = 1e-5f * (absf(current_mm) + absf(pp.tip_mm.z) + 1.f);
+    t = meshEntry(tool, pp, o, current_mm - pp.tip_mm.z + slack);
+  } else {
+    t = analyticEntry(tool, o, pp.dir);
+  }
+  if (t == FLT_MAX) return FLT_MAX;
+  const float h = (pp.tip_mm.z + t) + 0.f;
+  return h < current_mm ? h : FLT_MAX;
+}
+
+/// True if the posture cannot lower any line: its lowest point is not below the highest height of
+/// the culling tiles under its footprint (tile maxima may be stale-high, which stays conservative).
+FIELDPATH_HD bool postureCulled(const GridView& g, const PreparedPosture& pp,
+                                const float* tile_max_mm) {
+  if (pp.ix0 > pp.ix1 || pp.iy0 > pp.iy1) return true;
+  const int tx0 = pp.ix0 >> g.tile_shift, tx1 = pp.ix1 >> g.tile_shift;
+  const int ty0 = pp.iy0 >> g.tile_shift, ty1 = pp.iy1 >> g.tile_shift;
+  for (int ty = ty0; ty <= ty1; ++ty)
+    for (int tx = tx0; tx <= tx1; ++tx)
+      if (!(pp.lowest_z_mm >= tile_max_mm[ty * g.tiles_x + tx])) return false;
+  return true;
+}
+
+/// Canonical 2D edge function: the same two points give exactly opposite values whichever way
+/// round the edge is traversed (watertight rasterisation of a shared edge).
+FIELDPATH_HD float edgeFunction(Vec3f a, Vec3f b, float px, float py) {
+  const bool swap = (b.x < a.x) || (b.x == a.x && b.y < a.y);
+  const Vec3f p = swap ? b : a, q = swap ? a : b;
+  const float e = (q.x - p.x) * (py - p.y) - (q.y - p.y) * (px - p.x);
+  return swap ? -e : e;
+}
+
+/// Rasterises one world-frame triangle onto the lines. `sign` = -1 keeps triangles facing down
+/// (clockwise seen from above) and calls lower(ix, iy, z); +1 keeps those facing up.
+template <class Visit>
+FIELDPATH_HD void rasterTriangle(const GridView& g, Vec3f w0, Vec3f w1, Vec3f w2, float sign,
+                                 Visit visit) {
+  const float area2 = (w1.x - w0.x) * (w2.y - w0.y) - (w1.y - w0.y) * (w2.x - w0.x);
+  if (!(area2 * sign > 0.f)) return;
+  const double xmin = minf(w0.x, minf(w1.x, w2.x)), xmax = maxf(w0.x, maxf(w1.x, w2.x));
+  const double ymin = minf(w0.y, minf(w1.y, w2.y)), ymax = maxf(w0.y, maxf(w1.y, w2.y));
+  const double fx0 = (xmin - g.x0_mm) / g.dx_mm - 0.5, fx1 = (xmax - g.x0_mm) / g.dx_mm - 0.5;
+  const double fy0 = (ymin - g.y0_mm) / g.dy_mm - 0.5, fy1 = (ymax - g.y0_mm) / g.dy_mm - 0.5;
+  if (!(fx1 >= -1.0 && fy1 >= -1.0 && fx0 <= g.nx && fy0 <= g.ny)) return;
+  const int ix0 = clampi(firstLine(fx0, g.nx) - 1, 0, g.nx - 1),
+            ix1 = clampi(lastLine(fx1, g.nx) + 1, 0, g.nx - 1);
+  const int iy0 = clampi(firstLine(fy0, g.ny) - 1, 0, g.ny - 1),
+            iy1 = clampi(lastLine(fy1, g.ny) + 1, 0, g.ny - 1);
+  for (int iy = iy0; iy <= iy1; ++iy) {
+    const float py = static_cast<float>(g.y0_mm + (iy + 0.5) * g.dy_mm);
+    for (int ix = ix0; ix <= ix1; ++ix) {
+      const float px = static_cast<float>(g.x0_mm + (ix + 0.5) * g.dx_mm);
+      const float e0 = edgeFunction(w1, w2, px, py) * sign;
+      const float e1 = edgeFunction(w2, w0, px, py) * sign;
+      const float e2 = edgeFunction(w0, w1, px, py) * sign;
+      if (e0 < 0.f || e1 < 0.f || e2 < 0.f) continue;
+      const float sum = e0 + e1 + e2;
+      if (sum == 0.f) continue;
+      visit(ix, iy, (e0 * w0.z + e1 * w1.z + e2 * w2.z) / sum + 0.f);
+    }
+  }
+}
+
+/// SIMSURF1's coarse work item: one posture, every triangle transformed and rasterised.
+template <class Lower>
+FIELDPATH_HD void coarsePosture(const GridView& g, const ToolView& tool, Posture pose,
+                                Lower lower) {
+  const Mat3f rot = rotationFromZ(pose.axis);
+  for (int t = 0; t < tool.triangle_count; ++t) {
+    const Vec3f w0 = mul(rot, tool.vertices[tool.indices[3 * t]]) + pose.tip_mm;
+    const Vec3f w1 = mul(rot, tool.vertices[tool.indices[3 * t + 1]]) + pose.tip_mm;
+    const Vec3f w2 = mul(rot, tool.vertices[tool.indices[3 * t + 2]]) + pose.tip_mm;
+    rasterTriangle(g, w0, w1, w2, -1.f, lower);
+  }
+}
+
+}  // namespace fieldpath::zbuffer

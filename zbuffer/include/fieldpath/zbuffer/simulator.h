@@ -1,0 +1,135 @@
+#pragma once
+/// Z-buffer machining simulation (DESIGN.md "The Z-buffer", seeds 000 and 001): vertical lines on
+/// an nx × ny grid start at the stock height and are lowered, for every posture, to the lowest
+/// point of the placed tool. CPU (OpenMP) reference and CUDA backend, same results bit for bit.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "fieldpath/common/progress.h"
+#include "fieldpath/zbuffer/kernels.h"
+
+namespace fieldpath::zbuffer {
+
+/// Region and line spacing of a height map (mm, world). Line (ix, iy) stands at
+/// x = x0 + (ix+0.5) dx, y = y0 + (iy+0.5) dy; heights are stored row by row (row = iy).
+struct Grid {
+  double x0_mm = 0, y0_mm = 0;
+  double dx_mm = 1, dy_mm = 1;
+  int nx = 0, ny = 0;
+
+  /// nx × ny lines covering [x0, x1] × [y0, y1]. Throws common::InputError for a region of zero
+  /// or negative area, a zero grid, or non-finite numbers.
+  static Grid fromRegion(double x0_mm, double y0_mm, double x1_mm, double y1_mm, int nx, int ny);
+  std::size_t lineCount() const {
+    return static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny);
+  }
+};
+
+/// A closed, outward-oriented (CCW seen from outside) triangle mesh in the tool frame: tip at the
+/// origin, axis +z, mm.
+struct ToolMesh {
+  std::vector<Vec3f> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+};
+
+/// The tool: an analytic ball / torus / flat end mill with its cylindrical shank closed at L, or a
+/// mesh. Build with the factories; they throw common::InputError for impossible dimensions.
+struct Tool {
+  ToolKind kind = ToolKind::Ball;
+  float radius_mm = 0, corner_radius_mm = 0, length_mm = 0;
+  ToolMesh mesh;  ///< kind == Mesh only
+
+  static Tool ball(double radius_mm, double length_mm);
+  static Tool torus(double radius_mm, double corner_radius_mm, double length_mm);
+  static Tool flat(double radius_mm, double length_mm);
+  static Tool fromMesh(ToolMesh mesh);
+};
+
+enum class Backend { Auto, Cpu, Cuda };
+/// Fast: per posture, only the lines under the tool (analytic envelope, or the line in the tool
+/// frame through a BVH of the mesh) plus conservative culling. Coarse: SIMSURF1's algorithm (one
+/// work item per posture, every triangle transformed and rasterised), kept as the benchmark peer.
+enum class Engine { Fast, Coarse };
+
+const char* backendName(Backend backend);
+/// True if a CUDA device can be used (built with CUDA and cudaGetDeviceCount succeeds with >= 1).
+bool cudaAvailable();
+
+/// Supplies postures block by block: fills `out` from the front and returns how many it wrote;
+/// 0 ends the stream. Lets 27 million postures pass through a fixed buffer.
+using PostureSource = std::function<std::size_t(std::span<Posture> out)>;
+
+struct SimulationRequest {
+  Grid grid;
+  Tool tool;
+  /// Initial heights (mm), row-major ny × nx; empty → every line starts at stock_mm.
+  std::vector<float> initial_heights_mm;
+  float stock_mm = 0.f;
+  Backend backend = Backend::Auto;
+  Engine engine = Engine::Fast;
+  std::size_t block_postures = std::size_t{1} << 20;  ///< postures per streamed block
+  common::Progress progress;  ///< fraction is postures done / expected_postures (if known)
+  std::size_t expected_postures = 0;
+};
+
+struct SimulationResult {
+  std::vector<float> heights_mm;   ///< ny × nx, row = iy
+  Backend backend = Backend::Cpu;  ///< the one that ran
+  std::size_t postures = 0;
+  std::size_t postures_culled = 0;  ///< Fast engine: skipped by the footprint/height test
+  std::size_t lines_lowered = 0;    ///< lines below their initial height at the end
+  double seconds = 0;               ///< simulation proper (upload + kernels + download)
+};
+
+/// Runs the simulation over every posture of `source`. Throws common::InputError for an invalid
+/// grid or tool, or Backend::Cuda without a device; common::Interrupted if progress says stop.
+SimulationResult simulate(const SimulationRequest& request, const PostureSource& source);
+/// Convenience: all postures from memory.
+SimulationResult simulate(const SimulationRequest& request, std::span<const Posture> postures);
+
+/// Bytes the simulation of `grid` needs on the host (heights, initial copy, tiles, outputs).
+std::size_t estimateHostBytes(const Grid& grid);
+/// Throws common::InputError with the estimate if the grid cannot fit in `available_bytes`
+/// (default: half the physical memory).
+void checkGridFits(const Grid& grid, std::size_t available_bytes = 0);
+
+/// Stock as the top of a part mesh (world frame, mm): the highest up-facing point on each line;
+/// lines that miss the part start at its lowest z.
+std::vector<float> stockFromPart(const Grid& grid, std::span<const Vec3f> vertices,
+                                 std::span<const std::array<std::uint32_t, 3>> triangles);
+
+namespace detail {
+
+/// Flattened tool data shared by the backends (leaf-ordered BVH triangles, nodes, indices).
+struct ToolData {
+  ToolView view;  ///< pointers into the vectors below (host copies)
+  std::vector<float> bvh_triangles;
+  std::vector<BvhNode> bvh_nodes;
+  std::vector<Vec3f> vertices;
+  std::vector<std::uint32_t> indices;
+};
+ToolData prepareTool(const Tool& tool);
+GridView makeGridView(const Grid& grid);
+
+/// A backend: keeps the heights between blocks. The CPU and CUDA engines implement the same calls.
+class BackendEngine {
+ public:
+  virtual ~BackendEngine() = default;
+  /// Lowers the heights by every posture of the block; returns how many postures were culled.
+  virtual std::size_t cut(std::span<const Posture> block, Engine engine) = 0;
+  virtual std::vector<float> heights() = 0;
+};
+std::unique_ptr<BackendEngine> makeCpuEngine(const GridView& grid, const ToolData& tool,
+                                             std::vector<float> heights_mm);
+/// Throws std::runtime_error if built without CUDA or no device is present.
+std::unique_ptr<BackendEngine> makeCudaEngine(const GridView& grid, const ToolData& tool,
+                                              std::vector<float> heights_mm);
+
+}  // namespace detail
+}  // namespace fieldpath::zbuffer

@@ -1,0 +1,42 @@
+#pragma once
+/// The CUDA engine behind a C++17 interface (nvcc gets C++17 under CMake 3.25; the public API is
+/// C++20). Wrapped into detail::BackendEngine by cuda_adapter.cpp.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+#include "fieldpath/zbuffer/kernels.h"
+
+namespace fieldpath::zbuffer::cuda {
+
+/// Host arrays of a prepared tool (see detail::ToolData); copied to the device by the engine.
+struct ToolArrays {
+  ToolView view;
+  const BvhNode* nodes = nullptr;
+  std::size_t node_count = 0;
+  const float* triangles = nullptr;  ///< 9 floats per triangle
+  std::size_t triangle_floats = 0;
+  const Vec3f* vertices = nullptr;
+  std::size_t vertex_count = 0;
+  const std::uint32_t* indices = nullptr;
+  std::size_t index_count = 0;
+};
+
+bool available();
+
+class Engine {
+ public:
+  Engine(const GridView& grid, const ToolArrays& tool, const float* heights_mm, std::size_t lines);
+  ~Engine();
+  Engine(const Engine&) = delete;
+  Engine& operator=(const Engine&) = delete;
+  /// Lowers the heights by `count` postures; returns how many were culled (fast engine).
+  std::size_t cut(const Posture* postures, std::size_t count, bool coarse);
+  void heights(float* out_mm) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fieldpath::zbuffer::cuda

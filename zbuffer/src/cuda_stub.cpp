@@ -1,0 +1,16 @@
+/// Built when CUDA is not: the CUDA backend reports itself absent.
+#include <stdexcept>
+
+#include "fieldpath/zbuffer/simulator.h"
+
+namespace fieldpath::zbuffer {
+
+bool cudaAvailable() { return false; }
+
+namespace detail {
+std::unique_ptr<BackendEngine> makeCudaEngine(const GridView&, const ToolData&,
+                                              std::vector<float>) {
+  throw std::runtime_error("fieldpath was built without the CUDA backend");
+}
+}  // namespace detail
+}  // namespace fieldpath::zbuffer

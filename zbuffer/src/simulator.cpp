@@ -1,0 +1,311 @@
+#include "fieldpath/zbuffer/simulator.h"
+
+#include <unistd.h>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "fieldpath/common/errors.h"
+
+namespace fieldpath::zbuffer {
+
+using common::InputError;
+
+Grid Grid::fromRegion(double x0_mm, double y0_mm, double x1_mm, double y1_mm, int nx, int ny) {
+  if (!std::isfinite(x0_mm) || !std::isfinite(y0_mm) || !std::isfinite(x1_mm) ||
+      !std::isfinite(y1_mm))
+    throw InputError("region: non-finite coordinate");
+  if (!(x1_mm > x0_mm) || !(y1_mm > y0_mm))
+    throw InputError("region: zero or negative area (need x0 < x1 and y0 < y1)");
+  if (nx <= 0 || ny <= 0)
+    throw InputError("grid: " + std::to_string(nx) + "x" + std::to_string(ny) +
+                     " has no lines (need >= 1 in each direction)");
+  Grid g;
+  g.x0_mm = x0_mm;
+  g.y0_mm = y0_mm;
+  g.nx = nx;
+  g.ny = ny;
+  g.dx_mm = (x1_mm - x0_mm) / nx;
+  g.dy_mm = (y1_mm - y0_mm) / ny;
+  return g;
+}
+
+namespace {
+void requireDims(bool ok, const char* what) {
+  if (!ok) throw InputError(std::string("tool: ") + what);
+}
+}  // namespace
+
+Tool Tool::ball(double radius_mm, double length_mm) {
+  requireDims(std::isfinite(radius_mm) && radius_mm > 0, "ball radius must be finite and > 0");
+  requireDims(std::isfinite(length_mm) && length_mm >= radius_mm,
+              "length must be >= the ball radius");
+  return Tool{ToolKind::Ball, float(radius_mm), float(radius_mm), float(length_mm), {}};
+}
+Tool Tool::torus(double radius_mm, double corner_radius_mm, double length_mm) {
+  requireDims(std::isfinite(radius_mm) && radius_mm > 0, "torus radius must be finite and > 0");
+  requireDims(
+      std::isfinite(corner_radius_mm) && corner_radius_mm > 0 && corner_radius_mm <= radius_mm,
+      "torus corner radius must be in (0, R]");
+  requireDims(std::isfinite(length_mm) && length_mm >= corner_radius_mm,
+              "length must be >= the corner radius");
+  return Tool{ToolKind::Torus, float(radius_mm), float(corner_radius_mm), float(length_mm), {}};
+}
+Tool Tool::flat(double radius_mm, double length_mm) {
+  requireDims(std::isfinite(radius_mm) && radius_mm > 0, "flat radius must be finite and > 0");
+  requireDims(std::isfinite(length_mm) && length_mm > 0, "length must be > 0");
+  return Tool{ToolKind::Flat, float(radius_mm), 0.f, float(length_mm), {}};
+}
+Tool Tool::fromMesh(ToolMesh mesh) {
+  requireDims(!mesh.triangles.empty(), "mesh has no triangles");
+  for (const auto& v : mesh.vertices)
+    requireDims(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z),
+                "mesh has a non-finite vertex");
+  for (const auto& t : mesh.triangles)
+    for (auto i : t) requireDims(i < mesh.vertices.size(), "mesh triangle index out of range");
+  Tool tool;
+  tool.kind = ToolKind::Mesh;
+  tool.mesh = std::move(mesh);
+  return tool;
+}
+
+const char* backendName(Backend backend) {
+  switch (backend) {
+    case Backend::Auto:
+      return "auto";
+    case Backend::Cpu:
+      return "cpu";
+    case Backend::Cuda:
+      return "cuda";
+  }
+  return "?";
+}
+
+namespace detail {
+
+GridView makeGridView(const Grid& grid) {
+  GridView g;
+  g.x0_mm = grid.x0_mm;
+  g.y0_mm = grid.y0_mm;
+  g.dx_mm = grid.dx_mm;
+  g.dy_mm = grid.dy_mm;
+  g.nx = grid.nx;
+  g.ny = grid.ny;
+  g.tile_shift = 4;
+  g.tiles_x = (grid.nx + 15) >> 4;
+  g.tiles_y = (grid.ny + 15) >> 4;
+  return g;
+}
+
+namespace {
+
+struct Box {
+  float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX};
+  float hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+  void add(Vec3f p) {
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], comp(p, k));
+      hi[k] = std::max(hi[k], comp(p, k));
+    }
+  }
+};
+
+/// Median-split BVH over triangle centroids, leaves of <= 4 triangles, depth-first layout.
+struct BvhBuilder {
+  const ToolMesh& mesh;
+  std::vector<std::uint32_t> order;
+  std::vector<Vec3f> centroid;
+  std::vector<BvhNode> nodes;
+  float pad;
+
+  int build(std::size_t begin, std::size_t end) {
+    Box box, cbox;
+    for (std::size_t i = begin; i < end; ++i) {
+      for (auto v : mesh.triangles[order[i]]) box.add(mesh.vertices[v]);
+      cbox.add(centroid[order[i]]);
+    }
+    const int index = static_cast<int>(nodes.size());
+    BvhNode node{};
+    for (int k = 0; k < 3; ++k) {
+      node.lo[k] = box.lo[k] - pad;
+      node.hi[k] = box.hi[k] + pad;
+    }
+    nodes.push_back(node);
+    if (end - begin <= 4) {
+      nodes[index].first = static_cast<std::int32_t>(begin);
+      nodes[index].count = static_cast<std::int32_t>(end - begin);
+      return index;
+    }
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (cbox.hi[k] - cbox.lo[k] > cbox.hi[axis] - cbox.lo[axis]) axis = k;
+    const std::size_t mid = (begin + end) / 2;
+    std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
+                     [&](std::uint32_t a, std::uint32_t b) {
+                       return comp(centroid[a], axis) < comp(centroid[b], axis);
+                     });
+    build(begin, mid);
+    const int right = build(mid, end);
+    nodes[index].first = right;
+    nodes[index].count = 0;
+    return index;
+  }
+};
+
+}  // namespace
+
+ToolData prepareTool(const Tool& tool) {
+  ToolData data;
+  ToolView& v = data.view;
+  v.kind = tool.kind;
+  v.radius_mm = tool.radius_mm;
+  v.corner_radius_mm = tool.corner_radius_mm;
+  v.length_mm = tool.length_mm;
+  if (tool.kind != ToolKind::Mesh) {
+    v.hull_radius_mm = tool.radius_mm;
+    v.hull_zmin_mm = 0.f;
+    v.hull_zmax_mm = tool.length_mm;
+    return data;
+  }
+  const ToolMesh& mesh = tool.mesh;
+  if (mesh.triangles.empty()) throw InputError("tool: mesh has no triangles");
+  Box all;
+  float hull_r = 0.f;
+  for (const auto& p : mesh.vertices) {
+    all.add(p);
+    hull_r = std::max(hull_r, std::sqrt(p.x * p.x + p.y * p.y));
+  }
+  const float size =
+      std::max({all.hi[0] - all.lo[0], all.hi[1] - all.lo[1], all.hi[2] - all.lo[2], 1e-3f});
+  v.hull_radius_mm = hull_r * (1.f + 1e-6f) + 1e-6f * size;
+  v.hull_zmin_mm = all.lo[2];
+  v.hull_zmax_mm = all.hi[2];
+
+  BvhBuilder b{mesh, {}, {}, {}, 1e-5f * size};
+  b.order.resize(mesh.triangles.size());
+  std::iota(b.order.begin(), b.order.end(), 0u);
+  b.centroid.reserve(mesh.triangles.size());
+  for (const auto& t : mesh.triangles) {
+    const Vec3f c = mesh.vertices[t[0]] + mesh.vertices[t[1]] + mesh.vertices[t[2]];
+    b.centroid.push_back((1.f / 3.f) * c);
+  }
+  b.build(0, mesh.triangles.size());
+  data.bvh_nodes = std::move(b.nodes);
+  data.bvh_triangles.reserve(9 * mesh.triangles.size());
+  for (auto t : b.order)
+    for (auto vi : mesh.triangles[t]) {
+      const Vec3f p = mesh.vertices[vi];
+      data.bvh_triangles.insert(data.bvh_triangles.end(), {p.x, p.y, p.z});
+    }
+  data.vertices = mesh.vertices;
+  for (const auto& t : mesh.triangles) data.indices.insert(data.indices.end(), t.begin(), t.end());
+  v.bvh_nodes = data.bvh_nodes.data();
+  v.bvh_triangles = data.bvh_triangles.data();
+  v.vertices = data.vertices.data();
+  v.indices = data.indices.data();
+  v.triangle_count = static_cast<std::int32_t>(mesh.triangles.size());
+  return data;
+}
+
+}  // namespace detail
+
+std::size_t estimateHostBytes(const Grid& grid) {
+  // heights + initial copy (float each), culling tiles, and the outputs (STL/PNG are decimated).
+  const double lines = double(grid.nx) * double(grid.ny);
+  return static_cast<std::size_t>(std::min(lines * 12.0 + 64.0 * 1024 * 1024, 1e19));
+}
+
+void checkGridFits(const Grid& grid, std::size_t available_bytes) {
+  if (available_bytes == 0) {
+    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    available_bytes =
+        pages > 0 && page > 0 ? std::size_t(pages) * std::size_t(page) / 2 : (std::size_t{4} << 30);
+  }
+  const std::size_t need = estimateHostBytes(grid);
+  if (need > available_bytes || grid.lineCount() > (std::size_t{1} << 31)) {
+    std::ostringstream os;
+    os << "grid " << grid.nx << "x" << grid.ny << " is too large: it needs about "
+       << need / (1 << 20) << " MiB of memory, " << available_bytes / (1 << 20)
+       << " MiB available (and at most 2^31 lines)";
+    throw InputError(os.str());
+  }
+}
+
+std::vector<float> stockFromPart(const Grid& grid, std::span<const Vec3f> vertices,
+                                 std::span<const std::array<std::uint32_t, 3>> triangles) {
+  if (triangles.empty()) throw InputError("part: mesh has no triangles");
+  float zmin = FLT_MAX;
+  for (const auto& v : vertices) zmin = std::min(zmin, v.z);
+  const GridView g = detail::makeGridView(grid);
+  std::vector<float> top(grid.lineCount(), -FLT_MAX);
+  for (const auto& t : triangles) {
+    if (t[0] >= vertices.size() || t[1] >= vertices.size() || t[2] >= vertices.size())
+      throw InputError("part: triangle index out of range");
+    rasterTriangle(g, vertices[t[0]], vertices[t[1]], vertices[t[2]], 1.f,
+                   [&](int ix, int iy, float z) {
+                     float& h = top[std::size_t(iy) * grid.nx + ix];
+                     h = std::max(h, z);
+                   });
+  }
+  for (auto& h : top)
+    if (h == -FLT_MAX) h = zmin;
+  return top;
+}
+
+SimulationResult simulate(const SimulationRequest& request, const PostureSource& source) {
+  const Grid& grid = request.grid;
+  if (grid.nx <= 0 || grid.ny <= 0) throw InputError("grid: no lines");
+  checkGridFits(grid);
+  if (!request.initial_heights_mm.empty() && request.initial_heights_mm.size() != grid.lineCount())
+    throw InputError("initial heights: size does not match the grid");
+  if (request.engine == Engine::Coarse && request.tool.kind != ToolKind::Mesh)
+    throw InputError("the coarse engine needs a mesh tool");
+  Backend backend = request.backend;
+  if (backend == Backend::Auto) backend = cudaAvailable() ? Backend::Cuda : Backend::Cpu;
+  if (backend == Backend::Cuda && !cudaAvailable())
+    throw InputError("backend cuda: no CUDA device available (built without CUDA or no GPU)");
+
+  const detail::ToolData tool = detail::prepareTool(request.tool);
+  const GridView g = detail::makeGridView(grid);
+  std::vector<float> initial = request.initial_heights_mm;
+  if (initial.empty()) initial.assign(grid.lineCount(), request.stock_mm);
+
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<detail::BackendEngine> engine = backend == Backend::Cuda
+                                                      ? detail::makeCudaEngine(g, tool, initial)
+                                                      : detail::makeCpuEngine(g, tool, initial);
+  SimulationResult result;
+  result.backend = backend;
+  std::vector<Posture> block(std::max<std::size_t>(1, request.block_postures));
+  for (;;) {
+    const std::size_t n = source(std::span<Posture>(block));
+    if (n == 0) break;
+    result.postures_culled += engine->cut(
+        std::span<const Posture>(block.data(), std::min(n, block.size())), request.engine);
+    result.postures += n;
+    const double total = double(std::max(request.expected_postures, result.postures));
+    common::report(request.progress, double(result.postures) / total, "simulate");
+  }
+  result.heights_mm = engine->heights();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (std::size_t i = 0; i < initial.size(); ++i)
+    result.lines_lowered += result.heights_mm[i] < initial[i];
+  common::report(request.progress, 1.0, "simulate");
+  return result;
+}
+
+SimulationResult simulate(const SimulationRequest& request, std::span<const Posture> postures) {
+  std::size_t next = 0;
+  SimulationRequest req = request;
+  if (req.expected_postures == 0) req.expected_postures = postures.size();
+  return simulate(req, [&](std::span<Posture> out) {
+    const std::size_t n = std::min(out.size(), postures.size() - next);
+    std::copy_n(postures.begin() + next, n, out.begin());
+    next += n;
+    return n;
+  });
+}
+
+}  // namespace fieldpath::zbuffer
