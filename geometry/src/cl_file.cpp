@@ -43,16 +43,14 @@ std::string quoted(std::string_view token) {
   return s + (token.size() > 32 ? "...'" : "'");
 }
 
-/// Parses a whole token as a finite double; nullopt-like via the bool.
-bool parseNumber(std::string_view token, double& value) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-  return ec == std::errc() && end == token.data() + token.size();
-}
-
+/// Parses a whole token (an optional leading '+' allowed) as a finite double.
 double parseFinite(std::string_view token, const std::filesystem::path& file, std::size_t line) {
-  double value;
-  if (!parseNumber(token, value)) fail(file, line, quoted(token) + " is not a number");
+  std::string_view digits = token;
+  if (!digits.empty() && digits.front() == '+') digits.remove_prefix(1);
+  double value = 0;
+  const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+  if (ec == std::errc::result_out_of_range) fail(file, line, quoted(token) + " is out of range");
+  if (ec != std::errc() || end != digits.data() + digits.size()) fail(file, line, quoted(token) + " is not a number");
   if (!std::isfinite(value)) fail(file, line, quoted(token) + " is not finite");
   return value;
 }

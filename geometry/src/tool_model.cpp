@@ -236,8 +236,10 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
   const Profile profile = fullProfile(tool, holder);
 
   // A triangle spanning a profile step and a circumferential step deviates from the surface by
-  // about the sum of both sagittas (to leading order), so each gets under half the tolerance.
-  const double sagitta_mm = 0.45 * chord_tol_mm;
+  // about the sum of both sagittas (to leading order), so with arcs in the profile each gets under
+  // half the tolerance; straight profiles (cylinders, cones, planes) have only the circumferential one.
+  const bool has_arcs = std::any_of(profile.begin(), profile.end(), [](const ProfileSegment& s) { return s.is_arc; });
+  const double sagitta_mm = (has_arcs ? 0.45 : 0.9) * chord_tol_mm;
   double max_rho_mm = 0;
   for (const auto& s : profile) max_rho_mm = std::max({max_rho_mm, s.from.x(), s.to.x()});
   const int sectors = std::max(8, static_cast<int>(std::ceil(2 * kPi / angularStep(max_rho_mm, sagitta_mm))));

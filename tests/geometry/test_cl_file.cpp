@@ -104,6 +104,7 @@ TEST(ClFile, MalformedLinesNameTheLine) {
   expectClError("1 2 3 0 0 1\n\xff\xfe\x01garbage 2 3 0 0 1\n", 2, "not a number");
   expectClError("1 2 3 0 0 1\n1 2 3 0 0 1 0 9\n", 2, "too many columns");
   expectClError("1 2 3 0 0 1x\n", 1, "not a number");
+  expectClError("1 2 3 0 0 1\n1 2 1e999 0 0 1\n", 2, "out of range");
   expectClError("1,2,3,0,0,1\n", 1, "short line");
 }
 

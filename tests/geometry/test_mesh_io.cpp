@@ -68,6 +68,29 @@ TEST(MeshIo, AsciiStlClosedForm) {
   EXPECT_NEAR(meshVolume(m), 1.0 / 6.0, 1e-12);
 }
 
+TEST(MeshIo, AsciiPlyAndObjWithQuadsClosedForm) {
+  // Unit cube as six quads: split into 12 triangles, 8 vertices, volume 1.
+  const char* quads = "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+  std::string obj, ply = "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
+                         "property float z\nelement face 6\nproperty list uchar int vertex_indices\nend_header\n";
+  for (int i = 0; i < 8; ++i) {
+    const std::string v = std::to_string(i & 1) + " " + std::to_string((i >> 1) & 1) + " " + std::to_string((i >> 2) & 1);
+    obj += "v " + v + "\n";
+    ply += v + "\n";
+  }
+  obj += quads;
+  for (std::string_view line : {"0 2 3 1", "4 5 7 6", "0 1 5 4", "2 6 7 3", "0 4 6 2", "1 3 7 5"})
+    ply += "4 " + std::string(line) + "\n";
+  for (const auto& [name, text] : {std::pair{"cube.obj", obj}, std::pair{"cube.ply", ply}}) {
+    const TriangleMesh m = loadMesh(writeBytes(name, text));
+    EXPECT_EQ(m.vertices.size(), 8u) << name;
+    EXPECT_EQ(m.triangles.size(), 12u) << name;
+    EXPECT_TRUE(validateMesh(m).closed()) << name << ": " << validateMesh(m).summary();
+    EXPECT_NEAR(meshVolume(m), 1.0, 1e-12) << name;
+    EXPECT_NEAR(meshArea(m), 6.0, 1e-12) << name;
+  }
+}
+
 TEST(MeshIo, RoundTripsStlObjPly) {
   const TriangleMesh tool = toolMesh(parseToolSpec("torus:5:1:20"), parseHolderProfile("20:8,35:8"), 0.01);
   for (const char* ext : {".stl", ".obj", ".ply", ".STL"}) {

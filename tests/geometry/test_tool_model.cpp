@@ -90,13 +90,17 @@ TEST(ToolModel, MeshesAreClosedAndWithinTolerance) {
       const MeshReport report = validateMesh(mesh);
       ASSERT_TRUE(report.closed()) << report.summary();
 
-      // Vertices on the surface; centroids and edge midpoints within the tolerance.
+      // Vertices on the surface; every point of a barycentric grid (centroid and edge midpoints
+      // included) within the tolerance.
       double max_vertex_mm = 0, max_interior_mm = 0;
       for (const auto& v : mesh.vertices) max_vertex_mm = std::max(max_vertex_mm, toolSurfaceDistance(tool, v));
       for (const auto& t : mesh.triangles) {
         const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
-        for (const Vec3& p : {Vec3((a + b + c) / 3), Vec3((a + b) / 2), Vec3((b + c) / 2), Vec3((c + a) / 2)})
-          max_interior_mm = std::max(max_interior_mm, toolSurfaceDistance(tool, p));
+        max_interior_mm = std::max(max_interior_mm, toolSurfaceDistance(tool, (a + b + c) / 3));
+        constexpr int n = 4;
+        for (int i = 0; i <= n; ++i)
+          for (int j = 0; i + j <= n; ++j)
+            max_interior_mm = std::max(max_interior_mm, toolSurfaceDistance(tool, a + (i * (b - a) + j * (c - a)) / n));
       }
       EXPECT_LT(max_vertex_mm, 1e-12);
       EXPECT_LE(max_interior_mm, tol);
