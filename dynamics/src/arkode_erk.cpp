@@ -13,12 +13,12 @@ namespace {
 class ArkodeErk final : public Integrator {
  public:
   ArkodeErk(OdeSystem& system, int size, double t0, const double* y0, const IntegratorSettings& settings)
-      : Integrator(system, size, y0) {
+      : Integrator(system, size, y0, settings.atol) {
     mem_.reset(ERKStepCreate(rhsTrampoline, t0, y_, ctx_));
     FIELDPATH_SUNDIALS_NOT_NULL(mem_, "ERKStepCreate");
     void* mem = mem_.get();
     FIELDPATH_SUNDIALS_CHECK(ERKStepSetErrHandlerFn(mem, keepErrorMessage, &last_error_));
-    FIELDPATH_SUNDIALS_CHECK(ERKStepSStolerances(mem, settings.rtol, settings.atol));
+    FIELDPATH_SUNDIALS_CHECK(ERKStepSVtolerances(mem, settings.rtol, atol_));
     FIELDPATH_SUNDIALS_CHECK(ERKStepSetUserData(mem, &system_));
     FIELDPATH_SUNDIALS_CHECK(ERKStepSetMaxNumSteps(mem, settings.max_steps));
     if (settings.max_step_s > 0.0) FIELDPATH_SUNDIALS_CHECK(ERKStepSetMaxStep(mem, settings.max_step_s));

@@ -21,13 +21,13 @@ struct LinearSolverDeleter {
 class CvodeBdf final : public Integrator {
  public:
   CvodeBdf(OdeSystem& system, int size, double t0, const double* y0, const IntegratorSettings& settings)
-      : Integrator(system, size, y0) {
+      : Integrator(system, size, y0, settings.atol) {
     mem_.reset(CVodeCreate(CV_BDF, ctx_));
     FIELDPATH_SUNDIALS_NOT_NULL(mem_, "CVodeCreate");
     void* mem = mem_.get();
     FIELDPATH_SUNDIALS_CHECK(CVodeSetErrHandlerFn(mem, keepErrorMessage, &last_error_));
     FIELDPATH_SUNDIALS_CHECK(CVodeInit(mem, rhsTrampoline, t0, y_));
-    FIELDPATH_SUNDIALS_CHECK(CVodeSStolerances(mem, settings.rtol, settings.atol));
+    FIELDPATH_SUNDIALS_CHECK(CVodeSVtolerances(mem, settings.rtol, atol_));
     FIELDPATH_SUNDIALS_CHECK(CVodeSetUserData(mem, &system_));
     matrix_.reset(SUNDenseMatrix(size, size, ctx_));
     FIELDPATH_SUNDIALS_NOT_NULL(matrix_, "SUNDenseMatrix");

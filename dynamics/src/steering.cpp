@@ -209,6 +209,24 @@ AxisMoment axisMoment(const field::ForceField& field, std::span<const Vec3> node
                        lead_rad, tilt_rad, nodes_mm, forces);
 }
 
+Eigen::Matrix2d fieldStiffness(const field::ForceField& field, std::span<const Vec3> nodes_tool_frame_mm,
+                               double ball_radius_mm, const LocalFrame& frame, const Vec3& centre_mm,
+                               double lead_rad, double tilt_rad, double delta_rad) {
+  const std::vector<Vec3> offsets = offsetsFromCentre(nodes_tool_frame_mm, ball_radius_mm);
+  std::vector<Vec3> nodes_mm, forces;
+  Eigen::Matrix2d k;
+  for (int column = 0; column < 2; ++column) {
+    const double dl = column == 0 ? delta_rad : 0.0, dt = column == 1 ? delta_rad : 0.0;
+    const AxisMoment plus =
+        momentOfNodes(field, offsets, frame, centre_mm, lead_rad + dl, tilt_rad + dt, nodes_mm, forces);
+    const AxisMoment minus =
+        momentOfNodes(field, offsets, frame, centre_mm, lead_rad - dl, tilt_rad - dt, nodes_mm, forces);
+    k(0, column) = -(plus.lead_torque - minus.lead_torque) / (2.0 * delta_rad);
+    k(1, column) = -(plus.tilt_torque - minus.tilt_torque) / (2.0 * delta_rad);
+  }
+  return k;
+}
+
 SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
   validate(pass, request);
   SteeringSystem system(pass, request);
@@ -223,7 +241,13 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
 
   detail::IntegratorSettings settings;
   settings.rtol = request.params.rtol;
-  settings.atol = request.params.atol;
+  // Angles get atol (rad); rates atol · ω (rad/s), ω the spring's natural frequency sqrt(k/J) or,
+  // if slower, one output interval: a rate tolerance on the angle tolerance's scale. One atol for
+  // both would be far below the rounding noise of the rates when k/J is large (stiff cases).
+  const double rate_scale_per_s = std::max(std::sqrt(request.params.stiffness / request.params.inertia),
+                                           v / request.step_mm);
+  const double atol = request.params.atol;
+  settings.atol = {atol, atol, atol * rate_scale_per_s, atol * rate_scale_per_s};
   settings.max_step_s = request.step_mm / v;  // never step over a feature longer than one output step
   settings.max_steps = request.max_steps_per_output;
   std::unique_ptr<detail::Integrator> integrator =

@@ -40,8 +40,11 @@ void keepErrorMessage(int /*error_code*/, const char* module, const char* functi
   *static_cast<std::string*>(eh_data) = std::string(module) + "/" + function + ": " + msg;
 }
 
-Integrator::Integrator(OdeSystem& system, int size, const double* y0) : system_(system), y_(size, ctx_) {
+Integrator::Integrator(OdeSystem& system, int size, const double* y0, const std::vector<double>& atol)
+    : system_(system), y_(size, ctx_), atol_(size, ctx_) {
   std::copy_n(y0, size, y_.data());
+  if (atol.size() != static_cast<std::size_t>(size)) throw std::logic_error("atol: one value per component");
+  std::copy_n(atol.data(), size, atol_.data());
 }
 
 int Integrator::advance(double t_out, double* y) {

@@ -5,6 +5,7 @@
 #include <exception>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
@@ -95,7 +96,7 @@ class Integrator {
   const std::string& lastError() const { return last_error_; }
 
  protected:
-  Integrator(OdeSystem& system, int size, const double* y0);
+  Integrator(OdeSystem& system, int size, const double* y0, const std::vector<double>& atol);
   virtual int evolve(double t_out) = 0;          ///< one CVode / ERKStepEvolve call on y_
   virtual void reinit(double t) = 0;             ///< from y_; resets the solver's own counters
   virtual SolverStats counters() const = 0;      ///< since the last (re)initialisation
@@ -103,6 +104,7 @@ class Integrator {
   OdeSystem& system_;
   Context ctx_;  ///< declared before every object created in it
   Vector y_;
+  Vector atol_;  ///< absolute tolerance per component
   std::string last_error_;
 
  private:
@@ -119,7 +121,8 @@ struct FreeByAddress {
 };
 
 struct IntegratorSettings {
-  double rtol = 1e-6, atol = 1e-9;
+  double rtol = 1e-6;
+  std::vector<double> atol;  ///< per component (angles in rad, rates in rad/s)
   double max_step_s = 0.0;  ///< 0 = unlimited; set to the output interval so no feature is stepped over
   long max_steps = 500;     ///< per advance() call
 };

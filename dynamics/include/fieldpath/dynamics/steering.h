@@ -47,7 +47,9 @@ struct SteeringRequest {
   double initial_tilt_rate_rad_per_s = 0.0;
   LimitPolicy on_limit = LimitPolicy::Report;
   double max_angle_change_deg_per_mm = 0.0;  ///< between output samples, either angle; 0 = unchecked
-  long max_steps_per_output = 500;           ///< solver step budget per output interval
+  /// Solver step budget per output interval. BDF needs a few hundred to resolve a stiff start at
+  /// tight tolerances; ERK runs out of it when stability, not accuracy, limits its step.
+  long max_steps_per_output = 5000;
   /// Optional: distance (mm) from the placed nodes (world frame) to the obstacles, stored in each
   /// sample (pathgen passes an FCL or point query). NaN in the samples when unset.
   std::function<double(std::span<const Vec3> nodes_world_mm)> clearance;
@@ -105,5 +107,13 @@ struct AxisMoment {
 AxisMoment axisMoment(const field::ForceField& field, std::span<const Vec3> nodes_tool_frame_mm,
                       double ball_radius_mm, const LocalFrame& frame, const Vec3& centre_mm,
                       double lead_rad, double tilt_rad);
+
+/// The field's own angular stiffness K = -∂τ/∂θ (2×2, rows/columns lead, tilt; torque per rad) at
+/// one pose, by central differences of axisMoment (step `delta_rad`). Near a wall K adds to the spring:
+/// the default "critical" c = 2·sqrt(k·J) is then underdamped (a step in a wall overshoots); a
+/// damping of 2·sqrt((k + K_tilt,tilt)·J) for the stiffest expected pose keeps the response critical.
+Eigen::Matrix2d fieldStiffness(const field::ForceField& field, std::span<const Vec3> nodes_tool_frame_mm,
+                               double ball_radius_mm, const LocalFrame& frame, const Vec3& centre_mm,
+                               double lead_rad, double tilt_rad, double delta_rad = 1e-4);
 
 }  // namespace fieldpath::dynamics
