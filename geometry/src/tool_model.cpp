@@ -240,9 +240,6 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
   // half the tolerance; straight profiles (cylinders, cones, planes) have only the circumferential one.
   const bool has_arcs = std::any_of(profile.begin(), profile.end(), [](const ProfileSegment& s) { return s.is_arc; });
   const double sagitta_mm = (has_arcs ? 0.45 : 0.9) * chord_tol_mm;
-  double max_rho_mm = 0;
-  for (const auto& s : profile) max_rho_mm = std::max({max_rho_mm, s.from.x(), s.to.x()});
-  const int sectors = std::max(8, static_cast<int>(std::ceil(2 * kPi / angularStep(max_rho_mm, sagitta_mm))));
 
   // Profile points from the tip to the top; arcs subdivided, straight pieces left whole.
   std::vector<Vec2> points{profile.front().from};
@@ -253,29 +250,44 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
     for (int i = 1; i <= pieces; ++i) points.push_back(s.at(static_cast<double>(i) / pieces));
   }
 
+  // One ring of vertices per profile point, vertex j at angle 2πj/N. A ring's N keeps the chord
+  // sagitta within budget at the largest radius of the ring and its neighbours, so the triangles
+  // on either side of it do too; rings on the axis are one vertex. Smaller rings get fewer
+  // vertices, which keeps the triangles near the tip well shaped.
+  const std::size_t count = points.size();
+  std::vector<int> first(count), sectors(count);
   TriangleMesh mesh;
-  std::vector<double> cos_j(sectors), sin_j(sectors);
-  for (int j = 0; j < sectors; ++j) {
-    cos_j[j] = std::cos(2 * kPi * j / sectors);
-    sin_j[j] = std::sin(2 * kPi * j / sectors);
-  }
-  // ring[k] = first vertex index of profile point k; on the axis a ring is a single vertex.
-  std::vector<int> ring(points.size());
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    ring[k] = static_cast<int>(mesh.vertices.size());
-    const Vec2& q = points[k];
-    if (q.x() == 0.0) {
-      mesh.vertices.emplace_back(0.0, 0.0, q.y());
-    } else {
-      for (int j = 0; j < sectors; ++j) mesh.vertices.emplace_back(q.x() * cos_j[j], q.x() * sin_j[j], q.y());
+  for (std::size_t k = 0; k < count; ++k) {
+    first[k] = static_cast<int>(mesh.vertices.size());
+    const double rho_mm = points[k].x(), z_mm = points[k].y();
+    if (rho_mm == 0.0) {
+      sectors[k] = 1;
+      mesh.vertices.emplace_back(0.0, 0.0, z_mm);
+      continue;
+    }
+    const double widest_mm = std::max({rho_mm, points[k - 1].x(), points[k + 1].x()});
+    sectors[k] = std::max(8, static_cast<int>(std::ceil(2 * kPi / angularStep(widest_mm, sagitta_mm))));
+    for (int j = 0; j < sectors[k]; ++j) {
+      const double a = 2 * kPi * j / sectors[k];
+      mesh.vertices.emplace_back(rho_mm * std::cos(a), rho_mm * std::sin(a), z_mm);
     }
   }
-  const auto vertex = [&](std::size_t k, int j) { return points[k].x() == 0.0 ? ring[k] : ring[k] + j % sectors; };
-  for (std::size_t k = 0; k + 1 < points.size(); ++k) {
-    for (int j = 0; j < sectors; ++j) {
-      const int a = vertex(k, j), b = vertex(k, j + 1), c = vertex(k + 1, j + 1), d = vertex(k + 1, j);
-      if (a != b) mesh.triangles.emplace_back(a, b, c);  // lower edge not collapsed on the axis
-      if (c != d) mesh.triangles.emplace_back(a, c, d);  // upper edge not collapsed on the axis
+  // Zip neighbouring rings together by angle: advance on the ring whose next vertex comes first.
+  // Outward orientation: the profile runs upwards with the solid on its left.
+  for (std::size_t k = 0; k + 1 < count; ++k) {
+    const int n_lo = sectors[k], n_hi = sectors[k + 1];
+    const auto lo = [&](int i) { return first[k] + i % n_lo; };
+    const auto hi = [&](int j) { return first[k + 1] + j % n_hi; };
+    for (int i = 0, j = 0; i < n_lo || j < n_hi;) {
+      // next lower angle 2π(i+1)/n_lo <= next upper angle 2π(j+1)/n_hi, compared exactly
+      const bool advance_lo = i < n_lo && (j == n_hi || static_cast<long>(i + 1) * n_hi <= static_cast<long>(j + 1) * n_lo);
+      if (advance_lo) {
+        if (n_lo > 1) mesh.triangles.emplace_back(lo(i), lo(i + 1), hi(j));
+        ++i;
+      } else {
+        if (n_hi > 1) mesh.triangles.emplace_back(lo(i), hi(j + 1), hi(j));
+        ++j;
+      }
     }
   }
   return mesh;
@@ -315,7 +327,11 @@ std::vector<SurfaceNode> surfaceNodes(const ToolSpec& tool, const HolderProfile&
 }
 
 double toolSurfaceDistance(const ToolSpec& tool, const Vec3& point_tool_frame_mm) {
-  const Profile profile = fullProfile(tool, {});
+  return toolSurfaceDistance(tool, {}, point_tool_frame_mm);
+}
+
+double toolSurfaceDistance(const ToolSpec& tool, const HolderProfile& holder, const Vec3& point_tool_frame_mm) {
+  const Profile profile = fullProfile(tool, holder);
   const Vec2 q(std::hypot(point_tool_frame_mm.x(), point_tool_frame_mm.y()), point_tool_frame_mm.z());
   double distance_mm = std::numeric_limits<double>::infinity();
   for (const auto& s : profile) distance_mm = std::min(distance_mm, s.distance(q));

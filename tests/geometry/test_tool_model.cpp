@@ -155,6 +155,27 @@ TEST(ToolModel, HolderJoinsTheToolIntoOneClosedSolid) {
   EXPECT_THROW(toolMesh(tool, parseHolderProfile("30:6,50:6"), 0.01), InputError);  // inside the tool
 }
 
+TEST(ToolModel, HolderMeshesWithinTolerance) {
+  // Steps, a steep cone from a thin neck (rings of very different sizes) and a narrowing top.
+  const ToolSpec tool = parseToolSpec("torus:4:1:30");
+  for (const char* text : {"30:6,45:6,45:12,90:12", "30:1,32:1,40:16,60:16,70:5"}) {
+    const HolderProfile holder = parseHolderProfile(text);
+    for (double tol : {0.05, 0.002}) {
+      SCOPED_TRACE(testing::Message() << text << " tol " << tol);
+      const TriangleMesh mesh = toolMesh(tool, holder, tol);
+      EXPECT_TRUE(validateMesh(mesh).closed()) << validateMesh(mesh).summary();
+      double max_mm = 0;
+      for (const auto& v : mesh.vertices) EXPECT_LT(toolSurfaceDistance(tool, holder, v), 1e-12);
+      for (const auto& t : mesh.triangles) {
+        const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+        for (const Vec3& p : {Vec3((a + b + c) / 3), Vec3((a + b) / 2), Vec3((b + c) / 2), Vec3((c + a) / 2)})
+          max_mm = std::max(max_mm, toolSurfaceDistance(tool, holder, p));
+      }
+      EXPECT_LE(max_mm, tol);
+    }
+  }
+}
+
 TEST(ToolModel, BadToleranceIsInputError) {
   for (double tol : {0.0, -1.0, std::nan(""), HUGE_VAL})
     EXPECT_THROW(toolMesh(parseToolSpec("ball:3"), {}, tol), InputError) << tol;
@@ -198,6 +219,7 @@ TEST(ToolModel, HolderNodesAreMarked) {
   const auto nodes = surfaceNodes(tool, parseHolderProfile("40:6,55:6,55:12,90:12"), 1.0);
   std::size_t holder_nodes = 0;
   for (const auto& n : nodes) {
+    EXPECT_LT(toolSurfaceDistance(tool, parseHolderProfile("40:6,55:6,55:12,90:12"), n.position_mm), 1e-12);
     if (n.part == NodePart::Tool) {
       EXPECT_LE(n.position_mm.z(), 40.0);
       EXPECT_LT(toolSurfaceDistance(tool, n.position_mm), 1e-12);

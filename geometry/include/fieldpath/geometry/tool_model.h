@@ -45,5 +45,7 @@ std::vector<SurfaceNode> surfaceNodes(const ToolSpec& tool, const HolderProfile&
 /// |distance| (mm) from a point in the tool frame to the analytic surface of the tool body
 /// (cutting end, shank cylinder and flat top at L).
 double toolSurfaceDistance(const ToolSpec& tool, const Vec3& point_tool_frame_mm);
+/// |distance| (mm) to the analytic surface of tool and holder joined as toolMesh joins them.
+double toolSurfaceDistance(const ToolSpec& tool, const HolderProfile& holder, const Vec3& point_tool_frame_mm);
 
 }  // namespace fieldpath::geometry
