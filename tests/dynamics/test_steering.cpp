@@ -199,7 +199,6 @@ TEST(PlaneWall, SettlesAtTheStaticEquilibrium) {
   const SteeringResult result = runToleranceStable(straightPass(300.0), request);
   ASSERT_EQ(result.status, Status::Ok) << result.message;
   const PostureSample& last = result.samples.back();
-  std::printf("equilibrium tilt %.6f deg, settled %.6f deg\n", expected / kDeg, last.tilt_rad / kDeg);
   EXPECT_GT(expected, 1.0 * kDeg);  // a real deflection, away from the wall (towards -b = -y)
   EXPECT_NEAR(last.tilt_rad, expected, 1e-6);
   EXPECT_NEAR(last.lead_rad, 0.0, 1e-12);  // a wall along the feed gives no lead moment
@@ -373,13 +372,165 @@ TEST_P(CoarseLattice, VoxelBoundaryCrossingsDoNotDiverge) {
     lo = std::min(lo, s.tilt_rad);
     hi = std::max(hi, s.tilt_rad);
   }
-  std::printf("exact %.4f deg, coarse %.4f .. %.4f deg\n", settled_exact / kDeg, lo / kDeg, hi / kDeg);
   EXPECT_GT(lo, 0.5 * settled_exact);
   EXPECT_LT(hi, 1.5 * settled_exact);
 }
 
 INSTANTIATE_TEST_SUITE_P(Dynamics, CoarseLattice, ::testing::Values(false, true),
                          [](const auto& info) { return info.param ? "nearest" : "trilinear"; });
+
+// ---- degenerate frames ----------------------------------------------------------------------
+
+TEST(HardCases, FeedParallelToTheNormalStaysFinite) {
+  const auto wall = wallAt(4.0);
+  const Pass base = straightPass(300.0);
+  Pass plunge{300.0, [&](double s_mm) {
+                PassFrame f = base.frameAt(s_mm);
+                if (s_mm > 80.0 && s_mm < 90.0) f.feed = Vec3::UnitZ();   // feed along the normal
+                if (s_mm >= 90.0 && s_mm < 95.0) f.feed = Vec3::Zero();   // or no feed direction at all
+                return f;
+              }};
+  const SteeringResult result = runToleranceStable(plunge, requestFor(wall.get()));
+  ASSERT_EQ(result.status, Status::Ok) << result.message;
+  EXPECT_NEAR(result.samples.back().tilt_rad, staticTilt(*wall, 1.0, 0.0, 0.5), 1e-6);  // recovers
+}
+
+TEST(HardCases, VerticalAxesUpAndDownStayFinite) {
+  const auto wall = wallAt(4.0);
+  const SteeringResult up = runToleranceStable(straightPass(300.0), requestFor(wall.get()));
+  ASSERT_EQ(up.status, Status::Ok) << up.message;
+  for (const PostureSample& s : up.samples)
+    if (s.s_mm == 0.0) EXPECT_EQ(s.posture.axis, Vec3::UnitZ());  // the nominal axis is exactly vertical
+
+  // Machining a ceiling: normal -z, axis -z at the nominal (rotationFromZ's special case). Mirror
+  // image of the upright case in z, so the axis leans away from the wall by the same amount.
+  Pass ceiling{300.0, [](double s_mm) {
+                 PassFrame f;
+                 f.centre_mm = Vec3(s_mm, 0.0, -kRadius);
+                 f.feed = Vec3::UnitX();
+                 f.normal = -Vec3::UnitZ();
+                 return f;
+               }};
+  const SteeringResult down = runToleranceStable(ceiling, requestFor(wall.get()));
+  ASSERT_EQ(down.status, Status::Ok) << down.message;
+  EXPECT_EQ(down.samples.front().posture.axis, -Vec3::UnitZ());
+  const Vec3 axis_up = up.samples.back().posture.axis, axis_down = down.samples.back().posture.axis;
+  EXPECT_LT(axis_down.y(), 0.0);  // away from the wall at +y
+  EXPECT_NEAR(axis_down.y(), axis_up.y(), 1e-6);
+  EXPECT_NEAR(axis_down.z(), -axis_up.z(), 1e-6);
+}
+
+// ---- limits, reports, input -------------------------------------------------------------------
+
+TEST(Limits, TiltLimitIsReportedWithThePathPosition) {
+  const auto wall = wallAt(4.0);
+  SteeringRequest request = requestFor(wall.get());
+  request.params.max_tilt_deg = 3.0;  // the wall wants 4.6°
+  const SteeringResult result = steerPass(straightPass(300.0), request);
+  ASSERT_EQ(result.status, Status::TiltLimit);
+  EXPECT_NE(result.message.find("s = "), std::string::npos) << result.message;
+  EXPECT_NE(result.message.find("dynamics.max_tilt_deg"), std::string::npos) << result.message;
+  EXPECT_GT(result.samples.back().tilt_rad, 3.0 * kDeg);  // the offending sample is included
+  EXPECT_LT(result.samples.size(), 301u);
+  for (std::size_t i = 0; i + 1 < result.samples.size(); ++i) EXPECT_LE(result.samples[i].tilt_rad, 3.0 * kDeg);
+}
+
+TEST(Limits, ClampHoldsTheAxisAtTheLimit) {
+  const auto wall = wallAt(4.0);
+  SteeringRequest request = requestFor(wall.get());
+  request.params.max_tilt_deg = 3.0;
+  request.on_limit = LimitPolicy::Clamp;
+  const SteeringResult result = runToleranceStable(straightPass(300.0), request);
+  ASSERT_EQ(result.status, Status::Ok) << result.message;
+  EXPECT_GT(result.clamped_samples, 0);
+  EXPECT_EQ(result.stats.restarts, result.clamped_samples);
+  for (const PostureSample& s : result.samples) EXPECT_LE(s.tilt_rad, 3.0 * kDeg * (1 + 1e-12));
+  EXPECT_NEAR(result.samples.back().tilt_rad, 3.0 * kDeg, 1e-12);
+  EXPECT_TRUE(result.samples.back().limited);
+}
+
+TEST(Limits, AngleChangePerMmIsReported) {
+  SteeringRequest request = requestFor(nullptr);
+  request.initial_tilt_rad = 0.2;
+  request.max_angle_change_deg_per_mm = 0.1;  // the free return turns ≈ 0.35°/mm at its fastest
+  const SteeringResult result = steerPass(straightPass(100.0), request);
+  EXPECT_EQ(result.status, Status::RateLimit);
+  EXPECT_NE(result.message.find("s = "), std::string::npos) << result.message;
+  request.max_angle_change_deg_per_mm = 1.0;
+  EXPECT_EQ(steerPass(straightPass(100.0), request).status, Status::Ok);
+}
+
+TEST(Inputs, BadSettingsNameTheirKey) {
+  const Pass pass = straightPass(10.0);
+  auto expectKey = [&](SteeringRequest request, const std::string& key) {
+    try {
+      steerPass(pass, request);
+      ADD_FAILURE() << "no error for " << key;
+    } catch (const common::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  };
+  SteeringRequest r = requestFor(nullptr);
+  r.params.inertia = 0.0;
+  expectKey(r, "dynamics.inertia");
+  r = requestFor(nullptr);
+  r.params.feed_mm_per_min = NAN;
+  expectKey(r, "dynamics.feed");
+  r = requestFor(nullptr);
+  r.params.rtol = -1.0;
+  expectKey(r, "dynamics.rtol");
+  r = requestFor(nullptr);
+  r.step_mm = 0.0;
+  expectKey(r, "path.step");
+  r = requestFor(nullptr);
+  r.params.max_tilt_deg = 0.0;
+  expectKey(r, "dynamics.max_tilt_deg");
+  EXPECT_THROW(steerPass(Pass{10.0, {}}, requestFor(nullptr)), common::InputError);
+}
+
+TEST(Outputs, SamplesEveryStepEndingOnTheLength) {
+  SteeringRequest request = requestFor(nullptr);
+  request.step_mm = 0.4;
+  const SteeringResult result = steerPass(straightPass(10.0), request);
+  ASSERT_EQ(result.samples.size(), 26u);  // 0, 0.4, ..., 9.6, 10
+  EXPECT_DOUBLE_EQ(result.samples[1].s_mm, 0.4);
+  EXPECT_DOUBLE_EQ(result.samples.back().s_mm, 10.0);
+  const PostureSample& s = result.samples.back();
+  EXPECT_NEAR((s.posture.tip_mm + kRadius * s.posture.axis - Vec3(10.0, 0, kRadius)).norm(), 0.0, 1e-12);
+  EXPECT_TRUE(std::isnan(s.clearance_mm));  // no clearance hook
+  EXPECT_EQ(steerPass(straightPass(0.0), request).samples.size(), 1u);
+}
+
+TEST(Outputs, ProgressReachesTheEndAndCanInterrupt) {
+  SteeringRequest request = requestFor(nullptr);
+  double last = -1.0;
+  request.progress = [&](double fraction, std::string_view) {
+    EXPECT_GE(fraction, last);
+    last = fraction;
+    return true;
+  };
+  steerPass(straightPass(50.0), request);
+  EXPECT_DOUBLE_EQ(last, 1.0);
+  request.progress = [](double fraction, std::string_view) { return fraction < 0.5; };
+  EXPECT_THROW(steerPass(straightPass(50.0), request), common::Interrupted);
+}
+
+/// A field that fails part-way: the exception must cross the C solver and reach the caller.
+struct FailingField final : field::ForceField {
+  void evaluate(std::span<const Vec3> points, std::span<Vec3> forces) const override {
+    if (points[0].x() > 20.0) throw std::runtime_error("field lookup failed");
+    for (Vec3& f : forces) f.setZero();
+  }
+};
+
+TEST(Outputs, FieldErrorsPropagateThroughTheSolver) {
+  const FailingField field;
+  for (Integrator integrator : {Integrator::Bdf, Integrator::Erk}) {
+    SteeringRequest request = requestFor(&field);
+    request.params.integrator = integrator;
+    EXPECT_THROW(steerPass(straightPass(50.0), request), std::runtime_error);
+  }
+}
 
 }  // namespace
 }  // namespace fieldpath::dynamics
