@@ -15,6 +15,9 @@ using common::InputError;
 using Vec2 = Eigen::Vector2d;  ///< meridian half-plane: (rho = distance from the axis, z), mm
 
 constexpr double kPi = std::numbers::pi;
+/// Sizes beyond which a tolerance or spacing is taken as a mistake (memory, not accuracy).
+constexpr double kMaxTriangles = 2e7;
+constexpr double kMaxNodes = 2e7;
 
 /// One piece of a revolved profile: a straight segment, or a circular arc about `centre` from
 /// `start_rad` to `end_rad` (counter-clockwise in the (rho, z) plane). `from`/`to` are exact end
@@ -241,6 +244,18 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
   const bool has_arcs = std::any_of(profile.begin(), profile.end(), [](const ProfileSegment& s) { return s.is_arc; });
   const double sagitta_mm = (has_arcs ? 0.45 : 0.9) * chord_tol_mm;
 
+  // Refuse tolerances that would not fit in memory (bad input must not crash or hang).
+  double max_rho_mm = 0, rings = 0;
+  for (const auto& s : profile) {
+    max_rho_mm = std::max({max_rho_mm, s.from.x(), s.to.x()});
+    rings += s.is_arc ? (s.end_rad - s.start_rad) / angularStep(s.radius_mm, sagitta_mm) + 1 : 1;
+  }
+  const double triangles_estimate = 2 * rings * (2 * kPi / angularStep(max_rho_mm, sagitta_mm) + 8);
+  if (triangles_estimate > kMaxTriangles)
+    throw InputError("chordal tolerance " + std::to_string(chord_tol_mm) + " mm is too fine: about " +
+                     std::to_string(static_cast<long long>(triangles_estimate)) + " triangles (limit " +
+                     std::to_string(static_cast<long long>(kMaxTriangles)) + ")");
+
   // Profile points from the tip to the top; arcs subdivided, straight pieces left whole.
   std::vector<Vec2> points{profile.front().from};
   for (const auto& s : profile) {
@@ -300,6 +315,13 @@ std::vector<SurfaceNode> surfaceNodes(const ToolSpec& tool, const HolderProfile&
   if (!holder.empty() && holder.front().z_mm < tool.length_mm)
     throw InputError("holder starts below the tool length");
   const Profile profile = fullProfile(tool, holder);
+
+  double nodes_estimate = 0;
+  for (const auto& s : profile)
+    nodes_estimate += (s.length() / spacing_mm + 2) * (2 * kPi * std::max(s.from.x(), s.to.x()) / spacing_mm + 1);
+  if (nodes_estimate > kMaxNodes)
+    throw InputError("node spacing " + std::to_string(spacing_mm) + " mm is too fine: about " +
+                     std::to_string(static_cast<long long>(nodes_estimate)) + " nodes");
 
   std::vector<SurfaceNode> nodes;
   const auto addRing = [&](const ProfileSegment& s, double t, int ring_index) {

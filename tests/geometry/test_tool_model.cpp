@@ -179,6 +179,10 @@ TEST(ToolModel, HolderMeshesWithinTolerance) {
 TEST(ToolModel, BadToleranceIsInputError) {
   for (double tol : {0.0, -1.0, std::nan(""), HUGE_VAL})
     EXPECT_THROW(toolMesh(parseToolSpec("ball:3"), {}, tol), InputError) << tol;
+  // Absurdly fine: refused up front instead of exhausting memory.
+  EXPECT_THROW(toolMesh(parseToolSpec("ball:3"), {}, 1e-12), InputError);
+  EXPECT_THROW(surfaceNodes(parseToolSpec("ball:3"), {}, 1e-6), InputError);
+  EXPECT_THROW(surfaceNodes(parseToolSpec("ball:3"), {}, 0.0), InputError);
 }
 
 TEST(ToolModel, SurfaceNodesLieOnTheSurfaceAboutSpacingApart) {
