@@ -1,22 +1,28 @@
 #include "fieldpath/geometry/posture.h"
 
+#include <cmath>
+
 namespace fieldpath::geometry {
 
 Eigen::Matrix3d rotationFromZ(const Vec3& axis) {
   const Vec3 a = axis.normalized();
   const double i = a.x(), j = a.y(), k = a.z();
-  const double s = i * i + j * j;
-  double f;  // = 1/(1+k), computed without cancellation on either hemisphere
+  // f·i², f·i·j, f·j² with f = 1/(1+k), computed without cancellation on either hemisphere:
+  // for k < 0, f = (1-k)/(i²+j²), applied to the unit horizontal direction (i, j)/hypot(i, j) so
+  // that tiny i, j (axis within 1e-160 of -z) neither underflow nor overflow.
+  double fii, fij, fjj;
   if (k >= 0.0) {
-    f = 1.0 / (1.0 + k);
-  } else if (s > 0.0) {
-    f = (1.0 - k) / s;
+    const double f = 1.0 / (1.0 + k);
+    fii = f * i * i, fij = f * i * j, fjj = f * j * j;
   } else {
-    return Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+    const double h = std::hypot(i, j);
+    if (h == 0.0) return Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();  // rotation by π about x
+    const double ci = i / h, cj = j / h;
+    fii = (1.0 - k) * ci * ci, fij = (1.0 - k) * ci * cj, fjj = (1.0 - k) * cj * cj;
   }
   Eigen::Matrix3d r;
-  r << 1.0 - f * i * i, -f * i * j, i,  //
-      -f * i * j, 1.0 - f * j * j, j,   //
+  r << 1.0 - fii, -fij, i,  //
+      -fij, 1.0 - fjj, j,   //
       -i, -j, k;
   return r;
 }

@@ -54,6 +54,12 @@ TEST(Posture, AxesNearMinusZ) {
   }
   const Eigen::Matrix3d r = rotationFromZ(-Vec3::UnitZ());
   expectProperRotationMappingZTo(r, -Vec3::UnitZ());
+  // Horizontal parts so small that i² + j² underflows: still a finite proper rotation.
+  for (const Vec3& a : {Vec3(1e-160, 0, -1), Vec3(1e-200, -1e-200, -1), Vec3(0, 5e-324, -1)}) {
+    const Eigen::Matrix3d m = rotationFromZ(a);
+    ASSERT_TRUE(m.allFinite()) << a.transpose();
+    expectProperRotationMappingZTo(m, a);
+  }
 }
 
 TEST(Posture, MinimalRotationFixesTheCommonPerpendicular) {
