@@ -81,48 +81,103 @@ ProfileSegment cornerArc(Vec2 centre, double radius_mm) {
   return s;
 }
 
-/// Tip → side of the shank at (R, L): cutting end then shank cylinder. No top.
-Profile toolSide(const ToolSpec& tool) {
-  const double big_r = tool.radius_mm, len = tool.length_mm;
+/// Height (mm) of the cutting end above the tip: where the shank cylinder begins.
+double cuttingEndHeight(const ToolSpec& tool) {
+  return tool.shape == ToolShape::Ball ? tool.radius_mm : tool.shape == ToolShape::Torus ? tool.corner_radius_mm : 0.0;
+}
+
+/// Tip → side of the shank up to (R, top_z): cutting end then shank cylinder. No top.
+Profile toolSide(const ToolSpec& tool, double top_z_mm) {
+  const double big_r = tool.radius_mm;
   Profile p;
-  double side_start_z = 0.0;
   switch (tool.shape) {
     case ToolShape::Ball:
       p.push_back(cornerArc(Vec2(0.0, big_r), big_r));
-      p.back().from = Vec2(0.0, 0.0);
-      side_start_z = big_r;
       break;
     case ToolShape::Torus: {
       const double r = tool.corner_radius_mm;
       if (big_r - r > 0) p.push_back(line(Vec2(0.0, 0.0), Vec2(big_r - r, 0.0)));
       p.push_back(cornerArc(Vec2(big_r - r, r), r));
-      if (big_r - r <= 0) p.back().from = Vec2(0.0, 0.0);
-      side_start_z = r;
       break;
     }
     case ToolShape::Flat:
       p.push_back(line(Vec2(0.0, 0.0), Vec2(big_r, 0.0)));
       break;
   }
-  if (len > side_start_z) p.push_back(line(Vec2(big_r, side_start_z), Vec2(big_r, len)));
+  const double side_start_z = cuttingEndHeight(tool);
+  if (top_z_mm > side_start_z) p.push_back(line(Vec2(big_r, side_start_z), Vec2(big_r, top_z_mm)));
   return p;
 }
 
+/// The holder's outline (rho, z) joined with the tool: below the tool top L the union of the two
+/// solids is at least the shank radius R, so the outline is widened to R there (crossings of
+/// rho = R and of z = L become points of their own).
+std::vector<Vec2> holderOutline(const ToolSpec& tool, const HolderProfile& holder) {
+  const double big_r = tool.radius_mm, len = tool.length_mm;
+  std::vector<Vec2> raw;
+  for (std::size_t i = 0; i < holder.size(); ++i) {
+    const Vec2 b(holder[i].radius_mm, holder[i].z_mm);
+    if (i > 0) {
+      const Vec2 a = raw.back();
+      std::vector<std::pair<double, Vec2>> cuts;
+      if (a.y() < len && b.y() > len) {
+        const double t = (len - a.y()) / (b.y() - a.y());
+        cuts.push_back({t, Vec2(a.x() + t * (b.x() - a.x()), len)});
+      }
+      if ((a.x() - big_r) * (b.x() - big_r) < 0) {
+        const double t = (big_r - a.x()) / (b.x() - a.x());
+        const double z = a.y() + t * (b.y() - a.y());
+        if (z < len) cuts.push_back({t, Vec2(big_r, z)});
+      }
+      std::sort(cuts.begin(), cuts.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
+      for (const auto& cut : cuts) raw.push_back(cut.second);
+    }
+    raw.push_back(b);
+  }
+  std::vector<Vec2> outline;
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const Vec2& u = raw[i];
+    if (u.y() > len) {
+      outline.push_back(u);
+      continue;
+    }
+    outline.emplace_back(std::max(u.x(), big_r), u.y());
+    // Leaving the tool's top upwards at a radius below R: step in along z = L first.
+    if (u.y() == len && u.x() < big_r && i + 1 < raw.size() && raw[i + 1].y() > len) outline.push_back(u);
+  }
+  return outline;
+}
+
 /// The whole closed profile from the tip to the top on the axis: tool side, then either the flat
-/// top at L, or the holder stations (the shank runs on up to the first station if it starts above
-/// L) and the holder's top face.
+/// top at L, or the outline of tool and holder joined (holderOutline) and the top face.
 Profile fullProfile(const ToolSpec& tool, const HolderProfile& holder) {
-  Profile p = toolSide(tool);
-  const auto add = [&p](Vec2 to, NodePart part) {
-    if ((to - p.back().to).norm() > 0) p.push_back(line(p.back().to, to, part));
-  };
+  const double big_r = tool.radius_mm, len = tool.length_mm;
   if (holder.empty()) {
-    add(Vec2(0.0, tool.length_mm), NodePart::Tool);
+    Profile p = toolSide(tool, len);
+    p.push_back(line(p.back().to, Vec2(0.0, len)));
     return p;
   }
-  add(Vec2(tool.radius_mm, holder.front().z_mm), NodePart::Tool);
-  for (const HolderStation& s : holder) add(Vec2(s.radius_mm, s.z_mm), NodePart::Holder);
-  add(Vec2(0.0, holder.back().z_mm), NodePart::Holder);
+  if (!(holder.front().z_mm > cuttingEndHeight(tool)))
+    throw InputError("holder starts at z " + std::to_string(holder.front().z_mm) +
+                     " mm, not above the cutting end of the tool (" + std::to_string(cuttingEndHeight(tool)) + " mm)");
+  // The shank runs up to the first station, also past L into a holder that starts above the tool.
+  Profile p = toolSide(tool, holder.front().z_mm);
+  // Pieces on the shank cylinder below L are tool surface; the rest is holder.
+  const auto add = [&](Vec2 to) {
+    const Vec2 from = p.back().to;
+    if ((to - from).norm() == 0) return;
+    const bool on_shank = from.x() == big_r && to.x() == big_r && to.y() <= len;
+    p.push_back(line(from, to, on_shank ? NodePart::Tool : NodePart::Holder));
+  };
+  for (const Vec2& q : holderOutline(tool, holder)) add(q);
+  const double holder_top_mm = holder.back().z_mm;
+  if (holder_top_mm < len) {  // a collar round the shank: the tool goes on above it
+    add(Vec2(big_r, holder_top_mm));
+    add(Vec2(big_r, len));
+    p.push_back(line(p.back().to, Vec2(0.0, len)));
+  } else {
+    add(Vec2(0.0, holder_top_mm));
+  }
   return p;
 }
 
@@ -206,9 +261,7 @@ void validateToolSpec(const ToolSpec& tool) {
   if (tool.shape == ToolShape::Torus &&
       !(tool.corner_radius_mm > 0 && tool.corner_radius_mm <= tool.radius_mm))
     throw InputError("corner radius must be in (0, R]");
-  const double end_mm = tool.shape == ToolShape::Ball    ? tool.radius_mm
-                        : tool.shape == ToolShape::Torus ? tool.corner_radius_mm
-                                                         : 0.0;
+  const double end_mm = cuttingEndHeight(tool);
   if (!std::isfinite(tool.length_mm) || !(tool.length_mm >= end_mm) || !(tool.length_mm > 0))
     throw InputError("tool length must cover the cutting end (>= " + std::to_string(end_mm) + " mm)");
 }
@@ -233,9 +286,6 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
   validateHolderProfile(holder);
   if (!std::isfinite(chord_tol_mm) || !(chord_tol_mm > 0))
     throw InputError("chordal tolerance must be a finite number > 0 mm");
-  if (!holder.empty() && holder.front().z_mm < tool.length_mm)
-    throw InputError("holder starts at z " + std::to_string(holder.front().z_mm) +
-                     " mm, below the tool length " + std::to_string(tool.length_mm) + " mm");
   const Profile profile = fullProfile(tool, holder);
 
   // A triangle spanning a profile step and a circumferential step deviates from the surface by
@@ -312,8 +362,6 @@ std::vector<SurfaceNode> surfaceNodes(const ToolSpec& tool, const HolderProfile&
   validateToolSpec(tool);
   validateHolderProfile(holder);
   if (!std::isfinite(spacing_mm) || !(spacing_mm > 0)) throw InputError("node spacing must be a finite number > 0 mm");
-  if (!holder.empty() && holder.front().z_mm < tool.length_mm)
-    throw InputError("holder starts below the tool length");
   const Profile profile = fullProfile(tool, holder);
 
   double nodes_estimate = 0;

@@ -152,7 +152,34 @@ TEST(ToolModel, HolderJoinsTheToolIntoOneClosedSolid) {
     for (const auto& v : mesh.vertices) top = std::max(top, v.z());
     EXPECT_EQ(top, holder.back().z_mm);
   }
-  EXPECT_THROW(toolMesh(tool, parseHolderProfile("30:6,50:6"), 0.01), InputError);  // inside the tool
+  EXPECT_THROW(toolMesh(tool, parseHolderProfile("2:6,50:6"), 0.01), InputError);  // below the ball's top
+}
+
+TEST(ToolModel, HolderOverlappingTheShankIsTheUnion) {
+  // ball R 3, L 40. Volumes of the union, by hand: ball end 18π, then cylinders and frustums.
+  const ToolSpec tool = parseToolSpec("ball:3:40");
+  struct Case {
+    const char* holder;
+    double volume_over_pi;
+  };
+  const Case cases[] = {
+      {"30:6,50:6", 18 + 9 * 27 + 36 * 20},                    // holder swallows the shank top
+      {"30:2,36:8,50:8", 18 + 9 * 28 + 5.0 * 97 / 3 + 64 * 14},  // cone crosses R at z 31
+      {"20:5,30:5", 18 + 9 * 17 + 25 * 10 + 9 * 10},           // collar, shank and top above it
+      {"30:2,40:2,50:6", 18 + 9 * 37 + 10.0 * (4 + 12 + 36) / 3},  // narrower than R up to L, then wider
+      {"35:4,40:4,40:1,45:1", 18 + 9 * 32 + 16 * 5 + 1 * 5},   // steps in to a neck at L
+  };
+  for (const Case& c : cases) {
+    const HolderProfile holder = parseHolderProfile(c.holder);
+    const TriangleMesh mesh = toolMesh(tool, holder, 0.002);
+    EXPECT_TRUE(validateMesh(mesh).closed()) << c.holder << ": " << validateMesh(mesh).summary();
+    for (const auto& v : mesh.vertices) ASSERT_LT(toolSurfaceDistance(tool, holder, v), 1e-12) << c.holder;
+    const double exact = kPi * c.volume_over_pi;
+    EXPECT_LT(meshVolume(mesh), exact) << c.holder;
+    EXPECT_LT(exact - meshVolume(mesh), 0.002 * meshArea(mesh)) << c.holder;  // chordal shell
+    for (const auto& n : surfaceNodes(tool, holder, 0.5))
+      EXPECT_LT(toolSurfaceDistance(tool, holder, n.position_mm), 1e-12) << c.holder;
+  }
 }
 
 TEST(ToolModel, HolderMeshesWithinTolerance) {

@@ -26,7 +26,10 @@ void validateHolderProfile(const HolderProfile& holder);
 /// Closed, outward-oriented mesh of tool body (cutting end + cylindrical shank to L) and holder,
 /// every point within `chord_tol_mm` of the analytic surface. Angular steps come from the sagitta
 /// formula; the tip lies on the axis with no degenerate triangles there. The holder (may be empty)
-/// is joined to the top of the tool: the profile runs tip → L → holder stations → top on the axis.
+/// and the tool make one solid (their union): a holder starting above L is reached by the shank
+/// running on; one starting below L (the shank inside it) is widened to at least R up to L; one
+/// ending below L is a collar with the shank and the top at L above it. The first station must lie
+/// above the cutting end. Throws common::InputError for bad tool, holder or tolerance.
 TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double chord_tol_mm);
 
 enum class NodePart { Tool, Holder };
