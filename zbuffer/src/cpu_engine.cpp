@@ -75,8 +75,8 @@ class CpuEngine final : public BackendEngine {
     std::size_t culled = 0;
 #pragma omp parallel for schedule(dynamic, 16) reduction(+ : culled)
     for (long p = 0; p < n; ++p) {
-      const PreparedPosture pp = preparePosture(g, tool, block[p]);
-      if (postureCulled(g, pp, tiles)) {
+      PreparedPosture pp = preparePosture(g, tool, block[p]);
+      if (cullPosture(g, tool, pp, tiles)) {
         ++culled;
         continue;
       }

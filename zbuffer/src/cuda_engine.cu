@@ -46,8 +46,8 @@ __global__ void fastKernel(GridView g, ToolView tool, const Posture* postures, i
   const int lane = threadIdx.x & 31;
   const int p = blockIdx.x * kWarpsPerBlock + (threadIdx.x >> 5);
   if (p >= count) return;
-  const PreparedPosture pp = preparePosture(g, tool, postures[p]);
-  if (postureCulled(g, pp, tile_max)) {
+  PreparedPosture pp = preparePosture(g, tool, postures[p]);
+  if (cullPosture(g, tool, pp, tile_max)) {
     if (lane == 0 && blockIdx.y == 0) atomicAdd(culled, 1ull);
     return;
   }

@@ -254,7 +254,11 @@ std::vector<float> stockFromPart(const Grid& grid, std::span<const Vec3f> vertic
   return top;
 }
 
-SimulationResult simulate(const SimulationRequest& request, const PostureSource& source) {
+namespace {
+
+/// Runs the blocks that `next` hands out (an empty span ends), without copying them.
+template <class NextBlock>
+SimulationResult run(const SimulationRequest& request, NextBlock next) {
   const Grid& grid = request.grid;
   if (grid.nx <= 0 || grid.ny <= 0) throw InputError("grid: no lines");
   checkGridFits(grid);
@@ -278,13 +282,11 @@ SimulationResult simulate(const SimulationRequest& request, const PostureSource&
                                                       : detail::makeCpuEngine(g, tool, initial);
   SimulationResult result;
   result.backend = backend;
-  std::vector<Posture> block(std::max<std::size_t>(1, request.block_postures));
   for (;;) {
-    const std::size_t n = source(std::span<Posture>(block));
-    if (n == 0) break;
-    result.postures_culled += engine->cut(
-        std::span<const Posture>(block.data(), std::min(n, block.size())), request.engine);
-    result.postures += n;
+    const std::span<const Posture> block = next();
+    if (block.empty()) break;
+    result.postures_culled += engine->cut(block, request.engine);
+    result.postures += block.size();
     const double total = double(std::max(request.expected_postures, result.postures));
     common::report(request.progress, double(result.postures) / total, "simulate");
   }
@@ -296,15 +298,26 @@ SimulationResult simulate(const SimulationRequest& request, const PostureSource&
   return result;
 }
 
+}  // namespace
+
+SimulationResult simulate(const SimulationRequest& request, const PostureSource& source) {
+  std::vector<Posture> buffer(std::max<std::size_t>(1, request.block_postures));
+  return run(request, [&] {
+    const std::size_t n = std::min(source(std::span<Posture>(buffer)), buffer.size());
+    return std::span<const Posture>(buffer.data(), n);
+  });
+}
+
 SimulationResult simulate(const SimulationRequest& request, std::span<const Posture> postures) {
-  std::size_t next = 0;
   SimulationRequest req = request;
   if (req.expected_postures == 0) req.expected_postures = postures.size();
-  return simulate(req, [&](std::span<Posture> out) {
-    const std::size_t n = std::min(out.size(), postures.size() - next);
-    std::copy_n(postures.begin() + next, n, out.begin());
+  const std::size_t block = std::max<std::size_t>(1, request.block_postures);
+  std::size_t next = 0;
+  return run(req, [&] {
+    const std::size_t n = std::min(block, postures.size() - next);
+    const auto out = postures.subspan(next, n);
     next += n;
-    return n;
+    return out;
   });
 }
 

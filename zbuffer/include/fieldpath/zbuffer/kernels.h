@@ -71,6 +71,30 @@ FIELDPATH_HD int lastLine(double f, int n) {
   return static_cast<int>(floor(f < 0.0 ? 0.0 : (f > n - 1.0 ? n - 1.0 : f)));
 }
 
+/// Lines that the part of the hull between axial heights z0 and z1 (tool frame, mm) may meet.
+FIELDPATH_HD void setFootprint(const GridView& g, PreparedPosture& pp, float hull_r, float z0,
+                               float z1, float margin) {
+  const float i = pp.rot.m[0][2], j = pp.rot.m[1][2];
+  const float ex = hull_r * sqrtf(maxf(0.f, 1.f - i * i)) + margin;
+  const float ey = hull_r * sqrtf(maxf(0.f, 1.f - j * j)) + margin;
+  const float xa = pp.tip_mm.x + z0 * i, xb = pp.tip_mm.x + z1 * i;
+  const float ya = pp.tip_mm.y + z0 * j, yb = pp.tip_mm.y + z1 * j;
+  const double xmin = minf(xa, xb) - ex, xmax = maxf(xa, xb) + ex;
+  const double ymin = minf(ya, yb) - ey, ymax = maxf(ya, yb) + ey;
+  const double fx0 = (xmin - g.x0_mm) / g.dx_mm - 0.5, fx1 = (xmax - g.x0_mm) / g.dx_mm - 0.5;
+  const double fy0 = (ymin - g.y0_mm) / g.dy_mm - 0.5, fy1 = (ymax - g.y0_mm) / g.dy_mm - 0.5;
+  if (fx1 < 0.0 || fy1 < 0.0 || fx0 > g.nx - 1.0 || fy0 > g.ny - 1.0 || !(fx0 <= fx1) ||
+      !(fy0 <= fy1)) {
+    pp.ix0 = pp.iy0 = 1;
+    pp.ix1 = pp.iy1 = 0;
+  } else {
+    pp.ix0 = firstLine(fx0, g.nx);
+    pp.ix1 = lastLine(fx1, g.nx);
+    pp.iy0 = firstLine(fy0, g.ny);
+    pp.iy1 = lastLine(fy1, g.ny);
+  }
+}
+
 /// Lowest possible world z of the placed tool and its footprint on the grid.
 FIELDPATH_HD PreparedPosture preparePosture(const GridView& g, const ToolView& tool, Posture pose) {
   PreparedPosture pp;
@@ -92,24 +116,7 @@ FIELDPATH_HD PreparedPosture preparePosture(const GridView& g, const ToolView& t
   const float margin = 1e-5f * (absf(pose.tip_mm.z) + hull_r + z1 - z0) + 1e-6f;
   pp.lowest_z_mm = lowest - margin;
 
-  const float ex = hull_r * sqrtf(maxf(0.f, 1.f - i * i)) + margin;
-  const float ey = hull_r * sqrtf(maxf(0.f, 1.f - j * j)) + margin;
-  const float xa = pose.tip_mm.x + z0 * i, xb = pose.tip_mm.x + z1 * i;
-  const float ya = pose.tip_mm.y + z0 * j, yb = pose.tip_mm.y + z1 * j;
-  const double xmin = minf(xa, xb) - ex, xmax = maxf(xa, xb) + ex;
-  const double ymin = minf(ya, yb) - ey, ymax = maxf(ya, yb) + ey;
-  const double fx0 = (xmin - g.x0_mm) / g.dx_mm - 0.5, fx1 = (xmax - g.x0_mm) / g.dx_mm - 0.5;
-  const double fy0 = (ymin - g.y0_mm) / g.dy_mm - 0.5, fy1 = (ymax - g.y0_mm) / g.dy_mm - 0.5;
-  if (fx1 < 0.0 || fy1 < 0.0 || fx0 > g.nx - 1.0 || fy0 > g.ny - 1.0 || !(fx0 <= fx1) ||
-      !(fy0 <= fy1)) {
-    pp.ix0 = pp.iy0 = 1;
-    pp.ix1 = pp.iy1 = 0;
-  } else {
-    pp.ix0 = firstLine(fx0, g.nx);
-    pp.ix1 = lastLine(fx1, g.nx);
-    pp.iy0 = firstLine(fy0, g.ny);
-    pp.iy1 = lastLine(fy1, g.ny);
-  }
+  setFootprint(g, pp, hull_r, z0, z1, margin);
 
   // Shear constants of the watertight test for rays along pp.dir (tool frame).
   const float ax = absf(pp.dir.x), ay = absf(pp.dir.y), az = absf(pp.dir.z);
@@ -328,15 +335,28 @@ FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const Prepar
 
 /// True if the posture cannot lower any line: its lowest point is not below the highest height of
 /// the culling tiles under its footprint (tile maxima may be stale-high, which stays conservative).
-FIELDPATH_HD bool postureCulled(const GridView& g, const PreparedPosture& pp,
-                                const float* tile_max_mm) {
+/// Otherwise shrinks the footprint to the part of the tool that can reach below that height (the
+/// shank of a tilted tool mostly cannot), which changes no result.
+FIELDPATH_HD bool cullPosture(const GridView& g, const ToolView& tool, PreparedPosture& pp,
+                              const float* tile_max_mm) {
   if (pp.ix0 > pp.ix1 || pp.iy0 > pp.iy1) return true;
   const int tx0 = pp.ix0 >> g.tile_shift, tx1 = pp.ix1 >> g.tile_shift;
   const int ty0 = pp.iy0 >> g.tile_shift, ty1 = pp.iy1 >> g.tile_shift;
+  float top = -FLT_MAX;
   for (int ty = ty0; ty <= ty1; ++ty)
-    for (int tx = tx0; tx <= tx1; ++tx)
-      if (!(pp.lowest_z_mm >= tile_max_mm[ty * g.tiles_x + tx])) return false;
-  return true;
+    for (int tx = tx0; tx <= tx1; ++tx) top = maxf(top, tile_max_mm[ty * g.tiles_x + tx]);
+  if (pp.lowest_z_mm >= top) return true;
+  const float i = pp.rot.m[0][2], j = pp.rot.m[1][2], k = pp.rot.m[2][2];
+  if (k > 1e-3f) {
+    const float margin =
+        1e-5f * (absf(pp.tip_mm.z) + absf(top) + tool.hull_radius_mm + tool.hull_zmax_mm) + 1e-6f;
+    const float reach =
+        (top - pp.tip_mm.z + tool.hull_radius_mm * sqrtf(i * i + j * j) + margin) / k + margin;
+    if (reach < tool.hull_zmax_mm)
+      setFootprint(g, pp, tool.hull_radius_mm, tool.hull_zmin_mm, maxf(tool.hull_zmin_mm, reach),
+                   margin);
+  }
+  return false;
 }
 
 /// Canonical 2D edge function: the same two points give exactly opposite values whichever way
