@@ -23,7 +23,8 @@ constexpr double kUnitAsIs = 8 * std::numeric_limits<double>::epsilon();
 /// Axes off unit length by less than this are normalised; the others are rejected (DESIGN.md).
 constexpr double kUnitTolerance = 1e-3;
 
-[[noreturn]] void fail(const std::filesystem::path& file, std::size_t line, const std::string& why) {
+[[noreturn]] void fail(const std::filesystem::path& file, std::size_t line,
+                       const std::string& why) {
   throw InputError(file.string() + ":" + std::to_string(line) + ": " + why);
 }
 
@@ -50,7 +51,8 @@ double parseFinite(std::string_view token, const std::filesystem::path& file, st
   double value = 0;
   const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
   if (ec == std::errc::result_out_of_range) fail(file, line, quoted(token) + " is out of range");
-  if (ec != std::errc() || end != digits.data() + digits.size()) fail(file, line, quoted(token) + " is not a number");
+  if (ec != std::errc() || end != digits.data() + digits.size())
+    fail(file, line, quoted(token) + " is not a number");
   if (!std::isfinite(value)) fail(file, line, quoted(token) + " is not finite");
   return value;
 }
@@ -69,7 +71,8 @@ Vec3 checkedAxis(const Vec3& axis, const std::filesystem::path& file, std::size_
 
 std::ifstream openForReading(const std::filesystem::path& file) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(file.string() + ": no such file");
+  if (!std::filesystem::is_regular_file(file, ec))
+    throw InputError(file.string() + ": no such file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string() + ": cannot open for reading");
   return in;
@@ -114,9 +117,12 @@ std::vector<Posture> readClFile(const std::filesystem::path& file) {
     const auto tokens = splitWhitespace(content);
     if (tokens.empty()) continue;
     if (tokens.size() < 6)
-      fail(file, line, "short line: " + std::to_string(tokens.size()) + " numbers, need x y z i j k");
+      fail(file, line,
+           "short line: " + std::to_string(tokens.size()) + " numbers, need x y z i j k");
     if (tokens.size() > 7)
-      fail(file, line, "too many columns: " + std::to_string(tokens.size()) + ", expected x y z i j k [spindle]");
+      fail(file, line,
+           "too many columns: " + std::to_string(tokens.size()) +
+               ", expected x y z i j k [spindle]");
     double v[7];
     for (std::size_t c = 0; c < tokens.size(); ++c) v[c] = parseFinite(tokens[c], file, line);
     Posture p;
@@ -138,16 +144,20 @@ void writeClFile(const std::filesystem::path& file, std::span<const Posture> pos
     std::istringstream lines{std::string(comment)};
     for (std::string line; std::getline(lines, line);) text += "# " + line + "\n";
   }
-  text += "# x y z i j k" + std::string(!postures.empty() && postures[0].has_spindle ? " spindle_rad" : "") +
+  text += "# x y z i j k" +
+          std::string(!postures.empty() && postures[0].has_spindle ? " spindle_rad" : "") +
           "  (tool tip, mm; unit tool axis)\n";
   for (const Posture& p : postures) {
-    const double values[] = {p.tip_mm.x(), p.tip_mm.y(), p.tip_mm.z(), p.axis.x(), p.axis.y(), p.axis.z()};
+    const double values[] = {p.tip_mm.x(), p.tip_mm.y(), p.tip_mm.z(),
+                             p.axis.x(),   p.axis.y(),   p.axis.z()};
     for (double v : values) {
       appendNumber(text, v);
       text += ' ';
     }
-    if (p.has_spindle) appendNumber(text, p.spindle_rad);
-    else text.pop_back();
+    if (p.has_spindle)
+      appendNumber(text, p.spindle_rad);
+    else
+      text.pop_back();
     text += '\n';
   }
   common::writeTextAtomically(file, text);
@@ -162,7 +172,8 @@ void writeAptFile(const std::filesystem::path& file, std::span<const Posture> po
                            : t.shape == ToolShape::Torus ? t.corner_radius_mm
                                                          : 0.0;
   std::string text = "PARTNO/" + header.part_name + "\nUNITS/MM\nMULTAX/ON\nCUTTER/";
-  const double cutter[] = {2 * t.radius_mm, corner_mm, t.radius_mm - corner_mm, corner_mm, 0.0, 0.0, t.length_mm};
+  const double cutter[] = {2 * t.radius_mm, corner_mm, t.radius_mm - corner_mm, corner_mm, 0.0, 0.0,
+                           t.length_mm};
   for (double v : cutter) {
     appendNumber(text, v);
     text += ',';
@@ -173,7 +184,8 @@ void writeAptFile(const std::filesystem::path& file, std::span<const Posture> po
   text += '\n';
   for (const Posture& p : postures) {
     text += "GOTO/";
-    const double values[] = {p.tip_mm.x(), p.tip_mm.y(), p.tip_mm.z(), p.axis.x(), p.axis.y(), p.axis.z()};
+    const double values[] = {p.tip_mm.x(), p.tip_mm.y(), p.tip_mm.z(),
+                             p.axis.x(),   p.axis.y(),   p.axis.z()};
     for (double v : values) {
       appendNumber(text, v);
       text += ',';
@@ -192,7 +204,8 @@ std::vector<Posture> readAptFile(const std::filesystem::path& file) {
   std::size_t record_line = 0;
   for (std::size_t line = 1; std::getline(in, text); ++line) {
     std::string_view content(text);
-    while (!content.empty() && std::isspace(static_cast<unsigned char>(content.back()))) content.remove_suffix(1);
+    while (!content.empty() && std::isspace(static_cast<unsigned char>(content.back())))
+      content.remove_suffix(1);
     if (record.empty()) record_line = line;
     if (!content.empty() && content.back() == '$') {
       record += content.substr(0, content.size() - 1);
@@ -204,8 +217,10 @@ std::vector<Posture> readAptFile(const std::filesystem::path& file) {
     const auto slash = statement.find('/');
     if (slash == std::string::npos) continue;
     std::string_view major = std::string_view(statement).substr(0, slash);
-    while (!major.empty() && std::isspace(static_cast<unsigned char>(major.back()))) major.remove_suffix(1);
-    while (!major.empty() && std::isspace(static_cast<unsigned char>(major.front()))) major.remove_prefix(1);
+    while (!major.empty() && std::isspace(static_cast<unsigned char>(major.back())))
+      major.remove_suffix(1);
+    while (!major.empty() && std::isspace(static_cast<unsigned char>(major.front())))
+      major.remove_prefix(1);
     if (major != "GOTO") continue;
     std::vector<double> v;
     std::string_view rest = std::string_view(statement).substr(slash + 1);

@@ -11,16 +11,19 @@
 namespace fieldpath::geometry {
 
 bool MeshReport::closed() const {
-  return triangles > 0 && non_finite_vertices == 0 && degenerate_triangles == 0 && open_edges == 0 &&
-         non_manifold_edges == 0 && inconsistent_edges == 0;
+  return triangles > 0 && non_finite_vertices == 0 && degenerate_triangles == 0 &&
+         open_edges == 0 && non_manifold_edges == 0 && inconsistent_edges == 0;
 }
 
 std::string MeshReport::summary() const {
-  std::string s = std::to_string(vertices) + " vertices, " + std::to_string(triangles) + " triangles";
+  std::string s =
+      std::to_string(vertices) + " vertices, " + std::to_string(triangles) + " triangles";
   if (closed()) return s + ", closed";
   const std::pair<std::size_t, const char*> problems[] = {
-      {non_finite_vertices, "non-finite vertices"}, {degenerate_triangles, "degenerate triangles"},
-      {open_edges, "open edges"},                   {non_manifold_edges, "non-manifold edges"},
+      {non_finite_vertices, "non-finite vertices"},
+      {degenerate_triangles, "degenerate triangles"},
+      {open_edges, "open edges"},
+      {non_manifold_edges, "non-manifold edges"},
       {inconsistent_edges, "inconsistently oriented edges"}};
   if (triangles == 0) s += ", empty";
   for (const auto& [count, what] : problems)
@@ -58,9 +61,12 @@ MeshReport validateMesh(const TriangleMesh& mesh) {
   }
   for (const auto& [edge, uses] : edges) {
     const int total = uses[0] + uses[1];
-    if (total == 1) ++r.open_edges;
-    else if (total > 2) ++r.non_manifold_edges;
-    else if (uses[0] != 1) ++r.inconsistent_edges;
+    if (total == 1)
+      ++r.open_edges;
+    else if (total > 2)
+      ++r.non_manifold_edges;
+    else if (uses[0] != 1)
+      ++r.inconsistent_edges;
   }
   return r;
 }

@@ -6,10 +6,10 @@
 #include <map>
 #include <string>
 
-#include <assimp/Exporter.hpp>
-#include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/errors.h"
@@ -27,13 +27,13 @@ std::string lowerExtension(const std::filesystem::path& file) {
 
 /// A one-mesh assimp scene holding `mesh` (assimp stores single precision).
 void fillScene(aiScene& scene, const TriangleMesh& mesh) {
-  scene.mMaterials = new aiMaterial*[1]{new aiMaterial()};
+  scene.mMaterials = new aiMaterial* [1] { new aiMaterial() };
   scene.mNumMaterials = 1;
   scene.mRootNode = new aiNode();
   scene.mRootNode->mMeshes = new unsigned[1]{0};
   scene.mRootNode->mNumMeshes = 1;
   auto* out = new aiMesh();
-  scene.mMeshes = new aiMesh*[1]{out};
+  scene.mMeshes = new aiMesh* [1] { out };
   scene.mNumMeshes = 1;
   out->mMaterialIndex = 0;
   out->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
@@ -41,7 +41,8 @@ void fillScene(aiScene& scene, const TriangleMesh& mesh) {
   out->mVertices = new aiVector3D[mesh.vertices.size()];
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
     const auto& v = mesh.vertices[i];
-    out->mVertices[i] = aiVector3D(static_cast<ai_real>(v.x()), static_cast<ai_real>(v.y()), static_cast<ai_real>(v.z()));
+    out->mVertices[i] = aiVector3D(static_cast<ai_real>(v.x()), static_cast<ai_real>(v.y()),
+                                   static_cast<ai_real>(v.z()));
   }
   out->mNumFaces = static_cast<unsigned>(mesh.triangles.size());
   out->mFaces = new aiFace[mesh.triangles.size()];
@@ -57,12 +58,14 @@ void fillScene(aiScene& scene, const TriangleMesh& mesh) {
 
 TriangleMesh loadMesh(const std::filesystem::path& file) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(file.string() + ": no such file");
+  if (!std::filesystem::is_regular_file(file, ec))
+    throw InputError(file.string() + ": no such file");
   if (std::filesystem::file_size(file, ec) == 0) throw InputError(file.string() + ": empty file");
 
   Assimp::Importer importer;
   // Points and lines are dropped; polygons are split into triangles; node transforms applied.
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
+                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   const aiScene* scene = nullptr;
   try {
     scene = importer.ReadFile(file.string(), aiProcess_Triangulate | aiProcess_SortByPType |
@@ -72,7 +75,8 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
   }
   if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0) {
     const std::string why = importer.GetErrorString();
-    throw InputError(file.string() + ": cannot read mesh" + (why.empty() ? std::string() : ": " + why));
+    throw InputError(file.string() + ": cannot read mesh" +
+                     (why.empty() ? std::string() : ": " + why));
   }
 
   // Identical positions are joined across faces and meshes (STL stores every corner per face).
@@ -84,14 +88,16 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
     std::vector<int> remap(in->mNumVertices);
     for (unsigned i = 0; i < in->mNumVertices; ++i) {
       const aiVector3D& v = in->mVertices[i];
-      const auto [it, added] = index_of.try_emplace({v.x, v.y, v.z}, static_cast<int>(mesh.vertices.size()));
+      const auto [it, added] =
+          index_of.try_emplace({v.x, v.y, v.z}, static_cast<int>(mesh.vertices.size()));
       if (added) mesh.vertices.emplace_back(v.x, v.y, v.z);
       remap[i] = it->second;
     }
     for (unsigned f = 0; f < in->mNumFaces; ++f) {
       const aiFace& face = in->mFaces[f];
       if (face.mNumIndices != 3) continue;
-      mesh.triangles.emplace_back(remap[face.mIndices[0]], remap[face.mIndices[1]], remap[face.mIndices[2]]);
+      mesh.triangles.emplace_back(remap[face.mIndices[0]], remap[face.mIndices[1]],
+                                  remap[face.mIndices[2]]);
     }
   }
   if (mesh.triangles.empty()) throw InputError(file.string() + ": no triangles in the mesh file");
@@ -100,9 +106,13 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
 
 void saveMesh(const TriangleMesh& mesh, const std::filesystem::path& file) {
   const std::string ext = lowerExtension(file);
-  const char* format = ext == ".stl" ? "stlb" : ext == ".obj" ? "objnomtl" : ext == ".ply" ? "plyb" : nullptr;
+  const char* format = ext == ".stl"   ? "stlb"
+                       : ext == ".obj" ? "objnomtl"
+                       : ext == ".ply" ? "plyb"
+                                       : nullptr;
   if (format == nullptr)
-    throw InputError(file.string() + ": unknown mesh extension '" + ext + "' (use .stl, .obj or .ply)");
+    throw InputError(file.string() + ": unknown mesh extension '" + ext +
+                     "' (use .stl, .obj or .ply)");
   aiScene scene;
   fillScene(scene, mesh);
   Assimp::Exporter exporter;
@@ -110,7 +120,10 @@ void saveMesh(const TriangleMesh& mesh, const std::filesystem::path& file) {
   if (blob == nullptr)
     throw std::runtime_error(file.string() + ": mesh export failed: " + exporter.GetErrorString());
   common::writeFileAtomically(
-      file, [blob](std::ofstream& out) { out.write(static_cast<const char*>(blob->data), static_cast<std::streamsize>(blob->size)); },
+      file,
+      [blob](std::ofstream& out) {
+        out.write(static_cast<const char*>(blob->data), static_cast<std::streamsize>(blob->size));
+      },
       std::ios::out | std::ios::binary);
 }
 

@@ -83,7 +83,9 @@ ProfileSegment cornerArc(Vec2 centre, double radius_mm) {
 
 /// Height (mm) of the cutting end above the tip: where the shank cylinder begins.
 double cuttingEndHeight(const ToolSpec& tool) {
-  return tool.shape == ToolShape::Ball ? tool.radius_mm : tool.shape == ToolShape::Torus ? tool.corner_radius_mm : 0.0;
+  return tool.shape == ToolShape::Ball    ? tool.radius_mm
+         : tool.shape == ToolShape::Torus ? tool.corner_radius_mm
+                                          : 0.0;
 }
 
 /// Tip → side of the shank up to (R, top_z): cutting end then shank cylinder. No top.
@@ -129,7 +131,8 @@ std::vector<Vec2> holderOutline(const ToolSpec& tool, const HolderProfile& holde
         const double z = a.y() + t * (b.y() - a.y());
         if (z < len) cuts.push_back({t, Vec2(big_r, z)});
       }
-      std::sort(cuts.begin(), cuts.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
+      std::sort(cuts.begin(), cuts.end(),
+                [](const auto& u, const auto& v) { return u.first < v.first; });
       for (const auto& cut : cuts) raw.push_back(cut.second);
     }
     raw.push_back(b);
@@ -143,7 +146,8 @@ std::vector<Vec2> holderOutline(const ToolSpec& tool, const HolderProfile& holde
     }
     outline.emplace_back(std::max(u.x(), big_r), u.y());
     // Leaving the tool's top upwards at a radius below R: step in along z = L first.
-    if (u.y() == len && u.x() < big_r && i + 1 < raw.size() && raw[i + 1].y() > len) outline.push_back(u);
+    if (u.y() == len && u.x() < big_r && i + 1 < raw.size() && raw[i + 1].y() > len)
+      outline.push_back(u);
   }
   return outline;
 }
@@ -159,7 +163,8 @@ Profile fullProfile(const ToolSpec& tool, const HolderProfile& holder) {
   }
   if (!(holder.front().z_mm > cuttingEndHeight(tool)))
     throw InputError("holder starts at z " + std::to_string(holder.front().z_mm) +
-                     " mm, not above the cutting end of the tool (" + std::to_string(cuttingEndHeight(tool)) + " mm)");
+                     " mm, not above the cutting end of the tool (" +
+                     std::to_string(cuttingEndHeight(tool)) + " mm)");
   // The shank runs up to the first station, also past L into a holder that starts above the tool.
   Profile p = toolSide(tool, holder.front().z_mm);
   // Pieces on the shank cylinder below L are tool surface; the rest is holder.
@@ -190,7 +195,8 @@ double angularStep(double radius_mm, double sagitta_mm) {
 double parseNumberField(std::string_view token, std::string_view what, std::string_view text) {
   double value = 0;
   const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-  if (token.empty() || ec != std::errc() || end != token.data() + token.size() || !std::isfinite(value))
+  if (token.empty() || ec != std::errc() || end != token.data() + token.size() ||
+      !std::isfinite(value))
     throw InputError(std::string(what) + " '" + std::string(text) + "': '" + std::string(token) +
                      "' is not a finite number");
   return value;
@@ -200,7 +206,8 @@ std::vector<std::string_view> split(std::string_view text, char separator) {
   std::vector<std::string_view> parts;
   for (std::size_t start = 0;;) {
     const auto end = text.find(separator, start);
-    parts.push_back(text.substr(start, end == std::string_view::npos ? std::string_view::npos : end - start));
+    parts.push_back(
+        text.substr(start, end == std::string_view::npos ? std::string_view::npos : end - start));
     if (end == std::string_view::npos) return parts;
     start = end + 1;
   }
@@ -223,14 +230,16 @@ ToolSpec parseToolSpec(std::string_view text) {
     tool.shape = ToolShape::Flat;
     needed = 2;
   } else {
-    throw InputError("tool shape '" + std::string(text) + "': expected ball:R[:L], torus:R:r[:L] or flat:R[:L]");
+    throw InputError("tool shape '" + std::string(text) +
+                     "': expected ball:R[:L], torus:R:r[:L] or flat:R[:L]");
   }
   if (fields.size() != needed && fields.size() != needed + 1)
     throw InputError("tool shape '" + std::string(text) + "': expected " +
                      (needed == 3 ? "torus:R:r[:L]" : std::string(name) + ":R[:L]"));
   tool.radius_mm = parseNumberField(fields[1], "tool shape", text);
   tool.corner_radius_mm = needed == 3 ? parseNumberField(fields[2], "tool shape", text) : 0.0;
-  tool.length_mm = fields.size() > needed ? parseNumberField(fields[needed], "tool shape", text) : 4.0 * tool.radius_mm;
+  tool.length_mm = fields.size() > needed ? parseNumberField(fields[needed], "tool shape", text)
+                                          : 4.0 * tool.radius_mm;
   try {
     validateToolSpec(tool);
   } catch (const InputError& e) {
@@ -245,8 +254,10 @@ HolderProfile parseHolderProfile(std::string_view text) {
   for (std::string_view station : split(text, ',')) {
     const auto zr = split(station, ':');
     if (zr.size() != 2)
-      throw InputError("holder '" + std::string(text) + "': station '" + std::string(station) + "' is not z:r");
-    holder.push_back({parseNumberField(zr[0], "holder", text), parseNumberField(zr[1], "holder", text)});
+      throw InputError("holder '" + std::string(text) + "': station '" + std::string(station) +
+                       "' is not z:r");
+    holder.push_back(
+        {parseNumberField(zr[0], "holder", text), parseNumberField(zr[1], "holder", text)});
   }
   try {
     validateHolderProfile(holder);
@@ -257,13 +268,15 @@ HolderProfile parseHolderProfile(std::string_view text) {
 }
 
 void validateToolSpec(const ToolSpec& tool) {
-  if (!std::isfinite(tool.radius_mm) || !(tool.radius_mm > 0)) throw InputError("tool radius must be > 0");
+  if (!std::isfinite(tool.radius_mm) || !(tool.radius_mm > 0))
+    throw InputError("tool radius must be > 0");
   if (tool.shape == ToolShape::Torus &&
       !(tool.corner_radius_mm > 0 && tool.corner_radius_mm <= tool.radius_mm))
     throw InputError("corner radius must be in (0, R]");
   const double end_mm = cuttingEndHeight(tool);
   if (!std::isfinite(tool.length_mm) || !(tool.length_mm >= end_mm) || !(tool.length_mm > 0))
-    throw InputError("tool length must cover the cutting end (>= " + std::to_string(end_mm) + " mm)");
+    throw InputError("tool length must cover the cutting end (>= " + std::to_string(end_mm) +
+                     " mm)");
 }
 
 void validateHolderProfile(const HolderProfile& holder) {
@@ -290,8 +303,10 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
 
   // A triangle spanning a profile step and a circumferential step deviates from the surface by
   // about the sum of both sagittas (to leading order), so with arcs in the profile each gets under
-  // half the tolerance; straight profiles (cylinders, cones, planes) have only the circumferential one.
-  const bool has_arcs = std::any_of(profile.begin(), profile.end(), [](const ProfileSegment& s) { return s.is_arc; });
+  // half the tolerance; straight profiles (cylinders, cones, planes) have only the circumferential
+  // one.
+  const bool has_arcs =
+      std::any_of(profile.begin(), profile.end(), [](const ProfileSegment& s) { return s.is_arc; });
   const double sagitta_mm = (has_arcs ? 0.45 : 0.9) * chord_tol_mm;
 
   // Refuse tolerances that would not fit in memory (bad input must not crash or hang).
@@ -302,15 +317,17 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
   }
   const double triangles_estimate = 2 * rings * (2 * kPi / angularStep(max_rho_mm, sagitta_mm) + 8);
   if (triangles_estimate > kMaxTriangles)
-    throw InputError("chordal tolerance " + std::to_string(chord_tol_mm) + " mm is too fine: about " +
-                     std::to_string(static_cast<long long>(triangles_estimate)) + " triangles (limit " +
-                     std::to_string(static_cast<long long>(kMaxTriangles)) + ")");
+    throw InputError(
+        "chordal tolerance " + std::to_string(chord_tol_mm) + " mm is too fine: about " +
+        std::to_string(static_cast<long long>(triangles_estimate)) + " triangles (limit " +
+        std::to_string(static_cast<long long>(kMaxTriangles)) + ")");
 
   // Profile points from the tip to the top; arcs subdivided, straight pieces left whole.
   std::vector<Vec2> points{profile.front().from};
   for (const auto& s : profile) {
     const int pieces =
-        s.is_arc ? std::max(1, static_cast<int>(std::ceil((s.end_rad - s.start_rad) / angularStep(s.radius_mm, sagitta_mm))))
+        s.is_arc ? std::max(1, static_cast<int>(std::ceil((s.end_rad - s.start_rad) /
+                                                          angularStep(s.radius_mm, sagitta_mm))))
                  : 1;
     for (int i = 1; i <= pieces; ++i) points.push_back(s.at(static_cast<double>(i) / pieces));
   }
@@ -331,7 +348,8 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
       continue;
     }
     const double widest_mm = std::max({rho_mm, points[k - 1].x(), points[k + 1].x()});
-    sectors[k] = std::max(8, static_cast<int>(std::ceil(2 * kPi / angularStep(widest_mm, sagitta_mm))));
+    sectors[k] =
+        std::max(8, static_cast<int>(std::ceil(2 * kPi / angularStep(widest_mm, sagitta_mm))));
     for (int j = 0; j < sectors[k]; ++j) {
       const double a = 2 * kPi * j / sectors[k];
       mesh.vertices.emplace_back(rho_mm * std::cos(a), rho_mm * std::sin(a), z_mm);
@@ -345,7 +363,8 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
     const auto hi = [&](int j) { return first[k + 1] + j % n_hi; };
     for (int i = 0, j = 0; i < n_lo || j < n_hi;) {
       // next lower angle 2π(i+1)/n_lo <= next upper angle 2π(j+1)/n_hi, compared exactly
-      const bool advance_lo = i < n_lo && (j == n_hi || static_cast<long>(i + 1) * n_hi <= static_cast<long>(j + 1) * n_lo);
+      const bool advance_lo = i < n_lo && (j == n_hi || static_cast<long>(i + 1) * n_hi <=
+                                                            static_cast<long>(j + 1) * n_lo);
       if (advance_lo) {
         if (n_lo > 1) mesh.triangles.emplace_back(lo(i), lo(i + 1), hi(j));
         ++i;
@@ -358,15 +377,18 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
   return mesh;
 }
 
-std::vector<SurfaceNode> surfaceNodes(const ToolSpec& tool, const HolderProfile& holder, double spacing_mm) {
+std::vector<SurfaceNode> surfaceNodes(const ToolSpec& tool, const HolderProfile& holder,
+                                      double spacing_mm) {
   validateToolSpec(tool);
   validateHolderProfile(holder);
-  if (!std::isfinite(spacing_mm) || !(spacing_mm > 0)) throw InputError("node spacing must be a finite number > 0 mm");
+  if (!std::isfinite(spacing_mm) || !(spacing_mm > 0))
+    throw InputError("node spacing must be a finite number > 0 mm");
   const Profile profile = fullProfile(tool, holder);
 
   double nodes_estimate = 0;
   for (const auto& s : profile)
-    nodes_estimate += (s.length() / spacing_mm + 2) * (2 * kPi * std::max(s.from.x(), s.to.x()) / spacing_mm + 1);
+    nodes_estimate +=
+        (s.length() / spacing_mm + 2) * (2 * kPi * std::max(s.from.x(), s.to.x()) / spacing_mm + 1);
   if (nodes_estimate > kMaxNodes)
     throw InputError("node spacing " + std::to_string(spacing_mm) + " mm is too fine: about " +
                      std::to_string(static_cast<long long>(nodes_estimate)) + " nodes");
@@ -400,9 +422,11 @@ double toolSurfaceDistance(const ToolSpec& tool, const Vec3& point_tool_frame_mm
   return toolSurfaceDistance(tool, {}, point_tool_frame_mm);
 }
 
-double toolSurfaceDistance(const ToolSpec& tool, const HolderProfile& holder, const Vec3& point_tool_frame_mm) {
+double toolSurfaceDistance(const ToolSpec& tool, const HolderProfile& holder,
+                           const Vec3& point_tool_frame_mm) {
   const Profile profile = fullProfile(tool, holder);
-  const Vec2 q(std::hypot(point_tool_frame_mm.x(), point_tool_frame_mm.y()), point_tool_frame_mm.z());
+  const Vec2 q(std::hypot(point_tool_frame_mm.x(), point_tool_frame_mm.y()),
+               point_tool_frame_mm.z());
   double distance_mm = std::numeric_limits<double>::infinity();
   for (const auto& s : profile) distance_mm = std::min(distance_mm, s.distance(q));
   return distance_mm;

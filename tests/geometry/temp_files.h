@@ -9,7 +9,8 @@
 namespace fieldpath::geometry::test_files {
 
 inline std::filesystem::path tempPath(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("fieldpath_test_geometry_" + std::to_string(::getpid()));
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("fieldpath_test_geometry_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   return dir / name;
 }

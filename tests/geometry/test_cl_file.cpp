@@ -24,8 +24,10 @@ void expectSame(const std::vector<Posture>& a, const std::vector<Posture>& b) {
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     for (int c = 0; c < 3; ++c) {
-      EXPECT_TRUE(bitwiseEqual(a[i].tip_mm[c], b[i].tip_mm[c])) << i << " " << a[i].tip_mm[c] << " " << b[i].tip_mm[c];
-      EXPECT_TRUE(bitwiseEqual(a[i].axis[c], b[i].axis[c])) << i << " " << a[i].axis[c] << " " << b[i].axis[c];
+      EXPECT_TRUE(bitwiseEqual(a[i].tip_mm[c], b[i].tip_mm[c]))
+          << i << " " << a[i].tip_mm[c] << " " << b[i].tip_mm[c];
+      EXPECT_TRUE(bitwiseEqual(a[i].axis[c], b[i].axis[c]))
+          << i << " " << a[i].axis[c] << " " << b[i].axis[c];
     }
     EXPECT_EQ(a[i].has_spindle, b[i].has_spindle);
     EXPECT_TRUE(bitwiseEqual(a[i].spindle_rad, b[i].spindle_rad));
@@ -68,7 +70,8 @@ void expectClError(const std::string& text, int line, const std::string& what) {
 }  // namespace
 
 TEST(ClFile, ClosedFormRead) {
-  const auto p = readClFile(writeBytes("one.cl", "# header\n\n1 2 3 0 0 1   # trailing\n  4\t5 6 0 1 0 0.5\r\n"));
+  const auto p = readClFile(
+      writeBytes("one.cl", "# header\n\n1 2 3 0 0 1   # trailing\n  4\t5 6 0 1 0 0.5\r\n"));
   ASSERT_EQ(p.size(), 2u);
   EXPECT_EQ(p[0].tip_mm, Vec3(1, 2, 3));
   EXPECT_EQ(p[0].axis, Vec3::UnitZ());
@@ -136,8 +139,8 @@ TEST(AptFile, WritesHeaderAndParsesBackExactly) {
   writeAptFile(p, postures, header);
   std::ifstream in(p);
   std::string l1, l2, l3, l4, l5, l6;
-  std::getline(in, l1), std::getline(in, l2), std::getline(in, l3), std::getline(in, l4), std::getline(in, l5),
-      std::getline(in, l6);
+  std::getline(in, l1), std::getline(in, l2), std::getline(in, l3), std::getline(in, l4),
+      std::getline(in, l5), std::getline(in, l6);
   EXPECT_EQ(l1, "PARTNO/IMPELLER");
   EXPECT_EQ(l2, "UNITS/MM");
   EXPECT_EQ(l3, "MULTAX/ON");
@@ -155,7 +158,8 @@ TEST(AptFile, WritesHeaderAndParsesBackExactly) {
 }
 
 TEST(AptFile, ReadsContinuationAndRejectsBadGoto) {
-  const auto p = readAptFile(writeBytes("c.apt", "PARTNO/X\nGOTO/1,2,$\n 3,0,0,1\nGOTO/4,5,6\nFINI\n"));
+  const auto p =
+      readAptFile(writeBytes("c.apt", "PARTNO/X\nGOTO/1,2,$\n 3,0,0,1\nGOTO/4,5,6\nFINI\n"));
   ASSERT_EQ(p.size(), 2u);
   EXPECT_EQ(p[0].tip_mm, Vec3(1, 2, 3));
   EXPECT_EQ(p[1].tip_mm, Vec3(4, 5, 6));

@@ -31,19 +31,22 @@ std::string slurp(const fs::path& p) {
 /// Runs the built `fieldpath` with `args` (shell words), capturing exit code, stdout and stderr.
 ProcessResult runFieldpath(const std::string& args) {
   const fs::path out = tempPath("cli.out"), err = tempPath("cli.err");
-  const std::string cmd =
-      std::string("'") + FIELDPATH_EXE + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
+  const std::string cmd = std::string("'") + FIELDPATH_EXE + "' " + args + " >'" + out.string() +
+                          "' 2>'" + err.string() + "'";
   const int status = std::system(cmd.c_str());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
 }
 
-std::size_t lines(const std::string& s) { return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n')); }
+std::size_t lines(const std::string& s) {
+  return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
+}
 
 }  // namespace
 
 TEST(CliTool, WritesAClosedMesh) {
   const fs::path out = tempPath("cli_tool.stl");
-  const ProcessResult r = runFieldpath("tool --shape ball:3:12 --holder 12:5,30:5 --tol 0.01 --out '" + out.string() + "'");
+  const ProcessResult r = runFieldpath(
+      "tool --shape ball:3:12 --holder 12:5,30:5 --tol 0.01 --out '" + out.string() + "'");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(lines(r.out), 1u) << r.out;
   EXPECT_NE(r.out.find("closed yes"), std::string::npos) << r.out;
@@ -53,8 +56,9 @@ TEST(CliTool, WritesAClosedMesh) {
 
 TEST(CliTool, BadInputIsOneLineAndExitOne) {
   const fs::path out = tempPath("cli_bad.stl");
-  for (const std::string args : {"--shape cone:3", "--shape ball:3 --tol 0", "--shape ball:3 --tol -1",
-                                 "--shape ball:3 --holder 5:1", "--shape torus:3:4"}) {
+  for (const std::string args :
+       {"--shape cone:3", "--shape ball:3 --tol 0", "--shape ball:3 --tol -1",
+        "--shape ball:3 --holder 5:1", "--shape torus:3:4"}) {
     const ProcessResult r = runFieldpath("tool " + args + " --out '" + out.string() + "'");
     EXPECT_EQ(r.exit_code, 1) << args;
     EXPECT_EQ(lines(r.err), 1u) << args << ": " << r.err;

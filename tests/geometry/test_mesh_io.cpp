@@ -71,10 +71,13 @@ TEST(MeshIo, AsciiStlClosedForm) {
 TEST(MeshIo, AsciiPlyAndObjWithQuadsClosedForm) {
   // Unit cube as six quads: split into 12 triangles, 8 vertices, volume 1.
   const char* quads = "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
-  std::string obj, ply = "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
-                         "property float z\nelement face 6\nproperty list uchar int vertex_indices\nend_header\n";
+  std::string obj,
+      ply =
+          "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
+          "property float z\nelement face 6\nproperty list uchar int vertex_indices\nend_header\n";
   for (int i = 0; i < 8; ++i) {
-    const std::string v = std::to_string(i & 1) + " " + std::to_string((i >> 1) & 1) + " " + std::to_string((i >> 2) & 1);
+    const std::string v = std::to_string(i & 1) + " " + std::to_string((i >> 1) & 1) + " " +
+                          std::to_string((i >> 2) & 1);
     obj += "v " + v + "\n";
     ply += v + "\n";
   }
@@ -92,7 +95,8 @@ TEST(MeshIo, AsciiPlyAndObjWithQuadsClosedForm) {
 }
 
 TEST(MeshIo, RoundTripsStlObjPly) {
-  const TriangleMesh tool = toolMesh(parseToolSpec("torus:5:1:20"), parseHolderProfile("20:8,35:8"), 0.01);
+  const TriangleMesh tool =
+      toolMesh(parseToolSpec("torus:5:1:20"), parseHolderProfile("20:8,35:8"), 0.01);
   for (const char* ext : {".stl", ".obj", ".ply", ".STL"}) {
     SCOPED_TRACE(ext);
     const fs::path p = tempPath(std::string("tool") + ext);
@@ -106,7 +110,9 @@ TEST(MeshIo, RoundTripsStlObjPly) {
     // Same triangles in the same order, vertices to single precision.
     for (std::size_t t = 0; t < tool.triangles.size(); t += 97)
       for (int c = 0; c < 3; ++c)
-        EXPECT_LT((back.vertices[back.triangles[t][c]] - tool.vertices[tool.triangles[t][c]]).norm(), 1e-5);
+        EXPECT_LT(
+            (back.vertices[back.triangles[t][c]] - tool.vertices[tool.triangles[t][c]]).norm(),
+            1e-5);
   }
   EXPECT_THROW(saveMesh(tool, tempPath("tool.xyz")), InputError);
 }
@@ -137,7 +143,8 @@ TEST(MeshIo, BrokenFilesAreInputErrors) {
 TEST(MeshIo, DefectiveMeshesLoadAndAreReported) {
   // Tetrahedron with one facet missing: loads, three open edges.
   std::string open = kAsciiTetra;
-  open.erase(open.find("facet normal 1 1 1"), open.find("endsolid") - open.find("facet normal 1 1 1"));
+  open.erase(open.find("facet normal 1 1 1"),
+             open.find("endsolid") - open.find("facet normal 1 1 1"));
   const TriangleMesh m = loadMesh(writeBytes("open.stl", open));
   const MeshReport r = validateMesh(m);
   EXPECT_EQ(r.triangles, 3u);

@@ -24,19 +24,25 @@ struct Analytic {
 
 Analytic analytic(const ToolSpec& t) {
   const double big_r = t.radius_mm, len = t.length_mm;
-  const double r = t.shape == ToolShape::Ball ? big_r : t.shape == ToolShape::Torus ? t.corner_radius_mm : 0.0;
+  const double r = t.shape == ToolShape::Ball    ? big_r
+                   : t.shape == ToolShape::Torus ? t.corner_radius_mm
+                                                 : 0.0;
   const double c = big_r - r;
   Analytic a;
   // bottom disc + corner (quarter torus) + cylinder + top disc
-  a.area_mm2 = kPi * c * c + 2 * kPi * r * (c * kPi / 2 + r) + 2 * kPi * big_r * (len - r) + kPi * big_r * big_r;
-  a.volume_mm3 = kPi * (c * c * r + kPi * c * r * r / 2 + 2 * r * r * r / 3) + kPi * big_r * big_r * (len - r);
-  // ∫H dA: corner π(cπ/2 + 2r) (for r = 0 this is the bottom rim edge), cylinder π(L - r), top rim π²R/2.
-  a.mean_curvature_integral_mm = kPi * (c * kPi / 2 + 2 * r) + kPi * (len - r) + kPi * kPi * big_r / 2;
+  a.area_mm2 = kPi * c * c + 2 * kPi * r * (c * kPi / 2 + r) + 2 * kPi * big_r * (len - r) +
+               kPi * big_r * big_r;
+  a.volume_mm3 =
+      kPi * (c * c * r + kPi * c * r * r / 2 + 2 * r * r * r / 3) + kPi * big_r * big_r * (len - r);
+  // ∫H dA: corner π(cπ/2 + 2r) (for r = 0 this is the bottom rim edge), cylinder π(L - r), top rim
+  // π²R/2.
+  a.mean_curvature_integral_mm =
+      kPi * (c * kPi / 2 + 2 * r) + kPi * (len - r) + kPi * kPi * big_r / 2;
   return a;
 }
 
 std::vector<ToolSpec> sampleTools() {
-  return {parseToolSpec("ball:3"), parseToolSpec("ball:3:3"), parseToolSpec("torus:5:1:25"),
+  return {parseToolSpec("ball:3"),      parseToolSpec("ball:3:3"),  parseToolSpec("torus:5:1:25"),
           parseToolSpec("torus:2:2:8"), parseToolSpec("flat:4:10"), parseToolSpec("ball:0.5:30")};
 }
 
@@ -52,9 +58,9 @@ TEST(ToolModel, ParseToolSpec) {
   EXPECT_EQ(t.corner_radius_mm, 1.5);
   EXPECT_EQ(t.length_mm, 30.0);
   EXPECT_EQ(parseToolSpec("flat:2:7").length_mm, 7.0);
-  for (const char* bad : {"", "ball", "ball:", "ball:-1", "ball:0", "ball:3:2", "ball:3:x", "ball:3:12:1",
-                          "torus:3", "torus:3:4", "torus:3:0", "cone:3", "flat:nan", "flat:inf", "ball:3 ",
-                          "ball:1e999"}) {
+  for (const char* bad :
+       {"", "ball", "ball:", "ball:-1", "ball:0", "ball:3:2", "ball:3:x", "ball:3:12:1", "torus:3",
+        "torus:3:4", "torus:3:0", "cone:3", "flat:nan", "flat:inf", "ball:3 ", "ball:1e999"}) {
     EXPECT_THROW(parseToolSpec(bad), InputError) << bad;
   }
 }
@@ -65,27 +71,29 @@ TEST(ToolModel, ParseHolderProfile) {
   EXPECT_EQ(h[2].z_mm, 55.0);
   EXPECT_EQ(h[2].radius_mm, 12.0);
   EXPECT_TRUE(parseHolderProfile("").empty());
-  for (const char* bad : {"40", "40:6", "40:6,30:8", "40:6,40:6", "40:0,50:6", "40:6,,50:6", "a:b,1:2", "40:6:1,50:2"})
+  for (const char* bad : {"40", "40:6", "40:6,30:8", "40:6,40:6", "40:0,50:6", "40:6,,50:6",
+                          "a:b,1:2", "40:6:1,50:2"})
     EXPECT_THROW(parseHolderProfile(bad), InputError) << bad;
 }
 
 TEST(ToolModel, DistanceToAnalyticSurfaceClosedForm) {
   const ToolSpec ball = parseToolSpec("ball:3:12");
   EXPECT_NEAR(toolSurfaceDistance(ball, Vec3(0, 0, 0)), 0.0, 1e-15);
-  EXPECT_NEAR(toolSurfaceDistance(ball, Vec3(0, 0, 3)), 3.0, 1e-15);        // ball centre
-  EXPECT_NEAR(toolSurfaceDistance(ball, Vec3(0, 0, -1)), 1.0, 1e-15);       // below the tip
-  EXPECT_NEAR(toolSurfaceDistance(ball, Vec3(0, 5, 8)), 2.0, 1e-15);        // beside the shank
-  EXPECT_NEAR(toolSurfaceDistance(ball, Vec3(0, 0, 13)), 1.0, 1e-15);       // above the top
+  EXPECT_NEAR(toolSurfaceDistance(ball, Vec3(0, 0, 3)), 3.0, 1e-15);   // ball centre
+  EXPECT_NEAR(toolSurfaceDistance(ball, Vec3(0, 0, -1)), 1.0, 1e-15);  // below the tip
+  EXPECT_NEAR(toolSurfaceDistance(ball, Vec3(0, 5, 8)), 2.0, 1e-15);   // beside the shank
+  EXPECT_NEAR(toolSurfaceDistance(ball, Vec3(0, 0, 13)), 1.0, 1e-15);  // above the top
   EXPECT_NEAR(toolSurfaceDistance(ball, Vec3(4, 0, 13)), std::sqrt(2.0), 1e-15);  // off the rim
   const ToolSpec torus = parseToolSpec("torus:5:1:20");
-  EXPECT_NEAR(toolSurfaceDistance(torus, Vec3(2, 0, -0.5)), 0.5, 1e-15);    // below the flat bottom
-  EXPECT_NEAR(toolSurfaceDistance(torus, Vec3(4, 0, 1)), 1.0, 1e-15);       // corner centre circle
+  EXPECT_NEAR(toolSurfaceDistance(torus, Vec3(2, 0, -0.5)), 0.5, 1e-15);  // below the flat bottom
+  EXPECT_NEAR(toolSurfaceDistance(torus, Vec3(4, 0, 1)), 1.0, 1e-15);     // corner centre circle
 }
 
 TEST(ToolModel, MeshesAreClosedAndWithinTolerance) {
   for (const ToolSpec& tool : sampleTools()) {
     for (double tol : {0.05, 0.01, 0.001}) {
-      SCOPED_TRACE(testing::Message() << "R " << tool.radius_mm << " shape " << int(tool.shape) << " tol " << tol);
+      SCOPED_TRACE(testing::Message()
+                   << "R " << tool.radius_mm << " shape " << int(tool.shape) << " tol " << tol);
       const TriangleMesh mesh = toolMesh(tool, {}, tol);
       const MeshReport report = validateMesh(mesh);
       ASSERT_TRUE(report.closed()) << report.summary();
@@ -93,14 +101,16 @@ TEST(ToolModel, MeshesAreClosedAndWithinTolerance) {
       // Vertices on the surface; every point of a barycentric grid (centroid and edge midpoints
       // included) within the tolerance.
       double max_vertex_mm = 0, max_interior_mm = 0;
-      for (const auto& v : mesh.vertices) max_vertex_mm = std::max(max_vertex_mm, toolSurfaceDistance(tool, v));
+      for (const auto& v : mesh.vertices)
+        max_vertex_mm = std::max(max_vertex_mm, toolSurfaceDistance(tool, v));
       for (const auto& t : mesh.triangles) {
         const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
         max_interior_mm = std::max(max_interior_mm, toolSurfaceDistance(tool, (a + b + c) / 3));
         constexpr int n = 4;
         for (int i = 0; i <= n; ++i)
           for (int j = 0; i + j <= n; ++j)
-            max_interior_mm = std::max(max_interior_mm, toolSurfaceDistance(tool, a + (i * (b - a) + j * (c - a)) / n));
+            max_interior_mm = std::max(
+                max_interior_mm, toolSurfaceDistance(tool, a + (i * (b - a) + j * (c - a)) / n));
       }
       EXPECT_LT(max_vertex_mm, 1e-12);
       EXPECT_LE(max_interior_mm, tol);
@@ -143,7 +153,8 @@ TEST(ToolModel, HolderJoinsTheToolIntoOneClosedSolid) {
     const double r = 3, shank_top = holder.front().z_mm;
     double exact_mm3 = 2 * kPi / 3 * r * r * r + kPi * r * r * (shank_top - r);
     for (std::size_t i = 0; i + 1 < holder.size(); ++i) {
-      const double h = holder[i + 1].z_mm - holder[i].z_mm, a = holder[i].radius_mm, b = holder[i + 1].radius_mm;
+      const double h = holder[i + 1].z_mm - holder[i].z_mm, a = holder[i].radius_mm,
+                   b = holder[i + 1].radius_mm;
       exact_mm3 += kPi * h * (a * a + a * b + b * b) / 3;  // frustum
     }
     EXPECT_LT(meshVolume(mesh), exact_mm3);
@@ -152,7 +163,8 @@ TEST(ToolModel, HolderJoinsTheToolIntoOneClosedSolid) {
     for (const auto& v : mesh.vertices) top = std::max(top, v.z());
     EXPECT_EQ(top, holder.back().z_mm);
   }
-  EXPECT_THROW(toolMesh(tool, parseHolderProfile("2:6,50:6"), 0.01), InputError);  // below the ball's top
+  EXPECT_THROW(toolMesh(tool, parseHolderProfile("2:6,50:6"), 0.01),
+               InputError);  // below the ball's top
 }
 
 TEST(ToolModel, HolderOverlappingTheShankIsTheUnion) {
@@ -163,17 +175,19 @@ TEST(ToolModel, HolderOverlappingTheShankIsTheUnion) {
     double volume_over_pi;
   };
   const Case cases[] = {
-      {"30:6,50:6", 18 + 9 * 27 + 36 * 20},                    // holder swallows the shank top
+      {"30:6,50:6", 18 + 9 * 27 + 36 * 20},                      // holder swallows the shank top
       {"30:2,36:8,50:8", 18 + 9 * 28 + 5.0 * 97 / 3 + 64 * 14},  // cone crosses R at z 31
-      {"20:5,30:5", 18 + 9 * 17 + 25 * 10 + 9 * 10},           // collar, shank and top above it
-      {"30:2,40:2,50:6", 18 + 9 * 37 + 10.0 * (4 + 12 + 36) / 3},  // narrower than R up to L, then wider
-      {"35:4,40:4,40:1,45:1", 18 + 9 * 32 + 16 * 5 + 1 * 5},   // steps in to a neck at L
+      {"20:5,30:5", 18 + 9 * 17 + 25 * 10 + 9 * 10},             // collar, shank and top above it
+      {"30:2,40:2,50:6",
+       18 + 9 * 37 + 10.0 * (4 + 12 + 36) / 3},               // narrower than R up to L, then wider
+      {"35:4,40:4,40:1,45:1", 18 + 9 * 32 + 16 * 5 + 1 * 5},  // steps in to a neck at L
   };
   for (const Case& c : cases) {
     const HolderProfile holder = parseHolderProfile(c.holder);
     const TriangleMesh mesh = toolMesh(tool, holder, 0.002);
     EXPECT_TRUE(validateMesh(mesh).closed()) << c.holder << ": " << validateMesh(mesh).summary();
-    for (const auto& v : mesh.vertices) ASSERT_LT(toolSurfaceDistance(tool, holder, v), 1e-12) << c.holder;
+    for (const auto& v : mesh.vertices)
+      ASSERT_LT(toolSurfaceDistance(tool, holder, v), 1e-12) << c.holder;
     const double exact = kPi * c.volume_over_pi;
     EXPECT_LT(meshVolume(mesh), exact) << c.holder;
     EXPECT_LT(exact - meshVolume(mesh), 0.002 * meshArea(mesh)) << c.holder;  // chordal shell
@@ -195,7 +209,8 @@ TEST(ToolModel, HolderMeshesWithinTolerance) {
       for (const auto& v : mesh.vertices) EXPECT_LT(toolSurfaceDistance(tool, holder, v), 1e-12);
       for (const auto& t : mesh.triangles) {
         const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
-        for (const Vec3& p : {Vec3((a + b + c) / 3), Vec3((a + b) / 2), Vec3((b + c) / 2), Vec3((c + a) / 2)})
+        for (const Vec3& p :
+             {Vec3((a + b + c) / 3), Vec3((a + b) / 2), Vec3((b + c) / 2), Vec3((c + a) / 2)})
           max_mm = std::max(max_mm, toolSurfaceDistance(tool, holder, p));
       }
       EXPECT_LE(max_mm, tol);
@@ -226,8 +241,10 @@ TEST(ToolModel, SurfaceNodesLieOnTheSurfaceAboutSpacingApart) {
         EXPECT_NEAR(toolSurfaceDistance(tool, n.position_mm + 1e-3 * n.normal), 1e-3, 1e-9);
       }
       // The tip is a node.
-      EXPECT_TRUE(std::any_of(nodes.begin(), nodes.end(), [](const SurfaceNode& n) { return n.position_mm == Vec3::Zero(); }));
-      // Coverage: random points of the analytic surface (from a fine mesh) are within `spacing` of a node.
+      EXPECT_TRUE(std::any_of(nodes.begin(), nodes.end(),
+                              [](const SurfaceNode& n) { return n.position_mm == Vec3::Zero(); }));
+      // Coverage: random points of the analytic surface (from a fine mesh) are within `spacing` of
+      // a node.
       const TriangleMesh fine = toolMesh(tool, {}, 1e-3);
       std::mt19937 rng(7);
       std::uniform_int_distribution<std::size_t> pick(0, fine.vertices.size() - 1);
@@ -250,7 +267,8 @@ TEST(ToolModel, HolderNodesAreMarked) {
   const auto nodes = surfaceNodes(tool, parseHolderProfile("40:6,55:6,55:12,90:12"), 1.0);
   std::size_t holder_nodes = 0;
   for (const auto& n : nodes) {
-    EXPECT_LT(toolSurfaceDistance(tool, parseHolderProfile("40:6,55:6,55:12,90:12"), n.position_mm), 1e-12);
+    EXPECT_LT(toolSurfaceDistance(tool, parseHolderProfile("40:6,55:6,55:12,90:12"), n.position_mm),
+              1e-12);
     if (n.part == NodePart::Tool) {
       EXPECT_LE(n.position_mm.z(), 40.0);
       EXPECT_LT(toolSurfaceDistance(tool, n.position_mm), 1e-12);

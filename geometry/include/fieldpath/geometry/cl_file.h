@@ -13,8 +13,8 @@
 namespace fieldpath::geometry {
 
 /// Reads a `.cl` file. Axes off unit length by < 1e-3 are normalised. Throws common::InputError
-/// "FILE:LINE: reason" for non-finite numbers, short/long lines, zero or non-unit axes, garbage, and
-/// "FILE: reason" for a missing file or one without postures.
+/// "FILE:LINE: reason" for non-finite numbers, short/long lines, zero or non-unit axes, garbage,
+/// and "FILE: reason" for a missing file or one without postures.
 std::vector<Posture> readClFile(const std::filesystem::path& file);
 
 /// Writes a `.cl` file atomically, numbers in shortest round-trip form (reading it back gives the

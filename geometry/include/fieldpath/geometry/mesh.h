@@ -1,5 +1,6 @@
 #pragma once
-/// Indexed triangle meshes (mm). Orientation: counter-clockwise seen from outside (outward normals).
+/// Indexed triangle meshes (mm). Orientation: counter-clockwise seen from outside (outward
+/// normals).
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -13,7 +14,8 @@ struct TriangleMesh {
   std::vector<Eigen::Vector3i> triangles;  ///< vertex indices, CCW from outside
 };
 
-/// Counts of what is wrong with a mesh (nothing is repaired). Edges are undirected vertex-index pairs.
+/// Counts of what is wrong with a mesh (nothing is repaired). Edges are undirected vertex-index
+/// pairs.
 struct MeshReport {
   std::size_t vertices = 0;
   std::size_t triangles = 0;
@@ -32,7 +34,8 @@ struct MeshReport {
 MeshReport validateMesh(const TriangleMesh& mesh);
 /// Total triangle area, mm².
 double meshArea(const TriangleMesh& mesh);
-/// Signed enclosed volume (divergence theorem), mm³; positive for outward orientation of a closed mesh.
+/// Signed enclosed volume (divergence theorem), mm³; positive for outward orientation of a closed
+/// mesh.
 double meshVolume(const TriangleMesh& mesh);
 
 }  // namespace fieldpath::geometry

@@ -11,8 +11,8 @@ namespace fieldpath::geometry {
 /// Throws common::InputError "FILE: reason" for a missing, unreadable, broken or empty file.
 TriangleMesh loadMesh(const std::filesystem::path& file);
 
-/// Writes by extension: .stl (binary), .obj, .ply (binary); atomically (temporary name, then rename).
-/// Throws common::InputError for an unknown extension.
+/// Writes by extension: .stl (binary), .obj, .ply (binary); atomically (temporary name, then
+/// rename). Throws common::InputError for an unknown extension.
 void saveMesh(const TriangleMesh& mesh, const std::filesystem::path& file);
 
 }  // namespace fieldpath::geometry

@@ -1,6 +1,7 @@
 #pragma once
-/// Postures (DESIGN.md "Conventions of data"): tool tip p and unit axis a from the tip to the spindle,
-/// and the rigid transform that places a tool-frame object (tip at origin, axis +z) at a posture.
+/// Postures (DESIGN.md "Conventions of data"): tool tip p and unit axis a from the tip to the
+/// spindle, and the rigid transform that places a tool-frame object (tip at origin, axis +z) at a
+/// posture.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 

@@ -43,12 +43,14 @@ struct SurfaceNode {
 
 /// Nodes spread over the revolved surface about `spacing_mm` apart (along the profile and around
 /// the axis), including the tip, and the flat top (tool only) or the holder's end faces.
-std::vector<SurfaceNode> surfaceNodes(const ToolSpec& tool, const HolderProfile& holder, double spacing_mm);
+std::vector<SurfaceNode> surfaceNodes(const ToolSpec& tool, const HolderProfile& holder,
+                                      double spacing_mm);
 
 /// |distance| (mm) from a point in the tool frame to the analytic surface of the tool body
 /// (cutting end, shank cylinder and flat top at L).
 double toolSurfaceDistance(const ToolSpec& tool, const Vec3& point_tool_frame_mm);
 /// |distance| (mm) to the analytic surface of tool and holder joined as toolMesh joins them.
-double toolSurfaceDistance(const ToolSpec& tool, const HolderProfile& holder, const Vec3& point_tool_frame_mm);
+double toolSurfaceDistance(const ToolSpec& tool, const HolderProfile& holder,
+                           const Vec3& point_tool_frame_mm);
 
 }  // namespace fieldpath::geometry
