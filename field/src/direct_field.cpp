@@ -44,7 +44,7 @@ DirectField::DirectField(ObstacleSamples samples, const FieldParams& params)
   index_->samples = std::move(samples);
   index_->params = params;
   index_->positions.points = &index_->samples.points_mm;
-  index_->transform = openvdb::math::Transform::createLinearTransform(0.5 * params.r0_mm);
+  index_->transform = openvdb::math::Transform::createLinearTransform(params.r0_mm);
   index_->grid = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(
       index_->positions, *index_->transform);
 }

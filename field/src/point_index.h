@@ -28,16 +28,16 @@ struct SamplePositions {
   }
 };
 
-/// Runs fn(i, state) for every query index, in parallel, with one state per task.
+/// Runs fn(i, state) for every query index, in parallel (TBB) when there are at least
+/// `serial_below` of them, with one state per task.
 template <class MakeState, class Fn>
-void parallelOverPoints(std::size_t n, MakeState&& make_state, Fn&& fn) {
-  constexpr std::size_t kSerialBelow = 64;
-  if (n < kSerialBelow) {
+void parallelOverPoints(std::size_t n, MakeState&& make_state, Fn&& fn, std::size_t serial_below = 64) {
+  if (n < serial_below) {
     auto state = make_state();
     for (std::size_t i = 0; i < n; ++i) fn(i, state);
     return;
   }
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& range) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, serial_below / 2 + 1), [&](const auto& range) {
     auto state = make_state();
     for (std::size_t i = range.begin(); i != range.end(); ++i) fn(i, state);
   });
@@ -54,7 +54,7 @@ struct DirectField::Index {
   ObstacleSamples samples;
   FieldParams params;
   SamplePositions positions;
-  openvdb::math::Transform::Ptr transform;  ///< index voxels of r0 / 2
+  openvdb::math::Transform::Ptr transform;  ///< index voxels of r0 (a search visits 3³ of them)
   openvdb::tools::PointIndexGrid::Ptr grid;
 
   using Iterator = openvdb::tools::PointIndexIterator<openvdb::tools::PointIndexTree>;
