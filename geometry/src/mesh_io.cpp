@@ -3,8 +3,8 @@
 #include <array>
 #include <cctype>
 #include <exception>
-#include <map>
 #include <string>
+#include <unordered_map>
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -24,6 +24,15 @@ std::string lowerExtension(const std::filesystem::path& file) {
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return ext;
 }
+
+/// Hash of a position's exact bits (joining needs equality, not nearness).
+struct PositionHash {
+  std::size_t operator()(const std::array<ai_real, 3>& p) const {
+    std::size_t h = 0;
+    for (ai_real c : p) h = h * 0x9E3779B97F4A7C15ull + std::hash<ai_real>{}(c);
+    return h;
+  }
+};
 
 /// A one-mesh assimp scene holding `mesh` (assimp stores single precision).
 void fillScene(aiScene& scene, const TriangleMesh& mesh) {
@@ -81,7 +90,7 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
 
   // Identical positions are joined across faces and meshes (STL stores every corner per face).
   TriangleMesh mesh;
-  std::map<std::array<ai_real, 3>, int> index_of;
+  std::unordered_map<std::array<ai_real, 3>, int, PositionHash> index_of;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh* in = scene->mMeshes[m];
     if ((in->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) continue;
