@@ -1,9 +1,10 @@
-/// bench_dynamics: the tool-axis dynamics on the seed's test case (seed 004 §2.3): 7 passes, ≈500 mm
-/// of path, ≈500 tool + holder nodes, two twisted walls of ≈5100 obstacle samples (bench/field/walls.h).
-/// Prints markdown tables: per field and integrator, the median wall time of the whole path over
-/// repeated runs, solver work (steps, RHS evaluations per mm, Jacobians), time per RHS evaluation,
-/// the speed ratio against the direct field with BDF measured in the same run, and the error of
-/// every variant's angles against the reference (direct field, BDF, tolerances / 100).
+/// bench_dynamics: the tool-axis dynamics on the seed's test case (seed 004 §2.3): 7 passes, ≈500
+/// mm of path, ≈500 tool + holder nodes, two twisted walls of ≈5100 obstacle samples
+/// (bench/field/walls.h). Prints markdown tables: per field and integrator, the median wall time of
+/// the whole path over repeated runs, solver work (steps, RHS evaluations per mm, Jacobians), time
+/// per RHS evaluation, the speed ratio against the direct field with BDF measured in the same run,
+/// and the error of every variant's angles against the reference (direct field, BDF, tolerances /
+/// 100).
 ///   bench_dynamics [--repeats N] [--quick] [--gain G] [--outer-y MM]
 #include <algorithm>
 #include <chrono>
@@ -38,8 +39,8 @@ double median(std::vector<double> v) {
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
-/// Pass k of 7 along +x on the channel floor (z = 0), ball centre at y from -outer to +outer mm. The
-/// walls lean in over x < 0: with outer = 8 the upright shank of the outer passes starts 0.4 mm
+/// Pass k of 7 along +x on the channel floor (z = 0), ball centre at y from -outer to +outer mm.
+/// The walls lean in over x < 0: with outer = 8 the upright shank of the outer passes starts 0.4 mm
 /// into the top of a wall (inside the voxel field's inner band) and is pushed out.
 dynamics::Pass channelPass(int k, double outer_y_mm) {
   const double y = -outer_y_mm + 2.0 * outer_y_mm * k / (kPasses - 1);
@@ -63,7 +64,8 @@ struct PathRun {
 PathRun runPath(const dynamics::SteeringRequest& request, double outer_y_mm) {
   PathRun run;
   const auto start = std::chrono::steady_clock::now();
-  for (int k = 0; k < kPasses; ++k) run.passes.push_back(dynamics::steerPass(channelPass(k, outer_y_mm), request));
+  for (int k = 0; k < kPasses; ++k)
+    run.passes.push_back(dynamics::steerPass(channelPass(k, outer_y_mm), request));
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   run.status = "ok";
   for (const auto& r : run.passes) {
@@ -72,7 +74,8 @@ PathRun runPath(const dynamics::SteeringRequest& request, double outer_y_mm) {
     run.jacobians += r.stats.jacobian_evals;
     run.failures += r.stats.error_test_failures + r.stats.convergence_failures;
     if (r.status != dynamics::Status::Ok) run.status = dynamics::toString(r.status);
-    for (const auto& s : r.samples) run.max_tilt_deg = std::max(run.max_tilt_deg, std::abs(s.tilt_rad) / kDeg);
+    for (const auto& s : r.samples)
+      run.max_tilt_deg = std::max(run.max_tilt_deg, std::abs(s.tilt_rad) / kDeg);
   }
   return run;
 }
@@ -124,7 +127,8 @@ int main(int argc, char** argv) {
     } else if (!std::strcmp(argv[i], "--quick")) {
       quick = true;
     } else {
-      std::fprintf(stderr, "usage: bench_dynamics [--repeats N] [--quick] [--gain G] [--outer-y MM]\n");
+      std::fprintf(stderr,
+                   "usage: bench_dynamics [--repeats N] [--quick] [--gain G] [--outer-y MM]\n");
       return 1;
     }
   }
@@ -133,8 +137,10 @@ int main(int argc, char** argv) {
   field::FieldParams field_params;  // r0 5, r_min 0.25, area weights
   field_params.sample_step_mm = 2.0;
   field_params.gain = gain;
-  const std::vector<geometry::TriangleMesh> walls = {bench::twistedWall(+1.0, 3.7), bench::twistedWall(-1.0, 3.7)};
-  const field::ObstacleSamples samples = field::sampleObstacles(walls, field_params.sample_step_mm, field_params.weights);
+  const std::vector<geometry::TriangleMesh> walls = {bench::twistedWall(+1.0, 3.7),
+                                                     bench::twistedWall(-1.0, 3.7)};
+  const field::ObstacleSamples samples =
+      field::sampleObstacles(walls, field_params.sample_step_mm, field_params.weights);
   const field::DirectField direct(samples, field_params);
   const field::BruteForceField brute(samples, field_params);
 
@@ -144,7 +150,8 @@ int main(int argc, char** argv) {
   const geometry::HolderProfile holder = {{50.0, 6.0}, {65.0, 6.0}, {65.0, 12.0}, {100.0, 12.0}};
   const double node_spacing_mm = 3.3;
   std::vector<Vec3> nodes;
-  for (const auto& n : geometry::surfaceNodes(tool, holder, node_spacing_mm)) nodes.push_back(n.position_mm);
+  for (const auto& n : geometry::surfaceNodes(tool, holder, node_spacing_mm))
+    nodes.push_back(n.position_mm);
 
   dynamics::SteeringRequest request;
   request.nodes_tool_frame_mm = nodes;
@@ -152,13 +159,17 @@ int main(int argc, char** argv) {
   request.step_mm = 0.5;
   request.on_limit = dynamics::LimitPolicy::Clamp;  // every variant runs the whole path
 
-  std::printf("# bench_dynamics: %d passes, %.0f mm of path, %zu tool+holder nodes (spacing %.1f mm), "
-              "%zu obstacle samples, gain %.1e, passes at |y| <= %.1f mm, output every %.1f mm, feed %.0f mm/min, "
-              "%d threads, medians of %d runs\n\n",
-              kPasses, kPasses * 2.0 * kPassHalfLength, nodes.size(), node_spacing_mm, samples.size(), gain, outer_y_mm,
-              request.step_mm, request.params.feed_mm_per_min, tbb::info::default_concurrency(), repeats);
+  std::printf(
+      "# bench_dynamics: %d passes, %.0f mm of path, %zu tool+holder nodes (spacing %.1f mm), "
+      "%zu obstacle samples, gain %.1e, passes at |y| <= %.1f mm, output every %.1f mm, feed %.0f "
+      "mm/min, "
+      "%d threads, medians of %d runs\n\n",
+      kPasses, kPasses * 2.0 * kPassHalfLength, nodes.size(), node_spacing_mm, samples.size(), gain,
+      outer_y_mm, request.step_mm, request.params.feed_mm_per_min, tbb::info::default_concurrency(),
+      repeats);
 
-  // ---- fields -------------------------------------------------------------------------------------
+  // ---- fields
+  // -------------------------------------------------------------------------------------
   struct Variant {
     std::string name;
     const field::ForceField* field;
@@ -166,7 +177,8 @@ int main(int argc, char** argv) {
     int repeats;
   };
   std::vector<std::unique_ptr<field::VoxelField>> voxels;
-  std::vector<Variant> variants = {{"direct (PointIndexGrid)", &direct, dynamics::Integrator::Bdf, repeats}};
+  std::vector<Variant> variants = {
+      {"direct (PointIndexGrid)", &direct, dynamics::Integrator::Bdf, repeats}};
   std::printf("| voxel field | build (s) | active nodes | memory (MiB) |\n|---|---|---|---|\n");
   for (double h : quick ? std::vector<double>{0.5} : std::vector<double>{1.0, 0.5, 0.25}) {
     for (auto interpolation : {field::Interpolation::Trilinear, field::Interpolation::Quadratic}) {
@@ -180,12 +192,14 @@ int main(int argc, char** argv) {
       char name[64];
       std::snprintf(name, sizeof name, "voxel h %.2f %s", h,
                     interpolation == field::Interpolation::Trilinear ? "trilinear" : "quadratic");
-      std::printf("| %s | %.2f | %zu | %.1f |\n", name, st.build_seconds, st.active_nodes, st.memory_bytes / 1048576.0);
+      std::printf("| %s | %.2f | %zu | %.1f |\n", name, st.build_seconds, st.active_nodes,
+                  st.memory_bytes / 1048576.0);
       variants.push_back({name, voxels.back().get(), dynamics::Integrator::Bdf, repeats});
     }
   }
   variants.push_back({"direct, ERK (explicit peer)", &direct, dynamics::Integrator::Erk, repeats});
-  if (!quick) variants.push_back({"brute force (seed's method)", &brute, dynamics::Integrator::Bdf, 1});
+  if (!quick)
+    variants.push_back({"brute force (seed's method)", &brute, dynamics::Integrator::Bdf, 1});
 
   // ---- reference ------------------------------------------------------------------------------
   dynamics::SteeringRequest tight = request;
@@ -196,8 +210,9 @@ int main(int argc, char** argv) {
 
   std::printf("\n## Whole path (BDF = CVODE, dense Newton, DQ Jacobian; rtol %.0e, atol %.0e)\n\n",
               request.params.rtol, request.params.atol);
-  std::printf("| field, integrator | path (s) | × direct BDF | steps | RHS evals | RHS / mm | Jacobians | "
-              "µs / RHS | status | max tilt (°) | max error (°) | at pass, s (mm) | RMS error (°) |\n");
+  std::printf(
+      "| field, integrator | path (s) | × direct BDF | steps | RHS evals | RHS / mm | Jacobians | "
+      "µs / RHS | status | max tilt (°) | max error (°) | at pass, s (mm) | RMS error (°) |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   double direct_seconds = 0.0;
   for (const Variant& v : variants) {
@@ -214,14 +229,19 @@ int main(int argc, char** argv) {
     if (direct_seconds == 0.0) direct_seconds = t;
     const double length_mm = kPasses * 2.0 * kPassHalfLength;
     const AngleError e = angleError(run, reference);
-    std::printf("| %s%s | %.3f | %.2f | %ld | %ld | %.1f | %ld | %.1f | %s | %.2f | %.1e | %d, %.1f | %.1e |\n",
-                v.name.c_str(), v.integrator == dynamics::Integrator::Bdf ? ", BDF" : "", t, direct_seconds / t,
-                run.steps, run.rhs_evals, run.rhs_evals / length_mm, run.jacobians, 1e6 * t / run.rhs_evals,
-                run.status.c_str(), run.max_tilt_deg, e.max_deg, e.worst_pass, e.worst_s_mm, e.rms_deg);
+    std::printf(
+        "| %s%s | %.3f | %.2f | %ld | %ld | %.1f | %ld | %.1f | %s | %.2f | %.1e | %d, %.1f | %.1e "
+        "|\n",
+        v.name.c_str(), v.integrator == dynamics::Integrator::Bdf ? ", BDF" : "", t,
+        direct_seconds / t, run.steps, run.rhs_evals, run.rhs_evals / length_mm, run.jacobians,
+        1e6 * t / run.rhs_evals, run.status.c_str(), run.max_tilt_deg, e.max_deg, e.worst_pass,
+        e.worst_s_mm, e.rms_deg);
     std::fflush(stdout);
   }
-  std::printf("\nreference: direct field, BDF, rtol %.0e, atol %.0e: %ld RHS evals, status %s, max tilt %.2f°\n",
-              tight.params.rtol, tight.params.atol, reference.rhs_evals, reference.status.c_str(),
-              reference.max_tilt_deg);
+  std::printf(
+      "\nreference: direct field, BDF, rtol %.0e, atol %.0e: %ld RHS evals, status %s, max tilt "
+      "%.2f°\n",
+      tight.params.rtol, tight.params.atol, reference.rhs_evals, reference.status.c_str(),
+      reference.max_tilt_deg);
   return 0;
 }

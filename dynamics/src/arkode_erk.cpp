@@ -12,7 +12,8 @@ namespace {
 
 class ArkodeErk final : public Integrator {
  public:
-  ArkodeErk(OdeSystem& system, int size, double t0, const double* y0, const IntegratorSettings& settings)
+  ArkodeErk(OdeSystem& system, int size, double t0, const double* y0,
+            const IntegratorSettings& settings)
       : Integrator(system, size, y0, settings.atol) {
     mem_.reset(ERKStepCreate(rhsTrampoline, t0, y_, ctx_));
     FIELDPATH_SUNDIALS_NOT_NULL(mem_, "ERKStepCreate");
@@ -21,10 +22,13 @@ class ArkodeErk final : public Integrator {
     FIELDPATH_SUNDIALS_CHECK(ERKStepSVtolerances(mem, settings.rtol, atol_));
     FIELDPATH_SUNDIALS_CHECK(ERKStepSetUserData(mem, &system_));
     FIELDPATH_SUNDIALS_CHECK(ERKStepSetMaxNumSteps(mem, settings.max_steps));
-    if (settings.max_step_s > 0.0) FIELDPATH_SUNDIALS_CHECK(ERKStepSetMaxStep(mem, settings.max_step_s));
+    if (settings.max_step_s > 0.0)
+      FIELDPATH_SUNDIALS_CHECK(ERKStepSetMaxStep(mem, settings.max_step_s));
   }
 
-  std::string flagName(int flag) const override { return takeFlagName(ERKStepGetReturnFlagName(flag)); }
+  std::string flagName(int flag) const override {
+    return takeFlagName(ERKStepGetReturnFlagName(flag));
+  }
 
  private:
   int evolve(double t_out) override {
@@ -32,7 +36,9 @@ class ArkodeErk final : public Integrator {
     return ERKStepEvolve(mem_.get(), t_out, y_, &t_reached, ARK_NORMAL);
   }
 
-  void reinit(double t) override { FIELDPATH_SUNDIALS_CHECK(ERKStepReInit(mem_.get(), rhsTrampoline, t, y_)); }
+  void reinit(double t) override {
+    FIELDPATH_SUNDIALS_CHECK(ERKStepReInit(mem_.get(), rhsTrampoline, t, y_));
+  }
 
   SolverStats counters() const override {
     void* mem = mem_.get();

@@ -20,7 +20,8 @@ struct LinearSolverDeleter {
 
 class CvodeBdf final : public Integrator {
  public:
-  CvodeBdf(OdeSystem& system, int size, double t0, const double* y0, const IntegratorSettings& settings)
+  CvodeBdf(OdeSystem& system, int size, double t0, const double* y0,
+           const IntegratorSettings& settings)
       : Integrator(system, size, y0, settings.atol) {
     mem_.reset(CVodeCreate(CV_BDF, ctx_));
     FIELDPATH_SUNDIALS_NOT_NULL(mem_, "CVodeCreate");
@@ -35,10 +36,13 @@ class CvodeBdf final : public Integrator {
     FIELDPATH_SUNDIALS_NOT_NULL(solver_, "SUNLinSol_Dense");
     FIELDPATH_SUNDIALS_CHECK(CVodeSetLinearSolver(mem, solver_.get(), matrix_.get()));
     FIELDPATH_SUNDIALS_CHECK(CVodeSetMaxNumSteps(mem, settings.max_steps));
-    if (settings.max_step_s > 0.0) FIELDPATH_SUNDIALS_CHECK(CVodeSetMaxStep(mem, settings.max_step_s));
+    if (settings.max_step_s > 0.0)
+      FIELDPATH_SUNDIALS_CHECK(CVodeSetMaxStep(mem, settings.max_step_s));
   }
 
-  std::string flagName(int flag) const override { return takeFlagName(CVodeGetReturnFlagName(flag)); }
+  std::string flagName(int flag) const override {
+    return takeFlagName(CVodeGetReturnFlagName(flag));
+  }
 
  private:
   int evolve(double t_out) override {

@@ -18,22 +18,26 @@ constexpr int kStateSize = 4;  ///< lead, tilt (rad), lead rate, tilt rate (rad/
 
 /// Places the nodes (offsets from the ball centre, tool frame) at axis a and sums their moment.
 AxisMoment momentOfNodes(const field::ForceField& field, std::span<const Vec3> offsets_mm,
-                         const LocalFrame& frame, const Vec3& centre_mm, double lead_rad, double tilt_rad,
-                         std::vector<Vec3>& nodes_mm, std::vector<Vec3>& forces) {
-  const Eigen::Matrix3d rotation = geometry::rotationFromZ(axisFromAngles(frame, lead_rad, tilt_rad));
+                         const LocalFrame& frame, const Vec3& centre_mm, double lead_rad,
+                         double tilt_rad, std::vector<Vec3>& nodes_mm, std::vector<Vec3>& forces) {
+  const Eigen::Matrix3d rotation =
+      geometry::rotationFromZ(axisFromAngles(frame, lead_rad, tilt_rad));
   nodes_mm.resize(offsets_mm.size());
   forces.resize(offsets_mm.size());
-  for (std::size_t i = 0; i < offsets_mm.size(); ++i) nodes_mm[i] = centre_mm + rotation * offsets_mm[i];
+  for (std::size_t i = 0; i < offsets_mm.size(); ++i)
+    nodes_mm[i] = centre_mm + rotation * offsets_mm[i];
   field.evaluate(nodes_mm, forces);
   AxisMoment out;
-  for (std::size_t i = 0; i < offsets_mm.size(); ++i) out.moment += (nodes_mm[i] - centre_mm).cross(forces[i]);
+  for (std::size_t i = 0; i < offsets_mm.size(); ++i)
+    out.moment += (nodes_mm[i] - centre_mm).cross(forces[i]);
   out.lead_torque = out.moment.dot(frame.b);
   out.tilt_torque = out.moment.dot(frame.f);
   return out;
 }
 
 /// Node offsets from the ball centre in the tool frame: x - (0, 0, R).
-std::vector<Vec3> offsetsFromCentre(std::span<const Vec3> nodes_tool_frame_mm, double ball_radius_mm) {
+std::vector<Vec3> offsetsFromCentre(std::span<const Vec3> nodes_tool_frame_mm,
+                                    double ball_radius_mm) {
   std::vector<Vec3> out(nodes_tool_frame_mm.begin(), nodes_tool_frame_mm.end());
   for (Vec3& p : out) p.z() -= ball_radius_mm;
   return out;
@@ -51,7 +55,8 @@ void validate(const Pass& pass, const SteeringRequest& request) {
   requireThat(std::isfinite(p.inertia) && p.inertia > 0.0, "dynamics.inertia", "> 0", p.inertia);
   requireThat(!std::isnan(p.damping) && std::isfinite(p.effectiveDamping()), "dynamics.damping",
               ">= 0 (negative = critical)", p.damping);
-  requireThat(std::isfinite(p.stiffness) && p.stiffness >= 0.0, "dynamics.stiffness", ">= 0", p.stiffness);
+  requireThat(std::isfinite(p.stiffness) && p.stiffness >= 0.0, "dynamics.stiffness", ">= 0",
+              p.stiffness);
   requireThat(std::isfinite(p.feed_mm_per_min) && p.feed_mm_per_min > 0.0, "dynamics.feed", "> 0",
               p.feed_mm_per_min);
   requireThat(std::isfinite(p.rtol) && p.rtol > 0.0, "dynamics.rtol", "> 0", p.rtol);
@@ -60,9 +65,10 @@ void validate(const Pass& pass, const SteeringRequest& request) {
               p.max_tilt_deg);
   requireThat(p.max_lead_deg > 0.0 && p.max_lead_deg <= 90.0, "dynamics.max_lead_deg", "in (0, 90]",
               p.max_lead_deg);
-  requireThat(std::isfinite(request.step_mm) && request.step_mm > 0.0, "path.step", "> 0", request.step_mm);
-  requireThat(std::isfinite(request.ball_radius_mm) && request.ball_radius_mm > 0.0, "tool.radius", "> 0",
-              request.ball_radius_mm);
+  requireThat(std::isfinite(request.step_mm) && request.step_mm > 0.0, "path.step", "> 0",
+              request.step_mm);
+  requireThat(std::isfinite(request.ball_radius_mm) && request.ball_radius_mm > 0.0, "tool.radius",
+              "> 0", request.ball_radius_mm);
   requireThat(std::isfinite(pass.length_mm) && pass.length_mm >= 0.0, "pass length (mm)", ">= 0",
               pass.length_mm);
   requireThat(request.max_angle_change_deg_per_mm >= 0.0, "max angle change (deg/mm)", ">= 0",
@@ -87,7 +93,9 @@ class SteeringSystem final : public detail::OdeSystem {
   double feedMmPerS() const { return feed_mm_per_s_; }
 
   /// Arc length at time t, kept on the pass (solver stages may look slightly past the end).
-  double arcLength(double t_s) const { return std::clamp(feed_mm_per_s_ * t_s, 0.0, pass_.length_mm); }
+  double arcLength(double t_s) const {
+    return std::clamp(feed_mm_per_s_ * t_s, 0.0, pass_.length_mm);
+  }
 
   int rhs(double t_s, const double* y, double* ydot) override {
     const double s_mm = arcLength(t_s);
@@ -95,8 +103,10 @@ class SteeringSystem final : public detail::OdeSystem {
     const AxisMoment m = moment(pass_frame, y[0], y[1]);
     ydot[0] = y[2];
     ydot[1] = y[3];
-    ydot[2] = (m.lead_torque - damping_ * y[2] - stiffness_ * (y[0] - pass_frame.lead0_rad)) / inertia_;
-    ydot[3] = (m.tilt_torque - damping_ * y[3] - stiffness_ * (y[1] - pass_frame.tilt0_rad)) / inertia_;
+    ydot[2] =
+        (m.lead_torque - damping_ * y[2] - stiffness_ * (y[0] - pass_frame.lead0_rad)) / inertia_;
+    ydot[3] =
+        (m.tilt_torque - damping_ * y[3] - stiffness_ * (y[1] - pass_frame.tilt0_rad)) / inertia_;
     const bool finite = std::isfinite(ydot[2]) && std::isfinite(ydot[3]);
     return finite ? 0 : 1;  // recoverable: the solver retries a shorter step, then gives up
   }
@@ -128,8 +138,8 @@ class SteeringSystem final : public detail::OdeSystem {
  private:
   AxisMoment moment(const PassFrame& pass_frame, double lead_rad, double tilt_rad) {
     if (!request_.field) return {};
-    return momentOfNodes(*request_.field, offsets_mm_, localFrame(pass_frame), pass_frame.centre_mm, lead_rad,
-                         tilt_rad, nodes_mm_, forces_);
+    return momentOfNodes(*request_.field, offsets_mm_, localFrame(pass_frame), pass_frame.centre_mm,
+                         lead_rad, tilt_rad, nodes_mm_, forces_);
   }
 
   void placeNodes(const PassFrame& pass_frame, const Vec3& axis) {
@@ -161,7 +171,8 @@ struct LimitCheck {
   bool clamped = false;
 };
 
-LimitCheck checkAngles(const DynamicsParams& p, LimitPolicy policy, std::array<double, kStateSize>& y) {
+LimitCheck checkAngles(const DynamicsParams& p, LimitPolicy policy,
+                       std::array<double, kStateSize>& y) {
   LimitCheck out;
   const struct {
     const char* name;
@@ -181,7 +192,8 @@ LimitCheck checkAngles(const DynamicsParams& p, LimitPolicy policy, std::array<d
     }
     std::ostringstream msg;
     msg.precision(4);
-    msg << a.name << " " << y[a.index] * kDegPerRad << "° exceeds " << a.key << " = " << a.max_deg << "°";
+    msg << a.name << " " << y[a.index] * kDegPerRad << "° exceeds " << a.key << " = " << a.max_deg
+        << "°";
     out.status = Status::TiltLimit;
     out.what = msg.str();
     return out;
@@ -193,34 +205,39 @@ LimitCheck checkAngles(const DynamicsParams& p, LimitPolicy policy, std::array<d
 
 const char* toString(Status status) {
   switch (status) {
-    case Status::Ok: return "ok";
-    case Status::TiltLimit: return "tilt limit";
-    case Status::RateLimit: return "angle change limit";
-    case Status::SolverFailed: return "solver failed";
+    case Status::Ok:
+      return "ok";
+    case Status::TiltLimit:
+      return "tilt limit";
+    case Status::RateLimit:
+      return "angle change limit";
+    case Status::SolverFailed:
+      return "solver failed";
   }
   return "?";
 }
 
 AxisMoment axisMoment(const field::ForceField& field, std::span<const Vec3> nodes_tool_frame_mm,
-                      double ball_radius_mm, const LocalFrame& frame, const Vec3& centre_mm, double lead_rad,
-                      double tilt_rad) {
+                      double ball_radius_mm, const LocalFrame& frame, const Vec3& centre_mm,
+                      double lead_rad, double tilt_rad) {
   std::vector<Vec3> nodes_mm, forces;
-  return momentOfNodes(field, offsetsFromCentre(nodes_tool_frame_mm, ball_radius_mm), frame, centre_mm,
-                       lead_rad, tilt_rad, nodes_mm, forces);
+  return momentOfNodes(field, offsetsFromCentre(nodes_tool_frame_mm, ball_radius_mm), frame,
+                       centre_mm, lead_rad, tilt_rad, nodes_mm, forces);
 }
 
-Eigen::Matrix2d fieldStiffness(const field::ForceField& field, std::span<const Vec3> nodes_tool_frame_mm,
-                               double ball_radius_mm, const LocalFrame& frame, const Vec3& centre_mm,
-                               double lead_rad, double tilt_rad, double delta_rad) {
+Eigen::Matrix2d fieldStiffness(const field::ForceField& field,
+                               std::span<const Vec3> nodes_tool_frame_mm, double ball_radius_mm,
+                               const LocalFrame& frame, const Vec3& centre_mm, double lead_rad,
+                               double tilt_rad, double delta_rad) {
   const std::vector<Vec3> offsets = offsetsFromCentre(nodes_tool_frame_mm, ball_radius_mm);
   std::vector<Vec3> nodes_mm, forces;
   Eigen::Matrix2d k;
   for (int column = 0; column < 2; ++column) {
     const double dl = column == 0 ? delta_rad : 0.0, dt = column == 1 ? delta_rad : 0.0;
-    const AxisMoment plus =
-        momentOfNodes(field, offsets, frame, centre_mm, lead_rad + dl, tilt_rad + dt, nodes_mm, forces);
-    const AxisMoment minus =
-        momentOfNodes(field, offsets, frame, centre_mm, lead_rad - dl, tilt_rad - dt, nodes_mm, forces);
+    const AxisMoment plus = momentOfNodes(field, offsets, frame, centre_mm, lead_rad + dl,
+                                          tilt_rad + dt, nodes_mm, forces);
+    const AxisMoment minus = momentOfNodes(field, offsets, frame, centre_mm, lead_rad - dl,
+                                           tilt_rad - dt, nodes_mm, forces);
     k(0, column) = -(plus.lead_torque - minus.lead_torque) / (2.0 * delta_rad);
     k(1, column) = -(plus.tilt_torque - minus.tilt_torque) / (2.0 * delta_rad);
   }
@@ -235,20 +252,21 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
   const PassFrame start = pass.frameAt(0.0);
   std::array<double, kStateSize> y = {request.initial_lead_rad.value_or(start.lead0_rad),
                                       request.initial_tilt_rad.value_or(start.tilt0_rad),
-                                      request.initial_lead_rate_rad_per_s, request.initial_tilt_rate_rad_per_s};
-  for (double value : y)
-    requireThat(std::isfinite(value), "initial axis state", "finite", value);
+                                      request.initial_lead_rate_rad_per_s,
+                                      request.initial_tilt_rate_rad_per_s};
+  for (double value : y) requireThat(std::isfinite(value), "initial axis state", "finite", value);
 
   detail::IntegratorSettings settings;
   settings.rtol = request.params.rtol;
   // Angles get atol (rad); rates atol · ω (rad/s), ω the spring's natural frequency sqrt(k/J) or,
   // if slower, one output interval: a rate tolerance on the angle tolerance's scale. One atol for
   // both would be far below the rounding noise of the rates when k/J is large (stiff cases).
-  const double rate_scale_per_s = std::max(std::sqrt(request.params.stiffness / request.params.inertia),
-                                           v / request.step_mm);
+  const double rate_scale_per_s =
+      std::max(std::sqrt(request.params.stiffness / request.params.inertia), v / request.step_mm);
   const double atol = request.params.atol;
   settings.atol = {atol, atol, atol * rate_scale_per_s, atol * rate_scale_per_s};
-  settings.max_step_s = request.step_mm / v;  // never step over a feature longer than one output step
+  settings.max_step_s =
+      request.step_mm / v;  // never step over a feature longer than one output step
   settings.max_steps = request.max_steps_per_output;
   std::unique_ptr<detail::Integrator> integrator =
       request.params.integrator == Integrator::Erk
@@ -267,8 +285,9 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
       const int flag = integrator->advance(s_mm / v, y.data());
       if (flag < 0) {
         result.status = Status::SolverFailed;
-        result.message = at(s_mm) + (request.params.integrator == Integrator::Erk ? "ARKODE ERK" : "CVODE BDF") +
-                          " failed (" + integrator->flagName(flag) + "): " + integrator->lastError();
+        result.message =
+            at(s_mm) + (request.params.integrator == Integrator::Erk ? "ARKODE ERK" : "CVODE BDF") +
+            " failed (" + integrator->flagName(flag) + "): " + integrator->lastError();
         break;
       }
     }
@@ -279,7 +298,8 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
     if (check.status == Status::Ok && max_change_rad_per_mm > 0.0 && !result.samples.empty()) {
       const PostureSample& prev = result.samples.back();
       const double ds_mm = s_mm - prev.s_mm;
-      const double change = std::max(std::abs(sample.lead_rad - prev.lead_rad), std::abs(sample.tilt_rad - prev.tilt_rad));
+      const double change = std::max(std::abs(sample.lead_rad - prev.lead_rad),
+                                     std::abs(sample.tilt_rad - prev.tilt_rad));
       if (ds_mm > 0.0 && change > max_change_rad_per_mm * ds_mm) {
         sample.limited = true;
         if (request.on_limit == LimitPolicy::Report) {
@@ -300,7 +320,8 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
       break;
     }
     if (k % report_every == 0)
-      common::report(request.progress, intervals > 0 ? static_cast<double>(k) / intervals : 1.0, "dynamics");
+      common::report(request.progress, intervals > 0 ? static_cast<double>(k) / intervals : 1.0,
+                     "dynamics");
   }
   result.stats = integrator->stats();
   return result;

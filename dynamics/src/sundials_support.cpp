@@ -9,8 +9,9 @@
 namespace fieldpath::dynamics::detail {
 
 void throwSundials(const char* call, long flag, const char* file, int line) {
-  throw std::runtime_error(std::string(call) + " failed with flag " + std::to_string(flag) + " at " +
-                           std::filesystem::path(file).filename().string() + ":" + std::to_string(line));
+  throw std::runtime_error(std::string(call) + " failed with flag " + std::to_string(flag) +
+                           " at " + std::filesystem::path(file).filename().string() + ":" +
+                           std::to_string(line));
 }
 
 Context::Context() { FIELDPATH_SUNDIALS_CHECK(SUNContext_Create(nullptr, &ctx_)); }
@@ -40,10 +41,12 @@ void keepErrorMessage(int /*error_code*/, const char* module, const char* functi
   *static_cast<std::string*>(eh_data) = std::string(module) + "/" + function + ": " + msg;
 }
 
-Integrator::Integrator(OdeSystem& system, int size, const double* y0, const std::vector<double>& atol)
+Integrator::Integrator(OdeSystem& system, int size, const double* y0,
+                       const std::vector<double>& atol)
     : system_(system), y_(size, ctx_), atol_(size, ctx_) {
   std::copy_n(y0, size, y_.data());
-  if (atol.size() != static_cast<std::size_t>(size)) throw std::logic_error("atol: one value per component");
+  if (atol.size() != static_cast<std::size_t>(size))
+    throw std::logic_error("atol: one value per component");
   std::copy_n(atol.data(), size, atol_.data());
 }
 

@@ -18,17 +18,18 @@ namespace fieldpath::dynamics::detail {
 /// call is an internal error (exit 2), never a numerical outcome.
 [[noreturn]] void throwSundials(const char* call, long flag, const char* file, int line);
 
-#define FIELDPATH_SUNDIALS_CHECK(call)                                                         \
-  do {                                                                                         \
-    const long fieldpath_flag_ = static_cast<long>(call);                                      \
-    if (fieldpath_flag_ < 0)                                                                   \
+#define FIELDPATH_SUNDIALS_CHECK(call)                                                          \
+  do {                                                                                          \
+    const long fieldpath_flag_ = static_cast<long>(call);                                       \
+    if (fieldpath_flag_ < 0)                                                                    \
       ::fieldpath::dynamics::detail::throwSundials(#call, fieldpath_flag_, __FILE__, __LINE__); \
   } while (false)
 
 /// Constructors return null on failure; same report as a negative flag.
-#define FIELDPATH_SUNDIALS_NOT_NULL(ptr, call) \
-  do {                                         \
-    if ((ptr) == nullptr) ::fieldpath::dynamics::detail::throwSundials(call, 0, __FILE__, __LINE__); \
+#define FIELDPATH_SUNDIALS_NOT_NULL(ptr, call)                                   \
+  do {                                                                           \
+    if ((ptr) == nullptr)                                                        \
+      ::fieldpath::dynamics::detail::throwSundials(call, 0, __FILE__, __LINE__); \
   } while (false)
 
 /// SUNContext owner (SUNDIALS 6.4: SUNContext_Create(nullptr, &ctx)).
@@ -76,7 +77,8 @@ int rhsTrampoline(sunrealtype t, N_Vector y, N_Vector ydot, void* user_data);
 
 /// Error handler for CVODE and ARKODE: keeps the message (for SteeringResult::message) instead of
 /// printing it on stderr. eh_data is a std::string.
-void keepErrorMessage(int error_code, const char* module, const char* function, char* msg, void* eh_data);
+void keepErrorMessage(int error_code, const char* module, const char* function, char* msg,
+                      void* eh_data);
 
 /// A time integrator over an OdeSystem; CVODE BDF and ARKODE ERK derive from it. It owns the
 /// context and the state vector and keeps the counters across restarts.
@@ -97,9 +99,9 @@ class Integrator {
 
  protected:
   Integrator(OdeSystem& system, int size, const double* y0, const std::vector<double>& atol);
-  virtual int evolve(double t_out) = 0;          ///< one CVode / ERKStepEvolve call on y_
-  virtual void reinit(double t) = 0;             ///< from y_; resets the solver's own counters
-  virtual SolverStats counters() const = 0;      ///< since the last (re)initialisation
+  virtual int evolve(double t_out) = 0;      ///< one CVode / ERKStepEvolve call on y_
+  virtual void reinit(double t) = 0;         ///< from y_; resets the solver's own counters
+  virtual SolverStats counters() const = 0;  ///< since the last (re)initialisation
 
   OdeSystem& system_;
   Context ctx_;  ///< declared before every object created in it
@@ -123,8 +125,9 @@ struct FreeByAddress {
 struct IntegratorSettings {
   double rtol = 1e-6;
   std::vector<double> atol;  ///< per component (angles in rad, rates in rad/s)
-  double max_step_s = 0.0;  ///< 0 = unlimited; set to the output interval so no feature is stepped over
-  long max_steps = 500;     ///< per advance() call
+  double max_step_s =
+      0.0;  ///< 0 = unlimited; set to the output interval so no feature is stepped over
+  long max_steps = 500;  ///< per advance() call
 };
 
 std::unique_ptr<Integrator> makeCvodeBdf(OdeSystem& system, int size, double t0, const double* y0,

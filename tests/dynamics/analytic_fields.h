@@ -15,8 +15,9 @@ namespace fieldpath::dynamics::testing {
 using geometry::Vec3;
 
 /// Eq. 1 integrated over an infinite plane with area weights: at distance d from the plane
-/// (r_min < d < r0) the field is |F| = π·gain·(r0 - d)² / (d·r0²) along the plane normal; held at its
-/// r_min value below r_min (and inside the wall, d < 0, so an entered node is pushed out); 0 beyond r0.
+/// (r_min < d < r0) the field is |F| = π·gain·(r0 - d)² / (d·r0²) along the plane normal; held at
+/// its r_min value below r_min (and inside the wall, d < 0, so an entered node is pushed out); 0
+/// beyond r0.
 struct PlaneField final : field::ForceField {
   Vec3 point_mm = Vec3::Zero();
   Vec3 normal = Vec3::UnitY();  ///< unit, from the wall into free space
@@ -87,14 +88,15 @@ struct LatticeField final : field::ForceField {
 };
 
 /// Ball-end tool and shank as rings of `per_ring` nodes (tool frame, tip at 0, axis +z): ball rings
-/// every `dz_mm` from the tip, then shank rings up to `length_mm`. Each ring has a node at angle 0, so
-/// the set is symmetric under y → -y. R = 3, L = 40, dz = 1, 12 per ring gives ≈ 500 nodes.
-inline std::vector<Vec3> ringNodes(double radius_mm = 3.0, double length_mm = 40.0, double dz_mm = 1.0,
-                                   int per_ring = 12) {
+/// every `dz_mm` from the tip, then shank rings up to `length_mm`. Each ring has a node at angle 0,
+/// so the set is symmetric under y → -y. R = 3, L = 40, dz = 1, 12 per ring gives ≈ 500 nodes.
+inline std::vector<Vec3> ringNodes(double radius_mm = 3.0, double length_mm = 40.0,
+                                   double dz_mm = 1.0, int per_ring = 12) {
   std::vector<Vec3> nodes{Vec3::Zero()};
   for (double z = dz_mm; z <= length_mm + 1e-9; z += dz_mm) {
-    const double r = z < radius_mm ? std::sqrt(radius_mm * radius_mm - (radius_mm - z) * (radius_mm - z))
-                                   : radius_mm;
+    const double r = z < radius_mm
+                         ? std::sqrt(radius_mm * radius_mm - (radius_mm - z) * (radius_mm - z))
+                         : radius_mm;
     for (int k = 0; k < per_ring; ++k) {
       const double phi = 2.0 * std::numbers::pi * k / per_ring;
       nodes.emplace_back(r * std::cos(phi), r * std::sin(phi), z);
@@ -103,7 +105,8 @@ inline std::vector<Vec3> ringNodes(double radius_mm = 3.0, double length_mm = 40
   return nodes;
 }
 
-/// A straight pass along +x on the plane z = 0 (normal +z), ball centre at height R, starting at x0.
+/// A straight pass along +x on the plane z = 0 (normal +z), ball centre at height R, starting at
+/// x0.
 inline Pass straightPass(double length_mm, double radius_mm = 3.0, double x0_mm = 0.0) {
   return Pass{length_mm, [=](double s_mm) {
                 PassFrame f;

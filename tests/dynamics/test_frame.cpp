@@ -57,8 +57,8 @@ TEST(AxisFromAngles, MatchesRotationsAboutBThenF) {
   const Vec3 a = axisFromAngles(fr, lead, tilt);
   EXPECT_NEAR((a - expected).norm(), 0.0, 1e-12);
   EXPECT_NEAR(a.norm(), 1.0, 1e-12);
-  EXPECT_GT(axisFromAngles(fr, 0.1, 0.0).dot(fr.f), 0.0);   // positive lead leans forward
-  EXPECT_LT(axisFromAngles(fr, 0.0, 0.1).dot(fr.b), 0.0);   // positive tilt leans towards -b
+  EXPECT_GT(axisFromAngles(fr, 0.1, 0.0).dot(fr.f), 0.0);  // positive lead leans forward
+  EXPECT_LT(axisFromAngles(fr, 0.0, 0.1).dot(fr.b), 0.0);  // positive tilt leans towards -b
   EXPECT_NEAR((axisFromAngles(fr, 0.0, 0.0) - fr.n).norm(), 0.0, 0.0);  // nominal = normal, exactly
 }
 

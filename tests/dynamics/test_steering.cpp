@@ -51,7 +51,8 @@ void expectAllFinite(const SteeringResult& result) {
   ASSERT_FALSE(result.samples.empty());
   for (const PostureSample& s : result.samples) {
     ASSERT_TRUE(std::isfinite(s.lead_rad) && std::isfinite(s.tilt_rad)) << "s = " << s.s_mm;
-    ASSERT_TRUE(std::isfinite(s.lead_rate_rad_per_s) && std::isfinite(s.tilt_rate_rad_per_s)) << "s = " << s.s_mm;
+    ASSERT_TRUE(std::isfinite(s.lead_rate_rad_per_s) && std::isfinite(s.tilt_rate_rad_per_s))
+        << "s = " << s.s_mm;
     ASSERT_TRUE(s.moment.allFinite() && s.posture.tip_mm.allFinite() && s.posture.axis.allFinite())
         << "s = " << s.s_mm;
     ASSERT_NEAR(s.posture.axis.norm(), 1.0, 1e-12);
@@ -108,8 +109,9 @@ double staticTilt(const field::ForceField& field, double stiffness, double lo_ra
   return 0.5 * (lo_rad + hi_rad);
 }
 
-/// Undamped swing from rest at tilt 0: the turning point θmax > 0 where the work of the field equals
-/// the spring energy, ∫0^θmax (τ(φ) - k φ) dφ = 0 (trapezoids, linear interpolation of the crossing).
+/// Undamped swing from rest at tilt 0: the turning point θmax > 0 where the work of the field
+/// equals the spring energy, ∫0^θmax (τ(φ) - k φ) dφ = 0 (trapezoids, linear interpolation of the
+/// crossing).
 double undampedTurningPoint(const field::ForceField& field, double stiffness, double hi_rad) {
   const int n = 5000;
   const double dphi = hi_rad / n;
@@ -142,7 +144,8 @@ double analyticAngle(double J, double c, double k, double theta_i, double t) {
   if (std::abs(zeta - 1.0) < 1e-12) return theta_i * (1.0 + w0 * t) * std::exp(-w0 * t);
   if (zeta < 1.0) {
     const double wd = w0 * std::sqrt(1.0 - zeta * zeta);
-    return std::exp(-zeta * w0 * t) * theta_i * (std::cos(wd * t) + zeta * w0 / wd * std::sin(wd * t));
+    return std::exp(-zeta * w0 * t) * theta_i *
+           (std::cos(wd * t) + zeta * w0 / wd * std::sin(wd * t));
   }
   const double root = std::sqrt(zeta * zeta - 1.0);
   const double r1 = -w0 * (zeta - root), r2 = -w0 * (zeta + root);
@@ -164,8 +167,10 @@ TEST_P(FreeResponse, MatchesTheAnalyticDampedOscillator) {
   double worst = 0.0;
   for (const PostureSample& s : result.samples) {
     const double t = s.s_mm / v;
-    worst = std::max(worst, std::abs(s.lead_rad - analyticAngle(p.inertia, p.effectiveDamping(), p.stiffness, 0.1, t)));
-    worst = std::max(worst, std::abs(s.tilt_rad - analyticAngle(p.inertia, p.effectiveDamping(), p.stiffness, 0.2, t)));
+    worst = std::max(worst, std::abs(s.lead_rad - analyticAngle(p.inertia, p.effectiveDamping(),
+                                                                p.stiffness, 0.1, t)));
+    worst = std::max(worst, std::abs(s.tilt_rad - analyticAngle(p.inertia, p.effectiveDamping(),
+                                                                p.stiffness, 0.2, t)));
     EXPECT_EQ(s.moment, Vec3::Zero());
   }
   EXPECT_LT(worst, 1e-4 * 0.2) << GetParam().name;
@@ -175,7 +180,8 @@ TEST_P(FreeResponse, MatchesTheAnalyticDampedOscillator) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Dynamics, FreeResponse,
-                         ::testing::Values(OscillatorCase{"under", 0.4}, OscillatorCase{"critical", -1.0},
+                         ::testing::Values(OscillatorCase{"under", 0.4},
+                                           OscillatorCase{"critical", -1.0},
                                            OscillatorCase{"over", 5.0}),
                          [](const auto& info) { return std::string(info.param.name); });
 
@@ -234,7 +240,8 @@ TEST(HardCases, NodeStartingWithinRMinOfAWall) {
   EXPECT_NEAR(settled, staticTilt(*wall, 1.0, 0.0, 0.6), 1e-6);
   EXPECT_GT(settled, staticTilt(*wallAt(4.0), 1.0, 0.0, 0.5));  // nearer wall, larger deflection
   EXPECT_LT(settled, request.params.max_tilt_deg * kDeg);
-  for (const PostureSample& s : result.samples) EXPECT_GE(s.tilt_rad, 0.0);  // only ever away from the wall
+  for (const PostureSample& s : result.samples)
+    EXPECT_GE(s.tilt_rad, 0.0);  // only ever away from the wall
 }
 
 TEST(HardCases, SymmetricNarrowChannelKeepsTheAxisUpright) {
@@ -252,7 +259,7 @@ TEST(HardCases, AsymmetricChannelTiltsAwayFromTheNearerWall) {
   const SteeringResult result = runToleranceStable(straightPass(300.0), requestFor(both.get()));
   ASSERT_EQ(result.status, Status::Ok) << result.message;
   const double settled = result.samples.back().tilt_rad;
-  EXPECT_GT(settled, 0.1 * kDeg);  // away from +y, the nearer wall
+  EXPECT_GT(settled, 0.1 * kDeg);                               // away from +y, the nearer wall
   EXPECT_LT(settled, staticTilt(*wallAt(4.0), 1.0, 0.0, 0.5));  // the far wall holds it back
   EXPECT_NEAR(settled, staticTilt(*both, 1.0, 0.0, 0.5), 1e-6);
 }
@@ -284,7 +291,8 @@ TEST(HardCases, StepInAWall) {
       fieldStiffness(*step->after, toolNodes(), kRadius, localFrame(pf), pf.centre_mm, 0.0, after);
   EXPECT_NEAR(k_field(1, 0), 0.0, 1e-9);  // a wall along the feed couples no lead into tilt
   EXPECT_GT(k_field(1, 1), 0.5 * request.params.stiffness);
-  request.params.damping = 2.0 * std::sqrt((request.params.stiffness + k_field(1, 1)) * request.params.inertia);
+  request.params.damping =
+      2.0 * std::sqrt((request.params.stiffness + k_field(1, 1)) * request.params.inertia);
   const SteeringResult critical = steerPass(straightPass(500.0), request);
   ASSERT_EQ(critical.status, Status::Ok) << critical.message;
   EXPECT_LT(peakTilt(critical), after * 1.005);
@@ -301,7 +309,8 @@ TEST(HardCases, StiffSystemBdfStaysBoundedErkReportsFailure) {
   const double expected = staticTilt(*wall, 1.0, 0.0, 0.5);
   EXPECT_NEAR(bdf.samples.back().tilt_rad, expected, 1e-6);  // quasi-static tracking
   for (const PostureSample& s : bdf.samples) EXPECT_LE(s.tilt_rad, expected * 1.001);
-  EXPECT_LT(bdf.stats.steps, 20 * static_cast<long>(bdf.samples.size()));  // large steps, not ERK-size
+  EXPECT_LT(bdf.stats.steps,
+            20 * static_cast<long>(bdf.samples.size()));  // large steps, not ERK-size
 
   request.params.integrator = Integrator::Erk;
   const SteeringResult erk = steerPass(pass, request);
@@ -332,7 +341,8 @@ TEST(HardCases, ZeroDampingStaysBounded) {
     lo = std::min(lo, s.tilt_rad);
     hi = std::max(hi, s.tilt_rad);
   }
-  // Energy is conserved: it swings between rest at 0 and the turning point, through the equilibrium.
+  // Energy is conserved: it swings between rest at 0 and the turning point, through the
+  // equilibrium.
   const double turning = undampedTurningPoint(*wall, 1.0, 0.5);
   EXPECT_GT(turning, equilibrium);
   EXPECT_GE(lo, -1e-4 * turning);
@@ -352,8 +362,8 @@ TEST_P(CoarseLattice, VoxelBoundaryCrossingsDoNotDiverge) {
   // Every node crosses voxel faces every 2 mm of feed.
   const Pass pass = straightPass(300.0, kRadius, 0.3);
   if (GetParam()) {
-    // Nearest-value sampling makes the moment discontinuous; where the equilibrium sits on a jump the
-    // axis chatters across it and the step budget runs out. That must be a clear report, not a
+    // Nearest-value sampling makes the moment discontinuous; where the equilibrium sits on a jump
+    // the axis chatters across it and the step budget runs out. That must be a clear report, not a
     // wrong or non-finite path.
     const SteeringResult chatter = steerPass(pass, request);
     expectAllFinite(chatter);
@@ -386,8 +396,9 @@ TEST(HardCases, FeedParallelToTheNormalStaysFinite) {
   const Pass base = straightPass(300.0);
   Pass plunge{300.0, [&](double s_mm) {
                 PassFrame f = base.frameAt(s_mm);
-                if (s_mm > 80.0 && s_mm < 90.0) f.feed = Vec3::UnitZ();   // feed along the normal
-                if (s_mm >= 90.0 && s_mm < 95.0) f.feed = Vec3::Zero();   // or no feed direction at all
+                if (s_mm > 80.0 && s_mm < 90.0) f.feed = Vec3::UnitZ();  // feed along the normal
+                if (s_mm >= 90.0 && s_mm < 95.0)
+                  f.feed = Vec3::Zero();  // or no feed direction at all
                 return f;
               }};
   const SteeringResult result = runToleranceStable(plunge, requestFor(wall.get()));
@@ -400,7 +411,8 @@ TEST(HardCases, VerticalAxesUpAndDownStayFinite) {
   const SteeringResult up = runToleranceStable(straightPass(300.0), requestFor(wall.get()));
   ASSERT_EQ(up.status, Status::Ok) << up.message;
   for (const PostureSample& s : up.samples)
-    if (s.s_mm == 0.0) EXPECT_EQ(s.posture.axis, Vec3::UnitZ());  // the nominal axis is exactly vertical
+    if (s.s_mm == 0.0)
+      EXPECT_EQ(s.posture.axis, Vec3::UnitZ());  // the nominal axis is exactly vertical
 
   // Machining a ceiling: normal -z, axis -z at the nominal (rotationFromZ's special case). Mirror
   // image of the upright case in z, so the axis leans away from the wall by the same amount.
@@ -432,7 +444,8 @@ TEST(Limits, TiltLimitIsReportedWithThePathPosition) {
   EXPECT_NE(result.message.find("dynamics.max_tilt_deg"), std::string::npos) << result.message;
   EXPECT_GT(result.samples.back().tilt_rad, 3.0 * kDeg);  // the offending sample is included
   EXPECT_LT(result.samples.size(), 301u);
-  for (std::size_t i = 0; i + 1 < result.samples.size(); ++i) EXPECT_LE(result.samples[i].tilt_rad, 3.0 * kDeg);
+  for (std::size_t i = 0; i + 1 < result.samples.size(); ++i)
+    EXPECT_LE(result.samples[i].tilt_rad, 3.0 * kDeg);
 }
 
 TEST(Limits, ClampHoldsTheAxisAtTheLimit) {
@@ -496,7 +509,8 @@ TEST(Outputs, SamplesEveryStepEndingOnTheLength) {
   EXPECT_DOUBLE_EQ(result.samples[1].s_mm, 0.4);
   EXPECT_DOUBLE_EQ(result.samples.back().s_mm, 10.0);
   const PostureSample& s = result.samples.back();
-  EXPECT_NEAR((s.posture.tip_mm + kRadius * s.posture.axis - Vec3(10.0, 0, kRadius)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((s.posture.tip_mm + kRadius * s.posture.axis - Vec3(10.0, 0, kRadius)).norm(), 0.0,
+              1e-12);
   EXPECT_TRUE(std::isnan(s.clearance_mm));  // no clearance hook
   EXPECT_EQ(steerPass(straightPass(0.0), request).samples.size(), 1u);
 }

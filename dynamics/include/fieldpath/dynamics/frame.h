@@ -21,12 +21,13 @@ struct LocalFrame {
   Vec3 f = Vec3::UnitX();
   Vec3 n = Vec3::UnitZ();
   Vec3 b = Vec3::UnitY();
-  bool degenerate = false;  ///< the feed was (nearly) parallel to the normal; f came from the fallback
+  bool degenerate =
+      false;  ///< the feed was (nearly) parallel to the normal; f came from the fallback
 };
 
 /// n normalised; f = the feed with its n component removed, normalised. When that is (nearly) zero
-/// (feed parallel to the normal, or a zero feed), f is `fallback_feed` projected the same way, and if
-/// that fails too, a fixed unit vector orthogonal to n (Eigen's unitOrthogonal), so the frame is
+/// (feed parallel to the normal, or a zero feed), f is `fallback_feed` projected the same way, and
+/// if that fails too, a fixed unit vector orthogonal to n (Eigen's unitOrthogonal), so the frame is
 /// always finite. Throws common::InputError if the normal is zero or not finite.
 LocalFrame localFrame(const PassFrame& frame, const Vec3& fallback_feed = Vec3::Zero());
 

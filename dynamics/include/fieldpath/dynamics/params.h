@@ -6,19 +6,24 @@ namespace fieldpath::dynamics {
 
 enum class Integrator { Bdf, Erk };  ///< CVODE BDF (default) or ARKODE ERK (explicit reference)
 
+/// Torques are in the field's unit times mm (τ = Σ (x_i - C) × F(x_i)); time in seconds.
 struct DynamicsParams {
-  double inertia = 1.0;     ///< J
-  double damping = -1.0;    ///< c; negative = critical, 2·sqrt(k·J)
-  double stiffness = 1.0;   ///< k
-  double feed_mm_per_min = 1000.0;
+  double inertia = 1.0;  ///< J, torque·s²/rad
+  double damping =
+      -1.0;  ///< c, torque·s/rad; negative = critical for the spring alone, 2·sqrt(k·J)
+  double stiffness = 1.0;           ///< k, torque/rad
+  double feed_mm_per_min = 1000.0;  ///< v: s = v t
   double rtol = 1.0e-6;
-  double atol = 1.0e-9;
+  double atol =
+      1.0e-9;  ///< on the angles (rad); the rates get atol·max(sqrt(k/J), 1 / output interval)
   double max_tilt_deg = 35.0;
   double max_lead_deg = 20.0;
   Integrator integrator = Integrator::Bdf;
 
   /// c, with the critical default resolved.
-  double effectiveDamping() const { return damping >= 0.0 ? damping : 2.0 * std::sqrt(stiffness * inertia); }
+  double effectiveDamping() const {
+    return damping >= 0.0 ? damping : 2.0 * std::sqrt(stiffness * inertia);
+  }
 };
 
 }  // namespace fieldpath::dynamics

@@ -1,7 +1,8 @@
 #pragma once
-/// Spring-damper steering of the tool axis along one pass (seed 004 §1.2, DESIGN.md "The dynamics"):
-/// the ball centre follows the pass exactly, the axis turns under the moment of the repulsive field
-/// at the tool and holder nodes, and a spring-damper pulls it back to the nominal angles:
+/// Spring-damper steering of the tool axis along one pass (seed 004 §1.2, DESIGN.md "The
+/// dynamics"): the ball centre follows the pass exactly, the axis turns under the moment of the
+/// repulsive field at the tool and holder nodes, and a spring-damper pulls it back to the nominal
+/// angles:
 ///
 ///   J θ'' + c θ' + k (θ - θ0(s)) = τ(θ),   θ = (lead, tilt),   s = v t,
 ///   τ = [ M·b, M·f ],   M = Σ (x_i - C) × F(x_i)   (world frame, about the ball centre C).
@@ -36,9 +37,10 @@ enum class LimitPolicy {
 };
 
 struct SteeringRequest {
-  const field::ForceField* field = nullptr;   ///< not owned; null = no field (free response)
-  std::span<const Vec3> nodes_tool_frame_mm;  ///< tool + holder nodes, tool frame (tip at 0, axis +z)
-  double ball_radius_mm = 3.0;                ///< R: the ball centre is at (0, 0, R) in the tool frame
+  const field::ForceField* field = nullptr;  ///< not owned; null = no field (free response)
+  std::span<const Vec3>
+      nodes_tool_frame_mm;      ///< tool + holder nodes, tool frame (tip at 0, axis +z)
+  double ball_radius_mm = 3.0;  ///< R: the ball centre is at (0, 0, R) in the tool frame
   DynamicsParams params;
   double step_mm = 0.5;  ///< arc length between output samples (the last one lands on length_mm)
   std::optional<double> initial_lead_rad;  ///< default: nominal θ0(0)
@@ -46,7 +48,8 @@ struct SteeringRequest {
   double initial_lead_rate_rad_per_s = 0.0;
   double initial_tilt_rate_rad_per_s = 0.0;
   LimitPolicy on_limit = LimitPolicy::Report;
-  double max_angle_change_deg_per_mm = 0.0;  ///< between output samples, either angle; 0 = unchecked
+  double max_angle_change_deg_per_mm =
+      0.0;  ///< between output samples, either angle; 0 = unchecked
   /// Solver step budget per output interval. BDF needs a few hundred to resolve a stiff start at
   /// tight tolerances; ERK runs out of it when stability, not accuracy, limits its step.
   long max_steps_per_output = 5000;
@@ -71,8 +74,8 @@ struct PostureSample {
 /// Solver counters, summed over restarts (clamps).
 struct SolverStats {
   long steps = 0;
-  long rhs_evals = 0;             ///< all right-hand-side evaluations, Jacobian ones included
-  long jacobian_evals = 0;        ///< dense difference-quotient Jacobians (BDF only)
+  long rhs_evals = 0;       ///< all right-hand-side evaluations, Jacobian ones included
+  long jacobian_evals = 0;  ///< dense difference-quotient Jacobians (BDF only)
   long error_test_failures = 0;
   long convergence_failures = 0;  ///< nonlinear (Newton) convergence failures (BDF only)
   long restarts = 0;              ///< re-initialisations after a clamp
@@ -109,11 +112,13 @@ AxisMoment axisMoment(const field::ForceField& field, std::span<const Vec3> node
                       double lead_rad, double tilt_rad);
 
 /// The field's own angular stiffness K = -∂τ/∂θ (2×2, rows/columns lead, tilt; torque per rad) at
-/// one pose, by central differences of axisMoment (step `delta_rad`). Near a wall K adds to the spring:
-/// the default "critical" c = 2·sqrt(k·J) is then underdamped (a step in a wall overshoots); a
-/// damping of 2·sqrt((k + K_tilt,tilt)·J) for the stiffest expected pose keeps the response critical.
-Eigen::Matrix2d fieldStiffness(const field::ForceField& field, std::span<const Vec3> nodes_tool_frame_mm,
-                               double ball_radius_mm, const LocalFrame& frame, const Vec3& centre_mm,
-                               double lead_rad, double tilt_rad, double delta_rad = 1e-4);
+/// one pose, by central differences of axisMoment (step `delta_rad`). Near a wall K adds to the
+/// spring: the default "critical" c = 2·sqrt(k·J) is then underdamped (a step in a wall
+/// overshoots); a damping of 2·sqrt((k + K_tilt,tilt)·J) for the stiffest expected pose keeps the
+/// response critical.
+Eigen::Matrix2d fieldStiffness(const field::ForceField& field,
+                               std::span<const Vec3> nodes_tool_frame_mm, double ball_radius_mm,
+                               const LocalFrame& frame, const Vec3& centre_mm, double lead_rad,
+                               double tilt_rad, double delta_rad = 1e-4);
 
 }  // namespace fieldpath::dynamics
