@@ -16,7 +16,8 @@ struct ToolSpec {
   double length_mm = 12.0;        ///< L, from the tip to the top of the cutting body
 };
 
-/// Holder: (z from the tip, radius) stations, mm, z strictly increasing; revolved about +z.
+/// Holder: (z from the tip, radius) stations, mm, revolved about +z; z increases, except that two
+/// stations may share z to make a step to another radius.
 struct HolderStation {
   double z_mm;
   double radius_mm;

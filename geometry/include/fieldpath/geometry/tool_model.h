@@ -13,7 +13,8 @@ namespace fieldpath::geometry {
 /// "ball:R[:L]" | "torus:R:r[:L]" | "flat:R[:L]" (mm); L defaults to 4R. Throws common::InputError.
 ToolSpec parseToolSpec(std::string_view text);
 
-/// "z0:r0,z1:r1,..." (mm, z from the tip, strictly increasing; r > 0). Empty text → empty profile.
+/// "z0:r0,z1:r1,..." (mm, z from the tip, increasing; equal z only for a step; r > 0). Empty text
+/// → empty profile.
 /// Throws common::InputError.
 HolderProfile parseHolderProfile(std::string_view text);
 
