@@ -21,7 +21,8 @@ HolderProfile parseHolderProfile(std::string_view text);
 /// Throws common::InputError if the tool is not meshable (R <= 0, r outside (0, R] for a torus,
 /// L below the cutting end, non-finite values).
 void validateToolSpec(const ToolSpec& tool);
-/// Throws common::InputError unless z strictly increases and every radius is finite and > 0.
+/// Throws common::InputError unless there are >= 2 stations, z increases (equal only for a step)
+/// and every radius is finite and > 0.
 void validateHolderProfile(const HolderProfile& holder);
 
 /// Closed, outward-oriented mesh of tool body (cutting end + cylindrical shank to L) and holder,
