@@ -1,11 +1,178 @@
+/// fieldpath field probe|build: the repulsive field of a scene's obstacles (DESIGN.md "The field").
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
 #include "commands.h"
 #include "errors.h"
+#include "fieldpath/field/direct_field.h"
+#include "fieldpath/field/voxel_field.h"
+#include "progress.h"
+#include "scene.h"
 
 namespace fieldpath::app {
+namespace {
 
-void addFieldCommand(CLI::App& app, const GlobalOptions& /*global*/) {
-  auto* cmd = app.add_subcommand("field", "(not yet implemented)");
-  cmd->callback([] { throw InputError("'field' is not implemented yet"); });
+using field::Vec3;
+
+/// `x y z` per line; `#` starts a comment; blank lines are skipped.
+std::vector<Vec3> readPoints(const std::string& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file + ": cannot open points file");
+  std::vector<Vec3> points;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
+    std::istringstream fields(line);
+    std::vector<std::string> words;
+    for (std::string w; fields >> w;) words.push_back(w);
+    if (words.empty()) continue;
+    if (words.size() != 3)
+      throw InputError(file + ":" + std::to_string(number) + ": expected 3 numbers `x y z`, got " +
+                       std::to_string(words.size()) + " fields");
+    Vec3 p;
+    for (int a = 0; a < 3; ++a) {
+      std::size_t used = 0;
+      try {
+        p[a] = std::stod(words[a], &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != words[a].size() || !std::isfinite(p[a]))
+        throw InputError(file + ":" + std::to_string(number) + ": '" + words[a] + "' is not a finite number");
+    }
+    points.push_back(p);
+  }
+  return points;
+}
+
+struct FieldOptions {
+  std::string scene;
+  std::string points;
+  bool direct = false;
+  double voxel_mm = 0.0;  ///< 0: the scene's field.voxel_size
+  std::string interpolation;  ///< "" : the scene's
+  std::string out;
+  std::string save_field;
+  double max_memory_mib = 4096.0;
+};
+
+/// The scene's obstacle samples and the exact field over them.
+struct Obstacles {
+  Scene scene;
+  std::unique_ptr<field::DirectField> direct;
+  double sampling_s = 0.0;
+};
+
+Obstacles loadObstacles(const FieldOptions& o) {
+  Obstacles result{loadScene(o.scene), nullptr, 0.0};
+  const auto start = std::chrono::steady_clock::now();
+  const Scene& s = result.scene;
+  result.direct = std::make_unique<field::DirectField>(
+      field::sampleObstacles(s.obstacles, s.field.sample_step_mm, s.field.weights), s.field);
+  result.sampling_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+field::VoxelRequest voxelRequest(const FieldOptions& o, const Scene& scene, bool quiet) {
+  field::VoxelRequest request;
+  request.voxel_size_mm = o.voxel_mm > 0.0 ? o.voxel_mm : scene.field.voxel_size_mm;
+  request.interpolation = scene.field.interpolation;
+  if (!o.interpolation.empty())
+    request.interpolation =
+        o.interpolation == "quadratic" ? field::Interpolation::Quadratic : field::Interpolation::Trilinear;
+  request.max_memory_bytes = static_cast<std::size_t>(o.max_memory_mib * 1024.0 * 1024.0);
+  request.progress = makeProgressLine(quiet);
+  return request;
+}
+
+std::string mib(std::size_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f MiB", bytes / (1024.0 * 1024.0));
+  return text;
+}
+
+void probe(const FieldOptions& o, const GlobalOptions& global) {
+  const std::vector<Vec3> points = readPoints(o.points);
+  const Obstacles obstacles = loadObstacles(o);
+  std::unique_ptr<field::VoxelField> voxel;
+  if (!o.direct) {
+    voxel = std::make_unique<field::VoxelField>(*obstacles.direct,
+                                                voxelRequest(o, obstacles.scene, global.quiet));
+    if (!o.save_field.empty()) voxel->save(o.save_field);
+  }
+  const field::ForceField& f = voxel ? static_cast<const field::ForceField&>(*voxel) : *obstacles.direct;
+  std::vector<Vec3> forces(points.size());
+  f.evaluate(points, forces);
+  std::string out = "# x y z Fx Fy Fz (mm; " + std::string(voxel ? "voxel" : "direct") + " field)\n";
+  char line[256];
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    std::snprintf(line, sizeof line, "%.9g %.9g %.9g %.9g %.9g %.9g\n", points[i].x(), points[i].y(), points[i].z(),
+                  forces[i].x(), forces[i].y(), forces[i].z());
+    out += line;
+  }
+  std::fputs(out.c_str(), stdout);
+}
+
+void build(const FieldOptions& o, const GlobalOptions& global) {
+  const Obstacles obstacles = loadObstacles(o);
+  const field::VoxelRequest request = voxelRequest(o, obstacles.scene, global.quiet);
+  const field::VoxelField voxel(*obstacles.direct, request);
+  voxel.save(o.out);
+  const field::VoxelStats& s = voxel.stats();
+  const auto& samples = obstacles.direct->samples();
+  std::printf("obstacles: %zu meshes, %zu samples (step %g mm, %.0f mm²)\n", obstacles.scene.obstacles.size(),
+              samples.size(), obstacles.scene.field.sample_step_mm, samples.area_mm2);
+  std::printf("voxel size: %g mm, %s\n", request.voxel_size_mm,
+              request.interpolation == field::Interpolation::Trilinear ? "trilinear" : "quadratic");
+  std::printf("estimated nodes: %zu\n", s.estimated_nodes);
+  std::printf("active nodes: %zu (%.2f %% of the dense box)\n", s.active_nodes,
+              s.dense_box_nodes ? 100.0 * s.active_nodes / s.dense_box_nodes : 0.0);
+  std::printf("dense-box nodes: %zu\n", s.dense_box_nodes);
+  std::printf("memory: %s\n", mib(s.memory_bytes).c_str());
+  std::printf("time: sampling %.3f s, build %.3f s\n", obstacles.sampling_s, s.build_seconds);
+  std::printf("wrote %s\n", o.out.c_str());
+}
+
+}  // namespace
+
+void addFieldCommand(CLI::App& app, const GlobalOptions& global) {
+  auto* cmd = app.add_subcommand("field", "The repulsive field of a scene's obstacles: probe it, build its voxels");
+  cmd->require_subcommand(1);
+  auto options = std::make_shared<FieldOptions>();
+
+  auto* probe_cmd = cmd->add_subcommand("probe", "Print `x y z Fx Fy Fz` at the points of a file");
+  probe_cmd->add_option("scene", options->scene, "Scene file (YAML)")->required();
+  probe_cmd->add_option("--points", options->points, "Points file: `x y z` a line, # comments")->required();
+  auto* direct = probe_cmd->add_flag("--direct", options->direct, "Exact sum over the samples within r0 (no voxels)");
+  probe_cmd->add_option("--voxel", options->voxel_mm, "Voxel size h, mm (default: the scene's field.voxel_size)")
+      ->check(CLI::PositiveNumber)
+      ->excludes(direct);
+  probe_cmd->add_option("--interpolation", options->interpolation, "trilinear | quadratic (default: the scene's)")
+      ->check(CLI::IsMember({"trilinear", "quadratic"}))
+      ->excludes(direct);
+  probe_cmd->add_option("--save-field", options->save_field, "Also write the voxel field to this .vdb file")
+      ->excludes(direct);
+  probe_cmd->add_option("--max-memory", options->max_memory_mib, "Refuse voxel fields estimated above this, MiB")
+      ->check(CLI::PositiveNumber);
+  probe_cmd->callback([options, &global] { probe(*options, global); });
+
+  auto* build_cmd = cmd->add_subcommand("build", "Build the sparse voxel field and write it as OpenVDB (.vdb)");
+  build_cmd->add_option("scene", options->scene, "Scene file (YAML)")->required();
+  build_cmd->add_option("--voxel", options->voxel_mm, "Voxel size h, mm (default: the scene's field.voxel_size)")
+      ->check(CLI::PositiveNumber);
+  build_cmd->add_option("--interpolation", options->interpolation, "trilinear | quadratic (default: the scene's)")
+      ->check(CLI::IsMember({"trilinear", "quadratic"}));
+  build_cmd->add_option("--out", options->out, "Output .vdb file")->required();
+  build_cmd->add_option("--max-memory", options->max_memory_mib, "Refuse voxel fields estimated above this, MiB")
+      ->check(CLI::PositiveNumber);
+  build_cmd->callback([options, &global] { build(*options, global); });
 }
 
 }  // namespace fieldpath::app

@@ -1,0 +1,59 @@
+#pragma once
+/// Scene files (DESIGN.md "Scene files"): one YAML file describes a job. Every key is read into a
+/// Scene here, checked, and its meshes loaded; relative paths are relative to the scene file.
+/// Defaults are those of the params structs (field/params.h, dynamics/params.h, pathgen/params.h,
+/// geometry/tool.h), documented there once.
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "fieldpath/dynamics/params.h"
+#include "fieldpath/field/params.h"
+#include "fieldpath/geometry/mesh.h"
+#include "fieldpath/geometry/tool.h"
+#include "fieldpath/pathgen/impeller.h"
+#include "fieldpath/pathgen/params.h"
+
+namespace fieldpath::app {
+
+struct Scene {
+  std::filesystem::path file;  ///< the scene file itself
+
+  /// `obstacles:` surfaces that repel (world frame, mm), loaded: `- mesh: FILE` entries in order,
+  /// then the impeller's blades once resolveImpeller has run.
+  std::vector<geometry::TriangleMesh> obstacles;
+  std::vector<std::filesystem::path> obstacle_files;  ///< the `- mesh:` files, resolved
+
+  /// `guide:` the machined surface: `{ mesh: FILE }`, loaded here, or `{ impeller: ... }`.
+  std::optional<geometry::TriangleMesh> guide;
+  std::optional<std::filesystem::path> guide_file;
+
+  /// `obstacles: - impeller: {...}`: the node as written, for resolveImpeller.
+  std::optional<YAML::Node> impeller;
+  /// `guide: { impeller: X }`: X as written (e.g. `hub`), for resolveImpeller.
+  std::optional<YAML::Node> guide_impeller;
+  /// Filled by resolveImpeller.
+  std::optional<pathgen::Impeller> impeller_model;
+
+  geometry::ToolSpec tool;                    ///< `tool:`
+  geometry::HolderProfile holder;             ///< `holder:` [[z, radius], ...]
+  double clearance_mm = 0.5;                  ///< `clearance:` tool+holder ↔ obstacles, mm
+  field::FieldParams field;                   ///< `field:`
+  dynamics::DynamicsParams dynamics;          ///< `dynamics:`
+  pathgen::PathParams path;                   ///< `path:`
+};
+
+/// Reads `file`, checks every key and value, loads the mesh files and, where the scene names the
+/// parametric impeller, calls resolveImpeller. Throws common::InputError "FILE:LINE: key: why"
+/// (key as a dotted path, e.g. `field.r0`, `obstacles[2].mesh`) for a missing or unreadable
+/// file, bad YAML, an unknown key, a value of the wrong type or out of range, or a mesh that
+/// cannot be loaded.
+Scene loadScene(const std::filesystem::path& file);
+
+/// Turns scene.impeller / scene.guide_impeller into meshes (obstacles, guide) and
+/// scene.impeller_model. Lives in scene_impeller.cpp (the impeller's owner replaces it).
+void resolveImpeller(Scene& scene);
+
+}  // namespace fieldpath::app
