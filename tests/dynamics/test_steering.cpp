@@ -82,31 +82,40 @@ SteeringResult runToleranceStable(const Pass& pass, SteeringRequest request) {
   return loose;
 }
 
-/// Tilt torque τ = M·f on the nodes tilted by `tilt_rad` beside a straight pass, summed here
-/// independently of steerPass: nodes turned about f (the minimal rotation for a pure tilt), moment
-/// about the ball centre.
-double tiltTorque(const field::ForceField& field, double tilt_rad) {
-  const PassFrame pf = straightPass(1.0).frameAt(0.0);
-  const Vec3 f = pf.feed;
-  const Eigen::Matrix3d rot = Eigen::AngleAxisd(tilt_rad, f).toRotationMatrix();
+/// Torque M·e about the unit axis e (f for tilt, b for lead) on the nodes turned by `angle_rad`
+/// about e, beside a straight pass at its start, summed here independently of steerPass: a pure
+/// tilt or pure lead turns the axis about f or b, and that rotation is the minimal one from e_z.
+double torqueAbout(const field::ForceField& field, const Vec3& e, double angle_rad) {
+  const Vec3 centre = straightPass(1.0).frameAt(0.0).centre_mm;
+  const Eigen::Matrix3d rot = Eigen::AngleAxisd(angle_rad, e).toRotationMatrix();
   Vec3 m = Vec3::Zero();
   for (const Vec3& p : toolNodes()) {
     const Vec3 r = rot * (p - Vec3(0, 0, kRadius));
-    m += r.cross(field.at(pf.centre_mm + r));
+    m += r.cross(field.at(centre + r));
   }
-  return m.dot(f);
+  return m.dot(e);
 }
 
-/// Tilt where k (θ - θ0) = τ(θ) (θ0 = 0), by bisection.
-double staticTilt(const field::ForceField& field, double stiffness, double lo_rad, double hi_rad) {
-  auto residual = [&](double tilt) { return stiffness * tilt - tiltTorque(field, tilt); };
-  EXPECT_LT(residual(lo_rad), 0.0);
-  EXPECT_GT(residual(hi_rad), 0.0);
+double tiltTorque(const field::ForceField& field, double tilt_rad) {
+  return torqueAbout(field, Vec3::UnitX(), tilt_rad);
+}
+
+/// Angle about e where k θ = τ(θ) (θ0 = 0), by bisection in [lo, hi] (a sign change required).
+double staticAngle(const field::ForceField& field, const Vec3& e, double stiffness, double lo_rad,
+                   double hi_rad) {
+  auto residual = [&](double angle) { return stiffness * angle - torqueAbout(field, e, angle); };
+  const bool rising = residual(lo_rad) < 0.0;
+  EXPECT_NE(rising, residual(hi_rad) < 0.0)
+      << "no sign change in [" << lo_rad << ", " << hi_rad << "]";
   for (int i = 0; i < 100; ++i) {
     const double mid = 0.5 * (lo_rad + hi_rad);
-    (residual(mid) < 0.0 ? lo_rad : hi_rad) = mid;
+    ((residual(mid) < 0.0) == rising ? lo_rad : hi_rad) = mid;
   }
   return 0.5 * (lo_rad + hi_rad);
+}
+
+double staticTilt(const field::ForceField& field, double stiffness, double lo_rad, double hi_rad) {
+  return staticAngle(field, Vec3::UnitX(), stiffness, lo_rad, hi_rad);
 }
 
 /// Undamped swing from rest at tilt 0: the turning point θmax > 0 where the work of the field
@@ -388,6 +397,41 @@ TEST_P(CoarseLattice, VoxelBoundaryCrossingsDoNotDiverge) {
 
 INSTANTIATE_TEST_SUITE_P(Dynamics, CoarseLattice, ::testing::Values(false, true),
                          [](const auto& info) { return info.param ? "nearest" : "trilinear"; });
+
+/// The tool dwelling at the start of the straight pass (the centre does not move; s still runs).
+Pass dwell(double length_mm) {
+  const PassFrame at_start = straightPass(1.0).frameAt(0.0);
+  return Pass{length_mm, [at_start](double) { return at_start; }};
+}
+
+TEST(PlaneWall, WallAheadLeansTheAxisBack) {
+  auto ahead =
+      std::make_shared<PlaneField>(Vec3(4.0, 0, 0), -Vec3::UnitX(), kGain);  // across the feed
+  const SteeringResult result = runToleranceStable(dwell(300.0), requestFor(ahead.get()));
+  ASSERT_EQ(result.status, Status::Ok) << result.message;
+  const PostureSample& last = result.samples.back();
+  const double expected = staticAngle(*ahead, Vec3::UnitY(), 1.0, -0.5, 0.0);  // about b = e_y
+  EXPECT_LT(expected, -1.0 * kDeg);  // leans back, away from the wall (towards -f)
+  EXPECT_NEAR(last.lead_rad, expected, 1e-6);
+  EXPECT_NEAR(last.tilt_rad, 0.0, 1e-12);
+  EXPECT_LT(last.posture.axis.x(), 0.0);
+}
+
+TEST(PlaneWall, CornerTurnsBothAngles) {
+  auto corner = std::make_shared<SumField>();
+  corner->parts = {std::make_shared<PlaneField>(Vec3(4.0, 0, 0), -Vec3::UnitX(), kGain),
+                   wallAt(4.5)};
+  const SteeringResult result = runToleranceStable(dwell(300.0), requestFor(corner.get()));
+  ASSERT_EQ(result.status, Status::Ok) << result.message;
+  const PostureSample& last = result.samples.back();
+  EXPECT_LT(last.lead_rad, -1.0 * kDeg);
+  EXPECT_GT(last.tilt_rad, 0.5 * kDeg);
+  // Settled: the spring balances the field's torque on both angles.
+  EXPECT_NEAR(last.lead_torque, last.lead_rad, 1e-6);
+  EXPECT_NEAR(last.tilt_torque, last.tilt_rad, 1e-6);
+  EXPECT_LT(last.posture.axis.x(), 0.0);
+  EXPECT_LT(last.posture.axis.y(), 0.0);
+}
 
 // ---- degenerate frames ----------------------------------------------------------------------
 
