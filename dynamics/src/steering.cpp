@@ -78,6 +78,15 @@ void validate(const Pass& pass, const SteeringRequest& request) {
   if (!pass.frameAt) throw common::InputError("pass: no frame function (frameAt is empty)");
 }
 
+/// "s = 12.500 mm: ", the prefix of every message about a path position.
+std::string at(double s_mm) {
+  std::ostringstream out;
+  out.setf(std::ios::fixed);
+  out.precision(3);
+  out << "s = " << s_mm << " mm: ";
+  return out.str();
+}
+
 /// J θ'' + c θ' + k (θ - θ0(s)) = τ(θ), first-order form, time in s, s = v t.
 class SteeringSystem final : public detail::OdeSystem {
  public:
@@ -99,7 +108,7 @@ class SteeringSystem final : public detail::OdeSystem {
 
   int rhs(double t_s, const double* y, double* ydot) override {
     const double s_mm = arcLength(t_s);
-    const PassFrame pass_frame = pass_.frameAt(s_mm);
+    const PassFrame pass_frame = frameAt(s_mm);
     const AxisMoment m = moment(pass_frame, y[0], y[1]);
     ydot[0] = y[2];
     ydot[1] = y[3];
@@ -113,7 +122,7 @@ class SteeringSystem final : public detail::OdeSystem {
 
   /// The sample at arc length s for state y; also leaves the placed nodes in nodes_mm_.
   PostureSample sample(double s_mm, const std::array<double, kStateSize>& y) {
-    const PassFrame pass_frame = pass_.frameAt(s_mm);
+    const PassFrame pass_frame = frameAt(s_mm);
     const AxisMoment m = moment(pass_frame, y[0], y[1]);
     PostureSample out;
     out.s_mm = s_mm;
@@ -136,6 +145,20 @@ class SteeringSystem final : public detail::OdeSystem {
   }
 
  private:
+  /// The pass frame at s; a non-finite centre or a bad normal is bad input naming s.
+  PassFrame frameAt(double s_mm) const {
+    const PassFrame f = pass_.frameAt(s_mm);
+    try {
+      requireThat(f.centre_mm.allFinite(), "pass frame: ball centre", "finite", f.centre_mm.norm());
+      requireThat(std::isfinite(f.lead0_rad) && std::isfinite(f.tilt0_rad),
+                  "pass frame: nominal angles", "finite", f.lead0_rad + f.tilt0_rad);
+      localFrame(f);  // throws for a zero or non-finite normal
+    } catch (const common::InputError& e) {
+      throw common::InputError(at(s_mm) + e.what());
+    }
+    return f;
+  }
+
   AxisMoment moment(const PassFrame& pass_frame, double lead_rad, double tilt_rad) {
     if (!request_.field) return {};
     return momentOfNodes(*request_.field, offsets_mm_, localFrame(pass_frame), pass_frame.centre_mm,
@@ -155,14 +178,6 @@ class SteeringSystem final : public detail::OdeSystem {
   double feed_mm_per_s_, inertia_, damping_, stiffness_;
   std::vector<Vec3> nodes_mm_, forces_;  // scratch, reused by every evaluation
 };
-
-std::string at(double s_mm) {
-  std::ostringstream out;
-  out.setf(std::ios::fixed);
-  out.precision(3);
-  out << "s = " << s_mm << " mm: ";
-  return out.str();
-}
 
 /// Limit checks on one sample; returns the violation (empty if none) and, with Clamp, clamps y.
 struct LimitCheck {

@@ -543,6 +543,24 @@ TEST(Inputs, BadSettingsNameTheirKey) {
   r.params.max_tilt_deg = 0.0;
   expectKey(r, "dynamics.max_tilt_deg");
   EXPECT_THROW(steerPass(Pass{10.0, {}}, requestFor(nullptr)), common::InputError);
+
+  const Pass base = straightPass(10.0);
+  const Pass broken{10.0, [&](double s_mm) {
+                      PassFrame f = base.frameAt(s_mm);
+                      if (s_mm > 5.0) f.normal = Vec3::Zero();
+                      return f;
+                    }};
+  for (Integrator integrator : {Integrator::Bdf, Integrator::Erk}) {
+    SteeringRequest request = requestFor(nullptr);
+    request.params.integrator = integrator;
+    try {
+      steerPass(broken, request);
+      ADD_FAILURE() << "no error for a zero normal";
+    } catch (const common::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("s = 5."), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("normal"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Outputs, SamplesEveryStepEndingOnTheLength) {
