@@ -31,8 +31,7 @@ class ArkodeErk final : public Integrator {
   }
 
  private:
-  int evolve(double t_out) override {
-    double t_reached = 0.0;
+  int evolve(double t_out, double& t_reached) override {
     return ERKStepEvolve(mem_.get(), t_out, y_, &t_reached, ARK_NORMAL);
   }
 

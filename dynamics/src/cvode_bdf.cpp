@@ -45,8 +45,7 @@ class CvodeBdf final : public Integrator {
   }
 
  private:
-  int evolve(double t_out) override {
-    double t_reached = 0.0;
+  int evolve(double t_out, double& t_reached) override {
     return CVode(mem_.get(), t_out, y_, &t_reached, CV_NORMAL);
   }
 

@@ -297,11 +297,13 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
   for (long k = 0; k <= intervals; ++k) {
     const double s_mm = std::min(static_cast<double>(k) * request.step_mm, pass.length_mm);
     if (k > 0) {
-      const int flag = integrator->advance(s_mm / v, y.data());
+      double t_reached_s = 0.0;
+      const int flag = integrator->advance(s_mm / v, y.data(), t_reached_s);
       if (flag < 0) {
         result.status = Status::SolverFailed;
         result.message =
-            at(s_mm) + (request.params.integrator == Integrator::Erk ? "ARKODE ERK" : "CVODE BDF") +
+            at(system.arcLength(t_reached_s)) +
+            (request.params.integrator == Integrator::Erk ? "ARKODE ERK" : "CVODE BDF") +
             " failed (" + integrator->flagName(flag) + "): " + integrator->lastError();
         break;
       }
@@ -310,6 +312,11 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
     if (check.clamped) integrator->restart(s_mm / v, y.data());
     PostureSample sample = system.sample(s_mm, y);
     sample.limited = check.clamped;
+    if (!sample.moment.allFinite()) {  // the solver saw it too late (at s = 0) or not at all
+      result.status = Status::SolverFailed;
+      result.message = at(s_mm) + "the field gave a non-finite moment";
+      break;
+    }
     if (check.status == Status::Ok && max_change_rad_per_mm > 0.0 && !result.samples.empty()) {
       const PostureSample& prev = result.samples.back();
       const double ds_mm = s_mm - prev.s_mm;

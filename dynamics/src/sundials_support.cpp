@@ -50,8 +50,9 @@ Integrator::Integrator(OdeSystem& system, int size, const double* y0,
   std::copy_n(atol.data(), size, atol_.data());
 }
 
-int Integrator::advance(double t_out, double* y) {
-  const int flag = evolve(t_out);
+int Integrator::advance(double t_out, double* y, double& t_reached) {
+  t_reached = t_out;
+  const int flag = evolve(t_out, t_reached);
   system_.rethrowPending();
   std::copy_n(y_.data(), N_VGetLength_Serial(y_), y);
   return flag;

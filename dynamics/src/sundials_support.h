@@ -88,8 +88,9 @@ class Integrator {
   Integrator(const Integrator&) = delete;
   Integrator& operator=(const Integrator&) = delete;
 
-  /// Advances to t_out (s); y (size n) receives the state. Returns the solver flag (< 0: failure).
-  int advance(double t_out, double* y);
+  /// Advances to t_out (s); y (size n) receives the state at t_reached (= t_out unless it failed).
+  /// Returns the solver flag (< 0: failure).
+  int advance(double t_out, double* y, double& t_reached);
   /// Starts again from (t, y), e.g. after a clamp; the counters keep counting.
   void restart(double t, const double* y);
   SolverStats stats() const;
@@ -99,7 +100,7 @@ class Integrator {
 
  protected:
   Integrator(OdeSystem& system, int size, const double* y0, const std::vector<double>& atol);
-  virtual int evolve(double t_out) = 0;      ///< one CVode / ERKStepEvolve call on y_
+  virtual int evolve(double t_out, double& t_reached) = 0;  ///< one CVode / ERKStepEvolve on y_
   virtual void reinit(double t) = 0;         ///< from y_; resets the solver's own counters
   virtual SolverStats counters() const = 0;  ///< since the last (re)initialisation
 

@@ -599,6 +599,33 @@ struct FailingField final : field::ForceField {
   }
 };
 
+/// A field that returns NaN beyond x = from_x_mm.
+struct NanField final : field::ForceField {
+  double from_x_mm = 0.0;
+  void evaluate(std::span<const Vec3> points, std::span<Vec3> forces) const override {
+    for (std::size_t i = 0; i < points.size(); ++i)
+      forces[i] = points[i].x() > from_x_mm ? Vec3::Constant(NAN) : Vec3::Zero();
+  }
+};
+
+TEST(Outputs, NonFiniteFieldIsASolverFailureNeverANanSample) {
+  NanField field;
+  for (double from_x_mm : {20.0, -100.0}) {  // part-way, and from the very start
+    field.from_x_mm = from_x_mm;
+    for (Integrator integrator : {Integrator::Bdf, Integrator::Erk}) {
+      SteeringRequest request = requestFor(&field);
+      request.params.integrator = integrator;
+      const SteeringResult result = steerPass(straightPass(50.0), request);
+      EXPECT_EQ(result.status, Status::SolverFailed);
+      EXPECT_NE(result.message.find("s = "), std::string::npos) << result.message;
+      for (const PostureSample& s : result.samples) {
+        EXPECT_TRUE(s.moment.allFinite() && std::isfinite(s.tilt_rad)) << "s = " << s.s_mm;
+        EXPECT_LT(s.s_mm, 20.0);
+      }
+    }
+  }
+}
+
 TEST(Outputs, FieldErrorsPropagateThroughTheSolver) {
   const FailingField field;
   for (Integrator integrator : {Integrator::Bdf, Integrator::Erk}) {
