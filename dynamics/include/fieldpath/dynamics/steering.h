@@ -9,6 +9,10 @@
 ///
 /// Integrated in time with CVODE (BDF, dense Newton, difference-quotient Jacobian) or, for
 /// comparison, ARKODE's explicit ERK, which reports SolverFailed when stiffness outruns its budget.
+/// τ_lead = M·b is DESIGN.md's; the exact generalised force of the lead (turned about b, then
+/// tilted about f) is M·R_f(tilt) b, which differs by O(tilt · M·n). Each steerPass call has its
+/// own SUNDIALS context: calls for different passes may run in parallel (if the field is
+/// thread-safe, as ForceField requires).
 #include <functional>
 #include <optional>
 #include <span>
@@ -38,8 +42,8 @@ enum class LimitPolicy {
 
 struct SteeringRequest {
   const field::ForceField* field = nullptr;  ///< not owned; null = no field (free response)
-  std::span<const Vec3>
-      nodes_tool_frame_mm;      ///< tool + holder nodes, tool frame (tip at 0, axis +z)
+  /// Tool + holder nodes, tool frame (tip at 0, axis +z), mm; not owned.
+  std::span<const Vec3> nodes_tool_frame_mm;
   double ball_radius_mm = 3.0;  ///< R: the ball centre is at (0, 0, R) in the tool frame
   DynamicsParams params;
   double step_mm = 0.5;  ///< arc length between output samples (the last one lands on length_mm)
@@ -48,8 +52,8 @@ struct SteeringRequest {
   double initial_lead_rate_rad_per_s = 0.0;
   double initial_tilt_rate_rad_per_s = 0.0;
   LimitPolicy on_limit = LimitPolicy::Report;
-  double max_angle_change_deg_per_mm =
-      0.0;  ///< between output samples, either angle; 0 = unchecked
+  /// Between output samples, either angle; 0 = unchecked.
+  double max_angle_change_deg_per_mm = 0.0;
   /// Solver step budget per output interval. BDF needs a few hundred to resolve a stiff start at
   /// tight tolerances; ERK runs out of it when stability, not accuracy, limits its step.
   long max_steps_per_output = 5000;
