@@ -6,6 +6,8 @@
 #include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/distance.h>
 #include <fcl/geometry/bvh/BVH_model.h>
+#include <fcl/geometry/geometric_shape_to_BVH_model.h>
+#include <fcl/geometry/shape/sphere.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -48,24 +50,27 @@ ClearanceChecker::ClearanceChecker(const geometry::TriangleMesh& tool_mesh,
 
 std::size_t ClearanceChecker::obstacleCount() const { return impl_->obstacles.size(); }
 
-double ClearanceChecker::clearance(const geometry::Posture& posture, int* obstacle) const {
-  const Eigen::Isometry3d placed = geometry::toolToWorld(posture);
-  const fcl::Transform3d tool_pose(placed.matrix());
-  // Collision objects are cheap views of the shared hierarchies: one per query keeps it thread-safe.
-  fcl::CollisionObjectd tool(impl_->tool, tool_pose);
+namespace {
+
+/// Nearest obstacle to `model` placed at `pose`: 0 if it touches or crosses one (collide()), else
+/// the exact distance. The geometry overloads of FCL avoid CollisionObject, whose constructor
+/// recomputes the model's bounding box on every query.
+double nearestObstacle(const Model& model, const fcl::Transform3d& pose,
+                       const std::vector<std::shared_ptr<Model>>& obstacles, int* obstacle) {
+  const fcl::Transform3d identity = fcl::Transform3d::Identity();
   double best = std::numeric_limits<double>::infinity();
   int best_index = -1;
-  for (size_t i = 0; i < impl_->obstacles.size(); ++i) {
-    fcl::CollisionObjectd other(impl_->obstacles[i], fcl::Transform3d::Identity());
+  for (size_t i = 0; i < obstacles.size(); ++i) {
     fcl::CollisionRequestd collision_request;
     fcl::CollisionResultd collision_result;
     double d;
-    if (fcl::collide(&tool, &other, collision_request, collision_result) > 0) {
+    if (fcl::collide(&model, pose, obstacles[i].get(), identity, collision_request,
+                     collision_result) > 0) {
       d = 0.0;
     } else {
       fcl::DistanceRequestd request;  // rel_err = abs_err = 0: exact triangle distances
       fcl::DistanceResultd result;
-      d = std::max(0.0, fcl::distance(&tool, &other, request, result));
+      d = std::max(0.0, fcl::distance(&model, pose, obstacles[i].get(), identity, request, result));
     }
     if (d < best) {
       best = d;
@@ -74,6 +79,37 @@ double ClearanceChecker::clearance(const geometry::Posture& posture, int* obstac
   }
   if (obstacle) *obstacle = best_index;
   return best;
+}
+
+}  // namespace
+
+double ClearanceChecker::clearance(const geometry::Posture& posture, int* obstacle) const {
+  const Eigen::Isometry3d placed = geometry::toolToWorld(posture);
+  return nearestObstacle(*impl_->tool, fcl::Transform3d(placed.matrix()), impl_->obstacles, obstacle);
+}
+
+double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double radius_mm,
+                                       std::size_t* at, int* obstacle) const {
+  // A point-sized sphere model: the distance from the centre to the obstacles, less the radius.
+  constexpr double kPointRadiusMm = 1e-4;
+  auto ball = std::make_shared<Model>();
+  fcl::generateBVHModel(*ball, fcl::Sphered(kPointRadiusMm), fcl::Transform3d::Identity(), 4u, 4u);
+  std::vector<double> distance(centres_mm.size());
+  std::vector<int> nearest(centres_mm.size());
+  tbb::parallel_for(size_t{0}, centres_mm.size(), [&](size_t i) {
+    fcl::Transform3d pose = fcl::Transform3d::Identity();
+    pose.translation() = centres_mm[i];
+    distance[i] = nearestObstacle(*ball, pose, impl_->obstacles, &nearest[i]);
+  });
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < distance.size(); ++i) {
+    if (distance[i] < best) {
+      best = distance[i];
+      if (at) *at = i;
+      if (obstacle) *obstacle = nearest[i];
+    }
+  }
+  return std::max(0.0, best - radius_mm);
 }
 
 ClearanceResult ClearanceChecker::check(std::span<const geometry::Posture> postures,

@@ -5,6 +5,7 @@
 #include <functional>
 #include <numbers>
 #include <sstream>
+#include <tuple>
 
 #include "fieldpath/common/errors.h"
 
@@ -14,6 +15,9 @@ namespace {
 using common::InputError;
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
+/// Longest mesh cell side, mm: right triangles of 1 mm legs are sampled once each by the field at
+/// a 1 mm step (sampling.h), and FCL's hierarchies stay tight.
+constexpr double kMaxEdgeMm = 1.0;
 
 std::string fmt(double value) {
   std::ostringstream s;
@@ -35,9 +39,10 @@ void requirePositive(double value, const char* key) {
 /// A grid mesh of P(a, b) over [0, 1]² whose linear triangles stay within `tol_mm` of P: the error
 /// of linear interpolation on a cell is at most (ha² Maa + 2 ha hb Mab + hb² Mbb) / 8 with M the
 /// largest second derivatives (estimated on a fine sample); each term gets a third of the budget.
-/// `flip` reverses the winding (the normal is P_a × P_b otherwise).
+/// Cells are also at most `max_edge_mm` long (by the chord) so that triangles stay well shaped
+/// for the field's sampling. `flip` reverses the winding (the normal is P_a × P_b otherwise).
 geometry::TriangleMesh gridMesh(const std::function<Vec3(double, double)>& p, double tol_mm,
-                                bool flip) {
+                                double max_edge_mm, bool flip) {
   constexpr int kProbe = 48;
   const double d = 1.0 / kProbe;
   double m_aa = 1e-12, m_bb = 1e-12, m_ab = 1e-12;
@@ -50,8 +55,19 @@ geometry::TriangleMesh gridMesh(const std::function<Vec3(double, double)>& p, do
                               p(a - d, b - d)) / (4 * d * d)).norm());
     }
   }
+  double length_a = 0, length_b = 0;  // longest iso-lines, mm
+  for (int j = 0; j <= 4; ++j) {
+    double la = 0, lb = 0;
+    for (int i = 0; i < kProbe; ++i) {
+      la += (p((i + 1) * d, j / 4.0) - p(i * d, j / 4.0)).norm();
+      lb += (p(j / 4.0, (i + 1) * d) - p(j / 4.0, i * d)).norm();
+    }
+    length_a = std::max(length_a, la);
+    length_b = std::max(length_b, lb);
+  }
   const double budget = tol_mm / 3.0;
-  double ha = std::sqrt(8.0 * budget / m_aa), hb = std::sqrt(8.0 * budget / m_bb);
+  double ha = std::min({1.0, std::sqrt(8.0 * budget / m_aa), max_edge_mm / length_a});
+  double hb = std::min({1.0, std::sqrt(8.0 * budget / m_bb), max_edge_mm / length_b});
   const double cross = 2.0 * ha * hb * m_ab / 8.0;
   if (cross > budget) {
     const double shrink = std::sqrt(budget / cross);
@@ -71,7 +87,13 @@ geometry::TriangleMesh gridMesh(const std::function<Vec3(double, double)>& p, do
   mesh.triangles.reserve(2 * static_cast<size_t>(na) * nb);
   for (int i = 0; i < na; ++i) {
     for (int j = 0; j < nb; ++j) {
-      const int v00 = id(i, j), v10 = id(i + 1, j), v01 = id(i, j + 1), v11 = id(i + 1, j + 1);
+      int v00 = id(i, j), v10 = id(i + 1, j), v01 = id(i, j + 1), v11 = id(i + 1, j + 1);
+      // Split along the shorter diagonal: skewed cells (twisted rulings) keep short edges.
+      if ((mesh.vertices[v10] - mesh.vertices[v01]).squaredNorm() <
+          (mesh.vertices[v00] - mesh.vertices[v11]).squaredNorm()) {
+        // rotate the cell's corner labels so that the split runs v10–v01
+        std::tie(v00, v10, v11, v01) = std::make_tuple(v10, v11, v01, v00);
+      }
       if (!flip) {
         mesh.triangles.emplace_back(v00, v10, v11);
         mesh.triangles.emplace_back(v00, v11, v01);
@@ -211,13 +233,14 @@ double Impeller::minGapMm(double* at_u) const {
 }
 
 geometry::TriangleMesh Impeller::hubMesh() const {
-  return gridMesh([this](double u, double v) { return hub(u, v); }, params_.chord_tol_mm, false);
+  return gridMesh([this](double u, double v) { return hub(u, v); }, params_.chord_tol_mm,
+                  kMaxEdgeMm, false);
 }
 
 geometry::TriangleMesh Impeller::bladeMesh(int side) const {
   auto surface = [this, side](double u, double t) { return blade(side, u, t); };
   // B_u × B_t points into the channel for the left blade when the winding is kept.
-  geometry::TriangleMesh mesh = gridMesh(surface, params_.chord_tol_mm, false);
+  geometry::TriangleMesh mesh = gridMesh(surface, params_.chord_tol_mm, kMaxEdgeMm, false);
   const auto& tri = mesh.triangles.front();
   const Vec3 n = (mesh.vertices[tri[1]] - mesh.vertices[tri[0]])
                      .cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]]);

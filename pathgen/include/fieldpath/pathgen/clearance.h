@@ -13,6 +13,8 @@
 
 namespace fieldpath::pathgen {
 
+using geometry::Vec3;
+
 struct ClearanceRequest {
   bool per_posture = true;  ///< fill ClearanceResult::clearance_mm
   /// Postures per progress report (and per parallel batch).
@@ -47,6 +49,12 @@ class ClearanceChecker {
   ClearanceResult check(std::span<const geometry::Posture> postures,
                         const ClearanceRequest& request = {},
                         const common::Progress& progress = {}) const;
+
+  /// Smallest distance (mm) from a ball of `radius_mm` at each centre (world frame) to the
+  /// obstacles, 0 if one touches; `at` and `obstacle` receive where. The ball of a ball-end mill
+  /// must clear the obstacles whatever the axis: exact (centre-to-mesh distance less the radius).
+  double ballClearance(std::span<const Vec3> centres_mm, double radius_mm, std::size_t* at = nullptr,
+                       int* obstacle = nullptr) const;
 
   std::size_t obstacleCount() const;
 

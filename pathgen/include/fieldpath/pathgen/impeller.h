@@ -31,13 +31,13 @@ struct ImpellerParams {
   double bend_mm = 10.0;         ///< `bend`: centreline y offset at u = 1 (y_c = bend u²)
   double hub_rise_mm = 12.0;     ///< `hub_rise`: hub height at u = 1 on the centreline (+ dish)
   double hub_dish_mm = 1.0;      ///< `hub_dish`: hub centre below its edges (concave across)
-  double blade_height_mm = 34.0; ///< `blade_height`: ruling length, foot to tip
+  double blade_height_mm = 16.5; ///< `blade_height`: ruling length, foot to tip
   /// `lean_left_deg: [in, out]`: left blade lean at u = 0 and u = 1 (> 0 over the channel).
   std::array<double, 2> lean_left_deg = {4.0, 24.0};
   /// `lean_right_deg: [in, out]`: right blade lean (> 0 over the channel, < 0 away from it).
   std::array<double, 2> lean_right_deg = {-8.0, 6.0};
   /// `passes_v: [first, last]`: v of the first and last pass (evenly spread in between).
-  std::array<double, 2> passes_v = {0.08, 0.92};
+  std::array<double, 2> passes_v = {0.25, 0.82};
   /// `u_range: [start, end]`: the part of the channel the passes cover.
   std::array<double, 2> u_range = {0.0, 1.0};
   double chord_tol_mm = 0.01;    ///< `chord_tol`: meshes within this of the surfaces

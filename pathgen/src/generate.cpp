@@ -1,0 +1,256 @@
+#include "fieldpath/pathgen/generate.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <sstream>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/dynamics/steering.h"
+#include "fieldpath/field/direct_field.h"
+#include "fieldpath/field/sampling.h"
+#include "fieldpath/field/voxel_field.h"
+#include "fieldpath/geometry/tool_model.h"
+
+namespace fieldpath::pathgen {
+namespace {
+
+using common::InputError;
+using Clock = std::chrono::steady_clock;
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+/// Tool + holder nodes aimed at (seed 004: "le maillage outil comporte 500 nœuds").
+constexpr double kTargetNodes = 500.0;
+
+double seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+/// Fraction [begin, end) of the whole job reported by `progress` with its own label.
+common::Progress scaled(const common::Progress& progress, double begin, double end,
+                        std::string label) {
+  if (!progress) return {};
+  return [=](double fraction, std::string_view) {
+    return progress(begin + (end - begin) * fraction, label);
+  };
+}
+
+/// Every pass station's ball must clear the obstacles by `clearance_mm` (whatever the axis).
+void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>& passes,
+                        double ball_radius_mm, double clearance_mm) {
+  for (const Pass& pass : passes) {
+    std::vector<Vec3> centres;
+    for (const PassSample& s : pass.samples) centres.push_back(s.centre_mm);
+    size_t at = 0;
+    int obstacle = -1;
+    const double d = checker.ballClearance(centres, ball_radius_mm, &at, &obstacle);
+    if (d < clearance_mm) {
+      std::ostringstream msg;
+      msg << "pass " << pass.index + 1 << " (v = " << pass.v << "): at s = " << pass.samples[at].s_mm
+          << " mm the ball is " << d << " mm from obstacle " << obstacle
+          << (obstacle == 0 ? " (left blade)" : obstacle == 1 ? " (right blade)" : "")
+          << ", less than `clearance` = " << clearance_mm
+          << " mm: the channel is narrower than the ball there (impeller.passes_v, width_in/out)";
+      throw InputError(msg.str());
+    }
+  }
+}
+
+/// The world box that tool + holder can reach: nodes at every pass station (every few mm) at the
+/// nominal axis and at the lead/tilt limits, padded by two voxels.
+Eigen::AlignedBox3d reachBox(const std::vector<Pass>& passes, const std::vector<Vec3>& nodes,
+                             double ball_radius_mm, const dynamics::DynamicsParams& dyn,
+                             double lead_rad, double pad_mm) {
+  Eigen::AlignedBox3d box;
+  const double max_tilt = dyn.max_tilt_deg * kDegToRad, max_lead = dyn.max_lead_deg * kDegToRad;
+  const std::pair<double, double> corners[] = {{lead_rad, 0.0},       {max_lead, 0.0},
+                                               {-max_lead, 0.0},      {lead_rad, max_tilt},
+                                               {lead_rad, -max_tilt}};
+  for (const Pass& pass : passes) {
+    const size_t stride = std::max<size_t>(1, pass.samples.size() / 16);
+    for (size_t i = 0; i < pass.samples.size(); i += stride) {
+      const PassSample& s = pass.samples[i];
+      const dynamics::LocalFrame frame{s.feed, s.normal, s.binormal, false};
+      for (const auto& [lead, tilt] : corners) {
+        const geometry::Posture p =
+            ballPosture(s.centre_mm, dynamics::axisFromAngles(frame, lead, tilt), ball_radius_mm);
+        const Eigen::Isometry3d placed = geometry::toolToWorld(p);
+        for (const Vec3& n : nodes) box.extend(placed * n);
+      }
+    }
+  }
+  box.min().array() -= pad_mm;
+  box.max().array() += pad_mm;
+  return box;
+}
+
+}  // namespace
+
+std::vector<geometry::TriangleMesh> obstacleMeshes(const Impeller& impeller,
+                                                   const std::vector<geometry::TriangleMesh>& extra) {
+  std::vector<geometry::TriangleMesh> meshes = {impeller.bladeMesh(0), impeller.bladeMesh(1)};
+  meshes.insert(meshes.end(), extra.begin(), extra.end());
+  return meshes;
+}
+
+double defaultNodeSpacingMm(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder) {
+  // Area of the revolved profile: ball/torus end ≈ hemisphere, shank, holder bands and end faces.
+  const double r = tool.radius_mm;
+  double area = 2 * std::numbers::pi * r * r + 2 * std::numbers::pi * r * (tool.length_mm - r);
+  double prev_z = tool.length_mm, prev_r = r;
+  for (const auto& station : holder) {
+    const double slant = std::hypot(station.z_mm - prev_z, station.radius_mm - prev_r);
+    area += std::numbers::pi * (station.radius_mm + prev_r) * slant;
+    prev_z = station.z_mm;
+    prev_r = station.radius_mm;
+  }
+  area += std::numbers::pi * prev_r * prev_r;  // top face
+  return std::sqrt(area / kTargetNodes);
+}
+
+GenerateResult generateImpellerPath(const GenerateRequest& request) {
+  const auto start = Clock::now();
+  GenerateResult result;
+  const geometry::ToolSpec& tool = request.tool;
+  if (tool.shape != geometry::ToolShape::Ball)
+    throw InputError("tool.shape: the impeller passes are for a ball-end mill (shape: ball)");
+  geometry::validateToolSpec(tool);
+  geometry::validateHolderProfile(request.holder);
+  if (!std::isfinite(request.clearance_mm) || request.clearance_mm < 0.0)
+    throw InputError("clearance: must be a finite distance >= 0 mm");
+  const double r = tool.radius_mm;
+  const double lead_rad = request.path.lead_deg * kDegToRad;
+
+  // ---- setup: geometry, passes, clearance hierarchies ----------------------------------------
+  const Impeller impeller(request.impeller);
+  result.passes = impellerPasses(impeller, request.path, r);
+  const std::vector<geometry::TriangleMesh> obstacles =
+      obstacleMeshes(impeller, request.extra_obstacles);
+  const geometry::TriangleMesh tool_mesh =
+      geometry::toolMesh(tool, request.holder, kClearanceMeshTolMm);
+  result.tool_triangles = tool_mesh.triangles.size();
+  const ClearanceChecker checker(tool_mesh, obstacles);
+  checkBallClearance(checker, result.passes, r, request.clearance_mm);
+  std::vector<Vec3> nodes;
+  for (const auto& node :
+       geometry::surfaceNodes(tool, request.holder, defaultNodeSpacingMm(tool, request.holder)))
+    nodes.push_back(node.position_mm);
+  result.tool_nodes = nodes.size();
+  for (const Pass& pass : result.passes) result.path_length_mm += pass.length_mm;
+  result.times.setup_s = seconds(start);
+
+  // ---- field -----------------------------------------------------------------------------------
+  const auto field_start = Clock::now();
+  std::unique_ptr<field::DirectField> direct;
+  std::unique_ptr<field::VoxelField> voxels;
+  std::unique_ptr<field::BruteForceField> brute;
+  const field::ForceField* force = nullptr;
+  const double h = request.field.voxel_size_mm;
+  result.reach_box_mm = reachBox(result.passes, nodes, r, request.dynamics, lead_rad,
+                                 request.mode == FieldMode::Voxel ? 2 * h : 0.0);
+  if (!request.nominal) {
+    field::ObstacleSamples samples =
+        field::sampleObstacles(obstacles, request.field.sample_step_mm, request.field.weights);
+    result.obstacle_points = samples.size();
+    direct = std::make_unique<field::DirectField>(std::move(samples), request.field);
+    force = direct.get();
+    if (request.mode == FieldMode::BruteForce) {
+      brute = std::make_unique<field::BruteForceField>(direct->samples(), request.field);
+      force = brute.get();
+    }
+    if (request.mode == FieldMode::Voxel) {
+      field::VoxelRequest voxel_request;
+      voxel_request.voxel_size_mm = h;
+      voxel_request.interpolation = request.field.interpolation;
+      voxel_request.region_mm = result.reach_box_mm;
+      voxel_request.progress = scaled(request.progress, 0.0, 0.3, "field");
+      voxels = std::make_unique<field::VoxelField>(*direct, voxel_request);
+      result.voxel_nodes = voxels->stats().active_nodes;
+      result.voxel_memory_bytes = voxels->stats().memory_bytes;
+      force = voxels.get();
+    }
+  }
+  result.times.field_s = seconds(field_start);
+
+  // ---- steering, pass by pass ----------------------------------------------------------------
+  const auto steer_start = Clock::now();
+  const int pass_count = static_cast<int>(result.passes.size());
+  for (const Pass& pass : result.passes) {
+    const std::string label =
+        "pass " + std::to_string(pass.index + 1) + "/" + std::to_string(pass_count);
+    const double begin = 0.3 + 0.6 * pass.index / pass_count;
+    const double end = 0.3 + 0.6 * (pass.index + 1) / pass_count;
+    if (request.nominal) {
+      for (const PassSample& s : pass.samples) {
+        GeneratedPosture g;
+        g.pass = pass.index;
+        g.s_mm = s.s_mm;
+        g.lead_rad = lead_rad;
+        g.posture = ballPosture(s.centre_mm, nominalAxis(s, lead_rad), r);
+        result.postures.push_back(g);
+      }
+      common::report(request.progress, end, label);
+      continue;
+    }
+    dynamics::Pass dyn_pass;
+    dyn_pass.length_mm = pass.length_mm;
+    dyn_pass.frameAt = [&impeller, &pass, lead_rad](double s_mm) {
+      const PassSample s = sampleAt(impeller, pass, s_mm);
+      dynamics::PassFrame frame;
+      frame.centre_mm = s.centre_mm;
+      frame.feed = s.feed;
+      frame.normal = s.normal;
+      frame.lead0_rad = lead_rad;
+      return frame;
+    };
+    dynamics::SteeringRequest steer;
+    steer.field = force;
+    steer.nodes_tool_frame_mm = nodes;
+    steer.ball_radius_mm = r;
+    steer.params = request.dynamics;
+    steer.step_mm = pass.samples.size() > 1 ? pass.samples[1].s_mm : pass.length_mm;
+    steer.progress = scaled(request.progress, begin, end, label);
+    const dynamics::SteeringResult steered = dynamics::steerPass(dyn_pass, steer);
+    if (steered.status != dynamics::Status::Ok)
+      throw InputError(label + " (v = " + std::to_string(pass.v) + "): " +
+                       dynamics::toString(steered.status) + ": " + steered.message);
+    for (const dynamics::PostureSample& s : steered.samples) {
+      GeneratedPosture g;
+      g.pass = pass.index;
+      g.s_mm = s.s_mm;
+      g.lead_rad = s.lead_rad;
+      g.tilt_rad = s.tilt_rad;
+      g.moment = s.moment.norm();
+      g.posture = s.posture;
+      result.postures.push_back(g);
+    }
+    const dynamics::SolverStats& st = steered.stats;
+    result.solver_steps += st.steps;
+    result.rhs_evals += st.rhs_evals;
+    result.jacobian_evals += st.jacobian_evals;
+    result.error_test_failures += st.error_test_failures;
+    result.convergence_failures += st.convergence_failures;
+  }
+  result.times.steering_s = seconds(steer_start);
+
+  // ---- exact clearance -------------------------------------------------------------------------
+  const auto clearance_start = Clock::now();
+  std::vector<geometry::Posture> postures;
+  postures.reserve(result.postures.size());
+  for (const GeneratedPosture& g : result.postures) postures.push_back(g.posture);
+  result.clearance = checker.check(postures, {}, scaled(request.progress, 0.9, 1.0, "clearance"));
+  for (size_t i = 0; i < result.postures.size(); ++i) {
+    GeneratedPosture& g = result.postures[i];
+    g.clearance_mm = result.clearance.clearance_mm[i];
+    result.max_tilt_deg = std::max(result.max_tilt_deg, std::abs(g.tilt_rad) / kDegToRad);
+    result.max_lead_deg = std::max(result.max_lead_deg, std::abs(g.lead_rad) / kDegToRad);
+  }
+  result.times.clearance_s = seconds(clearance_start);
+  result.times.total_s = seconds(start);
+  common::report(request.progress, 1.0, "done");
+  return result;
+}
+
+}  // namespace fieldpath::pathgen
