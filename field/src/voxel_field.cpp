@@ -174,8 +174,8 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
         const openvdb::Coord o = leaf.origin();
         const Vec3 lo = Vec3(o.x(), o.y(), o.z()) * h;
         const Vec3 hi = lo + Vec3::Constant((kLeafDim - 1) * h);
-        // The surface rule of law.h moves a band node by at most r_min + band_in.
-        const double pad = params.r0_mm + params.r_min_mm + band_in_mm;
+        // The surface rule of law.h moves a band node by at most 2 max(band_in, r_min).
+        const double pad = params.r0_mm + 2.0 * std::max(band_in_mm, params.r_min_mm);
         near.clear();
         index.forEachInBox(searcher, lo.array() - pad, hi.array() + pad,
                            [&](std::size_t j) { near.push_back(j); });

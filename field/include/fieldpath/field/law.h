@@ -8,11 +8,12 @@
 /// Surface rule (ours; the seed is silent, DESIGN.md asks for an outward force inside walls): let
 /// q* be the nearest sample within r0, n* its normal and η = (x - q*)·n* the height of x above
 /// its tangent plane (η < 0: inside the obstacle, the seed's normal sign test of §2.1). Where
-/// η < r_min, x gets the field at x'' = x + (r_min - η) n*, the point r_min above the surface:
-/// eq. 1 alone would give a plane's field that falls to zero on the surface (the r_min hold makes
-/// the samples under x pull sideways) and, inside, would push x deeper. So the field is held
-/// at its value r_min off the surface, finite and outward on both sides and continuous through
-/// η = r_min; a point exactly on a sample uses the sample's normal for u.
+/// η < r_min, x gets the field at x'' = x + (max(|η|, r_min) - η) n*: held at its value r_min
+/// off the surface for |η| < r_min, and mirrored out of the wall deeper inside. Eq. 1 alone
+/// would give a plane's field that falls to zero on the surface (the r_min hold makes the
+/// samples under x pull sideways) and, inside, would push x deeper. So the field is finite and
+/// outward on both sides, continuous through η = ±r_min, and even in η (which keeps voxel
+/// interpolation across a wall honest); a point exactly on a sample uses its normal for u.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -87,7 +88,10 @@ std::optional<Vec3> fieldAt(const Vec3& x_mm, ForEachNear&& for_each_near, const
   const Vec3& n = normals[nearest];
   const double height_mm = (x_mm - points[nearest]).dot(n);
   if (height_mm < -max_inside_depth_mm) return std::nullopt;
-  if (height_mm < params.r_min_mm) f = sum(x_mm + (params.r_min_mm - height_mm) * n, nullptr, nullptr);
+  if (height_mm < params.r_min_mm) {
+    const double lifted_mm = std::max(std::abs(height_mm), params.r_min_mm);
+    f = sum(x_mm + (lifted_mm - height_mm) * n, nullptr, nullptr);
+  }
   return Vec3(params.gain * f);
 }
 
