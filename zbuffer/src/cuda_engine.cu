@@ -89,6 +89,8 @@ struct Engine::Impl {
   float* triangles = nullptr;
   Vec3f* vertices = nullptr;
   std::uint32_t* indices = nullptr;
+  std::int32_t* bin_start = nullptr;
+  std::int32_t* bin_items = nullptr;
   std::int32_t* keys = nullptr;
   float* tile_max = nullptr;
   unsigned long long* culled = nullptr;
@@ -99,7 +101,8 @@ struct Engine::Impl {
     for (void* p :
          {static_cast<void*>(nodes), static_cast<void*>(triangles), static_cast<void*>(vertices),
           static_cast<void*>(indices), static_cast<void*>(keys), static_cast<void*>(tile_max),
-          static_cast<void*>(culled), static_cast<void*>(postures)})
+          static_cast<void*>(culled), static_cast<void*>(postures), static_cast<void*>(bin_start),
+          static_cast<void*>(bin_items)})
       if (p) cudaFree(p);
   }
 };
@@ -114,6 +117,8 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   m.tool.bvh_triangles = m.triangles = deviceCopy(tool.triangles, tool.triangle_floats);
   m.tool.vertices = m.vertices = deviceCopy(tool.vertices, tool.vertex_count);
   m.tool.indices = m.indices = deviceCopy(tool.indices, tool.index_count);
+  m.tool.bin_start = m.bin_start = deviceCopy(tool.bin_start, tool.bin_start_count);
+  m.tool.bin_items = m.bin_items = deviceCopy(tool.bin_items, tool.bin_item_count);
   std::vector<std::int32_t> keys(lines);
   for (std::size_t i = 0; i < lines; ++i) {
     std::int32_t bits;

@@ -20,6 +20,10 @@ struct ToolArrays {
   std::size_t vertex_count = 0;
   const std::uint32_t* indices = nullptr;
   std::size_t index_count = 0;
+  const std::int32_t* bin_start = nullptr;
+  std::size_t bin_start_count = 0;
+  const std::int32_t* bin_items = nullptr;
+  std::size_t bin_item_count = 0;
 };
 
 bool available();

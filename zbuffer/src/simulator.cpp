@@ -154,6 +154,52 @@ struct BvhBuilder {
   }
 };
 
+/// Bins the triangles that face down in the tool frame (candidates for vertical lines) on a
+/// uniform grid over their xy extent; each triangle goes to every bin its padded box overlaps.
+void binDownFacing(ToolData& data, float pad) {
+  ToolView& v = data.view;
+  const std::size_t count = data.bvh_triangles.size() / 9;
+  std::vector<std::int32_t> down;
+  Box box;
+  for (std::size_t t = 0; t < count; ++t) {
+    const float* p = data.bvh_triangles.data() + 9 * t;
+    const float area2 = (p[3] - p[0]) * (p[7] - p[1]) - (p[4] - p[1]) * (p[6] - p[0]);
+    const float scale = std::max({std::abs(p[3] - p[0]), std::abs(p[6] - p[0]),
+                                  std::abs(p[4] - p[1]), std::abs(p[7] - p[1])});
+    if (area2 > 1e-4f * scale * scale) continue;  // facing up (nearly vertical ones are kept)
+    down.push_back(static_cast<std::int32_t>(t));
+    for (int k = 0; k < 3; ++k)
+      box.add({p[3 * k] - pad, p[3 * k + 1] - pad, 0.f}),
+          box.add({p[3 * k] + pad, p[3 * k + 1] + pad, 0.f});
+  }
+  if (down.empty()) return;
+  const int bins = std::clamp(static_cast<int>(std::ceil(std::sqrt(down.size() / 2.0))), 1, 256);
+  const float side = std::max(box.hi[0] - box.lo[0], box.hi[1] - box.lo[1]) * (1.f + 1e-6f);
+  v.bins = bins;
+  v.bin_x0_mm = box.lo[0];
+  v.bin_y0_mm = box.lo[1];
+  v.bin_inv_mm = bins / side;
+  std::vector<std::vector<std::int32_t>> cells(std::size_t(bins) * bins);
+  const auto cellOf = [&](float x, float x0) {
+    return std::clamp(static_cast<int>((x - x0) * v.bin_inv_mm), 0, bins - 1);
+  };
+  for (auto t : down) {
+    const float* p = data.bvh_triangles.data() + 9 * t;
+    const float xlo = std::min({p[0], p[3], p[6]}) - pad, xhi = std::max({p[0], p[3], p[6]}) + pad;
+    const float ylo = std::min({p[1], p[4], p[7]}) - pad, yhi = std::max({p[1], p[4], p[7]}) + pad;
+    for (int cy = cellOf(ylo, v.bin_y0_mm); cy <= cellOf(yhi, v.bin_y0_mm); ++cy)
+      for (int cx = cellOf(xlo, v.bin_x0_mm); cx <= cellOf(xhi, v.bin_x0_mm); ++cx)
+        cells[std::size_t(cy) * bins + cx].push_back(t);
+  }
+  data.bin_start.assign(1, 0);
+  for (const auto& c : cells) {
+    data.bin_items.insert(data.bin_items.end(), c.begin(), c.end());
+    data.bin_start.push_back(static_cast<std::int32_t>(data.bin_items.size()));
+  }
+  v.bin_start = data.bin_start.data();
+  v.bin_items = data.bin_items.data();
+}
+
 }  // namespace
 
 ToolData prepareTool(const Tool& tool) {
@@ -206,6 +252,7 @@ ToolData prepareTool(const Tool& tool) {
   v.vertices = data.vertices.data();
   v.indices = data.indices.data();
   v.triangle_count = static_cast<std::int32_t>(mesh.triangles.size());
+  binDownFacing(data, 1e-5f * size);
   return data;
 }
 

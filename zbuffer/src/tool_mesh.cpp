@@ -7,6 +7,36 @@
 
 namespace fieldpath::zbuffer {
 
+namespace {
+
+/// Closes a ring of n vertices with n-2 triangles, cutting ears off every other vertex round after
+/// round (no long fan from one vertex: well-shaped triangles except the last few).
+void closePolygon(std::vector<std::array<std::uint32_t, 3>>& tris, std::uint32_t first, int n,
+                  bool facing_down) {
+  std::vector<std::uint32_t> poly(n);
+  for (int j = 0; j < n; ++j) poly[j] = first + static_cast<std::uint32_t>(j);
+  const auto add = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    if (facing_down)
+      tris.push_back({a, c, b});
+    else
+      tris.push_back({a, b, c});
+  };
+  while (poly.size() > 3) {
+    const std::size_t m = poly.size();
+    std::vector<std::uint32_t> next;
+    std::size_t k = 0;
+    for (; k + 2 < m || (m % 2 == 0 && k + 1 < m); k += 2) {
+      add(poly[k], poly[k + 1], poly[(k + 2) % m]);
+      next.push_back(poly[k]);
+    }
+    for (; k < m; ++k) next.push_back(poly[k]);
+    poly = std::move(next);
+  }
+  if (poly.size() == 3) add(poly[0], poly[1], poly[2]);
+}
+
+}  // namespace
+
 ToolMesh revolveProfile(const std::vector<std::pair<double, double>>& profile,
                         int segments_around) {
   const int n = segments_around;
@@ -32,8 +62,7 @@ ToolMesh revolveProfile(const std::vector<std::pair<double, double>>& profile,
   };
   const std::size_t last = profile.size() - 1;
   const bool bottom_pole = profile.front().first == 0.0, top_pole = profile.back().first == 0.0;
-  if (!bottom_pole)
-    for (int j = 1; j + 1 < n; ++j) tris.push_back({ring(0, 0), ring(0, j + 1), ring(0, j)});
+  if (!bottom_pole) closePolygon(tris, ring_start[0], n, true);
   for (std::size_t k = 0; k < last; ++k) {
     const bool lo_pole = profile[k].first == 0.0, hi_pole = profile[k + 1].first == 0.0;
     for (int j = 0; j < n; ++j) {

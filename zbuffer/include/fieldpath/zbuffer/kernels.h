@@ -42,6 +42,12 @@ struct ToolView {
   const Vec3f* vertices = nullptr;
   const std::uint32_t* indices = nullptr;  ///< 3 per triangle, CCW seen from outside
   std::int32_t triangle_count = 0;
+  // Mesh tools, vertical postures: down-facing triangles binned on a uniform grid over the tool's
+  // xy (tool frame), so a vertical line tests only the few triangles of its bin.
+  float bin_x0_mm = 0, bin_y0_mm = 0, bin_inv_mm = 0;
+  std::int32_t bins = 0;                    ///< per side; 0: no bins
+  const std::int32_t* bin_start = nullptr;  ///< bins²+1 offsets into bin_items
+  const std::int32_t* bin_items = nullptr;  ///< leaf-order triangle indices
 };
 
 /// Everything a posture needs, computed once per posture.
@@ -50,6 +56,7 @@ struct PreparedPosture {
   Vec3f tip_mm;
   Vec3f dir;          ///< world +z expressed in the tool frame (third row of rot)
   float lowest_z_mm;  ///< no point of the placed tool is below this (conservative)
+  bool vertical;      ///< axis exactly +z: rot is the identity
   int ix0, ix1, iy0,
       iy1;  ///< lines that may meet the tool (inclusive, clipped); empty if ix0 > ix1
   // Watertight ray/triangle test (Woop, Benthin, Wald 2013): axis permutation and shear.
@@ -114,7 +121,11 @@ FIELDPATH_HD PreparedPosture preparePosture(const GridView& g, const ToolView& t
     lowest = pose.tip_mm.z + minf(corner, shank);
   }
   const float margin = 1e-5f * (absf(pose.tip_mm.z) + hull_r + z1 - z0) + 1e-6f;
-  pp.lowest_z_mm = lowest - margin;
+  pp.vertical = pp.dir.x == 0.f && pp.dir.y == 0.f && pp.dir.z == 1.f;
+  // Vertical: the lowest point is exactly the tip plus the lowest vertex (heights are clamped to it
+  // in lineCut, so a line already at that height can be skipped without changing a bit).
+  pp.lowest_z_mm =
+      pp.vertical ? pose.tip_mm.z + (tool.kind == ToolKind::Mesh ? z0 : 0.f) : lowest - margin;
 
   setFootprint(g, pp, hull_r, z0, z1, margin);
 
@@ -329,7 +340,7 @@ FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const Prepar
     t = analyticEntry(tool, o, pp.dir);
   }
   if (t == FLT_MAX) return FLT_MAX;
-  const float h = (pp.tip_mm.z + t) + 0.f;
+  const float h = maxf(pp.tip_mm.z + t, pp.lowest_z_mm) + 0.f;
   return h < current_mm ? h : FLT_MAX;
 }
 

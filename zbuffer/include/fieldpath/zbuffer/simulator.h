@@ -113,6 +113,7 @@ struct ToolData {
   std::vector<BvhNode> bvh_nodes;
   std::vector<Vec3f> vertices;
   std::vector<std::uint32_t> indices;
+  std::vector<std::int32_t> bin_start, bin_items;
 };
 ToolData prepareTool(const Tool& tool);
 GridView makeGridView(const Grid& grid);

@@ -1,0 +1,599 @@
+/// Z-buffer benchmark: synthetic counterparts of seed 000's Table 1 cases 1-8 and seed 001's
+/// Random / Spiral / Roughing / Finishing / Cutting cases (with and without zoom). Same tool kinds
+/// and triangle counts, same posture counts and grids. For each case, in one run: our engine's
+/// median time, the SIMSURF1-style coarse kernel's time (one work item per posture, every
+/// triangle: the seeds' algorithm, the in-run peer), the published best time, the ratios, and the
+/// height error of both against the exact (analytic tool) result. Prints a markdown table.
+///
+///   bench_zbuffer [--backend cpu|cuda] [--cases 1,2,R,...|all] [--reps N] [--peer-limit P]
+///                 [--no-exact]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <functional>
+#include <map>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "fieldpath/zbuffer/simulator.h"
+#include "fieldpath/zbuffer/tool_mesh.h"
+
+namespace zb = fieldpath::zbuffer;
+
+namespace {
+
+/// Synthetic part surface z = S(x, y) (mm) with its gradient.
+struct Surface {
+  double amp1, lx, ly, amp2, l2;
+  double z(double x, double y) const {
+    return amp1 * std::sin(2 * std::numbers::pi * x / lx) *
+               std::cos(2 * std::numbers::pi * y / ly) +
+           amp2 * std::sin(2 * std::numbers::pi * (x + y) / l2);
+  }
+  void grad(double x, double y, double& gx, double& gy) const {
+    const double w = 2 * std::numbers::pi;
+    gx = amp1 * w / lx * std::cos(w * x / lx) * std::cos(w * y / ly) +
+         amp2 * w / l2 * std::cos(w * (x + y) / l2);
+    gy = -amp1 * w / ly * std::sin(w * x / lx) * std::sin(w * y / ly) +
+         amp2 * w / l2 * std::cos(w * (x + y) / l2);
+  }
+};
+
+enum class Kind { Roughing, Finish3, Finish5, Random, Spiral };
+
+struct Case {
+  std::string id, name;
+  Kind kind;
+  bool torus;       // torus (roughing) or sphere (ball) tool
+  int around, arc;  // mesh resolution → triangle count
+  double radius_mm, corner_mm, length_mm;
+  std::size_t postures;
+  int grid;
+  double width_mm;  // square region [0, width]²
+  Surface surface;
+  int lines;                      // raster lines (roughing: per level)
+  int levels;                     // roughing z-levels
+  double zoom[4] = {0, 0, 0, 0};  // zoom region (x0, y0, x1, y1), or none
+  double best_ms;                 // best published time, any device or engine
+  const char* best_src;
+  double
+      xeon_ms;  // published CPU SIMSURF1 time (seed 000: 4-core Xeon E5-1620v3; 001: 6-core X5650)
+};
+
+/// Line-raster position of posture k of P: zigzag lines along x over the margin-inset region.
+void raster(const Case& c, std::size_t k, std::size_t total, int lines, double& x, double& y,
+            int& line, double& w) {
+  const double m = c.radius_mm + 1;
+  const double u = (k + 0.5) / double(total) * lines;
+  line = std::min(lines - 1, int(u));
+  w = u - line;
+  const double span = c.width_mm - 2 * m;
+  x = m + (line % 2 == 0 ? w : 1 - w) * span;
+  y = m + (line + 0.5) / lines * span;
+}
+
+zb::Posture makePosture(const Case& c, std::size_t k) {
+  const double r = c.radius_mm;
+  const Surface& s = c.surface;
+  double x, y, w;
+  int line;
+  switch (c.kind) {
+    case Kind::Roughing: {
+      // z-levels from the stock top down, zigzag at each level, ~8% air moves (retract + traverse)
+      raster(c, k, c.postures, c.lines * c.levels, x, y, line, w);
+      const int level = line / c.lines;
+      const double top = std::abs(s.amp1) + std::abs(s.amp2) + 2;
+      const double zl = top - (level + 1) * (2 * top - 2) / c.levels;
+      if (w > 0.92) return {{float(x), float(y), float(top + 5)}, {0, 0, 1}};
+      return {{float(x), float(y), float(std::max(zl, s.z(x, y) + 0.5))}, {0, 0, 1}};
+    }
+    case Kind::Finish3:
+    case Kind::Finish5: {
+      raster(c, k, c.postures, c.lines, x, y, line, w);
+      double gx, gy;
+      s.grad(x, y, gx, gy);
+      double n[3] = {-gx, -gy, 1};
+      const double nn = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      for (double& v : n) v /= nn;
+      const double cx = x + r * n[0], cy = y + r * n[1], cz = s.z(x, y) + r * n[2];  // ball centre
+      double a[3] = {0, 0, 1};
+      if (c.kind == Kind::Finish5) {
+        a[0] = n[0] + 0.25;
+        a[1] = n[1] + 0.15;
+        a[2] = n[2];
+        const double na = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        for (double& v : a) v /= na;
+      }
+      return {{float(cx - r * a[0]), float(cy - r * a[1]), float(cz - r * a[2])},
+              {float(a[0]), float(a[1]), float(a[2])}};
+    }
+    case Kind::Random: {
+      std::mt19937_64 rng(k * 0x9e3779b97f4a7c15ull + 1);
+      std::uniform_real_distribution<double> u(r + 1, c.width_mm - r - 1);
+      return {{float(u(rng)), float(u(rng)), -0.05f}, {0, 0, 1}};
+    }
+    case Kind::Spiral: {
+      const double t = (k + 0.5) / double(c.postures);
+      const double turns = c.lines;
+      const double rad = (c.width_mm / 2 - r - 1) * (1 - t) + 0.5 * t;
+      const double th = 2 * std::numbers::pi * turns * t;
+      return {{float(c.width_mm / 2 + rad * std::cos(th)),
+               float(c.width_mm / 2 + rad * std::sin(th)), float(-0.02 - 0.2 * t)},
+              {0, 0, 1}};
+    }
+  }
+  return {};
+}
+
+std::vector<Case> allCases() {
+  const Surface blade{6, 120, 200, 1.5, 37}, mask{15, 260, 180, 2, 61}, wave{4, 40, 55, 1, 23},
+      aero{30, 1800, 1300, 5, 410}, flat{0, 1, 1, 0, 1}, cutting{0.01, 0.7, 0.9, 0, 1};
+  std::vector<Case> c;
+  // seed 000 Table 1 (grid 1024², case 8: 10000²); torus 25904 = 2·127·102 - 4, sphere 12482 =
+  // 2·79·79
+  c.push_back({"1",
+               "Blade roughing",
+               Kind::Roughing,
+               true,
+               127,
+               100,
+               5,
+               1,
+               25,
+               47837,
+               1024,
+               120,
+               blade,
+               40,
+               6,
+               {},
+               812,
+               "K40 Sim2",
+               8353});
+  c.push_back({"2",
+               "Mask roughing",
+               Kind::Roughing,
+               true,
+               127,
+               100,
+               5,
+               1,
+               25,
+               345848,
+               1024,
+               200,
+               mask,
+               60,
+               12,
+               {},
+               1198,
+               "TitanZ Sim2",
+               39304});
+  c.push_back({"3",
+               "Wave roughing",
+               Kind::Roughing,
+               true,
+               127,
+               100,
+               5,
+               1,
+               25,
+               8000000,
+               1024,
+               150,
+               wave,
+               90,
+               20,
+               {},
+               7190,
+               "K40 Sim2",
+               690700});
+  c.push_back({"4",
+               "Blade finishing (5-axis)",
+               Kind::Finish5,
+               false,
+               79,
+               78,
+               3,
+               3,
+               12,
+               53667,
+               1024,
+               120,
+               blade,
+               120,
+               1,
+               {},
+               1441,
+               "TitanZ Sim1",
+               10606});
+  c.push_back({"5",
+               "Wave finishing (5-axis)",
+               Kind::Finish5,
+               false,
+               79,
+               78,
+               3,
+               3,
+               12,
+               1000000,
+               1024,
+               150,
+               wave,
+               300,
+               1,
+               {},
+               2960,
+               "K40 Sim1",
+               59523});
+  c.push_back({"6",
+               "Mask finishing (3-axis)",
+               Kind::Finish3,
+               false,
+               79,
+               78,
+               3,
+               3,
+               12,
+               3015072,
+               1024,
+               200,
+               mask,
+               400,
+               1,
+               {},
+               8984,
+               "TitanZ Sim1",
+               168520});
+  c.push_back({"7",
+               "Aero finishing (3-axis)",
+               Kind::Finish3,
+               false,
+               79,
+               78,
+               5,
+               5,
+               20,
+               27425026,
+               1024,
+               2000,
+               aero,
+               700,
+               1,
+               {},
+               3273,
+               "TitanZ Sim1",
+               45022});
+  c.push_back({"8",
+               "Aero finishing 10000²",
+               Kind::Finish3,
+               false,
+               79,
+               78,
+               5,
+               5,
+               20,
+               27425026,
+               10000,
+               2000,
+               aero,
+               700,
+               1,
+               {},
+               28190,
+               "TitanZ Sim1",
+               206284});
+  // seed 001 Tables 1-4 (grid 1024²; sphere 320 = 2·16·10, 1984 = 2·32·31, 36389 → 36380 =
+  // 2·170·107)
+  c.push_back({"R",
+               "Random",
+               Kind::Random,
+               false,
+               16,
+               9,
+               0.5,
+               0.5,
+               2,
+               200000,
+               1024,
+               100,
+               flat,
+               1,
+               1,
+               {},
+               469 / 6.2,
+               "Q4000 coarse",
+               469});
+  c.push_back({"S",
+               "Spiral",
+               Kind::Spiral,
+               false,
+               32,
+               30,
+               0.5,
+               0.5,
+               2,
+               200000,
+               1024,
+               100,
+               flat,
+               60,
+               1,
+               {},
+               1414 / 4.7,
+               "Q4000 coarse",
+               1414});
+  c.push_back({"Ro",
+               "Roughing (= case 2)",
+               Kind::Roughing,
+               true,
+               127,
+               100,
+               5,
+               1,
+               25,
+               345848,
+               1024,
+               200,
+               mask,
+               60,
+               12,
+               {},
+               37766 / 5.8,
+               "Q4000 coarse",
+               37766});
+  c.push_back({"F",
+               "Finishing (sphere 1984)",
+               Kind::Finish3,
+               false,
+               32,
+               30,
+               3,
+               3,
+               12,
+               3015072,
+               1024,
+               200,
+               mask,
+               400,
+               1,
+               {},
+               218203 / 5.5,
+               "Q4000 coarse",
+               218203});
+  c.push_back({"C",
+               "Cutting (sphere 36380)",
+               Kind::Finish3,
+               false,
+               170,
+               106,
+               0.5,
+               0.5,
+               2,
+               144001,
+               1024,
+               4,
+               cutting,
+               12,
+               1,
+               {},
+               22882 / 8.3,
+               "Q4000 coarse",
+               22882});
+  c.push_back({"Rz",
+               "Random, zoom",
+               Kind::Random,
+               false,
+               16,
+               9,
+               0.5,
+               0.5,
+               2,
+               200000,
+               1024,
+               100,
+               flat,
+               1,
+               1,
+               {50, 50, 51.6, 51.6},
+               195 / 1.8,
+               "Q4000 fine",
+               195});
+  c.push_back({"Sz",
+               "Spiral, zoom",
+               Kind::Spiral,
+               false,
+               32,
+               30,
+               0.5,
+               0.5,
+               2,
+               200000,
+               1024,
+               100,
+               flat,
+               60,
+               1,
+               {70, 49.5, 71, 50.5},
+               368 / 3.2,
+               "Q4000 fine",
+               368});
+  c.push_back({"Fz",
+               "Finishing, zoom",
+               Kind::Finish3,
+               false,
+               32,
+               30,
+               3,
+               3,
+               12,
+               3015072,
+               1024,
+               200,
+               mask,
+               400,
+               1,
+               {100, 100, 100.3, 100.3},
+               825,
+               "X5650 CPU",
+               825});
+  return c;
+}
+
+struct Run {
+  double ms = 0;
+  zb::SimulationResult result;
+};
+
+Run runOnce(const zb::SimulationRequest& req, std::span<const zb::Posture> postures) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Run r;
+  r.result = zb::simulate(req, postures);
+  r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+/// Max and RMS |Δz| (mm) against the exact heights over the lines both runs lowered, and the
+/// number of lines only one of them lowered (grazing lines at the chordal error of the mesh).
+std::string heightError(const std::vector<float>& h, const std::vector<float>& exact, float stock) {
+  double max_mm = 0, sum = 0;
+  std::size_t n = 0, one_sided = 0;
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    const bool a = h[i] < stock, b = exact[i] < stock;
+    one_sided += a != b;
+    if (!a || !b) continue;
+    const double d = std::abs(double(h[i]) - exact[i]);
+    max_mm = std::max(max_mm, d);
+    sum += d * d;
+    ++n;
+  }
+  char text[96];
+  std::snprintf(text, sizeof text, "%.2f / %.3f (%zu)", max_mm * 1e3,
+                n ? std::sqrt(sum / n) * 1e3 : 0.0, one_sided);
+  return text;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string backend = zb::cudaAvailable() ? "cuda" : "cpu", which = "all";
+  int reps = 3;
+  std::size_t peer_limit = 0;  // 0: the whole case
+  bool exact = true;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const auto value = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
+    if (a == "--backend")
+      backend = value();
+    else if (a == "--cases")
+      which = value();
+    else if (a == "--reps")
+      reps = std::max(1, std::stoi(value()));
+    else if (a == "--peer-limit")
+      peer_limit = std::stoull(value());
+    else if (a == "--no-exact")
+      exact = false;
+    else {
+      std::fprintf(stderr,
+                   "usage: %s [--backend cpu|cuda] [--cases 1,2,R,...|all] [--reps N] "
+                   "[--peer-limit P] [--no-exact]\n",
+                   argv[0]);
+      return 1;
+    }
+  }
+  const zb::Backend be = backend == "cuda" ? zb::Backend::Cuda : zb::Backend::Cpu;
+  std::vector<std::string> wanted;
+  for (std::size_t p = 0; p <= which.size();) {
+    const std::size_t q = std::min(which.find(',', p), which.size());
+    wanted.push_back(which.substr(p, q - p));
+    p = q + 1;
+  }
+  std::printf(
+      "| case | P | T | grid | ours ms (median of %d) | coarse peer ms | best published ms | "
+      "best/ours | peer/ours | "
+      "CPU Sim1 ms | Sim1/ours | culled | lines touched | |Δz| ours µm: max / rms (one-sided "
+      "lines) | |Δz| peer µm | "
+      "analytic tool ms |\n",
+      reps);
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::fflush(stdout);
+  for (const Case& c : allCases()) {
+    if (which != "all" && std::find(wanted.begin(), wanted.end(), c.id) == wanted.end()) continue;
+    // postures generated before timing (in parallel), as a CL file would be read
+    std::vector<zb::Posture> postures(c.postures);
+#pragma omp parallel for schedule(static)
+    for (long k = 0; k < long(c.postures); ++k) postures[k] = makePosture(c, std::size_t(k));
+    const zb::Tool analytic = c.torus ? zb::Tool::torus(c.radius_mm, c.corner_mm, c.length_mm)
+                                      : zb::Tool::ball(c.radius_mm, c.length_mm);
+    const zb::Tool mesh = zb::Tool::fromMesh(zb::analyticToolMesh(analytic, c.around, c.arc));
+    zb::SimulationRequest req;
+    req.grid =
+        c.zoom[2] > c.zoom[0]
+            ? zb::Grid::fromRegion(c.zoom[0], c.zoom[1], c.zoom[2], c.zoom[3], c.grid, c.grid)
+            : zb::Grid::fromRegion(0, 0, c.width_mm, c.width_mm, c.grid, c.grid);
+    req.stock_mm = float(std::abs(c.surface.amp1) + std::abs(c.surface.amp2) + 3);
+    req.backend = be;
+    req.tool = mesh;
+    req.block_postures = std::size_t{1} << 22;
+
+    std::vector<double> times;
+    Run ours;
+    for (int r = 0; r < reps; ++r) {
+      ours = runOnce(req, postures);
+      times.push_back(ours.ms);
+    }
+    std::sort(times.begin(), times.end());
+    const double ours_ms = times[times.size() / 2];
+
+    // the peer: SIMSURF1's coarse algorithm, same backend, same mesh
+    zb::SimulationRequest peer_req = req;
+    peer_req.engine = zb::Engine::Coarse;
+    const std::size_t peer_n = peer_limit ? std::min(peer_limit, postures.size()) : postures.size();
+    // a limited peer runs an evenly spread subset and is scaled to the whole case
+    std::vector<zb::Posture> subset;
+    std::span<const zb::Posture> peer_postures = postures;
+    if (peer_n < postures.size()) {
+      for (std::size_t k = 0; k < peer_n; ++k)
+        subset.push_back(postures[k * postures.size() / peer_n]);
+      peer_postures = subset;
+    }
+    const Run peer = runOnce(peer_req, peer_postures);
+    const double peer_ms = peer.ms * double(postures.size()) / double(peer_n);
+    const bool peer_full = peer_n == postures.size();
+
+    std::string err_ours = "-", err_peer = "-";
+    double exact_ms = 0;
+    if (exact) {
+      zb::SimulationRequest ex = req;
+      ex.tool = analytic;
+      const Run exact_run = runOnce(ex, postures);
+      exact_ms = exact_run.ms;
+      err_ours = heightError(ours.result.heights_mm, exact_run.result.heights_mm, req.stock_mm);
+      if (peer_full)
+        err_peer = heightError(peer.result.heights_mm, exact_run.result.heights_mm, req.stock_mm);
+    }
+    std::printf(
+        "| %s %s | %zu | %zu | %d² | %.1f | %s%.1f | %.0f (%s) | %.1f× | %.1f× | %.0f | %.1f× | "
+        "%.1f%% | %zu | %s | %s | %.1f |\n",
+        c.id.c_str(), c.name.c_str(), c.postures, mesh.mesh.triangles.size(), c.grid, ours_ms,
+        peer_full ? "" : "~", peer_ms, c.best_ms, c.best_src, c.best_ms / ours_ms,
+        peer_ms / ours_ms, c.xeon_ms, c.xeon_ms / ours_ms,
+        100.0 * double(ours.result.postures_culled) / double(c.postures), ours.result.lines_lowered,
+        err_ours.c_str(), err_peer.c_str(), exact_ms);
+    std::fflush(stdout);
+  }
+  std::printf(
+      "\nours: fast engine (lines under the tool through a BVH of the mesh in the tool frame, "
+      "culling); "
+      "peer: coarse engine (every triangle of every posture), same backend%s; "
+      "|Δz|: against the analytic tool (exact envelope, also timed in the last column), over lines "
+      "both "
+      "runs lowered, with the count of lines only one lowered; "
+      "'~': peer timed on an evenly spread subset of %zu postures and scaled to the case.\n",
+      backend == "cuda" ? " (CUDA)" : " (CPU, OpenMP)", peer_limit);
+  return 0;
+}
