@@ -1,0 +1,127 @@
+/// `fieldpath field probe|build`, run as a program: output against the closed form of a plane, and
+/// bad input → exit 1 with one line on stderr and nothing on stdout.
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "fieldpath/field/law.h"
+#include "files.h"
+
+using fieldpath::app::test::TempDir;
+
+namespace {
+
+struct Outcome {
+  int exit_code;
+  std::string out, err;
+};
+
+std::string slurp(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Runs `fieldpath --quiet ARGS` in `dir`.
+Outcome runFieldpath(const TempDir& dir, const std::string& args) {
+  const auto out = dir.path() / "stdout.txt", err = dir.path() / "stderr.txt";
+  const std::string command = "cd '" + dir.path().string() + "' && '" FIELDPATH_EXE "' --quiet " + args + " > '" +
+                              out.string() + "' 2> '" + err.string() + "'";
+  const int status = std::system(command.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+}
+
+std::size_t lines(const std::string& text) {
+  std::size_t n = 0;
+  for (char c : text) n += c == '\n';
+  return n;
+}
+
+/// A plane obstacle (z = 0, 16 × 16 mm: infinite for r0 = 5 at its middle) and its scene.
+void planeScene(const TempDir& dir, const std::string& field_keys = "") {
+  dir.write("plane.stl", fieldpath::app::test::squareStl(8));
+  dir.write("scene.yaml", "obstacles:\n  - mesh: plane.stl\nfield:\n  sample_step: 0.5\n" + field_keys);
+}
+
+}  // namespace
+
+TEST(CliField, ProbeMatchesThePlaneClosedForm) {
+  TempDir dir;
+  planeScene(dir);
+  dir.write("points.txt", "# x y z\n0 0 1\n0.5 -0.5 2.5   # a comment\n\n0 0 3.75\n");
+  fieldpath::field::FieldParams p;
+  for (const std::string mode : {"--direct", "--voxel 0.25", ""}) {  // "": the scene's h = 0.5
+    const Outcome run = runFieldpath(dir, "field probe scene.yaml --points points.txt " + mode);
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    std::istringstream out(run.out);
+    std::string line;
+    std::vector<double> z, fz;
+    while (std::getline(out, line)) {
+      if (line.empty() || line[0] == '#') continue;
+      std::istringstream fields(line);
+      double x, y, zz, fx, fy, f;
+      ASSERT_TRUE(fields >> x >> y >> zz >> fx >> fy >> f) << line;
+      z.push_back(zz);
+      fz.push_back(f);
+    }
+    ASSERT_EQ(z.size(), 3u) << run.out;
+    for (std::size_t i = 0; i < z.size(); ++i) {
+      const double exact = fieldpath::field::planeFieldMagnitude(z[i], p);
+      // 2 %: the sampling's quadrature; 10 % off the nodes for the voxels (0.25, 0.5 mm)
+      const bool off_node = mode != "--direct" && z[i] == 3.75;
+      EXPECT_NEAR(fz[i], exact, (off_node ? 0.1 : 0.02) * exact) << mode << " z " << z[i];
+    }
+  }
+}
+
+TEST(CliField, BuildWritesTheVdbAndReportsNodes) {
+  TempDir dir;
+  planeScene(dir);
+  const Outcome run = runFieldpath(dir, "field build scene.yaml --voxel 1 --out out/field.vdb");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("active nodes: "), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("dense-box nodes: "), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("memory: "), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("build "), std::string::npos) << run.out;
+  EXPECT_GT(std::filesystem::file_size(dir.path() / "out/field.vdb"), 1000u);
+
+  const Outcome refused = runFieldpath(dir, "field build scene.yaml --voxel 0.01 --max-memory 64 --out big.vdb");
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("estimated"), std::string::npos) << refused.err;
+  EXPECT_EQ(lines(refused.err), 1u) << refused.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "big.vdb"));
+}
+
+TEST(CliField, BadInputExitsOneWithOneLine) {
+  struct Case {
+    std::string scene, points, key;
+  };
+  const std::string wall = "obstacles:\n  - mesh: plane.stl\n";
+  const std::vector<Case> cases{
+      {"obstacles:\n  - mesh: nowhere.stl\n", "0 0 1\n", "nowhere.stl"},
+      {wall + "field:\n  r0: -2\n", "0 0 1\n", "field.r0"},
+      {wall + "field:\n  r0: 2\n  r_min: 3\n", "0 0 1\n", "field.r_min"},
+      {wall + "field:\n  voxel_size: 0\n", "0 0 1\n", "field.voxel_size"},
+      {wall + "field:\n  r0: 2\nfeild: {}\n", "0 0 1\n", "feild"},
+      {wall + "field:\n  r0: [2]\n", "0 0 1\n", "field.r0"},
+      {wall, "0 0 1\n1 2\n", "points.txt:2"},
+      {wall, "0 0 1\n1 2 nan\n", "points.txt:2"},
+  };
+  for (const Case& c : cases) {
+    TempDir dir;
+    dir.write("plane.stl", fieldpath::app::test::squareStl(20));
+    dir.write("scene.yaml", c.scene);
+    dir.write("points.txt", c.points);
+    const Outcome run = runFieldpath(dir, "field probe scene.yaml --points points.txt");
+    EXPECT_EQ(run.exit_code, 1) << c.scene << run.err;
+    EXPECT_EQ(lines(run.err), 1u) << run.err;
+    EXPECT_NE(run.err.find(c.key), std::string::npos) << run.err;
+    EXPECT_TRUE(run.out.empty()) << run.out;
+  }
+}

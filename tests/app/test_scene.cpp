@@ -1,0 +1,165 @@
+/// Scene files: every key of DESIGN.md read into the Scene, defaults, paths relative to the file,
+/// and bad files rejected with the file, line and key.
+#include <gtest/gtest.h>
+
+#include "fieldpath/common/errors.h"
+#include "files.h"
+#include "scene.h"
+
+using namespace fieldpath;
+using app::test::TempDir;
+
+TEST(Scene, ReadsEveryKey) {
+  TempDir dir;
+  dir.write("meshes/left.stl", app::test::squareStl(10, 0));
+  dir.write("meshes/right.stl", app::test::squareStl(10, 5));
+  dir.write("meshes/hub.stl", app::test::squareStl(20, -3));
+  const auto file = dir.write("jobs/scene.yaml", R"(
+obstacles:
+  - mesh: ../meshes/left.stl
+  - mesh: ../meshes/right.stl
+guide: { mesh: ../meshes/hub.stl }
+tool: { shape: torus, radius: 4, corner_radius: 1, length: 30 }
+holder: [[40, 6], [55, 6], [55.5, 12], [90, 12]]
+clearance: 0.7
+field:
+  r0: 6.0
+  r_min: 0.3
+  gain: 2.5
+  sample_step: 0.8
+  weights: unit
+  voxel_size: 0.4
+  interpolation: quadratic
+dynamics:
+  inertia: 2.0
+  damping: 3.0
+  stiffness: 4.0
+  feed: 1200
+  rtol: 1.0e-7
+  atol: 1.0e-10
+  max_tilt_deg: 30
+  max_lead_deg: 15
+  integrator: erk
+path:
+  passes: 5
+  step: 0.25
+  lead_deg: 3
+)");
+  const app::Scene s = app::loadScene(file);
+  ASSERT_EQ(s.obstacles.size(), 2u);
+  EXPECT_EQ(s.obstacle_files[0], dir.path() / "jobs/../meshes/left.stl");
+  EXPECT_EQ(s.obstacles[0].triangles.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.obstacles[1].vertices[0].z(), 5.0);
+  ASSERT_TRUE(s.guide.has_value());
+  EXPECT_DOUBLE_EQ(s.guide->vertices[0].z(), -3.0);
+  EXPECT_FALSE(s.impeller.has_value());
+  EXPECT_EQ(s.tool.shape, geometry::ToolShape::Torus);
+  EXPECT_EQ(s.tool.radius_mm, 4.0);
+  EXPECT_EQ(s.tool.corner_radius_mm, 1.0);
+  EXPECT_EQ(s.tool.length_mm, 30.0);
+  ASSERT_EQ(s.holder.size(), 4u);
+  EXPECT_EQ(s.holder[2].z_mm, 55.5);
+  EXPECT_EQ(s.holder[2].radius_mm, 12.0);
+  EXPECT_EQ(s.clearance_mm, 0.7);
+  EXPECT_EQ(s.field.r0_mm, 6.0);
+  EXPECT_EQ(s.field.r_min_mm, 0.3);
+  EXPECT_EQ(s.field.gain, 2.5);
+  EXPECT_EQ(s.field.sample_step_mm, 0.8);
+  EXPECT_EQ(s.field.weights, field::Weights::Unit);
+  EXPECT_EQ(s.field.voxel_size_mm, 0.4);
+  EXPECT_EQ(s.field.interpolation, field::Interpolation::Quadratic);
+  EXPECT_EQ(s.dynamics.inertia, 2.0);
+  EXPECT_EQ(s.dynamics.damping, 3.0);
+  EXPECT_EQ(s.dynamics.stiffness, 4.0);
+  EXPECT_EQ(s.dynamics.feed_mm_per_min, 1200.0);
+  EXPECT_EQ(s.dynamics.rtol, 1e-7);
+  EXPECT_EQ(s.dynamics.atol, 1e-10);
+  EXPECT_EQ(s.dynamics.max_tilt_deg, 30.0);
+  EXPECT_EQ(s.dynamics.max_lead_deg, 15.0);
+  EXPECT_EQ(s.dynamics.integrator, dynamics::Integrator::Erk);
+  EXPECT_EQ(s.path.passes, 5);
+  EXPECT_EQ(s.path.step_mm, 0.25);
+  EXPECT_EQ(s.path.lead_deg, 3.0);
+}
+
+TEST(Scene, DefaultsComeFromTheParamsStructs) {
+  TempDir dir;
+  dir.write("wall.stl", app::test::squareStl(5));
+  const app::Scene s = app::loadScene(dir.write("s.yaml", "obstacles:\n  - mesh: wall.stl\ndynamics: { damping: critical }\n"));
+  EXPECT_EQ(s.obstacles.size(), 1u);
+  EXPECT_FALSE(s.guide.has_value());
+  const field::FieldParams f;
+  EXPECT_EQ(s.field.r0_mm, f.r0_mm);
+  EXPECT_EQ(s.field.r_min_mm, f.r_min_mm);
+  EXPECT_EQ(s.field.voxel_size_mm, f.voxel_size_mm);
+  EXPECT_EQ(s.field.weights, f.weights);
+  EXPECT_EQ(s.field.interpolation, f.interpolation);
+  EXPECT_LT(s.dynamics.damping, 0.0);  // critical
+  EXPECT_EQ(s.path.passes, pathgen::PathParams{}.passes);
+  EXPECT_EQ(s.tool.radius_mm, geometry::ToolSpec{}.radius_mm);
+}
+
+namespace {
+
+/// The InputError message of loading `yaml` (beside a valid wall.stl), or "" if it loads.
+std::string errorOf(const std::string& yaml, std::string* file_name = nullptr) {
+  TempDir dir;
+  dir.write("wall.stl", app::test::squareStl(5));
+  const auto file = dir.write("bad.yaml", yaml);
+  if (file_name) *file_name = file.string();
+  try {
+    app::loadScene(file);
+  } catch (const common::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Scene, BadFilesNameTheFileLineAndKey) {
+  struct Case {
+    const char* yaml;
+    const char* key;  // in the message
+    int line;         // 1-based, 0: no line expected
+  };
+  const Case cases[] = {
+      {"obstacles:\n  - mesh: missing.stl\n", "obstacles[1].mesh", 2},
+      {"obstacles:\n  - mesh: wall.stl\nfield:\n  r0: -1\n", "field.r0", 4},
+      {"obstacles:\n  - mesh: wall.stl\nfield:\n  r0: 5\n  r_min: 5\n", "field.r_min", 5},
+      {"obstacles:\n  - mesh: wall.stl\nfield:\n  r0: 0.2\n", "field.r_min", 4},
+      {"obstacles:\n  - mesh: wall.stl\nfield:\n  voxel_size: 0\n", "field.voxel_size", 4},
+      {"obstacles:\n  - mesh: wall.stl\nfield:\n  r0: five\n", "field.r0", 4},
+      {"obstacles:\n  - mesh: wall.stl\nfield:\n  weights: volume\n", "field.weights", 4},
+      {"obstacles:\n  - mesh: wall.stl\nfield:\n  gain: 1\n  rzero: 5\n", "field.rzero", 5},
+      {"obstacles:\n  - mesh: wall.stl\ncolour: red\n", "colour", 3},
+      {"obstacles:\n  - mesh: wall.stl\nfield: 5\n", "field", 3},
+      {"obstacles:\n  - mesh: wall.stl\n    impeller: {}\n", "obstacles[1]", 2},
+      {"field:\n  r0: 5\n", "obstacles", 0},
+      {"obstacles: []\n", "obstacles", 1},
+      {"obstacles:\n  - mesh: wall.stl\ntool: { shape: torus, radius: 3 }\n", "tool.corner_radius", 3},
+      {"obstacles:\n  - mesh: wall.stl\ntool: { shape: cone }\n", "tool.shape", 3},
+      {"obstacles:\n  - mesh: wall.stl\nholder: [[40, 6], [30, 6]]\n", "holder", 3},
+      {"obstacles:\n  - mesh: wall.stl\nholder: [[40, 6], [50]]\n", "holder[2]", 3},
+      {"obstacles:\n  - mesh: wall.stl\nclearance: -0.1\n", "clearance", 3},
+      {"obstacles:\n  - mesh: wall.stl\ndynamics:\n  max_tilt_deg: 95\n", "dynamics.max_tilt_deg", 4},
+      {"obstacles:\n  - mesh: wall.stl\ndynamics:\n  integrator: rk4\n", "dynamics.integrator", 4},
+      {"obstacles:\n  - mesh: wall.stl\npath:\n  passes: 2.5\n", "path.passes", 4},
+      {"obstacles:\n  - mesh: wall.stl\nguide: { mesh: hub.stl }\n", "guide.mesh", 3},
+      {"obstacles:\n  - mesh: wall.stl\nfield: { r0: [5\n", "YAML syntax", 0},
+  };
+  for (const Case& c : cases) {
+    std::string file;
+    const std::string message = errorOf(c.yaml, &file);
+    ASSERT_FALSE(message.empty()) << c.yaml;
+    EXPECT_EQ(message.rfind(file, 0), 0u) << message;  // starts with the file name
+    EXPECT_NE(message.find(c.key), std::string::npos) << message;
+    if (c.line > 0) EXPECT_NE(message.find(":" + std::to_string(c.line) + ": "), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+  EXPECT_NE(errorOf("obstacles:\n  - mesh: wall.stl\nfield: { r0: five }\n").find("five"), std::string::npos);
+}
+
+TEST(Scene, MissingSceneFile) {
+  EXPECT_THROW(app::loadScene("/nonexistent/scene.yaml"), common::InputError);
+}
