@@ -1,0 +1,598 @@
+#include "study.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+#include "fieldpath/common/atomic_file.h"
+#include "fieldpath/common/errors.h"
+#include "fieldpath/field/direct_field.h"
+#include "fieldpath/field/sampling.h"
+#include "fieldpath/field/voxel_field.h"
+#include "fieldpath/geometry/tool_model.h"
+#include "fieldpath/pathgen/clearance.h"
+#include "fieldpath/pathgen/impeller.h"
+
+#ifndef FIELDPATH_PLOT_STUDY_SCRIPT
+#define FIELDPATH_PLOT_STUDY_SCRIPT "scripts/plot_study.py"
+#endif
+
+namespace fieldpath::app {
+namespace {
+
+using common::InputError;
+constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+/// A study-line point as a tiny ball for the exact (FCL) wall distance, mm.
+constexpr double kPointRadiusMm = 1e-6;
+
+/// Study lines sit at mid blade height (ruling parameter t); line a runs along the part of the
+/// channel the passes cover (impeller u_range), line b crosses it in the middle of that part.
+constexpr double kLineBladeT = 0.5;
+
+common::Progress scaled(const common::Progress& progress, double begin, double end,
+                        const std::string& label) {
+  if (!progress) return {};
+  return [=](double fraction, std::string_view) {
+    return progress(begin + (end - begin) * fraction, label);
+  };
+}
+
+std::string interpolationName(field::Interpolation interpolation) {
+  return interpolation == field::Interpolation::Quadratic ? "quadratic" : "trilinear";
+}
+
+std::string modeName(pathgen::FieldMode mode) {
+  switch (mode) {
+    case pathgen::FieldMode::BruteForce: return "brute_force";
+    case pathgen::FieldMode::Direct: return "direct";
+    case pathgen::FieldMode::Voxel: return "voxel";
+  }
+  return "?";
+}
+
+/// A study line's points: t along the polyline, wall distances from FCL.
+StudyLine makeLine(std::string name, std::string description, std::vector<Vec3> points,
+                   const pathgen::ClearanceChecker& checker) {
+  StudyLine line;
+  line.name = std::move(name);
+  line.description = std::move(description);
+  double t = 0.0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (i) t += (points[i] - points[i - 1]).norm();
+    line.t_mm.push_back(t);
+    line.wall_distance_mm.push_back(
+        checker.ballClearance(std::span<const Vec3>(&points[i], 1), kPointRadiusMm));
+  }
+  line.points_mm = std::move(points);
+  return line;
+}
+
+/// Line a: along the channel at mid blade height, r0/2 off the left blade (mid-channel is beyond
+/// r0 of both blades on a channel wider than 2 r0: no field there to compare).
+std::vector<Vec3> lineAPoints(const pathgen::Impeller& impeller, double offset_mm, double step_mm) {
+  const double u0 = impeller.params().u_range[0], u1 = impeller.params().u_range[1];
+  auto at = [&](double u) {
+    return Vec3(impeller.blade(0, u, kLineBladeT) +
+                offset_mm * impeller.bladeNormal(0, u, kLineBladeT));
+  };
+  // Arc length of the offset curve, then even steps along it.
+  const int dense = 4000;
+  std::vector<double> s(dense + 1, 0.0);
+  for (int i = 1; i <= dense; ++i)
+    s[i] = s[i - 1] + (at(u0 + (u1 - u0) * i / dense) - at(u0 + (u1 - u0) * (i - 1) / dense)).norm();
+  const int count = std::max(2, static_cast<int>(std::ceil(s.back() / step_mm)) + 1);
+  std::vector<Vec3> points;
+  int k = 0;
+  for (int i = 0; i < count; ++i) {
+    const double target = s.back() * i / (count - 1);
+    while (k < dense - 1 && s[k + 1] < target) ++k;
+    const double w = s[k + 1] > s[k] ? (target - s[k]) / (s[k + 1] - s[k]) : 0.0;
+    points.push_back(at(u0 + (u1 - u0) * (k + w) / dense));
+  }
+  return points;
+}
+
+/// Line b: straight across the channel, wall to wall, mid blade height, at `u`.
+std::vector<Vec3> lineBPoints(const pathgen::Impeller& impeller, double u, double step_mm) {
+  const Vec3 a = impeller.blade(0, u, kLineBladeT), b = impeller.blade(1, u, kLineBladeT);
+  const int count = std::max(2, static_cast<int>(std::ceil((b - a).norm() / step_mm)) + 1);
+  std::vector<Vec3> points;
+  for (int i = 0; i < count; ++i) points.push_back(a + (b - a) * (double(i) / (count - 1)));
+  return points;
+}
+
+/// Force error of `approx` against `exact` over the points with `counted[i]` (see study.h).
+ForceError forceError(std::span<const Vec3> approx, std::span<const Vec3> exact,
+                      const std::vector<char>& counted, std::vector<double>* per_point) {
+  double max_ref = 0.0;
+  for (std::size_t i = 0; i < exact.size(); ++i)
+    if (counted[i]) max_ref = std::max(max_ref, exact[i].norm());
+  std::vector<Vec3> a, r;
+  ForceError e;
+  double sum_sq = 0.0;
+  std::size_t n = 0;
+  if (per_point) per_point->assign(exact.size(), kNaN);
+  for (std::size_t i = 0; i < exact.size(); ++i) {
+    if (!counted[i] || max_ref == 0.0) continue;
+    const double diff = (approx[i] - exact[i]).norm() / max_ref;
+    e.max_scaled = std::max(e.max_scaled, diff);
+    sum_sq += diff * diff;
+    ++n;
+    if (exact[i].norm() >= kErrorFloorFraction * max_ref) {
+      a.push_back(approx[i]);
+      r.push_back(exact[i]);
+      if (per_point) (*per_point)[i] = (approx[i] - exact[i]).norm() / exact[i].norm();
+    }
+  }
+  if (n) e.rms_scaled = std::sqrt(sum_sq / static_cast<double>(n));
+  e.relative = field::relativeError(a, r, kErrorFloorFraction * max_ref);
+  return e;
+}
+
+std::vector<Vec3> evaluate(const field::ForceField& field, std::span<const Vec3> points) {
+  std::vector<Vec3> forces(points.size());
+  field.evaluate(points, forces);
+  return forces;
+}
+
+/// What the errors of one variant are measured on, built once.
+struct ErrorSets {
+  std::vector<Vec3> nodes_mm;  ///< tool + holder nodes at every posture of the direct path
+  std::vector<Vec3> nodes_direct, line_a_direct, line_b_direct;
+  std::vector<char> nodes_counted, line_a_counted, line_b_counted;
+};
+
+std::string number(double value, int precision = 4) {
+  if (!std::isfinite(value)) return "nan";
+  std::ostringstream s;
+  s << std::setprecision(precision) << value;
+  return s.str();
+}
+
+std::string machineDescription() {
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  std::string line, model = "unknown CPU";
+  int cores = 0;
+  while (std::getline(cpuinfo, line)) {
+    if (line.rfind("model name", 0) == 0 && model == "unknown CPU") {
+      const auto colon = line.find(':');
+      if (colon != std::string::npos) model = line.substr(colon + 2);
+    }
+    if (line.rfind("processor", 0) == 0) ++cores;
+  }
+  return model + ", " + std::to_string(cores) + " logical cores";
+}
+
+}  // namespace
+
+std::string StudyVariant::name() const {
+  switch (mode) {
+    case pathgen::FieldMode::BruteForce: return "brute force";
+    case pathgen::FieldMode::Direct: return "direct";
+    case pathgen::FieldMode::Voxel: break;
+  }
+  std::ostringstream s;
+  s << "voxel " << voxel_size_mm << " mm " << interpolationName(interpolation);
+  return s.str();
+}
+
+std::vector<double> parseVoxelSizes(const std::string& text, const std::string& key) {
+  std::vector<double> sizes;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const double h = std::strtod(item.c_str(), &end);
+    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(h) || h <= 0.0)
+      throw InputError(key + ": '" + item + "' is not a voxel size > 0 mm (e.g. 2,1,0.5)");
+    sizes.push_back(h);
+  }
+  if (sizes.empty()) throw InputError(key + ": give at least one voxel size (e.g. 2,1,0.5)");
+  return sizes;
+}
+
+std::vector<field::Interpolation> parseInterpolations(const std::string& text,
+                                                      const std::string& key) {
+  std::vector<field::Interpolation> result;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (item == "trilinear") result.push_back(field::Interpolation::Trilinear);
+    else if (item == "quadratic") result.push_back(field::Interpolation::Quadratic);
+    else throw InputError(key + ": '" + item + "' is not trilinear or quadratic");
+  }
+  if (result.empty()) throw InputError(key + ": give trilinear, quadratic or both");
+  return result;
+}
+
+StudyResult runStudy(const StudyRequest& request) {
+  if (request.voxel_sizes_mm.empty()) throw InputError("--voxels: give at least one voxel size");
+  for (double h : request.voxel_sizes_mm)
+    if (!std::isfinite(h) || h <= 0.0) throw InputError("--voxels: voxel sizes must be > 0 mm");
+  if (request.interpolations.empty()) throw InputError("--interp: give at least one interpolation");
+  if (!std::isfinite(request.line_step_mm) || request.line_step_mm <= 0.0)
+    throw InputError("study line step must be > 0 mm");
+
+  std::vector<StudyVariant> variants;
+  if (request.brute_force) variants.push_back({pathgen::FieldMode::BruteForce});
+  variants.push_back({pathgen::FieldMode::Direct});
+  for (double h : request.voxel_sizes_mm)
+    for (field::Interpolation interp : request.interpolations)
+      variants.push_back({pathgen::FieldMode::Voxel, h, interp});
+
+  // Shares of the progress bar: each path run, then the error evaluation.
+  const double runs_end = 0.85;
+  const auto share = [&](std::size_t i) { return runs_end * double(i) / double(variants.size()); };
+
+  StudyResult result;
+  result.field = request.job.field;
+  result.clearance_mm = request.job.clearance_mm;
+  std::vector<pathgen::GenerateResult> runs;
+  for (std::size_t i = 0; i < variants.size(); ++i) {
+    pathgen::GenerateRequest job = request.job;
+    job.mode = variants[i].mode;
+    job.nominal = false;
+    if (variants[i].isVoxel()) {
+      job.field.voxel_size_mm = variants[i].voxel_size_mm;
+      job.field.interpolation = variants[i].interpolation;
+    }
+    job.progress = scaled(request.progress, share(i), share(i + 1), variants[i].name());
+    runs.push_back(pathgen::generateImpellerPath(job));
+    StudyRow row;
+    row.variant = variants[i];
+    row.times = runs.back().times;
+    row.total_s = row.times.field_s + row.times.steering_s;
+    row.min_clearance_mm = runs.back().clearance.min_clearance_mm;
+    row.colliding = runs.back().clearance.colliding;
+    row.max_tilt_deg = runs.back().max_tilt_deg;
+    result.rows.push_back(row);
+  }
+  const std::size_t direct_row = request.brute_force ? 1 : 0;
+  const pathgen::GenerateResult& direct_run = runs[direct_row];
+  result.postures = direct_run.postures.size();
+  result.tool_nodes = direct_run.tool_nodes;
+  result.obstacle_points = direct_run.obstacle_points;
+  result.path_length_mm = direct_run.path_length_mm;
+  result.reach_box_cm3 = direct_run.reach_box_mm.volume() / 1000.0;
+
+  // ---- speed-ups and tilt differences --------------------------------------------------------
+  const double brute_total = request.brute_force ? result.rows[0].total_s : kNaN;
+  const double direct_total = result.rows[direct_row].total_s;
+  result.middle_pass = static_cast<int>(direct_run.passes.size()) / 2;
+  for (const pathgen::GeneratedPosture& g : direct_run.postures)
+    if (g.pass == result.middle_pass) result.tilt_s_mm.push_back(g.s_mm);
+  for (std::size_t i = 0; i < result.rows.size(); ++i) {
+    StudyRow& row = result.rows[i];
+    row.speedup_vs_brute = brute_total / row.total_s;
+    row.speedup_vs_direct = direct_total / row.total_s;
+    const auto& postures = runs[i].postures;
+    if (postures.size() != direct_run.postures.size())
+      throw std::logic_error("study: " + row.variant.name() + " has " +
+                             std::to_string(postures.size()) + " postures, direct " +
+                             std::to_string(direct_run.postures.size()));
+    double sum_sq = 0.0;
+    std::vector<double> tilt;
+    for (std::size_t k = 0; k < postures.size(); ++k) {
+      const double d = std::abs(postures[k].tilt_rad - direct_run.postures[k].tilt_rad) * kRadToDeg;
+      row.tilt_max_deg = std::max(row.tilt_max_deg, d);
+      sum_sq += d * d;
+      if (postures[k].pass == result.middle_pass) tilt.push_back(postures[k].tilt_rad * kRadToDeg);
+    }
+    row.tilt_rms_deg = postures.empty() ? 0.0 : std::sqrt(sum_sq / double(postures.size()));
+    result.tilt_deg.push_back(std::move(tilt));
+  }
+
+  // ---- force errors: the exact field, the lines, the nodes along the direct path ------------
+  common::report(request.progress, runs_end, "errors");
+  const pathgen::GenerateRequest& job = request.job;
+  const pathgen::Impeller impeller(job.impeller);
+  const std::vector<geometry::TriangleMesh> obstacles =
+      pathgen::obstacleMeshes(impeller, job.extra_obstacles);
+  const pathgen::ClearanceChecker checker(
+      geometry::toolMesh(job.tool, job.holder, pathgen::kClearanceMeshTolMm), obstacles);
+  const field::DirectField direct(
+      field::sampleObstacles(obstacles, job.field.sample_step_mm, job.field.weights), job.field);
+
+  const auto& u_range = job.impeller.u_range;
+  const double u_mid = 0.5 * (u_range[0] + u_range[1]);
+  result.line_a = makeLine("a",
+                           "along the channel (u " + number(u_range[0]) + " to " +
+                               number(u_range[1]) +
+                               ", the passes' range), mid blade height, r0/2 off the left blade",
+                           lineAPoints(impeller, 0.5 * job.field.r0_mm, request.line_step_mm),
+                           checker);
+  result.line_b = makeLine("b",
+                           "across the channel at u = " + number(u_mid) +
+                               ", mid blade height, wall to wall",
+                           lineBPoints(impeller, u_mid, request.line_step_mm), checker);
+
+  ErrorSets sets;
+  std::vector<Vec3> tool_nodes;
+  for (const auto& node : geometry::surfaceNodes(
+           job.tool, job.holder, pathgen::defaultNodeSpacingMm(job.tool, job.holder)))
+    tool_nodes.push_back(node.position_mm);
+  for (const pathgen::GeneratedPosture& g : direct_run.postures) {
+    const Eigen::Isometry3d placed = geometry::toolToWorld(g.posture);
+    for (const Vec3& n : tool_nodes) sets.nodes_mm.push_back(placed * n);
+  }
+  result.node_points = sets.nodes_mm.size();
+  sets.nodes_direct = evaluate(direct, sets.nodes_mm);
+  sets.nodes_counted.assign(sets.nodes_mm.size(), 1);
+  for (StudyLine* line : {&result.line_a, &result.line_b}) {
+    auto& counted = line == &result.line_a ? sets.line_a_counted : sets.line_b_counted;
+    auto& exact = line == &result.line_a ? sets.line_a_direct : sets.line_b_direct;
+    exact = evaluate(direct, line->points_mm);
+    counted.clear();
+    for (std::size_t i = 0; i < exact.size(); ++i) {
+      line->direct_magnitude.push_back(exact[i].norm());
+      counted.push_back(line->wall_distance_mm[i] >= job.clearance_mm &&
+                        direct_run.reach_box_mm.contains(line->points_mm[i]));
+    }
+  }
+
+  for (std::size_t i = 0; i < result.rows.size(); ++i) {
+    StudyRow& row = result.rows[i];
+    common::report(request.progress,
+                   runs_end + (1.0 - runs_end) * double(i) / double(result.rows.size()), "errors");
+    std::unique_ptr<field::ForceField> approx;
+    if (row.variant.isVoxel()) {
+      field::VoxelRequest voxel_request;
+      voxel_request.voxel_size_mm = row.variant.voxel_size_mm;
+      voxel_request.interpolation = row.variant.interpolation;
+      voxel_request.region_mm = runs[i].reach_box_mm;  // the region generate used
+      auto voxels = std::make_unique<field::VoxelField>(direct, voxel_request);
+      row.active_nodes = voxels->stats().active_nodes;
+      row.dense_box_nodes = voxels->stats().dense_box_nodes;
+      row.voxel_memory_bytes = voxels->stats().memory_bytes;
+      approx = std::move(voxels);
+    } else if (row.variant.mode == pathgen::FieldMode::BruteForce) {
+      approx = std::make_unique<field::BruteForceField>(direct.samples(), job.field);
+    }
+    const field::ForceField& f = approx ? *approx : static_cast<const field::ForceField&>(direct);
+    for (StudyLine* line : {&result.line_a, &result.line_b}) {
+      const bool is_a = line == &result.line_a;
+      const std::vector<Vec3> forces = evaluate(f, line->points_mm);
+      std::vector<double> magnitude, per_point;
+      for (const Vec3& v : forces) magnitude.push_back(v.norm());
+      (is_a ? row.line_a : row.line_b) =
+          forceError(forces, is_a ? sets.line_a_direct : sets.line_b_direct,
+                     is_a ? sets.line_a_counted : sets.line_b_counted, &per_point);
+      line->magnitude.push_back(std::move(magnitude));
+      line->relative_error.push_back(std::move(per_point));
+    }
+    const std::vector<Vec3> node_forces =
+        approx ? evaluate(f, sets.nodes_mm) : sets.nodes_direct;
+    row.nodes = forceError(node_forces, sets.nodes_direct, sets.nodes_counted, nullptr);
+  }
+  common::report(request.progress, 1.0, "done");
+  return result;
+}
+
+// ---- outputs ------------------------------------------------------------------------------------
+namespace {
+
+std::string fixed(double value, int decimals) {
+  if (!std::isfinite(value)) return "–";
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(decimals) << value;
+  return s.str();
+}
+
+/// Largest relative force error of a row over both lines and the nodes, fraction.
+double maxForceError(const StudyRow& row) {
+  return std::max({row.line_a.relative.max_relative, row.line_b.relative.max_relative,
+                   row.nodes.relative.max_relative});
+}
+
+std::string csvText(const StudyResult& r) {
+  std::ostringstream s;
+  s << "variant,mode,voxel_mm,interpolation,active_nodes,dense_box_nodes,voxel_memory_mb,"
+       "field_s,path_s,clearance_s,total_s,speedup_vs_brute,speedup_vs_direct,"
+       "line_a_max_pct,line_a_rms_pct,line_b_max_pct,line_b_rms_pct,nodes_max_pct,nodes_rms_pct,"
+       "max_force_error_pct,nodes_max_scaled_pct,tilt_max_deg,tilt_rms_deg,min_clearance_mm,"
+       "colliding,max_tilt_deg\n";
+  for (const StudyRow& row : r.rows) {
+    const StudyVariant& v = row.variant;
+    s << v.name() << ',' << modeName(v.mode) << ',' << (v.isVoxel() ? number(v.voxel_size_mm) : "0")
+      << ',' << (v.isVoxel() ? interpolationName(v.interpolation) : "exact") << ','
+      << row.active_nodes << ',' << row.dense_box_nodes << ','
+      << number(row.voxel_memory_bytes / 1e6) << ',' << number(row.times.field_s) << ','
+      << number(row.times.steering_s) << ',' << number(row.times.clearance_s) << ','
+      << number(row.total_s) << ',' << number(row.speedup_vs_brute) << ','
+      << number(row.speedup_vs_direct) << ',' << number(100 * row.line_a.relative.max_relative)
+      << ',' << number(100 * row.line_a.relative.rms_relative) << ','
+      << number(100 * row.line_b.relative.max_relative) << ','
+      << number(100 * row.line_b.relative.rms_relative) << ','
+      << number(100 * row.nodes.relative.max_relative) << ','
+      << number(100 * row.nodes.relative.rms_relative) << ',' << number(100 * maxForceError(row))
+      << ',' << number(100 * row.nodes.max_scaled) << ',' << number(row.tilt_max_deg) << ','
+      << number(row.tilt_rms_deg) << ',' << number(row.min_clearance_mm) << ',' << row.colliding
+      << ',' << number(row.max_tilt_deg) << '\n';
+  }
+  return s.str();
+}
+
+std::string linesText(const StudyResult& r) {
+  std::ostringstream s;
+  s << "line,variant,t_mm,wall_distance_mm,direct_force,variant_force,relative_error\n";
+  for (const StudyLine* line : {&r.line_a, &r.line_b})
+    for (std::size_t v = 0; v < r.rows.size(); ++v) {
+      if (!r.rows[v].variant.isVoxel()) continue;
+      for (std::size_t i = 0; i < line->t_mm.size(); ++i)
+        s << line->name << ',' << r.rows[v].variant.name() << ',' << number(line->t_mm[i], 6) << ','
+          << number(line->wall_distance_mm[i], 5) << ',' << number(line->direct_magnitude[i], 6)
+          << ',' << number(line->magnitude[v][i], 6) << ','
+          << number(line->relative_error[v][i], 5) << '\n';
+    }
+  return s.str();
+}
+
+std::string tiltText(const StudyResult& r) {
+  std::ostringstream s;
+  s << "variant,pass,s_mm,tilt_deg\n";
+  for (std::size_t v = 0; v < r.rows.size(); ++v)
+    for (std::size_t i = 0; i < r.tilt_deg[v].size() && i < r.tilt_s_mm.size(); ++i)
+      s << r.rows[v].variant.name() << ',' << r.middle_pass + 1 << ',' << number(r.tilt_s_mm[i], 6)
+        << ',' << number(r.tilt_deg[v][i], 6) << '\n';
+  return s.str();
+}
+
+/// Seed 004 published figures by voxel size (Tables 1 and 2).
+struct Published {
+  double h_mm, nodes, field_s, total_s, force_pct, tilt_deg;
+};
+constexpr Published kPublished[] = {{2.0, 121e3, 32, 88, 15, 0.7},
+                                    {1.0, 784e3, 138, 194, 5, 0.5},
+                                    {0.5, 5389e3, 971, 1027, 1, 0.3}};
+constexpr double kPublishedDirectS = 3396;
+constexpr double kPublishedPathS = 56;
+/// Issue 7 targets: max force error and tilt difference by voxel size (half the seed's).
+struct Target {
+  double h_mm, force_pct, tilt_deg;
+};
+constexpr Target kTargets[] = {{2.0, 7.5, 0.35}, {1.0, 2.5, 0.25}, {0.5, 0.5, 0.1}};
+
+std::string markdownText(const StudyResult& r, const std::string& command_line,
+                         const std::string& machine) {
+  std::ostringstream s;
+  std::time_t now = std::time(nullptr);
+  char date[64];
+  std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+  s << "# Voxel-size study (seed 004 Tables 1–2, Figs. 5–6)\n\n"
+    << "- date: " << date << "\n- machine: " << machine << "\n- command: `" << command_line
+    << "`\n\n"
+    << "Job: " << r.postures << " postures on " << fixed(r.path_length_mm, 1)
+    << " mm of path, middle pass " << r.middle_pass + 1 << " plotted; " << r.tool_nodes
+    << " tool + holder nodes; " << r.obstacle_points << " obstacle points; voxel region (what tool"
+    << " + holder can reach) " << fixed(r.reach_box_cm3, 0) << " cm³; r0 = " << r.field.r0_mm
+    << " mm, r_min = " << r.field.r_min_mm << " mm, clearance = " << r.clearance_mm << " mm.\n\n"
+    << "## Definitions\n\n"
+    << "- **Relative force error** at a point x: `|F_v(x) - F_d(x)| / |F_d(x)|`, F_d the indexed"
+    << " direct field (exact eq. 1), counted where `|F_d(x)| >= " << kErrorFloorFraction * 100
+    << " % of max |F_d|` over the same set (line or nodes) and x is at least `clearance` from"
+    << " every obstacle. Why: the field fades to 0 at r0, where any relative error is"
+    << " meaningless and the nodes add nothing to the moment; points closer to a wall than"
+    << " `clearance` are never occupied by a valid path. `nodes scaled` is `|ΔF| / max |F_d|` over"
+    << " all nodes (no floor), the error relative to the largest force on the tool.\n"
+    << "- **Max force error** of a variant: the largest relative error over line a, line b and the"
+    << " nodes.\n"
+    << "- **Line a**: " << r.line_a.description << " (" << r.line_a.t_mm.size() << " points, "
+    << fixed(r.line_a.t_mm.back(), 1) << " mm). **Line b**: " << r.line_b.description << " ("
+    << r.line_b.t_mm.size() << " points, " << fixed(r.line_b.t_mm.back(), 1) << " mm).\n"
+    << "- **Nodes**: the " << r.tool_nodes << " tool + holder nodes at every posture of the direct"
+    << " path (" << r.node_points << " points).\n"
+    << "- **Times** (steady clock, this run): field = obstacle sampling + index (+ voxel build);"
+    << " path = steering of every pass; total = field + path (the seed's *temps total*); the FCL"
+    << " clearance check of each path is listed apart (the same work for every variant).\n"
+    << "- **Tilt difference**: `|θ_tilt,v - θ_tilt,d|` at every posture of every pass.\n\n";
+
+  s << "## Table 1: cost\n\n"
+    << "| variant | active nodes | dense-box nodes | memory MB | field s | path s | total s |"
+       " × vs brute | × vs direct | clearance s |\n"
+    << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const StudyRow& row : r.rows)
+    s << "| " << row.variant.name() << " | " << row.active_nodes << " | " << row.dense_box_nodes
+      << " | " << fixed(row.voxel_memory_bytes / 1e6, 1) << " | " << fixed(row.times.field_s, 3)
+      << " | " << fixed(row.times.steering_s, 3) << " | " << fixed(row.total_s, 3) << " | "
+      << fixed(row.speedup_vs_brute, 1) << " | " << fixed(row.speedup_vs_direct, 2) << " | "
+      << fixed(row.times.clearance_s, 2) << " |\n";
+  s << "\n**Published (seed 004 Table 1; Matlab on a Xeon E5-1620 @ 3.6 GHz, other hardware, "
+       "5100 obstacle points, 500 tool nodes, 660 cm³):**\n\n"
+    << "| method | voxel nodes | field s | path s | total s |\n|---|---:|---:|---:|---:|\n"
+    << "| direct | – | – | " << kPublishedDirectS << " | " << kPublishedDirectS << " |\n";
+  for (const Published& p : kPublished)
+    s << "| voxel " << p.h_mm << " mm | " << fixed(p.nodes / 1e3, 0) << "e3 | " << p.field_s
+      << " | " << kPublishedPathS << " (2 mm) | " << p.total_s << " |\n";
+
+  s << "\n## Table 2: what it breaks (errors in %, tilt in degrees)\n\n"
+    << "| variant | line a max | line a rms | line b max | line b rms | nodes max | nodes rms |"
+       " nodes scaled max | max force error | tilt diff max ° | tilt diff rms ° |"
+       " min clearance mm | colliding |\n"
+    << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const StudyRow& row : r.rows)
+    s << "| " << row.variant.name() << " | " << fixed(100 * row.line_a.relative.max_relative, 3)
+      << " | " << fixed(100 * row.line_a.relative.rms_relative, 3) << " | "
+      << fixed(100 * row.line_b.relative.max_relative, 3) << " | "
+      << fixed(100 * row.line_b.relative.rms_relative, 3) << " | "
+      << fixed(100 * row.nodes.relative.max_relative, 3) << " | "
+      << fixed(100 * row.nodes.relative.rms_relative, 3) << " | "
+      << fixed(100 * row.nodes.max_scaled, 3) << " | " << fixed(100 * maxForceError(row), 3)
+      << " | " << fixed(row.tilt_max_deg, 4) << " | " << fixed(row.tilt_rms_deg, 4) << " | "
+      << fixed(row.min_clearance_mm, 3) << " | " << row.colliding << " |\n";
+  s << "\n**Published (seed 004 Table 2; Matlab, linear interpolation, other hardware):**\n\n"
+    << "| voxel | force variation | tilt difference |\n|---|---:|---:|\n";
+  for (const Published& p : kPublished)
+    s << "| " << p.h_mm << " mm | up to " << p.force_pct << " % | up to " << p.tilt_deg << "° |\n";
+
+  // Targets of issue 7, best interpolation per voxel size.
+  s << "\n## Targets (issue 7)\n\n"
+    << "| voxel | best variant | max force error % (target) | tilt diff max ° (target) | met |\n"
+    << "|---|---|---:|---:|---|\n";
+  for (const Target& t : kTargets) {
+    const StudyRow* best = nullptr;
+    for (const StudyRow& row : r.rows)
+      if (row.variant.isVoxel() && std::abs(row.variant.voxel_size_mm - t.h_mm) < 1e-9 &&
+          (!best || maxForceError(row) < maxForceError(*best)))
+        best = &row;
+    if (!best) continue;
+    const bool met = 100 * maxForceError(*best) <= t.force_pct && best->tilt_max_deg <= t.tilt_deg;
+    s << "| " << t.h_mm << " mm | " << best->variant.name() << " | "
+      << fixed(100 * maxForceError(*best), 3) << " (≤ " << t.force_pct << ") | "
+      << fixed(best->tilt_max_deg, 4) << " (≤ " << t.tilt_deg << ") | " << (met ? "yes" : "**no**")
+      << " |\n";
+  }
+  const StudyRow* fastest = nullptr;
+  for (const StudyRow& row : r.rows)
+    if (row.variant.isVoxel() && maxForceError(row) <= 0.01 &&
+        (!fastest || row.total_s < fastest->total_s))
+      fastest = &row;
+  s << "\nSpeed at ≤ 1 % max force error (target ≥ 10× the indexed direct path): ";
+  if (fastest)
+    s << fastest->variant.name() << ", " << fixed(fastest->speedup_vs_direct, 2) << "× ("
+      << (fastest->speedup_vs_direct >= 10 ? "met" : "**not met**") << ").\n";
+  else
+    s << "no voxel variant reaches 1 % (**not met**).\n";
+  s << "\nFiles: study.csv (this table), lines.csv (Fig. 5 data), tilt.csv (Fig. 6 data), "
+       "speed_vs_error.png, force_error_lines.png, tilt_along_path.png.\n";
+  return s.str();
+}
+
+}  // namespace
+
+void writeStudy(const StudyResult& result, const std::filesystem::path& dir,
+                const std::string& command_line, const std::string& machine) {
+  common::writeTextAtomically(dir / "study.csv", csvText(result));
+  common::writeTextAtomically(dir / "lines.csv", linesText(result));
+  common::writeTextAtomically(dir / "tilt.csv", tiltText(result));
+  common::writeTextAtomically(dir / "study.md",
+                              markdownText(result, command_line,
+                                           machine.empty() ? machineDescription() : machine));
+}
+
+bool plotStudy(const std::filesystem::path& dir, std::string* message) {
+  const std::filesystem::path python = "/usr/bin/python3";
+  const std::filesystem::path script = FIELDPATH_PLOT_STUDY_SCRIPT;
+  auto fail = [&](const std::string& why) {
+    if (message) *message = why;
+    return false;
+  };
+  if (!std::filesystem::exists(python)) return fail("no /usr/bin/python3: pictures not made");
+  if (!std::filesystem::exists(script)) return fail("no " + script.string() + ": pictures not made");
+  const std::string command = python.string() + " '" + script.string() + "' '" + dir.string() + "'";
+  const int status = std::system(command.c_str());
+  if (status != 0)
+    return fail(script.string() + " failed (status " + std::to_string(status) +
+                "; python3-matplotlib missing?): pictures not made");
+  return true;
+}
+
+}  // namespace fieldpath::app

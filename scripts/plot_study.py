@@ -1,0 +1,148 @@
+#!/usr/bin/python3
+"""Pictures of `fieldpath study` (seed 004 Figs. 5-6) from the CSVs it writes.
+
+Usage: /usr/bin/python3 plot_study.py DIR
+Reads DIR/study.csv, DIR/lines.csv, DIR/tilt.csv; writes DIR/speed_vs_error.png,
+DIR/force_error_lines.png, DIR/tilt_along_path.png (each to a temporary name, then renamed).
+Exit 1 when matplotlib is missing (the caller says so and keeps the CSVs).
+"""
+import csv
+import math
+import os
+import sys
+from collections import OrderedDict
+
+try:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+except ImportError:
+    sys.stderr.write("plot_study.py: matplotlib is missing (apt-get install python3-matplotlib)\n")
+    sys.exit(1)
+
+
+def read(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def num(text):
+    try:
+        return float(text)
+    except ValueError:
+        return math.nan
+
+
+def save(fig, path):
+    tmp = path + ".tmp.png"
+    fig.savefig(tmp, dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    os.replace(tmp, path)
+
+
+def grouped(rows, key):
+    groups = OrderedDict()
+    for row in rows:
+        groups.setdefault(row[key], []).append(row)
+    return groups
+
+
+def speed_vs_error(study, out):
+    """Total time against max force error, one point per variant, Pareto front marked."""
+    fig, ax = plt.subplots(figsize=(7, 5))
+    points = []
+    exact_floor = None
+    for row in study:
+        err, t = num(row["max_force_error_pct"]), num(row["total_s"])
+        points.append((row["variant"], err, t))
+    errs = [e for _, e, _ in points if e > 0]
+    exact_floor = min(errs) / 10 if errs else 1e-3
+    shown = [(n, max(e, exact_floor), t, e) for n, e, t in points]
+    # Pareto front: no other variant is both faster and more accurate.
+    front = [p for p in shown
+             if not any((q[2] <= p[2] and q[1] <= p[1]) and (q[2] < p[2] or q[1] < p[1]) for q in shown)]
+    front.sort(key=lambda p: p[1])
+    for name, e, t, raw in shown:
+        marker = "s" if raw <= 0 else ("^" if "quadratic" in name else "o")
+        ax.scatter(e, t, marker=marker, s=50, zorder=3)
+        label = name + (" (exact)" if raw <= 0 else "")
+        ax.annotate(label, (e, t), textcoords="offset points", xytext=(6, 4), fontsize=8)
+    ax.plot([p[1] for p in front], [p[2] for p in front], "k--", lw=1, label="Pareto front", zorder=2)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("max relative force error, % (exact methods drawn at the left edge)")
+    ax.set_ylabel("total time (field + path), s")
+    ax.set_title("Speed against error (seed 004 Table 1-2)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(loc="upper right")
+    save(fig, os.path.join(out, "speed_vs_error.png"))
+
+
+def force_error_lines(lines, out):
+    """Relative error along line a and line b per voxel variant (like seed Fig. 5)."""
+    fig, axes = plt.subplots(2, 2, figsize=(12, 8), sharex="col")
+    for col, name in enumerate(["a", "b"]):
+        rows = [r for r in lines if r["line"] == name]
+        groups = grouped(rows, "variant")
+        top, bottom = axes[0][col], axes[1][col]
+        first = True
+        for variant, vr in groups.items():
+            t = [num(r["t_mm"]) for r in vr]
+            if first:
+                top.plot(t, [num(r["direct_force"]) for r in vr], "k-", lw=2, label="direct (exact)")
+                first = False
+            top.plot(t, [num(r["variant_force"]) for r in vr], lw=1, label=variant)
+            bottom.plot(t, [100 * num(r["relative_error"]) for r in vr], lw=1, label=variant)
+        top.set_title("line %s: |F| along the line" % name)
+        top.set_ylabel("|F|")
+        top.set_yscale("log")
+        bottom.set_title("line %s: relative error (counted points only)" % name)
+        bottom.set_ylabel("|F_v - F_d| / |F_d|, %")
+        bottom.set_yscale("log")
+        bottom.set_xlabel("t along the line, mm")
+        for ax in (top, bottom):
+            ax.grid(True, which="both", alpha=0.3)
+        top.legend(fontsize=7)
+    fig.suptitle("Force error along the study lines (seed 004 Fig. 5)")
+    save(fig, os.path.join(out, "force_error_lines.png"))
+
+
+def tilt_along_path(tilt, out):
+    """Tilt of the middle pass against arc length per variant, and its difference (seed Fig. 6)."""
+    groups = grouped(tilt, "variant")
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
+    direct = groups.get("direct")
+    ref = [num(r["tilt_deg"]) for r in direct] if direct else None
+    for variant, vr in groups.items():
+        s = [num(r["s_mm"]) for r in vr]
+        y = [num(r["tilt_deg"]) for r in vr]
+        style = "k-" if variant == "direct" else "-"
+        top.plot(s, y, style, lw=2 if variant == "direct" else 1, label=variant)
+        if ref and variant not in ("direct", "brute force"):
+            bottom.plot(s, [a - b for a, b in zip(y, ref)], lw=1, label=variant)
+    p = tilt[0]["pass"] if tilt else "?"
+    top.set_title("Tilt along the middle pass (pass %s)" % p)
+    top.set_ylabel("tilt, deg")
+    bottom.set_ylabel("tilt - tilt(direct), deg")
+    bottom.set_xlabel("arc length s, mm")
+    for ax in (top, bottom):
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle("Influence of the voxels on the tool axis (seed 004 Fig. 6)")
+    save(fig, os.path.join(out, "tilt_along_path.png"))
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.stderr.write(__doc__)
+        return 2
+    out = sys.argv[1]
+    speed_vs_error(read(os.path.join(out, "study.csv")), out)
+    force_error_lines(read(os.path.join(out, "lines.csv")), out)
+    tilt_along_path(read(os.path.join(out, "tilt.csv")), out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,154 @@
+// The voxel-size study (app/study.h) on a small impeller job: every csv cell finite, the two exact
+// methods agree, errors shrink as the voxels do.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "fieldpath/common/errors.h"
+#include "study.h"
+
+namespace fieldpath::app {
+namespace {
+
+/// A short stretch of the impeller channel: three short passes, coarse blade meshes.
+pathgen::GenerateRequest smallJob() {
+  pathgen::GenerateRequest job;
+  job.impeller.u_range = {0.55, 0.8};
+  job.impeller.passes_v = {0.3, 0.7};
+  job.impeller.chord_tol_mm = 0.5;
+  job.path.passes = 3;
+  job.path.step_mm = 1.0;
+  job.field.sample_step_mm = 1.0;
+  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
+  job.holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
+  job.dynamics.max_lead_deg = 45.0;  // the study compares angles; the limits are not under test
+  job.dynamics.max_tilt_deg = 45.0;
+  job.clearance_mm = 0.5;
+  return job;
+}
+
+struct Csv {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+};
+
+Csv readCsv(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  Csv csv;
+  std::string line;
+  auto split = [](const std::string& text) {
+    std::vector<std::string> cells;
+    std::stringstream s(text);
+    std::string cell;
+    while (std::getline(s, cell, ',')) cells.push_back(cell);
+    return cells;
+  };
+  if (std::getline(in, line)) csv.header = split(line);
+  while (std::getline(in, line)) csv.rows.push_back(split(line));
+  return csv;
+}
+
+/// One study run shared by the tests (a few seconds).
+class StudyTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    StudyRequest request;
+    request.job = smallJob();
+    request.voxel_sizes_mm = {2.0, 1.0, 0.5};
+    request.interpolations = {field::Interpolation::Trilinear};
+    request.line_step_mm = 0.1;
+    result_ = new StudyResult(runStudy(request));
+    dir_ = new std::filesystem::path(std::filesystem::temp_directory_path() /
+                                     ("fieldpath_test_study_" + std::to_string(::getpid())));
+    writeStudy(*result_, *dir_, "test_study", "test machine");
+  }
+  static void TearDownTestSuite() {
+    if (!std::getenv("FIELDPATH_KEEP_TEST_OUTPUT")) std::filesystem::remove_all(*dir_);
+    delete result_;
+    delete dir_;
+  }
+  static const StudyRow& row(const std::string& name) {
+    for (const StudyRow& r : result_->rows)
+      if (r.variant.name() == name) return r;
+    throw std::runtime_error("no row " + name);
+  }
+  static StudyResult* result_;
+  static std::filesystem::path* dir_;
+};
+StudyResult* StudyTest::result_ = nullptr;
+std::filesystem::path* StudyTest::dir_ = nullptr;
+
+TEST(StudyOptions, ParsesListsAndRejectsBadOnes) {
+  EXPECT_EQ(parseVoxelSizes("2,1,0.5", "--voxels"), (std::vector<double>{2.0, 1.0, 0.5}));
+  EXPECT_EQ(parseInterpolations("quadratic,trilinear", "--interp").size(), 2u);
+  for (const char* bad : {"", "2,,1", "0", "-1", "2,x", "nan", "inf"})
+    EXPECT_THROW(parseVoxelSizes(bad, "--voxels"), common::InputError) << bad;
+  EXPECT_THROW(parseInterpolations("cubic", "--interp"), common::InputError);
+}
+
+TEST_F(StudyTest, BruteForceEqualsTheIndexedDirectField) {
+  // Both evaluate eq. 1 exactly: same forces (to rounding), same path.
+  const StudyRow& brute = row("brute force");
+  EXPECT_LT(brute.line_a.relative.max_relative, 1e-9);
+  EXPECT_LT(brute.line_b.relative.max_relative, 1e-9);
+  EXPECT_LT(brute.nodes.relative.max_relative, 1e-9);
+  EXPECT_GT(brute.nodes.relative.count, 50u);
+  EXPECT_LT(brute.tilt_max_deg, 1e-4);
+  EXPECT_EQ(row("direct").tilt_max_deg, 0.0);
+}
+
+TEST_F(StudyTest, CsvHasEveryColumnFilledWithFiniteValues) {
+  const Csv csv = readCsv(*dir_ / "study.csv");
+  ASSERT_GE(csv.header.size(), 20u);
+  ASSERT_EQ(csv.rows.size(), 5u);  // brute force, direct, 3 voxel sizes
+  const std::map<std::string, bool> text_columns = {
+      {"variant", true}, {"mode", true}, {"interpolation", true}};
+  for (const auto& cells : csv.rows) {
+    ASSERT_EQ(cells.size(), csv.header.size());
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      ASSERT_FALSE(cells[c].empty()) << csv.header[c];
+      if (text_columns.count(csv.header[c])) continue;
+      std::size_t used = 0;
+      const double value = std::stod(cells[c], &used);
+      EXPECT_EQ(used, cells[c].size()) << csv.header[c] << " = " << cells[c];
+      EXPECT_TRUE(std::isfinite(value)) << cells[0] << ": " << csv.header[c] << " = " << cells[c];
+    }
+  }
+  for (const char* file : {"study.md", "lines.csv", "tilt.csv"})
+    EXPECT_GT(std::filesystem::file_size(*dir_ / file), 100u) << file;
+}
+
+TEST_F(StudyTest, ErrorsShrinkWithTheVoxelSize) {
+  const StudyRow* rows[] = {&row("voxel 2 mm trilinear"), &row("voxel 1 mm trilinear"),
+                            &row("voxel 0.5 mm trilinear")};
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_GT(rows[k]->active_nodes, 0u);
+    EXPECT_GE(rows[k]->dense_box_nodes, rows[k]->active_nodes);
+    EXPECT_GT(rows[k]->line_a.relative.count, 10u);
+    EXPECT_GT(rows[k]->line_b.relative.count, 10u);
+    EXPECT_EQ(rows[k]->colliding, 0u);
+  }
+  for (int k = 0; k < 2; ++k) {
+    const StudyRow& coarse = *rows[k];
+    const StudyRow& fine = *rows[k + 1];
+    SCOPED_TRACE(fine.variant.name());
+    EXPECT_GT(fine.active_nodes, coarse.active_nodes);
+    EXPECT_LT(fine.line_a.relative.max_relative, coarse.line_a.relative.max_relative);
+    EXPECT_LT(fine.line_a.relative.rms_relative, coarse.line_a.relative.rms_relative);
+    EXPECT_LT(fine.line_b.relative.max_relative, coarse.line_b.relative.max_relative);
+    EXPECT_LT(fine.line_b.relative.rms_relative, coarse.line_b.relative.rms_relative);
+    EXPECT_LT(fine.nodes.relative.max_relative, coarse.nodes.relative.max_relative);
+    EXPECT_LT(fine.nodes.relative.rms_relative, coarse.nodes.relative.rms_relative);
+    EXPECT_LT(fine.tilt_rms_deg, coarse.tilt_rms_deg);
+  }
+}
+
+}  // namespace
+}  // namespace fieldpath::app
