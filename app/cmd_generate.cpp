@@ -1,11 +1,163 @@
+/// `fieldpath generate SCENE [--direct | --voxel H] [--nominal] --out DIR`: the impeller path
+/// (path.cl, path.apt, angles.csv, report.json), written only once the whole job has succeeded.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
 #include "commands.h"
 #include "errors.h"
+#include "fieldpath/common/atomic_file.h"
+#include "fieldpath/geometry/cl_file.h"
+#include "impeller_job.h"
+#include "progress.h"
+#include "scene.h"
 
 namespace fieldpath::app {
+namespace {
 
-void addGenerateCommand(CLI::App& app, const GlobalOptions& /*global*/) {
-  auto* cmd = app.add_subcommand("generate", "(not yet implemented)");
-  cmd->callback([] { throw InputError("'generate' is not implemented yet"); });
+constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+
+const char* modeName(pathgen::FieldMode mode) {
+  switch (mode) {
+    case pathgen::FieldMode::Voxel: return "voxel";
+    case pathgen::FieldMode::Direct: return "direct";
+    case pathgen::FieldMode::BruteForce: return "brute_force";
+  }
+  return "?";
+}
+
+nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& job,
+                          const pathgen::GenerateResult& r) {
+  using nlohmann::json;
+  json passes = json::array();
+  for (const pathgen::Pass& pass : r.passes) {
+    double min_clearance = INFINITY, max_tilt = 0;
+    int postures = 0, colliding = 0;
+    for (const auto& g : r.postures) {
+      if (g.pass != pass.index) continue;
+      ++postures;
+      min_clearance = std::min(min_clearance, g.clearance_mm);
+      max_tilt = std::max(max_tilt, std::abs(g.tilt_rad) * kRadToDeg);
+      colliding += g.clearance_mm <= 0.0;
+    }
+    passes.push_back({{"pass", pass.index + 1}, {"v", pass.v}, {"length_mm", pass.length_mm},
+                      {"postures", postures}, {"min_clearance_mm", min_clearance},
+                      {"max_tilt_deg", max_tilt}, {"colliding_postures", colliding}});
+  }
+  const auto& c = r.clearance;
+  const auto& box = r.reach_box_mm;
+  auto index = [](std::size_t i) {
+    return i == pathgen::ClearanceResult::npos ? json(nullptr) : json(i);
+  };
+  return {
+      {"scene", scene.file.string()},
+      {"field_mode", job.nominal ? "nominal" : modeName(job.mode)},
+      {"voxel_size_mm", job.mode == pathgen::FieldMode::Voxel && !job.nominal
+                            ? json(job.field.voxel_size_mm) : json(nullptr)},
+      {"nominal", job.nominal},
+      {"postures", r.postures.size()},
+      {"passes", r.passes.size()},
+      {"path_length_mm", r.path_length_mm},
+      {"times_s",
+       {{"setup", r.times.setup_s}, {"field", r.times.field_s}, {"steering", r.times.steering_s},
+        {"clearance", r.times.clearance_s}, {"total", r.times.total_s}}},
+      {"counts",
+       {{"obstacle_points", r.obstacle_points}, {"tool_nodes", r.tool_nodes},
+        {"tool_triangles", r.tool_triangles}, {"voxel_nodes", r.voxel_nodes},
+        {"voxel_memory_bytes", r.voxel_memory_bytes}}},
+      {"reach_box_mm",
+       {{"min", {box.min().x(), box.min().y(), box.min().z()}},
+        {"max", {box.max().x(), box.max().y(), box.max().z()}},
+        {"volume_cm3", box.volume() / 1000.0}}},
+      {"clearance",
+       {{"required_mm", job.clearance_mm}, {"min_mm", c.min_clearance_mm},
+        {"min_posture", index(c.min_index)}, {"min_obstacle", c.min_obstacle + 1},
+        {"colliding_postures", c.colliding}, {"first_colliding_posture", index(c.first_colliding)},
+        {"ok", c.colliding == 0 && c.min_clearance_mm >= job.clearance_mm}}},
+      {"max_tilt_deg", r.max_tilt_deg},
+      {"max_lead_deg", r.max_lead_deg},
+      {"solver",
+       {{"steps", r.solver_steps}, {"rhs_evals", r.rhs_evals}, {"jacobian_evals", r.jacobian_evals},
+        {"error_test_failures", r.error_test_failures},
+        {"convergence_failures", r.convergence_failures}}},
+      {"per_pass", passes},
+  };
+}
+
+std::string anglesCsv(const pathgen::GenerateResult& r) {
+  std::ostringstream csv;
+  csv << "s_mm,pass,lead_deg,tilt_deg,moment,nearest_mm\n";
+  csv.precision(9);
+  for (const auto& g : r.postures)
+    csv << g.s_mm << ',' << g.pass + 1 << ',' << g.lead_rad * kRadToDeg << ','
+        << g.tilt_rad * kRadToDeg << ',' << g.moment << ',' << g.clearance_mm << '\n';
+  return csv.str();
+}
+
+}  // namespace
+
+void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
+  auto* cmd = app.add_subcommand(
+      "generate",
+      "Generate the impeller path of a scene: isoparametric passes on the hub, tool axis steered by "
+      "the repulsive field (CVODE), exact clearance (FCL). Writes path.cl, path.apt, angles.csv, "
+      "report.json");
+  struct Options {
+    std::string scene, out;
+    bool direct = false, nominal = false;
+    double voxel_mm = 0.0;
+  };
+  auto options = std::make_shared<Options>();
+  cmd->add_option("scene", options->scene, "Scene file (YAML)")->required();
+  auto* direct = cmd->add_flag("--direct", options->direct, "Exact field (radius search), no voxels");
+  auto* voxel = cmd->add_option("--voxel", options->voxel_mm,
+                                "Voxel size H, mm (default: the scene's field.voxel_size)");
+  direct->excludes(voxel);
+  cmd->add_flag("--nominal", options->nominal,
+                "The nominal path: axis on the hub normal (+ lead), no field, no dynamics");
+  cmd->add_option("--out", options->out, "Output folder")->required();
+  cmd->callback([options, &global] {
+    const Scene scene = loadScene(options->scene);
+    pathgen::GenerateRequest job = impellerJob(scene);
+    job.mode = options->direct ? pathgen::FieldMode::Direct : pathgen::FieldMode::Voxel;
+    if (options->voxel_mm != 0.0) {
+      if (!(options->voxel_mm > 0.0) || !std::isfinite(options->voxel_mm))
+        throw InputError("--voxel: the voxel size must be > 0 mm");
+      job.field.voxel_size_mm = options->voxel_mm;
+    }
+    job.nominal = options->nominal;
+    job.progress = makeProgressLine(global.quiet);
+    const pathgen::GenerateResult result = pathgen::generateImpellerPath(job);
+
+    // Every output is computed; now write them (each atomically).
+    const std::filesystem::path out = options->out;
+    std::vector<geometry::Posture> postures;
+    for (const auto& g : result.postures) postures.push_back(g.posture);
+    const std::string what = job.nominal ? "nominal path" : "field path";
+    geometry::writeClFile(out / "path.cl", postures,
+                          "fieldpath generate " + scene.file.string() + " (" + what +
+                              "): x y z i j k, tool tip and axis, mm");
+    geometry::AptHeader header;
+    header.part_name = "IMPELLER";
+    header.tool = job.tool;
+    header.feed_mm_per_min = job.dynamics.feed_mm_per_min;
+    geometry::writeAptFile(out / "path.apt", postures, header);
+    common::writeTextAtomically(out / "angles.csv", anglesCsv(result));
+    common::writeTextAtomically(out / "report.json", reportJson(scene, job, result).dump(2) + "\n");
+
+    const auto& c = result.clearance;
+    std::printf(
+        "%s: %zu postures on %zu passes, %.1f mm; max tilt %.2f deg, max lead %.2f deg; min "
+        "clearance %.3f mm (required %.3f), %zu colliding postures; %.2f s -> %s\n",
+        what.c_str(), result.postures.size(), result.passes.size(), result.path_length_mm,
+        result.max_tilt_deg, result.max_lead_deg, c.min_clearance_mm, job.clearance_mm,
+        c.colliding, result.times.total_s, out.string().c_str());
+  });
 }
 
 }  // namespace fieldpath::app

@@ -49,9 +49,7 @@ void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>
     if (d < clearance_mm) {
       std::ostringstream msg;
       msg << "pass " << pass.index + 1 << " (v = " << pass.v << "): at s = " << pass.samples[at].s_mm
-          << " mm the ball is " << d << " mm from obstacle " << obstacle
-          << (obstacle == 0 ? " (left blade)" : obstacle == 1 ? " (right blade)" : "")
-          << ", less than `clearance` = " << clearance_mm
+          << " mm the ball is " << d << " mm from obstacle " << obstacle + 1 << ", less than `clearance` = " << clearance_mm
           << " mm: the channel is narrower than the ball there (impeller.passes_v, width_in/out)";
       throw InputError(msg.str());
     }
@@ -249,7 +247,6 @@ GenerateResult generateImpellerPath(const GenerateRequest& request) {
   }
   result.times.clearance_s = seconds(clearance_start);
   result.times.total_s = seconds(start);
-  common::report(request.progress, 1.0, "done");
   return result;
 }
 

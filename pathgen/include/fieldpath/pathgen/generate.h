@@ -26,7 +26,7 @@ enum class FieldMode { Voxel, Direct, BruteForce };
 
 struct GenerateRequest {
   ImpellerParams impeller;
-  /// Obstacles besides the impeller's two blades (world frame, mm), e.g. scene `obstacles:` meshes.
+  /// Obstacles besides the impeller's two blades (world frame, mm), e.g. scene `- mesh:` entries.
   std::vector<geometry::TriangleMesh> extra_obstacles;
   PathParams path;
   field::FieldParams field;
@@ -81,9 +81,9 @@ double defaultNodeSpacingMm(const geometry::ToolSpec& tool, const geometry::Hold
 /// ball"), and when the dynamics leaves its limits (naming the pass and arc length).
 GenerateResult generateImpellerPath(const GenerateRequest& request);
 
-/// The obstacles of a request: the impeller's blades (0 = left, 1 = right), then the extra ones.
-std::vector<geometry::TriangleMesh> obstacleMeshes(const Impeller& impeller,
-                                                   const std::vector<geometry::TriangleMesh>& extra);
+/// The obstacles of a job: the impeller's blades (0 = left, 1 = right), then the extra ones.
+std::vector<geometry::TriangleMesh> obstacleMeshes(
+    const Impeller& impeller, const std::vector<geometry::TriangleMesh>& extra = {});
 
 /// Chordal tolerance of the tool + holder mesh used for the exact clearance, mm.
 inline constexpr double kClearanceMeshTolMm = 0.02;
