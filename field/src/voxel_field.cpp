@@ -174,18 +174,21 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
         const openvdb::Coord o = leaf.origin();
         const Vec3 lo = Vec3(o.x(), o.y(), o.z()) * h;
         const Vec3 hi = lo + Vec3::Constant((kLeafDim - 1) * h);
-        // The surface rule of law.h moves a band node by at most 2 max(band_in, r_min).
-        const double pad = params.r0_mm + 2.0 * std::max(band_in_mm, params.r_min_mm);
+        // Samples within r0 of the leaf's nodes, gathered once; the surface rule's second sum, at
+        // a point lifted off the wall (rare: nodes within r_min or inside), searches the index.
         near.clear();
-        index.forEachInBox(searcher, lo.array() - pad, hi.array() + pad,
+        index.forEachInBox(searcher, lo.array() - params.r0_mm, hi.array() + params.r0_mm,
                            [&](std::size_t j) { near.push_back(j); });
-        auto for_each_near = [&](const Vec3&, double, auto&& fn) {
-          for (std::size_t j : near) fn(j);
-        };
         for (auto it = leaf.beginValueAll(); it; ++it) {
           const openvdb::Coord ijk = it.getCoord();
           const Vec3 x(ijk.x() * h, ijk.y() * h, ijk.z() * h);
           if (request.region_mm && !request.region_mm->contains(x)) continue;
+          auto for_each_near = [&](const Vec3& center, double radius, auto&& fn) {
+            if (center == x)
+              for (std::size_t j : near) fn(j);
+            else
+              index.forEachNear(searcher, center, radius, fn);
+          };
           const auto f = detail::fieldAt(x, for_each_near, samples.points_mm, samples.normals,
                                          samples.weights, params, band_in_mm);
           if (!f) continue;

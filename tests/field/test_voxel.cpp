@@ -156,3 +156,12 @@ TEST(Voxel, SavesAVdbFile) {
   EXPECT_FALSE(std::filesystem::exists(file.string() + ".tmp"));
   std::filesystem::remove(file);
 }
+
+TEST(Voxel, NoObstacleGivesAZeroField) {
+  const DirectField direct(ObstacleSamples{}, FieldParams{});
+  const VoxelField voxel(direct, request(0.5));
+  EXPECT_EQ(voxel.stats().active_nodes, 0u);
+  EXPECT_EQ(voxel.stats().estimated_nodes, 0u);
+  EXPECT_EQ(direct.at(Vec3(1, 2, 3)), Vec3::Zero());
+  EXPECT_EQ(voxel.at(Vec3(1, 2, 3)), Vec3::Zero());
+}
