@@ -45,7 +45,8 @@ std::vector<Vec3> readPoints(const std::string& file) {
         used = 0;
       }
       if (used != words[a].size() || !std::isfinite(p[a]))
-        throw InputError(file + ":" + std::to_string(number) + ": '" + words[a] + "' is not a finite number");
+        throw InputError(file + ":" + std::to_string(number) + ": '" + words[a] +
+                         "' is not a finite number");
     }
     points.push_back(p);
   }
@@ -56,7 +57,7 @@ struct FieldOptions {
   std::string scene;
   std::string points;
   bool direct = false;
-  double voxel_mm = 0.0;  ///< 0: the scene's field.voxel_size
+  double voxel_mm = 0.0;      ///< 0: the scene's field.voxel_size
   std::string interpolation;  ///< "" : the scene's
   std::string out;
   std::string save_field;
@@ -76,7 +77,8 @@ Obstacles loadObstacles(const FieldOptions& o) {
   const Scene& s = result.scene;
   result.direct = std::make_unique<field::DirectField>(
       field::sampleObstacles(s.obstacles, s.field.sample_step_mm, s.field.weights), s.field);
-  result.sampling_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.sampling_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 
@@ -85,8 +87,8 @@ field::VoxelRequest voxelRequest(const FieldOptions& o, const Scene& scene, bool
   request.voxel_size_mm = o.voxel_mm > 0.0 ? o.voxel_mm : scene.field.voxel_size_mm;
   request.interpolation = scene.field.interpolation;
   if (!o.interpolation.empty())
-    request.interpolation =
-        o.interpolation == "quadratic" ? field::Interpolation::Quadratic : field::Interpolation::Trilinear;
+    request.interpolation = o.interpolation == "quadratic" ? field::Interpolation::Quadratic
+                                                           : field::Interpolation::Trilinear;
   request.max_memory_bytes = static_cast<std::size_t>(o.max_memory_mib * 1024.0 * 1024.0);
   request.progress = makeProgressLine(quiet);
   return request;
@@ -107,14 +109,16 @@ void probe(const FieldOptions& o, const GlobalOptions& global) {
                                                 voxelRequest(o, obstacles.scene, global.quiet));
     if (!o.save_field.empty()) voxel->save(o.save_field);
   }
-  const field::ForceField& f = voxel ? static_cast<const field::ForceField&>(*voxel) : *obstacles.direct;
+  const field::ForceField& f =
+      voxel ? static_cast<const field::ForceField&>(*voxel) : *obstacles.direct;
   std::vector<Vec3> forces(points.size());
   f.evaluate(points, forces);
-  std::string out = "# x y z Fx Fy Fz (mm; " + std::string(voxel ? "voxel" : "direct") + " field)\n";
+  std::string out =
+      "# x y z Fx Fy Fz (mm; " + std::string(voxel ? "voxel" : "direct") + " field)\n";
   char line[256];
   for (std::size_t i = 0; i < points.size(); ++i) {
-    std::snprintf(line, sizeof line, "%.9g %.9g %.9g %.9g %.9g %.9g\n", points[i].x(), points[i].y(), points[i].z(),
-                  forces[i].x(), forces[i].y(), forces[i].z());
+    std::snprintf(line, sizeof line, "%.9g %.9g %.9g %.9g %.9g %.9g\n", points[i].x(),
+                  points[i].y(), points[i].z(), forces[i].x(), forces[i].y(), forces[i].z());
     out += line;
   }
   std::fputs(out.c_str(), stdout);
@@ -127,8 +131,9 @@ void build(const FieldOptions& o, const GlobalOptions& global) {
   voxel.save(o.out);
   const field::VoxelStats& s = voxel.stats();
   const auto& samples = obstacles.direct->samples();
-  std::printf("obstacles: %zu meshes, %zu samples (step %g mm, %.0f mm²)\n", obstacles.scene.obstacles.size(),
-              samples.size(), obstacles.scene.field.sample_step_mm, samples.area_mm2);
+  std::printf("obstacles: %zu meshes, %zu samples (step %g mm, %.0f mm²)\n",
+              obstacles.scene.obstacles.size(), samples.size(),
+              obstacles.scene.field.sample_step_mm, samples.area_mm2);
   std::printf("voxel size: %g mm, %s\n", request.voxel_size_mm,
               request.interpolation == field::Interpolation::Trilinear ? "trilinear" : "quadratic");
   std::printf("estimated nodes: %zu\n", s.estimated_nodes);
@@ -143,34 +148,52 @@ void build(const FieldOptions& o, const GlobalOptions& global) {
 }  // namespace
 
 void addFieldCommand(CLI::App& app, const GlobalOptions& global) {
-  auto* cmd = app.add_subcommand("field", "The repulsive field of a scene's obstacles: probe it, build its voxels");
+  auto* cmd = app.add_subcommand(
+      "field", "The repulsive field of a scene's obstacles: probe it, build its voxels");
   cmd->require_subcommand(1);
   auto options = std::make_shared<FieldOptions>();
 
   auto* probe_cmd = cmd->add_subcommand("probe", "Print `x y z Fx Fy Fz` at the points of a file");
   probe_cmd->add_option("scene", options->scene, "Scene file (YAML)")->required();
-  probe_cmd->add_option("--points", options->points, "Points file: `x y z` a line, # comments")->required();
-  auto* direct = probe_cmd->add_flag("--direct", options->direct, "Exact sum over the samples within r0 (no voxels)");
-  probe_cmd->add_option("--voxel", options->voxel_mm, "Voxel size h, mm (default: the scene's field.voxel_size)")
+  probe_cmd->add_option("--points", options->points, "Points file: `x y z` a line, # comments")
+      ->required();
+  auto* direct = probe_cmd->add_flag("--direct", options->direct,
+                                     "Exact sum over the samples within r0 (no voxels)");
+  probe_cmd
+      ->add_option("--voxel", options->voxel_mm,
+                   "Voxel size h, mm (default: the scene's field.voxel_size)")
       ->check(CLI::PositiveNumber)
       ->excludes(direct);
-  probe_cmd->add_option("--interpolation", options->interpolation, "trilinear | quadratic (default: the scene's)")
+  probe_cmd
+      ->add_option("--interpolation", options->interpolation,
+                   "trilinear | quadratic (default: the scene's)")
       ->check(CLI::IsMember({"trilinear", "quadratic"}))
       ->excludes(direct);
-  probe_cmd->add_option("--save-field", options->save_field, "Also write the voxel field to this .vdb file")
+  probe_cmd
+      ->add_option("--save-field", options->save_field,
+                   "Also write the voxel field to this .vdb file")
       ->excludes(direct);
-  probe_cmd->add_option("--max-memory", options->max_memory_mib, "Refuse voxel fields estimated above this, MiB")
+  probe_cmd
+      ->add_option("--max-memory", options->max_memory_mib,
+                   "Refuse voxel fields estimated above this, MiB")
       ->check(CLI::PositiveNumber);
   probe_cmd->callback([options, &global] { probe(*options, global); });
 
-  auto* build_cmd = cmd->add_subcommand("build", "Build the sparse voxel field and write it as OpenVDB (.vdb)");
+  auto* build_cmd =
+      cmd->add_subcommand("build", "Build the sparse voxel field and write it as OpenVDB (.vdb)");
   build_cmd->add_option("scene", options->scene, "Scene file (YAML)")->required();
-  build_cmd->add_option("--voxel", options->voxel_mm, "Voxel size h, mm (default: the scene's field.voxel_size)")
+  build_cmd
+      ->add_option("--voxel", options->voxel_mm,
+                   "Voxel size h, mm (default: the scene's field.voxel_size)")
       ->check(CLI::PositiveNumber);
-  build_cmd->add_option("--interpolation", options->interpolation, "trilinear | quadratic (default: the scene's)")
+  build_cmd
+      ->add_option("--interpolation", options->interpolation,
+                   "trilinear | quadratic (default: the scene's)")
       ->check(CLI::IsMember({"trilinear", "quadratic"}));
   build_cmd->add_option("--out", options->out, "Output .vdb file")->required();
-  build_cmd->add_option("--max-memory", options->max_memory_mib, "Refuse voxel fields estimated above this, MiB")
+  build_cmd
+      ->add_option("--max-memory", options->max_memory_mib,
+                   "Refuse voxel fields estimated above this, MiB")
       ->check(CLI::PositiveNumber);
   build_cmd->callback([options, &global] { build(*options, global); });
 }

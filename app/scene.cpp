@@ -22,7 +22,8 @@ class Reader {
   explicit Reader(std::filesystem::path file) : file_(std::move(file)) {}
 
   /// "FILE:LINE: key: why" (LINE from the node's YAML mark, 1-based, when it has one).
-  [[noreturn]] void fail(const YAML::Node& at, const std::string& key, const std::string& why) const {
+  [[noreturn]] void fail(const YAML::Node& at, const std::string& key,
+                         const std::string& why) const {
     std::string where = file_.string();
     if (at.IsDefined() && at.Mark().line >= 0) where += ":" + std::to_string(at.Mark().line + 1);
     throw InputError(where + ": " + key + ": " + why);
@@ -57,15 +58,16 @@ class Reader {
   }
 
   /// A number with `check(value)` true, else "must be <what>".
-  double number(const YAML::Node& node, const std::string& key, const std::function<bool(double)>& check,
-                const std::string& what) const {
+  double number(const YAML::Node& node, const std::string& key,
+                const std::function<bool(double)>& check, const std::string& what) const {
     const double value = number(node, key);
     if (!check(value)) fail(node, key, "must be " + what + " (got " + node.Scalar() + ")");
     return value;
   }
 
   double positive(const YAML::Node& node, const std::string& key) const {
-    return number(node, key, [](double v) { return v > 0.0; }, "> 0");
+    return number(
+        node, key, [](double v) { return v > 0.0; }, "> 0");
   }
 
   std::string word(const YAML::Node& node, const std::string& key,
@@ -97,7 +99,8 @@ class Reader {
   }
 
   /// Runs a module's own validation, naming the key and line in its error.
-  void check(const YAML::Node& node, const std::string& key, const std::function<void()>& validate) const {
+  void check(const YAML::Node& node, const std::string& key,
+             const std::function<void()>& validate) const {
     try {
       validate();
     } catch (const InputError& e) {
@@ -105,7 +108,9 @@ class Reader {
     }
   }
 
-  static std::string join(const std::string& a, const std::string& b) { return a.empty() ? b : a + "." + b; }
+  static std::string join(const std::string& a, const std::string& b) {
+    return a.empty() ? b : a + "." + b;
+  }
 
  private:
   std::filesystem::path file_;
@@ -118,7 +123,8 @@ struct MeshLoad {
   bool guide;
 };
 
-void readObstacles(const Reader& r, const YAML::Node& node, Scene& scene, std::vector<MeshLoad>& loads) {
+void readObstacles(const Reader& r, const YAML::Node& node, Scene& scene,
+                   std::vector<MeshLoad>& loads) {
   if (!node.IsSequence() || node.size() == 0)
     r.fail(node, "obstacles", "expected a list of `- mesh: FILE` or `- impeller: {...}`");
   for (std::size_t i = 0; i < node.size(); ++i) {
@@ -136,7 +142,8 @@ void readObstacles(const Reader& r, const YAML::Node& node, Scene& scene, std::v
   }
 }
 
-void readGuide(const Reader& r, const YAML::Node& node, Scene& scene, std::vector<MeshLoad>& loads) {
+void readGuide(const Reader& r, const YAML::Node& node, Scene& scene,
+               std::vector<MeshLoad>& loads) {
   r.expectMap(node, "guide", {"mesh", "impeller"});
   if (node.size() != 1) r.fail(node, "guide", "expected exactly one of mesh, impeller");
   if (node["mesh"]) {
@@ -151,12 +158,13 @@ void readTool(const Reader& r, const YAML::Node& node, geometry::ToolSpec& tool)
   r.expectMap(node, "tool", {"shape", "radius", "corner_radius", "length"});
   if (node["shape"]) {
     const std::string shape = r.word(node["shape"], "tool.shape", {"ball", "torus", "flat"});
-    tool.shape = shape == "ball" ? geometry::ToolShape::Ball
+    tool.shape = shape == "ball"    ? geometry::ToolShape::Ball
                  : shape == "torus" ? geometry::ToolShape::Torus
                                     : geometry::ToolShape::Flat;
   }
   if (node["radius"]) tool.radius_mm = r.positive(node["radius"], "tool.radius");
-  if (node["corner_radius"]) tool.corner_radius_mm = r.positive(node["corner_radius"], "tool.corner_radius");
+  if (node["corner_radius"])
+    tool.corner_radius_mm = r.positive(node["corner_radius"], "tool.corner_radius");
   if (node["length"]) tool.length_mm = r.positive(node["length"], "tool.length");
   if (tool.shape == geometry::ToolShape::Torus && !node["corner_radius"])
     r.fail(node, "tool.corner_radius", "required for a torus tool");
@@ -175,44 +183,51 @@ void readHolder(const Reader& r, const YAML::Node& node, geometry::HolderProfile
 }
 
 void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
-  r.expectMap(node, "field", {"r0", "r_min", "gain", "sample_step", "weights", "voxel_size", "interpolation"});
+  r.expectMap(node, "field",
+              {"r0", "r_min", "gain", "sample_step", "weights", "voxel_size", "interpolation"});
   if (node["r0"]) f.r0_mm = r.positive(node["r0"], "field.r0");
   if (node["r_min"]) f.r_min_mm = r.positive(node["r_min"], "field.r_min");
   if (!(f.r_min_mm < f.r0_mm)) {
     const YAML::Node at = node["r_min"] ? node["r_min"] : node["r0"];
-    r.fail(at, "field.r_min", "must be < r0 (r_min " + std::to_string(f.r_min_mm) + ", r0 " +
-                                  std::to_string(f.r0_mm) + ")");
+    r.fail(at, "field.r_min",
+           "must be < r0 (r_min " + std::to_string(f.r_min_mm) + ", r0 " + std::to_string(f.r0_mm) +
+               ")");
   }
   if (node["gain"]) f.gain = r.number(node["gain"], "field.gain");
   if (node["sample_step"]) f.sample_step_mm = r.positive(node["sample_step"], "field.sample_step");
   if (node["weights"])
-    f.weights = r.word(node["weights"], "field.weights", {"area", "unit"}) == "area" ? field::Weights::Area
-                                                                                      : field::Weights::Unit;
+    f.weights = r.word(node["weights"], "field.weights", {"area", "unit"}) == "area"
+                    ? field::Weights::Area
+                    : field::Weights::Unit;
   if (node["voxel_size"]) f.voxel_size_mm = r.positive(node["voxel_size"], "field.voxel_size");
   if (node["interpolation"])
-    f.interpolation = r.word(node["interpolation"], "field.interpolation", {"trilinear", "quadratic"}) == "trilinear"
+    f.interpolation = r.word(node["interpolation"], "field.interpolation",
+                             {"trilinear", "quadratic"}) == "trilinear"
                           ? field::Interpolation::Trilinear
                           : field::Interpolation::Quadratic;
 }
 
 void readDynamics(const Reader& r, const YAML::Node& node, dynamics::DynamicsParams& d) {
-  r.expectMap(node, "dynamics", {"inertia", "damping", "stiffness", "feed", "rtol", "atol", "max_tilt_deg",
-                                 "max_lead_deg", "integrator"});
+  r.expectMap(node, "dynamics",
+              {"inertia", "damping", "stiffness", "feed", "rtol", "atol", "max_tilt_deg",
+               "max_lead_deg", "integrator"});
   if (node["inertia"]) d.inertia = r.positive(node["inertia"], "dynamics.inertia");
   if (node["damping"]) {
     if (node["damping"].IsScalar() && node["damping"].Scalar() == "critical")
       d.damping = -1.0;
     else
-      d.damping = r.number(node["damping"], "dynamics.damping", [](double v) { return v >= 0.0; },
-                           ">= 0 or `critical`");
+      d.damping = r.number(
+          node["damping"], "dynamics.damping", [](double v) { return v >= 0.0; },
+          ">= 0 or `critical`");
   }
   if (node["stiffness"]) d.stiffness = r.positive(node["stiffness"], "dynamics.stiffness");
   if (node["feed"]) d.feed_mm_per_min = r.positive(node["feed"], "dynamics.feed");
   if (node["rtol"]) d.rtol = r.positive(node["rtol"], "dynamics.rtol");
   if (node["atol"]) d.atol = r.positive(node["atol"], "dynamics.atol");
   auto angle = [&](const char* key) {
-    return r.number(node[key], std::string("dynamics.") + key, [](double v) { return v > 0.0 && v < 90.0; },
-                    "in (0, 90)");
+    return r.number(
+        node[key], std::string("dynamics.") + key, [](double v) { return v > 0.0 && v < 90.0; },
+        "in (0, 90)");
   };
   if (node["max_tilt_deg"]) d.max_tilt_deg = angle("max_tilt_deg");
   if (node["max_lead_deg"]) d.max_lead_deg = angle("max_lead_deg");
@@ -225,15 +240,16 @@ void readDynamics(const Reader& r, const YAML::Node& node, dynamics::DynamicsPar
 void readPath(const Reader& r, const YAML::Node& node, pathgen::PathParams& p) {
   r.expectMap(node, "path", {"passes", "step", "lead_deg"});
   if (node["passes"]) {
-    const double passes = r.number(node["passes"], "path.passes",
-                                   [](double v) { return v >= 1.0 && v == std::floor(v) && v <= 1e6; },
-                                   "a whole number >= 1");
+    const double passes = r.number(
+        node["passes"], "path.passes",
+        [](double v) { return v >= 1.0 && v == std::floor(v) && v <= 1e6; }, "a whole number >= 1");
     p.passes = static_cast<int>(passes);
   }
   if (node["step"]) p.step_mm = r.positive(node["step"], "path.step");
   if (node["lead_deg"])
-    p.lead_deg = r.number(node["lead_deg"], "path.lead_deg", [](double v) { return std::abs(v) < 90.0; },
-                          "in (-90, 90)");
+    p.lead_deg = r.number(
+        node["lead_deg"], "path.lead_deg", [](double v) { return std::abs(v) < 90.0; },
+        "in (-90, 90)");
 }
 
 }  // namespace
@@ -246,13 +262,15 @@ Scene loadScene(const std::filesystem::path& file) {
   try {
     root = YAML::LoadFile(file.string());
   } catch (const YAML::ParserException& e) {
-    throw InputError(file.string() + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax: " + e.msg);
+    throw InputError(file.string() + ":" + std::to_string(e.mark.line + 1) +
+                     ": YAML syntax: " + e.msg);
   } catch (const YAML::Exception& e) {
     throw InputError(file.string() + ": cannot read scene file: " + e.msg);
   }
   const Reader r(file);
   if (!root.IsMap()) r.fail(root, "scene", "expected a map of keys (obstacles, guide, tool, ...)");
-  r.expectMap(root, "", {"obstacles", "guide", "tool", "holder", "clearance", "field", "dynamics", "path"});
+  r.expectMap(root, "",
+              {"obstacles", "guide", "tool", "holder", "clearance", "field", "dynamics", "path"});
 
   Scene scene;
   scene.file = file;
@@ -263,7 +281,8 @@ Scene loadScene(const std::filesystem::path& file) {
   if (root["tool"]) readTool(r, root["tool"], scene.tool);
   if (root["holder"]) readHolder(r, root["holder"], scene.holder);
   if (root["clearance"])
-    scene.clearance_mm = r.number(root["clearance"], "clearance", [](double v) { return v >= 0.0; }, ">= 0");
+    scene.clearance_mm = r.number(
+        root["clearance"], "clearance", [](double v) { return v >= 0.0; }, ">= 0");
   if (root["field"]) readField(r, root["field"], scene.field);
   if (root["dynamics"]) readDynamics(r, root["dynamics"], scene.dynamics);
   if (root["path"]) readPath(r, root["path"], scene.path);

@@ -37,12 +37,12 @@ struct Scene {
   /// Filled by resolveImpeller.
   std::optional<pathgen::Impeller> impeller_model;
 
-  geometry::ToolSpec tool;                    ///< `tool:`
-  geometry::HolderProfile holder;             ///< `holder:` [[z, radius], ...]
-  double clearance_mm = 0.5;                  ///< `clearance:` tool+holder ↔ obstacles, mm
-  field::FieldParams field;                   ///< `field:`
-  dynamics::DynamicsParams dynamics;          ///< `dynamics:`
-  pathgen::PathParams path;                   ///< `path:`
+  geometry::ToolSpec tool;            ///< `tool:`
+  geometry::HolderProfile holder;     ///< `holder:` [[z, radius], ...]
+  double clearance_mm = 0.5;          ///< `clearance:` tool+holder ↔ obstacles, mm
+  field::FieldParams field;           ///< `field:`
+  dynamics::DynamicsParams dynamics;  ///< `dynamics:`
+  pathgen::PathParams path;           ///< `path:`
 };
 
 /// Reads `file`, checks every key and value, loads the mesh files and, where the scene names the

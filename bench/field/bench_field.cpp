@@ -9,9 +9,9 @@
 ///   bench_field [--repeats N] [--points N] [--quick]
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <functional>
 #include <random>
 #include <string>
@@ -40,7 +40,8 @@ Times measure(const std::function<void()>& work) {
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c0);
   const auto start = std::chrono::steady_clock::now();
   work();
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c1);
   return {wall, (c1.tv_sec - c0.tv_sec) + 1e-9 * (c1.tv_nsec - c0.tv_nsec)};
 }
@@ -83,7 +84,8 @@ BandPoints bandPoints(const field::ObstacleSamples& s, const field::FieldParams&
       if (d2 < best) best = d2, nearest = j;
     }
     const double d = std::sqrt(best);
-    if (d >= 0.5 && d <= p.r0_mm - 0.5 && (x - s.points_mm[nearest]).dot(s.normals[nearest]) > 0.0) {
+    if (d >= 0.5 && d <= p.r0_mm - 0.5 &&
+        (x - s.points_mm[nearest]).dot(s.normals[nearest]) > 0.0) {
       out.points.push_back(x);
       out.distance_mm.push_back(d);
     }
@@ -100,8 +102,8 @@ std::vector<std::vector<Vec3>> toolNodeBatches(int postures) {
   for (int i = 0; i <= 8; ++i)  // hemisphere, rings of latitude
     for (int j = 0; j < 24; ++j) {
       const double lat = 0.5 * M_PI * i / 8, lon = 2 * M_PI * j / 24;
-      tool.emplace_back(radius * std::sin(lat) * std::cos(lon), radius * std::sin(lat) * std::sin(lon),
-                        radius * (1 - std::cos(lat)));
+      tool.emplace_back(radius * std::sin(lat) * std::cos(lon),
+                        radius * std::sin(lat) * std::sin(lon), radius * (1 - std::cos(lat)));
       if (i == 0) break;
     }
   for (int k = 1; k <= 14; ++k)  // shank rings up to 40 mm
@@ -137,9 +139,12 @@ int main(int argc, char** argv) {
   std::size_t n_points = 200000;
   bool quick = false;
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc) repeats = std::atoi(argv[++i]);
-    else if (!std::strcmp(argv[i], "--points") && i + 1 < argc) n_points = std::strtoul(argv[++i], nullptr, 10);
-    else if (!std::strcmp(argv[i], "--quick")) quick = true, repeats = 1, n_points = 20000;
+    if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc)
+      repeats = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--points") && i + 1 < argc)
+      n_points = std::strtoul(argv[++i], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--quick"))
+      quick = true, repeats = 1, n_points = 20000;
     else {
       std::fprintf(stderr, "usage: bench_field [--repeats N] [--points N] [--quick]\n");
       return 1;
@@ -147,22 +152,27 @@ int main(int argc, char** argv) {
   }
   const int cores = tbb::info::default_concurrency();
 
-  field::FieldParams params;  // r0 5, r_min 0.25, area weights
+  field::FieldParams params;    // r0 5, r_min 0.25, area weights
   params.sample_step_mm = 2.0;  // the walls' 4 mm triangles split in 4: ≈1.4 mm apart
   const auto walls = bench::twistedWalls();
   const Eigen::AlignedBox3d region = bench::wallsRegion();
-  const field::ObstacleSamples samples = field::sampleObstacles(walls, params.sample_step_mm, params.weights);
-  std::printf("# bench_field: two twisted walls, %zu samples (sample_step %.1f mm, %.0f mm²), region %.0f cm³, "
-              "r0 %.1f mm, r_min %.2f mm, %d threads, medians of %d runs, load average at start %s\n\n",
-              samples.size(), params.sample_step_mm, samples.area_mm2, region.volume() / 1000.0,
-              params.r0_mm, params.r_min_mm, cores, repeats, loadAverage().c_str());
+  const field::ObstacleSamples samples =
+      field::sampleObstacles(walls, params.sample_step_mm, params.weights);
+  std::printf(
+      "# bench_field: two twisted walls, %zu samples (sample_step %.1f mm, %.0f mm²), region %.0f "
+      "cm³, "
+      "r0 %.1f mm, r_min %.2f mm, %d threads, medians of %d runs, load average at start %s\n\n",
+      samples.size(), params.sample_step_mm, samples.area_mm2, region.volume() / 1000.0,
+      params.r0_mm, params.r_min_mm, cores, repeats, loadAverage().c_str());
 
   const field::DirectField direct(samples, params);
   const field::BruteForceField brute(samples, params);
 
   // ---- build ------------------------------------------------------------------------------
   std::printf("## Voxel build (trilinear; only the reachable region is built)\n\n");
-  std::printf("| h (mm) | build wall (s) | build CPU (s) | estimate | active nodes | region box nodes | active / box | memory (MiB) |\n");
+  std::printf(
+      "| h (mm) | build wall (s) | build CPU (s) | estimate | active nodes | region box nodes | "
+      "active / box | memory (MiB) |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
   for (double h : {2.0, 1.0, 0.5, 0.25}) {
     if (quick && h < 0.5) continue;
@@ -170,12 +180,13 @@ int main(int argc, char** argv) {
     request.voxel_size_mm = h;
     request.region_mm = region;
     field::VoxelStats stats;
-    const Times t = medianTimes(repeats, [&] { stats = field::VoxelField(direct, request).stats(); });
+    const Times t =
+        medianTimes(repeats, [&] { stats = field::VoxelField(direct, request).stats(); });
     const Vec3 nodes = (region.sizes() / h).array().floor() + 1.0;
     const double box_nodes = nodes.prod();
-    std::printf("| %.2f | %.3f | %.3f | %zu | %zu | %.0f | %.2f %% | %.1f |\n", h, t.wall_s, t.cpu_s,
-                stats.estimated_nodes, stats.active_nodes, box_nodes, 100.0 * stats.active_nodes / box_nodes,
-                stats.memory_bytes / 1048576.0);
+    std::printf("| %.2f | %.3f | %.3f | %zu | %zu | %.0f | %.2f %% | %.1f |\n", h, t.wall_s,
+                t.cpu_s, stats.estimated_nodes, stats.active_nodes, box_nodes,
+                100.0 * stats.active_nodes / box_nodes, stats.memory_bytes / 1048576.0);
   }
 
   // ---- rates ------------------------------------------------------------------------------
@@ -202,15 +213,17 @@ int main(int argc, char** argv) {
     return Rate{name, n / t.wall_s, n / t.cpu_s};
   };
   std::vector<Vec3> brute_forces(n_brute);
-  random_rates.push_back(rate("brute force (every sample)", n_brute,
-                              medianTimes(repeats, [&] { brute.evaluate(brute_points, brute_forces); })));
+  random_rates.push_back(rate("brute force (every sample)", n_brute, medianTimes(repeats, [&] {
+                                brute.evaluate(brute_points, brute_forces);
+                              })));
   random_rates.push_back(rate("direct (PointIndexGrid, r0)", points.size(),
                               medianTimes(repeats, [&] { direct.evaluate(points, forces); })));
   tool_rates.push_back(rate("direct (PointIndexGrid, r0)", n_tool,
                             medianTimes(repeats, [&] { evaluateBatches(direct); })));
 
   // ---- voxel variants: rates and errors -----------------------------------------------------
-  const std::vector<std::pair<double, double>> buckets{{0.5, 1.0}, {1.0, 2.0}, {2.0, 4.5}, {0.5, 4.5}};
+  const std::vector<std::pair<double, double>> buckets{
+      {0.5, 1.0}, {1.0, 2.0}, {2.0, 4.5}, {0.5, 4.5}};
   std::vector<std::string> error_rows;
   for (double h : quick ? std::vector<double>{0.5} : std::vector<double>{2.0, 1.0, 0.5, 0.25}) {
     for (auto interpolation : {field::Interpolation::Trilinear, field::Interpolation::Quadratic}) {
@@ -222,13 +235,16 @@ int main(int argc, char** argv) {
       char name[64];
       std::snprintf(name, sizeof name, "voxel h %.2f %s", h,
                     interpolation == field::Interpolation::Trilinear ? "trilinear" : "quadratic");
-      random_rates.push_back(rate(name, points.size(), medianTimes(repeats, [&] { voxel.evaluate(points, forces); })));
-      tool_rates.push_back(rate(name, n_tool, medianTimes(repeats, [&] { evaluateBatches(voxel); })));
+      random_rates.push_back(
+          rate(name, points.size(), medianTimes(repeats, [&] { voxel.evaluate(points, forces); })));
+      tool_rates.push_back(
+          rate(name, n_tool, medianTimes(repeats, [&] { evaluateBatches(voxel); })));
       std::string row = std::string("| ") + name;
       for (const auto& [lo, hi] : buckets) {
         std::vector<Vec3> a, b;
         for (std::size_t i = 0; i < points.size(); ++i)
-          if (band.distance_mm[i] >= lo && band.distance_mm[i] < hi) a.push_back(forces[i]), b.push_back(exact[i]);
+          if (band.distance_mm[i] >= lo && band.distance_mm[i] < hi)
+            a.push_back(forces[i]), b.push_back(exact[i]);
         const field::FieldError e = field::relativeError(a, b, 0.0);
         char cell[64];
         std::snprintf(cell, sizeof cell, " | %.1e / %.1e", e.max_relative, e.rms_relative);
@@ -238,28 +254,38 @@ int main(int argc, char** argv) {
     }
   }
 
-  auto printRates = [&](const char* title, const std::vector<Rate>& rates, const Rate& brute_rate, const Rate& direct_rate) {
+  auto printRates = [&](const char* title, const std::vector<Rate>& rates, const Rate& brute_rate,
+                        const Rate& direct_rate) {
     std::printf("\n## %s\n\n", title);
-    std::printf("| evaluator | M/s (wall) | M per CPU-s | × %d cores | × brute force | × direct |\n", cores);
+    std::printf(
+        "| evaluator | M/s (wall) | M per CPU-s | × %d cores | × brute force | × direct |\n",
+        cores);
     std::printf("|---|---|---|---|---|---|\n");
     for (const Rate& r : rates)
       std::printf("| %s | %.3f | %.3f | %.2f | %.1f | %.2f |\n", r.name.c_str(), r.wall_per_s / 1e6,
                   r.cpu_per_s / 1e6, cores * r.cpu_per_s / 1e6, r.cpu_per_s / brute_rate.cpu_per_s,
                   r.cpu_per_s / direct_rate.cpu_per_s);
   };
-  printRates(("Evaluation at " + std::to_string(points.size()) +
-              " random points of the band (brute force on the first " + std::to_string(n_brute) + ")").c_str(),
-             random_rates, random_rates[0], random_rates[1]);
-  printRates(("Evaluation at the nodes of a tool moving down the channel (" + std::to_string(batches.size()) +
-              " postures × " + std::to_string(batches.front().size()) + " nodes, one call a posture)").c_str(),
+  printRates(
+      ("Evaluation at " + std::to_string(points.size()) +
+       " random points of the band (brute force on the first " + std::to_string(n_brute) + ")")
+          .c_str(),
+      random_rates, random_rates[0], random_rates[1]);
+  printRates(("Evaluation at the nodes of a tool moving down the channel (" +
+              std::to_string(batches.size()) + " postures × " +
+              std::to_string(batches.front().size()) + " nodes, one call a posture)")
+                 .c_str(),
              tool_rates, random_rates[0], tool_rates[0]);
 
   const field::FieldError brute_error =
       field::relativeError(brute_forces, std::span<const Vec3>(exact.data(), n_brute), 0.0);
-  std::printf("\n## Relative error against the direct field at the random band points (max / RMS), by distance to the nearest sample\n\n");
-  std::printf("brute force against direct: max %.1e, RMS %.1e (rounding only)\n\n", brute_error.max_relative,
-              brute_error.rms_relative);
-  std::printf("| variant | 0.5-1 mm | 1-2 mm | 2-4.5 mm | all (0.5-4.5 mm) |\n|---|---|---|---|---|\n");
+  std::printf(
+      "\n## Relative error against the direct field at the random band points (max / RMS), by "
+      "distance to the nearest sample\n\n");
+  std::printf("brute force against direct: max %.1e, RMS %.1e (rounding only)\n\n",
+              brute_error.max_relative, brute_error.rms_relative);
+  std::printf(
+      "| variant | 0.5-1 mm | 1-2 mm | 2-4.5 mm | all (0.5-4.5 mm) |\n|---|---|---|---|---|\n");
   for (const auto& row : error_rows) std::printf("%s\n", row.c_str());
   return 0;
 }

@@ -14,7 +14,8 @@ namespace fieldpath::bench {
 
 inline geometry::TriangleMesh twistedWall(double side, double grid_mm = 4.0) {
   constexpr double kLength = 90.0, kHeight = 45.0, kHalfGap = 20.0, kTwist = 15.0 * M_PI / 180.0;
-  const int nu = static_cast<int>(std::ceil(kLength / grid_mm)), nv = static_cast<int>(std::ceil(kHeight / grid_mm));
+  const int nu = static_cast<int>(std::ceil(kLength / grid_mm)),
+            nv = static_cast<int>(std::ceil(kHeight / grid_mm));
   geometry::TriangleMesh m;
   for (int i = 0; i <= nu; ++i)
     for (int j = 0; j <= nv; ++j) {
@@ -37,7 +38,9 @@ inline geometry::TriangleMesh twistedWall(double side, double grid_mm = 4.0) {
   return m;
 }
 
-inline std::vector<geometry::TriangleMesh> twistedWalls() { return {twistedWall(+1.0), twistedWall(-1.0)}; }
+inline std::vector<geometry::TriangleMesh> twistedWalls() {
+  return {twistedWall(+1.0), twistedWall(-1.0)};
+}
 
 inline Eigen::AlignedBox3d wallsRegion() {
   return Eigen::AlignedBox3d(Eigen::Vector3d(-55, -30, -10), Eigen::Vector3d(55, 30, 90));

@@ -19,7 +19,8 @@ void validate(const FieldParams& p) {
     throw common::InputError("field." + key + ": " + why + " (got " + std::to_string(got) + ")");
   };
   if (!(p.r0_mm > 0.0) || !std::isfinite(p.r0_mm)) bad("r0", "must be > 0", p.r0_mm);
-  if (!(p.r_min_mm > 0.0) || !(p.r_min_mm < p.r0_mm)) bad("r_min", "must be in (0, r0)", p.r_min_mm);
+  if (!(p.r_min_mm > 0.0) || !(p.r_min_mm < p.r0_mm))
+    bad("r_min", "must be in (0, r0)", p.r_min_mm);
   if (!std::isfinite(p.gain)) bad("gain", "must be finite", p.gain);
   if (!(p.sample_step_mm > 0.0) || !std::isfinite(p.sample_step_mm))
     bad("sample_step", "must be > 0", p.sample_step_mm);
@@ -61,7 +62,9 @@ void DirectField::evaluate(std::span<const Vec3> points_mm, std::span<Vec3> forc
   const Index& index = *index_;
   parallelOverPoints(
       points_mm.size(), [&] { return index.searcher(); },
-      [&](std::size_t i, Index::Searcher& s) { forces[i] = index.fieldAt(s, points_mm[i]).value_or(Vec3::Zero()); });
+      [&](std::size_t i, Index::Searcher& s) {
+        forces[i] = index.fieldAt(s, points_mm[i]).value_or(Vec3::Zero());
+      });
 }
 
 BruteForceField::BruteForceField(ObstacleSamples samples, const FieldParams& params)

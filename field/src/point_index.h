@@ -31,16 +31,18 @@ struct SamplePositions {
 /// Runs fn(i, state) for every query index, in parallel (TBB) when there are at least
 /// `serial_below` of them, with one state per task.
 template <class MakeState, class Fn>
-void parallelOverPoints(std::size_t n, MakeState&& make_state, Fn&& fn, std::size_t serial_below = 64) {
+void parallelOverPoints(std::size_t n, MakeState&& make_state, Fn&& fn,
+                        std::size_t serial_below = 64) {
   if (n < serial_below) {
     auto state = make_state();
     for (std::size_t i = 0; i < n; ++i) fn(i, state);
     return;
   }
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, serial_below / 2 + 1), [&](const auto& range) {
-    auto state = make_state();
-    for (std::size_t i = range.begin(); i != range.end(); ++i) fn(i, state);
-  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, serial_below / 2 + 1),
+                    [&](const auto& range) {
+                      auto state = make_state();
+                      for (std::size_t i = range.begin(); i != range.end(); ++i) fn(i, state);
+                    });
 }
 
 inline void checkSpans(std::span<const Vec3> points, std::span<Vec3> forces) {
@@ -77,7 +79,8 @@ struct DirectField::Index {
   /// Calls fn(j) for every sample j in the world box [lo, hi] (and some a little beyond).
   template <class Fn>
   void forEachInBox(Searcher& s, const Vec3& lo, const Vec3& hi, Fn&& fn) const {
-    const openvdb::BBoxd box(openvdb::Vec3d(lo.x(), lo.y(), lo.z()), openvdb::Vec3d(hi.x(), hi.y(), hi.z()));
+    const openvdb::BBoxd box(openvdb::Vec3d(lo.x(), lo.y(), lo.z()),
+                             openvdb::Vec3d(hi.x(), hi.y(), hi.z()));
     s.iterator.worldSpaceSearchAndUpdate(box, s.accessor, positions, *transform);
     for (; s.iterator; ++s.iterator) fn(static_cast<std::size_t>(*s.iterator));
   }

@@ -11,7 +11,8 @@ namespace fieldpath::field {
 ObstacleSamples sampleObstacles(std::span<const geometry::TriangleMesh> meshes, double step_mm,
                                 Weights weights) {
   if (!(step_mm > 0.0) || !std::isfinite(step_mm))
-    throw common::InputError("field.sample_step: must be > 0 (got " + std::to_string(step_mm) + ")");
+    throw common::InputError("field.sample_step: must be > 0 (got " + std::to_string(step_mm) +
+                             ")");
   ObstacleSamples out;
   for (std::size_t m = 0; m < meshes.size(); ++m) {
     const auto& mesh = meshes[m];
@@ -27,8 +28,8 @@ ObstacleSamples sampleObstacles(std::span<const geometry::TriangleMesh> meshes, 
       if (!(area > 0.0)) continue;
       const Vec3 normal = cross.normalized();
       const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
-      const int n = std::max(
-          1, static_cast<int>(std::ceil(std::max(std::sqrt(area) / step_mm, longest / (1.5 * step_mm)))));
+      const int n = std::max(1, static_cast<int>(std::ceil(std::max(std::sqrt(area) / step_mm,
+                                                                    longest / (1.5 * step_mm)))));
       // Sub-triangles of the n×n split in barycentric steps e1 = (b-a)/n, e2 = (c-a)/n: "up" ones
       // have centroid a + (i + 1/3) e1 + (j + 1/3) e2 (i + j <= n-1), "down" ones
       // a + (i + 2/3) e1 + (j + 2/3) e2 (i + j <= n-2). All have area / n².

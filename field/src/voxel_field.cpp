@@ -61,7 +61,9 @@ std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams
   const Eigen::AlignedBox3d box = reachBox(samples, params, request);
   if (box.isEmpty()) return 0;
   // Nodes of the lattice i·h in [lo, hi] along one axis.
-  auto count = [h](double lo, double hi) { return std::max(0.0, std::floor(hi / h) - std::ceil(lo / h) + 1.0); };
+  auto count = [h](double lo, double hi) {
+    return std::max(0.0, std::floor(hi / h) - std::ceil(lo / h) + 1.0);
+  };
   double dense = 1.0;
   for (int a = 0; a < 3; ++a) dense *= count(box.min()[a], box.max()[a]);
   // Every built node lies within r0 of a sample, so in a cell (edge r0/2) at most two cells from
@@ -85,7 +87,8 @@ std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams
       const double lo = std::max(c[a] * cell_mm, box.min()[a]);
       const double hi = (c[a] + 1) * cell_mm;
       // half-open cell [lo, hi), except where the box's own (closed) end cuts it
-      nodes *= hi > box.max()[a] ? count(lo, box.max()[a]) : std::max(0.0, std::ceil(hi / h) - std::ceil(lo / h));
+      nodes *= hi > box.max()[a] ? count(lo, box.max()[a])
+                                 : std::max(0.0, std::ceil(hi / h) - std::ceil(lo / h));
     }
     cells += nodes;
   }
@@ -162,7 +165,8 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
 
   // Node values from the exact law, per leaf over the samples near it; in batches between
   // which the progress hook is called (from this thread only).
-  const std::size_t batches = std::max<std::size_t>(1, std::min<std::size_t>(20, leaves.size() / 64));
+  const std::size_t batches =
+      std::max<std::size_t>(1, std::min<std::size_t>(20, leaves.size() / 64));
   for (std::size_t batch = 0; batch < batches; ++batch) {
     const std::size_t begin = leaves.size() * batch / batches;
     const std::size_t end = leaves.size() * (batch + 1) / batches;
@@ -243,7 +247,8 @@ Vec3 trilinear(Grid::ConstAccessor& acc, const Vec3& p) {
       c[i] = acc.getValue(ijk.offsetBy(i & 4 ? 1 : 0, i & 2 ? 1 : 0, i & 1));
   }
   auto lerp = [](const openvdb::Vec3s& a, const openvdb::Vec3s& b, double w) {
-    return Vec3(a.x() + w * (b.x() - a.x()), a.y() + w * (b.y() - a.y()), a.z() + w * (b.z() - a.z()));
+    return Vec3(a.x() + w * (b.x() - a.x()), a.y() + w * (b.y() - a.y()),
+                a.z() + w * (b.z() - a.z()));
   };
   // c index bits: x (4), y (2), z (1)
   const Vec3 c00 = lerp(c[0], c[1], t.z()), c01 = lerp(c[2], c[3], t.z());

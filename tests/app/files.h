@@ -12,7 +12,8 @@ class TempDir {
  public:
   TempDir() {
     std::random_device rd;
-    path_ = std::filesystem::temp_directory_path() / ("fieldpath_app_" + std::to_string(rd()) + std::to_string(rd()));
+    path_ = std::filesystem::temp_directory_path() /
+            ("fieldpath_app_" + std::to_string(rd()) + std::to_string(rd()));
     std::filesystem::create_directories(path_);
   }
   ~TempDir() {
@@ -38,13 +39,14 @@ class TempDir {
 /// ASCII STL of the square [-a, a]² at height z, normal +z.
 inline std::string squareStl(double a, double z = 0.0) {
   auto v = [z](double x, double y) {
-    return "   vertex " + std::to_string(x) + " " + std::to_string(y) + " " + std::to_string(z) + "\n";
+    return "   vertex " + std::to_string(x) + " " + std::to_string(y) + " " + std::to_string(z) +
+           "\n";
   };
   auto facet = [](const std::string& a, const std::string& b, const std::string& c) {
     return " facet normal 0 0 1\n  outer loop\n" + a + b + c + "  endloop\n endfacet\n";
   };
-  return "solid square\n" + facet(v(-a, -a), v(a, -a), v(a, a)) + facet(v(-a, -a), v(a, a), v(-a, a)) +
-         "endsolid square\n";
+  return "solid square\n" + facet(v(-a, -a), v(a, -a), v(a, a)) +
+         facet(v(-a, -a), v(a, a), v(-a, a)) + "endsolid square\n";
 }
 
 }  // namespace fieldpath::app::test

@@ -31,8 +31,8 @@ std::string slurp(const std::filesystem::path& file) {
 /// Runs `fieldpath --quiet ARGS` in `dir`.
 Outcome runFieldpath(const TempDir& dir, const std::string& args) {
   const auto out = dir.path() / "stdout.txt", err = dir.path() / "stderr.txt";
-  const std::string command = "cd '" + dir.path().string() + "' && '" FIELDPATH_EXE "' --quiet " + args + " > '" +
-                              out.string() + "' 2> '" + err.string() + "'";
+  const std::string command = "cd '" + dir.path().string() + "' && '" FIELDPATH_EXE "' --quiet " +
+                              args + " > '" + out.string() + "' 2> '" + err.string() + "'";
   const int status = std::system(command.c_str());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
 }
@@ -46,7 +46,8 @@ std::size_t lines(const std::string& text) {
 /// A plane obstacle (z = 0, 16 × 16 mm: infinite for r0 = 5 at its middle) and its scene.
 void planeScene(const TempDir& dir, const std::string& field_keys = "") {
   dir.write("plane.stl", fieldpath::app::test::squareStl(8));
-  dir.write("scene.yaml", "obstacles:\n  - mesh: plane.stl\nfield:\n  sample_step: 0.5\n" + field_keys);
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: plane.stl\nfield:\n  sample_step: 0.5\n" + field_keys);
 }
 
 }  // namespace
@@ -91,7 +92,8 @@ TEST(CliField, BuildWritesTheVdbAndReportsNodes) {
   EXPECT_NE(run.out.find("build "), std::string::npos) << run.out;
   EXPECT_GT(std::filesystem::file_size(dir.path() / "out/field.vdb"), 1000u);
 
-  const Outcome refused = runFieldpath(dir, "field build scene.yaml --voxel 0.01 --max-memory 64 --out big.vdb");
+  const Outcome refused =
+      runFieldpath(dir, "field build scene.yaml --voxel 0.01 --max-memory 64 --out big.vdb");
   EXPECT_EQ(refused.exit_code, 1);
   EXPECT_NE(refused.err.find("estimated"), std::string::npos) << refused.err;
   EXPECT_EQ(lines(refused.err), 1u) << refused.err;

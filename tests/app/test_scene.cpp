@@ -85,7 +85,8 @@ path:
 TEST(Scene, DefaultsComeFromTheParamsStructs) {
   TempDir dir;
   dir.write("wall.stl", app::test::squareStl(5));
-  const app::Scene s = app::loadScene(dir.write("s.yaml", "obstacles:\n  - mesh: wall.stl\ndynamics: { damping: critical }\n"));
+  const app::Scene s = app::loadScene(
+      dir.write("s.yaml", "obstacles:\n  - mesh: wall.stl\ndynamics: { damping: critical }\n"));
   EXPECT_EQ(s.obstacles.size(), 1u);
   EXPECT_FALSE(s.guide.has_value());
   const field::FieldParams f;
@@ -137,12 +138,14 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
       {"obstacles:\n  - mesh: wall.stl\n    impeller: {}\n", "obstacles[1]", 2},
       {"field:\n  r0: 5\n", "obstacles", 0},
       {"obstacles: []\n", "obstacles", 1},
-      {"obstacles:\n  - mesh: wall.stl\ntool: { shape: torus, radius: 3 }\n", "tool.corner_radius", 3},
+      {"obstacles:\n  - mesh: wall.stl\ntool: { shape: torus, radius: 3 }\n", "tool.corner_radius",
+       3},
       {"obstacles:\n  - mesh: wall.stl\ntool: { shape: cone }\n", "tool.shape", 3},
       {"obstacles:\n  - mesh: wall.stl\nholder: [[40, 6], [30, 6]]\n", "holder", 3},
       {"obstacles:\n  - mesh: wall.stl\nholder: [[40, 6], [50]]\n", "holder[2]", 3},
       {"obstacles:\n  - mesh: wall.stl\nclearance: -0.1\n", "clearance", 3},
-      {"obstacles:\n  - mesh: wall.stl\ndynamics:\n  max_tilt_deg: 95\n", "dynamics.max_tilt_deg", 4},
+      {"obstacles:\n  - mesh: wall.stl\ndynamics:\n  max_tilt_deg: 95\n", "dynamics.max_tilt_deg",
+       4},
       {"obstacles:\n  - mesh: wall.stl\ndynamics:\n  integrator: rk4\n", "dynamics.integrator", 4},
       {"obstacles:\n  - mesh: wall.stl\npath:\n  passes: 2.5\n", "path.passes", 4},
       {"obstacles:\n  - mesh: wall.stl\nguide: { mesh: hub.stl }\n", "guide.mesh", 3},
@@ -154,10 +157,12 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
     ASSERT_FALSE(message.empty()) << c.yaml;
     EXPECT_EQ(message.rfind(file, 0), 0u) << message;  // starts with the file name
     EXPECT_NE(message.find(c.key), std::string::npos) << message;
-    if (c.line > 0) EXPECT_NE(message.find(":" + std::to_string(c.line) + ": "), std::string::npos) << message;
+    if (c.line > 0)
+      EXPECT_NE(message.find(":" + std::to_string(c.line) + ": "), std::string::npos) << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   }
-  EXPECT_NE(errorOf("obstacles:\n  - mesh: wall.stl\nfield: { r0: five }\n").find("five"), std::string::npos);
+  EXPECT_NE(errorOf("obstacles:\n  - mesh: wall.stl\nfield: { r0: five }\n").find("five"),
+            std::string::npos);
 }
 
 TEST(Scene, MissingSceneFile) {

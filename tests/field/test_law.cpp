@@ -169,11 +169,13 @@ TEST(Law, InsideAnObstacleTheForceIsFiniteAndOutward) {
   }
   // Deeper than r_min the field is mirrored out of the wall: even in the height.
   for (double depth : {0.3, 1.0, 2.0}) {
-    const Vec3 in = direct.at(Vec3(0.4, -0.3, 5.0 - depth)), out = direct.at(Vec3(0.4, -0.3, 5.0 + depth));
+    const Vec3 in = direct.at(Vec3(0.4, -0.3, 5.0 - depth)),
+               out = direct.at(Vec3(0.4, -0.3, 5.0 + depth));
     EXPECT_LT((in - out).norm(), 1e-12 * out.norm()) << depth;
   }
   // Continuous across the surface: just inside and just outside agree.
-  const Vec3 in = direct.at(Vec3(0.4, -0.3, 5.0 - 1e-7)), out = direct.at(Vec3(0.4, -0.3, 5.0 + 1e-7));
+  const Vec3 in = direct.at(Vec3(0.4, -0.3, 5.0 - 1e-7)),
+             out = direct.at(Vec3(0.4, -0.3, 5.0 + 1e-7));
   EXPECT_LT((in - out).norm(), 1e-4 * out.norm());
   // Exactly on a sample point: finite and along the outward normal.
   for (std::size_t j = 0; j < samples.size(); j += 97) {

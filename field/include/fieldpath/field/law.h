@@ -33,8 +33,8 @@ inline double phi(double r_mm, double r0_mm, double r_min_mm) {
   return (1.0 / r - 1.0 / r0_mm) / (r * r);
 }
 
-/// The contribution of one sample (eq. 1, without the surface rule): gain · w · φ(r) · u, world frame.
-/// u = (x - q)/r, or the sample's unit outward normal where x = q exactly.
+/// The contribution of one sample (eq. 1, without the surface rule): gain · w · φ(r) · u, world
+/// frame. u = (x - q)/r, or the sample's unit outward normal where x = q exactly.
 inline Vec3 sampleForce(const Vec3& x_mm, const Vec3& q_mm, const Vec3& normal, double weight,
                         const FieldParams& params) {
   const Vec3 d = x_mm - q_mm;

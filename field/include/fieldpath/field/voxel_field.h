@@ -33,8 +33,9 @@ struct VoxelRequest {
 struct VoxelStats {
   std::size_t estimated_nodes = 0;  ///< estimateVoxelNodes, before allocation
   std::size_t active_nodes = 0;     ///< nodes holding a value (the sparse grid)
-  std::size_t dense_box_nodes = 0;  ///< nodes of a dense grid over the bounding box of the active ones
-  std::size_t memory_bytes = 0;     ///< OpenVDB's memUsage of the grid
+  std::size_t dense_box_nodes =
+      0;                         ///< nodes of a dense grid over the bounding box of the active ones
+  std::size_t memory_bytes = 0;  ///< OpenVDB's memUsage of the grid
   double build_seconds = 0.0;
 };
 
