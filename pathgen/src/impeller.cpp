@@ -172,6 +172,12 @@ double Impeller::hubHeight(double x_mm, double y_mm) const {
   return p.hub_rise_mm * u * u - p.hub_dish_mm * (1.0 - eta * eta);
 }
 
+std::array<double, 2> Impeller::hubUV(double x_mm, double y_mm) const {
+  const double u = x_mm / params_.length_mm;
+  const double eta = (y_mm - params_.bend_mm * u * u) / halfWidth(u);
+  return {u, 0.5 * (eta + 1.0)};
+}
+
 Vec3 Impeller::hubNormalAt(double x_mm, double y_mm) const {
   const ImpellerParams& p = params_;
   const double u = x_mm / p.length_mm;

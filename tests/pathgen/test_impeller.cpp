@@ -120,3 +120,14 @@ TEST(Impeller, BadValuesNameTheirKey) {
   p.u_range = {0.6, 0.4};
   expectInputError(p, "impeller.u_range");
 }
+
+TEST(Impeller, HubUVInvertsTheParametrisation) {
+  const Impeller imp{ImpellerParams{}};
+  for (double u : {0.0, 0.4, 1.0})
+    for (double v : {0.1, 0.5, 0.95}) {
+      const Vec3 s = imp.hub(u, v);
+      const auto uv = imp.hubUV(s.x(), s.y());
+      EXPECT_NEAR(uv[0], u, 1e-12);
+      EXPECT_NEAR(uv[1], v, 1e-12);
+    }
+}

@@ -58,6 +58,8 @@ class Impeller {
   Vec3 hubNormal(double u, double v) const;
   /// Hub height h(x, y), mm; defined (extrapolated) beyond the blades too.
   double hubHeight(double x_mm, double y_mm) const;
+  /// Hub parameters (u, v) of the point above (x, y): the inverse of S in plan.
+  std::array<double, 2> hubUV(double x_mm, double y_mm) const;
   /// Unit hub normal at (x, y), from the gradient of h.
   Vec3 hubNormalAt(double x_mm, double y_mm) const;
   /// Blade point B(u, t); side 0 = left (v = 0), 1 = right (v = 1).
