@@ -33,6 +33,7 @@ class CpuEngine final : public BackendEngine {
     tool_.view.indices = tool_.indices.data();
     tool_.view.bin_start = tool_.bin_start.data();
     tool_.view.bin_items = tool_.bin_items.data();
+    tool_.view.radial_floor_mm = tool_.radial_floor.data();
     const std::size_t lines = std::size_t(grid.nx) * grid.ny;
     refresh_every_ = std::clamp<std::size_t>(lines / 8, 16384, std::size_t{1} << 24);
   }

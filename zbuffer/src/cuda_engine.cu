@@ -91,6 +91,7 @@ struct Engine::Impl {
   std::uint32_t* indices = nullptr;
   std::int32_t* bin_start = nullptr;
   std::int32_t* bin_items = nullptr;
+  float* radial_floor = nullptr;
   std::int32_t* keys = nullptr;
   float* tile_max = nullptr;
   unsigned long long* culled = nullptr;
@@ -102,7 +103,7 @@ struct Engine::Impl {
          {static_cast<void*>(nodes), static_cast<void*>(triangles), static_cast<void*>(vertices),
           static_cast<void*>(indices), static_cast<void*>(keys), static_cast<void*>(tile_max),
           static_cast<void*>(culled), static_cast<void*>(postures), static_cast<void*>(bin_start),
-          static_cast<void*>(bin_items)})
+          static_cast<void*>(bin_items), static_cast<void*>(radial_floor)})
       if (p) cudaFree(p);
   }
 };
@@ -119,6 +120,7 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   m.tool.indices = m.indices = deviceCopy(tool.indices, tool.index_count);
   m.tool.bin_start = m.bin_start = deviceCopy(tool.bin_start, tool.bin_start_count);
   m.tool.bin_items = m.bin_items = deviceCopy(tool.bin_items, tool.bin_item_count);
+  m.tool.radial_floor_mm = m.radial_floor = deviceCopy(tool.radial_floor, tool.radial_count);
   std::vector<std::int32_t> keys(lines);
   for (std::size_t i = 0; i < lines; ++i) {
     std::int32_t bits;

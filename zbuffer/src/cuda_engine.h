@@ -24,6 +24,8 @@ struct ToolArrays {
   std::size_t bin_start_count = 0;
   const std::int32_t* bin_items = nullptr;
   std::size_t bin_item_count = 0;
+  const float* radial_floor = nullptr;
+  std::size_t radial_count = 0;
 };
 
 bool available();

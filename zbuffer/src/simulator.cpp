@@ -198,6 +198,45 @@ void binDownFacing(ToolData& data, float pad) {
   }
   v.bin_start = data.bin_start.data();
   v.bin_items = data.bin_items.data();
+
+  // Radial floors: each down-facing triangle lowers the floor of every annulus its projection
+  // meets (one annulus of margin each side for the rounding of the line's radius).
+  float rmax = 0.f;
+  for (auto t : down)
+    for (int k = 0; k < 3; ++k) {
+      const float* p = data.bvh_triangles.data() + 9 * t + 3 * k;
+      rmax = std::max(rmax, std::sqrt(p[0] * p[0] + p[1] * p[1]));
+    }
+  const int rbins = 1024;
+  v.radial_max_mm = rmax * (1.f + 1e-5f) + pad;
+  v.radial_inv_mm = rbins / v.radial_max_mm;
+  data.radial_floor.assign(rbins, FLT_MAX);
+  for (auto t : down) {
+    const float* p = data.bvh_triangles.data() + 9 * t;
+    double rlo = 1e300, rhi = 0;
+    float zmin = std::min({p[2], p[5], p[8]});
+    for (int k = 0; k < 3; ++k) {
+      const double ax = p[3 * k], ay = p[3 * k + 1], bx = p[3 * ((k + 1) % 3)],
+                   by = p[3 * ((k + 1) % 3) + 1];
+      const double ex = bx - ax, ey = by - ay, len2 = ex * ex + ey * ey;
+      const double u = len2 > 0 ? std::clamp(-(ax * ex + ay * ey) / len2, 0.0, 1.0) : 0.0;
+      rlo = std::min(rlo, std::hypot(ax + u * ex, ay + u * ey));
+      rhi = std::max(rhi, std::hypot(ax, ay));
+    }
+    // origin inside the projection: the annulus starts at 0
+    const auto side = [&](int k) {
+      const int n = (k + 1) % 3;
+      return (p[3 * n] - p[3 * k]) * (0.0 - p[3 * k + 1]) -
+             (p[3 * n + 1] - p[3 * k + 1]) * (0.0 - p[3 * k]);
+    };
+    const double s0 = side(0), s1 = side(1), s2 = side(2);
+    if ((s0 >= 0 && s1 >= 0 && s2 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0)) rlo = 0;
+    const int b0 = std::max(0, static_cast<int>((rlo - pad) * v.radial_inv_mm) - 1);
+    const int b1 = std::min(rbins - 1, static_cast<int>((rhi + pad) * v.radial_inv_mm) + 1);
+    for (int b = b0; b <= b1; ++b) data.radial_floor[b] = std::min(data.radial_floor[b], zmin);
+  }
+  v.radial_floor_mm = data.radial_floor.data();
+  v.radial_bins = rbins;
 }
 
 }  // namespace

@@ -48,6 +48,12 @@ struct ToolView {
   std::int32_t bins = 0;                    ///< per side; 0: no bins
   const std::int32_t* bin_start = nullptr;  ///< bins²+1 offsets into bin_items
   const std::int32_t* bin_items = nullptr;  ///< leaf-order triangle indices
+  // Mesh tools, vertical postures: per annulus of radius about the axis, a floor (tool frame z, mm)
+  // below which no down-facing triangle lies; FLT_MAX where none does. Lets a vertical line that
+  // the tool cannot lower be skipped after one table look-up.
+  const float* radial_floor_mm = nullptr;
+  std::int32_t radial_bins = 0;
+  float radial_inv_mm = 0, radial_max_mm = 0;
 };
 
 /// Everything a posture needs, computed once per posture.
@@ -329,8 +335,19 @@ FIELDPATH_HD float meshEntry(const ToolView& tool, const PreparedPosture& pp, Ve
 /// `current_mm`. Analytic and mesh tools; -0 folded to +0 so that both backends store equal bits.
 FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
                            int ix, int iy, float current_mm) {
+  if (!(current_mm > pp.lowest_z_mm)) return FLT_MAX;
   float rx, ry;
   lineOffset(g, pp, ix, iy, rx, ry);
+  float floor_z = pp.lowest_z_mm;
+  if (pp.vertical && tool.radial_bins > 0) {
+    const float rho = sqrtf(rx * rx + ry * ry);
+    if (!(rho <= tool.radial_max_mm)) return FLT_MAX;
+    const int b = static_cast<int>(rho * tool.radial_inv_mm);
+    floor_z =
+        maxf(floor_z,
+             pp.tip_mm.z + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]);
+    if (!(current_mm > floor_z)) return FLT_MAX;
+  }
   const Vec3f o = mulTransposed(pp.rot, Vec3f{rx, ry, 0.f});
   float t;
   if (tool.kind == ToolKind::Mesh) {
@@ -340,7 +357,7 @@ FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const Prepar
     t = analyticEntry(tool, o, pp.dir);
   }
   if (t == FLT_MAX) return FLT_MAX;
-  const float h = maxf(pp.tip_mm.z + t, pp.lowest_z_mm) + 0.f;
+  const float h = maxf(pp.tip_mm.z + t, floor_z) + 0.f;
   return h < current_mm ? h : FLT_MAX;
 }
 

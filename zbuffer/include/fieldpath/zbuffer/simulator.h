@@ -114,6 +114,7 @@ struct ToolData {
   std::vector<Vec3f> vertices;
   std::vector<std::uint32_t> indices;
   std::vector<std::int32_t> bin_start, bin_items;
+  std::vector<float> radial_floor;
 };
 ToolData prepareTool(const Tool& tool);
 GridView makeGridView(const Grid& grid);
