@@ -12,7 +12,7 @@
 
 namespace fieldpath::bench {
 
-inline geometry::TriangleMesh twistedWall(double side, double grid_mm = 4.0) {
+inline geometry::TriangleMesh twistedWall(double side, double grid_mm = 3.6) {
   constexpr double kLength = 90.0, kHeight = 45.0, kHalfGap = 20.0, kTwist = 15.0 * M_PI / 180.0;
   const int nu = static_cast<int>(std::ceil(kLength / grid_mm)),
             nv = static_cast<int>(std::ceil(kHeight / grid_mm));

@@ -52,6 +52,15 @@ std::string mib(double bytes) {
   return text;
 }
 
+/// Index coordinates must fit OpenVDB's 32-bit Coord with room to spare.
+void checkExtent(const Eigen::AlignedBox3d& box, double cell_mm, const char* what) {
+  if (box.isEmpty()) return;
+  const double reach = std::max(box.min().cwiseAbs().maxCoeff(), box.max().cwiseAbs().maxCoeff());
+  if (reach / cell_mm > 1e9)
+    throw common::InputError(std::string(what) + " too small for the scene's extent (" +
+                             std::to_string(reach) + " mm from the origin)");
+}
+
 }  // namespace
 
 std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams& params,
@@ -69,6 +78,10 @@ std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams
   // Every built node lies within r0 of a sample, so in a cell (edge r0/2) at most two cells from
   // one holding a sample: count the nodes of those cells (clipped to the box) on a coarse mask.
   const double cell_mm = 0.5 * params.r0_mm;
+  checkExtent(box, h, "voxel size");
+  Eigen::AlignedBox3d all;
+  for (const Vec3& q : samples.points_mm) all.extend(q);
+  checkExtent(all, cell_mm, "field.r0");
   auto mask = openvdb::MaskGrid::create(false);
   {
     auto acc = mask->getAccessor();

@@ -88,6 +88,9 @@ TEST(Voxel, RefusesBeyondTheMemoryLimitWithTheEstimate) {
         << what;
   }
   EXPECT_THROW(VoxelField(direct, request(0.0)), fieldpath::common::InputError);
+  VoxelRequest tiny = request(1e-9);  // index coordinates beyond 32 bits
+  tiny.max_memory_bytes = std::size_t(-1);
+  EXPECT_THROW(VoxelField(direct, tiny), fieldpath::common::InputError);
   EXPECT_THROW(VoxelField(direct, request(-1.0)), fieldpath::common::InputError);
 }
 
