@@ -8,16 +8,31 @@ bool cudaAvailable() { return cuda::available(); }
 
 namespace detail {
 namespace {
+cuda::ToolArrays arrays(const ToolData& tool) {
+  cuda::ToolArrays a;
+  a.view = tool.view;
+  a.nodes = tool.bvh_nodes.data();
+  a.node_count = tool.bvh_nodes.size();
+  a.triangles = tool.bvh_triangles.data();
+  a.triangle_floats = tool.bvh_triangles.size();
+  a.vertices = tool.vertices.data();
+  a.vertex_count = tool.vertices.size();
+  a.indices = tool.indices.data();
+  a.index_count = tool.indices.size();
+  a.bin_start = tool.bin_start.data();
+  a.bin_start_count = tool.bin_start.size();
+  a.bin_items = tool.bin_items.data();
+  a.bin_item_count = tool.bin_items.size();
+  a.radial_floor = tool.radial_floor.data();
+  a.radial_count = tool.radial_floor.size();
+  return a;
+}
+
 class CudaAdapter final : public BackendEngine {
  public:
   CudaAdapter(const GridView& grid, const ToolData& tool, const std::vector<float>& heights)
-      : lines_(heights.size()),
-        engine_(grid,
-                cuda::ToolArrays{tool.view, tool.bvh_nodes.data(), tool.bvh_nodes.size(),
-                                 tool.bvh_triangles.data(), tool.bvh_triangles.size(),
-                                 tool.vertices.data(), tool.vertices.size(), tool.indices.data(),
-                                 tool.indices.size()},
-                heights.data(), heights.size()) {}
+      : lines_(heights.size()), engine_(grid, arrays(tool), heights.data(), heights.size()) {}
+
   std::size_t cut(std::span<const Posture> block, Engine engine) override {
     return engine_.cut(block.data(), block.size(), engine == Engine::Coarse);
   }
