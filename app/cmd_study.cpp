@@ -1,11 +1,78 @@
+/// fieldpath study SCENE --voxels 2,1,0.5 --out DIR: speed against error of the voxel field
+/// (seed 004 Tables 1–2, Figs. 5–6); the work is in study.h.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
 #include "commands.h"
 #include "errors.h"
+#include "impeller_job.h"
+#include "progress.h"
+#include "scene.h"
+#include "study.h"
 
 namespace fieldpath::app {
+namespace {
 
-void addStudyCommand(CLI::App& app, const GlobalOptions& /*global*/) {
-  auto* cmd = app.add_subcommand("study", "(not yet implemented)");
-  cmd->callback([] { throw InputError("'study' is not implemented yet"); });
+struct StudyOptions {
+  std::string scene;
+  std::string voxels = "2,1,0.5";
+  std::string interpolations = "trilinear,quadratic";
+  bool no_brute_force = false;
+  double line_step_mm = 0.05;
+  std::string out;
+};
+
+void run(const StudyOptions& o, const GlobalOptions& global, const std::string& command_line) {
+  StudyRequest request;
+  request.voxel_sizes_mm = parseVoxelSizes(o.voxels, "--voxels");
+  request.interpolations = parseInterpolations(o.interpolations, "--interp");
+  request.brute_force = !o.no_brute_force;
+  request.line_step_mm = o.line_step_mm;
+  request.job = impellerJob(loadScene(o.scene));
+  request.progress = makeProgressLine(global.quiet);
+  const StudyResult result = runStudy(request);
+  const std::filesystem::path dir = o.out;
+  writeStudy(result, dir, command_line, "");
+  std::string message;
+  if (!plotStudy(dir, &message)) std::fprintf(stderr, "fieldpath study: %s\n", message.c_str());
+
+  std::printf("%-26s %10s %9s %9s %9s %9s %10s %9s\n", "variant", "nodes", "total_s", "x_direct",
+              "force_%", "nodes_%", "tilt_deg", "clear_mm");
+  for (const StudyRow& row : result.rows)
+    std::printf("%-26s %10zu %9.3f %9.2f %9.3f %9.3f %10.4f %9.3f\n", row.variant.name().c_str(),
+                row.active_nodes, row.total_s, row.speedup_vs_direct,
+                100 * std::max(row.line_a.relative.max_relative, row.line_b.relative.max_relative),
+                100 * row.nodes.relative.max_relative, row.tilt_max_deg, row.min_clearance_mm);
+  std::printf("study: %s\n", (dir / "study.md").string().c_str());
+}
+
+}  // namespace
+
+void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
+  auto options = std::make_shared<StudyOptions>();
+  auto* cmd = app.add_subcommand(
+      "study", "Speed against error of the voxel field on the impeller job (seed 004 Tables 1-2)");
+  cmd->add_option("scene", options->scene, "Scene file (YAML) with the impeller")->required();
+  cmd->add_option("--voxels", options->voxels, "Voxel sizes, mm, comma-separated")
+      ->capture_default_str();
+  cmd->add_option("--interp", options->interpolations,
+                  "Interpolations: trilinear, quadratic or both, comma-separated")
+      ->capture_default_str();
+  cmd->add_flag("--no-brute-force", options->no_brute_force,
+                "Skip the every-point direct sum (slow on large scenes)");
+  cmd->add_option("--line-step", options->line_step_mm, "Sampling of the study lines, mm")
+      ->capture_default_str();
+  cmd->add_option("--out", options->out, "Output folder")->required();
+  cmd->callback([options, &global] {
+    std::string command_line = "fieldpath study " + options->scene + " --voxels " +
+                               options->voxels + " --interp " + options->interpolations +
+                               (options->no_brute_force ? " --no-brute-force" : "") + " --out " +
+                               options->out;
+    run(*options, global, command_line);
+  });
 }
 
 }  // namespace fieldpath::app

@@ -246,9 +246,21 @@ StudyResult runStudy(const StudyRequest& request) {
       job.field.interpolation = variants[i].interpolation;
     }
     job.progress = scaled(request.progress, share(i), share(i + 1), variants[i].name());
-    runs.push_back(pathgen::generateImpellerPath(job));
     StudyRow row;
     row.variant = variants[i];
+    try {
+      runs.push_back(pathgen::generateImpellerPath(job));
+    } catch (const InputError& e) {
+      // An approximate field may steer the axis out of the scene's limits: that is a result.
+      if (variants[i].mode == pathgen::FieldMode::Direct) throw;
+      row.failure = e.what();
+      row.times = {kNaN, kNaN, kNaN, kNaN, kNaN};
+      row.total_s = row.speedup_vs_brute = row.speedup_vs_direct = kNaN;
+      row.tilt_max_deg = row.tilt_rms_deg = row.min_clearance_mm = row.max_tilt_deg = kNaN;
+      runs.emplace_back();
+      result.rows.push_back(row);
+      continue;
+    }
     row.times = runs.back().times;
     row.total_s = row.times.field_s + row.times.steering_s;
     row.min_clearance_mm = runs.back().clearance.min_clearance_mm;
@@ -272,6 +284,10 @@ StudyResult runStudy(const StudyRequest& request) {
     if (g.pass == result.middle_pass) result.tilt_s_mm.push_back(g.s_mm);
   for (std::size_t i = 0; i < result.rows.size(); ++i) {
     StudyRow& row = result.rows[i];
+    if (!row.failure.empty()) {
+      result.tilt_deg.emplace_back();
+      continue;
+    }
     row.speedup_vs_brute = brute_total / row.total_s;
     row.speedup_vs_direct = direct_total / row.total_s;
     const auto& postures = runs[i].postures;
@@ -348,7 +364,11 @@ StudyResult runStudy(const StudyRequest& request) {
       field::VoxelRequest voxel_request;
       voxel_request.voxel_size_mm = row.variant.voxel_size_mm;
       voxel_request.interpolation = row.variant.interpolation;
-      voxel_request.region_mm = runs[i].reach_box_mm;  // the region generate used
+      // The region generate uses: what tool + holder can reach, padded by two voxels.
+      Eigen::AlignedBox3d region = direct_run.reach_box_mm;
+      region.min().array() -= 2 * row.variant.voxel_size_mm;
+      region.max().array() += 2 * row.variant.voxel_size_mm;
+      voxel_request.region_mm = region;
       auto voxels = std::make_unique<field::VoxelField>(direct, voxel_request);
       row.active_nodes = voxels->stats().active_nodes;
       row.dense_box_nodes = voxels->stats().dense_box_nodes;
@@ -395,7 +415,7 @@ double maxForceError(const StudyRow& row) {
 
 std::string csvText(const StudyResult& r) {
   std::ostringstream s;
-  s << "variant,mode,voxel_mm,interpolation,active_nodes,dense_box_nodes,voxel_memory_mb,"
+  s << "variant,mode,voxel_mm,interpolation,status,active_nodes,dense_box_nodes,voxel_memory_mb,"
        "field_s,path_s,clearance_s,total_s,speedup_vs_brute,speedup_vs_direct,"
        "line_a_max_pct,line_a_rms_pct,line_b_max_pct,line_b_rms_pct,nodes_max_pct,nodes_rms_pct,"
        "max_force_error_pct,nodes_max_scaled_pct,tilt_max_deg,tilt_rms_deg,min_clearance_mm,"
@@ -404,7 +424,7 @@ std::string csvText(const StudyResult& r) {
     const StudyVariant& v = row.variant;
     s << v.name() << ',' << modeName(v.mode) << ',' << (v.isVoxel() ? number(v.voxel_size_mm) : "0")
       << ',' << (v.isVoxel() ? interpolationName(v.interpolation) : "exact") << ','
-      << row.active_nodes << ',' << row.dense_box_nodes << ','
+      << (row.failure.empty() ? "ok" : "failed") << ',' << row.active_nodes << ',' << row.dense_box_nodes << ','
       << number(row.voxel_memory_bytes / 1e6) << ',' << number(row.times.field_s) << ','
       << number(row.times.steering_s) << ',' << number(row.times.clearance_s) << ','
       << number(row.total_s) << ',' << number(row.speedup_vs_brute) << ','
@@ -544,6 +564,10 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
           (!best || maxForceError(row) < maxForceError(*best)))
         best = &row;
     if (!best) continue;
+    if (!best->failure.empty()) {
+      s << "| " << t.h_mm << " mm | " << best->variant.name() << " | path failed | – | **no** |\n";
+      continue;
+    }
     const bool met = 100 * maxForceError(*best) <= t.force_pct && best->tilt_max_deg <= t.tilt_deg;
     s << "| " << t.h_mm << " mm | " << best->variant.name() << " | "
       << fixed(100 * maxForceError(*best), 3) << " (≤ " << t.force_pct << ") | "
@@ -552,7 +576,7 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
   }
   const StudyRow* fastest = nullptr;
   for (const StudyRow& row : r.rows)
-    if (row.variant.isVoxel() && maxForceError(row) <= 0.01 &&
+    if (row.variant.isVoxel() && row.failure.empty() && maxForceError(row) <= 0.01 &&
         (!fastest || row.total_s < fastest->total_s))
       fastest = &row;
   s << "\nSpeed at ≤ 1 % max force error (target ≥ 10× the indexed direct path): ";
@@ -561,6 +585,10 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
       << (fastest->speedup_vs_direct >= 10 ? "met" : "**not met**") << ").\n";
   else
     s << "no voxel variant reaches 1 % (**not met**).\n";
+  for (const StudyRow& row : r.rows)
+    if (!row.failure.empty())
+      s << "\n**" << row.variant.name() << "**: no path (" << row.failure
+        << "); its force errors are measured all the same, its times and angles are not.\n";
   s << "\nFiles: study.csv (this table), lines.csv (Fig. 5 data), tilt.csv (Fig. 6 data), "
        "speed_vs_error.png, force_error_lines.png, tilt_along_path.png.\n";
   return s.str();

@@ -62,6 +62,9 @@ struct ForceError {
 /// One row of study.csv.
 struct StudyRow {
   StudyVariant variant;
+  /// Why the variant's path could not be made (e.g. the axis left the scene's limits), else "";
+  /// its times, tilts and clearance are then NaN, its force errors still measured.
+  std::string failure;
   std::size_t active_nodes = 0;     ///< voxel nodes holding a value (0 for direct methods)
   std::size_t dense_box_nodes = 0;  ///< nodes of a dense grid over their bounding box
   std::size_t voxel_memory_bytes = 0;

@@ -109,7 +109,7 @@ TEST_F(StudyTest, CsvHasEveryColumnFilledWithFiniteValues) {
   ASSERT_GE(csv.header.size(), 20u);
   ASSERT_EQ(csv.rows.size(), 5u);  // brute force, direct, 3 voxel sizes
   const std::map<std::string, bool> text_columns = {
-      {"variant", true}, {"mode", true}, {"interpolation", true}};
+      {"variant", true}, {"mode", true}, {"interpolation", true}, {"status", true}};
   for (const auto& cells : csv.rows) {
     ASSERT_EQ(cells.size(), csv.header.size());
     for (std::size_t c = 0; c < cells.size(); ++c) {
@@ -134,6 +134,7 @@ TEST_F(StudyTest, ErrorsShrinkWithTheVoxelSize) {
     EXPECT_GT(rows[k]->line_a.relative.count, 10u);
     EXPECT_GT(rows[k]->line_b.relative.count, 10u);
     EXPECT_EQ(rows[k]->colliding, 0u);
+    EXPECT_EQ(rows[k]->failure, "");
   }
   for (int k = 0; k < 2; ++k) {
     const StudyRow& coarse = *rows[k];
