@@ -1,0 +1,187 @@
+/// The impeller example end to end through the built `fieldpath` binary: golden summary,
+/// generate → .cl → check round trip, APT read back, bad scenes → exit 1 naming the pass or key.
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+
+#include <unistd.h>
+#include <sys/wait.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "fieldpath/geometry/cl_file.h"
+
+namespace fs = std::filesystem;
+using fieldpath::geometry::Posture;
+
+namespace {
+
+const fs::path kScene = fs::path(FIELDPATH_SOURCE_DIR) / "examples/impeller/scene.yaml";
+
+struct Outcome {
+  int exit_code;
+  std::string output;  ///< stdout and stderr
+};
+
+Outcome run(const std::string& args) {
+  const std::string command = std::string("'") + FIELDPATH_BIN + "' --quiet " + args + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  std::string output;
+  std::array<char, 4096> buffer;
+  while (std::size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) output.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+nlohmann::json readJson(const fs::path& file) {
+  std::ifstream in(file);
+  return nlohmann::json::parse(in);
+}
+
+/// The golden answer file: key → (value, tolerance).
+std::map<std::string, std::pair<double, double>> readGolden() {
+  std::ifstream in(fs::path(FIELDPATH_SOURCE_DIR) / "tests/pathgen/impeller.golden");
+  std::map<std::string, std::pair<double, double>> golden;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream words(line);
+    std::string key;
+    double value, tolerance;
+    words >> key >> value >> tolerance;
+    golden[key] = {value, tolerance};
+  }
+  return golden;
+}
+
+/// One generate of the field path and one of the nominal path, shared by the tests.
+class ImpellerRun : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / ("fieldpath_test_cli_" + std::to_string(getpid()));
+    fs::remove_all(dir_);
+    field_ = run("generate '" + kScene.string() + "' --out '" + (dir_ / "field").string() + "'");
+    nominal_ = run("generate '" + kScene.string() + "' --nominal --out '" + (dir_ / "nominal").string() + "'");
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+  static inline fs::path dir_;
+  static inline Outcome field_, nominal_;
+};
+
+TEST_F(ImpellerRun, MatchesTheGoldenSummary) {
+  ASSERT_EQ(field_.exit_code, 0) << field_.output;
+  ASSERT_EQ(nominal_.exit_code, 0) << nominal_.output;
+  const auto field = readJson(dir_ / "field/report.json");
+  const auto nominal = readJson(dir_ / "nominal/report.json");
+  const std::map<std::string, double> actual = {
+      {"postures", field["postures"].get<double>()},
+      {"path_length_mm", field["path_length_mm"].get<double>()},
+      {"field.min_clearance_mm", field["clearance"]["min_mm"].get<double>()},
+      {"field.max_tilt_deg", field["max_tilt_deg"].get<double>()},
+      {"field.max_lead_deg", field["max_lead_deg"].get<double>()},
+      {"field.colliding_postures", field["clearance"]["colliding_postures"].get<double>()},
+      {"nominal.min_clearance_mm", nominal["clearance"]["min_mm"].get<double>()},
+      {"nominal.colliding_postures", nominal["clearance"]["colliding_postures"].get<double>()},
+  };
+  const auto golden = readGolden();
+  ASSERT_EQ(golden.size(), actual.size());
+  for (const auto& [key, expected] : golden) {
+    ASSERT_TRUE(actual.count(key)) << key;
+    EXPECT_NEAR(actual.at(key), expected.first, expected.second) << key;
+  }
+  // The point of the example: the field path is clear, the nominal one collides.
+  EXPECT_TRUE(field["clearance"]["ok"].get<bool>());
+  EXPECT_GE(field["clearance"]["min_mm"].get<double>(), field["clearance"]["required_mm"].get<double>());
+  EXPECT_GT(nominal["clearance"]["colliding_postures"].get<int>(), 0);
+  EXPECT_EQ(field["counts"]["obstacle_points"].get<int>(), 5100);
+}
+
+TEST_F(ImpellerRun, GenerateClCheckRoundTrip) {
+  ASSERT_EQ(field_.exit_code, 0) << field_.output;
+  const Outcome check = run("check '" + kScene.string() + "' --path '" + (dir_ / "field/path.cl").string() +
+                        "' --spacing 0.1 --backend cpu --out '" + (dir_ / "field").string() + "'");
+  ASSERT_EQ(check.exit_code, 0) << check.output;
+  const auto generated = readJson(dir_ / "field/report.json");
+  const auto checked = readJson(dir_ / "field/check.json");
+  // .cl numbers round-trip exactly: the same postures give the same FCL clearance.
+  EXPECT_EQ(checked["postures"], generated["postures"]);
+  EXPECT_DOUBLE_EQ(checked["clearance"]["min_mm"].get<double>(),
+                   generated["clearance"]["min_mm"].get<double>());
+  EXPECT_EQ(checked["clearance"]["colliding_postures"].get<int>(), 0);
+  // The ball centre follows the offset hub exactly: no gouge beyond float rounding.
+  EXPECT_LT(checked["surface"]["max_gouge_um"].get<double>(), 0.5);
+  EXPECT_GT(checked["surface"]["max_scallop_um"].get<double>(), 100.0);
+  EXPECT_TRUE(fs::exists(dir_ / "field/deviation.png"));
+
+  const Outcome nominal_check = run("check '" + kScene.string() + "' --path '" +
+                                (dir_ / "nominal/path.cl").string() + "' --spacing 0.2 --backend cpu");
+  EXPECT_EQ(nominal_check.exit_code, 0) << nominal_check.output;  // collisions are reported, exit 0
+  EXPECT_NE(nominal_check.output.find("COLLISIONS"), std::string::npos) << nominal_check.output;
+}
+
+TEST_F(ImpellerRun, AptReadBackEqualsTheClPostures) {
+  ASSERT_EQ(field_.exit_code, 0) << field_.output;
+  const auto cl = fieldpath::geometry::readClFile(dir_ / "field/path.cl");
+  const auto apt = fieldpath::geometry::readAptFile(dir_ / "field/path.apt");
+  ASSERT_EQ(apt.size(), cl.size());
+  for (std::size_t i = 0; i < cl.size(); ++i) {
+    EXPECT_NEAR((apt[i].tip_mm - cl[i].tip_mm).norm(), 0.0, 1e-6) << i;
+    EXPECT_NEAR((apt[i].axis - cl[i].axis).norm(), 0.0, 1e-6) << i;
+  }
+}
+
+/// The example scene with impeller keys replaced (or added when absent), written to a temporary file.
+fs::path badScene(const std::string& name, const std::map<std::string, std::string>& keys) {
+  std::ifstream in(kScene);
+  std::string yaml, line;
+  const std::string anchor = "  - impeller:";
+  std::map<std::string, std::string> missing = keys;
+  while (std::getline(in, line)) {
+    for (const auto& [key, value] : keys) {
+      if (line.rfind("      " + key + ":", 0) == 0) {
+        line = "      " + key + ": " + value;
+        missing.erase(key);
+      }
+    }
+    yaml += line + "\n";
+  }
+  for (const auto& [key, value] : missing) {
+    const auto at = yaml.find(anchor + "\n") + anchor.size() + 1;
+    yaml.insert(at, "      " + key + ": " + value + "\n");
+  }
+  const fs::path file =
+      fs::temp_directory_path() / ("fieldpath_bad_" + name + "_" + std::to_string(getpid()) + ".yaml");
+  std::ofstream(file) << yaml;
+  return file;
+}
+
+void expectBadScene(const std::string& name, const std::map<std::string, std::string>& keys,
+                    std::initializer_list<std::string> expected) {
+  const fs::path scene = badScene(name, keys);
+  const fs::path out = fs::temp_directory_path() / ("fieldpath_bad_out_" + std::to_string(getpid()));
+  const Outcome r = run("generate '" + scene.string() + "' --out '" + out.string() + "'");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;  // one line
+  for (const auto& words : expected) EXPECT_NE(r.output.find(words), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out / "path.cl"));  // no partial outputs
+  fs::remove(scene);
+  fs::remove_all(out);
+}
+
+TEST(BadScenes, ExitOneWithALineNamingThePassOrKey) {
+  expectBadScene("cross", {{"lean_left_deg", "[60, 60]"}, {"lean_right_deg", "[60, 60]"}},
+                 {"lean_left_deg", "blades cross"});
+  expectBadScene("narrow",
+                 {{"width_in", "8"}, {"width_out", "8"}, {"lean_left_deg", "[0, 0]"}, {"lean_right_deg", "[0, 0]"}},
+                 {"pass 1", "narrower than the ball"});
+  expectBadScene("empty", {{"u_range", "[0.5, 0.5]"}}, {"pass 1", "empty"});
+  expectBadScene("unknown", {{"spoke", "3"}}, {"obstacles.impeller.spoke", "unknown key"});
+}
+
+}  // namespace
