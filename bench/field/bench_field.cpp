@@ -6,18 +6,20 @@
 /// the band, by distance from the walls. Times are medians of repeated runs in this process; the
 /// rates are given per wall-clock second and per CPU second (the machine is shared: CPU seconds
 /// are what this process got, so "per CPU-s × cores" is what idle cores would give).
-///   bench_field [--repeats N] [--points N] [--quick]
+///   bench_field [--repeats N] [--points N] [--threads N] [--quick]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <functional>
+#include <optional>
 #include <random>
 #include <string>
 #include <tuple>
 #include <vector>
 
+#include <tbb/global_control.h>
 #include <tbb/info.h>
 
 #include "fieldpath/field/direct_field.h"
@@ -138,19 +140,25 @@ int main(int argc, char** argv) {
   int repeats = 5;
   std::size_t n_points = 200000;
   bool quick = false;
+  int threads = 0;  // 0: TBB's default
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc)
       repeats = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--points") && i + 1 < argc)
       n_points = std::strtoul(argv[++i], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc)
+      threads = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--quick"))
       quick = true, repeats = 1, n_points = 20000;
     else {
-      std::fprintf(stderr, "usage: bench_field [--repeats N] [--points N] [--quick]\n");
+      std::fprintf(stderr,
+                   "usage: bench_field [--repeats N] [--points N] [--threads N] [--quick]\n");
       return 1;
     }
   }
-  const int cores = tbb::info::default_concurrency();
+  std::optional<tbb::global_control> limit;
+  if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
+  const int cores = threads > 0 ? threads : tbb::info::default_concurrency();
 
   field::FieldParams params;    // r0 5, r_min 0.25, area weights
   params.sample_step_mm = 2.0;  // the walls' 3.6 mm triangles split in 4: ≈1.3 mm apart
