@@ -22,6 +22,7 @@ struct StudyOptions {
   std::string interpolations = "trilinear,quadratic";
   bool no_brute_force = false;
   double line_step_mm = 0.05;
+  int repeats = 1;
   std::string out;
 };
 
@@ -31,6 +32,7 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
   request.interpolations = parseInterpolations(o.interpolations, "--interp");
   request.brute_force = !o.no_brute_force;
   request.line_step_mm = o.line_step_mm;
+  request.repeats = o.repeats;
   request.job = impellerJob(loadScene(o.scene));
   request.progress = makeProgressLine(global.quiet);
   const StudyResult result = runStudy(request);
@@ -65,11 +67,14 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
                 "Skip the every-point direct sum (slow on large scenes)");
   cmd->add_option("--line-step", options->line_step_mm, "Sampling of the study lines, mm")
       ->capture_default_str();
+  cmd->add_option("--repeat", options->repeats, "Runs per variant; times are their medians")
+      ->capture_default_str();
   cmd->add_option("--out", options->out, "Output folder")->required();
   cmd->callback([options, &global] {
     std::string command_line = "fieldpath study " + options->scene + " --voxels " +
                                options->voxels + " --interp " + options->interpolations +
-                               (options->no_brute_force ? " --no-brute-force" : "") + " --out " +
+                               (options->no_brute_force ? " --no-brute-force" : "") + " --repeat " +
+                               std::to_string(options->repeats) + " --out " +
                                options->out;
     run(*options, global, command_line);
   });

@@ -49,6 +49,7 @@ struct StudyRequest {
                                                       field::Interpolation::Quadratic};
   bool brute_force = true;       ///< run the seed's every-point direct sum (slow on big scenes)
   double line_step_mm = 0.05;    ///< sampling of the study lines
+  int repeats = 1;               ///< runs per variant; times are their medians
   common::Progress progress;     ///< "brute force", "direct", "voxel 2 mm ...", "errors"
 };
 
@@ -77,6 +78,7 @@ struct StudyRow {
   double min_clearance_mm = 0.0;    ///< FCL, of this variant's path
   std::size_t colliding = 0;
   double max_tilt_deg = 0.0;        ///< largest |tilt| of the path
+  long solver_steps = 0, rhs_evals = 0;  ///< CVODE, all passes: a rough field costs steps
 };
 
 /// A study line: points, the exact field along it and each variant's field.
@@ -103,6 +105,7 @@ struct StudyResult {
   double path_length_mm = 0.0;
   double reach_box_cm3 = 0.0;  ///< volume of the region the voxels cover (direct run's box)
   double clearance_mm = 0.0;
+  int repeats = 1;             ///< runs per variant behind each time (medians)
   field::FieldParams field;    ///< r0, r_min, ... of the scene
 };
 

@@ -41,6 +41,15 @@ def save(fig, path):
     os.replace(tmp, path)
 
 
+def colours(names):
+    """One colour per variant, the same in every picture; the exact direct field in black."""
+    palette = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    others = [n for n in names if n != "direct"]
+    table = {n: palette[i % len(palette)] for i, n in enumerate(others)}
+    table["direct"] = "k"
+    return table
+
+
 def grouped(rows, key):
     groups = OrderedDict()
     for row in rows:
@@ -56,16 +65,18 @@ def speed_vs_error(study, out):
     for row in study:
         err, t = num(row["max_force_error_pct"]), num(row["total_s"])
         points.append((row["variant"], err, t))
-    errs = [e for _, e, _ in points if e > 0]
+    exact = 1e-6  # %: float rounding between the two exact methods
+    errs = [e for _, e, _ in points if e > exact]
     exact_floor = min(errs) / 10 if errs else 1e-3
-    shown = [(n, max(e, exact_floor), t, e) for n, e, t in points]
+    shown = [(n, max(e, exact_floor), t, e if e > exact else 0.0) for n, e, t in points if not math.isnan(t)]
     # Pareto front: no other variant is both faster and more accurate.
     front = [p for p in shown
              if not any((q[2] <= p[2] and q[1] <= p[1]) and (q[2] < p[2] or q[1] < p[1]) for q in shown)]
     front.sort(key=lambda p: p[1])
+    colour = colours([r["variant"] for r in study])
     for name, e, t, raw in shown:
         marker = "s" if raw <= 0 else ("^" if "quadratic" in name else "o")
-        ax.scatter(e, t, marker=marker, s=50, zorder=3)
+        ax.scatter(e, t, marker=marker, s=50, zorder=3, color=colour[name])
         label = name + (" (exact)" if raw <= 0 else "")
         ax.annotate(label, (e, t), textcoords="offset points", xytext=(6, 4), fontsize=8)
     ax.plot([p[1] for p in front], [p[2] for p in front], "k--", lw=1, label="Pareto front", zorder=2)
@@ -79,7 +90,7 @@ def speed_vs_error(study, out):
     save(fig, os.path.join(out, "speed_vs_error.png"))
 
 
-def force_error_lines(lines, out):
+def force_error_lines(lines, out, colour):
     """Relative error along line a and line b per voxel variant (like seed Fig. 5)."""
     fig, axes = plt.subplots(2, 2, figsize=(12, 8), sharex="col")
     for col, name in enumerate(["a", "b"]):
@@ -92,11 +103,14 @@ def force_error_lines(lines, out):
             if first:
                 top.plot(t, [num(r["direct_force"]) for r in vr], "k-", lw=2, label="direct (exact)")
                 first = False
-            top.plot(t, [num(r["variant_force"]) for r in vr], lw=1, label=variant)
-            bottom.plot(t, [100 * num(r["relative_error"]) for r in vr], lw=1, label=variant)
+            top.plot(t, [num(r["variant_force"]) for r in vr], lw=1, label=variant, color=colour[variant])
+            bottom.plot(t, [100 * num(r["relative_error"]) for r in vr], lw=1, label=variant,
+                        color=colour[variant])
         top.set_title("line %s: |F| along the line" % name)
         top.set_ylabel("|F|")
         top.set_yscale("log")
+        peak = max([num(r["direct_force"]) for r in rows] + [1e-30])
+        top.set_ylim(bottom=peak * 1e-4)
         bottom.set_title("line %s: relative error (counted points only)" % name)
         bottom.set_ylabel("|F_v - F_d| / |F_d|, %")
         bottom.set_yscale("log")
@@ -108,7 +122,7 @@ def force_error_lines(lines, out):
     save(fig, os.path.join(out, "force_error_lines.png"))
 
 
-def tilt_along_path(tilt, out):
+def tilt_along_path(tilt, out, colour):
     """Tilt of the middle pass against arc length per variant, and its difference (seed Fig. 6)."""
     groups = grouped(tilt, "variant")
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
@@ -117,10 +131,9 @@ def tilt_along_path(tilt, out):
     for variant, vr in groups.items():
         s = [num(r["s_mm"]) for r in vr]
         y = [num(r["tilt_deg"]) for r in vr]
-        style = "k-" if variant == "direct" else "-"
-        top.plot(s, y, style, lw=2 if variant == "direct" else 1, label=variant)
+        top.plot(s, y, "-", lw=2 if variant == "direct" else 1, label=variant, color=colour[variant])
         if ref and variant not in ("direct", "brute force"):
-            bottom.plot(s, [a - b for a, b in zip(y, ref)], lw=1, label=variant)
+            bottom.plot(s, [a - b for a, b in zip(y, ref)], lw=1, label=variant, color=colour[variant])
     p = tilt[0]["pass"] if tilt else "?"
     top.set_title("Tilt along the middle pass (pass %s)" % p)
     top.set_ylabel("tilt, deg")
@@ -138,9 +151,11 @@ def main():
         sys.stderr.write(__doc__)
         return 2
     out = sys.argv[1]
-    speed_vs_error(read(os.path.join(out, "study.csv")), out)
-    force_error_lines(read(os.path.join(out, "lines.csv")), out)
-    tilt_along_path(read(os.path.join(out, "tilt.csv")), out)
+    study = read(os.path.join(out, "study.csv"))
+    colour = colours([r["variant"] for r in study])
+    speed_vs_error(study, out)
+    force_error_lines(read(os.path.join(out, "lines.csv")), out, colour)
+    tilt_along_path(read(os.path.join(out, "tilt.csv")), out, colour)
     return 0
 
 
