@@ -42,21 +42,36 @@ struct SurfaceStats {
 /// 3 × 5 pixel glyphs for the legend of deviation.png: digits, '-', '.', 'u', 'm'.
 const char* glyph(char c) {
   switch (c) {
-    case '0': return "111101101101111";
-    case '1': return "010110010010111";
-    case '2': return "111001111100111";
-    case '3': return "111001111001111";
-    case '4': return "101101111001001";
-    case '5': return "111100111001111";
-    case '6': return "111100111101111";
-    case '7': return "111001001001001";
-    case '8': return "111101111101111";
-    case '9': return "111101111001111";
-    case '-': return "000000111000000";
-    case '.': return "000000000000010";
-    case 'u': return "000000101101111";
-    case 'm': return "000000111111101";
-    default: return "000000000000000";
+    case '0':
+      return "111101101101111";
+    case '1':
+      return "010110010010111";
+    case '2':
+      return "111001111100111";
+    case '3':
+      return "111001111001111";
+    case '4':
+      return "101101111001001";
+    case '5':
+      return "111100111001111";
+    case '6':
+      return "111100111101111";
+    case '7':
+      return "111001001001001";
+    case '8':
+      return "111101111101111";
+    case '9':
+      return "111101111001111";
+    case '-':
+      return "000000111000000";
+    case '.':
+      return "000000000000010";
+    case 'u':
+      return "000000101101111";
+    case 'm':
+      return "000000111111101";
+    default:
+      return "000000000000000";
   }
 }
 
@@ -74,14 +89,16 @@ struct Image {
         for (int c = 0; c < 3; ++c)
           if (g[r * 3 + c] == '1')
             for (int dy = 0; dy < scale; ++dy)
-              for (int dx = 0; dx < scale; ++dx) set(x + c * scale + dx, y + r * scale + dy, {0, 0, 0});
+              for (int dx = 0; dx < scale; ++dx)
+                set(x + c * scale + dx, y + r * scale + dy, {0, 0, 0});
       x += 4 * scale;
     }
   }
 };
 
 /// Diverging colours: blue for gouge (down to -gouge_scale), white at 0, red for scallop.
-std::array<std::uint8_t, 3> deviationColour(double dev_um, double gouge_scale_um, double scallop_scale_um) {
+std::array<std::uint8_t, 3> deviationColour(double dev_um, double gouge_scale_um,
+                                            double scallop_scale_um) {
   const double t = dev_um < 0 ? std::min(1.0, -dev_um / gouge_scale_um)
                               : std::min(1.0, dev_um / scallop_scale_um);
   const auto fade = static_cast<std::uint8_t>(255.0 * (1.0 - t));
@@ -100,7 +117,8 @@ std::string microns(double um) {
 void writeDeviationPng(const std::filesystem::path& file, const zbuffer::Grid& grid,
                        const std::vector<float>& dev_um, const SurfaceStats& stats) {
   const int max_side = 1200;
-  const int k = std::max(1, static_cast<int>(std::ceil(std::max(grid.nx, grid.ny) / double(max_side))));
+  const int k =
+      std::max(1, static_cast<int>(std::ceil(std::max(grid.nx, grid.ny) / double(max_side))));
   const int map_w = grid.nx / k, map_h = grid.ny / k;
   const int scale = std::max(2, map_h / 120), bar_w = 12 * scale, legend_w = bar_w + 28 * scale;
   Image img{map_w + legend_w, std::max(map_h, 60 * scale), {}};
@@ -111,8 +129,9 @@ void writeDeviationPng(const std::filesystem::path& file, const zbuffer::Grid& g
     for (int px = 0; px < map_w; ++px) {
       const int ix = px * k, iy = (map_h - 1 - py) * k;
       const float d = dev_um[static_cast<std::size_t>(iy) * grid.nx + ix];
-      img.set(px, py, std::isnan(d) ? std::array<std::uint8_t, 3>{200, 200, 200}
-                                    : deviationColour(d, gouge_scale, scallop_scale));
+      img.set(px, py,
+              std::isnan(d) ? std::array<std::uint8_t, 3>{200, 200, 200}
+                            : deviationColour(d, gouge_scale, scallop_scale));
     }
   }
   // Colour bar: top = max scallop, middle = 0, bottom = max gouge.
@@ -120,7 +139,8 @@ void writeDeviationPng(const std::filesystem::path& file, const zbuffer::Grid& g
   for (int y = 0; y < bar_h; ++y) {
     const double t = 1.0 - 2.0 * y / (bar_h - 1);  // +1 top, -1 bottom
     const double dev = t >= 0 ? t * scallop_scale : t * gouge_scale;
-    for (int x = 0; x < bar_w; ++x) img.set(bar_x + x, bar_top + y, deviationColour(dev, gouge_scale, scallop_scale));
+    for (int x = 0; x < bar_w; ++x)
+      img.set(bar_x + x, bar_top + y, deviationColour(dev, gouge_scale, scallop_scale));
   }
   const int label_x = bar_x + bar_w + 2 * scale;
   img.text(label_x, bar_top, microns(scallop_scale), scale);
@@ -146,8 +166,10 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
   auto options = std::make_shared<Options>();
   cmd->add_option("scene", options->scene, "Scene file (YAML)")->required();
   cmd->add_option("--path", options->path, "Path file (.cl: x y z i j k per line)")->required();
-  cmd->add_option("--out", options->out, "Output folder (check.json, deviation.png, deviation.npy)");
-  cmd->add_option("--spacing", options->spacing_mm, "Z-buffer line spacing, mm")->capture_default_str();
+  cmd->add_option("--out", options->out,
+                  "Output folder (check.json, deviation.png, deviation.npy)");
+  cmd->add_option("--spacing", options->spacing_mm, "Z-buffer line spacing, mm")
+      ->capture_default_str();
   cmd->add_option("--backend", options->backend, "Z-buffer backend: auto | cpu | cuda")
       ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
       ->capture_default_str();
@@ -175,12 +197,15 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         band.extend(impeller.hub(ip.u_range[0] + (ip.u_range[1] - ip.u_range[0]) * i / 64.0,
                                  v0 + (v1 - v0) * j / 16.0));
     const double margin = job.tool.radius_mm;
-    const int nx = std::max(2, static_cast<int>(std::ceil((band.sizes().x() + 2 * margin) / options->spacing_mm)));
-    const int ny = std::max(2, static_cast<int>(std::ceil((band.sizes().y() + 2 * margin) / options->spacing_mm)));
+    const int nx = std::max(
+        2, static_cast<int>(std::ceil((band.sizes().x() + 2 * margin) / options->spacing_mm)));
+    const int ny = std::max(
+        2, static_cast<int>(std::ceil((band.sizes().y() + 2 * margin) / options->spacing_mm)));
     zbuffer::SimulationRequest sim;
-    sim.grid = zbuffer::Grid::fromRegion(band.min().x() - margin, band.min().y() - margin,
-                                         band.min().x() - margin + nx * options->spacing_mm,
-                                         band.min().y() - margin + ny * options->spacing_mm, nx, ny);
+    sim.grid =
+        zbuffer::Grid::fromRegion(band.min().x() - margin, band.min().y() - margin,
+                                  band.min().x() - margin + nx * options->spacing_mm,
+                                  band.min().y() - margin + ny * options->spacing_mm, nx, ny);
     zbuffer::checkGridFits(sim.grid);
     sim.tool = zbuffer::Tool::ball(job.tool.radius_mm, job.tool.length_mm);
     sim.backend = options->backend == "cpu"    ? zbuffer::Backend::Cpu
@@ -239,16 +264,19 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"path", options->path},
         {"postures", postures.size()},
         {"clearance",
-         {{"required_mm", job.clearance_mm}, {"min_mm", clearance.min_clearance_mm},
-          {"min_posture", index(clearance.min_index)}, {"min_obstacle", clearance.min_obstacle + 1},
+         {{"required_mm", job.clearance_mm},
+          {"min_mm", clearance.min_clearance_mm},
+          {"min_posture", index(clearance.min_index)},
+          {"min_obstacle", clearance.min_obstacle + 1},
           {"colliding_postures", clearance.colliding},
           {"first_colliding_posture", index(clearance.first_colliding)},
           {"tool_mesh_chord_tol_mm", pathgen::kClearanceMeshTolMm},
           {"ok", clearance.colliding == 0 && clearance.min_clearance_mm >= job.clearance_mm}}},
         {"surface",
-         {{"grid", {{"origin", {sim.grid.x0_mm, sim.grid.y0_mm}},
-                    {"spacing", {sim.grid.dx_mm, sim.grid.dy_mm}},
-                    {"shape", {sim.grid.ny, sim.grid.nx}}}},
+         {{"grid",
+           {{"origin", {sim.grid.x0_mm, sim.grid.y0_mm}},
+            {"spacing", {sim.grid.dx_mm, sim.grid.dy_mm}},
+            {"shape", {sim.grid.ny, sim.grid.nx}}}},
           {"backend", zbuffer::backendName(simulated.backend)},
           {"simulation_s", simulated.seconds},
           {"band_lines", stats.lines},
@@ -271,10 +299,12 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         "surface: %zu lines, max gouge %.2f um (%zu lines below %.1f um), max scallop %.1f um, "
         "rms %.1f um (%s, %.2f s)\n",
         postures.size(), clearance.min_clearance_mm, job.clearance_mm,
-        clearance.min_index == pathgen::ClearanceResult::npos ? "-" : std::to_string(clearance.min_index + 1).c_str(),
+        clearance.min_index == pathgen::ClearanceResult::npos
+            ? "-"
+            : std::to_string(clearance.min_index + 1).c_str(),
         clearance.colliding, clearance.colliding ? " (COLLISIONS)" : "", stats.lines,
-        stats.max_gouge_um, stats.gouged_lines, -kGougeToleranceUm, stats.max_scallop_um, stats.rms_um,
-        zbuffer::backendName(simulated.backend), simulated.seconds);
+        stats.max_gouge_um, stats.gouged_lines, -kGougeToleranceUm, stats.max_scallop_um,
+        stats.rms_um, zbuffer::backendName(simulated.backend), simulated.seconds);
   });
 }
 

@@ -24,9 +24,12 @@ constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 
 const char* modeName(pathgen::FieldMode mode) {
   switch (mode) {
-    case pathgen::FieldMode::Voxel: return "voxel";
-    case pathgen::FieldMode::Direct: return "direct";
-    case pathgen::FieldMode::BruteForce: return "brute_force";
+    case pathgen::FieldMode::Voxel:
+      return "voxel";
+    case pathgen::FieldMode::Direct:
+      return "direct";
+    case pathgen::FieldMode::BruteForce:
+      return "brute_force";
   }
   return "?";
 }
@@ -45,9 +48,13 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       max_tilt = std::max(max_tilt, std::abs(g.tilt_rad) * kRadToDeg);
       colliding += g.clearance_mm <= 0.0;
     }
-    passes.push_back({{"pass", pass.index + 1}, {"v", pass.v}, {"length_mm", pass.length_mm},
-                      {"postures", postures}, {"min_clearance_mm", min_clearance},
-                      {"max_tilt_deg", max_tilt}, {"colliding_postures", colliding}});
+    passes.push_back({{"pass", pass.index + 1},
+                      {"v", pass.v},
+                      {"length_mm", pass.length_mm},
+                      {"postures", postures},
+                      {"min_clearance_mm", min_clearance},
+                      {"max_tilt_deg", max_tilt},
+                      {"colliding_postures", colliding}});
   }
   const auto& c = r.clearance;
   const auto& box = r.reach_box_mm;
@@ -58,31 +65,42 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"scene", scene.file.string()},
       {"field_mode", job.nominal ? "nominal" : modeName(job.mode)},
       {"voxel_size_mm", job.mode == pathgen::FieldMode::Voxel && !job.nominal
-                            ? json(job.field.voxel_size_mm) : json(nullptr)},
+                            ? json(job.field.voxel_size_mm)
+                            : json(nullptr)},
       {"nominal", job.nominal},
       {"postures", r.postures.size()},
       {"passes", r.passes.size()},
       {"path_length_mm", r.path_length_mm},
       {"times_s",
-       {{"setup", r.times.setup_s}, {"field", r.times.field_s}, {"steering", r.times.steering_s},
-        {"clearance", r.times.clearance_s}, {"total", r.times.total_s}}},
+       {{"setup", r.times.setup_s},
+        {"field", r.times.field_s},
+        {"steering", r.times.steering_s},
+        {"clearance", r.times.clearance_s},
+        {"total", r.times.total_s}}},
       {"counts",
-       {{"obstacle_points", r.obstacle_points}, {"tool_nodes", r.tool_nodes},
-        {"tool_triangles", r.tool_triangles}, {"voxel_nodes", r.voxel_nodes},
+       {{"obstacle_points", r.obstacle_points},
+        {"tool_nodes", r.tool_nodes},
+        {"tool_triangles", r.tool_triangles},
+        {"voxel_nodes", r.voxel_nodes},
         {"voxel_memory_bytes", r.voxel_memory_bytes}}},
       {"reach_box_mm",
        {{"min", {box.min().x(), box.min().y(), box.min().z()}},
         {"max", {box.max().x(), box.max().y(), box.max().z()}},
         {"volume_cm3", box.volume() / 1000.0}}},
       {"clearance",
-       {{"required_mm", job.clearance_mm}, {"min_mm", c.min_clearance_mm},
-        {"min_posture", index(c.min_index)}, {"min_obstacle", c.min_obstacle + 1},
-        {"colliding_postures", c.colliding}, {"first_colliding_posture", index(c.first_colliding)},
+       {{"required_mm", job.clearance_mm},
+        {"min_mm", c.min_clearance_mm},
+        {"min_posture", index(c.min_index)},
+        {"min_obstacle", c.min_obstacle + 1},
+        {"colliding_postures", c.colliding},
+        {"first_colliding_posture", index(c.first_colliding)},
         {"ok", c.colliding == 0 && c.min_clearance_mm >= job.clearance_mm}}},
       {"max_tilt_deg", r.max_tilt_deg},
       {"max_lead_deg", r.max_lead_deg},
       {"solver",
-       {{"steps", r.solver_steps}, {"rhs_evals", r.rhs_evals}, {"jacobian_evals", r.jacobian_evals},
+       {{"steps", r.solver_steps},
+        {"rhs_evals", r.rhs_evals},
+        {"jacobian_evals", r.jacobian_evals},
         {"error_test_failures", r.error_test_failures},
         {"convergence_failures", r.convergence_failures}}},
       {"per_pass", passes},
@@ -104,7 +122,8 @@ std::string anglesCsv(const pathgen::GenerateResult& r) {
 void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
   auto* cmd = app.add_subcommand(
       "generate",
-      "Generate the impeller path of a scene: isoparametric passes on the hub, tool axis steered by "
+      "Generate the impeller path of a scene: isoparametric passes on the hub, tool axis steered "
+      "by "
       "the repulsive field (CVODE), exact clearance (FCL). Writes path.cl, path.apt, angles.csv, "
       "report.json");
   struct Options {
@@ -114,7 +133,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
   };
   auto options = std::make_shared<Options>();
   cmd->add_option("scene", options->scene, "Scene file (YAML)")->required();
-  auto* direct = cmd->add_flag("--direct", options->direct, "Exact field (radius search), no voxels");
+  auto* direct =
+      cmd->add_flag("--direct", options->direct, "Exact field (radius search), no voxels");
   auto* voxel = cmd->add_option("--voxel", options->voxel_mm,
                                 "Voxel size H, mm (default: the scene's field.voxel_size)");
   direct->excludes(voxel);
@@ -155,8 +175,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
         "%s: %zu postures on %zu passes, %.1f mm; max tilt %.2f deg, max lead %.2f deg; min "
         "clearance %.3f mm (required %.3f), %zu colliding postures; %.2f s -> %s\n",
         what.c_str(), result.postures.size(), result.passes.size(), result.path_length_mm,
-        result.max_tilt_deg, result.max_lead_deg, c.min_clearance_mm, job.clearance_mm,
-        c.colliding, result.times.total_s, out.string().c_str());
+        result.max_tilt_deg, result.max_lead_deg, c.min_clearance_mm, job.clearance_mm, c.colliding,
+        result.times.total_s, out.string().c_str());
   });
 }
 

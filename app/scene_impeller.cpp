@@ -1,5 +1,6 @@
 /// The parametric impeller in scene files: `obstacles: - impeller: {...}` (keys of
-/// pathgen::ImpellerParams, documented in examples/impeller/scene.yaml) and `guide: { impeller: hub }`.
+/// pathgen::ImpellerParams, documented in examples/impeller/scene.yaml) and `guide: { impeller: hub
+/// }`.
 #include <string>
 
 #include "fieldpath/common/errors.h"
@@ -37,28 +38,42 @@ pathgen::ImpellerParams readImpeller(const Scene& scene, const YAML::Node& node)
   const std::string prefix = "obstacles.impeller.";
   pathgen::ImpellerParams p;
   if (node.IsNull()) return p;  // `- impeller:` alone: every default
-  if (!node.IsMap()) throw InputError(where(scene, node) + "obstacles.impeller: expected a map of keys");
+  if (!node.IsMap())
+    throw InputError(where(scene, node) + "obstacles.impeller: expected a map of keys");
   for (const auto& kv : node) {
     const std::string key = kv.first.Scalar();
     const YAML::Node& value = kv.second;
     const std::string name = prefix + key;
-    if (key == "length") p.length_mm = number(scene, value, name);
-    else if (key == "width_in") p.width_in_mm = number(scene, value, name);
-    else if (key == "width_out") p.width_out_mm = number(scene, value, name);
-    else if (key == "bend") p.bend_mm = number(scene, value, name);
-    else if (key == "hub_rise") p.hub_rise_mm = number(scene, value, name);
-    else if (key == "hub_dish") p.hub_dish_mm = number(scene, value, name);
-    else if (key == "blade_height") p.blade_height_mm = number(scene, value, name);
-    else if (key == "lean_left_deg") p.lean_left_deg = pair(scene, value, name);
-    else if (key == "lean_right_deg") p.lean_right_deg = pair(scene, value, name);
-    else if (key == "passes_v") p.passes_v = pair(scene, value, name);
-    else if (key == "u_range") p.u_range = pair(scene, value, name);
-    else if (key == "chord_tol") p.chord_tol_mm = number(scene, value, name);
+    if (key == "length")
+      p.length_mm = number(scene, value, name);
+    else if (key == "width_in")
+      p.width_in_mm = number(scene, value, name);
+    else if (key == "width_out")
+      p.width_out_mm = number(scene, value, name);
+    else if (key == "bend")
+      p.bend_mm = number(scene, value, name);
+    else if (key == "hub_rise")
+      p.hub_rise_mm = number(scene, value, name);
+    else if (key == "hub_dish")
+      p.hub_dish_mm = number(scene, value, name);
+    else if (key == "blade_height")
+      p.blade_height_mm = number(scene, value, name);
+    else if (key == "lean_left_deg")
+      p.lean_left_deg = pair(scene, value, name);
+    else if (key == "lean_right_deg")
+      p.lean_right_deg = pair(scene, value, name);
+    else if (key == "passes_v")
+      p.passes_v = pair(scene, value, name);
+    else if (key == "u_range")
+      p.u_range = pair(scene, value, name);
+    else if (key == "chord_tol")
+      p.chord_tol_mm = number(scene, value, name);
     else
-      throw InputError(where(scene, kv.first) + name +
-                       ": unknown key (expected one of: length, width_in, width_out, bend, hub_rise, "
-                       "hub_dish, blade_height, lean_left_deg, lean_right_deg, passes_v, u_range, "
-                       "chord_tol)");
+      throw InputError(
+          where(scene, kv.first) + name +
+          ": unknown key (expected one of: length, width_in, width_out, bend, hub_rise, "
+          "hub_dish, blade_height, lean_left_deg, lean_right_deg, passes_v, u_range, "
+          "chord_tol)");
   }
   return p;
 }
@@ -67,8 +82,9 @@ pathgen::ImpellerParams readImpeller(const Scene& scene, const YAML::Node& node)
 
 void resolveImpeller(Scene& scene) {
   if (!scene.impeller)
-    throw InputError(where(scene, *scene.guide_impeller) +
-                     "guide.impeller: needs the impeller among the obstacles (`- impeller: {...}`)");
+    throw InputError(
+        where(scene, *scene.guide_impeller) +
+        "guide.impeller: needs the impeller among the obstacles (`- impeller: {...}`)");
   const YAML::Node& node = *scene.impeller;
   const pathgen::ImpellerParams params = readImpeller(scene, node);
   try {
@@ -88,9 +104,10 @@ void resolveImpeller(Scene& scene) {
 
 pathgen::GenerateRequest impellerJob(const Scene& scene) {
   if (!scene.impeller_model || !scene.guide_impeller)
-    throw InputError(scene.file.string() +
-                     ": guide: generate and check need `guide: { impeller: hub }` with the impeller "
-                     "among the obstacles (the passes follow its hub)");
+    throw InputError(
+        scene.file.string() +
+        ": guide: generate and check need `guide: { impeller: hub }` with the impeller "
+        "among the obstacles (the passes follow its hub)");
   pathgen::GenerateRequest job;
   job.impeller = scene.impeller_model->params();
   // resolveImpeller appended the two blades last; the meshes before them are the extra obstacles.

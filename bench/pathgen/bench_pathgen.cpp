@@ -89,12 +89,18 @@ int main(int argc, char** argv) {
   bool brute = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--scene" && i + 1 < argc) scene_file = argv[++i];
-    else if (a == "--bin" && i + 1 < argc) bin = argv[++i];
-    else if (a == "--repeats" && i + 1 < argc) repeats = std::max(1, std::atoi(argv[++i]));
-    else if (a == "--brute") brute = true;
+    if (a == "--scene" && i + 1 < argc)
+      scene_file = argv[++i];
+    else if (a == "--bin" && i + 1 < argc)
+      bin = argv[++i];
+    else if (a == "--repeats" && i + 1 < argc)
+      repeats = std::max(1, std::atoi(argv[++i]));
+    else if (a == "--brute")
+      brute = true;
     else {
-      std::fprintf(stderr, "usage: bench_pathgen [--scene FILE] [--bin FIELDPATH] [--repeats N] [--brute]\n");
+      std::fprintf(
+          stderr,
+          "usage: bench_pathgen [--scene FILE] [--bin FIELDPATH] [--repeats N] [--brute]\n");
       return 1;
     }
   }
@@ -132,28 +138,35 @@ int main(int argc, char** argv) {
   }
 
   const Row& direct = rows.front();
-  std::printf("impeller: %zu postures on %zu passes, %.1f mm; %zu obstacle points, %zu tool+holder "
-              "nodes; %d repeats (median), %u hardware threads\n\n",
-              direct.last.postures.size(), direct.last.passes.size(), direct.last.path_length_mm,
-              direct.last.obstacle_points, direct.last.tool_nodes, repeats,
-              std::max(1u, std::thread::hardware_concurrency()));
-  std::printf("| variant | voxel nodes | field s | steering s | clearance s | total s | total / direct "
-              "| max |Δtilt| deg | max |Δlead| deg | max tilt deg | min clearance mm | colliding |\n");
+  std::printf(
+      "impeller: %zu postures on %zu passes, %.1f mm; %zu obstacle points, %zu tool+holder "
+      "nodes; %d repeats (median), %u hardware threads\n\n",
+      direct.last.postures.size(), direct.last.passes.size(), direct.last.path_length_mm,
+      direct.last.obstacle_points, direct.last.tool_nodes, repeats,
+      std::max(1u, std::thread::hardware_concurrency()));
+  std::printf(
+      "| variant | voxel nodes | field s | steering s | clearance s | total s | total / direct "
+      "| max |Δtilt| deg | max |Δlead| deg | max tilt deg | min clearance mm | colliding |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   for (const Row& row : rows) {
     double dtilt = 0, dlead = 0;
     for (size_t i = 0; i < row.last.postures.size() && i < direct.last.postures.size(); ++i) {
-      dtilt = std::max(dtilt, std::abs(row.last.postures[i].tilt_rad - direct.last.postures[i].tilt_rad));
-      dlead = std::max(dlead, std::abs(row.last.postures[i].lead_rad - direct.last.postures[i].lead_rad));
+      dtilt = std::max(dtilt,
+                       std::abs(row.last.postures[i].tilt_rad - direct.last.postures[i].tilt_rad));
+      dlead = std::max(dlead,
+                       std::abs(row.last.postures[i].lead_rad - direct.last.postures[i].lead_rad));
     }
-    std::printf("| %s | %zu | %.3f | %.3f | %.3f | %.3f | %.2f | %.3f | %.3f | %.2f | %.3f | %zu |\n",
-                row.variant.name.c_str(), row.last.voxel_nodes, row.field_s, row.steering_s,
-                row.clearance_s, row.total_s, row.total_s / direct.total_s, dtilt * kRadToDeg,
-                dlead * kRadToDeg, row.last.max_tilt_deg, row.last.clearance.min_clearance_mm,
-                row.last.clearance.colliding);
+    std::printf(
+        "| %s | %zu | %.3f | %.3f | %.3f | %.3f | %.2f | %.3f | %.3f | %.2f | %.3f | %zu |\n",
+        row.variant.name.c_str(), row.last.voxel_nodes, row.field_s, row.steering_s,
+        row.clearance_s, row.total_s, row.total_s / direct.total_s, dtilt * kRadToDeg,
+        dlead * kRadToDeg, row.last.max_tilt_deg, row.last.clearance.min_clearance_mm,
+        row.last.clearance.colliding);
   }
 
-  std::printf("\nend to end, `fieldpath generate` (process wall time incl. start-up and writing outputs):\n\n");
+  std::printf(
+      "\nend to end, `fieldpath generate` (process wall time incl. start-up and writing "
+      "outputs):\n\n");
   std::printf("| command | median wall s | peak RSS MiB | wall / direct |\n|---|---:|---:|---:|\n");
   const std::string out = "/tmp/bench_pathgen_" + std::to_string(getpid());
   const auto [direct_s, direct_mib] =
@@ -161,7 +174,8 @@ int main(int argc, char** argv) {
   const auto [voxel_s, voxel_mib] =
       runProgram({bin, "--quiet", "generate", scene_file, "--voxel", "0.5", "--out", out}, repeats);
   std::printf("| generate --direct | %.3f | %.1f | 1.00 |\n", direct_s, direct_mib);
-  std::printf("| generate --voxel 0.5 | %.3f | %.1f | %.2f |\n", voxel_s, voxel_mib, voxel_s / direct_s);
+  std::printf("| generate --voxel 0.5 | %.3f | %.1f | %.2f |\n", voxel_s, voxel_mib,
+              voxel_s / direct_s);
   std::error_code ec;
   std::filesystem::remove_all(out, ec);
   return 0;

@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <string>
 
-#include <fcl/narrowphase/collision.h>
-#include <fcl/narrowphase/distance.h>
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/geometry/geometric_shape_to_BVH_model.h>
 #include <fcl/geometry/shape/sphere.h>
+#include <fcl/narrowphase/collision.h>
+#include <fcl/narrowphase/distance.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -85,7 +85,8 @@ double nearestObstacle(const Model& model, const fcl::Transform3d& pose,
 
 double ClearanceChecker::clearance(const geometry::Posture& posture, int* obstacle) const {
   const Eigen::Isometry3d placed = geometry::toolToWorld(posture);
-  return nearestObstacle(*impl_->tool, fcl::Transform3d(placed.matrix()), impl_->obstacles, obstacle);
+  return nearestObstacle(*impl_->tool, fcl::Transform3d(placed.matrix()), impl_->obstacles,
+                         obstacle);
 }
 
 double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double radius_mm,

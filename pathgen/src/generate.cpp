@@ -48,8 +48,9 @@ void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>
     const double d = checker.ballClearance(centres, ball_radius_mm, &at, &obstacle);
     if (d < clearance_mm) {
       std::ostringstream msg;
-      msg << "pass " << pass.index + 1 << " (v = " << pass.v << "): at s = " << pass.samples[at].s_mm
-          << " mm the ball is " << d << " mm from obstacle " << obstacle + 1 << ", less than `clearance` = " << clearance_mm
+      msg << "pass " << pass.index + 1 << " (v = " << pass.v
+          << "): at s = " << pass.samples[at].s_mm << " mm the ball is " << d
+          << " mm from obstacle " << obstacle + 1 << ", less than `clearance` = " << clearance_mm
           << " mm: the channel is narrower than the ball there (impeller.passes_v, width_in/out)";
       throw InputError(msg.str());
     }
@@ -63,8 +64,10 @@ Eigen::AlignedBox3d reachBox(const std::vector<Pass>& passes, const std::vector<
                              double lead_rad, double pad_mm) {
   Eigen::AlignedBox3d box;
   const double max_tilt = dyn.max_tilt_deg * kDegToRad, max_lead = dyn.max_lead_deg * kDegToRad;
-  const std::pair<double, double> corners[] = {{lead_rad, 0.0},       {max_lead, 0.0},
-                                               {-max_lead, 0.0},      {lead_rad, max_tilt},
+  const std::pair<double, double> corners[] = {{lead_rad, 0.0},
+                                               {max_lead, 0.0},
+                                               {-max_lead, 0.0},
+                                               {lead_rad, max_tilt},
                                                {lead_rad, -max_tilt}};
   for (const Pass& pass : passes) {
     const size_t stride = std::max<size_t>(1, pass.samples.size() / 16);
@@ -86,8 +89,8 @@ Eigen::AlignedBox3d reachBox(const std::vector<Pass>& passes, const std::vector<
 
 }  // namespace
 
-std::vector<geometry::TriangleMesh> obstacleMeshes(const Impeller& impeller,
-                                                   const std::vector<geometry::TriangleMesh>& extra) {
+std::vector<geometry::TriangleMesh> obstacleMeshes(
+    const Impeller& impeller, const std::vector<geometry::TriangleMesh>& extra) {
   std::vector<geometry::TriangleMesh> meshes = {impeller.bladeMesh(0), impeller.bladeMesh(1)};
   meshes.insert(meshes.end(), extra.begin(), extra.end());
   return meshes;
@@ -212,8 +215,8 @@ GenerateResult generateImpellerPath(const GenerateRequest& request) {
     steer.progress = scaled(request.progress, begin, end, label);
     const dynamics::SteeringResult steered = dynamics::steerPass(dyn_pass, steer);
     if (steered.status != dynamics::Status::Ok)
-      throw InputError(label + " (v = " + std::to_string(pass.v) + "): " +
-                       dynamics::toString(steered.status) + ": " + steered.message);
+      throw InputError(label + " (v = " + std::to_string(pass.v) +
+                       "): " + dynamics::toString(steered.status) + ": " + steered.message);
     for (const dynamics::PostureSample& s : steered.samples) {
       GeneratedPosture g;
       g.pass = pass.index;

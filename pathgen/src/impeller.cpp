@@ -51,8 +51,10 @@ geometry::TriangleMesh gridMesh(const std::function<Vec3(double, double)>& p, do
       const double a = i * d, b = j * d;
       m_aa = std::max(m_aa, ((p(a + d, b) - 2 * p(a, b) + p(a - d, b)) / (d * d)).norm());
       m_bb = std::max(m_bb, ((p(a, b + d) - 2 * p(a, b) + p(a, b - d)) / (d * d)).norm());
-      m_ab = std::max(m_ab, ((p(a + d, b + d) - p(a + d, b - d) - p(a - d, b + d) +
-                              p(a - d, b - d)) / (4 * d * d)).norm());
+      m_ab = std::max(
+          m_ab,
+          ((p(a + d, b + d) - p(a + d, b - d) - p(a - d, b + d) + p(a - d, b - d)) / (4 * d * d))
+              .norm());
     }
   }
   double length_a = 0, length_b = 0;  // longest iso-lines, mm
@@ -138,15 +140,14 @@ Impeller::Impeller(const ImpellerParams& params) : params_(params) {
     if (u < 0.0 || u > 1.0)
       throw InputError("impeller.u_range: must lie in [0, 1] (got " + fmt(u) + ")");
   }
-  if (p.u_range[1] < p.u_range[0])
-    throw InputError("impeller.u_range: end before start");
+  if (p.u_range[1] < p.u_range[0]) throw InputError("impeller.u_range: end before start");
   if (std::abs(p.hub_dish_mm) > 0.25 * std::min(p.width_in_mm, p.width_out_mm))
     throw InputError("impeller.hub_dish: must stay below a quarter of the channel width");
   double at_u = 0.0;
   const double gap_mm = minGapMm(&at_u);
   if (gap_mm <= 0.0)
-    throw InputError("impeller.lean_left_deg/lean_right_deg: the blades cross at u = " +
-                     fmt(at_u) + " (gap across the channel " + fmt(gap_mm) + " mm)");
+    throw InputError("impeller.lean_left_deg/lean_right_deg: the blades cross at u = " + fmt(at_u) +
+                     " (gap across the channel " + fmt(gap_mm) + " mm)");
 }
 
 double Impeller::halfWidth(double u) const {
@@ -227,7 +228,7 @@ double Impeller::minGapMm(double* at_u) const {
   for (int i = 0; i <= kSamples; ++i) {
     const double u = static_cast<double>(i) / kSamples;
     const Vec3 across = footInward(0, u);  // left → right, horizontal
-    for (double t : {0.0, 1.0}) {  // the gap is linear in t along the rulings
+    for (double t : {0.0, 1.0}) {          // the gap is linear in t along the rulings
       const double gap = (blade(1, u, t) - blade(0, u, t)).dot(across);
       if (gap < best) {
         best = gap;

@@ -16,7 +16,8 @@ namespace {
 TriangleMesh box(const Vec3& lo, const Vec3& hi) {
   TriangleMesh m;
   for (int i = 0; i < 8; ++i)
-    m.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+    m.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(),
+                            i & 4 ? hi.z() : lo.z());
   const int f[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
                         {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
   for (const auto& t : f) m.triangles.emplace_back(t[0], t[1], t[2]);
@@ -46,7 +47,8 @@ TEST(Clearance, BoxToolBesideAWallClosedForm) {
   Posture tilted;
   tilted.axis = Vec3(std::sin(theta), 0, std::cos(theta));
   int nearest = -1;
-  EXPECT_NEAR(checker.clearance(tilted, &nearest), 5.0 - (10 * std::sin(theta) + std::cos(theta)), 1e-9);
+  EXPECT_NEAR(checker.clearance(tilted, &nearest), 5.0 - (10 * std::sin(theta) + std::cos(theta)),
+              1e-9);
   EXPECT_EQ(nearest, 0);
 
   Posture crossing;
@@ -54,7 +56,8 @@ TEST(Clearance, BoxToolBesideAWallClosedForm) {
   Posture beyond;
   beyond.tip_mm = Vec3(-17, 0, 0);  // 2 mm from the second wall
   const std::vector<Posture> postures = {upright, tilted, crossing, beyond, crossing};
-  const auto result = checker.check(postures, pathgen::ClearanceRequest{.per_posture = true, .batch = 2});
+  const auto result =
+      checker.check(postures, pathgen::ClearanceRequest{.per_posture = true, .batch = 2});
   EXPECT_EQ(result.postures, 5u);
   EXPECT_EQ(result.colliding, 2u);
   EXPECT_EQ(result.first_colliding, 2u);
@@ -76,4 +79,20 @@ TEST(Clearance, EmptyMeshIsBadInput) {
   const std::vector<TriangleMesh> obstacles = {TriangleMesh{}};
   EXPECT_THROW(pathgen::ClearanceChecker(box(Vec3(-1, -1, 0), Vec3(1, 1, 1)), obstacles),
                common::InputError);
+}
+
+// Closed form: a ball of radius 1 centred 5 mm from the wall x = 5 clears it by 4 mm; the
+// nearest of several centres is reported.
+TEST(Clearance, BallClearanceIsCentreDistanceLessTheRadius) {
+  const TriangleMesh tool = box(Vec3(-1, -1, 0), Vec3(1, 1, 10));
+  const std::vector<TriangleMesh> obstacles = {wall(5.0), wall(-20.0)};
+  const pathgen::ClearanceChecker checker(tool, obstacles);
+  const std::vector<Vec3> centres = {Vec3(0, 0, 0), Vec3(2.5, 3, -4), Vec3(-10, 0, 0)};
+  std::size_t at = 99;
+  int obstacle = -1;
+  EXPECT_NEAR(checker.ballClearance(centres, 1.0, &at, &obstacle), 1.5, 1e-3);
+  EXPECT_EQ(at, 1u);
+  EXPECT_EQ(obstacle, 0);
+  const std::vector<Vec3> touching = {Vec3(4.5, 0, 0)};
+  EXPECT_EQ(checker.ballClearance(touching, 1.0), 0.0);
 }

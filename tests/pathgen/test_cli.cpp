@@ -9,8 +9,8 @@
 #include <sstream>
 #include <string>
 
-#include <unistd.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -34,7 +34,8 @@ Outcome run(const std::string& args) {
   FILE* pipe = popen(command.c_str(), "r");
   std::string output;
   std::array<char, 4096> buffer;
-  while (std::size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) output.append(buffer.data(), n);
+  while (std::size_t n = fread(buffer.data(), 1, buffer.size(), pipe))
+    output.append(buffer.data(), n);
   const int status = pclose(pipe);
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
 }
@@ -67,7 +68,8 @@ class ImpellerRun : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("fieldpath_test_cli_" + std::to_string(getpid()));
     fs::remove_all(dir_);
     field_ = run("generate '" + kScene.string() + "' --out '" + (dir_ / "field").string() + "'");
-    nominal_ = run("generate '" + kScene.string() + "' --nominal --out '" + (dir_ / "nominal").string() + "'");
+    nominal_ = run("generate '" + kScene.string() + "' --nominal --out '" +
+                   (dir_ / "nominal").string() + "'");
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
   static inline fs::path dir_;
@@ -97,15 +99,17 @@ TEST_F(ImpellerRun, MatchesTheGoldenSummary) {
   }
   // The point of the example: the field path is clear, the nominal one collides.
   EXPECT_TRUE(field["clearance"]["ok"].get<bool>());
-  EXPECT_GE(field["clearance"]["min_mm"].get<double>(), field["clearance"]["required_mm"].get<double>());
+  EXPECT_GE(field["clearance"]["min_mm"].get<double>(),
+            field["clearance"]["required_mm"].get<double>());
   EXPECT_GT(nominal["clearance"]["colliding_postures"].get<int>(), 0);
   EXPECT_EQ(field["counts"]["obstacle_points"].get<int>(), 5100);
 }
 
 TEST_F(ImpellerRun, GenerateClCheckRoundTrip) {
   ASSERT_EQ(field_.exit_code, 0) << field_.output;
-  const Outcome check = run("check '" + kScene.string() + "' --path '" + (dir_ / "field/path.cl").string() +
-                        "' --spacing 0.1 --backend cpu --out '" + (dir_ / "field").string() + "'");
+  const Outcome check =
+      run("check '" + kScene.string() + "' --path '" + (dir_ / "field/path.cl").string() +
+          "' --spacing 0.1 --backend cpu --out '" + (dir_ / "field").string() + "'");
   ASSERT_EQ(check.exit_code, 0) << check.output;
   const auto generated = readJson(dir_ / "field/report.json");
   const auto checked = readJson(dir_ / "field/check.json");
@@ -119,8 +123,9 @@ TEST_F(ImpellerRun, GenerateClCheckRoundTrip) {
   EXPECT_GT(checked["surface"]["max_scallop_um"].get<double>(), 100.0);
   EXPECT_TRUE(fs::exists(dir_ / "field/deviation.png"));
 
-  const Outcome nominal_check = run("check '" + kScene.string() + "' --path '" +
-                                (dir_ / "nominal/path.cl").string() + "' --spacing 0.2 --backend cpu");
+  const Outcome nominal_check =
+      run("check '" + kScene.string() + "' --path '" + (dir_ / "nominal/path.cl").string() +
+          "' --spacing 0.2 --backend cpu");
   EXPECT_EQ(nominal_check.exit_code, 0) << nominal_check.output;  // collisions are reported, exit 0
   EXPECT_NE(nominal_check.output.find("COLLISIONS"), std::string::npos) << nominal_check.output;
 }
@@ -136,7 +141,8 @@ TEST_F(ImpellerRun, AptReadBackEqualsTheClPostures) {
   }
 }
 
-/// The example scene with impeller keys replaced (or added when absent), written to a temporary file.
+/// The example scene with impeller keys replaced (or added when absent), written to a temporary
+/// file.
 fs::path badScene(const std::string& name, const std::map<std::string, std::string>& keys) {
   std::ifstream in(kScene);
   std::string yaml, line;
@@ -155,8 +161,8 @@ fs::path badScene(const std::string& name, const std::map<std::string, std::stri
     const auto at = yaml.find(anchor + "\n") + anchor.size() + 1;
     yaml.insert(at, "      " + key + ": " + value + "\n");
   }
-  const fs::path file =
-      fs::temp_directory_path() / ("fieldpath_bad_" + name + "_" + std::to_string(getpid()) + ".yaml");
+  const fs::path file = fs::temp_directory_path() /
+                        ("fieldpath_bad_" + name + "_" + std::to_string(getpid()) + ".yaml");
   std::ofstream(file) << yaml;
   return file;
 }
@@ -164,7 +170,8 @@ fs::path badScene(const std::string& name, const std::map<std::string, std::stri
 void expectBadScene(const std::string& name, const std::map<std::string, std::string>& keys,
                     std::initializer_list<std::string> expected) {
   const fs::path scene = badScene(name, keys);
-  const fs::path out = fs::temp_directory_path() / ("fieldpath_bad_out_" + std::to_string(getpid()));
+  const fs::path out =
+      fs::temp_directory_path() / ("fieldpath_bad_out_" + std::to_string(getpid()));
   const Outcome r = run("generate '" + scene.string() + "' --out '" + out.string() + "'");
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;  // one line
@@ -178,7 +185,10 @@ TEST(BadScenes, ExitOneWithALineNamingThePassOrKey) {
   expectBadScene("cross", {{"lean_left_deg", "[60, 60]"}, {"lean_right_deg", "[60, 60]"}},
                  {"lean_left_deg", "blades cross"});
   expectBadScene("narrow",
-                 {{"width_in", "8"}, {"width_out", "8"}, {"lean_left_deg", "[0, 0]"}, {"lean_right_deg", "[0, 0]"}},
+                 {{"width_in", "8"},
+                  {"width_out", "8"},
+                  {"lean_left_deg", "[0, 0]"},
+                  {"lean_right_deg", "[0, 0]"}},
                  {"pass 1", "narrower than the ball"});
   expectBadScene("empty", {{"u_range", "[0.5, 0.5]"}}, {"pass 1", "empty"});
   expectBadScene("unknown", {{"spoke", "3"}}, {"obstacles.impeller.spoke", "unknown key"});

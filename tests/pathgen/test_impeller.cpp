@@ -3,9 +3,9 @@
 #include <gtest/gtest.h>
 
 #include "fieldpath/common/errors.h"
-#include "fixtures.h"
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/pathgen/impeller.h"
+#include "fixtures.h"
 
 using namespace fieldpath;
 using pathgen::Impeller;
@@ -72,7 +72,8 @@ TEST(Impeller, MeshesStayWithinTheChordTolerance) {
   for (const auto& t : hub.triangles) {
     const Vec3 c = (hub.vertices[t[0]] + hub.vertices[t[1]] + hub.vertices[t[2]]) / 3.0;
     worst_mm = std::max(worst_mm, std::abs(c.z() - imp.hubHeight(c.x(), c.y())));
-    const Vec3 n = (hub.vertices[t[1]] - hub.vertices[t[0]]).cross(hub.vertices[t[2]] - hub.vertices[t[0]]);
+    const Vec3 n =
+        (hub.vertices[t[1]] - hub.vertices[t[0]]).cross(hub.vertices[t[2]] - hub.vertices[t[0]]);
     ASSERT_GT(n.z(), 0.0);  // normals up
   }
   EXPECT_LE(worst_mm, p.chord_tol_mm);
@@ -82,7 +83,8 @@ TEST(Impeller, MeshesStayWithinTheChordTolerance) {
   EXPECT_EQ(report.degenerate_triangles, 0u);
   EXPECT_EQ(report.inconsistent_edges, 0u);
   const auto& t = blade.triangles[blade.triangles.size() / 2];
-  const Vec3 n = (blade.vertices[t[1]] - blade.vertices[t[0]]).cross(blade.vertices[t[2]] - blade.vertices[t[0]]);
+  const Vec3 n = (blade.vertices[t[1]] - blade.vertices[t[0]])
+                     .cross(blade.vertices[t[2]] - blade.vertices[t[0]]);
   EXPECT_GT(n.dot(imp.hub(0.5, 1) - imp.hub(0.5, 0)), 0.0);  // left blade faces the channel
 }
 

@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "fieldpath/common/errors.h"
-#include "fixtures.h"
 #include "fieldpath/pathgen/passes.h"
+#include "fixtures.h"
 
 using namespace fieldpath;
 using namespace fieldpath::pathgen;

@@ -26,11 +26,11 @@ struct ClearanceResult {
   std::size_t postures = 0;
   /// Smallest distance tool + holder ↔ obstacles over all postures, mm; 0 when any collides.
   double min_clearance_mm = std::numeric_limits<double>::infinity();
-  std::size_t min_index = npos;     ///< posture of the minimum (the first colliding one if any)
-  int min_obstacle = -1;            ///< obstacle index of the minimum
-  std::size_t colliding = 0;        ///< postures that touch or cross an obstacle (collide() or d ≤ 0)
+  std::size_t min_index = npos;  ///< posture of the minimum (the first colliding one if any)
+  int min_obstacle = -1;         ///< obstacle index of the minimum
+  std::size_t colliding = 0;  ///< postures that touch or cross an obstacle (collide() or d ≤ 0)
   std::size_t first_colliding = npos;
-  std::vector<double> clearance_mm; ///< per posture, mm; 0 for colliding ones (if per_posture)
+  std::vector<double> clearance_mm;  ///< per posture, mm; 0 for colliding ones (if per_posture)
 };
 
 /// Tool + holder mesh (tool frame: tip at the origin, axis +z) against fixed obstacle meshes.
@@ -53,8 +53,8 @@ class ClearanceChecker {
   /// Smallest distance (mm) from a ball of `radius_mm` at each centre (world frame) to the
   /// obstacles, 0 if one touches; `at` and `obstacle` receive where. The ball of a ball-end mill
   /// must clear the obstacles whatever the axis: exact (centre-to-mesh distance less the radius).
-  double ballClearance(std::span<const Vec3> centres_mm, double radius_mm, std::size_t* at = nullptr,
-                       int* obstacle = nullptr) const;
+  double ballClearance(std::span<const Vec3> centres_mm, double radius_mm,
+                       std::size_t* at = nullptr, int* obstacle = nullptr) const;
 
   std::size_t obstacleCount() const;
 

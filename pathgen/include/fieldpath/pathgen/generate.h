@@ -21,7 +21,8 @@
 
 namespace fieldpath::pathgen {
 
-/// BruteForce: every obstacle point for every node (seed 004's direct method; the study's timing peer).
+/// BruteForce: every obstacle point for every node (seed 004's direct method; the study's timing
+/// peer).
 enum class FieldMode { Voxel, Direct, BruteForce };
 
 struct GenerateRequest {
@@ -33,7 +34,8 @@ struct GenerateRequest {
   dynamics::DynamicsParams dynamics;
   geometry::ToolSpec tool;
   geometry::HolderProfile holder;
-  double clearance_mm = 0.5;  ///< required min distance tool + holder ↔ obstacles (reported against)
+  double clearance_mm =
+      0.5;  ///< required min distance tool + holder ↔ obstacles (reported against)
   FieldMode mode = FieldMode::Voxel;
   /// Nominal path: the axis stays on the nominal angles (no field, no dynamics).
   bool nominal = false;
@@ -42,10 +44,10 @@ struct GenerateRequest {
 
 /// One output posture with what the dynamics and the clearance check say about it.
 struct GeneratedPosture {
-  int pass = 0;         ///< 0-based
-  double s_mm = 0.0;    ///< arc length along the pass
+  int pass = 0;       ///< 0-based
+  double s_mm = 0.0;  ///< arc length along the pass
   double lead_rad = 0.0, tilt_rad = 0.0;
-  double moment = 0.0;  ///< |M| of the field about the ball centre (0 for the nominal path)
+  double moment = 0.0;        ///< |M| of the field about the ball centre (0 for the nominal path)
   double clearance_mm = 0.0;  ///< exact (FCL) nearest distance to the obstacles; 0 if colliding
   geometry::Posture posture;
 };
@@ -65,8 +67,8 @@ struct GenerateResult {
   std::size_t tool_triangles = 0;   ///< of the clearance mesh
   std::size_t voxel_nodes = 0;      ///< active nodes (voxel mode)
   std::size_t voxel_memory_bytes = 0;
-  Eigen::AlignedBox3d reach_box_mm; ///< region of the voxels: what tool + holder can reach
-  double path_length_mm = 0;        ///< sum of the pass lengths (ball centre)
+  Eigen::AlignedBox3d reach_box_mm;  ///< region of the voxels: what tool + holder can reach
+  double path_length_mm = 0;         ///< sum of the pass lengths (ball centre)
   double max_tilt_deg = 0, max_lead_deg = 0;  ///< largest |angle| on the path
   long solver_steps = 0, rhs_evals = 0, jacobian_evals = 0, error_test_failures = 0,
        convergence_failures = 0;

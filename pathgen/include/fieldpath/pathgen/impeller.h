@@ -1,7 +1,7 @@
 #pragma once
-/// The parametric impeller channel ("veine", seed 004 Fig. 2): a hub (the guide surface, machined by
-/// the ball end) between two twisted blade walls (ruled surfaces, the obstacles), narrowing along
-/// its length. World frame, mm: x along the channel, y across it (left blade at low y), z up.
+/// The parametric impeller channel ("veine", seed 004 Fig. 2): a hub (the guide surface, machined
+/// by the ball end) between two twisted blade walls (ruled surfaces, the obstacles), narrowing
+/// along its length. World frame, mm: x along the channel, y across it (left blade at low y), z up.
 ///
 /// Hub: S(u, v), u ∈ [0, 1] along the channel, v ∈ [0, 1] across it (0 = foot of the left blade,
 /// 1 = foot of the right one). It is also a smooth height field z = h(x, y), so the Z-buffer can be
@@ -25,13 +25,13 @@ using geometry::Vec3;
 /// Scene `impeller: {...}` keys (examples/impeller/scene.yaml documents them). Defaults, once,
 /// here: sized like seed 004's case (7 passes ≈ 500 mm, blades ≈ 5100 points at 1 mm).
 struct ImpellerParams {
-  double length_mm = 72.0;       ///< `length`: channel length along x
-  double width_in_mm = 34.0;     ///< `width_in`: hub width between the blade feet at u = 0
-  double width_out_mm = 22.0;    ///< `width_out`: at u = 1 (the channel narrows)
-  double bend_mm = 10.0;         ///< `bend`: centreline y offset at u = 1 (y_c = bend u²)
-  double hub_rise_mm = 12.0;     ///< `hub_rise`: hub height at u = 1 on the centreline (+ dish)
-  double hub_dish_mm = 1.0;      ///< `hub_dish`: hub centre below its edges (concave across)
-  double blade_height_mm = 16.5; ///< `blade_height`: ruling length, foot to tip
+  double length_mm = 72.0;        ///< `length`: channel length along x
+  double width_in_mm = 34.0;      ///< `width_in`: hub width between the blade feet at u = 0
+  double width_out_mm = 22.0;     ///< `width_out`: at u = 1 (the channel narrows)
+  double bend_mm = 10.0;          ///< `bend`: centreline y offset at u = 1 (y_c = bend u²)
+  double hub_rise_mm = 12.0;      ///< `hub_rise`: hub height at u = 1 on the centreline (+ dish)
+  double hub_dish_mm = 1.0;       ///< `hub_dish`: hub centre below its edges (concave across)
+  double blade_height_mm = 16.5;  ///< `blade_height`: ruling length, foot to tip
   /// `lean_left_deg: [in, out]`: left blade lean at u = 0 and u = 1 (> 0 over the channel).
   std::array<double, 2> lean_left_deg = {4.0, 24.0};
   /// `lean_right_deg: [in, out]`: right blade lean (> 0 over the channel, < 0 away from it).
@@ -40,7 +40,7 @@ struct ImpellerParams {
   std::array<double, 2> passes_v = {0.25, 0.82};
   /// `u_range: [start, end]`: the part of the channel the passes cover.
   std::array<double, 2> u_range = {0.0, 1.0};
-  double chord_tol_mm = 0.01;    ///< `chord_tol`: meshes within this of the surfaces
+  double chord_tol_mm = 0.01;  ///< `chord_tol`: meshes within this of the surfaces
 };
 
 /// The evaluated impeller: surfaces, their derivatives and meshes. A value type.
