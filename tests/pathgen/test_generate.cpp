@@ -1,0 +1,67 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/pathgen/generate.h"
+#include "fixtures.h"
+
+using namespace fieldpath;
+using namespace fieldpath::pathgen;
+
+namespace {
+
+GenerateRequest flatJob() {
+  GenerateRequest job;
+  job.impeller = test::flatChannel();
+  job.impeller.width_in_mm = job.impeller.width_out_mm = 44;  // walls 20 mm from the passes
+  job.impeller.passes_v = {0.45, 0.55};
+  job.path.passes = 2;
+  job.path.step_mm = 1.0;
+  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
+  job.holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
+  job.mode = FieldMode::Direct;
+  return job;
+}
+
+}  // namespace
+
+// Closed form: walls beyond r0 of every node exert no force, so the steered path is the nominal
+// one — axis on the hub normal (+z), tip = C - R a on the hub (z = 0), tilt and lead 0.
+TEST(Generate, NoForceGivesTheNominalPath) {
+  const GenerateResult field = generateImpellerPath(flatJob());
+  GenerateRequest nominal_job = flatJob();
+  nominal_job.nominal = true;
+  const GenerateResult nominal = generateImpellerPath(nominal_job);
+  ASSERT_EQ(field.postures.size(), nominal.postures.size());
+  ASSERT_EQ(field.postures.size(), 2u * 73u);  // 72 mm at 1 mm, ends included
+  for (size_t i = 0; i < field.postures.size(); ++i) {
+    const auto& g = field.postures[i];
+    EXPECT_NEAR(g.tilt_rad, 0.0, 1e-12);
+    EXPECT_NEAR(g.lead_rad, 0.0, 1e-12);
+    EXPECT_NEAR((g.posture.axis - Vec3::UnitZ()).norm(), 0.0, 1e-9);
+    EXPECT_NEAR(g.posture.tip_mm.z(), 0.0, 1e-9);
+    EXPECT_NEAR((g.posture.tip_mm - nominal.postures[i].posture.tip_mm).norm(), 0.0, 1e-9);
+    // The nearest wall is 22 - 2.2 - 3 mm from the shank's side (pass at v = 0.45 of 44 mm).
+    EXPECT_GT(g.clearance_mm, 10.0);
+  }
+  EXPECT_EQ(field.clearance.colliding, 0u);
+  EXPECT_NEAR(field.path_length_mm, 144.0, 1e-9);
+  EXPECT_EQ(field.obstacle_points > 0, true);
+  EXPECT_GT(field.tool_nodes, 400u);
+  EXPECT_LT(field.tool_nodes, 700u);
+}
+
+TEST(Generate, BadToolAndClearanceNameTheirKey) {
+  GenerateRequest job = flatJob();
+  job.tool.shape = geometry::ToolShape::Flat;
+  EXPECT_THROW(generateImpellerPath(job), common::InputError);
+  job = flatJob();
+  job.clearance_mm = -1;
+  try {
+    generateImpellerPath(job);
+    FAIL();
+  } catch (const common::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("clearance"), std::string::npos);
+  }
+}
