@@ -256,22 +256,11 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     stats.max_scallop_um = max_dev;
 
     using nlohmann::json;
-    auto index = [](std::size_t i) {
-      return i == pathgen::ClearanceResult::npos ? json(nullptr) : json(i);
-    };
     const json report = {
         {"scene", scene.file.string()},
         {"path", options->path},
         {"postures", postures.size()},
-        {"clearance",
-         {{"required_mm", job.clearance_mm},
-          {"min_mm", clearance.min_clearance_mm},
-          {"min_posture", index(clearance.min_index)},
-          {"min_obstacle", clearance.min_obstacle + 1},
-          {"colliding_postures", clearance.colliding},
-          {"first_colliding_posture", index(clearance.first_colliding)},
-          {"tool_mesh_chord_tol_mm", pathgen::kClearanceMeshTolMm},
-          {"ok", clearance.colliding == 0 && clearance.min_clearance_mm >= job.clearance_mm}}},
+        {"clearance", clearanceJson(clearance, job.clearance_mm)},
         {"surface",
          {{"grid",
            {{"origin", {sim.grid.x0_mm, sim.grid.y0_mm}},

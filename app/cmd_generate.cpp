@@ -56,11 +56,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
                       {"max_tilt_deg", max_tilt},
                       {"colliding_postures", colliding}});
   }
-  const auto& c = r.clearance;
   const auto& box = r.reach_box_mm;
-  auto index = [](std::size_t i) {
-    return i == pathgen::ClearanceResult::npos ? json(nullptr) : json(i);
-  };
   return {
       {"scene", scene.file.string()},
       {"field_mode", job.nominal ? "nominal" : modeName(job.mode)},
@@ -87,14 +83,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
        {{"min", {box.min().x(), box.min().y(), box.min().z()}},
         {"max", {box.max().x(), box.max().y(), box.max().z()}},
         {"volume_cm3", box.volume() / 1000.0}}},
-      {"clearance",
-       {{"required_mm", job.clearance_mm},
-        {"min_mm", c.min_clearance_mm},
-        {"min_posture", index(c.min_index)},
-        {"min_obstacle", c.min_obstacle + 1},
-        {"colliding_postures", c.colliding},
-        {"first_colliding_posture", index(c.first_colliding)},
-        {"ok", c.colliding == 0 && c.min_clearance_mm >= job.clearance_mm}}},
+      {"clearance", clearanceJson(r.clearance, job.clearance_mm)},
       {"max_tilt_deg", r.max_tilt_deg},
       {"max_lead_deg", r.max_lead_deg},
       {"solver",
@@ -122,9 +111,9 @@ std::string anglesCsv(const pathgen::GenerateResult& r) {
 void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
   auto* cmd = app.add_subcommand(
       "generate",
-      "Generate the impeller path of a scene: isoparametric passes on the hub, tool axis steered "
-      "by "
-      "the repulsive field (CVODE), exact clearance (FCL). Writes path.cl, path.apt, angles.csv, "
+      "Generate the impeller path of a scene: isoparametric passes on the hub, tool axis "
+      "steered by the repulsive field (CVODE), exact clearance (FCL). Writes path.cl, path.apt, "
+      "angles.csv, "
       "report.json");
   struct Options {
     std::string scene, out;
