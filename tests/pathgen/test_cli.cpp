@@ -195,3 +195,46 @@ TEST(BadScenes, ExitOneWithALineNamingThePassOrKey) {
 }
 
 }  // namespace
+
+namespace {
+
+// Closed form for the surface check: on a flat straight channel two straight passes 2 d apart
+// leave a scallop of height R - sqrt(R² - d²) midway, and nothing below the hub.
+TEST(CheckSurface, ScallopBetweenTwoStraightPassesIsClosedForm) {
+  const fs::path scene = badScene("flat", {{"width_in", "44"},
+                                           {"width_out", "44"},
+                                           {"bend", "0"},
+                                           {"hub_rise", "0"},
+                                           {"hub_dish", "0"},
+                                           {"lean_left_deg", "[0, 0]"},
+                                           {"lean_right_deg", "[0, 0]"},
+                                           {"passes_v", "[0.45, 0.55]"}});
+  std::string yaml;
+  {
+    std::ifstream in(scene);
+    std::stringstream text;
+    text << in.rdbuf();
+    yaml = text.str();
+  }
+  yaml.replace(yaml.find("  passes: 7"), 11, "  passes: 2");
+  std::ofstream(scene) << yaml;
+  const fs::path out = fs::temp_directory_path() / ("fieldpath_flat_" + std::to_string(getpid()));
+  const Outcome gen =
+      run("generate '" + scene.string() + "' --nominal --out '" + out.string() + "'");
+  ASSERT_EQ(gen.exit_code, 0) << gen.output;
+  const Outcome check = run("check '" + scene.string() + "' --path '" + (out / "path.cl").string() +
+                            "' --spacing 0.02 --backend cpu --out '" + out.string() + "'");
+  ASSERT_EQ(check.exit_code, 0) << check.output;
+  const auto report = readJson(out / "check.json");
+  const double r = 3.0, d = 0.5 * 0.1 * 44.0;  // passes at v = 0.45, 0.55 of 44 mm
+  const double scallop_um = 1000.0 * (r - std::sqrt(r * r - d * d));
+  // Lines lie within half a spacing of the midline: slope there d / sqrt(R² - d²).
+  const double tolerance_um = 1000.0 * 0.01 * d / std::sqrt(r * r - d * d) + 1.0;
+  EXPECT_NEAR(report["surface"]["max_scallop_um"].get<double>(), scallop_um, tolerance_um);
+  EXPECT_LT(report["surface"]["max_gouge_um"].get<double>(), 0.5);
+  EXPECT_EQ(report["clearance"]["colliding_postures"].get<int>(), 0);
+  fs::remove(scene);
+  fs::remove_all(out);
+}
+
+}  // namespace
