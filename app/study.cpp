@@ -288,7 +288,8 @@ StudyResult runStudy(const StudyRequest& request) {
       row.failure = e.what();
       row.times = {kNaN, kNaN, kNaN, kNaN, kNaN};
       row.total_s = row.speedup_vs_brute = row.speedup_vs_direct = kNaN;
-      row.tilt_max_deg = row.tilt_rms_deg = row.min_clearance_mm = row.max_tilt_deg = kNaN;
+      row.tilt_max_deg = row.tilt_rms_deg = row.tilt_middle_max_deg = kNaN;
+      row.min_clearance_mm = row.max_tilt_deg = kNaN;
       runs.emplace_back();
       result.rows.push_back(row);
       continue;
@@ -335,7 +336,9 @@ StudyResult runStudy(const StudyRequest& request) {
       const double d = std::abs(postures[k].tilt_rad - direct_run.postures[k].tilt_rad) * kRadToDeg;
       row.tilt_max_deg = std::max(row.tilt_max_deg, d);
       sum_sq += d * d;
-      if (postures[k].pass == result.middle_pass) tilt.push_back(postures[k].tilt_rad * kRadToDeg);
+      if (postures[k].pass != result.middle_pass) continue;
+      tilt.push_back(postures[k].tilt_rad * kRadToDeg);
+      row.tilt_middle_max_deg = std::max(row.tilt_middle_max_deg, d);
     }
     row.tilt_rms_deg = postures.empty() ? 0.0 : std::sqrt(sum_sq / double(postures.size()));
     result.tilt_deg.push_back(std::move(tilt));
@@ -482,7 +485,8 @@ std::string csvText(const StudyResult& r) {
   s << "variant,mode,voxel_mm,interpolation,status,active_nodes,dense_box_nodes,voxel_memory_mb,"
        "field_s,path_s,clearance_s,total_s,speedup_vs_brute,speedup_vs_direct,"
        "line_a_max_pct,line_a_rms_pct,line_b_max_pct,line_b_rms_pct,nodes_max_pct,nodes_rms_pct,"
-       "max_force_error_pct,nodes_max_scaled_pct,tilt_max_deg,tilt_rms_deg,min_clearance_mm,"
+       "max_force_error_pct,nodes_max_scaled_pct,tilt_max_deg,tilt_rms_deg,tilt_middle_max_deg,"
+       "min_clearance_mm,"
        "colliding,max_tilt_deg,solver_steps,rhs_evals\n";
   for (const StudyRow& row : r.rows) {
     const StudyVariant& v = row.variant;
@@ -499,7 +503,8 @@ std::string csvText(const StudyResult& r) {
       << number(100 * row.nodes.relative.max_relative) << ','
       << number(100 * row.nodes.relative.rms_relative) << ',' << number(100 * maxForceError(row))
       << ',' << number(100 * row.nodes.max_scaled) << ',' << number(row.tilt_max_deg) << ','
-      << number(row.tilt_rms_deg) << ',' << number(row.min_clearance_mm) << ',' << row.colliding
+      << number(row.tilt_rms_deg) << ',' << number(row.tilt_middle_max_deg) << ','
+      << number(row.min_clearance_mm) << ',' << row.colliding
       << ',' << number(row.max_tilt_deg) << ',' << row.solver_steps << ',' << row.rhs_evals
       << '\n';
   }
@@ -563,10 +568,11 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
     << "## Definitions\n\n"
     << "- **Relative force error** at a point x: `|F_v(x) - F_d(x)| / |F_d(x)|`, F_d the indexed"
     << " direct field (exact eq. 1), counted where `|F_d(x)| >= " << kErrorFloorFraction * 100
-    << " % of max |F_d|` over the same set (line or nodes) and x is at least `clearance` from"
-    << " every obstacle. Why: the field fades to 0 at r0, where any relative error is"
-    << " meaningless and the nodes add nothing to the moment; points closer to a wall than"
-    << " `clearance` are never occupied by a valid path. `nodes scaled` is `|ΔF| / max |F_d|` over"
+    << " % of max |F_d|` over the same set (line or nodes) and, on the lines, x is at least"
+    << " `clearance` from every obstacle (FCL) and inside the region tool + holder can reach."
+    << " Why: the field fades to 0 at r0, where any relative error is meaningless and the nodes"
+    << " add nothing to the moment; points closer to a wall than `clearance` or out of reach are"
+    << " never occupied by a valid path (and the voxels exist only in reach). `nodes scaled` is `|ΔF| / max |F_d|` over"
     << " all nodes (no floor), the error relative to the largest force on the tool.\n"
     << "- **Max force error** of a variant: the largest relative error over line a, line b and the"
     << " nodes.\n"
@@ -603,8 +609,8 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
   s << "\n## Table 2: what it breaks (errors in %, tilt in degrees)\n\n"
     << "| variant | line a max | line a rms | line b max | line b rms | nodes max | nodes rms |"
        " nodes scaled max | max force error | tilt diff max ° | tilt diff rms ° |"
-       " min clearance mm | colliding |\n"
-    << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+       " tilt diff max °, middle pass | min clearance mm | colliding |\n"
+    << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const StudyRow& row : r.rows)
     s << "| " << row.variant.name() << " | " << fixed(100 * row.line_a.relative.max_relative, 3)
       << " | " << fixed(100 * row.line_a.relative.rms_relative, 3) << " | "
@@ -614,7 +620,7 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
       << fixed(100 * row.nodes.relative.rms_relative, 3) << " | "
       << fixed(100 * row.nodes.max_scaled, 3) << " | " << fixed(100 * maxForceError(row), 3)
       << " | " << fixed(row.tilt_max_deg, 4) << " | " << fixed(row.tilt_rms_deg, 4) << " | "
-      << fixed(row.min_clearance_mm, 3) << " | " << row.colliding << " |\n";
+      << fixed(row.tilt_middle_max_deg, 4) << " | " << fixed(row.min_clearance_mm, 3) << " | " << row.colliding << " |\n";
   s << "\n**Published (seed 004 Table 2; Matlab, linear interpolation, other hardware):**\n\n"
     << "| voxel | force variation | tilt difference |\n|---|---:|---:|\n";
   for (const Published& p : kPublished)

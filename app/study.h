@@ -9,7 +9,8 @@
 /// Relative force error at a point x (one definition for lines and nodes):
 ///   e(x) = |F_v(x) - F_d(x)| / |F_d(x)|,  F_d the indexed direct field (exact eq. 1),
 /// counted only where |F_d(x)| >= kErrorFloorFraction · max |F_d| over the same set (line or
-/// nodes) and x is at least `clearance` from every obstacle (the free space the tool may occupy).
+/// nodes) and, on the lines, x is at least `clearance` from every obstacle and inside the region
+/// tool + holder can reach (the free space a valid path may occupy; voxels exist only there).
 /// The floor drops the fringe near r0 where the field fades to zero: there the relative error of
 /// any interpolation means nothing, and those nodes add nothing to the moment. The error
 /// normalised by the set's max |F_d| (scaled) is reported beside it.
@@ -75,6 +76,7 @@ struct StudyRow {
   double speedup_vs_direct = 0.0;   ///< indexed direct total / this total
   ForceError line_a, line_b, nodes;
   double tilt_max_deg = 0.0, tilt_rms_deg = 0.0;  ///< |tilt - tilt_direct| over every posture
+  double tilt_middle_max_deg = 0.0;  ///< the same over the middle pass (seed 004 Table 2's)
   double min_clearance_mm = 0.0;    ///< FCL, of this variant's path
   std::size_t colliding = 0;
   double max_tilt_deg = 0.0;        ///< largest |tilt| of the path
