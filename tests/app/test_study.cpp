@@ -1,9 +1,11 @@
 // The voxel-size study (app/study.h) on a small impeller job: every csv cell finite, the two exact
 // methods agree, errors shrink as the voxels do.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdlib>
+#include <iterator>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "fieldpath/common/errors.h"
+#include "files.h"
 #include "study.h"
 
 namespace fieldpath::app {
@@ -149,6 +152,51 @@ TEST_F(StudyTest, ErrorsShrinkWithTheVoxelSize) {
     EXPECT_LT(fine.nodes.relative.rms_relative, coarse.nodes.relative.rms_relative);
     EXPECT_LT(fine.tilt_rms_deg, coarse.tilt_rms_deg);
   }
+}
+
+/// The small job as a scene file.
+constexpr const char* kSmallScene = R"(obstacles:
+  - impeller: { u_range: [0.55, 0.8], passes_v: [0.3, 0.7], chord_tol: 0.5 }
+guide: { impeller: hub }
+tool: { shape: ball, radius: 3, length: 40 }
+holder: [[40, 6], [55, 6], [55, 12], [90, 12]]
+clearance: 0.5
+dynamics: { max_tilt_deg: 45, max_lead_deg: 45 }
+path: { passes: 3, step: 1.0 }
+)";
+
+int runFieldpath(const test::TempDir& dir, const std::string& args) {
+  const std::string command = "cd '" + dir.path().string() + "' && '" FIELDPATH_EXE "' --quiet " +
+                              args + " > out.txt 2> err.txt";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(StudyCommand, WritesTablesAndPicturesOrSaysWhyNot) {
+  const test::TempDir dir;
+  dir.write("scene.yaml", kSmallScene);
+  ASSERT_EQ(runFieldpath(dir, "study scene.yaml --voxels 2,1 --interp trilinear --no-brute-force "
+                              "--line-step 0.2 --out study"),
+            0);
+  for (const char* file : {"study.csv", "study.md", "lines.csv", "tilt.csv"})
+    EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / file)) << file;
+  const Csv csv = readCsv(dir.path() / "study" / "study.csv");
+  EXPECT_EQ(csv.rows.size(), 3u);  // direct, 2 voxel sizes
+  // Pictures, unless python3/matplotlib is missing, which the command says on stderr.
+  std::ifstream err(dir.path() / "err.txt");
+  const std::string err_text((std::istreambuf_iterator<char>(err)), {});
+  if (err_text.find("pictures not made") == std::string::npos)
+    for (const char* file : {"speed_vs_error.png", "tilt_along_path.png", "force_error_lines.png"})
+      EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / file)) << file;
+}
+
+TEST(StudyCommand, BadInputIsExitOneWithNoOutputs) {
+  const test::TempDir dir;
+  dir.write("scene.yaml", kSmallScene);
+  EXPECT_EQ(runFieldpath(dir, "study scene.yaml --voxels 2,0 --out study"), 1);
+  EXPECT_EQ(runFieldpath(dir, "study scene.yaml --interp cubic --out study"), 1);
+  EXPECT_EQ(runFieldpath(dir, "study missing.yaml --out study"), 1);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "study"));
 }
 
 }  // namespace
