@@ -75,6 +75,7 @@ struct StudyRow {
   double speedup_vs_brute = 0.0;    ///< brute total / this total; NaN when brute force was skipped
   double speedup_vs_direct = 0.0;   ///< indexed direct total / this total
   ForceError line_a, line_b, nodes;
+  ForceError moment;  ///< of τ = Σ (x_i - C) × F(x_i) per posture of the direct path
   double tilt_max_deg = 0.0, tilt_rms_deg = 0.0;  ///< |tilt - tilt_direct| over every posture
   double tilt_middle_max_deg = 0.0;  ///< the same over the middle pass (seed 004 Table 2's)
   double min_clearance_mm = 0.0;    ///< FCL, of this variant's path

@@ -150,6 +150,7 @@ TEST_F(StudyTest, ErrorsShrinkWithTheVoxelSize) {
     EXPECT_LT(fine.line_b.relative.rms_relative, coarse.line_b.relative.rms_relative);
     EXPECT_LT(fine.nodes.relative.max_relative, coarse.nodes.relative.max_relative);
     EXPECT_LT(fine.nodes.relative.rms_relative, coarse.nodes.relative.rms_relative);
+    EXPECT_LT(fine.moment.relative.max_relative, coarse.moment.relative.max_relative);
     EXPECT_LT(fine.tilt_rms_deg, coarse.tilt_rms_deg);
   }
 }
