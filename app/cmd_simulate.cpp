@@ -202,7 +202,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
         req.grid.y0_mm + req.grid.ny * req.grid.dy_mm);
     std::printf("lines touched   %zu of %zu (%.1f%%)\n", res.lines_lowered, req.grid.lineCount(),
                 100.0 * double(res.lines_lowered) / double(req.grid.lineCount()));
-    std::printf("heights         %.6g .. %.6g mm\n", double(*lo), double(*hi));
+    std::printf("heights         %.6g .. %.6g mm\n", double(*lo) + 0.0, double(*hi) + 0.0);
     std::printf("time            %.3f s\n", res.seconds);
     std::printf("backend         %s\n", zb::backendName(res.backend));
     std::printf(
