@@ -23,7 +23,8 @@ namespace fieldpath::pathgen {
 using geometry::Vec3;
 
 /// Scene `impeller: {...}` keys (examples/impeller/scene.yaml documents them). Defaults, once,
-/// here: sized like seed 004's case (7 passes ≈ 500 mm, blades ≈ 5100 points at 1 mm).
+/// here, equal to the example scene: sized like seed 004's case (7 passes ≈ 513 mm, blades
+/// sampled at 1 mm into 5100 points).
 struct ImpellerParams {
   double length_mm = 72.0;        ///< `length`: channel length along x
   double width_in_mm = 34.0;      ///< `width_in`: hub width between the blade feet at u = 0
@@ -35,7 +36,7 @@ struct ImpellerParams {
   /// `lean_left_deg: [in, out]`: left blade lean at u = 0 and u = 1 (> 0 over the channel).
   std::array<double, 2> lean_left_deg = {4.0, 24.0};
   /// `lean_right_deg: [in, out]`: right blade lean (> 0 over the channel, < 0 away from it).
-  std::array<double, 2> lean_right_deg = {-8.0, 6.0};
+  std::array<double, 2> lean_right_deg = {-8.0, 9.0};
   /// `passes_v: [first, last]`: v of the first and last pass (evenly spread in between).
   std::array<double, 2> passes_v = {0.25, 0.82};
   /// `u_range: [start, end]`: the part of the channel the passes cover.
