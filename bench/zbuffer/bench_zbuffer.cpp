@@ -6,7 +6,9 @@
 /// height error of both against the exact (analytic tool) result. Prints a markdown table.
 ///
 ///   bench_zbuffer [--backend cpu|cuda] [--cases 1,2,R,...|all] [--reps N] [--peer-limit P]
-///                 [--no-exact]
+///                 [--no-exact] [--variants]
+/// --variants: instead of the main table, the fast engine's median ms with each EngineTuning knob
+/// turned off in turn (the same heights, bit for bit, are checked on the way).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -457,6 +459,79 @@ Run runOnce(const zb::SimulationRequest& req, std::span<const zb::Posture> postu
   return r;
 }
 
+/// Postures generated before timing (in parallel), as a CL file would be read.
+std::vector<zb::Posture> casePostures(const Case& c) {
+  std::vector<zb::Posture> postures(c.postures);
+#pragma omp parallel for schedule(static)
+  for (long k = 0; k < long(c.postures); ++k) postures[k] = makePosture(c, std::size_t(k));
+  return postures;
+}
+
+zb::Tool analyticTool(const Case& c) {
+  return c.torus ? zb::Tool::torus(c.radius_mm, c.corner_mm, c.length_mm)
+                 : zb::Tool::ball(c.radius_mm, c.length_mm);
+}
+
+zb::SimulationRequest caseRequest(const Case& c, const zb::Tool& tool, zb::Backend be) {
+  zb::SimulationRequest req;
+  req.grid = c.zoom[2] > c.zoom[0]
+                 ? zb::Grid::fromRegion(c.zoom[0], c.zoom[1], c.zoom[2], c.zoom[3], c.grid, c.grid)
+                 : zb::Grid::fromRegion(0, 0, c.width_mm, c.width_mm, c.grid, c.grid);
+  req.stock_mm = float(std::abs(c.surface.amp1) + std::abs(c.surface.amp2) + 3);
+  req.backend = be;
+  req.tool = tool;
+  req.block_postures = std::size_t{1} << 22;
+  return req;
+}
+
+/// Median wall time (ms) of `reps` runs; `last` keeps the last run's result.
+double medianMs(const zb::SimulationRequest& req, std::span<const zb::Posture> postures, int reps,
+                Run& last) {
+  std::vector<double> times;
+  for (int r = 0; r < reps; ++r) {
+    last = runOnce(req, postures);
+    times.push_back(last.ms);
+  }
+  std::sort(times.begin(), times.end());
+  return times[times.size() / 2];
+}
+
+/// --variants: the fast engine (mesh tool) with all knobs on, then each knob off in turn.
+int variantTable(const std::string& backend, const std::vector<std::string>& wanted,
+                 const std::string& which, int reps) {
+  const zb::Backend be = backend == "cuda" ? zb::Backend::Cuda : zb::Backend::Cpu;
+  const char* names[] = {"all on",           "no vertical bins", "no lowest first",
+                         "no small threads", "no overlap",       "all off"};
+  std::printf("| case | P | grid |");
+  for (const char* n : names) std::printf(" %s ms |", n);
+  std::printf(" same bits |\n|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const Case& c : allCases()) {
+    if (which != "all" && std::find(wanted.begin(), wanted.end(), c.id) == wanted.end()) continue;
+    const std::vector<zb::Posture> postures = casePostures(c);
+    const zb::Tool mesh =
+        zb::Tool::fromMesh(zb::analyticToolMesh(analyticTool(c), c.around, c.arc));
+    std::printf("| %s %s | %zu | %d² |", c.id.c_str(), c.name.c_str(), c.postures, c.grid);
+    std::vector<float> first;
+    bool same = true;
+    for (int v = 0; v < 6; ++v) {
+      zb::SimulationRequest req = caseRequest(c, mesh, be);
+      zb::EngineTuning& t = req.tuning;
+      t.vertical_bins = v != 1 && v != 5;
+      t.lowest_first = v != 2 && v != 5;
+      t.small_threads = v != 3 && v != 5;
+      t.overlap_upload = v != 4 && v != 5;
+      Run run;
+      std::printf(" %.1f |", medianMs(req, postures, reps, run));
+      std::fflush(stdout);
+      if (first.empty()) first = run.result.heights_mm;
+      same = same && std::memcmp(first.data(), run.result.heights_mm.data(), 4 * first.size()) == 0;
+    }
+    std::printf(" %s |\n", same ? "yes" : "NO");
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
 /// Max and RMS |Δz| (mm) against the exact heights over the lines both runs lowered, and the
 /// number of lines only one of them lowered (grazing lines at the chordal error of the mesh).
 std::string heightError(const std::vector<float>& h, const std::vector<float>& exact, float stock) {
@@ -484,6 +559,7 @@ int main(int argc, char** argv) {
   int reps = 3;
   std::size_t peer_limit = 0;  // 0: the whole case
   bool exact = true;
+  bool variants = false;  // time the fast engine with each tuning knob off instead of the table
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto value = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
@@ -497,10 +573,12 @@ int main(int argc, char** argv) {
       peer_limit = std::stoull(value());
     else if (a == "--no-exact")
       exact = false;
+    else if (a == "--variants")
+      variants = true;
     else {
       std::fprintf(stderr,
                    "usage: %s [--backend cpu|cuda] [--cases 1,2,R,...|all] [--reps N] "
-                   "[--peer-limit P] [--no-exact]\n",
+                   "[--peer-limit P] [--no-exact] [--variants]\n",
                    argv[0]);
       return 1;
     }
@@ -512,6 +590,7 @@ int main(int argc, char** argv) {
     wanted.push_back(which.substr(p, q - p));
     p = q + 1;
   }
+  if (variants) return variantTable(backend, wanted, which, reps);
   std::printf(
       "| case | P | T | grid | ours ms (median of %d) | coarse peer ms | best published ms | "
       "best/ours | peer/ours | "
@@ -523,31 +602,12 @@ int main(int argc, char** argv) {
   std::fflush(stdout);
   for (const Case& c : allCases()) {
     if (which != "all" && std::find(wanted.begin(), wanted.end(), c.id) == wanted.end()) continue;
-    // postures generated before timing (in parallel), as a CL file would be read
-    std::vector<zb::Posture> postures(c.postures);
-#pragma omp parallel for schedule(static)
-    for (long k = 0; k < long(c.postures); ++k) postures[k] = makePosture(c, std::size_t(k));
-    const zb::Tool analytic = c.torus ? zb::Tool::torus(c.radius_mm, c.corner_mm, c.length_mm)
-                                      : zb::Tool::ball(c.radius_mm, c.length_mm);
+    const std::vector<zb::Posture> postures = casePostures(c);
+    const zb::Tool analytic = analyticTool(c);
     const zb::Tool mesh = zb::Tool::fromMesh(zb::analyticToolMesh(analytic, c.around, c.arc));
-    zb::SimulationRequest req;
-    req.grid =
-        c.zoom[2] > c.zoom[0]
-            ? zb::Grid::fromRegion(c.zoom[0], c.zoom[1], c.zoom[2], c.zoom[3], c.grid, c.grid)
-            : zb::Grid::fromRegion(0, 0, c.width_mm, c.width_mm, c.grid, c.grid);
-    req.stock_mm = float(std::abs(c.surface.amp1) + std::abs(c.surface.amp2) + 3);
-    req.backend = be;
-    req.tool = mesh;
-    req.block_postures = std::size_t{1} << 22;
-
-    std::vector<double> times;
+    const zb::SimulationRequest req = caseRequest(c, mesh, be);
     Run ours;
-    for (int r = 0; r < reps; ++r) {
-      ours = runOnce(req, postures);
-      times.push_back(ours.ms);
-    }
-    std::sort(times.begin(), times.end());
-    const double ours_ms = times[times.size() / 2];
+    const double ours_ms = medianMs(req, postures, reps, ours);
 
     // the peer: SIMSURF1's coarse algorithm, same backend, same mesh
     zb::SimulationRequest peer_req = req;

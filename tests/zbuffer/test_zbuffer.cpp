@@ -264,6 +264,68 @@ TEST(Mesh, LinesThroughSharedVerticesAndEdgesAreNeverMissed) {
     }
 }
 
+TEST(Mesh, VerticalBinsEqualTheBvhBitForBit) {
+  // A vertical line tests only its bin's triangles; the result must be the BVH walk's, bit for bit,
+  // also for lines through the shared vertices and edges of the grid-bottom tool.
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const GridView g = detail::makeGridView(Grid::fromRegion(-1, -1, 1, 1, 4, 4));
+  for (const Tool& tool : {Tool::fromMesh(gridBottomTool()),
+                           Tool::fromMesh(analyticToolMesh(Tool::torus(5, 1, 25), 127, 100)),
+                           Tool::fromMesh(analyticToolMesh(Tool::ball(2, 8), 32, 31))}) {
+    const detail::ToolData data = detail::prepareTool(tool);
+    ASSERT_GT(data.view.bins, 0);
+    const PreparedPosture pp = preparePosture(g, data.view, pose(0, 0, 0, 0, 0, 1));
+    ASSERT_TRUE(pp.vertical);
+    const float reach = data.view.hull_radius_mm * 1.1f;
+    int hits = 0;
+    for (int k = 0; k < 20000; ++k) {
+      Vec3f o{float(reach * u(rng)), float(reach * u(rng)), 0.f};
+      if (k % 4 == 0) o = {std::round(o.x * 4) / 4, std::round(o.y * 4) / 4, 0.f};  // on edges
+      const float bvh = meshEntry(data.view, pp, o, FLT_MAX);
+      const float binned = binnedEntry(data.view, pp, o);
+      ASSERT_EQ(std::memcmp(&bvh, &binned, 4), 0)
+          << o.x << "," << o.y << ": " << bvh << " vs " << binned;
+      hits += bvh != FLT_MAX;
+    }
+    EXPECT_GT(hits, 5000);
+  }
+}
+
+/// Roughing-like postures: vertical, z-levels top down, plus the awkward ones.
+std::vector<Posture> roughingPostures(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Posture> p = awkwardPostures(100, seed);
+  for (int level = 0; level < 5; ++level)
+    for (int k = 0; k < 200; ++k)
+      p.push_back(pose(4 * u(rng), 4 * u(rng), 1.5 - 0.5 * level + 0.1 * u(rng), 0, 0, 1));
+  return p;
+}
+
+TEST(Tuning, EveryVariantGivesTheSameBits) {
+  // The tuning knobs change the order, the culling and the triangle look-up, never a height.
+  const Grid g = Grid::fromRegion(-6, -6, 6, 6, 64, 64);
+  const auto postures = roughingPostures(23);
+  {
+    const Tool tool = Tool::fromMesh(analyticToolMesh(Tool::torus(2, 0.5, 8), 40, 6));
+    std::vector<float> first;
+    for (int variant = 0; variant < 8; ++variant) {
+      SimulationRequest req;
+      req.grid = g;
+      req.tool = tool;
+      req.stock_mm = kStock;
+      req.backend = Backend::Cpu;
+      req.tuning.vertical_bins = variant & 1;
+      req.tuning.lowest_first = variant & 2;
+      req.block_postures = variant & 4 ? 97 : 1 << 20;
+      const auto h = simulate(req, postures).heights_mm;
+      if (first.empty()) first = h;
+      ASSERT_EQ(std::memcmp(first.data(), h.data(), 4 * h.size()), 0) << "variant " << variant;
+    }
+  }
+}
+
 TEST(Mesh, TiltedSphereMeshHasNoHoles) {
   // Inside the silhouette (by a margin) every line must be lowered, for random tilts.
   const Tool ana = Tool::ball(2, 6);  // the shank covers the upper half of the ball

@@ -37,8 +37,9 @@ std::vector<Posture> randomPostures(int count, unsigned seed, double extent) {
 }
 
 void expectSameBits(const Grid& g, const Tool& tool, const std::vector<Posture>& postures,
-                    Engine engine) {
+                    Engine engine, EngineTuning tuning = {}) {
   SimulationRequest req;
+  req.tuning = tuning;
   req.grid = g;
   req.tool = tool;
   req.stock_mm = 5.f;
@@ -79,6 +80,25 @@ TEST_F(CpuVsCuda, MeshToolBitIdenticalFastAndCoarse) {
   const Tool mesh = Tool::fromMesh(analyticToolMesh(Tool::torus(3, 1, 12), 48, 8));
   expectSameBits(g, mesh, p, Engine::Fast);
   expectSameBits(g, mesh, p, Engine::Coarse);
+}
+
+TEST_F(CpuVsCuda, EveryTuningVariantBitIdentical) {
+  // Small footprints (thread per posture) and large ones (warp per posture) in one run: a fine
+  // ball over a coarse grid, tilted postures reach far; each variant of the GPU engine must give
+  // the CPU reference's bits.
+  const Grid g = Grid::fromRegion(-20, -20, 20, 20, 96, 96);
+  const auto p = randomPostures(4000, 4, 18);
+  const Tool small_mesh = Tool::fromMesh(analyticToolMesh(Tool::ball(0.8, 6), 32, 31));
+  for (int variant = 0; variant < 16; ++variant) {
+    EngineTuning t;
+    t.vertical_bins = variant & 1;
+    t.lowest_first = variant & 2;
+    t.small_threads = variant & 4;
+    t.overlap_upload = variant & 8;
+    SCOPED_TRACE("variant " + std::to_string(variant));
+    expectSameBits(g, small_mesh, p, Engine::Fast, t);
+    if (variant % 4 == 2) expectSameBits(g, Tool::ball(0.8, 6), p, Engine::Fast, t);
+  }
 }
 
 TEST_F(CpuVsCuda, ZoomWithFewPosturesBitIdentical) {

@@ -1,5 +1,6 @@
-/// CPU reference backend (OpenMP): one work item per posture, line heights lowered with an atomic
-/// compare-and-swap minimum (the minimum does not depend on the order of postures).
+/// CPU reference backend (OpenMP): one work item per posture (lowest first within a block), line
+/// heights lowered with an atomic compare-and-swap minimum (the minimum does not depend on the
+/// order of postures).
 #include <algorithm>
 #include <atomic>
 
@@ -21,9 +22,11 @@ inline float loadRelaxed(float& slot) {
 
 class CpuEngine final : public BackendEngine {
  public:
-  CpuEngine(const GridView& grid, const ToolData& tool, std::vector<float> heights)
+  CpuEngine(const GridView& grid, const ToolData& tool, std::vector<float> heights,
+            const EngineTuning& tuning)
       : grid_(grid),
         tool_(tool),
+        tuning_(tuning),
         heights_(std::move(heights)),
         tile_max_(std::size_t(grid.tiles_x) * grid.tiles_y) {
     // re-point the view at this engine's own copies
@@ -34,26 +37,50 @@ class CpuEngine final : public BackendEngine {
     tool_.view.bin_start = tool_.bin_start.data();
     tool_.view.bin_items = tool_.bin_items.data();
     tool_.view.radial_floor_mm = tool_.radial_floor.data();
+    // Tile maxima are refreshed between chunks: often when postures come lowest first (each
+    // refresh lets the tiles cut so far cull the higher postures), bounded by the refresh cost.
     const std::size_t lines = std::size_t(grid.nx) * grid.ny;
-    refresh_every_ = std::clamp<std::size_t>(lines / 8, 16384, std::size_t{1} << 24);
+    refresh_every_ = tuning.lowest_first
+                         ? std::clamp<std::size_t>(lines / 64, 2048, std::size_t{1} << 24)
+                         : std::clamp<std::size_t>(lines / 8, 16384, std::size_t{1} << 24);
   }
 
-  std::size_t cut(std::span<const Posture> block, Engine engine) override {
+  void cut(std::span<const Posture> block, Engine engine) override {
     if (engine == Engine::Coarse) {
       coarse(block);
-      return 0;
+      return;
     }
-    std::size_t culled = 0;
+    const std::vector<std::uint32_t> order = processingOrder(block);
     for (std::size_t begin = 0; begin < block.size(); begin += refresh_every_) {
       refreshTiles();
-      culled += fast(block.subspan(begin, std::min(refresh_every_, block.size() - begin)));
+      const std::size_t end = std::min(block.size(), begin + refresh_every_);
+      culled_ += fast(block, order, begin, end);
     }
-    return culled;
   }
 
   std::vector<float> heights() override { return heights_; }
+  std::size_t culled() override { return culled_; }
 
  private:
+  /// Indices of the block's postures in processing order (lowest point first, see lowestKey).
+  std::vector<std::uint32_t> processingOrder(std::span<const Posture> block) const {
+    std::vector<std::uint32_t> order(block.size());
+    if (!tuning_.lowest_first) {
+      for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<std::uint32_t>(k);
+      return order;
+    }
+    std::vector<std::uint64_t> keyed(block.size());
+    const GridView g = grid_;
+    const ToolView tool = tool_.view;
+    const long n = static_cast<long>(block.size());
+#pragma omp parallel for schedule(static)
+    for (long p = 0; p < n; ++p)
+      keyed[p] = (std::uint64_t{lowestKey(g, tool, block[p])} << 32) | std::uint64_t(p);
+    std::sort(keyed.begin(), keyed.end());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<std::uint32_t>(keyed[k]);
+    return order;
+  }
+
   void refreshTiles() {
     const GridView& g = grid_;
 #pragma omp parallel for schedule(static)
@@ -69,16 +96,16 @@ class CpuEngine final : public BackendEngine {
       }
   }
 
-  std::size_t fast(std::span<const Posture> block) {
+  std::size_t fast(std::span<const Posture> block, const std::vector<std::uint32_t>& order,
+                   std::size_t begin, std::size_t end) {
     const GridView g = grid_;
     const ToolView tool = tool_.view;
     float* h = heights_.data();
     const float* tiles = tile_max_.data();
-    const long n = static_cast<long>(block.size());
     std::size_t culled = 0;
 #pragma omp parallel for schedule(dynamic, 16) reduction(+ : culled)
-    for (long p = 0; p < n; ++p) {
-      PreparedPosture pp = preparePosture(g, tool, block[p]);
+    for (long k = long(begin); k < long(end); ++k) {
+      PreparedPosture pp = preparePosture(g, tool, block[order[k]]);
       if (cullPosture(g, tool, pp, tiles)) {
         ++culled;
         continue;
@@ -107,16 +134,19 @@ class CpuEngine final : public BackendEngine {
 
   GridView grid_;
   ToolData tool_;
+  EngineTuning tuning_;
   std::vector<float> heights_;
   std::vector<float> tile_max_;
   std::size_t refresh_every_;
+  std::size_t culled_ = 0;
 };
 
 }  // namespace
 
 std::unique_ptr<BackendEngine> makeCpuEngine(const GridView& grid, const ToolData& tool,
-                                             std::vector<float> heights_mm) {
-  return std::make_unique<CpuEngine>(grid, tool, std::move(heights_mm));
+                                             std::vector<float> heights_mm,
+                                             const EngineTuning& tuning) {
+  return std::make_unique<CpuEngine>(grid, tool, std::move(heights_mm), tuning);
 }
 
 }  // namespace fieldpath::zbuffer::detail

@@ -30,12 +30,16 @@ cuda::ToolArrays arrays(const ToolData& tool) {
 
 class CudaAdapter final : public BackendEngine {
  public:
-  CudaAdapter(const GridView& grid, const ToolData& tool, const std::vector<float>& heights)
-      : lines_(heights.size()), engine_(grid, arrays(tool), heights.data(), heights.size()) {}
+  CudaAdapter(const GridView& grid, const ToolData& tool, const std::vector<float>& heights,
+              const EngineTuning& t)
+      : lines_(heights.size()),
+        engine_(grid, arrays(tool), heights.data(), heights.size(),
+                {t.lowest_first, t.small_threads, t.overlap_upload}) {}
 
-  std::size_t cut(std::span<const Posture> block, Engine engine) override {
-    return engine_.cut(block.data(), block.size(), engine == Engine::Coarse);
+  void cut(std::span<const Posture> block, Engine engine) override {
+    engine_.cut(block.data(), block.size(), engine == Engine::Coarse);
   }
+  std::size_t culled() override { return engine_.culled(); }
   std::vector<float> heights() override {
     std::vector<float> h(lines_);
     engine_.heights(h.data());
@@ -49,9 +53,10 @@ class CudaAdapter final : public BackendEngine {
 }  // namespace
 
 std::unique_ptr<BackendEngine> makeCudaEngine(const GridView& grid, const ToolData& tool,
-                                              std::vector<float> heights) {
+                                              std::vector<float> heights,
+                                              const EngineTuning& tuning) {
   if (!cuda::available()) throw std::runtime_error("no CUDA device");
-  return std::make_unique<CudaAdapter>(grid, tool, heights);
+  return std::make_unique<CudaAdapter>(grid, tool, heights, tuning);
 }
 }  // namespace detail
 }  // namespace fieldpath::zbuffer

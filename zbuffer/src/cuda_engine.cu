@@ -1,7 +1,12 @@
 /// CUDA backend: same per-line / per-triangle code as the CPU reference (kernels.h), compiled with
 /// -fmad=false and IEEE division and square root, so the heights are bit-identical to the CPU's.
 /// Heights live on the device as order-preserving int32 keys (one atomicMin per lowered line).
+/// Per block: upload (overlapping the previous block's kernels), sort lowest point first (CUB),
+/// then chunks of postures between tile-maximum refreshes; one thread per small-footprint
+/// posture, one warp per large one.
 #include <cuda_runtime.h>
+
+#include <cub/device/device_radix_sort.cuh>
 
 #include <algorithm>
 #include <cfloat>
@@ -39,26 +44,81 @@ __global__ void tileMaxKernel(GridView g, const std::int32_t* keys, float* tile_
   tile_max[t] = keyToFloat(m);
 }
 
-/// One warp per posture (split into gridDim.y chunks of lines when postures are few, as in a zoom):
-/// the lanes share the posture's footprint lines.
-__global__ void fastKernel(GridView g, ToolView tool, const Posture* postures, int count,
-                           const float* tile_max, std::int32_t* keys, unsigned long long* culled) {
-  const int lane = threadIdx.x & 31;
-  const int p = blockIdx.x * kWarpsPerBlock + (threadIdx.x >> 5);
-  if (p >= count) return;
-  PreparedPosture pp = preparePosture(g, tool, postures[p]);
-  if (cullPosture(g, tool, pp, tile_max)) {
-    if (lane == 0 && blockIdx.y == 0) atomicAdd(culled, 1ull);
-    return;
-  }
+/// Footprints of at most this many lines are cut by one thread (few lines per posture, as in a
+/// fine finishing path over a coarse grid); larger ones go to a warp.
+constexpr int kSmallFootprintLines = 48;
+
+/// Posture `k` of the chunk in processing order.
+__device__ inline Posture postureAt(const Posture* postures, const std::uint32_t* order, int k) {
+  return postures[order ? order[k] : std::uint32_t(k)];
+}
+
+/// Lowers every line of rows/columns assigned to this worker: lines l = first, first + step, ...
+/// of the culled footprint (the shared per-line code path of both backends is lineCut).
+__device__ inline void cutLines(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
+                                int first, int step, std::int32_t* keys) {
   const int w = pp.ix1 - pp.ix0 + 1;
   const int lines = w * (pp.iy1 - pp.iy0 + 1);
-  for (int l = blockIdx.y * 32 + lane; l < lines; l += 32 * gridDim.y) {
+  for (int l = first; l < lines; l += step) {
     const int ix = pp.ix0 + l % w, iy = pp.iy0 + l / w;
     std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
     const float z = lineCut(g, tool, pp, ix, iy, keyToFloat(*slot));
     if (z != FLT_MAX) atomicMin(slot, floatToKey(z));
   }
+}
+
+/// Sort keys (lowest point, see lowestKey) and identity indices of a block.
+__global__ void lowestKeyKernel(GridView g, ToolView tool, const Posture* postures, int count,
+                                std::uint32_t* keys, std::uint32_t* index) {
+  const int p = blockIdx.x * blockDim.x + threadIdx.x;
+  if (p >= count) return;
+  keys[p] = lowestKey(g, tool, postures[p]);
+  index[p] = std::uint32_t(p);
+}
+
+/// One thread per posture: prepare, cull, cut a small footprint here; a large one is queued for
+/// largeKernel (its warp repeats the same preparation and cull, hence the same footprint).
+__global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
+                            const std::uint32_t* order, int count, const float* tile_max,
+                            std::int32_t* keys, unsigned long long* culled, int* queue,
+                            int* queued) {
+  const int k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k >= count) return;
+  PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, k));
+  if (cullPosture(g, tool, pp, tile_max)) {
+    atomicAdd(culled, 1ull);
+    return;
+  }
+  if ((pp.ix1 - pp.ix0 + 1) * (pp.iy1 - pp.iy0 + 1) <= kSmallFootprintLines)
+    cutLines(g, tool, pp, 0, 1, keys);
+  else
+    queue[atomicAdd(queued, 1)] = k;
+}
+
+/// One warp per queued posture (split into gridDim.y chunks of lines when postures are few, as
+/// in a zoom): the lanes share the footprint's lines.
+__global__ void largeKernel(GridView g, ToolView tool, const Posture* postures,
+                            const std::uint32_t* order, const int* queue, const int* queued,
+                            const float* tile_max, std::int32_t* keys) {
+  const int q = blockIdx.x * kWarpsPerBlock + (threadIdx.x >> 5);
+  if (q >= *queued) return;
+  PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, queue[q]));
+  if (cullPosture(g, tool, pp, tile_max)) return;
+  cutLines(g, tool, pp, blockIdx.y * 32 + (threadIdx.x & 31), 32 * gridDim.y, keys);
+}
+
+/// One warp per posture, every footprint (the variant without small_threads).
+__global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
+                           const std::uint32_t* order, int count, const float* tile_max,
+                           std::int32_t* keys, unsigned long long* culled) {
+  const int k = blockIdx.x * kWarpsPerBlock + (threadIdx.x >> 5);
+  if (k >= count) return;
+  PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, k));
+  if (cullPosture(g, tool, pp, tile_max)) {
+    if ((threadIdx.x & 31) == 0 && blockIdx.y == 0) atomicAdd(culled, 1ull);
+    return;
+  }
+  cutLines(g, tool, pp, blockIdx.y * 32 + (threadIdx.x & 31), 32 * gridDim.y, keys);
 }
 
 /// SIMSURF1's coarse kernel: one thread per posture, every triangle.
@@ -80,47 +140,96 @@ T* deviceCopy(const T* host, std::size_t n) {
   return ptr;
 }
 
+template <class T>
+void deviceAlloc(T*& ptr, std::size_t n) {
+  if (ptr) FIELDPATH_CUDA_CHECK(cudaFree(ptr));
+  ptr = nullptr;
+  FIELDPATH_CUDA_CHECK(cudaMalloc(&ptr, std::max<std::size_t>(n, 1) * sizeof(T)));
+}
+
 }  // namespace
 
 struct Engine::Impl {
   GridView grid;
   ToolView tool;
-  BvhNode* nodes = nullptr;
-  float* triangles = nullptr;
-  Vec3f* vertices = nullptr;
-  std::uint32_t* indices = nullptr;
-  std::int32_t* bin_start = nullptr;
-  std::int32_t* bin_items = nullptr;
-  float* radial_floor = nullptr;
+  Options options;
+  std::vector<void*> owned;  ///< device allocations of the tool and the heights
   std::int32_t* keys = nullptr;
   float* tile_max = nullptr;
   unsigned long long* culled = nullptr;
-  Posture* postures = nullptr;
+  int* queued = nullptr;
+  // per-block buffers, two of each so that one block uploads while the other computes
+  Posture* postures[2] = {nullptr, nullptr};
+  std::uint32_t *sort_keys[2] = {nullptr, nullptr}, *sort_index[2] = {nullptr, nullptr};
+  int* queue = nullptr;
+  void* sort_temp = nullptr;
+  std::size_t sort_temp_bytes = 0;
   std::size_t capacity = 0, lines = 0, refresh_every = 0;
+  int slot = 0;
+  cudaStream_t copy_stream = nullptr, compute_stream = nullptr;
+  cudaEvent_t copied[2] = {nullptr, nullptr}, computed[2] = {nullptr, nullptr};
 
   ~Impl() {
+    if (compute_stream) cudaStreamSynchronize(compute_stream);
+    if (copy_stream) cudaStreamSynchronize(copy_stream);
+    for (void* p : owned) cudaFree(p);
     for (void* p :
-         {static_cast<void*>(nodes), static_cast<void*>(triangles), static_cast<void*>(vertices),
-          static_cast<void*>(indices), static_cast<void*>(keys), static_cast<void*>(tile_max),
-          static_cast<void*>(culled), static_cast<void*>(postures), static_cast<void*>(bin_start),
-          static_cast<void*>(bin_items), static_cast<void*>(radial_floor)})
+         {static_cast<void*>(keys), static_cast<void*>(tile_max), static_cast<void*>(culled),
+          static_cast<void*>(queued), static_cast<void*>(queue), sort_temp})
       if (p) cudaFree(p);
+    for (int k = 0; k < 2; ++k) {
+      for (void* p : {static_cast<void*>(postures[k]), static_cast<void*>(sort_keys[k]),
+                      static_cast<void*>(sort_index[k])})
+        if (p) cudaFree(p);
+      if (copied[k]) cudaEventDestroy(copied[k]);
+      if (computed[k]) cudaEventDestroy(computed[k]);
+    }
+    if (copy_stream) cudaStreamDestroy(copy_stream);
+    if (compute_stream) cudaStreamDestroy(compute_stream);
+  }
+
+  template <class T>
+  T* own(const T* host, std::size_t n) {
+    T* p = deviceCopy(host, n);
+    if (p) owned.push_back(p);
+    return p;
+  }
+
+  /// Room for blocks of `count` postures (waits for the queued work before reallocating).
+  void reserve(std::size_t count) {
+    if (count <= capacity) return;
+    FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(copy_stream));
+    FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(compute_stream));
+    for (int k = 0; k < 2; ++k) {
+      deviceAlloc(postures[k], count);
+      deviceAlloc(sort_keys[k], count);
+      deviceAlloc(sort_index[k], count);
+    }
+    deviceAlloc(queue, count);
+    std::size_t bytes = 0;
+    FIELDPATH_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, sort_keys[0], sort_keys[1],
+                                                         sort_index[0], sort_index[1], int(count)));
+    if (sort_temp) FIELDPATH_CUDA_CHECK(cudaFree(sort_temp));
+    FIELDPATH_CUDA_CHECK(cudaMalloc(&sort_temp, std::max<std::size_t>(bytes, 1)));
+    sort_temp_bytes = bytes;
+    capacity = count;
   }
 };
 
 Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* heights_mm,
-               std::size_t lines)
+               std::size_t lines, Options options)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.grid = grid;
+  m.options = options;
   m.tool = tool.view;
-  m.tool.bvh_nodes = m.nodes = deviceCopy(tool.nodes, tool.node_count);
-  m.tool.bvh_triangles = m.triangles = deviceCopy(tool.triangles, tool.triangle_floats);
-  m.tool.vertices = m.vertices = deviceCopy(tool.vertices, tool.vertex_count);
-  m.tool.indices = m.indices = deviceCopy(tool.indices, tool.index_count);
-  m.tool.bin_start = m.bin_start = deviceCopy(tool.bin_start, tool.bin_start_count);
-  m.tool.bin_items = m.bin_items = deviceCopy(tool.bin_items, tool.bin_item_count);
-  m.tool.radial_floor_mm = m.radial_floor = deviceCopy(tool.radial_floor, tool.radial_count);
+  m.tool.bvh_nodes = m.own(tool.nodes, tool.node_count);
+  m.tool.bvh_triangles = m.own(tool.triangles, tool.triangle_floats);
+  m.tool.vertices = m.own(tool.vertices, tool.vertex_count);
+  m.tool.indices = m.own(tool.indices, tool.index_count);
+  m.tool.bin_start = m.own(tool.bin_start, tool.bin_start_count);
+  m.tool.bin_items = m.own(tool.bin_items, tool.bin_item_count);
+  m.tool.radial_floor_mm = m.own(tool.radial_floor, tool.radial_count);
   std::vector<std::int32_t> keys(lines);
   for (std::size_t i = 0; i < lines; ++i) {
     std::int32_t bits;
@@ -132,55 +241,107 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
       cudaMalloc(&m.tile_max, sizeof(float) * std::max(1, grid.tiles_x * grid.tiles_y)));
   FIELDPATH_CUDA_CHECK(cudaMalloc(&m.culled, sizeof(unsigned long long)));
   FIELDPATH_CUDA_CHECK(cudaMemset(m.culled, 0, sizeof(unsigned long long)));
+  FIELDPATH_CUDA_CHECK(cudaMalloc(&m.queued, sizeof(int)));
+  FIELDPATH_CUDA_CHECK(cudaStreamCreateWithFlags(&m.copy_stream, cudaStreamNonBlocking));
+  FIELDPATH_CUDA_CHECK(cudaStreamCreateWithFlags(&m.compute_stream, cudaStreamNonBlocking));
+  for (int k = 0; k < 2; ++k) {
+    FIELDPATH_CUDA_CHECK(cudaEventCreateWithFlags(&m.copied[k], cudaEventDisableTiming));
+    FIELDPATH_CUDA_CHECK(cudaEventCreateWithFlags(&m.computed[k], cudaEventDisableTiming));
+  }
   m.lines = lines;
-  m.refresh_every = std::clamp<std::size_t>(lines / 8, std::size_t{1} << 16, std::size_t{1} << 24);
+  // Tile maxima are refreshed between chunks; lowest first, often (each refresh lets the tiles cut
+  // so far cull the higher postures that follow).
+  m.refresh_every =
+      options.lowest_first
+          ? std::clamp<std::size_t>(lines / 32, std::size_t{1} << 14, std::size_t{1} << 24)
+          : std::clamp<std::size_t>(lines / 8, std::size_t{1} << 16, std::size_t{1} << 24);
 }
 
 Engine::~Engine() = default;
 
-std::size_t Engine::cut(const Posture* block, std::size_t count, bool coarse) {
+void Engine::cut(const Posture* block, std::size_t count, bool coarse) {
   Impl& m = *impl_;
-  if (count == 0) return 0;
-  if (count > m.capacity) {
-    if (m.postures) FIELDPATH_CUDA_CHECK(cudaFree(m.postures));
-    m.postures = nullptr;
-    FIELDPATH_CUDA_CHECK(cudaMalloc(&m.postures, count * sizeof(Posture)));
-    m.capacity = count;
-  }
+  if (count == 0) return;
+  m.reserve(count);
+  const int s = m.slot;
+  m.slot ^= 1;
+  // Upload into this slot once the block that used it two calls ago is done; with overlap the
+  // copy runs on its own stream while the previous block's kernels still run.
+  cudaStream_t copy = m.options.overlap_upload ? m.copy_stream : m.compute_stream;
+  FIELDPATH_CUDA_CHECK(cudaStreamWaitEvent(copy, m.computed[s], 0));
   FIELDPATH_CUDA_CHECK(
-      cudaMemcpy(m.postures, block, count * sizeof(Posture), cudaMemcpyHostToDevice));
-  unsigned long long before = 0;
-  FIELDPATH_CUDA_CHECK(cudaMemcpy(&before, m.culled, sizeof(before), cudaMemcpyDeviceToHost));
+      cudaMemcpyAsync(m.postures[s], block, count * sizeof(Posture), cudaMemcpyHostToDevice, copy));
+  FIELDPATH_CUDA_CHECK(cudaEventRecord(m.copied[s], copy));
+  FIELDPATH_CUDA_CHECK(cudaStreamWaitEvent(m.compute_stream, m.copied[s], 0));
+
+  cudaStream_t st = m.compute_stream;
+  const Posture* postures = m.postures[s];
+  const int n = static_cast<int>(count);
   if (coarse) {
-    const int n = static_cast<int>(count);
-    coarseKernel<<<(n + 127) / 128, 128>>>(m.grid, m.tool, m.postures, n, m.keys);
+    coarseKernel<<<(n + 127) / 128, 128, 0, st>>>(m.grid, m.tool, postures, n, m.keys);
     FIELDPATH_CUDA_CHECK(cudaGetLastError());
   } else {
+    const std::uint32_t* order = nullptr;
+    if (m.options.lowest_first) {
+      lowestKeyKernel<<<(n + 127) / 128, 128, 0, st>>>(m.grid, m.tool, postures, n, m.sort_keys[s],
+                                                       m.sort_index[s]);
+      FIELDPATH_CUDA_CHECK(cudaGetLastError());
+      std::uint32_t* keys_out = m.sort_keys[s ^ 1];  // the other slot's scratch: same stream
+      std::uint32_t* index_out = m.sort_index[s ^ 1];
+      FIELDPATH_CUDA_CHECK(
+          cub::DeviceRadixSort::SortPairs(m.sort_temp, m.sort_temp_bytes, m.sort_keys[s], keys_out,
+                                          m.sort_index[s], index_out, n, 0, 32, st));
+      // keep the sorted order in this slot's index array (the other slot's is free after the sort)
+      FIELDPATH_CUDA_CHECK(
+          cudaMemcpyAsync(m.sort_index[s], index_out, count * 4, cudaMemcpyDeviceToDevice, st));
+      order = m.sort_index[s];
+    }
     const int tiles = m.grid.tiles_x * m.grid.tiles_y;
     for (std::size_t begin = 0; begin < count; begin += m.refresh_every) {
-      const int n = static_cast<int>(std::min(m.refresh_every, count - begin));
-      tileMaxKernel<<<(tiles + 255) / 256, 256>>>(m.grid, m.keys, m.tile_max);
+      const int chunk = static_cast<int>(std::min(m.refresh_every, count - begin));
+      const std::uint32_t* chunk_order = order ? order + begin : nullptr;
+      const Posture* chunk_postures = order ? postures : postures + begin;
+      tileMaxKernel<<<(tiles + 255) / 256, 256, 0, st>>>(m.grid, m.keys, m.tile_max);
       FIELDPATH_CUDA_CHECK(cudaGetLastError());
-      const int chunks = std::clamp(16384 / std::max(1, n), 1, 1024);
-      const dim3 blocks((n + kWarpsPerBlock - 1) / kWarpsPerBlock, chunks);
-      fastKernel<<<blocks, 32 * kWarpsPerBlock>>>(m.grid, m.tool, m.postures + begin, n, m.tile_max,
-                                                  m.keys, m.culled);
+      const int splits = std::clamp(16384 / std::max(1, chunk), 1, 1024);
+      const dim3 warps((chunk + kWarpsPerBlock - 1) / kWarpsPerBlock, splits);
+      if (m.options.small_threads) {
+        FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.queued, 0, sizeof(int), st));
+        smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(m.grid, m.tool, chunk_postures,
+                                                         chunk_order, chunk, m.tile_max, m.keys,
+                                                         m.culled, m.queue, m.queued);
+        FIELDPATH_CUDA_CHECK(cudaGetLastError());
+        largeKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
+            m.grid, m.tool, chunk_postures, chunk_order, m.queue, m.queued, m.tile_max, m.keys);
+      } else {
+        warpKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
+            m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, m.culled);
+      }
       FIELDPATH_CUDA_CHECK(cudaGetLastError());
     }
   }
-  unsigned long long after = 0;
-  FIELDPATH_CUDA_CHECK(cudaMemcpy(&after, m.culled, sizeof(after), cudaMemcpyDeviceToHost));
-  return static_cast<std::size_t>(after - before);
+  FIELDPATH_CUDA_CHECK(cudaEventRecord(m.computed[s], st));
+  // the caller may overwrite `block` once this returns
+  FIELDPATH_CUDA_CHECK(cudaEventSynchronize(m.copied[s]));
 }
 
 void Engine::heights(float* out_mm) const {
   const Impl& m = *impl_;
+  FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(m.compute_stream));
   std::vector<std::int32_t> keys(m.lines);
   FIELDPATH_CUDA_CHECK(cudaMemcpy(keys.data(), m.keys, m.lines * 4, cudaMemcpyDeviceToHost));
   for (std::size_t i = 0; i < m.lines; ++i) {
     const std::int32_t bits = orderedBits(keys[i]);
     std::memcpy(out_mm + i, &bits, 4);
   }
+}
+
+std::size_t Engine::culled() const {
+  const Impl& m = *impl_;
+  FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(m.compute_stream));
+  unsigned long long n = 0;
+  FIELDPATH_CUDA_CHECK(cudaMemcpy(&n, m.culled, sizeof(n), cudaMemcpyDeviceToHost));
+  return static_cast<std::size_t>(n);
 }
 
 bool available() {

@@ -32,13 +32,23 @@ bool available();
 
 class Engine {
  public:
-  Engine(const GridView& grid, const ToolArrays& tool, const float* heights_mm, std::size_t lines);
+  /// Tuning flags (see EngineTuning): lowest-first order, thread-per-posture for small
+  /// footprints, upload of the next block overlapping this block's kernels.
+  struct Options {
+    bool lowest_first = true, small_threads = true, overlap_upload = true;
+  };
+  Engine(const GridView& grid, const ToolArrays& tool, const float* heights_mm, std::size_t lines,
+         Options options);
   ~Engine();
   Engine(const Engine&) = delete;
   Engine& operator=(const Engine&) = delete;
-  /// Lowers the heights by `count` postures; returns how many were culled (fast engine).
-  std::size_t cut(const Posture* postures, std::size_t count, bool coarse);
+  /// Queues the lowering of the heights by `count` postures; returns once `postures` has been
+  /// read (the kernels may still run).
+  void cut(const Posture* postures, std::size_t count, bool coarse);
+  /// Waits for the queued work; the heights.
   void heights(float* out_mm) const;
+  /// Postures culled so far (fast engine); waits for the queued work.
+  std::size_t culled() const;
 
  private:
   struct Impl;

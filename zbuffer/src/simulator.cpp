@@ -357,26 +357,28 @@ SimulationResult run(const SimulationRequest& request, NextBlock next) {
   if (backend == Backend::Cuda && !cudaAvailable())
     throw InputError("backend cuda: no CUDA device available (built without CUDA or no GPU)");
 
-  const detail::ToolData tool = detail::prepareTool(request.tool);
+  detail::ToolData tool = detail::prepareTool(request.tool);
+  if (!request.tuning.vertical_bins) tool.view.bins = 0;
   const GridView g = detail::makeGridView(grid);
   std::vector<float> initial = request.initial_heights_mm;
   if (initial.empty()) initial.assign(grid.lineCount(), request.stock_mm);
 
   const auto start = std::chrono::steady_clock::now();
-  std::unique_ptr<detail::BackendEngine> engine = backend == Backend::Cuda
-                                                      ? detail::makeCudaEngine(g, tool, initial)
-                                                      : detail::makeCpuEngine(g, tool, initial);
+  std::unique_ptr<detail::BackendEngine> engine =
+      backend == Backend::Cuda ? detail::makeCudaEngine(g, tool, initial, request.tuning)
+                               : detail::makeCpuEngine(g, tool, initial, request.tuning);
   SimulationResult result;
   result.backend = backend;
   for (;;) {
     const std::span<const Posture> block = next();
     if (block.empty()) break;
-    result.postures_culled += engine->cut(block, request.engine);
+    engine->cut(block, request.engine);
     result.postures += block.size();
     const double total = double(std::max(request.expected_postures, result.postures));
     common::report(request.progress, double(result.postures) / total, "simulate");
   }
   result.heights_mm = engine->heights();
+  result.postures_culled = engine->culled();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (std::size_t i = 0; i < initial.size(); ++i)
     result.lines_lowered += result.heights_mm[i] < initial[i];

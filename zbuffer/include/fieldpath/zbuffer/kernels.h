@@ -4,6 +4,7 @@
 /// that they can be passed to a kernel by value.
 #include <cfloat>
 #include <cstdint>
+#include <cstring>
 
 #include "fieldpath/zbuffer/hd.h"
 
@@ -331,6 +332,25 @@ FIELDPATH_HD float meshEntry(const ToolView& tool, const PreparedPosture& pp, Ve
   }
 }
 
+/// Lowest entry of a vertical line (tool frame origin o, direction +z) into a mesh tool: only the
+/// triangles of o's bin, tested with the same watertight test as the BVH. Every triangle such a
+/// line can enter faces down and has o inside its padded xy box, hence sits in o's bin (the bin
+/// index is the same monotone float expression as at binning), so the minimum is the BVH's, bit
+/// for bit, at a handful of triangle tests instead of a tree walk.
+FIELDPATH_HD float binnedEntry(const ToolView& tool, const PreparedPosture& pp, Vec3f o) {
+  const float fx = (o.x - tool.bin_x0_mm) * tool.bin_inv_mm;
+  const float fy = (o.y - tool.bin_y0_mm) * tool.bin_inv_mm;
+  // outside every padded triangle box (a margin of one bin keeps the clamped edge bins exact)
+  if (!(fx > -1.f && fy > -1.f && fx < tool.bins + 1.f && fy < tool.bins + 1.f)) return FLT_MAX;
+  const int cx = clampi(static_cast<int>(fx), 0, tool.bins - 1);
+  const int cy = clampi(static_cast<int>(fy), 0, tool.bins - 1);
+  const int cell = cy * tool.bins + cx;
+  float best = FLT_MAX;
+  for (int k = tool.bin_start[cell]; k < tool.bin_start[cell + 1]; ++k)
+    best = minf(best, triangleEntry(pp, tool.bvh_triangles + 9 * tool.bin_items[k], o));
+  return best;
+}
+
 /// The height the posture would give line (ix, iy), or FLT_MAX if it cannot lower it below
 /// `current_mm`. Analytic and mesh tools; -0 folded to +0 so that both backends store equal bits.
 FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
@@ -352,7 +372,8 @@ FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const Prepar
   float t;
   if (tool.kind == ToolKind::Mesh) {
     const float slack = 1e-5f * (absf(current_mm) + absf(pp.tip_mm.z) + 1.f);
-    t = meshEntry(tool, pp, o, current_mm - pp.tip_mm.z + slack);
+    t = pp.vertical && tool.bins > 0 ? binnedEntry(tool, pp, o)
+                                     : meshEntry(tool, pp, o, current_mm - pp.tip_mm.z + slack);
   } else {
     t = analyticEntry(tool, o, pp.dir);
   }
@@ -385,6 +406,18 @@ FIELDPATH_HD bool cullPosture(const GridView& g, const ToolView& tool, PreparedP
                    margin);
   }
   return false;
+}
+
+/// Sort key of a posture for lowest-first processing: its lowest point as an unsigned key that
+/// orders like the float (postures that miss the grid last). Processing a block lowest first
+/// makes the first cut of a line nearly its final one, so later (higher) postures are culled by
+/// the tile maxima or skipped per line at one compare; the minimum, hence every bit, is the same.
+FIELDPATH_HD std::uint32_t lowestKey(const GridView& g, const ToolView& tool, Posture pose) {
+  const PreparedPosture pp = preparePosture(g, tool, pose);
+  if (pp.ix0 > pp.ix1 || pp.iy0 > pp.iy1) return 0xffffffffu;
+  std::int32_t bits;
+  memcpy(&bits, &pp.lowest_z_mm, 4);
+  return static_cast<std::uint32_t>(orderedBits(bits)) ^ 0x80000000u;
 }
 
 /// Canonical 2D edge function: the same two points give exactly opposite values whichever way

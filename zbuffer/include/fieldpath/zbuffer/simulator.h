@@ -65,6 +65,16 @@ bool cudaAvailable();
 /// 0 ends the stream. Lets 27 million postures pass through a fixed buffer.
 using PostureSource = std::function<std::size_t(std::span<Posture> out)>;
 
+/// Knobs of the fast engine that change its speed only, never a height bit (the minimum over
+/// postures does not depend on their order or on which ones are culled). Defaults are the fastest
+/// measured (bench/results/zbuffer-*.md); bench_zbuffer --variants times the others.
+struct EngineTuning {
+  bool vertical_bins = true;   ///< vertical mesh postures: bin look-up instead of the BVH walk
+  bool lowest_first = true;    ///< each block's postures processed lowest point first
+  bool small_threads = true;   ///< CUDA: one thread per small-footprint posture, warps for the rest
+  bool overlap_upload = true;  ///< CUDA: a block's upload overlaps the previous block's kernels
+};
+
 struct SimulationRequest {
   Grid grid;
   Tool tool;
@@ -76,6 +86,7 @@ struct SimulationRequest {
   std::size_t block_postures = std::size_t{1} << 20;  ///< postures per streamed block
   common::Progress progress;  ///< fraction is postures done / expected_postures (if known)
   std::size_t expected_postures = 0;
+  EngineTuning tuning;
 };
 
 struct SimulationResult {
@@ -123,15 +134,21 @@ GridView makeGridView(const Grid& grid);
 class BackendEngine {
  public:
   virtual ~BackendEngine() = default;
-  /// Lowers the heights by every posture of the block; returns how many postures were culled.
-  virtual std::size_t cut(std::span<const Posture> block, Engine engine) = 0;
+  /// Lowers the heights by every posture of the block (the engine may still be working on it
+  /// when this returns, but no longer reads `block`).
+  virtual void cut(std::span<const Posture> block, Engine engine) = 0;
+  /// Waits for all blocks; the final heights.
   virtual std::vector<float> heights() = 0;
+  /// Postures culled so far by the fast engine (valid after heights()).
+  virtual std::size_t culled() = 0;
 };
 std::unique_ptr<BackendEngine> makeCpuEngine(const GridView& grid, const ToolData& tool,
-                                             std::vector<float> heights_mm);
+                                             std::vector<float> heights_mm,
+                                             const EngineTuning& tuning);
 /// Throws std::runtime_error if built without CUDA or no device is present.
 std::unique_ptr<BackendEngine> makeCudaEngine(const GridView& grid, const ToolData& tool,
-                                              std::vector<float> heights_mm);
+                                              std::vector<float> heights_mm,
+                                              const EngineTuning& tuning);
 
 }  // namespace detail
 }  // namespace fieldpath::zbuffer
