@@ -217,9 +217,12 @@ GenerateResult generateImpellerPath(const GenerateRequest& request) {
     steer.step_mm = pass.samples.size() > 1 ? pass.samples[1].s_mm : pass.length_mm;
     steer.progress = scaled(request.progress, begin, end, label);
     const dynamics::SteeringResult steered = dynamics::steerPass(dyn_pass, steer);
-    if (steered.status != dynamics::Status::Ok)
-      throw InputError(label + " (v = " + std::to_string(pass.v) +
-                       "): " + dynamics::toString(steered.status) + ": " + steered.message);
+    if (steered.status != dynamics::Status::Ok) {
+      std::ostringstream msg;
+      msg << label << " (v = " << pass.v << "): " << dynamics::toString(steered.status) << ": "
+          << steered.message;
+      throw InputError(msg.str());
+    }
     for (const dynamics::PostureSample& s : steered.samples) {
       GeneratedPosture g;
       g.pass = pass.index;
