@@ -184,7 +184,8 @@ void readHolder(const Reader& r, const YAML::Node& node, geometry::HolderProfile
 
 void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
   r.expectMap(node, "field",
-              {"r0", "r_min", "gain", "sample_step", "weights", "voxel_size", "interpolation"});
+              {"r0", "r_min", "gain", "sample_step", "weights", "voxel_size", "interpolation",
+               "stored"});
   if (node["r0"]) f.r0_mm = r.positive(node["r0"], "field.r0");
   if (node["r_min"]) f.r_min_mm = r.positive(node["r_min"], "field.r_min");
   if (!(f.r_min_mm < f.r0_mm)) {
@@ -205,6 +206,10 @@ void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
                              {"trilinear", "quadratic"}) == "trilinear"
                           ? field::Interpolation::Trilinear
                           : field::Interpolation::Quadratic;
+  if (node["stored"])
+    f.stored = r.word(node["stored"], "field.stored", {"plane_ratio", "force"}) == "force"
+                   ? field::StoredQuantity::Force
+                   : field::StoredQuantity::PlaneRatio;
 }
 
 void readDynamics(const Reader& r, const YAML::Node& node, dynamics::DynamicsParams& d) {

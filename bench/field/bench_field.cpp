@@ -98,7 +98,7 @@ BandPoints bandPoints(const field::ObstacleSamples& s, const field::FieldParams&
 /// Nodes of a ball-end tool (R 3 mm, 40 mm long, ≈500 nodes, tool frame: tip at the origin,
 /// axis +z) for a tip moving down the middle of the channel: `postures` batches of nodes, each
 /// evaluated as one call, as the dynamics does.
-std::vector<std::vector<Vec3>> toolNodeBatches(int postures) {
+std::vector<std::vector<Vec3>> toolNodeBatches(int postures, double tip_y_mm = 0.0) {
   std::vector<Vec3> tool;
   const double radius = 3.0;
   for (int i = 0; i <= 8; ++i)  // hemisphere, rings of latitude
@@ -115,7 +115,7 @@ std::vector<std::vector<Vec3>> toolNodeBatches(int postures) {
     }
   std::vector<std::vector<Vec3>> batches;
   for (int p = 0; p < postures; ++p) {
-    const Vec3 tip(-44.0 + 88.0 * p / std::max(1, postures - 1), 0.0, 2.0);
+    const Vec3 tip(-44.0 + 88.0 * p / std::max(1, postures - 1), tip_y_mm, 2.0);
     std::vector<Vec3> nodes;
     for (const Vec3& n : tool) nodes.push_back(tip + n);
     batches.push_back(std::move(nodes));
@@ -132,6 +132,89 @@ std::string loadAverage() {
   }
   std::string s(text);
   return s.substr(0, s.find(' ', s.find(' ', s.find(' ') + 1) + 1));
+}
+
+/// Points where a voxel field is compared with the direct one, as the study (app/study.h) does:
+/// relative error where the point is in free space at least `clearance` from the walls and
+/// |F_d| is at least 1 % of the set's largest |F_d|. The walls are open sheets: free space is
+/// their channel side (η > 0 above the nearest sample) and beyond their edges; the distance to
+/// a wall is η where the point is over it (the nearest sample less than `over_mm` sideways),
+/// else the distance to the nearest sample.
+struct ErrorSet {
+  std::string name;
+  std::vector<Vec3> points;
+  std::vector<Vec3> exact;
+  std::vector<char> counted;
+};
+
+ErrorSet errorSet(std::string name, std::vector<Vec3> points, const field::DirectField& direct,
+                  double clearance_mm, double over_mm) {
+  ErrorSet set{std::move(name), std::move(points), {}, {}};
+  set.exact.resize(set.points.size());
+  direct.evaluate(set.points, set.exact);
+  const auto& s = direct.samples();
+  double max_ref = 0.0;
+  std::vector<char> clear(set.points.size());
+  for (std::size_t i = 0; i < set.points.size(); ++i) {
+    double best = HUGE_VAL;
+    std::size_t nearest = 0;
+    for (std::size_t j = 0; j < s.size(); ++j) {
+      const double d2 = (set.points[i] - s.points_mm[j]).squaredNorm();
+      if (d2 < best) best = d2, nearest = j;
+    }
+    const double eta = (set.points[i] - s.points_mm[nearest]).dot(s.normals[nearest]);
+    const bool over = best - eta * eta <= over_mm * over_mm;
+    clear[i] = over ? eta >= clearance_mm : std::sqrt(best) >= clearance_mm;
+    if (clear[i]) max_ref = std::max(max_ref, set.exact[i].norm());
+  }
+  for (std::size_t i = 0; i < set.points.size(); ++i)
+    set.counted.push_back(clear[i] && set.exact[i].norm() >= 0.01 * max_ref && max_ref > 0.0);
+  return set;
+}
+
+field::FieldError setError(const ErrorSet& set, const field::ForceField& f) {
+  std::vector<Vec3> approx(set.points.size()), a, r;
+  f.evaluate(set.points, approx);
+  for (std::size_t i = 0; i < approx.size(); ++i)
+    if (set.counted[i]) a.push_back(approx[i]), r.push_back(set.exact[i]);
+  return field::relativeError(a, r, 0.0);
+}
+
+std::vector<Vec3> segment(const Vec3& a, const Vec3& b, double step_mm) {
+  const int n = std::max(2, static_cast<int>(std::ceil((b - a).norm() / step_mm)) + 1);
+  std::vector<Vec3> points;
+  for (int i = 0; i < n; ++i) points.push_back(a + (b - a) * (double(i) / (n - 1)));
+  return points;
+}
+
+/// The study's lines on the walls: a, along the channel r0/2 off the +y wall at mid height;
+/// b, across the channel wall to wall at x = 22.5 (the walls turned ±7.5°), mid height; c, across
+/// the channel 2 mm above the walls' top edges (x = 22.5: the open edges, both sides of them);
+/// and the nodes of a tool moving down the channel 14 mm off its axis (its shank grazes the +y
+/// wall where it leans in).
+std::vector<ErrorSet> errorSets(const field::DirectField& direct, double r0_mm, double over_mm) {
+  using bench::wallNormal, bench::wallPoint;
+  const double v = 0.5 * bench::kHeight, x = 22.5;
+  std::vector<Vec3> a;
+  for (int i = 0; i <= 1760; ++i) {
+    const double xi = -44.0 + 88.0 * i / 1760;
+    a.push_back(wallPoint(1, xi, v) + 0.5 * r0_mm * wallNormal(1, xi, v));
+  }
+  const Vec3 top_l = wallPoint(-1, x, bench::kHeight), top_r = wallPoint(1, x, bench::kHeight);
+  std::vector<Vec3> tool;
+  for (const auto& batch : toolNodeBatches(200, 14.0))
+    tool.insert(tool.end(), batch.begin(), batch.end());
+  return {errorSet("line a", std::move(a), direct, 0.5, over_mm),
+          errorSet("line b", segment(wallPoint(-1, x, v), wallPoint(1, x, v), 0.05), direct, 0.5,
+                   over_mm),
+          errorSet("line c (edges)",
+                   segment(Vec3(x, -30, top_l.z() + 2), Vec3(x, 30, top_r.z() + 2), 0.05), direct,
+                   0.5, over_mm),
+          errorSet("tool nodes", std::move(tool), direct, 0.5, over_mm)};
+}
+
+const char* storedName(field::StoredQuantity s) {
+  return s == field::StoredQuantity::PlaneRatio ? "plane ratio" : "force";
 }
 
 }  // namespace
@@ -232,33 +315,51 @@ int main(int argc, char** argv) {
   // ---- voxel variants: rates and errors -----------------------------------------------------
   const std::vector<std::pair<double, double>> buckets{
       {0.5, 1.0}, {1.0, 2.0}, {2.0, 4.5}, {0.5, 4.5}};
-  std::vector<std::string> error_rows;
-  for (double h : quick ? std::vector<double>{0.5} : std::vector<double>{2.0, 1.0, 0.5, 0.25}) {
-    for (auto interpolation : {field::Interpolation::Trilinear, field::Interpolation::Quadratic}) {
-      field::VoxelRequest request;
-      request.voxel_size_mm = h;
-      request.region_mm = region;
-      request.interpolation = interpolation;
-      const field::VoxelField voxel(direct, request);
-      char name[64];
-      std::snprintf(name, sizeof name, "voxel h %.2f %s", h,
-                    interpolation == field::Interpolation::Trilinear ? "trilinear" : "quadratic");
-      random_rates.push_back(
-          rate(name, points.size(), medianTimes(repeats, [&] { voxel.evaluate(points, forces); })));
-      tool_rates.push_back(
-          rate(name, n_tool, medianTimes(repeats, [&] { evaluateBatches(voxel); })));
-      std::string row = std::string("| ") + name;
-      for (const auto& [lo, hi] : buckets) {
-        std::vector<Vec3> a, b;
-        for (std::size_t i = 0; i < points.size(); ++i)
-          if (band.distance_mm[i] >= lo && band.distance_mm[i] < hi)
-            a.push_back(forces[i]), b.push_back(exact[i]);
-        const field::FieldError e = field::relativeError(a, b, 0.0);
-        char cell[64];
-        std::snprintf(cell, sizeof cell, " | %.1e / %.1e", e.max_relative, e.rms_relative);
-        row += cell;
+  const std::vector<ErrorSet> sets = errorSets(direct, params.r0_mm, params.sample_step_mm);
+  std::vector<std::string> error_rows, set_rows;
+  for (double h :
+       quick ? std::vector<double>{1.0, 0.5} : std::vector<double>{2.0, 1.0, 0.5, 0.25}) {
+    for (auto stored : {field::StoredQuantity::Force, field::StoredQuantity::PlaneRatio}) {
+      for (auto interpolation :
+           {field::Interpolation::Trilinear, field::Interpolation::Quadratic}) {
+        field::VoxelRequest request;
+        request.voxel_size_mm = h;
+        request.region_mm = region;
+        request.interpolation = interpolation;
+        request.stored = stored;
+        const field::VoxelField voxel(direct, request);
+        char name[96];
+        std::snprintf(name, sizeof name, "voxel h %.2f %s %s", h, storedName(stored),
+                      interpolation == field::Interpolation::Trilinear ? "trilinear" : "quadratic");
+        random_rates.push_back(rate(name, points.size(),
+                                    medianTimes(repeats, [&] { voxel.evaluate(points, forces); })));
+        tool_rates.push_back(
+            rate(name, n_tool, medianTimes(repeats, [&] { evaluateBatches(voxel); })));
+        std::string row = std::string("| ") + name;
+        for (const auto& [lo, hi] : buckets) {
+          std::vector<Vec3> a, b;
+          for (std::size_t i = 0; i < points.size(); ++i)
+            if (band.distance_mm[i] >= lo && band.distance_mm[i] < hi)
+              a.push_back(forces[i]), b.push_back(exact[i]);
+          const field::FieldError e = field::relativeError(a, b, 0.0);
+          char cell[64];
+          std::snprintf(cell, sizeof cell, " | %.1e / %.1e", e.max_relative, e.rms_relative);
+          row += cell;
+        }
+        error_rows.push_back(row + " |");
+        char head[160];
+        std::snprintf(head, sizeof head, "| %s | %zu | %.3f", name, voxel.stats().active_nodes,
+                      voxel.stats().build_seconds);
+        row = head;
+        for (const ErrorSet& set : sets) {
+          const field::FieldError e = setError(set, voxel);
+          char cell[64];
+          std::snprintf(cell, sizeof cell, " | %.2f / %.2f", 100 * e.max_relative,
+                        100 * e.rms_relative);
+          row += cell;
+        }
+        set_rows.push_back(row + " |");
       }
-      error_rows.push_back(row + " |");
     }
   }
 
@@ -295,5 +396,19 @@ int main(int argc, char** argv) {
   std::printf(
       "| variant | 0.5-1 mm | 1-2 mm | 2-4.5 mm | all (0.5-4.5 mm) |\n|---|---|---|---|---|\n");
   for (const auto& row : error_rows) std::printf("%s\n", row.c_str());
+
+  std::printf(
+      "\n## Relative error (%%, max / RMS) on the study's sets: points >= 0.5 mm from every "
+      "sample where |F_direct| >= 1 %% of the set's largest (app/study.h's definition)\n\n");
+  std::printf("| variant | active nodes | build s (last run)");
+  for (const ErrorSet& set : sets) {
+    std::size_t n = 0;
+    for (char c : set.counted) n += c;
+    std::printf(" | %s (%zu pts)", set.name.c_str(), n);
+  }
+  std::printf(" |\n|---|---|---");
+  for (std::size_t i = 0; i < sets.size(); ++i) std::printf("|---");
+  std::printf("|\n");
+  for (const auto& row : set_rows) std::printf("%s\n", row.c_str());
   return 0;
 }

@@ -24,6 +24,30 @@ using Grid = openvdb::Vec3SGrid;
 using Leaf = Grid::TreeType::LeafNodeType;
 constexpr int kLeafDim = static_cast<int>(Leaf::DIM);  // 8 nodes a side
 
+using FloatGrid = openvdb::FloatGrid;
+using FloatLeaf = FloatGrid::TreeType::LeafNodeType;
+
+StoredQuantity storedOf(const FieldParams& params, const VoxelRequest& request) {
+  return request.stored.value_or(params.stored);
+}
+
+/// How far from a sample nodes are built (mm): r0, plus for the plane ratio a shell one cell
+/// diagonal beyond it, whose nodes carry the plane height past r0 (so that a cell straddling
+/// r0 interpolates s linearly through it instead of towards the zero background).
+double reachMm(const FieldParams& params, const VoxelRequest& request) {
+  return storedOf(params, request) == StoredQuantity::PlaneRatio
+             ? params.r0_mm + std::sqrt(3.0) * request.voxel_size_mm
+             : params.r0_mm;
+}
+
+/// Weight per mm² of sampled surface (κ of law.h PlaneLaw): 1 for area weights.
+double weightPerMm2(const ObstacleSamples& samples, const FieldParams& params) {
+  if (params.weights == Weights::Area || !(samples.area_mm2 > 0.0)) return 1.0;
+  double sum = 0.0;
+  for (double w : samples.weights) sum += w;
+  return sum / samples.area_mm2;
+}
+
 double insideBandMm(const FieldParams& params, const VoxelRequest& request) {
   return request.inside_band_mm >= 0.0 ? request.inside_band_mm
                                        : 2.0 * request.voxel_size_mm + params.r_min_mm;
@@ -34,14 +58,14 @@ void checkVoxelSize(double h_mm) {
     throw common::InputError("voxel size must be > 0 mm (got " + std::to_string(h_mm) + ")");
 }
 
-/// World box of the samples padded by r0, clipped to the region; empty if no sample.
+/// World box of the samples padded by reachMm, clipped to the region; empty if no sample.
 Eigen::AlignedBox3d reachBox(const ObstacleSamples& samples, const FieldParams& params,
                              const VoxelRequest& request) {
   Eigen::AlignedBox3d box;
   for (const Vec3& q : samples.points_mm) box.extend(q);
   if (box.isEmpty()) return box;
-  box.min().array() -= params.r0_mm;
-  box.max().array() += params.r0_mm;
+  box.min().array() -= reachMm(params, request);
+  box.max().array() += reachMm(params, request);
   if (request.region_mm) box = box.intersection(*request.region_mm);
   return box;
 }
@@ -75,9 +99,10 @@ std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams
   };
   double dense = 1.0;
   for (int a = 0; a < 3; ++a) dense *= count(box.min()[a], box.max()[a]);
-  // Every built node lies within r0 of a sample, so in a cell (edge r0/2) at most two cells from
-  // one holding a sample: count the nodes of those cells (clipped to the box) on a coarse mask.
-  const double cell_mm = 0.5 * params.r0_mm;
+  // Every built node lies within reachMm of a sample, so in a cell (edge reach/2) at most two
+  // cells from one holding a sample: count the nodes of those cells (clipped to the box) on a
+  // coarse mask.
+  const double cell_mm = 0.5 * reachMm(params, request);
   checkExtent(box, h, "voxel size");
   Eigen::AlignedBox3d all;
   for (const Vec3& q : samples.points_mm) all.extend(q);
@@ -110,11 +135,61 @@ std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams
 }
 
 struct VoxelField::Impl {
-  Grid::Ptr grid;
+  Grid::Ptr grid;            ///< F (Force) or G = F / P(s) (PlaneRatio), world frame
+  FloatGrid::Ptr closeness;  ///< PlaneRatio: r0 - s (mm), same topology; background 0 (s = r0)
   VoxelStats stats;
   double voxel_size_mm = 0.0;
   Interpolation interpolation = Interpolation::Trilinear;
+  StoredQuantity stored = StoredQuantity::Force;
+  std::optional<PlaneLaw> law;  ///< PlaneRatio
 };
+
+namespace {
+
+/// Whether x lies over (or under) the sampled surface: its nearest sample less than `over_mm`
+/// sideways. Beyond the edge of an open wall it does not, and "inside" means nothing there.
+bool overSurface(const detail::Probe& p, double over_mm) {
+  const double lateral_sq = p.nearest_mm * p.nearest_mm - p.height_mm * p.height_mm;
+  return lateral_sq <= over_mm * over_mm;
+}
+
+constexpr double kOverCos = 0.7;  ///< |cos| of the field's angle to n* over the surface
+
+/// The plane-ratio pair (s, G) of one node from its probe (law.h), so that P(s)·G is the
+/// node's force, s is the plane height η on both sides of a plane and G the plane's normal:
+/// - over the sampled surface within `near_mm` of it (on either side), the field of the samples
+///   is not yet that of a plane (each sample's 1/r³ shows, and the r_min hold): the node holds
+///   the plane's continuation, s = η and G = n*, so that cells reaching down to the wall
+///   interpolate the smooth field above it (these nodes alone do not give back F);
+/// - elsewhere s = P⁻¹(|F|), the height at which a plane gives |F| (negative under the surface),
+///   and G = F / P(s), the unit field direction;
+/// - past r0 (the shell, no sample within r0): s = max(η, r0) and G the wall's direction, the
+///   plane's continuation, so that a cell straddling r0 interpolates s linearly through it.
+/// "Over the surface" (overSurface) decides the sign: beyond the edge of an open wall the field
+/// is even about the wall's plane and s stays positive there.
+std::pair<double, Vec3> planeRatio(const detail::Probe& p, const Vec3& x, const Vec3& q,
+                                   const Vec3& n, const PlaneLaw& law, double gain, double over_mm,
+                                   double near_mm) {
+  const double eta = p.height_mm;
+  // Over the surface, and the field along its normal (beyond an edge it turns sideways, away
+  // from the edge, and the sign of η says nothing).
+  const bool over = overSurface(p, over_mm) &&
+                    (!p.force || std::abs(p.force->dot(n)) >= kOverCos * p.force->norm());
+  const double sign = gain < 0.0 ? -1.0 : 1.0;
+  if (!p.force) {  // shell: no sample within r0
+    if (!over) return {std::max(p.nearest_mm, law.r0_mm), sign * (x - q) / p.nearest_mm};
+    if (eta >= 0.0) return {std::max(eta, law.r0_mm), sign * n};
+    return {-std::max(-eta, law.r0_mm), Vec3::Zero()};
+  }
+  if (over && std::abs(eta) < near_mm)
+    return {eta, law.scale > 0.0 ? Vec3(sign * n) : Vec3::Zero()};
+  const double e = law.height(p.force->norm());
+  const double s = over && eta < 0.0 ? -e : e;
+  const double plane = law.at(s);
+  return {s, plane > 0.0 ? Vec3(*p.force / plane) : Vec3::Zero()};
+}
+
+}  // namespace
 
 VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
     : impl_(std::make_unique<Impl>()) {
@@ -125,6 +200,14 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
   const double h = request.voxel_size_mm;
   checkVoxelSize(h);
   const double band_in_mm = insideBandMm(params, request);
+  const StoredQuantity stored = storedOf(params, request);
+  const bool ratio = stored == StoredQuantity::PlaneRatio;
+  const double reach_mm = reachMm(params, request);
+  const PlaneLaw law(params, weightPerMm2(samples, params));
+  // Sideways reach of a sample (sub-triangle centroids: within 0.87 step of any surface point);
+  // closer to the surface than about one spacing the samples' field is not yet a plane's.
+  const double over_mm = params.sample_step_mm;
+  const double near_mm = ratio ? request.plane_near_mm.value_or(params.r_min_mm) : 0.0;
 
   auto refuse = [&](const std::string& what, double nodes, double bytes_per_node) {
     const double bytes = nodes * bytes_per_node;
@@ -136,17 +219,20 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
                              "; use a coarser voxel size or a smaller region");
   };
   impl_->stats.estimated_nodes = estimateVoxelNodes(samples, params, request);
-  refuse("estimated", static_cast<double>(impl_->stats.estimated_nodes), kVoxelBytesPerNode);
+  // The plane ratio adds a float to the Vec3f of a node.
+  const double value_bytes = ratio ? 16.0 : 12.0;
+  refuse("estimated", static_cast<double>(impl_->stats.estimated_nodes),
+         kVoxelBytesPerNode * value_bytes / 12.0);
 
-  // Candidate leaves (8³ nodes): those within r0 of a sample, inside the region.
+  // Candidate leaves (8³ nodes): those within reach of a sample, inside the region.
   const Eigen::AlignedBox3d reach = reachBox(samples, params, request);
   std::vector<openvdb::Coord> origins;
   if (!reach.isEmpty()) {
     const Vec3 lo_region = reach.min() / h, hi_region = reach.max() / h;
     const double leaf_mm = kLeafDim * h;
     for (const Vec3& q : samples.points_mm) {
-      const Vec3 lo = ((q.array() - params.r0_mm) / h).max(lo_region.array()).ceil();
-      const Vec3 hi = ((q.array() + params.r0_mm) / h).min(hi_region.array()).floor();
+      const Vec3 lo = ((q.array() - reach_mm) / h).max(lo_region.array()).ceil();
+      const Vec3 hi = ((q.array() + reach_mm) / h).min(hi_region.array()).floor();
       if ((lo.array() > hi.array()).any()) continue;
       const openvdb::Coord a(int(lo.x()), int(lo.y()), int(lo.z()));
       const openvdb::Coord b(int(hi.x()), int(hi.y()), int(hi.z()));
@@ -157,24 +243,33 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
             // Distance from q to the leaf's node box.
             const Vec3 box_lo = Vec3(i, j, k) * h;
             const Vec3 nearest = q.cwiseMax(box_lo).cwiseMin(box_lo + Vec3::Constant(leaf_mm - h));
-            if ((nearest - q).squaredNorm() < params.r0_mm * params.r0_mm)
-              origins.emplace_back(i, j, k);
+            if ((nearest - q).squaredNorm() < reach_mm * reach_mm) origins.emplace_back(i, j, k);
           }
     }
   }
   std::sort(origins.begin(), origins.end());
   origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
-  // Full leaves: a Vec3f a node, masks and header.
+  // Full leaves: the values of a node, masks and header.
   refuse("candidate leaves hold", static_cast<double>(origins.size()) * Leaf::SIZE,
-         static_cast<double>(sizeof(Leaf)) / Leaf::SIZE + 12.0);
+         static_cast<double>(sizeof(Leaf)) / Leaf::SIZE * value_bytes / 12.0 + 12.0);
 
   auto grid = Grid::create(openvdb::Vec3s(0.0f));
   grid->setTransform(openvdb::math::Transform::createLinearTransform(h));
-  grid->setName("force");
+  grid->setName(ratio ? "plane_ratio" : "force");
   grid->setVectorType(openvdb::VEC_INVARIANT);
+  FloatGrid::Ptr closeness;
+  if (ratio) {
+    closeness = FloatGrid::create(0.0f);
+    closeness->setTransform(grid->transform().copy());
+    closeness->setName("plane_closeness");
+  }
   std::vector<Leaf*> leaves;
+  std::vector<FloatLeaf*> float_leaves;
   leaves.reserve(origins.size());
-  for (const auto& o : origins) leaves.push_back(grid->tree().touchLeaf(o));
+  for (const auto& o : origins) {
+    leaves.push_back(grid->tree().touchLeaf(o));
+    if (ratio) float_leaves.push_back(closeness->tree().touchLeaf(o));
+  }
 
   // Node values from the exact law, per leaf over the samples near it; in batches between
   // which the progress hook is called (from this thread only).
@@ -191,10 +286,11 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
         const openvdb::Coord o = leaf.origin();
         const Vec3 lo = Vec3(o.x(), o.y(), o.z()) * h;
         const Vec3 hi = lo + Vec3::Constant((kLeafDim - 1) * h);
-        // Samples within r0 of the leaf's nodes, gathered once; the surface rule's second sum, at
-        // a point lifted off the wall (rare: nodes within r_min or inside), searches the index.
+        // Samples within reach of the leaf's nodes, gathered once; the surface rule's second
+        // sum, at a point lifted off the wall (rare: nodes within r_min or inside), searches the
+        // index.
         near.clear();
-        index.forEachInBox(searcher, lo.array() - params.r0_mm, hi.array() + params.r0_mm,
+        index.forEachInBox(searcher, lo.array() - reach_mm, hi.array() + reach_mm,
                            [&](std::size_t j) { near.push_back(j); });
         for (auto it = leaf.beginValueAll(); it; ++it) {
           const openvdb::Coord ijk = it.getCoord();
@@ -206,10 +302,21 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
             else
               index.forEachNear(searcher, center, radius, fn);
           };
-          const auto f = detail::fieldAt(x, for_each_near, samples.points_mm, samples.normals,
-                                         samples.weights, params, band_in_mm);
-          if (!f) continue;
-          it.setValue(openvdb::Vec3s(float(f->x()), float(f->y()), float(f->z())));
+          const detail::Probe p = detail::probe(x, for_each_near, samples.points_mm,
+                                                samples.normals, samples.weights, params, reach_mm);
+          if (p.nearest < 0 || (p.height_mm < -band_in_mm && overSurface(p, over_mm))) continue;
+          Vec3 value;
+          if (ratio) {
+            const auto [s, g] =
+                planeRatio(p, x, samples.points_mm[p.nearest], samples.normals[p.nearest], law,
+                           params.gain, over_mm, near_mm);
+            float_leaves[l]->setValueOn(it.pos(), float(params.r0_mm - s));
+            value = g;
+          } else {
+            if (!p.force) continue;
+            value = *p.force;
+          }
+          it.setValue(openvdb::Vec3s(float(value.x()), float(value.y()), float(value.z())));
           it.setValueOn();
         }
       }
@@ -217,17 +324,21 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
     common::report(request.progress, double(batch + 1) / double(batches), "field");
   }
   openvdb::tools::pruneInactive(grid->tree());
+  if (closeness) openvdb::tools::pruneInactive(closeness->tree());
 
   VoxelStats& stats = impl_->stats;
   stats.active_nodes = grid->activeVoxelCount();
   const openvdb::CoordBBox active_box = grid->evalActiveVoxelBoundingBox();
   stats.dense_box_nodes = active_box.empty() ? 0 : active_box.volume();
-  stats.memory_bytes = grid->memUsage();
+  stats.memory_bytes = grid->memUsage() + (closeness ? closeness->memUsage() : 0);
   stats.build_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   impl_->grid = std::move(grid);
+  impl_->closeness = std::move(closeness);
   impl_->voxel_size_mm = h;
   impl_->interpolation = request.interpolation;
+  impl_->stored = stored;
+  if (ratio) impl_->law = law;
 }
 
 VoxelField::~VoxelField() = default;
@@ -237,60 +348,129 @@ VoxelField& VoxelField::operator=(VoxelField&&) noexcept = default;
 const VoxelStats& VoxelField::stats() const { return impl_->stats; }
 double VoxelField::voxelSizeMm() const { return impl_->voxel_size_mm; }
 Interpolation VoxelField::interpolation() const { return impl_->interpolation; }
+StoredQuantity VoxelField::stored() const { return impl_->stored; }
 
 namespace {
 
-/// Trilinear interpolation in index space (OpenVDB BoxSampler's weights), with a fast path that
-/// reads the 8 corners straight from the leaf buffer when they share a leaf (7 cells in 8 along
-/// each axis), the accessor otherwise.
-Vec3 trilinear(Grid::ConstAccessor& acc, const Vec3& p) {
-  const Eigen::Vector3d base = p.array().floor();
-  const openvdb::Coord ijk(int(base.x()), int(base.y()), int(base.z()));
-  const Vec3 t = p - base;
-  openvdb::Vec3s c[8];
+/// The 8 corner values of the cell at ijk (index bits: x 4, y 2, z 1), read straight from the
+/// leaf buffer when they share a leaf (7 cells in 8 along each axis), through the accessor
+/// otherwise. False where the cell lies in an absent leaf (background everywhere).
+template <class Accessor, class Value>
+bool cellCorners(Accessor& acc, const openvdb::Coord& ijk, Value (&c)[8]) {
+  using LeafT = typename Accessor::TreeType::LeafNodeType;
   const openvdb::Coord in_leaf = ijk & (kLeafDim - 1);
   if (in_leaf.x() < kLeafDim - 1 && in_leaf.y() < kLeafDim - 1 && in_leaf.z() < kLeafDim - 1) {
-    const Leaf* leaf = acc.probeConstLeaf(ijk);
-    if (!leaf) return Vec3::Zero();  // background everywhere in the cell
-    const openvdb::Vec3s* v = leaf->buffer().data() + Leaf::coordToOffset(ijk);
+    const LeafT* leaf = acc.probeConstLeaf(ijk);
+    if (!leaf) return false;
+    const Value* v = leaf->buffer().data() + LeafT::coordToOffset(ijk);
     constexpr int dx = kLeafDim * kLeafDim, dy = kLeafDim;
     for (int i = 0; i < 8; ++i) c[i] = v[(i & 4 ? dx : 0) + (i & 2 ? dy : 0) + (i & 1)];
   } else {
     for (int i = 0; i < 8; ++i)
       c[i] = acc.getValue(ijk.offsetBy(i & 4 ? 1 : 0, i & 2 ? 1 : 0, i & 1));
   }
-  auto lerp = [](const openvdb::Vec3s& a, const openvdb::Vec3s& b, double w) {
-    return Vec3(a.x() + w * (b.x() - a.x()), a.y() + w * (b.y() - a.y()),
-                a.z() + w * (b.z() - a.z()));
-  };
-  // c index bits: x (4), y (2), z (1)
-  const Vec3 c00 = lerp(c[0], c[1], t.z()), c01 = lerp(c[2], c[3], t.z());
-  const Vec3 c10 = lerp(c[4], c[5], t.z()), c11 = lerp(c[6], c[7], t.z());
-  const Vec3 c0 = c00 + t.y() * (c01 - c00), c1 = c10 + t.y() * (c11 - c10);
-  return c0 + t.x() * (c1 - c0);
+  return true;
+}
+
+Vec3 widen(const openvdb::Vec3s& v) { return Vec3(v.x(), v.y(), v.z()); }
+double widen(float v) { return v; }
+
+/// Trilinear blend (OpenVDB BoxSampler's weights) of the corners at fractions t in the cell.
+template <class Value>
+auto blend(const Value (&c)[8], const Vec3& t) {
+  using R = decltype(widen(c[0]));
+  auto lerp = [](const R& a, const R& b, double w) -> R { return a + w * (b - a); };
+  const R c00 = lerp(widen(c[0]), widen(c[1]), t.z()), c01 = lerp(widen(c[2]), widen(c[3]), t.z());
+  const R c10 = lerp(widen(c[4]), widen(c[5]), t.z()), c11 = lerp(widen(c[6]), widen(c[7]), t.z());
+  return lerp(lerp(c00, c01, t.y()), lerp(c10, c11, t.y()), t.x());
+}
+
+struct Accessors {
+  Grid::ConstAccessor grid;
+  std::optional<FloatGrid::ConstAccessor> closeness;
+};
+
+/// Whether the plane-ratio blend holds in a cell, from its corner heights s (mm): s keeps one
+/// sign, or crosses zero as a linear function does across a wall (the sums over the four pairs
+/// of opposite corners, equal for a linear s, agree within `tolerance`). Otherwise the cell
+/// straddles a jump of s (behind the edge of an open wall, the inner end of the inside band),
+/// where P(s~) would read the wall's r_min value in mid-air; the corner forces are blended there.
+bool ratioHolds(const double (&s)[8], double tolerance) {
+  const bool negative = std::any_of(s, s + 8, [](double v) { return v < 0.0; });
+  const bool positive = std::any_of(s, s + 8, [](double v) { return v > 0.0; });
+  if (!negative || !positive) return true;
+  const double sums[4] = {s[0] + s[7], s[1] + s[6], s[2] + s[5], s[3] + s[4]};
+  const auto [lo, hi] = std::minmax_element(sums, sums + 4);
+  return *hi - *lo <= tolerance;
 }
 
 }  // namespace
 
 void VoxelField::evaluate(std::span<const Vec3> points_mm, std::span<Vec3> forces) const {
   checkSpans(points_mm, forces);
-  const Grid& grid = *impl_->grid;
-  const double inv_h = 1.0 / impl_->voxel_size_mm;
-  const bool quadratic = impl_->interpolation == Interpolation::Quadratic;
+  const Impl& impl = *impl_;
+  const double inv_h = 1.0 / impl.voxel_size_mm;
+  const bool quadratic = impl.interpolation == Interpolation::Quadratic;
+  const bool ratio = impl.stored == StoredQuantity::PlaneRatio;
+  const double linear_tolerance_mm = 0.5 * impl.voxel_size_mm;
   // A sample costs tens of ns: below a few thousand points (one tool's nodes) threads cost more
   // than they give.
   constexpr std::size_t kSerialBelow = 4096;
   parallelOverPoints(
-      points_mm.size(), [&] { return grid.getConstAccessor(); },
-      [&](std::size_t i, Grid::ConstAccessor& acc) {
+      points_mm.size(),
+      [&] {
+        Accessors a{impl.grid->getConstAccessor(), std::nullopt};
+        if (ratio) a.closeness.emplace(impl.closeness->getConstAccessor());
+        return a;
+      },
+      [&](std::size_t i, Accessors& acc) {
         const Vec3 p = points_mm[i] * inv_h;  // index space
-        if (!quadratic) {
-          forces[i] = trilinear(acc, p);
+        const Vec3 base = p.array().floor();
+        const openvdb::Coord ijk(int(base.x()), int(base.y()), int(base.z()));
+        const Vec3 t = p - base;
+        openvdb::Vec3s c[8];
+        if (!quadratic || ratio) {
+          if (!cellCorners(acc.grid, ijk, c)) {
+            forces[i] = Vec3::Zero();  // background at every corner
+            return;
+          }
+        }
+        if (!ratio) {
+          if (!quadratic) {
+            forces[i] = blend(c, t);
+            return;
+          }
+          openvdb::Vec3s v;
+          openvdb::tools::QuadraticSampler::sample(acc.grid, openvdb::Vec3R(p.x(), p.y(), p.z()),
+                                                   v);
+          forces[i] = widen(v);
           return;
         }
-        openvdb::Vec3s v;
-        openvdb::tools::QuadraticSampler::sample(acc, openvdb::Vec3R(p.x(), p.y(), p.z()), v);
-        forces[i] = Vec3(v.x(), v.y(), v.z());
+        const PlaneLaw& law = *impl.law;
+        float cc[8];
+        cellCorners(*acc.closeness, ijk, cc);
+        double s[8];
+        for (int k = 0; k < 8; ++k) s[k] = law.r0_mm - cc[k];
+        if (!ratioHolds(s, linear_tolerance_mm)) {
+          for (int k = 0; k < 8; ++k) c[k] *= float(law.at(s[k]));  // the node forces
+          forces[i] = blend(c, t);
+          return;
+        }
+        Vec3 g;
+        double closeness_mm;
+        if (quadratic) {
+          const openvdb::Vec3R at(p.x(), p.y(), p.z());
+          openvdb::Vec3s v;
+          openvdb::tools::QuadraticSampler::sample(acc.grid, at, v);
+          float cv = 0.0f;
+          openvdb::tools::QuadraticSampler::sample(*acc.closeness, at, cv);
+          g = widen(v);
+          closeness_mm = cv;
+        } else {
+          g = blend(c, t);
+          closeness_mm = blend(cc, t);
+        }
+        forces[i] = law.at(law.r0_mm - closeness_mm) * g;
       },
       kSerialBelow);
 }
@@ -307,7 +487,20 @@ std::vector<Vec3> VoxelField::activeNodes(std::size_t max_count) const {
 
 void VoxelField::save(const std::filesystem::path& file) const {
   initializeOpenVdb();
-  openvdb::GridCPtrVec grids{impl_->grid};
+  openvdb::GridCPtrVec grids;
+  if (impl_->stored == StoredQuantity::PlaneRatio) {
+    // The node forces P(s)·G (what users look at), then the two stored grids.
+    Grid::Ptr force = impl_->grid->deepCopy();
+    force->setName("force");
+    auto closeness = impl_->closeness->getConstAccessor();
+    for (auto it = force->beginValueOn(); it; ++it) {
+      const double s = impl_->law->r0_mm - closeness.getValue(it.getCoord());
+      it.setValue(*it * float(impl_->law->at(s)));
+    }
+    grids = {force, impl_->grid, impl_->closeness};
+  } else {
+    grids = {impl_->grid};
+  }
   common::writeFileAtomically(
       file, [&](std::ofstream& out) { openvdb::io::Stream(out).write(grids); },
       std::ios::out | std::ios::binary);

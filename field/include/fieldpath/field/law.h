@@ -53,46 +53,97 @@ inline double planeFieldMagnitude(double d_mm, const FieldParams& params) {
   return M_PI * params.gain * (r0 - d_mm) * (r0 - d_mm) / (d_mm * r0 * r0);
 }
 
+/// The plane law P calibrated to a sample set: the magnitude of the field of an infinite plane
+/// sampled like `samples` (weights per mm² of surface: 1 for area weights), at height d (mm):
+/// κ·π·|gain|·(r0 - d)²/(d·r0²). The voxel field's "plane ratio" stores F / P(d) beside d.
+struct PlaneLaw {
+  double r0_mm = 5.0;
+  double r_min_mm = 0.25;
+  double scale = 0.0;  ///< κ·π·|gain| / r0², in units of |F|·mm
+
+  PlaneLaw(const FieldParams& params, double weight_per_mm2 = 1.0)
+      : r0_mm(params.r0_mm),
+        r_min_mm(params.r_min_mm),
+        scale(weight_per_mm2 * M_PI * std::abs(params.gain) / (params.r0_mm * params.r0_mm)) {}
+
+  /// P at |d| held below r_min, zero from r0 on; d in mm.
+  double at(double d_mm) const {
+    const double d = std::max(std::abs(d_mm), r_min_mm);
+    if (d >= r0_mm) return 0.0;
+    return scale * (r0_mm - d) * (r0_mm - d) / d;
+  }
+  /// The height d in (0, r0] at which P(d) = magnitude, the lesser root of
+  /// scale·(r0 - d)² = magnitude·d, in its cancellation-free form; r0 for a zero magnitude.
+  double height(double magnitude) const {
+    if (!(magnitude > 0.0) || !(scale > 0.0)) return r0_mm;
+    const double b = 2.0 * scale * r0_mm + magnitude;
+    return 2.0 * scale * r0_mm * r0_mm /
+           (b + std::sqrt(magnitude * (4.0 * scale * r0_mm + magnitude)));
+  }
+};
+
 namespace detail {
+
+/// What one evaluation of eq. 1 learns at x: the field (with the surface rule) and the nearest
+/// sample, which the voxel build uses to place x relative to the surface.
+struct Probe {
+  std::optional<Vec3> force;     ///< nothing where no sample is within r0 (the field is zero)
+  long nearest = -1;             ///< nearest sample within the search radius, -1 if none
+  double nearest_mm = HUGE_VAL;  ///< |x - q*|
+  double height_mm = 0.0;        ///< η = (x - q*)·n*: < 0 inside the obstacle
+};
 
 /// Eq. 1 summed over candidate samples with the surface rule. `for_each_near(center, radius, fn)`
 /// must call fn(j) at least for every sample j within `radius` of `center` (a superset is fine);
-/// P, N are random-access ranges of Vec3 (points, normals), W of double (weights).
-/// Returns nothing where no sample is within r0 (the field is zero there) or where x is inside an
-/// obstacle deeper than `max_inside_depth_mm` (outside the voxel band).
+/// P, N are random-access ranges of Vec3 (points, normals), W of double (weights). The nearest
+/// sample is sought within `search_mm` (>= r0), the sum runs over those within r0.
 template <class ForEachNear, class P, class N, class W>
-std::optional<Vec3> fieldAt(const Vec3& x_mm, ForEachNear&& for_each_near, const P& points,
-                            const N& normals, const W& weights, const FieldParams& params,
-                            double max_inside_depth_mm = HUGE_VAL) {
+Probe probe(const Vec3& x_mm, ForEachNear&& for_each_near, const P& points, const N& normals,
+            const W& weights, const FieldParams& params, double search_mm) {
   const double r0_sq = params.r0_mm * params.r0_mm;
-  auto sum = [&](const Vec3& at, double* nearest_sq, long* nearest) {
+  auto sum = [&](const Vec3& at, double radius, double* nearest_sq, long* nearest) {
     Vec3 f = Vec3::Zero();
-    for_each_near(at, params.r0_mm, [&](std::size_t j) {
+    for_each_near(at, radius, [&](std::size_t j) {
       const Vec3 d = at - points[j];
       const double r2 = d.squaredNorm();
-      if (r2 >= r0_sq) return;
-      const double r = std::sqrt(r2);
-      const Vec3 u = r > 0.0 ? Vec3(d / r) : Vec3(normals[j]);
-      f += (weights[j] * phi(r, params.r0_mm, params.r_min_mm)) * u;
       if (nearest && r2 < *nearest_sq) {
         *nearest_sq = r2;
         *nearest = static_cast<long>(j);
       }
+      if (r2 >= r0_sq) return;
+      const double r = std::sqrt(r2);
+      const Vec3 u = r > 0.0 ? Vec3(d / r) : Vec3(normals[j]);
+      f += (weights[j] * phi(r, params.r0_mm, params.r_min_mm)) * u;
     });
     return f;
   };
-  double nearest_sq = r0_sq;
-  long nearest = -1;
-  Vec3 f = sum(x_mm, &nearest_sq, &nearest);
-  if (nearest < 0) return std::nullopt;
-  const Vec3& n = normals[nearest];
-  const double height_mm = (x_mm - points[nearest]).dot(n);
-  if (height_mm < -max_inside_depth_mm) return std::nullopt;
-  if (height_mm < params.r_min_mm) {
-    const double lifted_mm = std::max(std::abs(height_mm), params.r_min_mm);
-    f = sum(x_mm + (lifted_mm - height_mm) * n, nullptr, nullptr);
+  Probe out;
+  double nearest_sq = std::max(search_mm, params.r0_mm);
+  nearest_sq *= nearest_sq;
+  Vec3 f = sum(x_mm, std::sqrt(nearest_sq), &nearest_sq, &out.nearest);
+  if (out.nearest < 0) return out;
+  const Vec3& n = normals[out.nearest];
+  out.nearest_mm = std::sqrt(nearest_sq);
+  out.height_mm = (x_mm - points[out.nearest]).dot(n);
+  if (nearest_sq >= r0_sq) return out;
+  if (out.height_mm < params.r_min_mm) {
+    const double lifted_mm = std::max(std::abs(out.height_mm), params.r_min_mm);
+    f = sum(x_mm + (lifted_mm - out.height_mm) * n, params.r0_mm, nullptr, nullptr);
   }
-  return Vec3(params.gain * f);
+  out.force = Vec3(params.gain * f);
+  return out;
+}
+
+/// The field at x (probe() with the search radius r0). Returns nothing where no sample is within
+/// r0 (the field is zero there) or where x is inside an obstacle deeper than
+/// `max_inside_depth_mm` (outside the voxel band).
+template <class ForEachNear, class P, class N, class W>
+std::optional<Vec3> fieldAt(const Vec3& x_mm, ForEachNear&& for_each_near, const P& points,
+                            const N& normals, const W& weights, const FieldParams& params,
+                            double max_inside_depth_mm = HUGE_VAL) {
+  const Probe p = probe(x_mm, for_each_near, points, normals, weights, params, params.r0_mm);
+  if (!p.force || p.height_mm < -max_inside_depth_mm) return std::nullopt;
+  return p.force;
 }
 
 }  // namespace detail

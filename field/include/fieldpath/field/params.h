@@ -5,6 +5,15 @@ namespace fieldpath::field {
 
 enum class Weights { Area, Unit };                  ///< area weights, or w_j = 1 (seed 004)
 enum class Interpolation { Trilinear, Quadratic };  ///< voxel sampler
+/// What the voxel nodes store (scene `field.stored`).
+/// - Force: F itself; interpolated F has a large relative error where the field rises like 1/d
+///   towards a wall or fades at r0 (a cell spans much of either at h >= 1 mm).
+/// - PlaneRatio: the signed equivalent height s (the height above a plane whose field has |F|,
+///   signed by the side of the surface; a plane's height, linear across it) and G = F / P(s), P
+///   the plane law (law.h PlaneLaw; G is the unit field direction away from the wall's r_min
+///   zone); the query returns P(s~)·G~. Exact for a plane at any h, on both sides of it and
+///   through r0; the same at the nodes. One more float a node and a second lookup.
+enum class StoredQuantity { Force, PlaneRatio };
 
 struct FieldParams {
   double r0_mm = 5.0;           ///< neighbourhood of eq. 1: φ = 0 for r >= r0
@@ -14,6 +23,7 @@ struct FieldParams {
   Weights weights = Weights::Area;
   double voxel_size_mm = 0.5;  ///< h of the sparse grid
   Interpolation interpolation = Interpolation::Trilinear;
+  StoredQuantity stored = StoredQuantity::PlaneRatio;  ///< what voxel nodes hold
 };
 
 }  // namespace fieldpath::field

@@ -17,6 +17,12 @@ namespace fieldpath::field {
 struct VoxelRequest {
   double voxel_size_mm = 0.5;  ///< h; nodes at (i h, j h, k h), world frame
   Interpolation interpolation = Interpolation::Trilinear;
+  /// What the nodes hold; unset: the DirectField's FieldParams::stored (the scene's).
+  std::optional<StoredQuantity> stored;
+  /// PlaneRatio: nodes over the sampled surface closer to it than this (mm, either side) hold
+  /// the plane's continuation instead of their own sampled force (voxel_field.cpp planeRatio);
+  /// unset: r_min (where the direct field is held, not a plane's).
+  std::optional<double> plane_near_mm;
   /// Depth of the band of nodes kept inside obstacles (where the surface rule of law.h pushes a
   /// node out); negative: 2 h + r_min, so that every interpolation cell a node r_min deep
   /// reaches is built.
@@ -66,6 +72,7 @@ class VoxelField final : public ForceField {
   const VoxelStats& stats() const;
   double voxelSizeMm() const;
   Interpolation interpolation() const;
+  StoredQuantity stored() const;
   /// World positions (mm) of the active nodes, at most `max_count` of them.
   std::vector<Vec3> activeNodes(std::size_t max_count = std::size_t(-1)) const;
   /// Writes the grid (named "force") to a .vdb file atomically; Houdini and Blender open it.
