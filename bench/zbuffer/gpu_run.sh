@@ -22,10 +22,10 @@ ARGS=("$@")
 [ ${#ARGS[@]} -eq 0 ] && ARGS=(--backend cuda --reps 3 --peer-limit 3000000)
 timeout ${BENCH_TIMEOUT:-330} $B/bin/bench_zbuffer "${ARGS[@]}" > "$OUT/bench.md" 2>&1
 echo "bench rc=$?"
-VC=${VARIANT_CASES-1,2,3,4,6,7,R,C,Fz}
+VC=${VARIANT_CASES-1,2,3,4,5,6,7,R,S,C,Fz}
 if [ -n "$VC" ]; then
-  timeout ${VARIANT_TIMEOUT:-150} $B/bin/bench_zbuffer --backend cuda --variants --reps 1 --cases "$VC" \
-    > "$OUT/variants.md" 2>&1
+  timeout ${VARIANT_TIMEOUT:-200} $B/bin/bench_zbuffer --backend cuda --variants --reps ${VARIANT_REPS:-3} \
+    --cases "$VC" > "$OUT/variants.md" 2>&1
   echo "variants rc=$?"; cat "$OUT/variants.md"
 fi
 cat "$OUT/device.txt"

@@ -29,18 +29,12 @@ class CpuEngine final : public BackendEngine {
         tuning_(tuning),
         heights_(std::move(heights)),
         tile_max_(std::size_t(grid.tiles_x) * grid.tiles_y) {
-    // re-point the view at this engine's own copies
-    tool_.view.bvh_nodes = tool_.bvh_nodes.data();
-    tool_.view.bvh_triangles = tool_.bvh_triangles.data();
-    tool_.view.vertices = tool_.vertices.data();
-    tool_.view.indices = tool_.indices.data();
-    tool_.view.bin_start = tool_.bin_start.data();
-    tool_.view.bin_items = tool_.bin_items.data();
-    tool_.view.radial_floor_mm = tool_.radial_floor.data();
+    tool_.pointViewAtVectors();  // this engine's own copies
     // Tile maxima are refreshed between chunks: often when postures come lowest first (each
     // refresh lets the tiles cut so far cull the higher postures), bounded by the refresh cost.
     const std::size_t lines = std::size_t(grid.nx) * grid.ny;
-    refresh_every_ = tuning.lowest_first
+    refresh_every_ = tuning.refresh_postures ? tuning.refresh_postures
+                     : tuning.lowest_first
                          ? std::clamp<std::size_t>(lines / 64, 2048, std::size_t{1} << 24)
                          : std::clamp<std::size_t>(lines / 8, 16384, std::size_t{1} << 24);
   }

@@ -33,6 +33,12 @@ constexpr int kWarpsPerBlock = 4;
 __device__ inline float keyToFloat(std::int32_t key) { return __int_as_float(orderedBits(key)); }
 __device__ inline std::int32_t floatToKey(float h) { return orderedBits(__float_as_int(h)); }
 
+/// Float bits ↔ ordered keys in place (the map is its own inverse).
+__global__ void orderBitsKernel(std::int32_t* values, std::size_t n) {
+  const std::size_t i = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i < n) values[i] = orderedBits(values[i]);
+}
+
 __global__ void tileMaxKernel(GridView g, const std::int32_t* keys, float* tile_max) {
   const int t = blockIdx.x * blockDim.x + threadIdx.x;
   if (t >= g.tiles_x * g.tiles_y) return;
@@ -131,20 +137,36 @@ __global__ void coarseKernel(GridView g, ToolView tool, const Posture* postures,
   });
 }
 
-template <class T>
-T* deviceCopy(const T* host, std::size_t n) {
-  if (n == 0) return nullptr;
-  T* ptr = nullptr;
-  FIELDPATH_CUDA_CHECK(cudaMalloc(&ptr, n * sizeof(T)));
-  FIELDPATH_CUDA_CHECK(cudaMemcpy(ptr, host, n * sizeof(T), cudaMemcpyHostToDevice));
-  return ptr;
+/// Device memory comes from the stream-ordered pool, kept across engines (its release threshold
+/// is raised once), so that a simulation does not pay cudaMalloc/cudaFree for its buffers.
+void usePersistentPool() {
+  static const bool done = [] {
+    int device = 0;
+    cudaMemPool_t pool;
+    if (cudaGetDevice(&device) != cudaSuccess ||
+        cudaDeviceGetDefaultMemPool(&pool, device) != cudaSuccess)
+      return false;
+    std::uint64_t keep = UINT64_MAX;
+    return cudaMemPoolSetAttribute(pool, cudaMemPoolAttrReleaseThreshold, &keep) == cudaSuccess;
+  }();
+  (void)done;
 }
 
 template <class T>
-void deviceAlloc(T*& ptr, std::size_t n) {
-  if (ptr) FIELDPATH_CUDA_CHECK(cudaFree(ptr));
+void deviceAlloc(T*& ptr, std::size_t n, cudaStream_t st) {
+  if (ptr) FIELDPATH_CUDA_CHECK(cudaFreeAsync(ptr, st));
   ptr = nullptr;
-  FIELDPATH_CUDA_CHECK(cudaMalloc(&ptr, std::max<std::size_t>(n, 1) * sizeof(T)));
+  FIELDPATH_CUDA_CHECK(
+      cudaMallocAsync(reinterpret_cast<void**>(&ptr), std::max<std::size_t>(n, 1) * sizeof(T), st));
+}
+
+template <class T>
+T* deviceCopy(const T* host, std::size_t n, cudaStream_t st) {
+  if (n == 0) return nullptr;
+  T* ptr = nullptr;
+  deviceAlloc(ptr, n, st);
+  FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(ptr, host, n * sizeof(T), cudaMemcpyHostToDevice, st));
+  return ptr;
 }
 
 }  // namespace
@@ -170,27 +192,29 @@ struct Engine::Impl {
   cudaEvent_t copied[2] = {nullptr, nullptr}, computed[2] = {nullptr, nullptr};
 
   ~Impl() {
-    if (compute_stream) cudaStreamSynchronize(compute_stream);
     if (copy_stream) cudaStreamSynchronize(copy_stream);
-    for (void* p : owned) cudaFree(p);
+    if (!compute_stream) return;
+    cudaStreamSynchronize(compute_stream);
+    for (void* p : owned) cudaFreeAsync(p, compute_stream);
     for (void* p :
          {static_cast<void*>(keys), static_cast<void*>(tile_max), static_cast<void*>(culled),
           static_cast<void*>(queued), static_cast<void*>(queue), sort_temp})
-      if (p) cudaFree(p);
+      if (p) cudaFreeAsync(p, compute_stream);
     for (int k = 0; k < 2; ++k) {
       for (void* p : {static_cast<void*>(postures[k]), static_cast<void*>(sort_keys[k]),
                       static_cast<void*>(sort_index[k])})
-        if (p) cudaFree(p);
+        if (p) cudaFreeAsync(p, compute_stream);
       if (copied[k]) cudaEventDestroy(copied[k]);
       if (computed[k]) cudaEventDestroy(computed[k]);
     }
+    cudaStreamSynchronize(compute_stream);
     if (copy_stream) cudaStreamDestroy(copy_stream);
-    if (compute_stream) cudaStreamDestroy(compute_stream);
+    cudaStreamDestroy(compute_stream);
   }
 
   template <class T>
   T* own(const T* host, std::size_t n) {
-    T* p = deviceCopy(host, n);
+    T* p = deviceCopy(host, n, compute_stream);
     if (p) owned.push_back(p);
     return p;
   }
@@ -199,20 +223,23 @@ struct Engine::Impl {
   void reserve(std::size_t count) {
     if (count <= capacity) return;
     FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(copy_stream));
-    FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(compute_stream));
+    cudaStream_t st = compute_stream;
     for (int k = 0; k < 2; ++k) {
-      deviceAlloc(postures[k], count);
-      deviceAlloc(sort_keys[k], count);
-      deviceAlloc(sort_index[k], count);
+      deviceAlloc(postures[k], count, st);
+      deviceAlloc(sort_keys[k], count, st);
+      deviceAlloc(sort_index[k], count, st);
     }
-    deviceAlloc(queue, count);
+    deviceAlloc(queue, count, st);
     std::size_t bytes = 0;
     FIELDPATH_CUDA_CHECK(cub::DeviceRadixSort::SortPairs(nullptr, bytes, sort_keys[0], sort_keys[1],
                                                          sort_index[0], sort_index[1], int(count)));
-    if (sort_temp) FIELDPATH_CUDA_CHECK(cudaFree(sort_temp));
-    FIELDPATH_CUDA_CHECK(cudaMalloc(&sort_temp, std::max<std::size_t>(bytes, 1)));
+    unsigned char* temp = static_cast<unsigned char*>(sort_temp);
+    deviceAlloc(temp, bytes, st);
+    sort_temp = temp;
     sort_temp_bytes = bytes;
     capacity = count;
+    // the copy stream writes the new posture buffers: it must see them allocated
+    FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(st));
   }
 };
 
@@ -223,6 +250,14 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   m.grid = grid;
   m.options = options;
   m.tool = tool.view;
+  usePersistentPool();
+  FIELDPATH_CUDA_CHECK(cudaStreamCreateWithFlags(&m.copy_stream, cudaStreamNonBlocking));
+  FIELDPATH_CUDA_CHECK(cudaStreamCreateWithFlags(&m.compute_stream, cudaStreamNonBlocking));
+  for (int k = 0; k < 2; ++k) {
+    FIELDPATH_CUDA_CHECK(cudaEventCreateWithFlags(&m.copied[k], cudaEventDisableTiming));
+    FIELDPATH_CUDA_CHECK(cudaEventCreateWithFlags(&m.computed[k], cudaEventDisableTiming));
+  }
+  cudaStream_t st = m.compute_stream;
   m.tool.bvh_nodes = m.own(tool.nodes, tool.node_count);
   m.tool.bvh_triangles = m.own(tool.triangles, tool.triangle_floats);
   m.tool.vertices = m.own(tool.vertices, tool.vertex_count);
@@ -230,29 +265,22 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   m.tool.bin_start = m.own(tool.bin_start, tool.bin_start_count);
   m.tool.bin_items = m.own(tool.bin_items, tool.bin_item_count);
   m.tool.radial_floor_mm = m.own(tool.radial_floor, tool.radial_count);
-  std::vector<std::int32_t> keys(lines);
-  for (std::size_t i = 0; i < lines; ++i) {
-    std::int32_t bits;
-    std::memcpy(&bits, heights_mm + i, 4);
-    keys[i] = orderedBits(bits);
-  }
-  m.keys = deviceCopy(keys.data(), lines);
-  FIELDPATH_CUDA_CHECK(
-      cudaMalloc(&m.tile_max, sizeof(float) * std::max(1, grid.tiles_x * grid.tiles_y)));
-  FIELDPATH_CUDA_CHECK(cudaMalloc(&m.culled, sizeof(unsigned long long)));
-  FIELDPATH_CUDA_CHECK(cudaMemset(m.culled, 0, sizeof(unsigned long long)));
-  FIELDPATH_CUDA_CHECK(cudaMalloc(&m.queued, sizeof(int)));
-  FIELDPATH_CUDA_CHECK(cudaStreamCreateWithFlags(&m.copy_stream, cudaStreamNonBlocking));
-  FIELDPATH_CUDA_CHECK(cudaStreamCreateWithFlags(&m.compute_stream, cudaStreamNonBlocking));
-  for (int k = 0; k < 2; ++k) {
-    FIELDPATH_CUDA_CHECK(cudaEventCreateWithFlags(&m.copied[k], cudaEventDisableTiming));
-    FIELDPATH_CUDA_CHECK(cudaEventCreateWithFlags(&m.computed[k], cudaEventDisableTiming));
-  }
+  // heights → ordered keys on the device
+  m.keys = deviceCopy(reinterpret_cast<const std::int32_t*>(heights_mm), lines, st);
+  orderBitsKernel<<<unsigned((lines + 255) / 256), 256, 0, st>>>(m.keys, lines);
+  FIELDPATH_CUDA_CHECK(cudaGetLastError());
+  deviceAlloc(m.tile_max, std::max(1, grid.tiles_x * grid.tiles_y), st);
+  deviceAlloc(m.culled, 1, st);
+  FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.culled, 0, sizeof(unsigned long long), st));
+  deviceAlloc(m.queued, 1, st);
+  // the host arrays may go once this returns
+  FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(st));
   m.lines = lines;
   // Tile maxima are refreshed between chunks; lowest first, often (each refresh lets the tiles cut
   // so far cull the higher postures that follow).
   m.refresh_every =
-      options.lowest_first
+      options.refresh_postures ? options.refresh_postures
+      : options.lowest_first
           ? std::clamp<std::size_t>(lines / 32, std::size_t{1} << 14, std::size_t{1} << 24)
           : std::clamp<std::size_t>(lines / 8, std::size_t{1} << 16, std::size_t{1} << 24);
 }
@@ -327,13 +355,15 @@ void Engine::cut(const Posture* block, std::size_t count, bool coarse) {
 
 void Engine::heights(float* out_mm) const {
   const Impl& m = *impl_;
-  FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(m.compute_stream));
-  std::vector<std::int32_t> keys(m.lines);
-  FIELDPATH_CUDA_CHECK(cudaMemcpy(keys.data(), m.keys, m.lines * 4, cudaMemcpyDeviceToHost));
-  for (std::size_t i = 0; i < m.lines; ++i) {
-    const std::int32_t bits = orderedBits(keys[i]);
-    std::memcpy(out_mm + i, &bits, 4);
-  }
+  cudaStream_t st = m.compute_stream;
+  std::int32_t* bits = nullptr;
+  deviceAlloc(bits, m.lines, st);
+  FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(bits, m.keys, m.lines * 4, cudaMemcpyDeviceToDevice, st));
+  orderBitsKernel<<<unsigned((m.lines + 255) / 256), 256, 0, st>>>(bits, m.lines);
+  FIELDPATH_CUDA_CHECK(cudaGetLastError());
+  FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(out_mm, bits, m.lines * 4, cudaMemcpyDeviceToHost, st));
+  FIELDPATH_CUDA_CHECK(cudaFreeAsync(bits, st));
+  FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(st));
 }
 
 std::size_t Engine::culled() const {

@@ -36,6 +36,7 @@ class Engine {
   /// footprints, upload of the next block overlapping this block's kernels.
   struct Options {
     bool lowest_first = true, small_threads = true, overlap_upload = true;
+    std::size_t refresh_postures = 0;  ///< 0: from the grid size
   };
   Engine(const GridView& grid, const ToolArrays& tool, const float* heights_mm, std::size_t lines,
          Options options);

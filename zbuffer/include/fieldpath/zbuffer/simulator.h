@@ -73,6 +73,8 @@ struct EngineTuning {
   bool lowest_first = true;    ///< each block's postures processed lowest point first
   bool small_threads = true;   ///< CUDA: one thread per small-footprint posture, warps for the rest
   bool overlap_upload = true;  ///< CUDA: a block's upload overlaps the previous block's kernels
+  /// Postures between refreshes of the culling tiles' maxima; 0: chosen from the grid size.
+  std::size_t refresh_postures = 0;
 };
 
 struct SimulationRequest {
@@ -126,6 +128,8 @@ struct ToolData {
   std::vector<std::uint32_t> indices;
   std::vector<std::int32_t> bin_start, bin_items;
   std::vector<float> radial_floor;
+  /// Points the view's arrays at this object's vectors (after a copy).
+  void pointViewAtVectors();
 };
 ToolData prepareTool(const Tool& tool);
 GridView makeGridView(const Grid& grid);
