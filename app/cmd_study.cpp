@@ -20,6 +20,7 @@ struct StudyOptions {
   std::string scene;
   std::string voxels = "2,1,0.5";
   std::string interpolations = "trilinear,quadratic";
+  std::string stored = "force,plane_ratio";
   bool no_brute_force = false;
   double line_step_mm = 0.05;
   int repeats = 1;
@@ -30,6 +31,7 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
   StudyRequest request;
   request.voxel_sizes_mm = parseVoxelSizes(o.voxels, "--voxels");
   request.interpolations = parseInterpolations(o.interpolations, "--interp");
+  request.stored = parseStored(o.stored, "--stored");
   request.brute_force = !o.no_brute_force;
   request.line_step_mm = o.line_step_mm;
   request.repeats = o.repeats;
@@ -41,10 +43,10 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
   std::string message;
   if (!plotStudy(dir, &message)) std::fprintf(stderr, "fieldpath study: %s\n", message.c_str());
 
-  std::printf("%-26s %10s %9s %9s %9s %9s %10s %9s\n", "variant", "nodes", "total_s", "x_direct",
+  std::printf("%-38s %10s %9s %9s %9s %9s %10s %9s\n", "variant", "nodes", "total_s", "x_direct",
               "force_%", "nodes_%", "tilt_deg", "clear_mm");
   for (const StudyRow& row : result.rows)
-    std::printf("%-26s %10zu %9.3f %9.2f %9.3f %9.3f %10.4f %9.3f\n", row.variant.name().c_str(),
+    std::printf("%-38s %10zu %9.3f %9.2f %9.3f %9.3f %10.4f %9.3f\n", row.variant.name().c_str(),
                 row.active_nodes, row.total_s, row.speedup_vs_direct,
                 100 * std::max(row.line_a.relative.max_relative, row.line_b.relative.max_relative),
                 100 * row.nodes.relative.max_relative, row.tilt_max_deg, row.min_clearance_mm);
@@ -63,6 +65,9 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--interp", options->interpolations,
                   "Interpolations: trilinear, quadratic or both, comma-separated")
       ->capture_default_str();
+  cmd->add_option("--stored", options->stored,
+                  "What voxel nodes store: force, plane_ratio or both, comma-separated")
+      ->capture_default_str();
   cmd->add_flag("--no-brute-force", options->no_brute_force,
                 "Skip the every-point direct sum (slow on large scenes)");
   cmd->add_option("--line-step", options->line_step_mm, "Sampling of the study lines, mm")
@@ -73,6 +78,7 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
   cmd->callback([options, &global] {
     std::string command_line = "fieldpath study " + options->scene + " --voxels " +
                                options->voxels + " --interp " + options->interpolations +
+                               " --stored " + options->stored +
                                (options->no_brute_force ? " --no-brute-force" : "") + " --repeat " +
                                std::to_string(options->repeats) + " --out " +
                                options->out;

@@ -51,6 +51,10 @@ std::string interpolationName(field::Interpolation interpolation) {
   return interpolation == field::Interpolation::Quadratic ? "quadratic" : "trilinear";
 }
 
+std::string storedName(field::StoredQuantity stored) {
+  return stored == field::StoredQuantity::PlaneRatio ? "plane_ratio" : "force";
+}
+
 std::string modeName(pathgen::FieldMode mode) {
   switch (mode) {
     case pathgen::FieldMode::BruteForce: return "brute_force";
@@ -217,7 +221,8 @@ std::string StudyVariant::name() const {
     case pathgen::FieldMode::Voxel: break;
   }
   std::ostringstream s;
-  s << "voxel " << voxel_size_mm << " mm " << interpolationName(interpolation);
+  s << "voxel " << voxel_size_mm << " mm " << interpolationName(interpolation) << ' '
+    << storedName(stored);
   return s.str();
 }
 
@@ -234,6 +239,19 @@ std::vector<double> parseVoxelSizes(const std::string& text, const std::string& 
   }
   if (sizes.empty()) throw InputError(key + ": give at least one voxel size (e.g. 2,1,0.5)");
   return sizes;
+}
+
+std::vector<field::StoredQuantity> parseStored(const std::string& text, const std::string& key) {
+  std::vector<field::StoredQuantity> result;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (item == "force") result.push_back(field::StoredQuantity::Force);
+    else if (item == "plane_ratio") result.push_back(field::StoredQuantity::PlaneRatio);
+    else throw InputError(key + ": '" + item + "' is not force or plane_ratio");
+  }
+  if (result.empty()) throw InputError(key + ": give force, plane_ratio or both");
+  return result;
 }
 
 std::vector<field::Interpolation> parseInterpolations(const std::string& text,
@@ -255,6 +273,7 @@ StudyResult runStudy(const StudyRequest& request) {
   for (double h : request.voxel_sizes_mm)
     if (!std::isfinite(h) || h <= 0.0) throw InputError("--voxels: voxel sizes must be > 0 mm");
   if (request.interpolations.empty()) throw InputError("--interp: give at least one interpolation");
+  if (request.stored.empty()) throw InputError("--stored: give force, plane_ratio or both");
   if (request.repeats < 1) throw InputError("--repeat: must be >= 1");
   if (!std::isfinite(request.line_step_mm) || request.line_step_mm <= 0.0)
     throw InputError("study line step must be > 0 mm");
@@ -263,8 +282,9 @@ StudyResult runStudy(const StudyRequest& request) {
   if (request.brute_force) variants.push_back({pathgen::FieldMode::BruteForce});
   variants.push_back({pathgen::FieldMode::Direct});
   for (double h : request.voxel_sizes_mm)
-    for (field::Interpolation interp : request.interpolations)
-      variants.push_back({pathgen::FieldMode::Voxel, h, interp});
+    for (field::StoredQuantity stored : request.stored)
+      for (field::Interpolation interp : request.interpolations)
+        variants.push_back({pathgen::FieldMode::Voxel, h, interp, stored});
 
   // Shares of the progress bar: each path run, then the error evaluation.
   const double runs_end = 0.85;
@@ -282,6 +302,7 @@ StudyResult runStudy(const StudyRequest& request) {
     if (variants[i].isVoxel()) {
       job.field.voxel_size_mm = variants[i].voxel_size_mm;
       job.field.interpolation = variants[i].interpolation;
+      job.field.stored = variants[i].stored;
     }
     job.progress = scaled(request.progress, share(i), share(i + 1), variants[i].name());
     StudyRow row;
@@ -418,11 +439,13 @@ StudyResult runStudy(const StudyRequest& request) {
       field::VoxelRequest voxel_request;
       voxel_request.voxel_size_mm = row.variant.voxel_size_mm;
       voxel_request.interpolation = row.variant.interpolation;
-      // The region generate uses: what tool + holder can reach, padded by two voxels.
+      voxel_request.stored = row.variant.stored;
+      // The region generate used; for a failed run, the direct run's padded by two voxels as
+      // generate pads it.
       Eigen::AlignedBox3d region = direct_run.reach_box_mm;
       region.min().array() -= 2 * row.variant.voxel_size_mm;
       region.max().array() += 2 * row.variant.voxel_size_mm;
-      voxel_request.region_mm = region;
+      voxel_request.region_mm = row.failure.empty() ? runs[i].reach_box_mm : region;
       auto voxels = std::make_unique<field::VoxelField>(direct, voxel_request);
       row.active_nodes = voxels->stats().active_nodes;
       row.dense_box_nodes = voxels->stats().dense_box_nodes;
@@ -501,7 +524,7 @@ double maxForceError(const StudyRow& row) {
 
 std::string csvText(const StudyResult& r) {
   std::ostringstream s;
-  s << "variant,mode,voxel_mm,interpolation,status,active_nodes,dense_box_nodes,voxel_memory_mb,"
+  s << "variant,mode,voxel_mm,interpolation,stored,status,active_nodes,dense_box_nodes,voxel_memory_mb,"
        "field_s,path_s,clearance_s,total_s,speedup_vs_brute,speedup_vs_direct,"
        "line_a_max_pct,line_a_rms_pct,line_b_max_pct,line_b_rms_pct,nodes_max_pct,nodes_rms_pct,"
        "max_force_error_pct,nodes_max_scaled_pct,moment_max_pct,moment_rms_pct,tilt_max_deg,tilt_rms_deg,tilt_middle_max_deg,"
@@ -511,6 +534,7 @@ std::string csvText(const StudyResult& r) {
     const StudyVariant& v = row.variant;
     s << v.name() << ',' << modeName(v.mode) << ',' << (v.isVoxel() ? number(v.voxel_size_mm) : "0")
       << ',' << (v.isVoxel() ? interpolationName(v.interpolation) : "exact") << ','
+      << (v.isVoxel() ? storedName(v.stored) : "exact") << ','
       << (row.failure.empty() ? "ok" : "failed") << ',' << row.active_nodes << ',' << row.dense_box_nodes << ','
       << number(row.voxel_memory_bytes / 1e6) << ',' << number(row.times.field_s) << ','
       << number(row.times.steering_s) << ',' << number(row.times.clearance_s) << ','
@@ -652,6 +676,27 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
   for (const Published& p : kPublished)
     s << "| " << p.h_mm << " mm | up to " << p.force_pct << " % | up to " << p.tilt_deg << "° |\n";
 
+  // Where the line errors are: max relative error by distance to the nearest wall.
+  const double bands[] = {r.clearance_mm, 1.0, 2.0, r.field.r0_mm};
+  s << "\n**Where** (max relative error %, both lines, by distance d to the nearest wall, mm; the"
+       " samples are " << r.field.sample_step_mm << " mm apart):\n\n| variant |";
+  for (int b = 0; b + 1 < 4; ++b) s << " " << bands[b] << " ≤ d < " << bands[b + 1] << " |";
+  s << "\n|---|---:|---:|---:|\n";
+  for (std::size_t v = 0; v < r.rows.size(); ++v) {
+    if (!r.rows[v].variant.isVoxel()) continue;
+    s << "| " << r.rows[v].variant.name() << " |";
+    for (int b = 0; b + 1 < 4; ++b) {
+      double worst = 0.0;
+      for (const StudyLine* line : {&r.line_a, &r.line_b})
+        for (std::size_t i = 0; i < line->t_mm.size(); ++i) {
+          const double d = line->wall_distance_mm[i], e = line->relative_error[v][i];
+          if (d >= bands[b] && d < bands[b + 1] && std::isfinite(e)) worst = std::max(worst, e);
+        }
+      s << " " << fixed(100 * worst, 3) << " |";
+    }
+    s << "\n";
+  }
+
   // Targets of issue 7, best interpolation per voxel size.
   s << "\n## Targets (issue 7)\n\n"
     << "| voxel | best variant | max force error % (target) | tilt diff max ° (target) | met |\n"
@@ -694,7 +739,7 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
     if (row.variant.isVoxel() &&
         std::find(sizes.begin(), sizes.end(), row.variant.voxel_size_mm) == sizes.end())
       sizes.push_back(row.variant.voxel_size_mm);
-  s << "\n## Why trilinear misses the targets (closed form: a plane wall)\n\n"
+  s << "\n## Why stored force misses the targets (closed form: a plane wall)\n\n"
     << "Across a plane wall the field is `π·gain·(r0 - d)² / (d·r0²)` (law.h): it rises like 1/d"
     << " towards the wall and fades like (r0 - d)² at r0, so with r0 = " << r.field.r0_mm
     << " mm a voxel of 1–2 mm spans most of its range. The worst relative error of linear"
@@ -715,13 +760,13 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
     << fixed(2 * r.clearance_mm * std::sqrt(0.005), 2)
     << " mm near the walls; towards r0 the (r0 - d)² fade adds its own error (the d ≥ r0/2"
     << " column, whose floor reaches further out). Quadratic sampling does not help where a cell"
-    << " spans the 1/d rise: it overshoots. What would: store a quantity that is smooth across the wall and recover F"
-    << " at the query — F·d with the distance d stored beside it (d is linear across a plane, so"
-    << " trilinear reproduces it; last column), or better F / P(η), the ratio to the plane field"
-    << " P at the height η above the nearest sample's tangent plane (the surface rule's η),"
-    << " which is exactly 1 for a plane and varies only with the walls' curvature and the"
-    << " second wall; or finer voxels only within ~2 mm of the walls (OpenVDB multi-level grids)."
-    << " These are changes to field::VoxelField (not made here).\n";
+    << " spans the 1/d rise: it overshoots. What does: a stored quantity that is smooth across"
+    << " the wall, the force recovered at the query. F·d with d exact (last column) is not"
+    << " enough; `plane_ratio` (field::StoredQuantity::PlaneRatio) stores the signed equivalent"
+    << " plane height s and G = F / P(s), P the plane law, and returns P(s~)·G~: exact for a"
+    << " plane at any h (0 in this table), so what remains in the `plane_ratio` rows above is the"
+    << " walls' curvature and twist, the second wall, and the lumpy field of the discrete samples"
+    << " within about one sample spacing of a wall.\n";
   s << "\nFiles: study.csv (this table), lines.csv (Fig. 5 data), tilt.csv (Fig. 6 data), "
        "speed_vs_error.png, force_error_lines.png, tilt_along_path.png.\n";
   return s.str();

@@ -36,9 +36,10 @@ struct StudyVariant {
   pathgen::FieldMode mode = pathgen::FieldMode::Voxel;
   double voxel_size_mm = 0.0;  ///< voxel mode only
   field::Interpolation interpolation = field::Interpolation::Trilinear;
+  field::StoredQuantity stored = field::StoredQuantity::Force;  ///< what the voxel nodes hold
 
   bool isVoxel() const { return mode == pathgen::FieldMode::Voxel; }
-  /// "brute force", "direct", "voxel 2 mm trilinear" (tables, plots).
+  /// "brute force", "direct", "voxel 2 mm trilinear force" (tables, plots).
   std::string name() const;
 };
 
@@ -48,6 +49,8 @@ struct StudyRequest {
   std::vector<double> voxel_sizes_mm = {2.0, 1.0, 0.5};
   std::vector<field::Interpolation> interpolations = {field::Interpolation::Trilinear,
                                                       field::Interpolation::Quadratic};
+  std::vector<field::StoredQuantity> stored = {field::StoredQuantity::Force,
+                                               field::StoredQuantity::PlaneRatio};
   bool brute_force = true;       ///< run the seed's every-point direct sum (slow on big scenes)
   double line_step_mm = 0.05;    ///< sampling of the study lines
   int repeats = 1;               ///< runs per variant; times are their medians
@@ -130,5 +133,7 @@ bool plotStudy(const std::filesystem::path& dir, std::string* message);
 std::vector<double> parseVoxelSizes(const std::string& text, const std::string& key);
 std::vector<field::Interpolation> parseInterpolations(const std::string& text,
                                                       const std::string& key);
+/// "force,plane_ratio" → what the voxel nodes store. Throws InputError naming `key`.
+std::vector<field::StoredQuantity> parseStored(const std::string& text, const std::string& key);
 
 }  // namespace fieldpath::app

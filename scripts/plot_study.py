@@ -75,7 +75,9 @@ def speed_vs_error(study, out):
     front.sort(key=lambda p: p[1])
     colour = colours([r["variant"] for r in study])
     for name, e, t, raw in shown:
-        marker = "s" if raw <= 0 else ("^" if "quadratic" in name else "o")
+        ratio = "plane_ratio" in name
+        marker = "s" if raw <= 0 else {(False, False): "o", (True, False): "^", (False, True): "D",
+                                       (True, True): "v"}[("quadratic" in name, ratio)]
         ax.scatter(e, t, marker=marker, s=50, zorder=3, color=colour[name])
         label = name + (" (exact)" if raw <= 0 else "")
         ax.annotate(label, (e, t), textcoords="offset points", xytext=(6, 4), fontsize=8)

@@ -27,7 +27,7 @@ pathgen::GenerateRequest smallJob() {
   job.impeller.passes_v = {0.3, 0.7};
   job.impeller.chord_tol_mm = 0.5;
   job.path.passes = 3;
-  job.path.step_mm = 1.0;
+  job.path.step_mm = 2.0;
   job.field.sample_step_mm = 1.0;
   job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
   job.holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
@@ -66,7 +66,8 @@ class StudyTest : public ::testing::Test {
     request.job = smallJob();
     request.voxel_sizes_mm = {2.0, 1.0, 0.5};
     request.interpolations = {field::Interpolation::Trilinear};
-    request.line_step_mm = 0.1;
+    request.stored = {field::StoredQuantity::Force, field::StoredQuantity::PlaneRatio};
+    request.line_step_mm = 0.2;
     result_ = new StudyResult(runStudy(request));
     dir_ = new std::filesystem::path(std::filesystem::temp_directory_path() /
                                      ("fieldpath_test_study_" + std::to_string(::getpid())));
@@ -110,9 +111,9 @@ TEST_F(StudyTest, BruteForceEqualsTheIndexedDirectField) {
 TEST_F(StudyTest, CsvHasEveryColumnFilledWithFiniteValues) {
   const Csv csv = readCsv(*dir_ / "study.csv");
   ASSERT_GE(csv.header.size(), 20u);
-  ASSERT_EQ(csv.rows.size(), 5u);  // brute force, direct, 3 voxel sizes
+  ASSERT_EQ(csv.rows.size(), 8u);  // brute force, direct, 3 voxel sizes × 2 stored quantities
   const std::map<std::string, bool> text_columns = {
-      {"variant", true}, {"mode", true}, {"interpolation", true}, {"status", true}};
+      {"variant", true}, {"mode", true}, {"interpolation", true}, {"stored", true}, {"status", true}};
   for (const auto& cells : csv.rows) {
     ASSERT_EQ(cells.size(), csv.header.size());
     for (std::size_t c = 0; c < cells.size(); ++c) {
@@ -129,8 +130,9 @@ TEST_F(StudyTest, CsvHasEveryColumnFilledWithFiniteValues) {
 }
 
 TEST_F(StudyTest, ErrorsShrinkWithTheVoxelSize) {
-  const StudyRow* rows[] = {&row("voxel 2 mm trilinear"), &row("voxel 1 mm trilinear"),
-                            &row("voxel 0.5 mm trilinear")};
+  // Stored force: the interpolation error of F itself, which h controls.
+  const StudyRow* rows[] = {&row("voxel 2 mm trilinear force"), &row("voxel 1 mm trilinear force"),
+                            &row("voxel 0.5 mm trilinear force")};
   for (int k = 0; k < 3; ++k) {
     EXPECT_GT(rows[k]->active_nodes, 0u);
     EXPECT_GE(rows[k]->dense_box_nodes, rows[k]->active_nodes);
@@ -163,7 +165,7 @@ tool: { shape: ball, radius: 3, length: 40 }
 holder: [[40, 6], [55, 6], [55, 12], [90, 12]]
 clearance: 0.5
 dynamics: { max_tilt_deg: 45, max_lead_deg: 45 }
-path: { passes: 3, step: 1.0 }
+path: { passes: 3, step: 2.0 }
 )";
 
 int runFieldpath(const test::TempDir& dir, const std::string& args) {
@@ -182,7 +184,7 @@ TEST(StudyCommand, WritesTablesAndPicturesOrSaysWhyNot) {
   for (const char* file : {"study.csv", "study.md", "lines.csv", "tilt.csv"})
     EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / file)) << file;
   const Csv csv = readCsv(dir.path() / "study" / "study.csv");
-  EXPECT_EQ(csv.rows.size(), 3u);  // direct, 2 voxel sizes
+  EXPECT_EQ(csv.rows.size(), 5u);  // direct, 2 voxel sizes × 2 stored quantities
   // Pictures, unless python3/matplotlib is missing, which the command says on stderr.
   std::ifstream err(dir.path() / "err.txt");
   const std::string err_text((std::istreambuf_iterator<char>(err)), {});
