@@ -506,17 +506,15 @@ int variantTable(const std::string& backend, const std::vector<std::string>& wan
   using Knob = std::function<void(zb::EngineTuning&)>;
   const std::vector<std::pair<const char*, Knob>> variants = {
       {"default", [](zb::EngineTuning&) {}},
-      {"refresh 2^15", [](zb::EngineTuning& t) { t.refresh_postures = 1 << 15; }},
       {"refresh 2^17", [](zb::EngineTuning& t) { t.refresh_postures = 1 << 17; }},
       {"refresh 2^19", [](zb::EngineTuning& t) { t.refresh_postures = 1 << 19; }},
       {"no lowest first", [](zb::EngineTuning& t) { t.lowest_first = false; }},
       {"no small threads", [](zb::EngineTuning& t) { t.small_threads = false; }},
       {"no overlap", [](zb::EngineTuning& t) { t.overlap_upload = false; }},
       {"no vertical bins", [](zb::EngineTuning& t) { t.vertical_bins = false; }},
+      {"no tile skip", [](zb::EngineTuning& t) { t.tile_skip = false; }},
       {"all off (run 3's engine)",
-       [](zb::EngineTuning& t) {
-         t = {false, false, false, false, 0};
-       }},
+       [](zb::EngineTuning& t) { t = {false, false, false, false, false, 0}; }},
   };
   std::printf("| case | P | grid |");
   for (const auto& v : variants) std::printf(" %s ms |", v.first);

@@ -89,12 +89,14 @@ TEST_F(CpuVsCuda, EveryTuningVariantBitIdentical) {
   const Grid g = Grid::fromRegion(-20, -20, 20, 20, 96, 96);
   const auto p = randomPostures(4000, 4, 18);
   const Tool small_mesh = Tool::fromMesh(analyticToolMesh(Tool::ball(0.8, 6), 32, 31));
-  for (int variant = 0; variant < 16; ++variant) {
+  for (int variant = 0; variant < 32; ++variant) {
     EngineTuning t;
     t.vertical_bins = variant & 1;
     t.lowest_first = variant & 2;
     t.small_threads = variant & 4;
     t.overlap_upload = variant & 8;
+    t.tile_skip = variant & 16;
+    t.refresh_postures = variant % 3 == 0 ? 64 : 0;  // many refreshes between the chunks
     SCOPED_TRACE("variant " + std::to_string(variant));
     expectSameBits(g, small_mesh, p, Engine::Fast, t);
     if (variant % 4 == 2) expectSameBits(g, Tool::ball(0.8, 6), p, Engine::Fast, t);

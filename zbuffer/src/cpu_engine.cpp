@@ -96,6 +96,7 @@ class CpuEngine final : public BackendEngine {
     const ToolView tool = tool_.view;
     float* h = heights_.data();
     const float* tiles = tile_max_.data();
+    const bool skip = tuning_.tile_skip;
     std::size_t culled = 0;
 #pragma omp parallel for schedule(dynamic, 16) reduction(+ : culled)
     for (long k = long(begin); k < long(end); ++k) {
@@ -104,12 +105,11 @@ class CpuEngine final : public BackendEngine {
         ++culled;
         continue;
       }
-      for (int iy = pp.iy0; iy <= pp.iy1; ++iy)
-        for (int ix = pp.ix0; ix <= pp.ix1; ++ix) {
-          float& slot = h[std::size_t(iy) * g.nx + ix];
-          const float z = lineCut(g, tool, pp, ix, iy, loadRelaxed(slot));
-          if (z != FLT_MAX) atomicLower(slot, z);
-        }
+      forEachLiveLine(g, tool, pp, tiles, skip, 0, 1, 0, 1, [&](int ix, int iy) {
+        float& slot = h[std::size_t(iy) * g.nx + ix];
+        const float z = lineCut(g, tool, pp, ix, iy, loadRelaxed(slot));
+        if (z != FLT_MAX) atomicLower(slot, z);
+      });
     }
     return culled;
   }

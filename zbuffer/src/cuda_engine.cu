@@ -59,18 +59,17 @@ __device__ inline Posture postureAt(const Posture* postures, const std::uint32_t
   return postures[order ? order[k] : std::uint32_t(k)];
 }
 
-/// Lowers every line of rows/columns assigned to this worker: lines l = first, first + step, ...
-/// of the culled footprint (the shared per-line code path of both backends is lineCut).
+/// Lowers the live lines of the culled footprint: tiles tile_first, +tile_step, ...; lines first,
+/// +step, ... of each (the shared per-line code path of both backends is lineCut).
 __device__ inline void cutLines(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
+                                const float* tile_max, bool skip, int tile_first, int tile_step,
                                 int first, int step, std::int32_t* keys) {
-  const int w = pp.ix1 - pp.ix0 + 1;
-  const int lines = w * (pp.iy1 - pp.iy0 + 1);
-  for (int l = first; l < lines; l += step) {
-    const int ix = pp.ix0 + l % w, iy = pp.iy0 + l / w;
-    std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
-    const float z = lineCut(g, tool, pp, ix, iy, keyToFloat(*slot));
-    if (z != FLT_MAX) atomicMin(slot, floatToKey(z));
-  }
+  forEachLiveLine(g, tool, pp, tile_max, skip, tile_first, tile_step, first, step,
+                  [&](int ix, int iy) {
+                    std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
+                    const float z = lineCut(g, tool, pp, ix, iy, keyToFloat(*slot));
+                    if (z != FLT_MAX) atomicMin(slot, floatToKey(z));
+                  });
 }
 
 /// Sort keys (lowest point, see lowestKey) and identity indices of a block.
@@ -86,8 +85,8 @@ __global__ void lowestKeyKernel(GridView g, ToolView tool, const Posture* postur
 /// largeKernel (its warp repeats the same preparation and cull, hence the same footprint).
 __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
                             const std::uint32_t* order, int count, const float* tile_max,
-                            std::int32_t* keys, unsigned long long* culled, int* queue,
-                            int* queued) {
+                            std::int32_t* keys, unsigned long long* culled, int* queue, int* queued,
+                            bool skip) {
   const int k = blockIdx.x * blockDim.x + threadIdx.x;
   if (k >= count) return;
   PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, k));
@@ -96,7 +95,7 @@ __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
     return;
   }
   if ((pp.ix1 - pp.ix0 + 1) * (pp.iy1 - pp.iy0 + 1) <= kSmallFootprintLines)
-    cutLines(g, tool, pp, 0, 1, keys);
+    cutLines(g, tool, pp, tile_max, skip, 0, 1, 0, 1, keys);
   else
     queue[atomicAdd(queued, 1)] = k;
 }
@@ -105,18 +104,18 @@ __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
 /// in a zoom): the lanes share the footprint's lines.
 __global__ void largeKernel(GridView g, ToolView tool, const Posture* postures,
                             const std::uint32_t* order, const int* queue, const int* queued,
-                            const float* tile_max, std::int32_t* keys) {
+                            const float* tile_max, std::int32_t* keys, bool skip) {
   const int q = blockIdx.x * kWarpsPerBlock + (threadIdx.x >> 5);
   if (q >= *queued) return;
   PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, queue[q]));
   if (cullPosture(g, tool, pp, tile_max)) return;
-  cutLines(g, tool, pp, blockIdx.y * 32 + (threadIdx.x & 31), 32 * gridDim.y, keys);
+  cutLines(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, threadIdx.x & 31, 32, keys);
 }
 
 /// One warp per posture, every footprint (the variant without small_threads).
 __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
                            const std::uint32_t* order, int count, const float* tile_max,
-                           std::int32_t* keys, unsigned long long* culled) {
+                           std::int32_t* keys, unsigned long long* culled, bool skip) {
   const int k = blockIdx.x * kWarpsPerBlock + (threadIdx.x >> 5);
   if (k >= count) return;
   PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, k));
@@ -124,7 +123,7 @@ __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
     if ((threadIdx.x & 31) == 0 && blockIdx.y == 0) atomicAdd(culled, 1ull);
     return;
   }
-  cutLines(g, tool, pp, blockIdx.y * 32 + (threadIdx.x & 31), 32 * gridDim.y, keys);
+  cutLines(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, threadIdx.x & 31, 32, keys);
 }
 
 /// SIMSURF1's coarse kernel: one thread per posture, every triangle.
@@ -276,12 +275,13 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   // the host arrays may go once this returns
   FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(st));
   m.lines = lines;
-  // Tile maxima are refreshed between chunks; lowest first, often (each refresh lets the tiles cut
-  // so far cull the higher postures that follow).
+  // Tile maxima are refreshed between chunks. Lowest first, 2^17 postures per chunk: smaller
+  // chunks cull more but leave the GPU half idle (2^15: case 3 378 ms, 2^17: 255 ms, 2^19: 259 ms
+  // on an H200, bench/results/zbuffer-h200.md run 5).
   m.refresh_every =
       options.refresh_postures ? options.refresh_postures
       : options.lowest_first
-          ? std::clamp<std::size_t>(lines / 32, std::size_t{1} << 14, std::size_t{1} << 24)
+          ? std::size_t{1} << 17
           : std::clamp<std::size_t>(lines / 8, std::size_t{1} << 16, std::size_t{1} << 24);
 }
 
@@ -335,15 +335,17 @@ void Engine::cut(const Posture* block, std::size_t count, bool coarse) {
       const dim3 warps((chunk + kWarpsPerBlock - 1) / kWarpsPerBlock, splits);
       if (m.options.small_threads) {
         FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.queued, 0, sizeof(int), st));
-        smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(m.grid, m.tool, chunk_postures,
-                                                         chunk_order, chunk, m.tile_max, m.keys,
-                                                         m.culled, m.queue, m.queued);
+        smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(
+            m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, m.culled,
+            m.queue, m.queued, m.options.tile_skip);
         FIELDPATH_CUDA_CHECK(cudaGetLastError());
-        largeKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
-            m.grid, m.tool, chunk_postures, chunk_order, m.queue, m.queued, m.tile_max, m.keys);
+        largeKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(m.grid, m.tool, chunk_postures,
+                                                           chunk_order, m.queue, m.queued,
+                                                           m.tile_max, m.keys, m.options.tile_skip);
       } else {
-        warpKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
-            m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, m.culled);
+        warpKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(m.grid, m.tool, chunk_postures,
+                                                          chunk_order, chunk, m.tile_max, m.keys,
+                                                          m.culled, m.options.tile_skip);
       }
       FIELDPATH_CUDA_CHECK(cudaGetLastError());
     }

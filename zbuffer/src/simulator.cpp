@@ -237,6 +237,10 @@ void binDownFacing(ToolData& data, float pad) {
     const int b1 = std::min(rbins - 1, static_cast<int>((rhi + pad) * v.radial_inv_mm) + 1);
     for (int b = b0; b <= b1; ++b) data.radial_floor[b] = std::min(data.radial_floor[b], zmin);
   }
+  // Made non-decreasing in the radius (each floor lowered to the smallest beyond it, still a
+  // floor), so that the floor at a rectangle's smallest radius bounds all its lines (tileFloor).
+  for (int b = rbins - 2; b >= 0; --b)
+    data.radial_floor[b] = std::min(data.radial_floor[b], data.radial_floor[b + 1]);
   v.radial_floor_mm = data.radial_floor.data();
   v.radial_bins = rbins;
 }

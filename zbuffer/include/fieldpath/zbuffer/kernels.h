@@ -382,6 +382,52 @@ FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const Prepar
   return h < current_mm ? h : FLT_MAX;
 }
 
+/// A floor of the heights the posture can give the lines of the rectangle [ix0, ix1] × [iy0, iy1]:
+/// lineCut gives none of them a height below it (FLT_MAX: it lowers none of them), so a rectangle
+/// whose highest line is at or below it is skipped whole without changing a bit. Vertical mesh
+/// tools: the radial floor at the rectangle's smallest line radius (the table is non-decreasing,
+/// and each line's float radius is at least that one: the same monotone float expressions).
+FIELDPATH_HD float rectFloor(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
+                             int ix0, int ix1, int iy0, int iy1) {
+  if (!(pp.vertical && tool.radial_bins > 0)) return pp.lowest_z_mm;
+  float ax, ay, bx, by;
+  lineOffset(g, pp, ix0, iy0, ax, ay);
+  lineOffset(g, pp, ix1, iy1, bx, by);
+  const float rx = (ax <= 0.f && bx >= 0.f) ? 0.f : minf(absf(ax), absf(bx));
+  const float ry = (ay <= 0.f && by >= 0.f) ? 0.f : minf(absf(ay), absf(by));
+  const float rho = sqrtf(rx * rx + ry * ry);
+  if (!(rho <= tool.radial_max_mm)) return FLT_MAX;
+  const int b = static_cast<int>(rho * tool.radial_inv_mm);
+  return maxf(pp.lowest_z_mm,
+              pp.tip_mm.z + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]);
+}
+
+/// Visits the lines of the (culled) footprint tile by tile: tiles tile_first, tile_first +
+/// tile_step, ... in footprint order; a tile whose maximum (possibly stale-high) is at or below
+/// its rectangle's floor is skipped whole; of the others, lines first, first + step, ... get
+/// cut(ix, iy). Shared by the CPU loop (0, 1, 0, 1) and the CUDA warps (lanes, 32).
+template <class CutLine>
+FIELDPATH_HD void forEachLiveLine(const GridView& g, const ToolView& tool,
+                                  const PreparedPosture& pp, const float* tile_max, bool skip,
+                                  int tile_first, int tile_step, int first, int step, CutLine cut) {
+  const int tx0 = pp.ix0 >> g.tile_shift, tx1 = pp.ix1 >> g.tile_shift;
+  const int ty0 = pp.iy0 >> g.tile_shift, ty1 = pp.iy1 >> g.tile_shift;
+  const int tw = tx1 - tx0 + 1, tiles = tw * (ty1 - ty0 + 1);
+  for (int t = tile_first; t < tiles; t += tile_step) {
+    const int tx = tx0 + t % tw, ty = ty0 + t / tw;
+    const int ix0 = tx << g.tile_shift > pp.ix0 ? tx << g.tile_shift : pp.ix0;
+    const int iy0 = ty << g.tile_shift > pp.iy0 ? ty << g.tile_shift : pp.iy0;
+    const int ix1 =
+        ((tx + 1) << g.tile_shift) - 1 < pp.ix1 ? ((tx + 1) << g.tile_shift) - 1 : pp.ix1;
+    const int iy1 =
+        ((ty + 1) << g.tile_shift) - 1 < pp.iy1 ? ((ty + 1) << g.tile_shift) - 1 : pp.iy1;
+    if (skip && tile_max[ty * g.tiles_x + tx] <= rectFloor(g, tool, pp, ix0, ix1, iy0, iy1))
+      continue;
+    const int w = ix1 - ix0 + 1, lines = w * (iy1 - iy0 + 1);
+    for (int l = first; l < lines; l += step) cut(ix0 + l % w, iy0 + l / w);
+  }
+}
+
 /// True if the posture cannot lower any line: its lowest point is not below the highest height of
 /// the culling tiles under its footprint (tile maxima may be stale-high, which stays conservative).
 /// Otherwise shrinks the footprint to the part of the tool that can reach below that height (the
