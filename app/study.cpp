@@ -237,35 +237,39 @@ std::vector<double> parseVoxelSizes(const std::string& text, const std::string& 
       throw InputError(key + ": '" + item + "' is not a voxel size > 0 mm (e.g. 2,1,0.5)");
     sizes.push_back(h);
   }
-  if (sizes.empty()) throw InputError(key + ": give at least one voxel size (e.g. 2,1,0.5)");
+  if (sizes.empty() || text.back() == ',')
+    throw InputError(key + ": give voxel sizes separated by commas (e.g. 2,1,0.5)");
   return sizes;
 }
 
-std::vector<field::StoredQuantity> parseStored(const std::string& text, const std::string& key) {
-  std::vector<field::StoredQuantity> result;
+namespace {
+/// "a,b" → the values of the two names `first` and `second`; InputError naming `key` otherwise.
+template <class T>
+std::vector<T> parsePair(const std::string& text, const std::string& key,
+                         std::pair<const char*, T> first, std::pair<const char*, T> second) {
+  const std::string names = std::string(first.first) + " or " + second.first;
+  std::vector<T> result;
   std::stringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
-    if (item == "force") result.push_back(field::StoredQuantity::Force);
-    else if (item == "plane_ratio") result.push_back(field::StoredQuantity::PlaneRatio);
-    else throw InputError(key + ": '" + item + "' is not force or plane_ratio");
+    if (item == first.first) result.push_back(first.second);
+    else if (item == second.first) result.push_back(second.second);
+    else throw InputError(key + ": '" + item + "' is not " + names);
   }
-  if (result.empty()) throw InputError(key + ": give force, plane_ratio or both");
+  if (result.empty() || text.back() == ',') throw InputError(key + ": give " + names + " or both");
   return result;
+}
+}  // namespace
+
+std::vector<field::StoredQuantity> parseStored(const std::string& text, const std::string& key) {
+  return parsePair(text, key, std::pair{"force", field::StoredQuantity::Force},
+                   std::pair{"plane_ratio", field::StoredQuantity::PlaneRatio});
 }
 
 std::vector<field::Interpolation> parseInterpolations(const std::string& text,
                                                       const std::string& key) {
-  std::vector<field::Interpolation> result;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    if (item == "trilinear") result.push_back(field::Interpolation::Trilinear);
-    else if (item == "quadratic") result.push_back(field::Interpolation::Quadratic);
-    else throw InputError(key + ": '" + item + "' is not trilinear or quadratic");
-  }
-  if (result.empty()) throw InputError(key + ": give trilinear, quadratic or both");
-  return result;
+  return parsePair(text, key, std::pair{"trilinear", field::Interpolation::Trilinear},
+                   std::pair{"quadratic", field::Interpolation::Quadratic});
 }
 
 StudyResult runStudy(const StudyRequest& request) {

@@ -92,9 +92,13 @@ std::filesystem::path* StudyTest::dir_ = nullptr;
 TEST(StudyOptions, ParsesListsAndRejectsBadOnes) {
   EXPECT_EQ(parseVoxelSizes("2,1,0.5", "--voxels"), (std::vector<double>{2.0, 1.0, 0.5}));
   EXPECT_EQ(parseInterpolations("quadratic,trilinear", "--interp").size(), 2u);
-  for (const char* bad : {"", "2,,1", "0", "-1", "2,x", "nan", "inf"})
+  for (const char* bad : {"", "2,,1", "2,", "0", "-1", "2,x", "nan", "inf"})
     EXPECT_THROW(parseVoxelSizes(bad, "--voxels"), common::InputError) << bad;
   EXPECT_THROW(parseInterpolations("cubic", "--interp"), common::InputError);
+  EXPECT_EQ(parseStored("plane_ratio", "--stored"),
+            std::vector<field::StoredQuantity>{field::StoredQuantity::PlaneRatio});
+  EXPECT_THROW(parseStored("force,", "--stored"), common::InputError);
+  EXPECT_THROW(parseStored("ratio", "--stored"), common::InputError);
 }
 
 TEST_F(StudyTest, BruteForceEqualsTheIndexedDirectField) {
