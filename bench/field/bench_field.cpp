@@ -6,7 +6,7 @@
 /// the band, by distance from the walls. Times are medians of repeated runs in this process; the
 /// rates are given per wall-clock second and per CPU second (the machine is shared: CPU seconds
 /// are what this process got, so "per CPU-s × cores" is what idle cores would give).
-///   bench_field [--repeats N] [--points N] [--threads N] [--quick]
+///   bench_field [--repeats N] [--points N] [--threads N] [--sample-step MM] [--quick]
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -224,6 +224,7 @@ int main(int argc, char** argv) {
   std::size_t n_points = 200000;
   bool quick = false;
   int threads = 0;  // 0: TBB's default
+  double sample_step_mm = 2.0;  // the walls' 3.6 mm triangles split in 4: ≈1.3 mm apart
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc)
       repeats = std::atoi(argv[++i]);
@@ -231,11 +232,14 @@ int main(int argc, char** argv) {
       n_points = std::strtoul(argv[++i], nullptr, 10);
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc)
       threads = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--sample-step") && i + 1 < argc)
+      sample_step_mm = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--quick"))
       quick = true, repeats = 1, n_points = 20000;
     else {
       std::fprintf(stderr,
-                   "usage: bench_field [--repeats N] [--points N] [--threads N] [--quick]\n");
+                   "usage: bench_field [--repeats N] [--points N] [--threads N] [--sample-step MM] "
+                   "[--quick]\n");
       return 1;
     }
   }
@@ -244,7 +248,7 @@ int main(int argc, char** argv) {
   const int cores = threads > 0 ? threads : tbb::info::default_concurrency();
 
   field::FieldParams params;    // r0 5, r_min 0.25, area weights
-  params.sample_step_mm = 2.0;  // the walls' 3.6 mm triangles split in 4: ≈1.3 mm apart
+  params.sample_step_mm = sample_step_mm;
   const auto walls = bench::twistedWalls();
   const Eigen::AlignedBox3d region = bench::wallsRegion();
   const field::ObstacleSamples samples =

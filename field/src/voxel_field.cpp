@@ -155,21 +155,32 @@ bool overSurface(const detail::Probe& p, double over_mm) {
 
 constexpr double kOverCos = 0.7;  ///< |cos| of the field's angle to n* over the surface
 
-/// The plane-ratio pair (s, G) of one node from its probe (law.h), so that P(s)·G is the
-/// node's force, s is the plane height η on both sides of a plane and G the plane's normal:
-/// - over the sampled surface within `near_mm` of it (on either side), the field of the samples
-///   is not yet that of a plane (each sample's 1/r³ shows, and the r_min hold): the node holds
-///   the plane's continuation, s = η and G = n*, so that cells reaching down to the wall
-///   interpolate the smooth field above it (these nodes alone do not give back F);
-/// - elsewhere s = P⁻¹(|F|), the height at which a plane gives |F| (negative under the surface),
-///   and G = F / P(s), the unit field direction;
-/// - past r0 (the shell, no sample within r0): s = max(η, r0) and G the wall's direction, the
+/// The plane-ratio pair (s, G) of one node from its probe (law.h): P(s)·G is the field there
+/// and s is the plane height η on both sides of a plane, G the plane's normal.
+/// - Elsewhere than below: s = P⁻¹(|F|), the height at which a plane gives |F|, and
+///   G = F / P(s), the unit field direction: the node gives back F.
+/// - Over the sampled surface closer than `near_mm` above it, or under it (inside the obstacle,
+///   down to the inside band): the samples' own field there is not yet a plane's (each sample's
+///   1/r³ shows, the r_min hold; inside, the surface rule's mirror), so the node holds the
+///   continuation of the field at the point x' lifted to near_mm above the surface: s = s' - δ
+///   (δ the lift) and G = G' of x'. Cells that reach down to or through the wall then
+///   interpolate the field above it, and a node inside gets P(|s|)·G, finite and outward.
+/// - Past r0 (the shell, no sample within r0): s = max(η, r0) and G the wall's direction, the
 ///   plane's continuation, so that a cell straddling r0 interpolates s linearly through it.
-/// "Over the surface" (overSurface) decides the sign: beyond the edge of an open wall the field
-/// is even about the wall's plane and s stays positive there.
-std::pair<double, Vec3> planeRatio(const detail::Probe& p, const Vec3& x, const Vec3& q,
-                                   const Vec3& n, const PlaneLaw& law, double gain, double over_mm,
-                                   double near_mm) {
+/// "Over the surface" (overSurface, and a field along n*) decides the side: beyond the edge of
+/// an open wall the field is even about the wall's plane and s stays positive there.
+/// `field_at(x')` is the direct field at a point.
+/// One node of the plane ratio: s (mm), G, and whether it lies over/under the surface.
+struct RatioNode {
+  double s_mm;
+  Vec3 g;
+  bool over;
+};
+
+template <class FieldAt>
+RatioNode planeRatio(const detail::Probe& p, const Vec3& x, const Vec3& q, const Vec3& n,
+                     const PlaneLaw& law, double gain, double over_mm, double near_mm,
+                     FieldAt&& field_at) {
   const double eta = p.height_mm;
   // Over the surface, and the field along its normal (beyond an edge it turns sideways, away
   // from the edge, and the sign of η says nothing).
@@ -177,16 +188,18 @@ std::pair<double, Vec3> planeRatio(const detail::Probe& p, const Vec3& x, const 
                     (!p.force || std::abs(p.force->dot(n)) >= kOverCos * p.force->norm());
   const double sign = gain < 0.0 ? -1.0 : 1.0;
   if (!p.force) {  // shell: no sample within r0
-    if (!over) return {std::max(p.nearest_mm, law.r0_mm), sign * (x - q) / p.nearest_mm};
-    if (eta >= 0.0) return {std::max(eta, law.r0_mm), sign * n};
-    return {-std::max(-eta, law.r0_mm), Vec3::Zero()};
+    if (!over) return {std::max(p.nearest_mm, law.r0_mm), sign * (x - q) / p.nearest_mm, false};
+    if (eta >= 0.0) return {std::max(eta, law.r0_mm), sign * n, true};
+    return {-std::max(-eta, law.r0_mm), Vec3::Zero(), true};
   }
-  if (over && std::abs(eta) < near_mm)
-    return {eta, law.scale > 0.0 ? Vec3(sign * n) : Vec3::Zero()};
-  const double e = law.height(p.force->norm());
-  const double s = over && eta < 0.0 ? -e : e;
-  const double plane = law.at(s);
-  return {s, plane > 0.0 ? Vec3(*p.force / plane) : Vec3::Zero()};
+  auto ratioOf = [&](const Vec3& f, double lift_mm) {
+    const double e = law.height(f.norm());
+    const double plane = law.at(e);
+    return RatioNode{e - lift_mm, plane > 0.0 ? Vec3(f / plane) : Vec3::Zero(), over};
+  };
+  if (!over || eta >= near_mm) return ratioOf(*p.force, 0.0);
+  const double lift_mm = near_mm - eta;
+  return ratioOf(field_at(Vec3(x + lift_mm * n)), lift_mm);
 }
 
 }  // namespace
@@ -207,7 +220,7 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
   // Sideways reach of a sample (sub-triangle centroids: within 0.87 step of any surface point);
   // closer to the surface than about one spacing the samples' field is not yet a plane's.
   const double over_mm = params.sample_step_mm;
-  const double near_mm = ratio ? request.plane_near_mm.value_or(params.r_min_mm) : 0.0;
+  const double near_mm = request.plane_near_mm.value_or(2.0 * params.r_min_mm);
 
   auto refuse = [&](const std::string& what, double nodes, double bytes_per_node) {
     const double bytes = nodes * bytes_per_node;
@@ -307,11 +320,17 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
           if (p.nearest < 0 || (p.height_mm < -band_in_mm && overSurface(p, over_mm))) continue;
           Vec3 value;
           if (ratio) {
-            const auto [s, g] =
-                planeRatio(p, x, samples.points_mm[p.nearest], samples.normals[p.nearest], law,
-                           params.gain, over_mm, near_mm);
-            float_leaves[l]->setValueOn(it.pos(), float(params.r0_mm - s));
-            value = g;
+            const RatioNode node = planeRatio(
+                p, x, samples.points_mm[p.nearest], samples.normals[p.nearest], law, params.gain,
+                over_mm, near_mm,
+                [&](const Vec3& at) { return index.fieldAt(searcher, at).value_or(Vec3::Zero()); });
+            // The closeness grid's active mask carries `over` (see ratioHolds).
+            const float closeness_mm = float(params.r0_mm - node.s_mm);
+            if (node.over)
+              float_leaves[l]->setValueOn(it.pos(), closeness_mm);
+            else
+              float_leaves[l]->setValueOff(it.pos(), closeness_mm);
+            value = node.g;
           } else {
             if (!p.force) continue;
             value = *p.force;
@@ -324,7 +343,7 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
     common::report(request.progress, double(batch + 1) / double(batches), "field");
   }
   openvdb::tools::pruneInactive(grid->tree());
-  if (closeness) openvdb::tools::pruneInactive(closeness->tree());
+  // (closeness keeps its leaves: its inactive nodes hold values, those beyond open edges.)
 
   VoxelStats& stats = impl_->stats;
   stats.active_nodes = grid->activeVoxelCount();
@@ -355,19 +374,28 @@ namespace {
 /// The 8 corner values of the cell at ijk (index bits: x 4, y 2, z 1), read straight from the
 /// leaf buffer when they share a leaf (7 cells in 8 along each axis), through the accessor
 /// otherwise. False where the cell lies in an absent leaf (background everywhere).
+/// `on`, if given, receives the corners' active states.
 template <class Accessor, class Value>
-bool cellCorners(Accessor& acc, const openvdb::Coord& ijk, Value (&c)[8]) {
+bool cellCorners(Accessor& acc, const openvdb::Coord& ijk, Value (&c)[8], bool* on = nullptr) {
   using LeafT = typename Accessor::TreeType::LeafNodeType;
   const openvdb::Coord in_leaf = ijk & (kLeafDim - 1);
   if (in_leaf.x() < kLeafDim - 1 && in_leaf.y() < kLeafDim - 1 && in_leaf.z() < kLeafDim - 1) {
     const LeafT* leaf = acc.probeConstLeaf(ijk);
     if (!leaf) return false;
-    const Value* v = leaf->buffer().data() + LeafT::coordToOffset(ijk);
+    const openvdb::Index base = LeafT::coordToOffset(ijk);
+    const Value* v = leaf->buffer().data() + base;
     constexpr int dx = kLeafDim * kLeafDim, dy = kLeafDim;
-    for (int i = 0; i < 8; ++i) c[i] = v[(i & 4 ? dx : 0) + (i & 2 ? dy : 0) + (i & 1)];
+    for (int i = 0; i < 8; ++i) {
+      const int offset = (i & 4 ? dx : 0) + (i & 2 ? dy : 0) + (i & 1);
+      c[i] = v[offset];
+      if (on) on[i] = leaf->isValueOn(base + offset);
+    }
   } else {
-    for (int i = 0; i < 8; ++i)
-      c[i] = acc.getValue(ijk.offsetBy(i & 4 ? 1 : 0, i & 2 ? 1 : 0, i & 1));
+    for (int i = 0; i < 8; ++i) {
+      const openvdb::Coord corner = ijk.offsetBy(i & 4 ? 1 : 0, i & 2 ? 1 : 0, i & 1);
+      c[i] = acc.getValue(corner);
+      if (on) on[i] = acc.isValueOn(corner);
+    }
   }
   return true;
 }
@@ -390,18 +418,15 @@ struct Accessors {
   std::optional<FloatGrid::ConstAccessor> closeness;
 };
 
-/// Whether the plane-ratio blend holds in a cell, from its corner heights s (mm): s keeps one
-/// sign, or crosses zero as a linear function does across a wall (the sums over the four pairs
-/// of opposite corners, equal for a linear s, agree within `tolerance`). Otherwise the cell
-/// straddles a jump of s (behind the edge of an open wall, the inner end of the inside band),
-/// where P(s~) would read the wall's r_min value in mid-air; the corner forces are blended there.
-bool ratioHolds(const double (&s)[8], double tolerance) {
-  const bool negative = std::any_of(s, s + 8, [](double v) { return v < 0.0; });
-  const bool positive = std::any_of(s, s + 8, [](double v) { return v > 0.0; });
-  if (!negative || !positive) return true;
-  const double sums[4] = {s[0] + s[7], s[1] + s[6], s[2] + s[5], s[3] + s[4]};
-  const auto [lo, hi] = std::minmax_element(sums, sums + 4);
-  return *hi - *lo <= tolerance;
+/// Whether the plane-ratio blend holds in a cell, from its corner heights s (mm) and whether
+/// each corner lies over/under the surface (the closeness grid's active mask): everywhere but
+/// where corners under the surface (s < 0) meet corners that are not (beyond the edge of an open
+/// wall, where s > 0 on both sides of the wall's plane; past the inner end of the inside band).
+/// s jumps there, and P(s~) would read the wall's r_min value in mid-air; the corner forces are
+/// blended instead.
+bool ratioHolds(const double (&s)[8], const bool (&over)[8]) {
+  const bool under = std::any_of(s, s + 8, [](double v) { return v < 0.0; });
+  return !under || std::all_of(over, over + 8, [](bool v) { return v; });
 }
 
 }  // namespace
@@ -412,7 +437,6 @@ void VoxelField::evaluate(std::span<const Vec3> points_mm, std::span<Vec3> force
   const double inv_h = 1.0 / impl.voxel_size_mm;
   const bool quadratic = impl.interpolation == Interpolation::Quadratic;
   const bool ratio = impl.stored == StoredQuantity::PlaneRatio;
-  const double linear_tolerance_mm = 0.5 * impl.voxel_size_mm;
   // A sample costs tens of ns: below a few thousand points (one tool's nodes) threads cost more
   // than they give.
   constexpr std::size_t kSerialBelow = 4096;
@@ -448,10 +472,11 @@ void VoxelField::evaluate(std::span<const Vec3> points_mm, std::span<Vec3> force
         }
         const PlaneLaw& law = *impl.law;
         float cc[8];
-        cellCorners(*acc.closeness, ijk, cc);
+        bool over[8] = {};
+        cellCorners(*acc.closeness, ijk, cc, over);
         double s[8];
         for (int k = 0; k < 8; ++k) s[k] = law.r0_mm - cc[k];
-        if (!ratioHolds(s, linear_tolerance_mm)) {
+        if (!ratioHolds(s, over)) {
           for (int k = 0; k < 8; ++k) c[k] *= float(law.at(s[k]));  // the node forces
           forces[i] = blend(c, t);
           return;

@@ -59,8 +59,8 @@ TEST(Voxel, EqualsDirectAtTheNodes) {
     const std::vector<Vec3> fv = evaluate(voxel, nodes), fd = evaluate(direct, nodes);
     std::size_t nonzero = 0;
     for (std::size_t i = 0; i < nodes.size(); ++i) {
-      // The plane ratio's nodes over the surface closer than sample_step (1 mm) hold the plane's
-      // continuation instead (voxel_field.h VoxelRequest::plane_near_mm).
+      // The plane ratio's nodes within 0.5 mm over the surface and those under it hold the
+      // continuation of the field above it instead (VoxelRequest::plane_near_mm).
       const double to_surface = std::abs(nodes[i].cwiseAbs().maxCoeff() - 5.0);
       if (stored == StoredQuantity::PlaneRatio && to_surface < 1.5) continue;
       ASSERT_LE((fv[i] - fd[i]).norm(), 2e-6 * fd[i].norm() + 1e-12) << nodes[i].transpose();

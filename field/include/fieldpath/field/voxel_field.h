@@ -19,9 +19,10 @@ struct VoxelRequest {
   Interpolation interpolation = Interpolation::Trilinear;
   /// What the nodes hold; unset: the DirectField's FieldParams::stored (the scene's).
   std::optional<StoredQuantity> stored;
-  /// PlaneRatio: nodes over the sampled surface closer to it than this (mm, either side) hold
-  /// the plane's continuation instead of their own sampled force (voxel_field.cpp planeRatio);
-  /// unset: r_min (where the direct field is held, not a plane's).
+  /// PlaneRatio: nodes over the sampled surface closer than this (mm) and those under it hold
+  /// the continuation of the field this far above the surface, not their own (voxel_field.cpp
+  /// planeRatio); unset: max(2 r_min, sample_step / 2), where a sampled wall's field is close
+  /// to a plane's.
   std::optional<double> plane_near_mm;
   /// Depth of the band of nodes kept inside obstacles (where the surface rule of law.h pushes a
   /// node out); negative: 2 h + r_min, so that every interpolation cell a node r_min deep
