@@ -242,6 +242,26 @@ TEST(Voxel, PlaneRatioIsExactForAPlaneAtAnyVoxelSize) {
   }
 }
 
+namespace {
+
+/// Relative errors (1 % floor, metrics.h) of trilinear voxels of size h storing the plane ratio
+/// and the force, printed.
+std::pair<FieldError, FieldError> ratioAndForceErrors(const DirectField& direct, double h,
+                                                      const std::vector<Vec3>& x,
+                                                      const std::vector<Vec3>& exact,
+                                                      const char* what) {
+  FieldError e[2];
+  for (int i = 0; i < 2; ++i) {
+    const VoxelField voxel(direct, request(h, Interpolation::Trilinear, kStored[1 - i]));
+    e[i] = relativeErrorAboveFloor(evaluate(voxel, x), exact, 0.01);
+  }
+  std::printf("h %.2f, %s: max / RMS relative error, plane ratio %.3f / %.4f, force %.3f / %.4f\n",
+              h, what, e[0].max_relative, e[0].rms_relative, e[1].max_relative, e[1].rms_relative);
+  return {e[0], e[1]};
+}
+
+}  // namespace
+
 TEST(Voxel, PlaneRatioErrorShrinksWithVoxelSizeAndBeatsTheStoredForce) {
   // Around a cube (faces, edges and corners: not a plane), 1 to 3.5 mm off its surface.
   const FieldParams p;
@@ -257,16 +277,7 @@ TEST(Voxel, PlaneRatioErrorShrinksWithVoxelSizeAndBeatsTheStoredForce) {
   const std::vector<Vec3> exact = evaluate(direct, x);
   double previous = HUGE_VAL;
   for (double h : {2.0, 1.0, 0.5}) {
-    const FieldError er =
-        relativeErrorAboveFloor(evaluate(VoxelField(direct, request(h)), x), exact, 0.01);
-    const FieldError ef = relativeErrorAboveFloor(
-        evaluate(VoxelField(direct, request(h, Interpolation::Trilinear, StoredQuantity::Force)),
-                 x),
-        exact, 0.01);
-    std::printf(
-        "h %.2f: cube, max / RMS relative error, plane ratio %.3f / %.4f, force %.3f / "
-        "%.4f\n",
-        h, er.max_relative, er.rms_relative, ef.max_relative, ef.rms_relative);
+    const auto [er, ef] = ratioAndForceErrors(direct, h, x, exact, "cube");
     EXPECT_LT(er.max_relative, 0.6 * previous) << h;
     EXPECT_LT(er.rms_relative, 0.5 * ef.rms_relative) << h;
     EXPECT_LT(er.max_relative, ef.max_relative) << h;
@@ -288,15 +299,7 @@ TEST(Voxel, NoSpuriousForceBeyondTheEdgeOfAnOpenWall) {
   for (int i = 0; i < 2000; ++i) x.push_back(Vec3(past(rng), along(rng), side(rng)));
   const std::vector<Vec3> exact = evaluate(direct, x);
   for (double h : {1.0, 0.5}) {
-    const FieldError e =
-        relativeErrorAboveFloor(evaluate(VoxelField(direct, request(h)), x), exact, 0.01);
-    const FieldError ef = relativeErrorAboveFloor(
-        evaluate(VoxelField(direct, request(h, Interpolation::Trilinear, StoredQuantity::Force)),
-                 x),
-        exact, 0.01);
-    std::printf(
-        "h %.2f: past an open edge, max / RMS relative error %.3f / %.4f (force %.3f / %.4f)\n", h,
-        e.max_relative, e.rms_relative, ef.max_relative, ef.rms_relative);
+    const auto [e, ef] = ratioAndForceErrors(direct, h, x, exact, "past an open edge");
     EXPECT_GT(e.count, x.size() / 2);
     // No better than storing F where a cell spans the edge's fast fall, but never the blow-up.
     EXPECT_LT(e.max_relative, 1.2 * ef.max_relative + 0.05) << h;
