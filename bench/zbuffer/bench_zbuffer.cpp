@@ -513,6 +513,7 @@ int variantTable(const std::string& backend, const std::vector<std::string>& wan
       {"no overlap", [](zb::EngineTuning& t) { t.overlap_upload = false; }},
       {"no vertical bins", [](zb::EngineTuning& t) { t.vertical_bins = false; }},
       {"no tile skip", [](zb::EngineTuning& t) { t.tile_skip = false; }},
+      {"no pinned staging", [](zb::EngineTuning& t) { t.pinned_staging = false; }},
       {"all off (run 3's engine)",
        [](zb::EngineTuning& t) { t = {false, false, false, false, false, 0}; }},
   };

@@ -33,9 +33,9 @@ class CudaAdapter final : public BackendEngine {
   CudaAdapter(const GridView& grid, const ToolData& tool, const std::vector<float>& heights,
               const EngineTuning& t)
       : lines_(heights.size()),
-        engine_(
-            grid, arrays(tool), heights.data(), heights.size(),
-            {t.lowest_first, t.small_threads, t.overlap_upload, t.tile_skip, t.refresh_postures}) {}
+        engine_(grid, arrays(tool), heights.data(), heights.size(),
+                {t.lowest_first, t.small_threads, t.overlap_upload, t.tile_skip, t.pinned_staging,
+                 t.refresh_postures}) {}
 
   void cut(std::span<const Posture> block, Engine engine) override {
     engine_.cut(block.data(), block.size(), engine == Engine::Coarse);

@@ -12,6 +12,7 @@
 #include <cfloat>
 #include <climits>
 #include <cstring>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -168,6 +169,46 @@ T* deviceCopy(const T* host, std::size_t n, cudaStream_t st) {
   return ptr;
 }
 
+/// Pinned host staging buffers, kept for the process: pinning costs milliseconds per call.
+constexpr std::size_t kStageBytes = std::size_t{16} << 20;
+
+std::mutex& pinnedMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+std::vector<void*>& pinnedFree() {
+  static std::vector<void*> free;
+  return free;
+}
+void* acquirePinned() {
+  {
+    std::lock_guard lock(pinnedMutex());
+    if (!pinnedFree().empty()) {
+      void* p = pinnedFree().back();
+      pinnedFree().pop_back();
+      return p;
+    }
+  }
+  void* p = nullptr;
+  FIELDPATH_CUDA_CHECK(cudaMallocHost(&p, kStageBytes));
+  return p;
+}
+void releasePinned(void* p) {
+  std::lock_guard lock(pinnedMutex());
+  pinnedFree().push_back(p);
+}
+
+/// memcpy on all cores (one thread moves ~10 GB/s, less than the PCIe link).
+void parallelCopy(void* dst, const void* src, std::size_t bytes) {
+  const long parts = bytes >= (std::size_t{1} << 20) ? 16 : 1;
+#pragma omp parallel for schedule(static) if (parts > 1)
+  for (long k = 0; k < parts; ++k) {
+    const std::size_t a = bytes * std::size_t(k) / std::size_t(parts),
+                      b = bytes * std::size_t(k + 1) / std::size_t(parts);
+    std::memcpy(static_cast<char*>(dst) + a, static_cast<const char*>(src) + a, b - a);
+  }
+}
+
 }  // namespace
 
 struct Engine::Impl {
@@ -189,6 +230,52 @@ struct Engine::Impl {
   int slot = 0;
   cudaStream_t copy_stream = nullptr, compute_stream = nullptr;
   cudaEvent_t copied[2] = {nullptr, nullptr}, computed[2] = {nullptr, nullptr};
+  // pinned staging: two buffers, the host copy into one overlaps the DMA of the other
+  void* stage[2] = {nullptr, nullptr};
+  cudaEvent_t staged[2] = {nullptr, nullptr};
+  int stage_next = 0;
+
+  /// Host → device through the pinned buffers (or directly from pageable memory without them).
+  void upload(void* dst, const void* src, std::size_t bytes, cudaStream_t st) {
+    if (!stage[0]) {
+      FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(dst, src, bytes, cudaMemcpyHostToDevice, st));
+      return;
+    }
+    for (std::size_t off = 0; off < bytes; off += kStageBytes) {
+      const std::size_t n = std::min(kStageBytes, bytes - off);
+      const int b = stage_next;
+      stage_next ^= 1;
+      FIELDPATH_CUDA_CHECK(cudaEventSynchronize(staged[b]));  // its previous DMA is done
+      parallelCopy(stage[b], static_cast<const char*>(src) + off, n);
+      FIELDPATH_CUDA_CHECK(
+          cudaMemcpyAsync(static_cast<char*>(dst) + off, stage[b], n, cudaMemcpyHostToDevice, st));
+      FIELDPATH_CUDA_CHECK(cudaEventRecord(staged[b], st));
+    }
+  }
+
+  /// Device → host through the pinned buffers: the host copy of a piece overlaps the next DMA.
+  void download(void* dst, const void* src, std::size_t bytes, cudaStream_t st) {
+    if (!stage[0]) {
+      FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(dst, src, bytes, cudaMemcpyDeviceToHost, st));
+      FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(st));
+      return;
+    }
+    const auto enqueue = [&](std::size_t off, int b) {
+      const std::size_t n = std::min(kStageBytes, bytes - off);
+      FIELDPATH_CUDA_CHECK(cudaEventSynchronize(staged[b]));
+      FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(stage[b], static_cast<const char*>(src) + off, n,
+                                           cudaMemcpyDeviceToHost, st));
+      FIELDPATH_CUDA_CHECK(cudaEventRecord(staged[b], st));
+    };
+    int b = stage_next;
+    if (bytes > 0) enqueue(0, b);
+    for (std::size_t off = 0; off < bytes; off += kStageBytes, b ^= 1) {
+      if (off + kStageBytes < bytes) enqueue(off + kStageBytes, b ^ 1);
+      FIELDPATH_CUDA_CHECK(cudaEventSynchronize(staged[b]));
+      parallelCopy(static_cast<char*>(dst) + off, stage[b], std::min(kStageBytes, bytes - off));
+    }
+    stage_next = b;
+  }
 
   ~Impl() {
     if (copy_stream) cudaStreamSynchronize(copy_stream);
@@ -205,6 +292,8 @@ struct Engine::Impl {
         if (p) cudaFreeAsync(p, compute_stream);
       if (copied[k]) cudaEventDestroy(copied[k]);
       if (computed[k]) cudaEventDestroy(computed[k]);
+      if (staged[k]) cudaEventSynchronize(staged[k]), cudaEventDestroy(staged[k]);
+      if (stage[k]) releasePinned(stage[k]);
     }
     cudaStreamSynchronize(compute_stream);
     if (copy_stream) cudaStreamDestroy(copy_stream);
@@ -255,6 +344,8 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   for (int k = 0; k < 2; ++k) {
     FIELDPATH_CUDA_CHECK(cudaEventCreateWithFlags(&m.copied[k], cudaEventDisableTiming));
     FIELDPATH_CUDA_CHECK(cudaEventCreateWithFlags(&m.computed[k], cudaEventDisableTiming));
+    FIELDPATH_CUDA_CHECK(cudaEventCreateWithFlags(&m.staged[k], cudaEventDisableTiming));
+    if (options.pinned_staging) m.stage[k] = acquirePinned();
   }
   cudaStream_t st = m.compute_stream;
   m.tool.bvh_nodes = m.own(tool.nodes, tool.node_count);
@@ -265,7 +356,8 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   m.tool.bin_items = m.own(tool.bin_items, tool.bin_item_count);
   m.tool.radial_floor_mm = m.own(tool.radial_floor, tool.radial_count);
   // heights → ordered keys on the device
-  m.keys = deviceCopy(reinterpret_cast<const std::int32_t*>(heights_mm), lines, st);
+  deviceAlloc(m.keys, lines, st);
+  m.upload(m.keys, heights_mm, lines * 4, st);
   orderBitsKernel<<<unsigned((lines + 255) / 256), 256, 0, st>>>(m.keys, lines);
   FIELDPATH_CUDA_CHECK(cudaGetLastError());
   deviceAlloc(m.tile_max, std::max(1, grid.tiles_x * grid.tiles_y), st);
@@ -297,8 +389,7 @@ void Engine::cut(const Posture* block, std::size_t count, bool coarse) {
   // copy runs on its own stream while the previous block's kernels still run.
   cudaStream_t copy = m.options.overlap_upload ? m.copy_stream : m.compute_stream;
   FIELDPATH_CUDA_CHECK(cudaStreamWaitEvent(copy, m.computed[s], 0));
-  FIELDPATH_CUDA_CHECK(
-      cudaMemcpyAsync(m.postures[s], block, count * sizeof(Posture), cudaMemcpyHostToDevice, copy));
+  m.upload(m.postures[s], block, count * sizeof(Posture), copy);
   FIELDPATH_CUDA_CHECK(cudaEventRecord(m.copied[s], copy));
   FIELDPATH_CUDA_CHECK(cudaStreamWaitEvent(m.compute_stream, m.copied[s], 0));
 
@@ -351,8 +442,8 @@ void Engine::cut(const Posture* block, std::size_t count, bool coarse) {
     }
   }
   FIELDPATH_CUDA_CHECK(cudaEventRecord(m.computed[s], st));
-  // the caller may overwrite `block` once this returns
-  FIELDPATH_CUDA_CHECK(cudaEventSynchronize(m.copied[s]));
+  // the caller may overwrite `block` once this returns (staged: already copied)
+  if (!m.stage[0]) FIELDPATH_CUDA_CHECK(cudaEventSynchronize(m.copied[s]));
 }
 
 void Engine::heights(float* out_mm) const {
@@ -363,7 +454,7 @@ void Engine::heights(float* out_mm) const {
   FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(bits, m.keys, m.lines * 4, cudaMemcpyDeviceToDevice, st));
   orderBitsKernel<<<unsigned((m.lines + 255) / 256), 256, 0, st>>>(bits, m.lines);
   FIELDPATH_CUDA_CHECK(cudaGetLastError());
-  FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(out_mm, bits, m.lines * 4, cudaMemcpyDeviceToHost, st));
+  const_cast<Impl&>(m).download(out_mm, bits, m.lines * 4, st);
   FIELDPATH_CUDA_CHECK(cudaFreeAsync(bits, st));
   FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(st));
 }

@@ -35,7 +35,8 @@ class Engine {
   /// Tuning flags (see EngineTuning): lowest-first order, thread-per-posture for small
   /// footprints, upload of the next block overlapping this block's kernels.
   struct Options {
-    bool lowest_first = true, small_threads = true, overlap_upload = true, tile_skip = true;
+    bool lowest_first = true, small_threads = true, overlap_upload = true, tile_skip = true,
+         pinned_staging = true;
     std::size_t refresh_postures = 0;  ///< 0: from the grid size
   };
   Engine(const GridView& grid, const ToolArrays& tool, const float* heights_mm, std::size_t lines,

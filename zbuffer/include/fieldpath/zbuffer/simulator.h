@@ -74,6 +74,7 @@ struct EngineTuning {
   bool small_threads = true;   ///< CUDA: one thread per small-footprint posture, warps for the rest
   bool overlap_upload = true;  ///< CUDA: a block's upload overlaps the previous block's kernels
   bool tile_skip = true;       ///< footprint tiles whose lines the posture cannot lower skipped
+  bool pinned_staging = true;  ///< CUDA: transfers through pinned buffers, host copies on all cores
   /// Postures between refreshes of the culling tiles' maxima; 0: chosen from the grid size.
   std::size_t refresh_postures = 0;
 };
