@@ -367,12 +367,18 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   // the host arrays may go once this returns
   FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(st));
   m.lines = lines;
+  // Lowest first pays where footprints are large (roughing: case 3 210 ms sorted, 484 ms not);
+  // with a handful of lines per posture (a thread's footprint) the sort costs more than it culls
+  // and scatters the path's neighbours (case 7: 114 ms sorted, 57 ms not). Numbers: H200,
+  // bench/results/zbuffer-h200.md runs 6 and 8.
+  const double span_x = 2.0 * m.tool.hull_radius_mm / grid.dx_mm + 1.0,
+               span_y = 2.0 * m.tool.hull_radius_mm / grid.dy_mm + 1.0;
+  m.options.lowest_first = options.lowest_first && span_x * span_y > kSmallFootprintLines;
   // Tile maxima are refreshed between chunks. Lowest first, 2^17 postures per chunk: smaller
-  // chunks cull more but leave the GPU half idle (2^15: case 3 378 ms, 2^17: 255 ms, 2^19: 259 ms
-  // on an H200, bench/results/zbuffer-h200.md run 5).
+  // chunks cull more but leave the GPU half idle (2^15: case 3 378 ms, 2^17: 255 ms, 2^19: 259 ms).
   m.refresh_every =
       options.refresh_postures ? options.refresh_postures
-      : options.lowest_first
+      : m.options.lowest_first
           ? std::size_t{1} << 17
           : std::clamp<std::size_t>(lines / 8, std::size_t{1} << 16, std::size_t{1} << 24);
 }
