@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <sstream>
 #include <string>
 
 #include "commands.h"
@@ -76,11 +77,14 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   cmd->add_option("--out", options->out, "Output folder")->required();
   cmd->callback([options, &global] {
+    std::ostringstream line_step;
+    line_step << options->line_step_mm;
     std::string command_line = "fieldpath study " + options->scene + " --voxels " +
                                options->voxels + " --interp " + options->interpolations +
                                " --stored " + options->stored +
                                (options->no_brute_force ? " --no-brute-force" : "") + " --repeat " +
-                               std::to_string(options->repeats) + " --out " +
+                               std::to_string(options->repeats) + " --line-step " +
+                               line_step.str() + " --out " +
                                options->out;
     run(*options, global, command_line);
   });
