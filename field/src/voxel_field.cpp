@@ -49,8 +49,10 @@ double weightPerMm2(const ObstacleSamples& samples, const FieldParams& params) {
 }
 
 double insideBandMm(const FieldParams& params, const VoxelRequest& request) {
-  return request.inside_band_mm >= 0.0 ? request.inside_band_mm
-                                       : 2.0 * request.voxel_size_mm + params.r_min_mm;
+  if (request.inside_band_mm >= 0.0) return request.inside_band_mm;
+  const double cells_mm = 2.0 * request.voxel_size_mm + params.r_min_mm;
+  return storedOf(params, request) == StoredQuantity::PlaneRatio ? std::max(cells_mm, params.r0_mm)
+                                                                 : cells_mm;
 }
 
 void checkVoxelSize(double h_mm) {

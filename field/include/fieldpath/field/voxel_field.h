@@ -25,7 +25,9 @@ struct VoxelRequest {
   /// to a plane's.
   std::optional<double> plane_near_mm;
   /// Depth of the band of nodes kept inside obstacles (where the surface rule of law.h pushes a
-  /// node out); negative: 2 h + r_min, so that every interpolation cell a node r_min deep
+  /// node out); negative: for PlaneRatio max(2 h + r_min, r0), as deep as the direct field
+  /// pushes out (a node that starts deep in a wall keeps P(depth), ≈25 % more nodes on open
+  /// walls at 0.5 mm); for Force 2 h + r_min, so that every interpolation cell a node r_min deep
   /// reaches is built.
   double inside_band_mm = -1.0;
   /// Only nodes in this world box (mm): the region the tool can reach. Default: everywhere the
