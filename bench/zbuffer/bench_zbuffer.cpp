@@ -514,7 +514,7 @@ int variantTable(const std::string& backend, const std::vector<std::string>& wan
       {"no vertical bins", [](zb::EngineTuning& t) { t.vertical_bins = false; }},
       {"no tile skip", [](zb::EngineTuning& t) { t.tile_skip = false; }},
       {"no pinned staging", [](zb::EngineTuning& t) { t.pinned_staging = false; }},
-      {"all off (run 3's engine)",
+      {"all knobs off",
        [](zb::EngineTuning& t) { t = {false, false, false, false, false, 0}; }},
   };
   std::printf("| case | P | grid |");
