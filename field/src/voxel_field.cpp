@@ -157,6 +157,13 @@ bool overSurface(const detail::Probe& p, double over_mm) {
 
 constexpr double kOverCos = 0.7;  ///< |cos| of the field's angle to n* over the surface
 
+/// One node of the plane ratio: s (mm), G, and whether it lies over/under the surface.
+struct RatioNode {
+  double s_mm;
+  Vec3 g;
+  bool over;
+};
+
 /// The plane-ratio pair (s, G) of one node from its probe (law.h): P(s)·G is the field there
 /// and s is the plane height η on both sides of a plane, G the plane's normal.
 /// - Elsewhere than below: s = P⁻¹(|F|), the height at which a plane gives |F|, and
@@ -172,13 +179,6 @@ constexpr double kOverCos = 0.7;  ///< |cos| of the field's angle to n* over the
 /// "Over the surface" (overSurface, and a field along n*) decides the side: beyond the edge of
 /// an open wall the field is even about the wall's plane and s stays positive there.
 /// `field_at(x')` is the direct field at a point.
-/// One node of the plane ratio: s (mm), G, and whether it lies over/under the surface.
-struct RatioNode {
-  double s_mm;
-  Vec3 g;
-  bool over;
-};
-
 template <class FieldAt>
 RatioNode planeRatio(const detail::Probe& p, const Vec3& x, const Vec3& q, const Vec3& n,
                      const PlaneLaw& law, double gain, double over_mm, double near_mm,

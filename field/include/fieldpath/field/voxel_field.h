@@ -21,12 +21,11 @@ struct VoxelRequest {
   std::optional<StoredQuantity> stored;
   /// PlaneRatio: nodes over the sampled surface closer than this (mm) and those under it hold
   /// the continuation of the field this far above the surface, not their own (voxel_field.cpp
-  /// planeRatio); unset: max(2 r_min, sample_step / 2), where a sampled wall's field is close
-  /// to a plane's.
+  /// planeRatio); unset: 2 r_min (closer in, a sampled wall's field is far from a plane's).
   std::optional<double> plane_near_mm;
   /// Depth of the band of nodes kept inside obstacles (where the surface rule of law.h pushes a
   /// node out); negative: for PlaneRatio max(2 h + r_min, r0), as deep as the direct field
-  /// pushes out (a node that starts deep in a wall keeps P(depth), ≈25 % more nodes on open
+  /// pushes out (a node that starts deep in a wall keeps P(depth); ≈40 % more nodes on open
   /// walls at 0.5 mm); for Force 2 h + r_min, so that every interpolation cell a node r_min deep
   /// reaches is built.
   double inside_band_mm = -1.0;
