@@ -280,7 +280,7 @@ StudyResult runStudy(const StudyRequest& request) {
   if (request.stored.empty()) throw InputError("--stored: give force, plane_ratio or both");
   if (request.repeats < 1) throw InputError("--repeat: must be >= 1");
   if (!std::isfinite(request.line_step_mm) || request.line_step_mm <= 0.0)
-    throw InputError("study line step must be > 0 mm");
+    throw InputError("--line-step: the study lines need a step > 0 mm");
 
   std::vector<StudyVariant> variants;
   if (request.brute_force) variants.push_back({pathgen::FieldMode::BruteForce});
