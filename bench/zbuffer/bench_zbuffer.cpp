@@ -508,14 +508,15 @@ int variantTable(const std::string& backend, const std::vector<std::string>& wan
       {"default", [](zb::EngineTuning&) {}},
       {"refresh 2^17", [](zb::EngineTuning& t) { t.refresh_postures = 1 << 17; }},
       {"refresh 2^19", [](zb::EngineTuning& t) { t.refresh_postures = 1 << 19; }},
+      {"tiles 8²", [](zb::EngineTuning& t) { t.tile_shift = 3; }},
+      {"tiles 32²", [](zb::EngineTuning& t) { t.tile_shift = 5; }},
       {"no lowest first", [](zb::EngineTuning& t) { t.lowest_first = false; }},
       {"no small threads", [](zb::EngineTuning& t) { t.small_threads = false; }},
       {"no overlap", [](zb::EngineTuning& t) { t.overlap_upload = false; }},
       {"no vertical bins", [](zb::EngineTuning& t) { t.vertical_bins = false; }},
       {"no tile skip", [](zb::EngineTuning& t) { t.tile_skip = false; }},
       {"no pinned staging", [](zb::EngineTuning& t) { t.pinned_staging = false; }},
-      {"all knobs off",
-       [](zb::EngineTuning& t) { t = {false, false, false, false, false, 0}; }},
+      {"all knobs off", [](zb::EngineTuning& t) { t = {false, false, false, false, false, 0}; }},
   };
   std::printf("| case | P | grid |");
   for (const auto& v : variants) std::printf(" %s ms |", v.first);

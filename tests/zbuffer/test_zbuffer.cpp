@@ -319,6 +319,7 @@ TEST(Tuning, EveryVariantGivesTheSameBits) {
       req.tuning.vertical_bins = variant & 1;
       req.tuning.lowest_first = variant & 2;
       req.tuning.tile_skip = variant & 4;
+      req.tuning.tile_shift = 2 + variant % 3;
       req.block_postures = variant == 3 || variant == 6 ? 97 : 1 << 20;
       const auto h = simulate(req, postures).heights_mm;
       if (first.empty()) first = h;

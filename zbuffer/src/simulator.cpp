@@ -87,7 +87,7 @@ const char* backendName(Backend backend) {
 
 namespace detail {
 
-GridView makeGridView(const Grid& grid) {
+GridView makeGridView(const Grid& grid, int tile_shift) {
   GridView g;
   g.x0_mm = grid.x0_mm;
   g.y0_mm = grid.y0_mm;
@@ -95,9 +95,9 @@ GridView makeGridView(const Grid& grid) {
   g.dy_mm = grid.dy_mm;
   g.nx = grid.nx;
   g.ny = grid.ny;
-  g.tile_shift = 4;
-  g.tiles_x = (grid.nx + 15) >> 4;
-  g.tiles_y = (grid.ny + 15) >> 4;
+  g.tile_shift = tile_shift;
+  g.tiles_x = (grid.nx + (1 << tile_shift) - 1) >> tile_shift;
+  g.tiles_y = (grid.ny + (1 << tile_shift) - 1) >> tile_shift;
   return g;
 }
 
@@ -405,7 +405,9 @@ SimulationResult run(const SimulationRequest& request, NextBlock next) {
   detail::ToolData tool = preparedTool(request.tool);
   tool.pointViewAtVectors();
   if (!request.tuning.vertical_bins) tool.view.bins = 0;
-  const GridView g = detail::makeGridView(grid);
+  const int shift = request.tuning.tile_shift;
+  if (shift < 1 || shift > 8) throw InputError("tuning: tile_shift must be in [1, 8]");
+  const GridView g = detail::makeGridView(grid, shift);
   std::vector<float> initial = request.initial_heights_mm;
   if (initial.empty()) initial.assign(grid.lineCount(), request.stock_mm);
 

@@ -77,6 +77,7 @@ struct EngineTuning {
   bool pinned_staging = true;  ///< CUDA: transfers through pinned buffers, host copies on all cores
   /// Postures between refreshes of the culling tiles' maxima; 0: chosen from the grid size.
   std::size_t refresh_postures = 0;
+  int tile_shift = 4;  ///< culling tiles of 2^shift × 2^shift lines, shift in [1, 8]
 };
 
 struct SimulationRequest {
@@ -134,7 +135,8 @@ struct ToolData {
   void pointViewAtVectors();
 };
 ToolData prepareTool(const Tool& tool);
-GridView makeGridView(const Grid& grid);
+/// Culling tiles of 2^tile_shift × 2^tile_shift lines.
+GridView makeGridView(const Grid& grid, int tile_shift = 4);
 
 /// A backend: keeps the heights between blocks. The CPU and CUDA engines implement the same calls.
 class BackendEngine {
