@@ -175,7 +175,10 @@ void binDownFacing(ToolData& data, float pad) {
           box.add({p[3 * k] + pad, p[3 * k + 1] + pad, 0.f});
   }
   if (down.empty()) return;
-  const int bins = std::clamp(static_cast<int>(std::ceil(std::sqrt(down.size() / 2.0))), 1, 256);
+  // 4·√(down-facing triangles) bins per side: a revolved tool's triangles crowd at the axis (a fan
+  // of `around` triangles meets at the tip), so coarser bins (√(n/2) per side before) left dozens
+  // of triangles in the central ones; CPU, seed 001 spiral: 1776 → 521 ms, random 730 → 342 ms.
+  const int bins = std::clamp(static_cast<int>(std::ceil(std::sqrt(down.size() * 16.0))), 1, 2048);
   const float side = std::max(box.hi[0] - box.lo[0], box.hi[1] - box.lo[1]) * (1.f + 1e-6f);
   v.bins = bins;
   v.bin_x0_mm = box.lo[0];
