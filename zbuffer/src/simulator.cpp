@@ -184,23 +184,49 @@ void binDownFacing(ToolData& data, float pad) {
   v.bin_x0_mm = box.lo[0];
   v.bin_y0_mm = box.lo[1];
   v.bin_inv_mm = bins / side;
-  std::vector<std::vector<std::int32_t>> cells(std::size_t(bins) * bins);
   const auto cellOf = [&](float x, float x0) {
     return std::clamp(static_cast<int>((x - x0) * v.bin_inv_mm), 0, bins - 1);
   };
-  for (auto t : down) {
-    const float* p = data.bvh_triangles.data() + 9 * t;
-    const float xlo = std::min({p[0], p[3], p[6]}) - pad, xhi = std::max({p[0], p[3], p[6]}) + pad;
-    const float ylo = std::min({p[1], p[4], p[7]}) - pad, yhi = std::max({p[1], p[4], p[7]}) + pad;
-    for (int cy = cellOf(ylo, v.bin_y0_mm); cy <= cellOf(yhi, v.bin_y0_mm); ++cy)
-      for (int cx = cellOf(xlo, v.bin_x0_mm); cx <= cellOf(xhi, v.bin_x0_mm); ++cx)
-        cells[std::size_t(cy) * bins + cx].push_back(t);
-  }
-  data.bin_start.assign(1, 0);
-  for (const auto& c : cells) {
-    data.bin_items.insert(data.bin_items.end(), c.begin(), c.end());
-    data.bin_start.push_back(static_cast<std::int32_t>(data.bin_items.size()));
-  }
+  // Two passes (count, then fill after a prefix sum): no per-cell vectors for ~10^5 cells.
+  const auto forEachCell = [&](auto visit) {
+    for (auto t : down) {
+      const float* p = data.bvh_triangles.data() + 9 * t;
+      const float xlo = std::min({p[0], p[3], p[6]}) - pad,
+                  xhi = std::max({p[0], p[3], p[6]}) + pad;
+      const float ylo = std::min({p[1], p[4], p[7]}) - pad,
+                  yhi = std::max({p[1], p[4], p[7]}) + pad;
+      // Row by row: the cells the triangle's part within the row's band (grown by the pad and a
+      // tenth of a cell for the rounding of the bin index) can touch, not its whole bounding box.
+      const double cell_mm = 1.0 / v.bin_inv_mm, grow = pad + 0.1 * cell_mm;
+      for (int cy = cellOf(ylo, v.bin_y0_mm); cy <= cellOf(yhi, v.bin_y0_mm); ++cy) {
+        const double y0 = v.bin_y0_mm + cy * cell_mm - grow,
+                     y1 = v.bin_y0_mm + (cy + 1) * cell_mm + grow;
+        double xmin = 1e300, xmax = -1e300;
+        for (int k = 0; k < 3; ++k) {
+          const double ax = p[3 * k], ay = p[3 * k + 1], bx = p[3 * ((k + 1) % 3)],
+                       by = p[3 * ((k + 1) % 3) + 1];
+          if (ay >= y0 && ay <= y1) xmin = std::min(xmin, ax), xmax = std::max(xmax, ax);
+          for (double yc : {y0, y1})  // the edge's crossings of the band's borders
+            if ((ay - yc) * (by - yc) < 0) {
+              const double xc = ax + (bx - ax) * (yc - ay) / (by - ay);
+              xmin = std::min(xmin, xc);
+              xmax = std::max(xmax, xc);
+            }
+        }
+        if (xmin > xmax) continue;
+        for (int cx = cellOf(float(xmin - grow), v.bin_x0_mm);
+             cx <= cellOf(float(xmax + grow), v.bin_x0_mm); ++cx)
+          visit(std::size_t(cy) * bins + cx, t);
+      }
+    }
+  };
+  data.bin_start.assign(std::size_t(bins) * bins + 1, 0);
+  forEachCell([&](std::size_t cell, std::int32_t) { ++data.bin_start[cell + 1]; });
+  for (std::size_t c = 1; c < data.bin_start.size(); ++c)
+    data.bin_start[c] += data.bin_start[c - 1];
+  data.bin_items.resize(static_cast<std::size_t>(data.bin_start.back()));
+  std::vector<std::int32_t> fill(data.bin_start.begin(), data.bin_start.end() - 1);
+  forEachCell([&](std::size_t cell, std::int32_t t) { data.bin_items[fill[cell]++] = t; });
   v.bin_start = data.bin_start.data();
   v.bin_items = data.bin_items.data();
 
