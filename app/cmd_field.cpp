@@ -162,7 +162,7 @@ void addFieldCommand(CLI::App& app, const GlobalOptions& global) {
   probe_cmd
       ->add_option("--voxel", options->voxel_mm,
                    "Voxel size h, mm (default: the scene's field.voxel_size)")
-      ->check(CLI::PositiveNumber)
+      ->check(positiveFinite("mm"))
       ->excludes(direct);
   probe_cmd
       ->add_option("--interpolation", options->interpolation,
@@ -176,7 +176,7 @@ void addFieldCommand(CLI::App& app, const GlobalOptions& global) {
   probe_cmd
       ->add_option("--max-memory", options->max_memory_mib,
                    "Refuse voxel fields estimated above this, MiB")
-      ->check(CLI::PositiveNumber);
+      ->check(positiveFinite("MiB"));
   probe_cmd->callback([options, &global] { probe(*options, global); });
 
   auto* build_cmd =
@@ -185,7 +185,7 @@ void addFieldCommand(CLI::App& app, const GlobalOptions& global) {
   build_cmd
       ->add_option("--voxel", options->voxel_mm,
                    "Voxel size h, mm (default: the scene's field.voxel_size)")
-      ->check(CLI::PositiveNumber);
+      ->check(positiveFinite("mm"));
   build_cmd
       ->add_option("--interpolation", options->interpolation,
                    "trilinear | quadratic (default: the scene's)")
@@ -194,7 +194,7 @@ void addFieldCommand(CLI::App& app, const GlobalOptions& global) {
   build_cmd
       ->add_option("--max-memory", options->max_memory_mib,
                    "Refuse voxel fields estimated above this, MiB")
-      ->check(CLI::PositiveNumber);
+      ->check(positiveFinite("MiB"));
   build_cmd->callback([options, &global] { build(*options, global); });
 }
 

@@ -125,7 +125,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
   auto* direct =
       cmd->add_flag("--direct", options->direct, "Exact field (radius search), no voxels");
   auto* voxel = cmd->add_option("--voxel", options->voxel_mm,
-                                "Voxel size H, mm (default: the scene's field.voxel_size)");
+                                "Voxel size H, mm (default: the scene's field.voxel_size)")
+                    ->check(positiveFinite("mm"));
   direct->excludes(voxel);
   cmd->add_flag("--nominal", options->nominal,
                 "The nominal path: axis on the hub normal (+ lead), no field, no dynamics");

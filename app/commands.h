@@ -2,9 +2,31 @@
 /// Each sub-command lives in its own cmd_*.cpp and registers itself here. A registration adds the
 /// sub-command and its options to `app` and sets its callback; the callback throws InputError for
 /// bad input (exit 1) and returns normally on success (exit 0).
+#include <cmath>
+#include <string>
+
 #include <CLI/CLI.hpp>
 
 namespace fieldpath::app {
+
+/// CLI11 check for a size option: a finite number > 0 (in `unit`), with a short message otherwise
+/// (CLI::PositiveNumber lets NaN through and prints its range as a 300-digit number).
+inline CLI::Validator positiveFinite(const std::string& unit) {
+  return CLI::Validator(
+      [unit](std::string& text) -> std::string {
+        double value = 0.0;
+        std::size_t used = 0;
+        try {
+          value = std::stod(text, &used);
+        } catch (...) {
+          return "'" + text + "' is not a number";
+        }
+        if (used != text.size() || !std::isfinite(value) || value <= 0.0)
+          return "must be a finite number > 0 " + unit + ", got '" + text + "'";
+        return {};
+      },
+      unit + " > 0");
+}
 
 struct GlobalOptions {
   bool quiet = false;  ///< silence progress lines on stderr

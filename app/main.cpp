@@ -13,8 +13,9 @@
 
 int main(int argc, char** argv) {
   using namespace fieldpath::app;
-  CLI::App app{"fieldpath: collision-free 5-axis ball-end milling paths (repulsive field), "
-               "clearance check and Z-buffer machining simulation"};
+  CLI::App app{
+      "fieldpath: collision-free 5-axis ball-end milling paths (repulsive field), "
+      "clearance check and Z-buffer machining simulation"};
   app.set_version_flag("--version", std::string("fieldpath ") + FIELDPATH_VERSION);
   app.require_subcommand(1);
   GlobalOptions global;
@@ -30,8 +31,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);  // prints help / version / the usage error
-    return code == 0 ? 0 : 1;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // A usage error is bad input: one line, exit 1 (CLI11's own report adds a second line).
+    std::fprintf(stderr, "fieldpath: error: %s (see --help)\n", e.what());
+    return 1;
   } catch (const InputError& e) {
     std::fprintf(stderr, "fieldpath: error: %s\n", e.what());
     return 1;

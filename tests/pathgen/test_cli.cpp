@@ -194,6 +194,19 @@ TEST(BadScenes, ExitOneWithALineNamingThePassOrKey) {
   expectBadScene("unknown", {{"spoke", "3"}}, {"obstacles.impeller.spoke", "unknown key"});
 }
 
+TEST(BadOptions, VoxelSizeMustBeAPositiveLength) {
+  const fs::path out =
+      fs::temp_directory_path() / ("fieldpath_bad_opt_" + std::to_string(getpid()));
+  for (const char* h : {"0", "-1", "nan", "2mm"}) {
+    const Outcome r =
+        run("generate '" + kScene.string() + "' --voxel " + h + " --out '" + out.string() + "'");
+    EXPECT_EQ(r.exit_code, 1) << h << ": " << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;  // one line
+    EXPECT_NE(r.output.find("--voxel"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
 }  // namespace
 
 namespace {
