@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 packages=(
   build-essential cmake git pkg-config
   libeigen3-dev libopenvdb-dev libboost-iostreams-dev libnanovdb-dev libfcl-dev libassimp-dev
-  libsundials-dev libtbb-dev libcli11-dev libyaml-cpp-dev nlohmann-json3-dev
+  libsundials-dev libtbb-dev libcli11-dev libyaml-cpp-dev nlohmann-json3-dev zlib1g-dev
   libgtest-dev googletest libbenchmark-dev
   python3-matplotlib python3-numpy
 )

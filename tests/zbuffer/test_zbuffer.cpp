@@ -10,6 +10,10 @@
 #include <fstream>
 #include <random>
 
+#ifdef FIELDPATH_TEST_ZLIB
+#include <zlib.h>
+#endif
+
 #include "fieldpath/common/errors.h"
 #include "fieldpath/zbuffer/outputs.h"
 #include "fieldpath/zbuffer/simulator.h"
@@ -414,6 +418,49 @@ TEST(Outputs, NpyJsonStlPngAreWellFormed) {
   EXPECT_NE(j.find("\"shape\":[2,3]"), std::string::npos);
   std::filesystem::remove_all(dir);
 }
+
+#ifdef FIELDPATH_TEST_ZLIB
+/// Reads a big-endian u32 at `at`.
+std::uint32_t be32(const std::string& s, std::size_t at) {
+  std::uint32_t v = 0;
+  for (int k = 0; k < 4; ++k) v = (v << 8) | static_cast<std::uint8_t>(s[at + k]);
+  return v;
+}
+
+TEST(Outputs, PngDecodesToTheSamePixels) {
+  // Independent check with zlib: every chunk's CRC, and the inflated scanlines equal the input.
+  const int w = 37, h = 11;
+  std::vector<std::uint8_t> rgb(3 * w * h);
+  std::mt19937 rng(7);
+  for (std::size_t i = 0; i < rgb.size(); ++i) rgb[i] = (i % 5 == 0) ? rng() & 0xff : i & 0xff;
+  const std::string png = encodePng(w, h, rgb);
+  ASSERT_EQ(png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  std::string idat;
+  for (std::size_t at = 8; at < png.size();) {
+    const std::uint32_t len = be32(png, at);
+    const std::string type = png.substr(at + 4, 4);
+    const uLong crc = crc32(0L, reinterpret_cast<const Bytef*>(png.data() + at + 4), len + 4);
+    EXPECT_EQ(be32(png, at + 8 + len), crc) << type;
+    if (type == "IHDR") {
+      EXPECT_EQ(be32(png, at + 8), std::uint32_t(w));
+      EXPECT_EQ(be32(png, at + 12), std::uint32_t(h));
+    }
+    if (type == "IDAT") idat += png.substr(at + 8, len);
+    at += 12 + len;
+  }
+  std::string raw(h * (3 * w + 1), '\xff');
+  uLongf size = raw.size();
+  ASSERT_EQ(uncompress(reinterpret_cast<Bytef*>(raw.data()), &size,
+                       reinterpret_cast<const Bytef*>(idat.data()), idat.size()),
+            Z_OK);
+  ASSERT_EQ(size, raw.size());
+  for (int y = 0; y < h; ++y) {
+    EXPECT_EQ(raw[y * (3 * w + 1)], 0) << "filter byte of row " << y;
+    EXPECT_EQ(0, std::memcmp(raw.data() + y * (3 * w + 1) + 1, rgb.data() + 3 * w * y, 3 * w))
+        << "row " << y;
+  }
+}
+#endif
 
 TEST(BadInput, RegionGridAndToolAreChecked) {
   EXPECT_THROW(Grid::fromRegion(0, 0, 0, 5, 10, 10), common::InputError);

@@ -5,8 +5,13 @@
 #include <cmath>
 #include <cstring>
 #include <sstream>
+#include <stdexcept>
 
 #include "fieldpath/common/atomic_file.h"
+
+#ifdef FIELDPATH_HAVE_ZLIB
+#include <zlib.h>
+#endif
 
 namespace fieldpath::zbuffer {
 namespace {
@@ -15,7 +20,27 @@ void putU32be(std::string& s, std::uint32_t v) {
   for (int k = 3; k >= 0; --k) s.push_back(static_cast<char>((v >> (8 * k)) & 0xff));
 }
 
-std::uint32_t crc32(const char* data, std::size_t n, std::uint32_t crc = 0) {
+#ifdef FIELDPATH_HAVE_ZLIB
+std::uint32_t pngCrc(const std::string& typed) {
+  return static_cast<std::uint32_t>(
+      ::crc32(0L, reinterpret_cast<const Bytef*>(typed.data()), static_cast<uInt>(typed.size())));
+}
+
+/// zlib stream of the filtered scanlines, compressed (heights.png is mostly smooth shading).
+std::string zlibStream(const std::string& raw) {
+  uLongf size = compressBound(static_cast<uLong>(raw.size()));
+  std::string z(size, '\0');
+  if (compress2(reinterpret_cast<Bytef*>(z.data()), &size,
+                reinterpret_cast<const Bytef*>(raw.data()), static_cast<uLong>(raw.size()),
+                6) != Z_OK)
+    throw std::runtime_error("PNG: zlib compression failed");
+  z.resize(size);
+  return z;
+}
+#else
+// Without zlib (the GPU machine builds the Z-buffer alone): CRC-32 and stored (uncompressed)
+// deflate blocks, which every PNG reader accepts.
+std::uint32_t pngCrc(const std::string& typed) {
   static const auto table = [] {
     std::array<std::uint32_t, 256> t{};
     for (std::uint32_t i = 0; i < 256; ++i) {
@@ -25,33 +50,12 @@ std::uint32_t crc32(const char* data, std::size_t n, std::uint32_t crc = 0) {
     }
     return t;
   }();
-  crc = ~crc;
-  for (std::size_t i = 0; i < n; ++i)
-    crc = table[(crc ^ static_cast<std::uint8_t>(data[i])) & 0xff] ^ (crc >> 8);
+  std::uint32_t crc = ~0u;
+  for (unsigned char c : typed) crc = table[(crc ^ c) & 0xff] ^ (crc >> 8);
   return ~crc;
 }
 
-void chunk(std::string& png, const char* type, const std::string& body) {
-  putU32be(png, static_cast<std::uint32_t>(body.size()));
-  std::string typed = std::string(type, 4) + body;
-  png += typed;
-  putU32be(png, crc32(typed.data(), typed.size()));
-}
-
-/// Sampling stride so that a side of n lines gives at most max_side samples.
-int strideFor(int n, int max_side) { return std::max(1, (n + max_side - 1) / max_side); }
-
-}  // namespace
-
-std::string encodePng(int width, int height, std::span<const std::uint8_t> rgb) {
-  // zlib stream of stored (uncompressed) deflate blocks over the filtered scanlines (filter 0).
-  std::string raw;
-  raw.reserve(std::size_t(height) * (3 * std::size_t(width) + 1));
-  for (int y = 0; y < height; ++y) {
-    raw.push_back('\0');
-    raw.append(reinterpret_cast<const char*>(rgb.data()) + std::size_t(y) * 3 * width,
-               3 * std::size_t(width));
-  }
+std::string zlibStream(const std::string& raw) {
   std::string z = {'\x78', '\x01'};
   std::uint32_t a = 1, b = 0;
   for (unsigned char c : raw) {
@@ -70,6 +74,32 @@ std::string encodePng(int width, int height, std::span<const std::uint8_t> rgb) 
     if (last) break;
   }
   putU32be(z, (b << 16) | a);
+  return z;
+}
+#endif
+
+void chunk(std::string& png, const char* type, const std::string& body) {
+  putU32be(png, static_cast<std::uint32_t>(body.size()));
+  std::string typed = std::string(type, 4) + body;
+  png += typed;
+  putU32be(png, pngCrc(typed));
+}
+
+/// Sampling stride so that a side of n lines gives at most max_side samples.
+int strideFor(int n, int max_side) { return std::max(1, (n + max_side - 1) / max_side); }
+
+}  // namespace
+
+std::string encodePng(int width, int height, std::span<const std::uint8_t> rgb) {
+  // Filtered scanlines (filter 0: none) in one zlib stream.
+  std::string raw;
+  raw.reserve(std::size_t(height) * (3 * std::size_t(width) + 1));
+  for (int y = 0; y < height; ++y) {
+    raw.push_back('\0');
+    raw.append(reinterpret_cast<const char*>(rgb.data()) + std::size_t(y) * 3 * width,
+               3 * std::size_t(width));
+  }
+  const std::string z = zlibStream(raw);
 
   std::string png = "\x89PNG\r\n\x1a\n";
   std::string ihdr;
