@@ -26,7 +26,8 @@ fi
 
 # CUDA is used when /usr/local/cuda exists (CMake's FIELDPATH_WITH_CUDA=AUTO finds nvcc there).
 jobs=$(nproc)
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release ${FIELDPATH_CMAKE_ARGS:-} >build.configure.log 2>&1 \
-  || { cat build.configure.log >&2; exit 1; }
-grep -E "fieldpath: CUDA" build.configure.log >&2 || true
+mkdir -p build
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release ${FIELDPATH_CMAKE_ARGS:-} >build/configure.log 2>&1 \
+  || { cat build/configure.log >&2; exit 1; }
+grep -E "fieldpath: CUDA" build/configure.log >&2 || true
 cmake --build build -j"$jobs"
