@@ -22,12 +22,12 @@ inline float loadRelaxed(float& slot) {
 
 class CpuEngine final : public BackendEngine {
  public:
-  CpuEngine(const GridView& grid, const ToolData& tool, std::vector<float> heights,
+  CpuEngine(const GridView& grid, const ToolData& tool, std::span<const float> heights,
             const EngineTuning& tuning)
       : grid_(grid),
         tool_(tool),
         tuning_(tuning),
-        heights_(std::move(heights)),
+        heights_(heights.begin(), heights.end()),
         tile_max_(std::size_t(grid.tiles_x) * grid.tiles_y) {
     tool_.pointViewAtVectors();  // this engine's own copies
     // Tile maxima are refreshed between chunks: often when postures come lowest first (each
@@ -52,7 +52,7 @@ class CpuEngine final : public BackendEngine {
     }
   }
 
-  std::vector<float> heights() override { return heights_; }
+  std::vector<float> heights() override { return std::move(heights_); }
   std::size_t culled() override { return culled_; }
 
  private:
@@ -138,9 +138,9 @@ class CpuEngine final : public BackendEngine {
 }  // namespace
 
 std::unique_ptr<BackendEngine> makeCpuEngine(const GridView& grid, const ToolData& tool,
-                                             std::vector<float> heights_mm,
+                                             std::span<const float> heights_mm,
                                              const EngineTuning& tuning) {
-  return std::make_unique<CpuEngine>(grid, tool, std::move(heights_mm), tuning);
+  return std::make_unique<CpuEngine>(grid, tool, heights_mm, tuning);
 }
 
 }  // namespace fieldpath::zbuffer::detail

@@ -30,7 +30,7 @@ cuda::ToolArrays arrays(const ToolData& tool) {
 
 class CudaAdapter final : public BackendEngine {
  public:
-  CudaAdapter(const GridView& grid, const ToolData& tool, const std::vector<float>& heights,
+  CudaAdapter(const GridView& grid, const ToolData& tool, std::span<const float> heights,
               const EngineTuning& t)
       : lines_(heights.size()),
         engine_(grid, arrays(tool), heights.data(), heights.size(),
@@ -54,7 +54,7 @@ class CudaAdapter final : public BackendEngine {
 }  // namespace
 
 std::unique_ptr<BackendEngine> makeCudaEngine(const GridView& grid, const ToolData& tool,
-                                              std::vector<float> heights,
+                                              std::span<const float> heights,
                                               const EngineTuning& tuning) {
   if (!cuda::available()) throw std::runtime_error("no CUDA device");
   return std::make_unique<CudaAdapter>(grid, tool, heights, tuning);

@@ -8,8 +8,8 @@ namespace fieldpath::zbuffer {
 bool cudaAvailable() { return false; }
 
 namespace detail {
-std::unique_ptr<BackendEngine> makeCudaEngine(const GridView&, const ToolData&, std::vector<float>,
-                                              const EngineTuning&) {
+std::unique_ptr<BackendEngine> makeCudaEngine(const GridView&, const ToolData&,
+                                              std::span<const float>, const EngineTuning&) {
   throw std::runtime_error("fieldpath was built without the CUDA backend");
 }
 }  // namespace detail

@@ -437,8 +437,11 @@ SimulationResult run(const SimulationRequest& request, NextBlock next) {
   const int shift = request.tuning.tile_shift;
   if (shift < 1 || shift > 8) throw InputError("tuning: tile_shift must be in [1, 8]");
   const GridView g = detail::makeGridView(grid, shift);
-  std::vector<float> initial = request.initial_heights_mm;
-  if (initial.empty()) initial.assign(grid.lineCount(), request.stock_mm);
+  std::vector<float> stock;  // only where no initial heights are given
+  if (request.initial_heights_mm.empty()) stock.assign(grid.lineCount(), request.stock_mm);
+  const std::span<const float> initial = request.initial_heights_mm.empty()
+                                             ? std::span<const float>(stock)
+                                             : request.initial_heights_mm;
 
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<detail::BackendEngine> engine =

@@ -145,17 +145,19 @@ class BackendEngine {
   /// Lowers the heights by every posture of the block (the engine may still be working on it
   /// when this returns, but no longer reads `block`).
   virtual void cut(std::span<const Posture> block, Engine engine) = 0;
-  /// Waits for all blocks; the final heights.
+  /// Waits for all blocks; the final heights (called once, at the end: the CPU engine hands over
+  /// its buffer).
   virtual std::vector<float> heights() = 0;
   /// Postures culled so far by the fast engine (valid after heights()).
   virtual std::size_t culled() = 0;
 };
+/// `heights_mm`: the initial heights, read during the call only.
 std::unique_ptr<BackendEngine> makeCpuEngine(const GridView& grid, const ToolData& tool,
-                                             std::vector<float> heights_mm,
+                                             std::span<const float> heights_mm,
                                              const EngineTuning& tuning);
 /// Throws std::runtime_error if built without CUDA or no device is present.
 std::unique_ptr<BackendEngine> makeCudaEngine(const GridView& grid, const ToolData& tool,
-                                              std::vector<float> heights_mm,
+                                              std::span<const float> heights_mm,
                                               const EngineTuning& tuning);
 
 }  // namespace detail
