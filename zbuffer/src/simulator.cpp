@@ -227,8 +227,6 @@ void binDownFacing(ToolData& data, float pad) {
   data.bin_items.resize(static_cast<std::size_t>(data.bin_start.back()));
   std::vector<std::int32_t> fill(data.bin_start.begin(), data.bin_start.end() - 1);
   forEachCell([&](std::size_t cell, std::int32_t t) { data.bin_items[fill[cell]++] = t; });
-  v.bin_start = data.bin_start.data();
-  v.bin_items = data.bin_items.data();
 
   // Radial floors: each down-facing triangle lowers the floor of every annulus its projection
   // meets (one annulus of margin each side for the rounding of the line's radius).
@@ -270,7 +268,6 @@ void binDownFacing(ToolData& data, float pad) {
   // floor), so that the floor at a rectangle's smallest radius bounds all its lines (tileFloor).
   for (int b = rbins - 2; b >= 0; --b)
     data.radial_floor[b] = std::min(data.radial_floor[b], data.radial_floor[b + 1]);
-  v.radial_floor_mm = data.radial_floor.data();
   v.radial_bins = rbins;
 }
 
@@ -331,12 +328,9 @@ ToolData prepareTool(const Tool& tool) {
     }
   data.vertices = mesh.vertices;
   for (const auto& t : mesh.triangles) data.indices.insert(data.indices.end(), t.begin(), t.end());
-  v.bvh_nodes = data.bvh_nodes.data();
-  v.bvh_triangles = data.bvh_triangles.data();
-  v.vertices = data.vertices.data();
-  v.indices = data.indices.data();
   v.triangle_count = static_cast<std::int32_t>(mesh.triangles.size());
   binDownFacing(data, 1e-5f * size);
+  data.pointViewAtVectors();
   return data;
 }
 

@@ -25,8 +25,8 @@ std::size_t writeSurfaceStl(const std::filesystem::path& file, const Grid& grid,
 void writeReliefPng(const std::filesystem::path& file, const Grid& grid,
                     std::span<const float> heights_mm, int max_side = 4096);
 
-/// Minimal PNG encoder (stored deflate blocks, no compression library): 8-bit RGB, row-major, top
-/// row first.
+/// Minimal PNG encoder: 8-bit RGB, row-major, top row first. Compressed with zlib where it is
+/// installed, stored (uncompressed) deflate blocks otherwise.
 std::string encodePng(int width, int height, std::span<const std::uint8_t> rgb);
 
 }  // namespace fieldpath::zbuffer
