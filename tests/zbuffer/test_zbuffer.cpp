@@ -311,24 +311,22 @@ TEST(Tuning, EveryVariantGivesTheSameBits) {
   // The tuning knobs change the order, the culling and the triangle look-up, never a height.
   const Grid g = Grid::fromRegion(-6, -6, 6, 6, 64, 64);
   const auto postures = roughingPostures(23);
-  {
-    const Tool tool = Tool::fromMesh(analyticToolMesh(Tool::torus(2, 0.5, 8), 40, 6));
-    std::vector<float> first;
-    for (int variant = 0; variant < 8; ++variant) {
-      SimulationRequest req;
-      req.grid = g;
-      req.tool = tool;
-      req.stock_mm = kStock;
-      req.backend = Backend::Cpu;
-      req.tuning.vertical_bins = variant & 1;
-      req.tuning.lowest_first = variant & 2;
-      req.tuning.tile_skip = variant & 4;
-      req.tuning.tile_shift = 2 + variant % 3;
-      req.block_postures = variant == 3 || variant == 6 ? 97 : 1 << 20;
-      const auto h = simulate(req, postures).heights_mm;
-      if (first.empty()) first = h;
-      ASSERT_EQ(std::memcmp(first.data(), h.data(), 4 * h.size()), 0) << "variant " << variant;
-    }
+  const Tool tool = Tool::fromMesh(analyticToolMesh(Tool::torus(2, 0.5, 8), 40, 6));
+  std::vector<float> first;
+  for (int variant = 0; variant < 8; ++variant) {
+    SimulationRequest req;
+    req.grid = g;
+    req.tool = tool;
+    req.stock_mm = kStock;
+    req.backend = Backend::Cpu;
+    req.tuning.vertical_bins = variant & 1;
+    req.tuning.lowest_first = variant & 2;
+    req.tuning.tile_skip = variant & 4;
+    req.tuning.tile_shift = 2 + variant % 3;
+    req.block_postures = variant == 3 || variant == 6 ? 97 : 1 << 20;
+    const auto h = simulate(req, postures).heights_mm;
+    if (first.empty()) first = h;
+    ASSERT_EQ(std::memcmp(first.data(), h.data(), 4 * h.size()), 0) << "variant " << variant;
   }
 }
 
@@ -385,8 +383,14 @@ TEST(Stock, PartTopIsTheStartingHeight) {
                           {2, 2, 1}, {8, 2, 1}, {8, 8, 1}, {2, 8, 1}};
   std::vector<std::array<std::uint32_t, 3>> t = {{0, 1, 2}, {0, 2, 3}, {4, 6, 5}, {4, 7, 6}};
   const auto h = stockFromPart(g, v, t);
-  EXPECT_EQ(h[10 * 20 + 10], 5.f);
-  EXPECT_EQ(h[0], 1.f);  // outside the part: its lowest z
+  for (int iy = 0; iy < g.ny; ++iy)
+    for (int ix = 0; ix < g.nx; ++ix) {
+      // lines at 0.25, 0.75, ...: none on the box's edges
+      const double x = g.x0_mm + (ix + 0.5) * g.dx_mm, y = g.y0_mm + (iy + 0.5) * g.dy_mm;
+      const bool on_top = x > 2 && x < 8 && y > 2 && y < 8;
+      EXPECT_EQ(h[std::size_t(iy) * g.nx + ix], on_top ? 5.f : 1.f)  // outside: the lowest z
+          << ix << "," << iy;
+    }
 }
 
 TEST(Outputs, NpyJsonStlPngAreWellFormed) {
@@ -406,7 +410,19 @@ TEST(Outputs, NpyJsonStlPngAreWellFormed) {
   std::memcpy(&last, data.data() + data.size() - 4, 4);
   EXPECT_EQ(last, 6.f);
   EXPECT_EQ(writeSurfaceStl(dir / "s.stl", g, h), 4u);
-  EXPECT_EQ(std::filesystem::file_size(dir / "s.stl"), 84u + 4 * 50);
+  {
+    std::ifstream stl(dir / "s.stl", std::ios::binary);
+    const std::string s((std::istreambuf_iterator<char>(stl)), {});
+    ASSERT_EQ(s.size(), 84u + 4 * 50);
+    // first triangle: lines (0,0), (1,0), (1,1) at (0.5,0.5,1), (1.5,0.5,2), (1.5,1.5,5)
+    float f[12];
+    std::memcpy(f, s.data() + 84, sizeof f);
+    const float want[9] = {0.5f, 0.5f, 1, 1.5f, 0.5f, 2, 1.5f, 1.5f, 5};
+    for (int k = 0; k < 9; ++k) EXPECT_EQ(f[3 + k], want[k]) << k;
+    // unit normal of the plane z = 1 + (x - 0.5) + 3 (y - 0.5): (-1, -3, 1) / sqrt(11), facing up
+    const float n[3] = {-1.f, -3.f, 1.f};
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(f[k], n[k] / std::sqrt(11.f), 1e-6f) << k;
+  }
   writeReliefPng(dir / "r.png", g, h);
   std::ifstream png(dir / "r.png", std::ios::binary);
   std::string p((std::istreambuf_iterator<char>(png)), {});
