@@ -410,9 +410,11 @@ detail::ToolData preparedTool(const Tool& tool) {
   return *data;
 }
 
-/// Runs the blocks that `next` hands out (an empty span ends), without copying them.
+/// Runs the blocks that `next` hands out (an empty span ends), without copying them;
+/// `expected_postures` (0: unknown) scales the progress.
 template <class NextBlock>
-SimulationResult run(const SimulationRequest& request, NextBlock next) {
+SimulationResult run(const SimulationRequest& request, std::size_t expected_postures,
+                     NextBlock next) {
   const Grid& grid = request.grid;
   if (grid.nx <= 0 || grid.ny <= 0) throw InputError("grid: no lines");
   checkGridFits(grid);
@@ -448,7 +450,7 @@ SimulationResult run(const SimulationRequest& request, NextBlock next) {
     if (block.empty()) break;
     engine->cut(block, request.engine);
     result.postures += block.size();
-    const double total = double(std::max(request.expected_postures, result.postures));
+    const double total = double(std::max(expected_postures, result.postures));
     common::report(request.progress, double(result.postures) / total, "simulate");
   }
   result.heights_mm = engine->heights();
@@ -464,18 +466,19 @@ SimulationResult run(const SimulationRequest& request, NextBlock next) {
 
 SimulationResult simulate(const SimulationRequest& request, const PostureSource& source) {
   std::vector<Posture> buffer(std::max<std::size_t>(1, request.block_postures));
-  return run(request, [&] {
+  return run(request, request.expected_postures, [&] {
     const std::size_t n = std::min(source(std::span<Posture>(buffer)), buffer.size());
     return std::span<const Posture>(buffer.data(), n);
   });
 }
 
 SimulationResult simulate(const SimulationRequest& request, std::span<const Posture> postures) {
-  SimulationRequest req = request;
-  if (req.expected_postures == 0) req.expected_postures = postures.size();
   const std::size_t block = std::max<std::size_t>(1, request.block_postures);
   std::size_t next = 0;
-  return run(req, [&] {
+  // no copy of the request (its tool mesh and initial heights) to fill in the expected count
+  const std::size_t expected =
+      request.expected_postures ? request.expected_postures : postures.size();
+  return run(request, expected, [&] {
     const std::size_t n = std::min(block, postures.size() - next);
     const auto out = postures.subspan(next, n);
     next += n;
