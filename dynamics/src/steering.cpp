@@ -16,16 +16,21 @@ namespace {
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 constexpr int kStateSize = 4;  ///< lead, tilt (rad), lead rate, tilt rate (rad/s)
 
-/// Places the nodes (offsets from the ball centre, tool frame) at axis a and sums their moment.
+/// Places the nodes (offsets from the ball centre, tool frame) at axis a: world frame, mm.
+void placeNodes(std::span<const Vec3> offsets_mm, const Vec3& centre_mm, const Vec3& axis,
+                std::vector<Vec3>& nodes_mm) {
+  const Eigen::Matrix3d rotation = geometry::rotationFromZ(axis);
+  nodes_mm.resize(offsets_mm.size());
+  for (std::size_t i = 0; i < offsets_mm.size(); ++i)
+    nodes_mm[i] = centre_mm + rotation * offsets_mm[i];
+}
+
+/// Places the nodes at the axis of (lead, tilt) and sums their moment about the ball centre.
 AxisMoment momentOfNodes(const field::ForceField& field, std::span<const Vec3> offsets_mm,
                          const LocalFrame& frame, const Vec3& centre_mm, double lead_rad,
                          double tilt_rad, std::vector<Vec3>& nodes_mm, std::vector<Vec3>& forces) {
-  const Eigen::Matrix3d rotation =
-      geometry::rotationFromZ(axisFromAngles(frame, lead_rad, tilt_rad));
-  nodes_mm.resize(offsets_mm.size());
+  placeNodes(offsets_mm, centre_mm, axisFromAngles(frame, lead_rad, tilt_rad), nodes_mm);
   forces.resize(offsets_mm.size());
-  for (std::size_t i = 0; i < offsets_mm.size(); ++i)
-    nodes_mm[i] = centre_mm + rotation * offsets_mm[i];
   field.evaluate(nodes_mm, forces);
   AxisMoment out;
   for (std::size_t i = 0; i < offsets_mm.size(); ++i)
@@ -108,8 +113,9 @@ class SteeringSystem final : public detail::OdeSystem {
 
   int rhs(double t_s, const double* y, double* ydot) override {
     const double s_mm = arcLength(t_s);
-    const PassFrame pass_frame = frameAt(s_mm);
-    const AxisMoment m = moment(pass_frame, y[0], y[1]);
+    const Frames frames = frameAt(s_mm);
+    const AxisMoment m = moment(frames, y[0], y[1]);
+    const PassFrame& pass_frame = frames.pass;
     ydot[0] = y[2];
     ydot[1] = y[3];
     ydot[2] =
@@ -122,8 +128,8 @@ class SteeringSystem final : public detail::OdeSystem {
 
   /// The sample at arc length s for state y; also leaves the placed nodes in nodes_mm_.
   PostureSample sample(double s_mm, const std::array<double, kStateSize>& y) {
-    const PassFrame pass_frame = frameAt(s_mm);
-    const AxisMoment m = moment(pass_frame, y[0], y[1]);
+    const Frames frames = frameAt(s_mm);
+    const AxisMoment m = moment(frames, y[0], y[1]);
     PostureSample out;
     out.s_mm = s_mm;
     out.lead_rad = y[0];
@@ -133,43 +139,41 @@ class SteeringSystem final : public detail::OdeSystem {
     out.lead_torque = m.lead_torque;
     out.tilt_torque = m.tilt_torque;
     out.moment = m.moment;
-    const Vec3 axis = axisFromAngles(localFrame(pass_frame), y[0], y[1]);
+    const Vec3 axis = axisFromAngles(frames.local, y[0], y[1]);
     out.posture.axis = axis;
-    out.posture.tip_mm = pass_frame.centre_mm - request_.ball_radius_mm * axis;
+    out.posture.tip_mm = frames.pass.centre_mm - request_.ball_radius_mm * axis;
     out.clearance_mm = std::numeric_limits<double>::quiet_NaN();
     if (request_.clearance) {
-      if (!request_.field) placeNodes(pass_frame, axis);
+      if (!request_.field) placeNodes(offsets_mm_, frames.pass.centre_mm, axis, nodes_mm_);
       out.clearance_mm = request_.clearance(nodes_mm_);
     }
     return out;
   }
 
  private:
-  /// The pass frame at s; a non-finite centre or a bad normal is bad input naming s.
-  PassFrame frameAt(double s_mm) const {
+  /// The pass frame at s and its local frame, computed once per evaluation.
+  struct Frames {
+    PassFrame pass;
+    LocalFrame local;
+  };
+
+  /// The frames at s; a non-finite centre or a bad normal is bad input naming s.
+  Frames frameAt(double s_mm) const {
     const PassFrame f = pass_.frameAt(s_mm);
     try {
       requireThat(f.centre_mm.allFinite(), "pass frame: ball centre", "finite", f.centre_mm.norm());
       requireThat(std::isfinite(f.lead0_rad) && std::isfinite(f.tilt0_rad),
                   "pass frame: nominal angles", "finite", f.lead0_rad + f.tilt0_rad);
-      localFrame(f);  // throws for a zero or non-finite normal
+      return {f, localFrame(f)};  // localFrame throws for a zero or non-finite normal
     } catch (const common::InputError& e) {
       throw common::InputError(at(s_mm) + e.what());
     }
-    return f;
   }
 
-  AxisMoment moment(const PassFrame& pass_frame, double lead_rad, double tilt_rad) {
+  AxisMoment moment(const Frames& frames, double lead_rad, double tilt_rad) {
     if (!request_.field) return {};
-    return momentOfNodes(*request_.field, offsets_mm_, localFrame(pass_frame), pass_frame.centre_mm,
+    return momentOfNodes(*request_.field, offsets_mm_, frames.local, frames.pass.centre_mm,
                          lead_rad, tilt_rad, nodes_mm_, forces_);
-  }
-
-  void placeNodes(const PassFrame& pass_frame, const Vec3& axis) {
-    const Eigen::Matrix3d rotation = geometry::rotationFromZ(axis);
-    nodes_mm_.resize(offsets_mm_.size());
-    for (std::size_t i = 0; i < offsets_mm_.size(); ++i)
-      nodes_mm_[i] = pass_frame.centre_mm + rotation * offsets_mm_[i];
   }
 
   const Pass& pass_;
