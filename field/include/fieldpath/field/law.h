@@ -135,15 +135,11 @@ Probe probe(const Vec3& x_mm, ForEachNear&& for_each_near, const P& points, cons
 }
 
 /// The field at x (probe() with the search radius r0). Returns nothing where no sample is within
-/// r0 (the field is zero there) or where x is inside an obstacle deeper than
-/// `max_inside_depth_mm` (outside the voxel band).
+/// r0 (the field is zero there).
 template <class ForEachNear, class P, class N, class W>
 std::optional<Vec3> fieldAt(const Vec3& x_mm, ForEachNear&& for_each_near, const P& points,
-                            const N& normals, const W& weights, const FieldParams& params,
-                            double max_inside_depth_mm = HUGE_VAL) {
-  const Probe p = probe(x_mm, for_each_near, points, normals, weights, params, params.r0_mm);
-  if (!p.force || p.height_mm < -max_inside_depth_mm) return std::nullopt;
-  return p.force;
+                            const N& normals, const W& weights, const FieldParams& params) {
+  return probe(x_mm, for_each_near, points, normals, weights, params, params.r0_mm).force;
 }
 
 }  // namespace detail
