@@ -87,8 +87,8 @@ PassSample sampleAt(const Impeller& impeller, const Pass& pass, double s_mm) {
   const double w = span > 0.0 ? (sample.s_mm - s_table[i - 1]) / span : 0.0;
   sample.u = u_table[i - 1] + w * (u_table[i] - u_table[i - 1]);
   auto centre = [&](double u) { return ballCentre(impeller, u, pass.v, pass.ball_radius_mm); };
-  sample.centre_mm = centre(sample.u);
   sample.normal = impeller.hubNormal(sample.u, pass.v);
+  sample.centre_mm = impeller.hub(sample.u, pass.v) + pass.ball_radius_mm * sample.normal;
   constexpr double du = 1e-5;
   Vec3 tangent = centre(sample.u + du) - centre(sample.u - du);
   tangent -= tangent.dot(sample.normal) * sample.normal;  // exactly ⟂ n despite rounding
