@@ -13,7 +13,6 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "errors.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/tool_model.h"
@@ -169,6 +168,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--out", options->out,
                   "Output folder (check.json, deviation.png, deviation.npy)");
   cmd->add_option("--spacing", options->spacing_mm, "Z-buffer line spacing, mm")
+      ->check(positiveFinite("mm"))
       ->capture_default_str();
   cmd->add_option("--backend", options->backend, "Z-buffer backend: auto | cpu | cuda")
       ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
@@ -177,8 +177,6 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     const Scene scene = loadScene(options->scene);
     const pathgen::GenerateRequest job = impellerJob(scene);
     const std::vector<geometry::Posture> postures = geometry::readClFile(options->path);
-    if (!(options->spacing_mm > 0.0) || !std::isfinite(options->spacing_mm))
-      throw InputError("--spacing: must be > 0 mm");
     const common::Progress progress = makeProgressLine(global.quiet);
     const auto& impeller = *scene.impeller_model;
     const auto& ip = impeller.params();

@@ -10,7 +10,6 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "errors.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "impeller_job.h"
@@ -135,11 +134,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     const Scene scene = loadScene(options->scene);
     pathgen::GenerateRequest job = impellerJob(scene);
     job.mode = options->direct ? pathgen::FieldMode::Direct : pathgen::FieldMode::Voxel;
-    if (options->voxel_mm != 0.0) {
-      if (!(options->voxel_mm > 0.0) || !std::isfinite(options->voxel_mm))
-        throw InputError("--voxel: the voxel size must be > 0 mm");
-      job.field.voxel_size_mm = options->voxel_mm;
-    }
+    // 0: not given (positiveFinite rejects anything else that is not > 0).
+    if (options->voxel_mm != 0.0) job.field.voxel_size_mm = options->voxel_mm;
     job.nominal = options->nominal;
     job.progress = makeProgressLine(global.quiet);
     const pathgen::GenerateResult result = pathgen::generateImpellerPath(job);
