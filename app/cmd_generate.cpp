@@ -15,23 +15,12 @@
 #include "impeller_job.h"
 #include "progress.h"
 #include "scene.h"
+#include "study.h"
 
 namespace fieldpath::app {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / std::numbers::pi;
-
-const char* modeName(pathgen::FieldMode mode) {
-  switch (mode) {
-    case pathgen::FieldMode::Voxel:
-      return "voxel";
-    case pathgen::FieldMode::Direct:
-      return "direct";
-    case pathgen::FieldMode::BruteForce:
-      return "brute_force";
-  }
-  return "?";
-}
 
 nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& job,
                           const pathgen::GenerateResult& r) {
@@ -58,7 +47,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
   const auto& box = r.reach_box_mm;
   return {
       {"scene", scene.file.string()},
-      {"field_mode", job.nominal ? "nominal" : modeName(job.mode)},
+      {"field_mode", job.nominal ? "nominal" : fieldModeName(job.mode)},
       {"voxel_size_mm", job.mode == pathgen::FieldMode::Voxel && !job.nominal
                             ? json(job.field.voxel_size_mm)
                             : json(nullptr)},

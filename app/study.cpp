@@ -55,15 +55,6 @@ std::string storedName(field::StoredQuantity stored) {
   return stored == field::StoredQuantity::PlaneRatio ? "plane_ratio" : "force";
 }
 
-std::string modeName(pathgen::FieldMode mode) {
-  switch (mode) {
-    case pathgen::FieldMode::BruteForce: return "brute_force";
-    case pathgen::FieldMode::Direct: return "direct";
-    case pathgen::FieldMode::Voxel: return "voxel";
-  }
-  return "?";
-}
-
 /// A study line's points: t along the polyline, wall distances from FCL.
 StudyLine makeLine(std::string name, std::string description, std::vector<Vec3> points,
                    const pathgen::ClearanceChecker& checker) {
@@ -536,7 +527,7 @@ std::string csvText(const StudyResult& r) {
        "colliding,max_tilt_deg,solver_steps,rhs_evals\n";
   for (const StudyRow& row : r.rows) {
     const StudyVariant& v = row.variant;
-    s << v.name() << ',' << modeName(v.mode) << ',' << (v.isVoxel() ? number(v.voxel_size_mm) : "0")
+    s << v.name() << ',' << fieldModeName(v.mode) << ',' << (v.isVoxel() ? number(v.voxel_size_mm) : "0")
       << ',' << (v.isVoxel() ? interpolationName(v.interpolation) : "exact") << ','
       << (v.isVoxel() ? storedName(v.stored) : "exact") << ','
       << (row.failure.empty() ? "ok" : "failed") << ',' << row.active_nodes << ',' << row.dense_box_nodes << ','
