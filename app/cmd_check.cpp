@@ -22,6 +22,7 @@
 #include "impeller_job.h"
 #include "progress.h"
 #include "scene.h"
+#include "to_zbuffer.h"
 
 namespace fieldpath::app {
 namespace {
@@ -225,12 +226,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     for (float& h : sim.initial_heights_mm) h += kStockAllowanceMm;
     sim.progress = progress;
     sim.expected_postures = postures.size();
-    std::vector<zbuffer::Posture> zb_postures;
-    zb_postures.reserve(postures.size());
-    for (const auto& p : postures)
-      zb_postures.push_back({{float(p.tip_mm.x()), float(p.tip_mm.y()), float(p.tip_mm.z())},
-                             {float(p.axis.x()), float(p.axis.y()), float(p.axis.z())}});
-    const zbuffer::SimulationResult simulated = zbuffer::simulate(sim, zb_postures);
+    const zbuffer::SimulationResult simulated = zbuffer::simulate(sim, toZbuffer(postures));
 
     SurfaceStats stats;
     std::vector<float> dev_um(sim.grid.lineCount(), std::numeric_limits<float>::quiet_NaN());

@@ -17,6 +17,7 @@
 #include "fieldpath/zbuffer/outputs.h"
 #include "fieldpath/zbuffer/simulator.h"
 #include "progress.h"
+#include "to_zbuffer.h"
 
 namespace fieldpath::app {
 namespace {
@@ -25,19 +26,6 @@ namespace zb = zbuffer;
 
 bool isAnalyticToolText(const std::string& text) {
   return text.rfind("ball:", 0) == 0 || text.rfind("torus:", 0) == 0 || text.rfind("flat:", 0) == 0;
-}
-
-zb::ToolMesh toFloatMesh(const geometry::TriangleMesh& mesh) {
-  zb::ToolMesh out;
-  out.vertices.reserve(mesh.vertices.size());
-  for (const auto& v : mesh.vertices)
-    out.vertices.push_back(
-        {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())});
-  out.triangles.reserve(mesh.triangles.size());
-  for (const auto& t : mesh.triangles)
-    out.triangles.push_back({static_cast<std::uint32_t>(t.x()), static_cast<std::uint32_t>(t.y()),
-                             static_cast<std::uint32_t>(t.z())});
-  return out;
 }
 
 /// TOOL: ball:R[:L] | torus:R:r[:L] | flat:R[:L], or a mesh file (tool frame).
@@ -56,7 +44,7 @@ zb::Tool parseTool(const std::string& text) {
   const geometry::TriangleMesh mesh = geometry::loadMesh(text);
   if (mesh.triangles.empty()) throw InputError("--tool " + text + ": mesh has no triangles");
   try {
-    return zb::Tool::fromMesh(toFloatMesh(mesh));
+    return zb::Tool::fromMesh(toZbuffer(mesh));
   } catch (const InputError& e) {
     throw InputError("--tool " + text + ": " + e.what());
   }
@@ -148,12 +136,9 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     const auto [nx, ny] = parseGrid(o->grid);
     req.tool = parseTool(o->tool);
     const std::vector<geometry::Posture> path = geometry::readClFile(o->path);
-    std::vector<zb::Posture> postures;
-    postures.reserve(path.size());
+    const std::vector<zb::Posture> postures = toZbuffer(path);
     double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX, ztop = -DBL_MAX;
     for (const auto& p : path) {
-      postures.push_back({{float(p.tip_mm.x()), float(p.tip_mm.y()), float(p.tip_mm.z())},
-                          {float(p.axis.x()), float(p.axis.y()), float(p.axis.z())}});
       xmin = std::min(xmin, p.tip_mm.x());
       xmax = std::max(xmax, p.tip_mm.x());
       ymin = std::min(ymin, p.tip_mm.y());
@@ -176,7 +161,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
 
     if (!o->part.empty()) {
       const geometry::TriangleMesh part = geometry::loadMesh(o->part);
-      const zb::ToolMesh m = toFloatMesh(part);
+      const zb::ToolMesh m = toZbuffer(part);
       req.initial_heights_mm = zb::stockFromPart(req.grid, m.vertices, m.triangles);
     } else {
       req.stock_mm = static_cast<float>(std::isnan(o->stock_mm) ? ztop : o->stock_mm);

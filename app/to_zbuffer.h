@@ -1,0 +1,38 @@
+#pragma once
+/// geometry's double-precision types → the float types of zbuffer (which depends on no other
+/// module), shared by `simulate` and `check`.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "fieldpath/geometry/mesh.h"
+#include "fieldpath/geometry/posture.h"
+#include "fieldpath/zbuffer/simulator.h"
+
+namespace fieldpath::app {
+
+/// Tool tips and axes (mm, world frame), rounded to float.
+inline std::vector<zbuffer::Posture> toZbuffer(std::span<const geometry::Posture> path) {
+  std::vector<zbuffer::Posture> out;
+  out.reserve(path.size());
+  for (const auto& p : path)
+    out.push_back({{float(p.tip_mm.x()), float(p.tip_mm.y()), float(p.tip_mm.z())},
+                   {float(p.axis.x()), float(p.axis.y()), float(p.axis.z())}});
+  return out;
+}
+
+/// The same triangles with float vertices (mm).
+inline zbuffer::ToolMesh toZbuffer(const geometry::TriangleMesh& mesh) {
+  zbuffer::ToolMesh out;
+  out.vertices.reserve(mesh.vertices.size());
+  for (const auto& v : mesh.vertices)
+    out.vertices.push_back(
+        {static_cast<float>(v.x()), static_cast<float>(v.y()), static_cast<float>(v.z())});
+  out.triangles.reserve(mesh.triangles.size());
+  for (const auto& t : mesh.triangles)
+    out.triangles.push_back({static_cast<std::uint32_t>(t.x()), static_cast<std::uint32_t>(t.y()),
+                             static_cast<std::uint32_t>(t.z())});
+  return out;
+}
+
+}  // namespace fieldpath::app
