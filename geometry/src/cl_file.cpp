@@ -168,9 +168,7 @@ void writeAptFile(const std::filesystem::path& file, std::span<const Posture> po
   // CUTTER/d,r,e,f,a,b,h: diameter, corner radius, corner centre offsets (radial e, axial f),
   // taper angles a, b (0 for these tools), height h.
   const ToolSpec& t = header.tool;
-  const double corner_mm = t.shape == ToolShape::Ball    ? t.radius_mm
-                           : t.shape == ToolShape::Torus ? t.corner_radius_mm
-                                                         : 0.0;
+  const double corner_mm = cornerRadius(t);
   std::string text = "PARTNO/" + header.part_name + "\nUNITS/MM\nMULTAX/ON\nCUTTER/";
   const double cutter[] = {2 * t.radius_mm, corner_mm, t.radius_mm - corner_mm, corner_mm, 0.0, 0.0,
                            t.length_mm};

@@ -81,13 +81,6 @@ ProfileSegment cornerArc(Vec2 centre, double radius_mm) {
   return s;
 }
 
-/// Height (mm) of the cutting end above the tip: where the shank cylinder begins.
-double cuttingEndHeight(const ToolSpec& tool) {
-  return tool.shape == ToolShape::Ball    ? tool.radius_mm
-         : tool.shape == ToolShape::Torus ? tool.corner_radius_mm
-                                          : 0.0;
-}
-
 /// Tip → side of the shank up to (R, top_z): cutting end then shank cylinder. No top.
 Profile toolSide(const ToolSpec& tool, double top_z_mm) {
   const double big_r = tool.radius_mm;
@@ -106,7 +99,7 @@ Profile toolSide(const ToolSpec& tool, double top_z_mm) {
       p.push_back(line(Vec2(0.0, 0.0), Vec2(big_r, 0.0)));
       break;
   }
-  const double side_start_z = cuttingEndHeight(tool);
+  const double side_start_z = cornerRadius(tool);
   if (top_z_mm > side_start_z) p.push_back(line(Vec2(big_r, side_start_z), Vec2(big_r, top_z_mm)));
   return p;
 }
@@ -161,10 +154,10 @@ Profile fullProfile(const ToolSpec& tool, const HolderProfile& holder) {
     p.push_back(line(p.back().to, Vec2(0.0, len)));
     return p;
   }
-  if (!(holder.front().z_mm > cuttingEndHeight(tool)))
+  if (!(holder.front().z_mm > cornerRadius(tool)))
     throw InputError("holder starts at z " + std::to_string(holder.front().z_mm) +
                      " mm, not above the cutting end of the tool (" +
-                     std::to_string(cuttingEndHeight(tool)) + " mm)");
+                     std::to_string(cornerRadius(tool)) + " mm)");
   // The shank runs up to the first station, also past L into a holder that starts above the tool.
   Profile p = toolSide(tool, holder.front().z_mm);
   // Pieces on the shank cylinder below L are tool surface; the rest is holder.
@@ -273,7 +266,7 @@ void validateToolSpec(const ToolSpec& tool) {
   if (tool.shape == ToolShape::Torus &&
       !(tool.corner_radius_mm > 0 && tool.corner_radius_mm <= tool.radius_mm))
     throw InputError("corner radius must be in (0, R]");
-  const double end_mm = cuttingEndHeight(tool);
+  const double end_mm = cornerRadius(tool);
   if (!std::isfinite(tool.length_mm) || !(tool.length_mm >= end_mm) || !(tool.length_mm > 0))
     throw InputError("tool length must cover the cutting end (>= " + std::to_string(end_mm) +
                      " mm)");

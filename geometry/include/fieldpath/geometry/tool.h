@@ -16,6 +16,14 @@ struct ToolSpec {
   double length_mm = 12.0;        ///< L, from the tip to the top of the cutting body
 };
 
+/// Corner radius of the cutting end, mm: R for a ball, r for a torus, 0 for a flat end. It is also
+/// the height above the tip where the cutting end meets the shank cylinder.
+inline double cornerRadius(const ToolSpec& tool) {
+  return tool.shape == ToolShape::Ball    ? tool.radius_mm
+         : tool.shape == ToolShape::Torus ? tool.corner_radius_mm
+                                          : 0.0;
+}
+
 /// Holder: (z from the tip, radius) stations, mm, revolved about +z; z increases, except that two
 /// stations may share z to make a step to another radius.
 struct HolderStation {
