@@ -19,6 +19,7 @@
 #include <tbb/info.h>
 
 #include "../field/walls.h"
+#include "fieldpath/common/stats.h"
 #include "fieldpath/dynamics/steering.h"
 #include "fieldpath/field/direct_field.h"
 #include "fieldpath/field/voxel_field.h"
@@ -34,10 +35,7 @@ constexpr int kPasses = 7;
 constexpr double kPassHalfLength = 36.0;  ///< x ∈ [-36, 36]: 7 × 72 = 504 mm
 constexpr double kBallRadius = 3.0;
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
+using common::median;
 
 /// Pass k of 7 along +x on the channel floor (z = 0), ball centre at y from -outer to +outer mm.
 /// The walls lean in over x < 0: with outer = 8 the upright shank of the outer passes starts 0.4 mm

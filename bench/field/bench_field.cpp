@@ -22,6 +22,7 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
+#include "fieldpath/common/stats.h"
 #include "fieldpath/field/direct_field.h"
 #include "fieldpath/field/metrics.h"
 #include "fieldpath/field/voxel_field.h"
@@ -48,10 +49,7 @@ Times measure(const std::function<void()>& work) {
   return {wall, (c1.tv_sec - c0.tv_sec) + 1e-9 * (c1.tv_nsec - c0.tv_nsec)};
 }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
+using common::median;
 
 /// Medians of wall and CPU seconds over repeated runs.
 Times medianTimes(int repeats, const std::function<void()>& work) {
@@ -223,7 +221,7 @@ int main(int argc, char** argv) {
   int repeats = 5;
   std::size_t n_points = 200000;
   bool quick = false;
-  int threads = 0;  // 0: TBB's default
+  int threads = 0;              // 0: TBB's default
   double sample_step_mm = 2.0;  // the walls' 3.6 mm triangles split in 4: ≈1.3 mm apart
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--repeats") && i + 1 < argc)
@@ -247,7 +245,7 @@ int main(int argc, char** argv) {
   if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
   const int cores = threads > 0 ? threads : tbb::info::default_concurrency();
 
-  field::FieldParams params;    // r0 5, r_min 0.25, area weights
+  field::FieldParams params;  // r0 5, r_min 0.25, area weights
   params.sample_step_mm = sample_step_mm;
   const auto walls = bench::twistedWalls();
   const Eigen::AlignedBox3d region = bench::wallsRegion();

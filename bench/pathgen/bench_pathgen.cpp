@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "fieldpath/common/stats.h"
 #include "fieldpath/pathgen/generate.h"
 #include "impeller_job.h"
 #include "scene.h"
@@ -31,11 +32,7 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using common::median;
 
 struct Variant {
   std::string name;

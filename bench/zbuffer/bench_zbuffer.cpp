@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "fieldpath/common/stats.h"
 #include "fieldpath/zbuffer/simulator.h"
 #include "fieldpath/zbuffer/tool_mesh.h"
 
@@ -210,8 +211,7 @@ double medianMs(const zb::SimulationRequest& req, std::span<const zb::Posture> p
     times.push_back(last.ms);
   }
   if (first_ms) *first_ms = times.front();
-  std::sort(times.begin(), times.end());
-  return times[times.size() / 2];
+  return fieldpath::common::median(std::move(times));
 }
 
 /// --variants: the fast engine (mesh tool) with the default tuning, then one knob changed at a
