@@ -1,8 +1,12 @@
 #pragma once
 /// Scratch folders and files for the app tests.
+#include <sys/wait.h>
+
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 #include <string>
 
 namespace fieldpath::app::test {
@@ -35,6 +39,28 @@ class TempDir {
  private:
   std::filesystem::path path_;
 };
+
+inline std::string slurp(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Exit code, stdout and stderr of a run of the built `fieldpath`.
+struct Outcome {
+  int exit_code;
+  std::string out, err;
+};
+
+/// Runs `fieldpath --quiet ARGS` in `dir` (FIELDPATH_EXE: the test target's compile definition).
+inline Outcome runFieldpath(const TempDir& dir, const std::string& args) {
+  const auto out = dir.path() / "stdout.txt", err = dir.path() / "stderr.txt";
+  const std::string command = "cd '" + dir.path().string() + "' && '" FIELDPATH_EXE "' --quiet " +
+                              args + " > '" + out.string() + "' 2> '" + err.string() + "'";
+  const int status = std::system(command.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+}
 
 /// ASCII STL of the square [-a, a]² at height z, normal +z.
 inline std::string squareStl(double a, double z = 0.0) {

@@ -1,8 +1,6 @@
 /// `fieldpath field probe|build`, run as a program: output against the closed form of a plane, and
 /// bad input → exit 1 with one line on stderr and nothing on stdout.
 #include <cmath>
-#include <cstdlib>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -12,30 +10,11 @@
 #include "fieldpath/field/law.h"
 #include "files.h"
 
+using fieldpath::app::test::Outcome;
+using fieldpath::app::test::runFieldpath;
 using fieldpath::app::test::TempDir;
 
 namespace {
-
-struct Outcome {
-  int exit_code;
-  std::string out, err;
-};
-
-std::string slurp(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-/// Runs `fieldpath --quiet ARGS` in `dir`.
-Outcome runFieldpath(const TempDir& dir, const std::string& args) {
-  const auto out = dir.path() / "stdout.txt", err = dir.path() / "stderr.txt";
-  const std::string command = "cd '" + dir.path().string() + "' && '" FIELDPATH_EXE "' --quiet " +
-                              args + " > '" + out.string() + "' 2> '" + err.string() + "'";
-  const int status = std::system(command.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-}
 
 std::size_t lines(const std::string& text) {
   std::size_t n = 0;

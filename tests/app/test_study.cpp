@@ -1,11 +1,10 @@
 // The voxel-size study (app/study.h) on a small impeller job: every csv cell finite, the two exact
 // methods agree, errors shrink as the voxels do.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
-#include <iterator>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -172,27 +171,19 @@ dynamics: { max_tilt_deg: 45, max_lead_deg: 45 }
 path: { passes: 3, step: 2.0 }
 )";
 
-int runFieldpath(const test::TempDir& dir, const std::string& args) {
-  const std::string command = "cd '" + dir.path().string() + "' && '" FIELDPATH_EXE "' --quiet " +
-                              args + " > out.txt 2> err.txt";
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 TEST(StudyCommand, WritesTablesAndPicturesOrSaysWhyNot) {
   const test::TempDir dir;
   dir.write("scene.yaml", kSmallScene);
-  ASSERT_EQ(runFieldpath(dir, "study scene.yaml --voxels 2,1 --interp trilinear --no-brute-force "
-                              "--line-step 0.2 --out study"),
-            0);
+  const test::Outcome run = test::runFieldpath(
+      dir, "study scene.yaml --voxels 2,1 --interp trilinear --no-brute-force --line-step 0.2 "
+           "--out study");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
   for (const char* file : {"study.csv", "study.md", "lines.csv", "tilt.csv"})
     EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / file)) << file;
   const Csv csv = readCsv(dir.path() / "study" / "study.csv");
   EXPECT_EQ(csv.rows.size(), 5u);  // direct, 2 voxel sizes × 2 stored quantities
   // Pictures, unless python3/matplotlib is missing, which the command says on stderr.
-  std::ifstream err(dir.path() / "err.txt");
-  const std::string err_text((std::istreambuf_iterator<char>(err)), {});
-  if (err_text.find("pictures not made") == std::string::npos)
+  if (run.err.find("pictures not made") == std::string::npos)
     for (const char* file : {"speed_vs_error.png", "tilt_along_path.png", "force_error_lines.png"})
       EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / file)) << file;
 }
@@ -200,9 +191,9 @@ TEST(StudyCommand, WritesTablesAndPicturesOrSaysWhyNot) {
 TEST(StudyCommand, BadInputIsExitOneWithNoOutputs) {
   const test::TempDir dir;
   dir.write("scene.yaml", kSmallScene);
-  EXPECT_EQ(runFieldpath(dir, "study scene.yaml --voxels 2,0 --out study"), 1);
-  EXPECT_EQ(runFieldpath(dir, "study scene.yaml --interp cubic --out study"), 1);
-  EXPECT_EQ(runFieldpath(dir, "study missing.yaml --out study"), 1);
+  EXPECT_EQ(test::runFieldpath(dir, "study scene.yaml --voxels 2,0 --out study").exit_code, 1);
+  EXPECT_EQ(test::runFieldpath(dir, "study scene.yaml --interp cubic --out study").exit_code, 1);
+  EXPECT_EQ(test::runFieldpath(dir, "study missing.yaml --out study").exit_code, 1);
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "study"));
 }
 
