@@ -46,7 +46,9 @@ def main():
                 ax.axvline(i, color="grey", lw=0.5)
     fig.suptitle("Impeller channel: tool axis along the path and clearance to the blades")
     fig.tight_layout()
-    fig.savefig(out / "tilt.png", dpi=110)
+    tmp = out / "tilt.tmp.png"  # written then renamed: no truncated tilt.png (DESIGN.md)
+    fig.savefig(tmp, dpi=110)
+    tmp.replace(out / "tilt.png")
 
 
 if __name__ == "__main__":
