@@ -42,7 +42,6 @@ zb::Tool parseTool(const std::string& text) {
     }
   }
   const geometry::TriangleMesh mesh = geometry::loadMesh(text);
-  if (mesh.triangles.empty()) throw InputError("--tool " + text + ": mesh has no triangles");
   try {
     return zb::Tool::fromMesh(toZbuffer(mesh));
   } catch (const InputError& e) {
