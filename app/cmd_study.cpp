@@ -84,8 +84,7 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
                                " --stored " + options->stored +
                                (options->no_brute_force ? " --no-brute-force" : "") + " --repeat " +
                                std::to_string(options->repeats) + " --line-step " +
-                               line_step.str() + " --out " +
-                               options->out;
+                               line_step.str() + " --out " + options->out;
     run(*options, global, command_line);
   });
 }

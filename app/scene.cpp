@@ -183,9 +183,9 @@ void readHolder(const Reader& r, const YAML::Node& node, geometry::HolderProfile
 }
 
 void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
-  r.expectMap(node, "field",
-              {"r0", "r_min", "gain", "sample_step", "weights", "voxel_size", "interpolation",
-               "stored"});
+  r.expectMap(
+      node, "field",
+      {"r0", "r_min", "gain", "sample_step", "weights", "voxel_size", "interpolation", "stored"});
   if (node["r0"]) f.r0_mm = r.positive(node["r0"], "field.r0");
   if (node["r_min"]) f.r_min_mm = r.positive(node["r_min"], "field.r_min");
   if (!(f.r_min_mm < f.r0_mm)) {

@@ -84,7 +84,8 @@ std::vector<Vec3> lineAPoints(const pathgen::Impeller& impeller, double offset_m
   const int dense = 4000;
   std::vector<double> s(dense + 1, 0.0);
   for (int i = 1; i <= dense; ++i)
-    s[i] = s[i - 1] + (at(u0 + (u1 - u0) * i / dense) - at(u0 + (u1 - u0) * (i - 1) / dense)).norm();
+    s[i] =
+        s[i - 1] + (at(u0 + (u1 - u0) * i / dense) - at(u0 + (u1 - u0) * (i - 1) / dense)).norm();
   const int count = std::max(2, static_cast<int>(std::ceil(s.back() / step_mm)) + 1);
   std::vector<Vec3> points;
   int k = 0;
@@ -164,7 +165,7 @@ std::vector<Vec3> evaluate(const field::ForceField& field, std::span<const Vec3>
 
 /// What the errors of one variant are measured on, built once.
 struct ErrorSets {
-  std::vector<Vec3> nodes_mm;  ///< tool + holder nodes at every posture of the direct path
+  std::vector<Vec3> nodes_mm;    ///< tool + holder nodes at every posture of the direct path
   std::vector<Vec3> centres_mm;  ///< ball centre of each posture
   std::size_t nodes_per_posture = 0;
   std::vector<Vec3> moments_direct;
@@ -207,9 +208,12 @@ std::string machineDescription() {
 
 std::string StudyVariant::name() const {
   switch (mode) {
-    case pathgen::FieldMode::BruteForce: return "brute force";
-    case pathgen::FieldMode::Direct: return "direct";
-    case pathgen::FieldMode::Voxel: break;
+    case pathgen::FieldMode::BruteForce:
+      return "brute force";
+    case pathgen::FieldMode::Direct:
+      return "direct";
+    case pathgen::FieldMode::Voxel:
+      break;
   }
   std::ostringstream s;
   s << "voxel " << voxel_size_mm << " mm " << interpolationName(interpolation) << ' '
@@ -243,9 +247,12 @@ std::vector<T> parsePair(const std::string& text, const std::string& key,
   std::stringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
-    if (item == first.first) result.push_back(first.second);
-    else if (item == second.first) result.push_back(second.second);
-    else throw InputError(key + ": '" + item + "' is not " + names);
+    if (item == first.first)
+      result.push_back(first.second);
+    else if (item == second.first)
+      result.push_back(second.second);
+    else
+      throw InputError(key + ": '" + item + "' is not " + names);
   }
   if (result.empty() || text.back() == ',') throw InputError(key + ": give " + names + " or both");
   return result;
@@ -386,16 +393,14 @@ StudyResult runStudy(const StudyRequest& request) {
 
   const auto& u_range = job.impeller.u_range;
   const double u_mid = 0.5 * (u_range[0] + u_range[1]);
-  result.line_a = makeLine("a",
-                           "along the channel (u " + number(u_range[0]) + " to " +
-                               number(u_range[1]) +
-                               ", the passes' range), mid blade height, r0/2 off the left blade",
-                           lineAPoints(impeller, 0.5 * job.field.r0_mm, request.line_step_mm),
-                           checker);
-  result.line_b = makeLine("b",
-                           "across the channel at u = " + number(u_mid) +
-                               ", mid blade height, wall to wall",
-                           lineBPoints(impeller, u_mid, request.line_step_mm), checker);
+  result.line_a =
+      makeLine("a",
+               "along the channel (u " + number(u_range[0]) + " to " + number(u_range[1]) +
+                   ", the passes' range), mid blade height, r0/2 off the left blade",
+               lineAPoints(impeller, 0.5 * job.field.r0_mm, request.line_step_mm), checker);
+  result.line_b = makeLine(
+      "b", "across the channel at u = " + number(u_mid) + ", mid blade height, wall to wall",
+      lineBPoints(impeller, u_mid, request.line_step_mm), checker);
 
   ErrorSets sets;
   std::vector<Vec3> tool_nodes;
@@ -461,11 +466,10 @@ StudyResult runStudy(const StudyRequest& request) {
       line->magnitude.push_back(std::move(magnitude));
       line->relative_error.push_back(std::move(per_point));
     }
-    const std::vector<Vec3> node_forces =
-        approx ? evaluate(f, sets.nodes_mm) : sets.nodes_direct;
+    const std::vector<Vec3> node_forces = approx ? evaluate(f, sets.nodes_mm) : sets.nodes_direct;
     row.nodes = forceError(node_forces, sets.nodes_direct, sets.nodes_counted, nullptr);
-    row.moment = forceError(sets.moments(node_forces), sets.moments_direct, sets.moments_counted,
-                            nullptr);
+    row.moment =
+        forceError(sets.moments(node_forces), sets.moments_direct, sets.moments_counted, nullptr);
   }
   common::report(request.progress, 1.0, "done");
   return result;
@@ -519,23 +523,27 @@ double maxForceError(const StudyRow& row) {
 
 std::string csvText(const StudyResult& r) {
   std::ostringstream s;
-  s << "variant,mode,voxel_mm,interpolation,stored,status,active_nodes,dense_box_nodes,voxel_memory_mb,"
+  s << "variant,mode,voxel_mm,interpolation,stored,status,active_nodes,dense_box_nodes,voxel_"
+       "memory_mb,"
        "field_s,path_s,clearance_s,total_s,speedup_vs_brute,speedup_vs_direct,"
        "line_a_max_pct,line_a_rms_pct,line_b_max_pct,line_b_rms_pct,nodes_max_pct,nodes_rms_pct,"
-       "max_force_error_pct,nodes_max_scaled_pct,moment_max_pct,moment_rms_pct,tilt_max_deg,tilt_rms_deg,tilt_middle_max_deg,"
+       "max_force_error_pct,nodes_max_scaled_pct,moment_max_pct,moment_rms_pct,tilt_max_deg,tilt_"
+       "rms_deg,tilt_middle_max_deg,"
        "min_clearance_mm,"
        "colliding,max_tilt_deg,solver_steps,rhs_evals\n";
   for (const StudyRow& row : r.rows) {
     const StudyVariant& v = row.variant;
-    s << v.name() << ',' << fieldModeName(v.mode) << ',' << (v.isVoxel() ? number(v.voxel_size_mm) : "0")
-      << ',' << (v.isVoxel() ? interpolationName(v.interpolation) : "exact") << ','
+    s << v.name() << ',' << fieldModeName(v.mode) << ','
+      << (v.isVoxel() ? number(v.voxel_size_mm) : "0") << ','
+      << (v.isVoxel() ? interpolationName(v.interpolation) : "exact") << ','
       << (v.isVoxel() ? storedName(v.stored) : "exact") << ','
-      << (row.failure.empty() ? "ok" : "failed") << ',' << row.active_nodes << ',' << row.dense_box_nodes << ','
-      << number(row.voxel_memory_bytes / 1e6) << ',' << number(row.times.field_s) << ','
-      << number(row.times.steering_s) << ',' << number(row.times.clearance_s) << ','
-      << number(row.total_s) << ',' << number(row.speedup_vs_brute) << ','
-      << number(row.speedup_vs_direct) << ',' << number(100 * row.line_a.relative.max_relative)
-      << ',' << number(100 * row.line_a.relative.rms_relative) << ','
+      << (row.failure.empty() ? "ok" : "failed") << ',' << row.active_nodes << ','
+      << row.dense_box_nodes << ',' << number(row.voxel_memory_bytes / 1e6) << ','
+      << number(row.times.field_s) << ',' << number(row.times.steering_s) << ','
+      << number(row.times.clearance_s) << ',' << number(row.total_s) << ','
+      << number(row.speedup_vs_brute) << ',' << number(row.speedup_vs_direct) << ','
+      << number(100 * row.line_a.relative.max_relative) << ','
+      << number(100 * row.line_a.relative.rms_relative) << ','
       << number(100 * row.line_b.relative.max_relative) << ','
       << number(100 * row.line_b.relative.rms_relative) << ','
       << number(100 * row.nodes.relative.max_relative) << ','
@@ -544,9 +552,8 @@ std::string csvText(const StudyResult& r) {
       << number(100 * row.moment.relative.max_relative) << ','
       << number(100 * row.moment.relative.rms_relative) << ',' << number(row.tilt_max_deg) << ','
       << number(row.tilt_rms_deg) << ',' << number(row.tilt_middle_max_deg) << ','
-      << number(row.min_clearance_mm) << ',' << row.colliding
-      << ',' << number(row.max_tilt_deg) << ',' << row.solver_steps << ',' << row.rhs_evals
-      << '\n';
+      << number(row.min_clearance_mm) << ',' << row.colliding << ',' << number(row.max_tilt_deg)
+      << ',' << row.solver_steps << ',' << row.rhs_evals << '\n';
   }
   return s.str();
 }
@@ -560,8 +567,8 @@ std::string linesText(const StudyResult& r) {
       for (std::size_t i = 0; i < line->t_mm.size(); ++i)
         s << line->name << ',' << r.rows[v].variant.name() << ',' << number(line->t_mm[i], 6) << ','
           << number(line->wall_distance_mm[i], 5) << ',' << number(line->direct_magnitude[i], 6)
-          << ',' << number(line->magnitude[v][i], 6) << ','
-          << number(line->relative_error[v][i], 5) << '\n';
+          << ',' << number(line->magnitude[v][i], 6) << ',' << number(line->relative_error[v][i], 5)
+          << '\n';
     }
   return s.str();
 }
@@ -612,7 +619,8 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
     << " `clearance` from every obstacle (FCL) and inside the region tool + holder can reach."
     << " Why: the field fades to 0 at r0, where any relative error is meaningless and the nodes"
     << " add nothing to the moment; points closer to a wall than `clearance` or out of reach are"
-    << " never occupied by a valid path (and the voxels exist only in reach). `nodes scaled` is `|ΔF| / max |F_d|` over"
+    << " never occupied by a valid path (and the voxels exist only in reach). `nodes scaled` is "
+       "`|ΔF| / max |F_d|` over"
     << " all nodes (no floor), the error relative to the largest force on the tool.\n"
     << "- **Moment error**: the same relative error of the field's moment on the tool about the"
     << " ball centre, `τ = Σ (x_i - C) × F(x_i)` over the tool + holder nodes, per posture of the"
@@ -664,8 +672,9 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
       << fixed(100 * row.nodes.relative.rms_relative, 3) << " | "
       << fixed(100 * row.nodes.max_scaled, 3) << " | " << fixed(100 * maxForceError(row), 3)
       << " | " << fixed(100 * row.moment.relative.max_relative, 3) << " | "
-      << fixed(100 * row.moment.relative.rms_relative, 3) << " | " << fixed(row.tilt_max_deg, 4) << " | " << fixed(row.tilt_rms_deg, 4) << " | "
-      << fixed(row.tilt_middle_max_deg, 4) << " | " << fixed(row.min_clearance_mm, 3) << " | " << row.colliding << " |\n";
+      << fixed(100 * row.moment.relative.rms_relative, 3) << " | " << fixed(row.tilt_max_deg, 4)
+      << " | " << fixed(row.tilt_rms_deg, 4) << " | " << fixed(row.tilt_middle_max_deg, 4) << " | "
+      << fixed(row.min_clearance_mm, 3) << " | " << row.colliding << " |\n";
   s << "\n**Published (seed 004 Table 2; Matlab, linear interpolation, other hardware):**\n\n"
     << "| voxel | force variation | tilt difference |\n|---|---:|---:|\n";
   for (const Published& p : kPublished)
@@ -674,7 +683,8 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
   // Where the line errors are: max relative error by distance to the nearest wall.
   const double bands[] = {r.clearance_mm, 1.0, 2.0, r.field.r0_mm};
   s << "\n**Where** (max relative error %, both lines, by distance d to the nearest wall, mm; the"
-       " samples are " << r.field.sample_step_mm << " mm apart):\n\n| variant |";
+       " samples are "
+    << r.field.sample_step_mm << " mm apart):\n\n| variant |";
   for (int b = 0; b + 1 < 4; ++b) s << " " << bands[b] << " ≤ d < " << bands[b + 1] << " |";
   s << "\n|---|---:|---:|---:|\n";
   for (std::size_t v = 0; v < r.rows.size(); ++v) {
@@ -745,11 +755,13 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
     << " interpolation along the normal (trilinear does this along each axis), over heights d ≥"
     << " d_min where |F| ≥ " << kErrorFloorFraction * 100 << " % of |F(d_min)|, worst over"
     << " the grid's offset to the wall (%):\n\n"
-    << "| voxel | stored F, d ≥ clearance (" << r.clearance_mm << " mm) | stored F, d ≥ 1 mm |"
+    << "| voxel | stored F, d ≥ clearance (" << r.clearance_mm
+    << " mm) | stored F, d ≥ 1 mm |"
        " stored F, d ≥ r0/2 | stored F·d, d ≥ clearance |\n|---|---:|---:|---:|---:|\n";
   for (double h : sizes)
-    s << "| " << h << " mm | " << fixed(100 * planeInterpolationError(h, r.clearance_mm, r.field, false), 1)
-      << " | " << fixed(100 * planeInterpolationError(h, 1.0, r.field, false), 1) << " | "
+    s << "| " << h << " mm | "
+      << fixed(100 * planeInterpolationError(h, r.clearance_mm, r.field, false), 1) << " | "
+      << fixed(100 * planeInterpolationError(h, 1.0, r.field, false), 1) << " | "
       << fixed(100 * planeInterpolationError(h, 0.5 * r.field.r0_mm, r.field, false), 1) << " | "
       << fixed(100 * planeInterpolationError(h, r.clearance_mm, r.field, true), 1) << " |\n";
   s << "\nThe 1-D error of linear interpolation of f is about h²/8·|f''|/f; for the 1/d rise that"
@@ -778,9 +790,9 @@ void writeStudy(const StudyResult& result, const std::filesystem::path& dir,
   common::writeTextAtomically(dir / "study.csv", csvText(result));
   common::writeTextAtomically(dir / "lines.csv", linesText(result));
   common::writeTextAtomically(dir / "tilt.csv", tiltText(result));
-  common::writeTextAtomically(dir / "study.md",
-                              markdownText(result, command_line,
-                                           machine.empty() ? machineDescription() : machine));
+  common::writeTextAtomically(
+      dir / "study.md",
+      markdownText(result, command_line, machine.empty() ? machineDescription() : machine));
 }
 
 bool plotStudy(const std::filesystem::path& dir, std::string* message) {
@@ -791,7 +803,8 @@ bool plotStudy(const std::filesystem::path& dir, std::string* message) {
     return false;
   };
   if (!std::filesystem::exists(python)) return fail("no /usr/bin/python3: pictures not made");
-  if (!std::filesystem::exists(script)) return fail("no " + script.string() + ": pictures not made");
+  if (!std::filesystem::exists(script))
+    return fail("no " + script.string() + ": pictures not made");
   const std::string command = python.string() + " '" + script.string() + "' '" + dir.string() + "'";
   const int status = std::system(command.c_str());
   if (status != 0)

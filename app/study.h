@@ -34,9 +34,12 @@ inline constexpr double kErrorFloorFraction = 0.01;
 /// "voxel" | "direct" | "brute_force": the field mode as report.json and study.csv name it.
 inline const char* fieldModeName(pathgen::FieldMode mode) {
   switch (mode) {
-    case pathgen::FieldMode::Voxel: return "voxel";
-    case pathgen::FieldMode::Direct: return "direct";
-    case pathgen::FieldMode::BruteForce: return "brute_force";
+    case pathgen::FieldMode::Voxel:
+      return "voxel";
+    case pathgen::FieldMode::Direct:
+      return "direct";
+    case pathgen::FieldMode::BruteForce:
+      return "brute_force";
   }
   return "?";
 }
@@ -61,16 +64,16 @@ struct StudyRequest {
                                                       field::Interpolation::Quadratic};
   std::vector<field::StoredQuantity> stored = {field::StoredQuantity::Force,
                                                field::StoredQuantity::PlaneRatio};
-  bool brute_force = true;       ///< run the seed's every-point direct sum (slow on big scenes)
-  double line_step_mm = 0.05;    ///< sampling of the study lines
-  int repeats = 1;               ///< runs per variant; times are their medians
-  common::Progress progress;     ///< "brute force", "direct", "voxel 2 mm ...", "errors"
+  bool brute_force = true;     ///< run the seed's every-point direct sum (slow on big scenes)
+  double line_step_mm = 0.05;  ///< sampling of the study lines
+  int repeats = 1;             ///< runs per variant; times are their medians
+  common::Progress progress;   ///< "brute force", "direct", "voxel 2 mm ...", "errors"
 };
 
 /// Force error of one variant on one point set (relative, see the file comment), as fractions.
 struct ForceError {
-  field::FieldError relative;    ///< |ΔF| / |F_d| where |F_d| >= floor
-  double max_scaled = 0.0;       ///< max |ΔF| / max |F_d| over the set
+  field::FieldError relative;  ///< |ΔF| / |F_d| where |F_d| >= floor
+  double max_scaled = 0.0;     ///< max |ΔF| / max |F_d| over the set
   double rms_scaled = 0.0;
 };
 
@@ -83,25 +86,25 @@ struct StudyRow {
   std::size_t active_nodes = 0;     ///< voxel nodes holding a value (0 for direct methods)
   std::size_t dense_box_nodes = 0;  ///< nodes of a dense grid over their bounding box
   std::size_t voxel_memory_bytes = 0;
-  pathgen::StageTimes times;        ///< of generateImpellerPath for this variant
-  double total_s = 0.0;             ///< field_s + steering_s: what the seed's "temps total" counts
-  double speedup_vs_brute = 0.0;    ///< brute total / this total; NaN when brute force was skipped
-  double speedup_vs_direct = 0.0;   ///< indexed direct total / this total
+  pathgen::StageTimes times;       ///< of generateImpellerPath for this variant
+  double total_s = 0.0;            ///< field_s + steering_s: what the seed's "temps total" counts
+  double speedup_vs_brute = 0.0;   ///< brute total / this total; NaN when brute force was skipped
+  double speedup_vs_direct = 0.0;  ///< indexed direct total / this total
   ForceError line_a, line_b, nodes;
   ForceError moment;  ///< of τ = Σ (x_i - C) × F(x_i) per posture of the direct path
   double tilt_max_deg = 0.0, tilt_rms_deg = 0.0;  ///< |tilt - tilt_direct| over every posture
   double tilt_middle_max_deg = 0.0;  ///< the same over the middle pass (seed 004 Table 2's)
-  double min_clearance_mm = 0.0;    ///< FCL, of this variant's path
+  double min_clearance_mm = 0.0;     ///< FCL, of this variant's path
   std::size_t colliding = 0;
-  double max_tilt_deg = 0.0;        ///< largest |tilt| of the path
+  double max_tilt_deg = 0.0;             ///< largest |tilt| of the path
   long solver_steps = 0, rhs_evals = 0;  ///< CVODE, all passes: a rough field costs steps
 };
 
 /// A study line: points, the exact field along it and each variant's field.
 struct StudyLine {
-  std::string name;                ///< "a" or "b"
+  std::string name;  ///< "a" or "b"
   std::string description;
-  std::vector<double> t_mm;        ///< arc length from the start
+  std::vector<double> t_mm;  ///< arc length from the start
   std::vector<Vec3> points_mm;
   std::vector<double> wall_distance_mm;  ///< to the nearest obstacle (FCL)
   std::vector<double> direct_magnitude;  ///< |F_d|
@@ -114,15 +117,15 @@ struct StudyLine {
 struct StudyResult {
   std::vector<StudyRow> rows;  ///< brute force (if run), direct, then voxel variants
   StudyLine line_a, line_b;
-  int middle_pass = 0;                      ///< 0-based, the pass of tilt.csv
-  std::vector<double> tilt_s_mm;            ///< arc length along the middle pass
+  int middle_pass = 0;                        ///< 0-based, the pass of tilt.csv
+  std::vector<double> tilt_s_mm;              ///< arc length along the middle pass
   std::vector<std::vector<double>> tilt_deg;  ///< per row, tilt along the middle pass
   std::size_t postures = 0, tool_nodes = 0, obstacle_points = 0, node_points = 0;
   double path_length_mm = 0.0;
   double reach_box_cm3 = 0.0;  ///< volume of the region the voxels cover (direct run's box)
   double clearance_mm = 0.0;
-  int repeats = 1;             ///< runs per variant behind each time (medians)
-  field::FieldParams field;    ///< r0, r_min, ... of the scene
+  int repeats = 1;           ///< runs per variant behind each time (medians)
+  field::FieldParams field;  ///< r0, r_min, ... of the scene
 };
 
 /// Runs every variant. Throws common::InputError for bad settings (empty or non-positive

@@ -115,8 +115,11 @@ TEST_F(StudyTest, CsvHasEveryColumnFilledWithFiniteValues) {
   const Csv csv = readCsv(*dir_ / "study.csv");
   ASSERT_GE(csv.header.size(), 20u);
   ASSERT_EQ(csv.rows.size(), 8u);  // brute force, direct, 3 voxel sizes × 2 stored quantities
-  const std::map<std::string, bool> text_columns = {
-      {"variant", true}, {"mode", true}, {"interpolation", true}, {"stored", true}, {"status", true}};
+  const std::map<std::string, bool> text_columns = {{"variant", true},
+                                                    {"mode", true},
+                                                    {"interpolation", true},
+                                                    {"stored", true},
+                                                    {"status", true}};
   for (const auto& cells : csv.rows) {
     ASSERT_EQ(cells.size(), csv.header.size());
     for (std::size_t c = 0; c < cells.size(); ++c) {
@@ -175,8 +178,9 @@ TEST(StudyCommand, WritesTablesAndPicturesOrSaysWhyNot) {
   const test::TempDir dir;
   dir.write("scene.yaml", kSmallScene);
   const test::Outcome run = test::runFieldpath(
-      dir, "study scene.yaml --voxels 2,1 --interp trilinear --no-brute-force --line-step 0.2 "
-           "--out study");
+      dir,
+      "study scene.yaml --voxels 2,1 --interp trilinear --no-brute-force --line-step 0.2 "
+      "--out study");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   for (const char* file : {"study.csv", "study.md", "lines.csv", "tilt.csv"})
     EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / file)) << file;
