@@ -14,6 +14,7 @@
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/stats.h"
 #include "fieldpath/field/direct_field.h"
 #include "fieldpath/field/law.h"
 #include "fieldpath/field/sampling.h"
@@ -135,18 +136,12 @@ ForceError forceError(std::span<const Vec3> approx, std::span<const Vec3> exact,
   return e;
 }
 
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  const std::size_t n = values.size();
-  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
-}
-
 /// Stage by stage median of repeated runs.
 pathgen::StageTimes medianTimes(const std::vector<pathgen::StageTimes>& runs) {
   auto of = [&](double pathgen::StageTimes::*stage) {
     std::vector<double> values;
     for (const auto& t : runs) values.push_back(t.*stage);
-    return median(values);
+    return common::median(values);
   };
   pathgen::StageTimes t;
   t.setup_s = of(&pathgen::StageTimes::setup_s);
