@@ -1,6 +1,7 @@
 #include "fieldpath/geometry/tool_model.h"
 
 #include <algorithm>
+#include <limits>
 #include <charconv>
 #include <cmath>
 #include <numbers>
