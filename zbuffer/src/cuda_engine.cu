@@ -10,8 +10,12 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <chrono>
 #include <climits>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <map>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -62,15 +66,23 @@ __device__ inline Posture postureAt(const Posture* postures, const std::uint32_t
 
 /// Lowers the live lines of the culled footprint: tiles tile_first, +tile_step, ...; lines first,
 /// +step, ... of each (the shared per-line code path of both backends is lineCut).
+/// `stats` (trace runs only, else null): lines visited and lines lowered, summed over the grid.
 __device__ inline void cutLines(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
                                 const float* tile_max, bool skip, int tile_first, int tile_step,
-                                int first, int step, std::int32_t* keys) {
+                                int first, int step, std::int32_t* keys,
+                                unsigned long long* stats) {
+  unsigned visited = 0, lowered = 0;
   forEachLiveLine(g, tool, pp, tile_max, skip, tile_first, tile_step, first, step,
                   [&](int ix, int iy) {
                     std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
                     const float z = lineCut(g, tool, pp, ix, iy, keyToFloat(*slot));
-                    if (z != FLT_MAX) atomicMin(slot, floatToKey(z));
+                    ++visited;
+                    if (z != FLT_MAX) ++lowered, atomicMin(slot, floatToKey(z));
                   });
+  if (stats) {
+    atomicAdd(stats, static_cast<unsigned long long>(visited));
+    atomicAdd(stats + 1, static_cast<unsigned long long>(lowered));
+  }
 }
 
 /// Sort keys (lowest point, see lowestKey) and identity indices of a block.
@@ -87,7 +99,7 @@ __global__ void lowestKeyKernel(GridView g, ToolView tool, const Posture* postur
 __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
                             const std::uint32_t* order, int count, const float* tile_max,
                             std::int32_t* keys, unsigned long long* culled, int* queue, int* queued,
-                            bool skip) {
+                            bool skip, unsigned long long* stats) {
   const int k = blockIdx.x * blockDim.x + threadIdx.x;
   if (k >= count) return;
   PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, k));
@@ -96,7 +108,7 @@ __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
     return;
   }
   if ((pp.ix1 - pp.ix0 + 1) * (pp.iy1 - pp.iy0 + 1) <= kSmallFootprintLines)
-    cutLines(g, tool, pp, tile_max, skip, 0, 1, 0, 1, keys);
+    cutLines(g, tool, pp, tile_max, skip, 0, 1, 0, 1, keys, stats);
   else
     queue[atomicAdd(queued, 1)] = k;
 }
@@ -105,18 +117,20 @@ __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
 /// in a zoom): the lanes share the footprint's lines.
 __global__ void largeKernel(GridView g, ToolView tool, const Posture* postures,
                             const std::uint32_t* order, const int* queue, const int* queued,
-                            const float* tile_max, std::int32_t* keys, bool skip) {
+                            const float* tile_max, std::int32_t* keys, bool skip,
+                            unsigned long long* stats) {
   const int q = blockIdx.x * kWarpsPerBlock + (threadIdx.x >> 5);
   if (q >= *queued) return;
   PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, queue[q]));
   if (cullPosture(g, tool, pp, tile_max)) return;
-  cutLines(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, threadIdx.x & 31, 32, keys);
+  cutLines(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, threadIdx.x & 31, 32, keys, stats);
 }
 
 /// One warp per posture, every footprint (the variant without small_threads).
 __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
                            const std::uint32_t* order, int count, const float* tile_max,
-                           std::int32_t* keys, unsigned long long* culled, bool skip) {
+                           std::int32_t* keys, unsigned long long* culled, bool skip,
+                           unsigned long long* stats) {
   const int k = blockIdx.x * kWarpsPerBlock + (threadIdx.x >> 5);
   if (k >= count) return;
   PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, k));
@@ -124,7 +138,7 @@ __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
     if ((threadIdx.x & 31) == 0 && blockIdx.y == 0) atomicAdd(culled, 1ull);
     return;
   }
-  cutLines(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, threadIdx.x & 31, 32, keys);
+  cutLines(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, threadIdx.x & 31, 32, keys, stats);
 }
 
 /// SIMSURF1's coarse kernel: one thread per posture, every triangle.
@@ -234,6 +248,53 @@ struct Engine::Impl {
   void* stage[2] = {nullptr, nullptr};
   cudaEvent_t staged[2] = {nullptr, nullptr};
   int stage_next = 0;
+  // FIELDPATH_ZB_TRACE=1 (benchmarks only): device time per stage (events around each launch) and
+  // the lines visited / lowered, printed to stderr when the heights are read.
+  bool trace = false;
+  unsigned long long* stats = nullptr;
+  struct Mark {
+    const char* stage;
+    cudaEvent_t begin, end;
+  };
+  std::vector<Mark> marks;
+  std::chrono::steady_clock::time_point created;
+
+  template <class Launch>
+  void timed(const char* stage_name, cudaStream_t st, Launch launch) {
+    if (!trace) return launch();
+    Mark mk{stage_name, nullptr, nullptr};
+    FIELDPATH_CUDA_CHECK(cudaEventCreate(&mk.begin));
+    FIELDPATH_CUDA_CHECK(cudaEventCreate(&mk.end));
+    FIELDPATH_CUDA_CHECK(cudaEventRecord(mk.begin, st));
+    launch();
+    FIELDPATH_CUDA_CHECK(cudaEventRecord(mk.end, st));
+    marks.push_back(mk);
+  }
+
+  void printTrace() {
+    if (!trace) return;
+    FIELDPATH_CUDA_CHECK(cudaDeviceSynchronize());
+    std::map<std::string, std::pair<double, int>> total;
+    for (const Mark& mk : marks) {
+      float ms = 0;
+      FIELDPATH_CUDA_CHECK(cudaEventElapsedTime(&ms, mk.begin, mk.end));
+      total[mk.stage].first += ms;
+      ++total[mk.stage].second;
+      cudaEventDestroy(mk.begin);
+      cudaEventDestroy(mk.end);
+    }
+    marks.clear();
+    unsigned long long counts[2] = {0, 0};
+    FIELDPATH_CUDA_CHECK(cudaMemcpy(counts, stats, sizeof counts, cudaMemcpyDeviceToHost));
+    std::fprintf(
+        stderr, "trace: wall since engine start %.2f ms; lines visited %llu, lowered %llu\n",
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - created)
+            .count(),
+        counts[0], counts[1]);
+    for (const auto& [name, t] : total)
+      std::fprintf(stderr, "trace:   %-10s %9.2f ms in %d launches\n", name.c_str(), t.first,
+                   t.second);
+  }
 
   /// Host → device through the pinned buffers (or directly from pageable memory without them).
   void upload(void* dst, const void* src, std::size_t bytes, cudaStream_t st) {
@@ -282,9 +343,9 @@ struct Engine::Impl {
     if (!compute_stream) return;
     cudaStreamSynchronize(compute_stream);
     for (void* p : owned) cudaFreeAsync(p, compute_stream);
-    for (void* p :
-         {static_cast<void*>(keys), static_cast<void*>(tile_max), static_cast<void*>(culled),
-          static_cast<void*>(queued), static_cast<void*>(queue), sort_temp})
+    for (void* p : {static_cast<void*>(keys), static_cast<void*>(tile_max),
+                    static_cast<void*>(culled), static_cast<void*>(queued),
+                    static_cast<void*>(queue), sort_temp, static_cast<void*>(stats)})
       if (p) cudaFreeAsync(p, compute_stream);
     for (int k = 0; k < 2; ++k) {
       for (void* p : {static_cast<void*>(postures[k]), static_cast<void*>(sort_keys[k]),
@@ -338,6 +399,8 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   m.grid = grid;
   m.options = options;
   m.tool = tool.view;
+  m.created = std::chrono::steady_clock::now();
+  m.trace = std::getenv("FIELDPATH_ZB_TRACE") != nullptr;
   usePersistentPool();
   FIELDPATH_CUDA_CHECK(cudaStreamCreateWithFlags(&m.copy_stream, cudaStreamNonBlocking));
   FIELDPATH_CUDA_CHECK(cudaStreamCreateWithFlags(&m.compute_stream, cudaStreamNonBlocking));
@@ -364,6 +427,10 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   deviceAlloc(m.culled, 1, st);
   FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.culled, 0, sizeof(unsigned long long), st));
   deviceAlloc(m.queued, 1, st);
+  if (m.trace) {
+    deviceAlloc(m.stats, 2, st);
+    FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.stats, 0, 2 * sizeof(unsigned long long), st));
+  }
   // the host arrays may go once this returns
   FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(st));
   m.lines = lines;
@@ -396,7 +463,7 @@ void Engine::cut(const Posture* block, std::size_t count, bool coarse) {
   // copy runs on its own stream while the previous block's kernels still run.
   cudaStream_t copy = m.options.overlap_upload ? m.copy_stream : m.compute_stream;
   FIELDPATH_CUDA_CHECK(cudaStreamWaitEvent(copy, m.computed[s], 0));
-  m.upload(m.postures[s], block, count * sizeof(Posture), copy);
+  m.timed("upload", copy, [&] { m.upload(m.postures[s], block, count * sizeof(Posture), copy); });
   FIELDPATH_CUDA_CHECK(cudaEventRecord(m.copied[s], copy));
   FIELDPATH_CUDA_CHECK(cudaStreamWaitEvent(m.compute_stream, m.copied[s], 0));
 
@@ -409,17 +476,20 @@ void Engine::cut(const Posture* block, std::size_t count, bool coarse) {
   } else {
     const std::uint32_t* order = nullptr;
     if (m.options.lowest_first) {
-      lowestKeyKernel<<<(n + 127) / 128, 128, 0, st>>>(m.grid, m.tool, postures, n, m.sort_keys[s],
-                                                       m.sort_index[s]);
-      FIELDPATH_CUDA_CHECK(cudaGetLastError());
-      std::uint32_t* keys_out = m.sort_keys[s ^ 1];  // the other slot's scratch: same stream
-      std::uint32_t* index_out = m.sort_index[s ^ 1];
-      FIELDPATH_CUDA_CHECK(
-          cub::DeviceRadixSort::SortPairs(m.sort_temp, m.sort_temp_bytes, m.sort_keys[s], keys_out,
-                                          m.sort_index[s], index_out, n, 0, 32, st));
-      // keep the sorted order in this slot's index array (the other slot's is free after the sort)
-      FIELDPATH_CUDA_CHECK(
-          cudaMemcpyAsync(m.sort_index[s], index_out, count * 4, cudaMemcpyDeviceToDevice, st));
+      m.timed("sort", st, [&] {
+        lowestKeyKernel<<<(n + 127) / 128, 128, 0, st>>>(m.grid, m.tool, postures, n,
+                                                         m.sort_keys[s], m.sort_index[s]);
+        FIELDPATH_CUDA_CHECK(cudaGetLastError());
+        std::uint32_t* keys_out = m.sort_keys[s ^ 1];  // the other slot's scratch: same stream
+        std::uint32_t* index_out = m.sort_index[s ^ 1];
+        FIELDPATH_CUDA_CHECK(
+            cub::DeviceRadixSort::SortPairs(m.sort_temp, m.sort_temp_bytes, m.sort_keys[s],
+                                            keys_out, m.sort_index[s], index_out, n, 0, 32, st));
+        // keep the sorted order in this slot's index array (the other slot's is free after the
+        // sort)
+        FIELDPATH_CUDA_CHECK(
+            cudaMemcpyAsync(m.sort_index[s], index_out, count * 4, cudaMemcpyDeviceToDevice, st));
+      });
       order = m.sort_index[s];
     }
     const int tiles = m.grid.tiles_x * m.grid.tiles_y;
@@ -427,25 +497,34 @@ void Engine::cut(const Posture* block, std::size_t count, bool coarse) {
       const int chunk = static_cast<int>(std::min(m.refresh_every, count - begin));
       const std::uint32_t* chunk_order = order ? order + begin : nullptr;
       const Posture* chunk_postures = order ? postures : postures + begin;
-      tileMaxKernel<<<(tiles + 255) / 256, 256, 0, st>>>(m.grid, m.keys, m.tile_max);
-      FIELDPATH_CUDA_CHECK(cudaGetLastError());
+      m.timed("tile max", st, [&] {
+        tileMaxKernel<<<(tiles + 255) / 256, 256, 0, st>>>(m.grid, m.keys, m.tile_max);
+        FIELDPATH_CUDA_CHECK(cudaGetLastError());
+      });
       const int splits = std::clamp(16384 / std::max(1, chunk), 1, 1024);
       const dim3 warps((chunk + kWarpsPerBlock - 1) / kWarpsPerBlock, splits);
       if (m.options.small_threads) {
         FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.queued, 0, sizeof(int), st));
-        smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(
-            m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, m.culled,
-            m.queue, m.queued, m.options.tile_skip);
-        FIELDPATH_CUDA_CHECK(cudaGetLastError());
-        largeKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(m.grid, m.tool, chunk_postures,
-                                                           chunk_order, m.queue, m.queued,
-                                                           m.tile_max, m.keys, m.options.tile_skip);
+        m.timed("small", st, [&] {
+          smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(
+              m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, m.culled,
+              m.queue, m.queued, m.options.tile_skip, m.stats);
+          FIELDPATH_CUDA_CHECK(cudaGetLastError());
+        });
+        m.timed("large", st, [&] {
+          largeKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
+              m.grid, m.tool, chunk_postures, chunk_order, m.queue, m.queued, m.tile_max, m.keys,
+              m.options.tile_skip, m.stats);
+          FIELDPATH_CUDA_CHECK(cudaGetLastError());
+        });
       } else {
-        warpKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(m.grid, m.tool, chunk_postures,
-                                                          chunk_order, chunk, m.tile_max, m.keys,
-                                                          m.culled, m.options.tile_skip);
+        m.timed("warp", st, [&] {
+          warpKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(m.grid, m.tool, chunk_postures,
+                                                            chunk_order, chunk, m.tile_max, m.keys,
+                                                            m.culled, m.options.tile_skip, m.stats);
+          FIELDPATH_CUDA_CHECK(cudaGetLastError());
+        });
       }
-      FIELDPATH_CUDA_CHECK(cudaGetLastError());
     }
   }
   FIELDPATH_CUDA_CHECK(cudaEventRecord(m.computed[s], st));
@@ -461,9 +540,11 @@ void Engine::heights(float* out_mm) const {
   FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(bits, m.keys, m.lines * 4, cudaMemcpyDeviceToDevice, st));
   orderBitsKernel<<<unsigned((m.lines + 255) / 256), 256, 0, st>>>(bits, m.lines);
   FIELDPATH_CUDA_CHECK(cudaGetLastError());
-  const_cast<Impl&>(m).download(out_mm, bits, m.lines * 4, st);
+  Impl& mm = const_cast<Impl&>(m);
+  mm.timed("download", st, [&] { mm.download(out_mm, bits, m.lines * 4, st); });
   FIELDPATH_CUDA_CHECK(cudaFreeAsync(bits, st));
   FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(st));
+  mm.printTrace();
 }
 
 std::size_t Engine::culled() const {

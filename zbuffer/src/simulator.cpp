@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <mutex>
 #include <numeric>
@@ -427,6 +429,7 @@ SimulationResult run(const SimulationRequest& request, std::size_t expected_post
   if (backend == Backend::Cuda && !cudaAvailable())
     throw InputError("backend cuda: no CUDA device available (built without CUDA or no GPU)");
 
+  const auto entered = std::chrono::steady_clock::now();
   detail::ToolData tool = preparedTool(request.tool);
   tool.pointViewAtVectors();
   if (!request.tuning.vertical_bins) tool.view.bins = 0;
@@ -453,11 +456,22 @@ SimulationResult run(const SimulationRequest& request, std::size_t expected_post
     const double total = double(std::max(expected_postures, result.postures));
     common::report(request.progress, double(result.postures) / total, "simulate");
   }
+  const auto cut_done = std::chrono::steady_clock::now();
   result.heights_mm = engine->heights();
   result.postures_culled = engine->culled();
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const auto read = std::chrono::steady_clock::now();
+  result.seconds = std::chrono::duration<double>(read - start).count();
   for (std::size_t i = 0; i < initial.size(); ++i)
     result.lines_lowered += result.heights_mm[i] < initial[i];
+  if (std::getenv("FIELDPATH_ZB_TRACE")) {  // benchmarks: where the host's time goes
+    const auto ms = [](auto a, auto b) {
+      return std::chrono::duration<double, std::milli>(b - a).count();
+    };
+    std::fprintf(stderr,
+                 "trace: host: set-up %.2f ms, engine + cut calls %.2f, heights %.2f, count %.2f\n",
+                 ms(entered, start), ms(start, cut_done), ms(cut_done, read),
+                 ms(read, std::chrono::steady_clock::now()));
+  }
   common::report(request.progress, 1.0, "simulate");
   return result;
 }
