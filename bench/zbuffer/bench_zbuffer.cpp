@@ -232,7 +232,16 @@ int variantTable(const std::string& backend, const std::vector<std::string>& wan
       {"no vertical bins", [](zb::EngineTuning& t) { t.vertical_bins = false; }},
       {"no tile skip", [](zb::EngineTuning& t) { t.tile_skip = false; }},
       {"no pinned staging", [](zb::EngineTuning& t) { t.pinned_staging = false; }},
-      {"all knobs off", [](zb::EngineTuning& t) { t = {false, false, false, false, false, 0}; }},
+      {"prepass 4", [](zb::EngineTuning& t) { t.prepass_stride = 4; }},
+      {"prepass 16", [](zb::EngineTuning& t) { t.prepass_stride = 16; }},
+      {"no prepass", [](zb::EngineTuning& t) { t.prepass_stride = 0; }},
+      {"no capsule floor", [](zb::EngineTuning& t) { t.capsule_floor = false; }},
+      {"all knobs off",
+       [](zb::EngineTuning& t) {
+         t = {false, false, false, false, false, false};
+         t.prepass_stride = 0;
+         t.capsule_floor = false;
+       }},
   };
   std::printf("| case | P | grid |");
   for (const auto& v : variants) std::printf(" %s ms |", v.first);

@@ -323,11 +323,68 @@ TEST(Tuning, EveryVariantGivesTheSameBits) {
     req.tuning.lowest_first = variant & 2;
     req.tuning.tile_skip = variant & 4;
     req.tuning.tile_shift = 2 + variant % 3;
+    req.tuning.prepass_stride = variant % 2 ? 0 : 3 + variant;
+    req.tuning.capsule_floor = variant % 3 != 1;
     req.block_postures = variant == 3 || variant == 6 ? 97 : 1 << 20;
     const auto h = simulate(req, postures).heights_mm;
     if (first.empty()) first = h;
     ASSERT_EQ(std::memcmp(first.data(), h.data(), 4 * h.size()), 0) << "variant " << variant;
   }
+}
+
+TEST(Culling, CapsuleFloorIsBelowEveryCutAndTightForABall) {
+  // The capsule floor of a line (and of a rectangle of lines) must never be above the height the
+  // tool's exact entry gives any of its lines, for every tool kind and any tilt; where it says
+  // FLT_MAX (out of the capsule's reach) the tool must miss the line.
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const Grid grid = Grid::fromRegion(-8, -8, 8, 8, 48, 48);
+  const GridView g = detail::makeGridView(grid, 2);
+  const std::vector<Tool> tools = {
+      Tool::ball(2, 8),
+      Tool::torus(3, 1, 10),
+      Tool::flat(2.5, 6),
+      Tool::fromMesh(analyticToolMesh(Tool::ball(2, 8), 32, 31)),
+      Tool::fromMesh(analyticToolMesh(Tool::torus(3, 1, 10), 40, 8)),
+      Tool::fromMesh(gridBottomTool())};
+  int hits = 0;
+  for (const Tool& tool : tools) {
+    const detail::ToolData data = detail::prepareTool(tool);
+    ASSERT_GT(data.view.cap_radius_mm, 0.f);
+    for (int k = 0; k < 60; ++k) {
+      const double tilt = k % 6 == 0 ? 0.0 : u(rng);
+      const Posture p = pose(2 * u(rng), 2 * u(rng), u(rng), tilt, k % 5 == 0 ? 0.0 : u(rng),
+                             k % 7 == 0 ? 0.05 : 0.3 + std::abs(u(rng)));
+      const PreparedPosture pp = preparePosture(g, data.view, p);
+      if (pp.ix0 > pp.ix1 || pp.iy0 > pp.iy1) continue;
+      float rect_min = FLT_MAX;
+      for (int iy = pp.iy0; iy <= pp.iy1; ++iy)
+        for (int ix = pp.ix0; ix <= pp.ix1; ++ix) {
+          float rx, ry;
+          lineOffset(g, pp, ix, iy, rx, ry);
+          const Vec3f o = mulTransposed(pp.rot, Vec3f{rx, ry, 0.f});
+          const float t = tool.kind == ToolKind::Mesh ? meshEntry(data.view, pp, o, FLT_MAX)
+                                                       : analyticEntry(data.view, o, pp.dir);
+          const float floor = capsuleFloor(
+              data.view, pp, segmentDistance(rx, ry, pp.cap_ax, pp.cap_ay, pp.cap_bx, pp.cap_by));
+          if (t == FLT_MAX) continue;
+          ++hits;
+          const float h = pp.tip_mm.z + t;
+          ASSERT_LE(floor, h) << "tool " << int(tool.kind) << " posture " << k << " line " << ix
+                              << "," << iy;
+          rect_min = std::min(rect_min, std::max(h, pp.lowest_z_mm));  // lineCut clamps so
+        }
+      // the whole footprint as one rectangle
+      ASSERT_LE(rectFloor(g, data.view, pp, pp.ix0, pp.ix1, pp.iy0, pp.iy1), rect_min);
+    }
+  }
+  EXPECT_GT(hits, 5000);
+  // Tight where it matters: a vertical ball's floor is its exact height, less the margin.
+  const detail::ToolData ball = detail::prepareTool(Tool::ball(2, 8));
+  const PreparedPosture pp = preparePosture(g, ball.view, pose(0, 0, 0, 0, 0, 1));
+  for (double d : {0.0, 0.5, 1.0, 1.5, 1.9})
+    EXPECT_NEAR(capsuleFloor(ball.view, pp, float(d)), 2 - std::sqrt(4 - d * d), 1e-3) << d;
+  EXPECT_EQ(capsuleFloor(ball.view, pp, 2.1f), FLT_MAX);
 }
 
 TEST(Mesh, TiltedSphereMeshHasNoHoles) {

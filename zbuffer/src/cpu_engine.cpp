@@ -22,14 +22,18 @@ inline float loadRelaxed(float& slot) {
 
 class CpuEngine final : public BackendEngine {
  public:
-  CpuEngine(const GridView& grid, const ToolData& tool, std::span<const float> heights,
-            const EngineTuning& tuning)
-      : grid_(grid),
-        tool_(tool),
-        tuning_(tuning),
-        heights_(heights.begin(), heights.end()),
-        tile_max_(std::size_t(grid.tiles_x) * grid.tiles_y) {
-    tool_.pointViewAtVectors();  // this engine's own copies
+  explicit CpuEngine(const EngineSetup& setup)
+      : grid_(setup.grid),
+        keep_tool_(setup.tool),
+        view_(setup.view),
+        tuning_(setup.tuning),
+        tile_max_(std::size_t(setup.grid.tiles_x) * setup.grid.tiles_y) {
+    const GridView& grid = setup.grid;
+    const EngineTuning& tuning = setup.tuning;
+    if (setup.heights_mm.empty())
+      heights_.assign(std::size_t(grid.nx) * grid.ny, setup.stock_mm);
+    else
+      heights_.assign(setup.heights_mm.begin(), setup.heights_mm.end());
     // Tile maxima are refreshed between chunks: often when postures come lowest first (each
     // refresh lets the tiles cut so far cull the higher postures), bounded by the refresh cost.
     const std::size_t lines = std::size_t(grid.nx) * grid.ny;
@@ -43,6 +47,17 @@ class CpuEngine final : public BackendEngine {
     if (engine == Engine::Coarse) {
       coarse(block);
       return;
+    }
+    if (tuning_.prepass_stride > 1 && block.size() >= 2 * std::size_t(tuning_.prepass_stride)) {
+      // every stride-th posture in path order first (see EngineTuning::prepass_stride); its
+      // culls are not counted (the main pass meets the same postures again)
+      std::vector<std::uint32_t> sparse;
+      for (std::size_t k = 0; k < block.size(); k += std::size_t(tuning_.prepass_stride))
+        sparse.push_back(static_cast<std::uint32_t>(k));
+      for (std::size_t begin = 0; begin < sparse.size(); begin += refresh_every_) {
+        refreshTiles();
+        fast(block, sparse, begin, std::min(sparse.size(), begin + refresh_every_));
+      }
     }
     const std::vector<std::uint32_t> order = processingOrder(block);
     for (std::size_t begin = 0; begin < block.size(); begin += refresh_every_) {
@@ -65,7 +80,7 @@ class CpuEngine final : public BackendEngine {
     }
     std::vector<std::uint64_t> keyed(block.size());
     const GridView g = grid_;
-    const ToolView tool = tool_.view;
+    const ToolView tool = view_;
     const long n = static_cast<long>(block.size());
 #pragma omp parallel for schedule(static)
     for (long p = 0; p < n; ++p)
@@ -93,7 +108,7 @@ class CpuEngine final : public BackendEngine {
   std::size_t fast(std::span<const Posture> block, const std::vector<std::uint32_t>& order,
                    std::size_t begin, std::size_t end) {
     const GridView g = grid_;
-    const ToolView tool = tool_.view;
+    const ToolView tool = view_;
     float* h = heights_.data();
     const float* tiles = tile_max_.data();
     const bool skip = tuning_.tile_skip;
@@ -116,7 +131,7 @@ class CpuEngine final : public BackendEngine {
 
   void coarse(std::span<const Posture> block) {
     const GridView g = grid_;
-    const ToolView tool = tool_.view;
+    const ToolView tool = view_;
     float* h = heights_.data();
     const long n = static_cast<long>(block.size());
 #pragma omp parallel for schedule(dynamic, 4)
@@ -127,7 +142,8 @@ class CpuEngine final : public BackendEngine {
   }
 
   GridView grid_;
-  ToolData tool_;
+  std::shared_ptr<const ToolData> keep_tool_;  ///< owns the arrays view_ points into
+  ToolView view_;
   EngineTuning tuning_;
   std::vector<float> heights_;
   std::vector<float> tile_max_;
@@ -137,10 +153,8 @@ class CpuEngine final : public BackendEngine {
 
 }  // namespace
 
-std::unique_ptr<BackendEngine> makeCpuEngine(const GridView& grid, const ToolData& tool,
-                                             std::span<const float> heights_mm,
-                                             const EngineTuning& tuning) {
-  return std::make_unique<CpuEngine>(grid, tool, heights_mm, tuning);
+std::unique_ptr<BackendEngine> makeCpuEngine(const EngineSetup& setup) {
+  return std::make_unique<CpuEngine>(setup);
 }
 
 }  // namespace fieldpath::zbuffer::detail

@@ -1,4 +1,6 @@
 /// detail::BackendEngine over the CUDA engine (built with CUDA only).
+#include <future>
+
 #include "cuda_engine.h"
 #include "fieldpath/zbuffer/simulator.h"
 
@@ -8,9 +10,10 @@ bool cudaAvailable() { return cuda::available(); }
 
 namespace detail {
 namespace {
-cuda::ToolArrays arrays(const ToolData& tool) {
+cuda::ToolArrays arrays(const ToolData& tool, const ToolView& view) {
   cuda::ToolArrays a;
-  a.view = tool.view;
+  a.view = view;
+  a.id = tool.id;
   a.nodes = tool.bvh_nodes.data();
   a.node_count = tool.bvh_nodes.size();
   a.triangles = tool.bvh_triangles.data();
@@ -28,21 +31,30 @@ cuda::ToolArrays arrays(const ToolData& tool) {
   return a;
 }
 
+cuda::Engine::Options options(const EngineTuning& t) {
+  return {t.lowest_first,   t.small_threads,    t.overlap_upload, t.tile_skip,
+          t.pinned_staging, t.refresh_postures, t.prepass_stride};
+}
+
 class CudaAdapter final : public BackendEngine {
  public:
-  CudaAdapter(const GridView& grid, const ToolData& tool, std::span<const float> heights,
-              const EngineTuning& t)
-      : lines_(heights.size()),
-        engine_(grid, arrays(tool), heights.data(), heights.size(),
-                {t.lowest_first, t.small_threads, t.overlap_upload, t.tile_skip, t.pinned_staging,
-                 t.refresh_postures}) {}
+  explicit CudaAdapter(const EngineSetup& s)
+      : lines_(std::size_t(s.grid.nx) * s.grid.ny),
+        engine_(s.grid, arrays(*s.tool, s.view),
+                s.heights_mm.empty() ? nullptr : s.heights_mm.data(), s.stock_mm, lines_,
+                options(s.tuning)) {
+    // A large output vector is zeroed (and its pages faulted in) by another thread while the
+    // device works: 400 MB for a 10000² grid is ~0.1 s of one core.
+    if (lines_ >= (std::size_t{1} << 24))
+      output_ = std::async(std::launch::async, [n = lines_] { return std::vector<float>(n); });
+  }
 
   void cut(std::span<const Posture> block, Engine engine) override {
     engine_.cut(block.data(), block.size(), engine == Engine::Coarse);
   }
   std::size_t culled() override { return engine_.culled(); }
   std::vector<float> heights() override {
-    std::vector<float> h(lines_);
+    std::vector<float> h = output_.valid() ? output_.get() : std::vector<float>(lines_);
     engine_.heights(h.data());
     return h;
   }
@@ -50,14 +62,13 @@ class CudaAdapter final : public BackendEngine {
  private:
   std::size_t lines_;
   cuda::Engine engine_;
+  std::future<std::vector<float>> output_;
 };
 }  // namespace
 
-std::unique_ptr<BackendEngine> makeCudaEngine(const GridView& grid, const ToolData& tool,
-                                              std::span<const float> heights,
-                                              const EngineTuning& tuning) {
+std::unique_ptr<BackendEngine> makeCudaEngine(const EngineSetup& setup) {
   if (!cuda::available()) throw std::runtime_error("no CUDA device");
-  return std::make_unique<CudaAdapter>(grid, tool, heights, tuning);
+  return std::make_unique<CudaAdapter>(setup);
 }
 }  // namespace detail
 }  // namespace fieldpath::zbuffer

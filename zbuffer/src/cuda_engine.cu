@@ -44,6 +44,18 @@ __global__ void orderBitsKernel(std::int32_t* values, std::size_t n) {
   if (i < n) values[i] = orderedBits(values[i]);
 }
 
+/// Every line at the same height (as an ordered key): a constant stock needs no upload.
+__global__ void fillKernel(std::int32_t* keys, std::size_t n, std::int32_t key) {
+  const std::size_t i = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i < n) keys[i] = key;
+}
+
+/// Processing order of a prepass: postures 0, stride, 2 stride, ... of the block.
+__global__ void strideOrderKernel(std::uint32_t* order, int count, int stride) {
+  const int k = blockIdx.x * blockDim.x + threadIdx.x;
+  if (k < count) order[k] = std::uint32_t(k) * std::uint32_t(stride);
+}
+
 __global__ void tileMaxKernel(GridView g, const std::int32_t* keys, float* tile_max) {
   const int t = blockIdx.x * blockDim.x + threadIdx.x;
   if (t >= g.tiles_x * g.tiles_y) return;
@@ -104,7 +116,7 @@ __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
   if (k >= count) return;
   PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, k));
   if (cullPosture(g, tool, pp, tile_max)) {
-    atomicAdd(culled, 1ull);
+    if (culled) atomicAdd(culled, 1ull);
     return;
   }
   if ((pp.ix1 - pp.ix0 + 1) * (pp.iy1 - pp.iy0 + 1) <= kSmallFootprintLines)
@@ -135,7 +147,7 @@ __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
   if (k >= count) return;
   PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, k));
   if (cullPosture(g, tool, pp, tile_max)) {
-    if ((threadIdx.x & 31) == 0 && blockIdx.y == 0) atomicAdd(culled, 1ull);
+    if (culled && (threadIdx.x & 31) == 0 && blockIdx.y == 0) atomicAdd(culled, 1ull);
     return;
   }
   cutLines(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, threadIdx.x & 31, 32, keys, stats);
@@ -172,15 +184,6 @@ void deviceAlloc(T*& ptr, std::size_t n, cudaStream_t st) {
   ptr = nullptr;
   FIELDPATH_CUDA_CHECK(
       cudaMallocAsync(reinterpret_cast<void**>(&ptr), std::max<std::size_t>(n, 1) * sizeof(T), st));
-}
-
-template <class T>
-T* deviceCopy(const T* host, std::size_t n, cudaStream_t st) {
-  if (n == 0) return nullptr;
-  T* ptr = nullptr;
-  deviceAlloc(ptr, n, st);
-  FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(ptr, host, n * sizeof(T), cudaMemcpyHostToDevice, st));
-  return ptr;
 }
 
 /// Pinned host staging buffers, kept for the process: pinning costs milliseconds per call.
@@ -223,13 +226,56 @@ void parallelCopy(void* dst, const void* src, std::size_t bytes) {
   }
 }
 
+/// A tool's arrays on the device. The last tool used stays there (keyed by ToolData::id) for the
+/// next simulation with it: a mesh tool's BVH, bins and floors are megabytes, uploaded once.
+struct DeviceTool {
+  ToolView view;
+  std::vector<void*> buffers;
+  DeviceTool() = default;
+  DeviceTool(const DeviceTool&) = delete;
+  DeviceTool& operator=(const DeviceTool&) = delete;
+  ~DeviceTool() {
+    for (void* p : buffers) cudaFree(p);
+  }
+  template <class T>
+  const T* copy(const T* host, std::size_t n) {
+    if (n == 0) return nullptr;
+    void* p = nullptr;
+    FIELDPATH_CUDA_CHECK(cudaMalloc(&p, n * sizeof(T)));
+    buffers.push_back(p);
+    FIELDPATH_CUDA_CHECK(cudaMemcpy(p, host, n * sizeof(T), cudaMemcpyHostToDevice));
+    return static_cast<const T*>(p);
+  }
+};
+
+/// The device copy of `tool`: the cached one if it has the same id, else a new upload.
+std::shared_ptr<const DeviceTool> deviceTool(const ToolArrays& tool) {
+  static std::mutex mutex;
+  static std::uint64_t cached_id = 0;
+  static std::shared_ptr<const DeviceTool> cached;
+  std::lock_guard lock(mutex);
+  if (cached && tool.id != 0 && cached_id == tool.id) return cached;
+  auto d = std::make_shared<DeviceTool>();
+  d->view = tool.view;
+  d->view.bvh_nodes = d->copy(tool.nodes, tool.node_count);
+  d->view.bvh_triangles = d->copy(tool.triangles, tool.triangle_floats);
+  d->view.vertices = d->copy(tool.vertices, tool.vertex_count);
+  d->view.indices = d->copy(tool.indices, tool.index_count);
+  d->view.bin_start = d->copy(tool.bin_start, tool.bin_start_count);
+  d->view.bin_items = d->copy(tool.bin_items, tool.bin_item_count);
+  d->view.radial_floor_mm = d->copy(tool.radial_floor, tool.radial_count);
+  cached_id = tool.id;
+  cached = d;
+  return d;
+}
+
 }  // namespace
 
 struct Engine::Impl {
   GridView grid;
-  ToolView tool;
+  ToolView tool;  ///< the run's view (scalars, knobs) with the device tool's arrays
+  std::shared_ptr<const DeviceTool> device_tool;
   Options options;
-  std::vector<void*> owned;  ///< device allocations of the tool and the heights
   std::int32_t* keys = nullptr;
   float* tile_max = nullptr;
   unsigned long long* culled = nullptr;
@@ -338,11 +384,52 @@ struct Engine::Impl {
     stage_next = b;
   }
 
+  /// Cuts `count` postures (in `order`, or as they come), chunk by chunk with the tile maxima
+  /// refreshed before each; `culled_count` (may be null) counts the culled postures.
+  void chunks(const Posture* postures, const std::uint32_t* order, std::size_t count,
+              unsigned long long* culled_count) {
+    cudaStream_t st = compute_stream;
+    Impl& m = *this;
+    const int tiles = m.grid.tiles_x * m.grid.tiles_y;
+    for (std::size_t begin = 0; begin < count; begin += m.refresh_every) {
+      const int chunk = static_cast<int>(std::min(m.refresh_every, count - begin));
+      const std::uint32_t* chunk_order = order ? order + begin : nullptr;
+      const Posture* chunk_postures = order ? postures : postures + begin;
+      m.timed("tile max", st, [&] {
+        tileMaxKernel<<<(tiles + 255) / 256, 256, 0, st>>>(m.grid, m.keys, m.tile_max);
+        FIELDPATH_CUDA_CHECK(cudaGetLastError());
+      });
+      const int splits = std::clamp(16384 / std::max(1, chunk), 1, 1024);
+      const dim3 warps((chunk + kWarpsPerBlock - 1) / kWarpsPerBlock, splits);
+      if (m.options.small_threads) {
+        FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.queued, 0, sizeof(int), st));
+        m.timed("small", st, [&] {
+          smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(
+              m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, culled_count,
+              m.queue, m.queued, m.options.tile_skip, m.stats);
+          FIELDPATH_CUDA_CHECK(cudaGetLastError());
+        });
+        m.timed("large", st, [&] {
+          largeKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
+              m.grid, m.tool, chunk_postures, chunk_order, m.queue, m.queued, m.tile_max, m.keys,
+              m.options.tile_skip, m.stats);
+          FIELDPATH_CUDA_CHECK(cudaGetLastError());
+        });
+      } else {
+        m.timed("warp", st, [&] {
+          warpKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
+              m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, culled_count,
+              m.options.tile_skip, m.stats);
+          FIELDPATH_CUDA_CHECK(cudaGetLastError());
+        });
+      }
+    }
+  }
+
   ~Impl() {
     if (copy_stream) cudaStreamSynchronize(copy_stream);
     if (!compute_stream) return;
     cudaStreamSynchronize(compute_stream);
-    for (void* p : owned) cudaFreeAsync(p, compute_stream);
     for (void* p : {static_cast<void*>(keys), static_cast<void*>(tile_max),
                     static_cast<void*>(culled), static_cast<void*>(queued),
                     static_cast<void*>(queue), sort_temp, static_cast<void*>(stats)})
@@ -359,13 +446,6 @@ struct Engine::Impl {
     cudaStreamSynchronize(compute_stream);
     if (copy_stream) cudaStreamDestroy(copy_stream);
     cudaStreamDestroy(compute_stream);
-  }
-
-  template <class T>
-  T* own(const T* host, std::size_t n) {
-    T* p = deviceCopy(host, n, compute_stream);
-    if (p) owned.push_back(p);
-    return p;
   }
 
   /// Room for blocks of `count` postures (waits for the queued work before reallocating).
@@ -393,7 +473,7 @@ struct Engine::Impl {
 };
 
 Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* heights_mm,
-               std::size_t lines, Options options)
+               float stock_mm, std::size_t lines, Options options)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   m.grid = grid;
@@ -411,17 +491,25 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
     if (options.pinned_staging) m.stage[k] = acquirePinned();
   }
   cudaStream_t st = m.compute_stream;
-  m.tool.bvh_nodes = m.own(tool.nodes, tool.node_count);
-  m.tool.bvh_triangles = m.own(tool.triangles, tool.triangle_floats);
-  m.tool.vertices = m.own(tool.vertices, tool.vertex_count);
-  m.tool.indices = m.own(tool.indices, tool.index_count);
-  m.tool.bin_start = m.own(tool.bin_start, tool.bin_start_count);
-  m.tool.bin_items = m.own(tool.bin_items, tool.bin_item_count);
-  m.tool.radial_floor_mm = m.own(tool.radial_floor, tool.radial_count);
+  m.device_tool = deviceTool(tool);
+  const ToolView& dv = m.device_tool->view;
+  m.tool.bvh_nodes = dv.bvh_nodes;
+  m.tool.bvh_triangles = dv.bvh_triangles;
+  m.tool.vertices = dv.vertices;
+  m.tool.indices = dv.indices;
+  m.tool.bin_start = dv.bin_start;
+  m.tool.bin_items = dv.bin_items;
+  m.tool.radial_floor_mm = dv.radial_floor_mm;
   // heights → ordered keys on the device
   deviceAlloc(m.keys, lines, st);
-  m.upload(m.keys, heights_mm, lines * 4, st);
-  orderBitsKernel<<<unsigned((lines + 255) / 256), 256, 0, st>>>(m.keys, lines);
+  if (heights_mm) {
+    m.upload(m.keys, heights_mm, lines * 4, st);
+    orderBitsKernel<<<unsigned((lines + 255) / 256), 256, 0, st>>>(m.keys, lines);
+  } else {
+    std::int32_t bits;
+    std::memcpy(&bits, &stock_mm, 4);
+    fillKernel<<<unsigned((lines + 255) / 256), 256, 0, st>>>(m.keys, lines, orderedBits(bits));
+  }
   FIELDPATH_CUDA_CHECK(cudaGetLastError());
   deviceAlloc(m.tile_max, std::max(1, grid.tiles_x * grid.tiles_y), st);
   deviceAlloc(m.culled, 1, st);
@@ -474,6 +562,18 @@ void Engine::cut(const Posture* block, std::size_t count, bool coarse) {
     coarseKernel<<<(n + 127) / 128, 128, 0, st>>>(m.grid, m.tool, postures, n, m.keys);
     FIELDPATH_CUDA_CHECK(cudaGetLastError());
   } else {
+    const int stride = m.options.prepass_stride;
+    if (stride > 1 && count >= 2 * std::size_t(stride)) {
+      // every stride-th posture in path order first (EngineTuning::prepass_stride), its order in
+      // the other slot's scratch (same stream; the sort below reuses it after); culls not counted
+      const int sparse = static_cast<int>((count + stride - 1) / stride);
+      std::uint32_t* sparse_order = m.sort_index[s ^ 1];
+      m.timed("prepass", st, [&] {
+        strideOrderKernel<<<(sparse + 255) / 256, 256, 0, st>>>(sparse_order, sparse, stride);
+        FIELDPATH_CUDA_CHECK(cudaGetLastError());
+        m.chunks(postures, sparse_order, std::size_t(sparse), nullptr);
+      });
+    }
     const std::uint32_t* order = nullptr;
     if (m.options.lowest_first) {
       m.timed("sort", st, [&] {
@@ -492,40 +592,7 @@ void Engine::cut(const Posture* block, std::size_t count, bool coarse) {
       });
       order = m.sort_index[s];
     }
-    const int tiles = m.grid.tiles_x * m.grid.tiles_y;
-    for (std::size_t begin = 0; begin < count; begin += m.refresh_every) {
-      const int chunk = static_cast<int>(std::min(m.refresh_every, count - begin));
-      const std::uint32_t* chunk_order = order ? order + begin : nullptr;
-      const Posture* chunk_postures = order ? postures : postures + begin;
-      m.timed("tile max", st, [&] {
-        tileMaxKernel<<<(tiles + 255) / 256, 256, 0, st>>>(m.grid, m.keys, m.tile_max);
-        FIELDPATH_CUDA_CHECK(cudaGetLastError());
-      });
-      const int splits = std::clamp(16384 / std::max(1, chunk), 1, 1024);
-      const dim3 warps((chunk + kWarpsPerBlock - 1) / kWarpsPerBlock, splits);
-      if (m.options.small_threads) {
-        FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.queued, 0, sizeof(int), st));
-        m.timed("small", st, [&] {
-          smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(
-              m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, m.culled,
-              m.queue, m.queued, m.options.tile_skip, m.stats);
-          FIELDPATH_CUDA_CHECK(cudaGetLastError());
-        });
-        m.timed("large", st, [&] {
-          largeKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
-              m.grid, m.tool, chunk_postures, chunk_order, m.queue, m.queued, m.tile_max, m.keys,
-              m.options.tile_skip, m.stats);
-          FIELDPATH_CUDA_CHECK(cudaGetLastError());
-        });
-      } else {
-        m.timed("warp", st, [&] {
-          warpKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(m.grid, m.tool, chunk_postures,
-                                                            chunk_order, chunk, m.tile_max, m.keys,
-                                                            m.culled, m.options.tile_skip, m.stats);
-          FIELDPATH_CUDA_CHECK(cudaGetLastError());
-        });
-      }
-    }
+    m.chunks(postures, order, count, m.culled);
   }
   FIELDPATH_CUDA_CHECK(cudaEventRecord(m.computed[s], st));
   // the caller may overwrite `block` once this returns (staged: already copied)

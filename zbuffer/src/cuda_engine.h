@@ -12,6 +12,7 @@ namespace fieldpath::zbuffer::cuda {
 /// Host arrays of a prepared tool (see detail::ToolData); copied to the device by the engine.
 struct ToolArrays {
   ToolView view;
+  std::uint64_t id = 0;  ///< detail::ToolData::id: the device copy is kept for the same id
   const BvhNode* nodes = nullptr;
   std::size_t node_count = 0;
   const float* triangles = nullptr;  ///< 9 floats per triangle
@@ -38,9 +39,11 @@ class Engine {
     bool lowest_first = true, small_threads = true, overlap_upload = true, tile_skip = true,
          pinned_staging = true;
     std::size_t refresh_postures = 0;  ///< 0: from the grid size
+    int prepass_stride = 0;            ///< see EngineTuning::prepass_stride
   };
-  Engine(const GridView& grid, const ToolArrays& tool, const float* heights_mm, std::size_t lines,
-         Options options);
+  /// `heights_mm`: the initial heights (`lines` of them), or null: every line at `stock_mm`.
+  Engine(const GridView& grid, const ToolArrays& tool, const float* heights_mm, float stock_mm,
+         std::size_t lines, Options options);
   ~Engine();
   Engine(const Engine&) = delete;
   Engine& operator=(const Engine&) = delete;

@@ -8,8 +8,7 @@ namespace fieldpath::zbuffer {
 bool cudaAvailable() { return false; }
 
 namespace detail {
-std::unique_ptr<BackendEngine> makeCudaEngine(const GridView&, const ToolData&,
-                                              std::span<const float>, const EngineTuning&) {
+std::unique_ptr<BackendEngine> makeCudaEngine(const EngineSetup&) {
   throw std::runtime_error("fieldpath was built without the CUDA backend");
 }
 }  // namespace detail

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -292,10 +293,18 @@ ToolData prepareTool(const Tool& tool) {
   v.radius_mm = tool.radius_mm;
   v.corner_radius_mm = tool.corner_radius_mm;
   v.length_mm = tool.length_mm;
+  static std::atomic<std::uint64_t> next_id{1};
+  data.id = next_id++;
   if (tool.kind != ToolKind::Mesh) {
     v.hull_radius_mm = tool.radius_mm;
     v.hull_zmin_mm = 0.f;
     v.hull_zmax_mm = tool.length_mm;
+    // The capsule of radius R about the axis from z = r up: the corner piece's points are within
+    // R of (0, 0, r) ((R-r)² + 2(R-r) r cos θ + r² <= R²), the shank's within R of the axis.
+    const float pad = 1e-6f * (tool.radius_mm + tool.length_mm);
+    v.cap_radius_mm = tool.radius_mm * (1.f + 1e-6f) + pad;
+    v.cap_z0_mm = tool.corner_radius_mm - pad;
+    v.cap_z1_mm = tool.length_mm + pad;
     return data;
   }
   const ToolMesh& mesh = tool.mesh;
@@ -311,6 +320,18 @@ ToolData prepareTool(const Tool& tool) {
   v.hull_radius_mm = hull_r * (1.f + 1e-6f) + 1e-6f * size;
   v.hull_zmin_mm = all.lo[2];
   v.hull_zmax_mm = all.hi[2];
+  // Capsule: radius the hull's; its segment starts as low as every vertex allows (vertex within R
+  // of (0, 0, c) or above it: c <= z + sqrt(R² - ρ²)). It holds every vertex, hence (convex) the
+  // whole mesh.
+  double cap_z0 = all.hi[2];
+  const double cap_r = v.hull_radius_mm;
+  for (const auto& p : mesh.vertices) {
+    const double rho2 = double(p.x) * p.x + double(p.y) * p.y;
+    cap_z0 = std::min(cap_z0, p.z + std::sqrt(std::max(0.0, cap_r * cap_r - rho2)));
+  }
+  v.cap_radius_mm = v.hull_radius_mm;
+  v.cap_z0_mm = static_cast<float>(cap_z0 - 1e-6 * size);
+  v.cap_z1_mm = all.hi[2] + 1e-6f * size;
 
   BvhBuilder b{mesh, {}, {}, {}, 1e-5f * size};
   b.order.resize(mesh.triangles.size());
@@ -397,19 +418,20 @@ bool sameTool(const Tool& a, const Tool& b) {
 /// prepareTool with a one-entry cache: a mesh tool's BVH, bins and radial floors (several ms for
 /// 25 000 triangles) are built once for a run of simulations with the same tool (compared bit
 /// for bit, a fraction of a millisecond).
-detail::ToolData preparedTool(const Tool& tool) {
+std::shared_ptr<const detail::ToolData> preparedTool(const Tool& tool) {
   static std::mutex mutex;
   static Tool cached_tool;
   static std::shared_ptr<const detail::ToolData> cached;
   {
     std::lock_guard lock(mutex);
-    if (cached && sameTool(cached_tool, tool)) return *cached;
+    if (cached && sameTool(cached_tool, tool)) return cached;
   }
-  auto data = std::make_shared<const detail::ToolData>(detail::prepareTool(tool));
+  auto data = std::make_shared<detail::ToolData>(detail::prepareTool(tool));
+  data->pointViewAtVectors();
   std::lock_guard lock(mutex);
   cached_tool = tool;
   cached = data;
-  return *data;
+  return data;
 }
 
 /// Runs the blocks that `next` hands out (an empty span ends), without copying them;
@@ -430,22 +452,23 @@ SimulationResult run(const SimulationRequest& request, std::size_t expected_post
     throw InputError("backend cuda: no CUDA device available (built without CUDA or no GPU)");
 
   const auto entered = std::chrono::steady_clock::now();
-  detail::ToolData tool = preparedTool(request.tool);
-  tool.pointViewAtVectors();
-  if (!request.tuning.vertical_bins) tool.view.bins = 0;
   const int shift = request.tuning.tile_shift;
   if (shift < 1 || shift > 8) throw InputError("tuning: tile_shift must be in [1, 8]");
-  const GridView g = detail::makeGridView(grid, shift);
-  std::vector<float> stock;  // only where no initial heights are given
-  if (request.initial_heights_mm.empty()) stock.assign(grid.lineCount(), request.stock_mm);
-  const std::span<const float> initial = request.initial_heights_mm.empty()
-                                             ? std::span<const float>(stock)
-                                             : request.initial_heights_mm;
+  if (request.tuning.prepass_stride < 0)
+    throw InputError("tuning: prepass_stride must be 0 (off) or positive");
+  detail::EngineSetup setup;
+  setup.grid = detail::makeGridView(grid, shift);
+  setup.tool = preparedTool(request.tool);  // shared, never copied: the view points into it
+  setup.view = setup.tool->view;
+  if (!request.tuning.vertical_bins) setup.view.bins = 0;
+  if (!request.tuning.capsule_floor) setup.view.cap_radius_mm = 0.f;
+  setup.heights_mm = request.initial_heights_mm;  // empty: every line at the stock
+  setup.stock_mm = request.stock_mm;
+  setup.tuning = request.tuning;
 
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<detail::BackendEngine> engine =
-      backend == Backend::Cuda ? detail::makeCudaEngine(g, tool, initial, request.tuning)
-                               : detail::makeCpuEngine(g, tool, initial, request.tuning);
+      backend == Backend::Cuda ? detail::makeCudaEngine(setup) : detail::makeCpuEngine(setup);
   SimulationResult result;
   result.backend = backend;
   for (;;) {
@@ -461,8 +484,15 @@ SimulationResult run(const SimulationRequest& request, std::size_t expected_post
   result.postures_culled = engine->culled();
   const auto read = std::chrono::steady_clock::now();
   result.seconds = std::chrono::duration<double>(read - start).count();
-  for (std::size_t i = 0; i < initial.size(); ++i)
-    result.lines_lowered += result.heights_mm[i] < initial[i];
+  const float* h = result.heights_mm.data();
+  const float* initial =
+      request.initial_heights_mm.empty() ? nullptr : request.initial_heights_mm.data();
+  const float stock = request.stock_mm;
+  const long lines = static_cast<long>(result.heights_mm.size());
+  std::size_t lowered = 0;
+#pragma omp parallel for schedule(static) reduction(+ : lowered) if (lines > (1 << 20))
+  for (long i = 0; i < lines; ++i) lowered += h[i] < (initial ? initial[i] : stock);
+  result.lines_lowered = lowered;
   if (std::getenv("FIELDPATH_ZB_TRACE")) {  // benchmarks: where the host's time goes
     const auto ms = [](auto a, auto b) {
       return std::chrono::duration<double, std::milli>(b - a).count();

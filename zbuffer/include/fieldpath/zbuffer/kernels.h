@@ -55,6 +55,10 @@ struct ToolView {
   const float* radial_floor_mm = nullptr;
   std::int32_t radial_bins = 0;
   float radial_inv_mm = 0, radial_max_mm = 0;
+  // All kinds: a capsule that contains the tool, the points within cap_radius_mm of the axis
+  // segment z in [cap_z0_mm, cap_z1_mm] (tool frame). Its lower envelope is a floor of the heights
+  // any posture (tilted ones too) can give a line or a tile, at a square root's cost; 0: none.
+  float cap_radius_mm = 0, cap_z0_mm = 0, cap_z1_mm = 0;
 };
 
 /// Everything a posture needs, computed once per posture.
@@ -70,6 +74,9 @@ struct PreparedPosture {
   int kx, ky, kz;
   float sx, sy, sz;
   Vec3f inv_dir;  ///< 1/dir with zeros replaced by ±1e-30 (no 0·∞ in the slab test)
+  // The tool's capsule (ToolView::cap_*) placed: its axis segment seen from above, a → b (mm,
+  // world xy relative to the tip), the segment's lowest world z, and a rounding margin (mm).
+  float cap_ax, cap_ay, cap_bx, cap_by, cap_zlow_mm, cap_margin_mm;
 };
 
 FIELDPATH_HD float safeInverse(float v) { return 1.f / (v == 0.f ? 1e-30f : v); }
@@ -151,7 +158,69 @@ FIELDPATH_HD PreparedPosture preparePosture(const GridView& g, const ToolView& t
   pp.sy = comp(pp.dir, pp.ky) / dkz;
   pp.sz = 1.f / dkz;
   pp.inv_dir = {safeInverse(pp.dir.x), safeInverse(pp.dir.y), safeInverse(pp.dir.z)};
+
+  const float c0 = tool.cap_z0_mm, c1 = tool.cap_z1_mm;
+  pp.cap_ax = c0 * i;
+  pp.cap_ay = c0 * j;
+  pp.cap_bx = c1 * i;
+  pp.cap_by = c1 * j;
+  pp.cap_zlow_mm = pose.tip_mm.z + minf(c0 * k, c1 * k);
+  pp.cap_margin_mm =
+      1e-5f * (absf(pose.tip_mm.z) + tool.cap_radius_mm + absf(c0) + absf(c1)) + 1e-6f;
   return pp;
+}
+
+/// Distance (mm) in the grid plane from point p to the segment a → b.
+FIELDPATH_HD float segmentDistance(float px, float py, float ax, float ay, float bx, float by) {
+  const float ex = bx - ax, ey = by - ay, len2 = ex * ex + ey * ey;
+  float u = len2 > 0.f ? ((px - ax) * ex + (py - ay) * ey) / len2 : 0.f;
+  u = u < 0.f ? 0.f : (u > 1.f ? 1.f : u);
+  const float dx = px - (ax + u * ex), dy = py - (ay + u * ey);
+  return sqrtf(dx * dx + dy * dy);
+}
+
+/// Distance (mm) in the grid plane from the rectangle [x0, x1] × [y0, y1] to the segment a → b:
+/// 0 if they meet (Liang-Barsky clip), else attained at a vertex of one of the two.
+FIELDPATH_HD float rectSegmentDistance(float x0, float x1, float y0, float y1, float ax, float ay,
+                                       float bx, float by) {
+  const float dx = bx - ax, dy = by - ay;
+  const float p[4] = {-dx, dx, -dy, dy}, q[4] = {ax - x0, x1 - ax, ay - y0, y1 - ay};
+  float t0 = 0.f, t1 = 1.f;
+  bool meets = true;
+  for (int k = 0; k < 4; ++k) {
+    if (p[k] == 0.f) {
+      if (q[k] < 0.f) meets = false;
+    } else {
+      const float r = q[k] / p[k];
+      if (p[k] < 0.f)
+        t0 = maxf(t0, r);
+      else
+        t1 = minf(t1, r);
+    }
+  }
+  if (meets && t0 <= t1) return 0.f;
+  const auto pointRect = [&](float px, float py) {
+    const float ex = maxf(maxf(x0 - px, px - x1), 0.f), ey = maxf(maxf(y0 - py, py - y1), 0.f);
+    return sqrtf(ex * ex + ey * ey);
+  };
+  float d = minf(pointRect(ax, ay), pointRect(bx, by));
+  d = minf(d, segmentDistance(x0, y0, ax, ay, bx, by));
+  d = minf(d, segmentDistance(x1, y0, ax, ay, bx, by));
+  d = minf(d, segmentDistance(x0, y1, ax, ay, bx, by));
+  return minf(d, segmentDistance(x1, y1, ax, ay, bx, by));
+}
+
+/// Floor of the capsule's lower envelope over the points at grid-plane distance >= d_mm from its
+/// placed axis segment: a point of the capsule above such a point is at most
+/// sqrt(R² - d²) below the segment. FLT_MAX where the capsule does not reach (d >= R). The
+/// distance is shrunk and the floor lowered by the posture's margin, far more than the float
+/// rounding of d, of this expression and of the tool's own entry height, so the floor is never
+/// above a height lineCut can give.
+FIELDPATH_HD float capsuleFloor(const ToolView& tool, const PreparedPosture& pp, float d_mm) {
+  const float r = tool.cap_radius_mm;
+  const float d = maxf(d_mm * (1.f - 1e-5f) - pp.cap_margin_mm, 0.f);
+  if (!(d < r)) return FLT_MAX;
+  return pp.cap_zlow_mm - sqrtf((r - d) * (r + d)) - pp.cap_margin_mm;
 }
 
 /// World coordinates of line (ix, iy) relative to the tip, formed in double, rounded once.
@@ -367,6 +436,10 @@ FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const Prepar
         maxf(floor_z,
              pp.tip_mm.z + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]);
     if (!(current_mm > floor_z)) return FLT_MAX;
+  } else if (tool.cap_radius_mm > 0.f) {
+    // a skip test only (no clamp): the margin keeps it below any height computed below
+    const float d = segmentDistance(rx, ry, pp.cap_ax, pp.cap_ay, pp.cap_bx, pp.cap_by);
+    if (!(current_mm > capsuleFloor(tool, pp, d))) return FLT_MAX;
   }
   const Vec3f o = mulTransposed(pp.rot, Vec3f{rx, ry, 0.f});
   float t;
@@ -387,12 +460,17 @@ FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const Prepar
 /// whose highest line is at or below it is skipped whole without changing a bit. Vertical mesh
 /// tools: the radial floor at the rectangle's smallest line radius (the table is non-decreasing,
 /// and each line's float radius is at least that one: the same monotone float expressions).
+/// Other postures and tools: the capsule's floor at the rectangle's distance from its segment.
 FIELDPATH_HD float rectFloor(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
                              int ix0, int ix1, int iy0, int iy1) {
-  if (!(pp.vertical && tool.radial_bins > 0)) return pp.lowest_z_mm;
   float ax, ay, bx, by;
   lineOffset(g, pp, ix0, iy0, ax, ay);
   lineOffset(g, pp, ix1, iy1, bx, by);
+  if (!(pp.vertical && tool.radial_bins > 0)) {
+    if (!(tool.cap_radius_mm > 0.f)) return pp.lowest_z_mm;
+    const float d = rectSegmentDistance(ax, bx, ay, by, pp.cap_ax, pp.cap_ay, pp.cap_bx, pp.cap_by);
+    return maxf(pp.lowest_z_mm, capsuleFloor(tool, pp, d));
+  }
   const float rx = (ax <= 0.f && bx >= 0.f) ? 0.f : minf(absf(ax), absf(bx));
   const float ry = (ay <= 0.f && by >= 0.f) ? 0.f : minf(absf(ay), absf(by));
   const float rho = sqrtf(rx * rx + ry * ry);

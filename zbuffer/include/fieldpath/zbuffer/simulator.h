@@ -78,6 +78,14 @@ struct EngineTuning {
   /// Postures between refreshes of the culling tiles' maxima; 0: chosen from the grid size.
   std::size_t refresh_postures = 0;
   int tile_shift = 4;  ///< culling tiles of 2^shift × 2^shift lines, shift in [1, 8]
+  /// Every prepass_stride-th posture of a block (in path order) cuts first, then the tile maxima
+  /// are refreshed and the whole block cuts: neighbours along a path cut nearly the same heights,
+  /// so the lines start near their final height and the floors (radial, capsule) and tile skips
+  /// turn most of the block's line visits away at one compare. 0 or 1: no prepass.
+  int prepass_stride = 8;
+  /// Capsule floor (ToolView::cap_*) for lines and tiles without a radial floor (tilted postures,
+  /// analytic tools).
+  bool capsule_floor = true;
 };
 
 struct SimulationRequest {
@@ -125,6 +133,9 @@ namespace detail {
 /// Flattened tool data shared by the backends (leaf-ordered BVH triangles, nodes, indices).
 struct ToolData {
   ToolView view;  ///< pointers into the vectors below (host copies)
+  /// Distinct for every prepareTool call: lets the CUDA backend keep the tool on the device for a
+  /// run of simulations with the same tool.
+  std::uint64_t id = 0;
   std::vector<float> bvh_triangles;
   std::vector<BvhNode> bvh_nodes;
   std::vector<Vec3f> vertices;
@@ -151,14 +162,20 @@ class BackendEngine {
   /// Postures culled so far by the fast engine (valid after heights()).
   virtual std::size_t culled() = 0;
 };
-/// `heights_mm`: the initial heights, read during the call only.
-std::unique_ptr<BackendEngine> makeCpuEngine(const GridView& grid, const ToolData& tool,
-                                             std::span<const float> heights_mm,
-                                             const EngineTuning& tuning);
+/// What an engine starts from. `tool` is kept alive by the engine; `view` is the tool's view as
+/// this run uses it (its pointers into `tool`'s arrays; e.g. bins switched off by a knob).
+/// `heights_mm`: the initial heights, read during the call only; empty: every line at `stock_mm`.
+struct EngineSetup {
+  GridView grid;
+  std::shared_ptr<const ToolData> tool;
+  ToolView view;
+  std::span<const float> heights_mm;
+  float stock_mm = 0.f;
+  EngineTuning tuning;
+};
+std::unique_ptr<BackendEngine> makeCpuEngine(const EngineSetup& setup);
 /// Throws std::runtime_error if built without CUDA or no device is present.
-std::unique_ptr<BackendEngine> makeCudaEngine(const GridView& grid, const ToolData& tool,
-                                              std::span<const float> heights_mm,
-                                              const EngineTuning& tuning);
+std::unique_ptr<BackendEngine> makeCudaEngine(const EngineSetup& setup);
 
 }  // namespace detail
 }  // namespace fieldpath::zbuffer
