@@ -1,11 +1,17 @@
 #include "fieldpath/field/voxel_field.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <limits>
+#include <optional>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include <openvdb/io/Stream.h>
 #include <openvdb/tools/Interpolation.h>
@@ -136,16 +142,6 @@ std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams
   return estimate >= 1e18 ? std::size_t(1e18) : static_cast<std::size_t>(estimate);
 }
 
-struct VoxelField::Impl {
-  Grid::Ptr grid;            ///< F (Force) or G = F / P(s) (PlaneRatio), world frame
-  FloatGrid::Ptr closeness;  ///< PlaneRatio: r0 - s (mm), same topology; background 0 (s = r0)
-  VoxelStats stats;
-  double voxel_size_mm = 0.0;
-  Interpolation interpolation = Interpolation::Trilinear;
-  StoredQuantity stored = StoredQuantity::Force;
-  std::optional<PlaneLaw> law;  ///< PlaneRatio
-};
-
 namespace {
 
 /// Whether x lies over (or under) the sampled surface: its nearest sample less than `over_mm`
@@ -205,171 +201,6 @@ RatioNode planeRatio(const detail::Probe& p, const Vec3& x, const Vec3& q, const
 }
 
 }  // namespace
-
-VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
-    : impl_(std::make_unique<Impl>()) {
-  const auto start = std::chrono::steady_clock::now();
-  const DirectField::Index& index = direct.index();
-  const ObstacleSamples& samples = index.samples;
-  const FieldParams& params = index.params;
-  const double h = request.voxel_size_mm;
-  checkVoxelSize(h);
-  const double band_in_mm = insideBandMm(params, request);
-  const StoredQuantity stored = storedOf(params, request);
-  const bool ratio = stored == StoredQuantity::PlaneRatio;
-  const double reach_mm = reachMm(params, request);
-  const PlaneLaw law(params, weightPerMm2(samples, params));
-  // Sideways reach of a sample (sub-triangle centroids: within 0.87 step of any surface point);
-  // closer to the surface than about one spacing the samples' field is not yet a plane's.
-  const double over_mm = params.sample_step_mm;
-  const double near_mm = request.plane_near_mm.value_or(2.0 * params.r_min_mm);
-
-  auto refuse = [&](const std::string& what, double nodes, double bytes_per_node) {
-    const double bytes = nodes * bytes_per_node;
-    if (bytes <= static_cast<double>(request.max_memory_bytes)) return;
-    throw common::InputError("voxel field at h = " + std::to_string(h) + " mm: " + what + " " +
-                             std::to_string(static_cast<long long>(nodes)) + " nodes (" +
-                             mib(bytes) + "), over the limit of " +
-                             mib(static_cast<double>(request.max_memory_bytes)) +
-                             "; use a coarser voxel size or a smaller region");
-  };
-  impl_->stats.estimated_nodes = estimateVoxelNodes(samples, params, request);
-  // The plane ratio adds a float to the Vec3f of a node.
-  const double value_bytes = ratio ? 16.0 : 12.0;
-  refuse("estimated", static_cast<double>(impl_->stats.estimated_nodes),
-         kVoxelBytesPerNode * value_bytes / 12.0);
-
-  // Candidate leaves (8³ nodes): those within reach of a sample, inside the region.
-  const Eigen::AlignedBox3d reach = reachBox(samples, params, request);
-  std::vector<openvdb::Coord> origins;
-  if (!reach.isEmpty()) {
-    const Vec3 lo_region = reach.min() / h, hi_region = reach.max() / h;
-    const double leaf_mm = kLeafDim * h;
-    for (const Vec3& q : samples.points_mm) {
-      const Vec3 lo = ((q.array() - reach_mm) / h).max(lo_region.array()).ceil();
-      const Vec3 hi = ((q.array() + reach_mm) / h).min(hi_region.array()).floor();
-      if ((lo.array() > hi.array()).any()) continue;
-      const openvdb::Coord a(int(lo.x()), int(lo.y()), int(lo.z()));
-      const openvdb::Coord b(int(hi.x()), int(hi.y()), int(hi.z()));
-      const openvdb::Coord la = a & ~(kLeafDim - 1), lb = b & ~(kLeafDim - 1);
-      for (int i = la.x(); i <= lb.x(); i += kLeafDim)
-        for (int j = la.y(); j <= lb.y(); j += kLeafDim)
-          for (int k = la.z(); k <= lb.z(); k += kLeafDim) {
-            // Distance from q to the leaf's node box.
-            const Vec3 box_lo = Vec3(i, j, k) * h;
-            const Vec3 nearest = q.cwiseMax(box_lo).cwiseMin(box_lo + Vec3::Constant(leaf_mm - h));
-            if ((nearest - q).squaredNorm() < reach_mm * reach_mm) origins.emplace_back(i, j, k);
-          }
-    }
-  }
-  std::sort(origins.begin(), origins.end());
-  origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
-  // Full leaves: the values of a node, masks and header.
-  refuse("candidate leaves hold", static_cast<double>(origins.size()) * Leaf::SIZE,
-         static_cast<double>(sizeof(Leaf)) / Leaf::SIZE * value_bytes / 12.0 + 12.0);
-
-  auto grid = Grid::create(openvdb::Vec3s(0.0f));
-  grid->setTransform(openvdb::math::Transform::createLinearTransform(h));
-  grid->setName(ratio ? "plane_ratio" : "force");
-  grid->setVectorType(openvdb::VEC_INVARIANT);
-  FloatGrid::Ptr closeness;
-  if (ratio) {
-    closeness = FloatGrid::create(0.0f);
-    closeness->setTransform(grid->transform().copy());
-    closeness->setName("plane_closeness");
-  }
-  std::vector<Leaf*> leaves;
-  std::vector<FloatLeaf*> float_leaves;
-  leaves.reserve(origins.size());
-  for (const auto& o : origins) {
-    leaves.push_back(grid->tree().touchLeaf(o));
-    if (ratio) float_leaves.push_back(closeness->tree().touchLeaf(o));
-  }
-
-  // Node values from the exact law, per leaf over the samples near it; in batches between
-  // which the progress hook is called (from this thread only).
-  const std::size_t batches =
-      std::max<std::size_t>(1, std::min<std::size_t>(20, leaves.size() / 64));
-  for (std::size_t batch = 0; batch < batches; ++batch) {
-    const std::size_t begin = leaves.size() * batch / batches;
-    const std::size_t end = leaves.size() * (batch + 1) / batches;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 1), [&](const auto& range) {
-      auto searcher = index.searcher();
-      std::vector<std::size_t> near;
-      for (std::size_t l = range.begin(); l != range.end(); ++l) {
-        Leaf& leaf = *leaves[l];
-        const openvdb::Coord o = leaf.origin();
-        const Vec3 lo = Vec3(o.x(), o.y(), o.z()) * h;
-        const Vec3 hi = lo + Vec3::Constant((kLeafDim - 1) * h);
-        // Samples within reach of the leaf's nodes, gathered once; the surface rule's second
-        // sum, at a point lifted off the wall (rare: nodes within r_min or inside), searches the
-        // index.
-        near.clear();
-        index.forEachInBox(searcher, lo.array() - reach_mm, hi.array() + reach_mm,
-                           [&](std::size_t j) { near.push_back(j); });
-        for (auto it = leaf.beginValueAll(); it; ++it) {
-          const openvdb::Coord ijk = it.getCoord();
-          const Vec3 x(ijk.x() * h, ijk.y() * h, ijk.z() * h);
-          if (request.region_mm && !request.region_mm->contains(x)) continue;
-          auto for_each_near = [&](const Vec3& center, double radius, auto&& fn) {
-            if (center == x)
-              for (std::size_t j : near) fn(j);
-            else
-              index.forEachNear(searcher, center, radius, fn);
-          };
-          const detail::Probe p = detail::probe(x, for_each_near, samples.points_mm,
-                                                samples.normals, samples.weights, params, reach_mm);
-          if (p.nearest < 0 || (p.height_mm < -band_in_mm && overSurface(p, over_mm))) continue;
-          Vec3 value;
-          if (ratio) {
-            const RatioNode node = planeRatio(
-                p, x, samples.points_mm[p.nearest], samples.normals[p.nearest], law, params.gain,
-                over_mm, near_mm,
-                [&](const Vec3& at) { return index.fieldAt(searcher, at).value_or(Vec3::Zero()); });
-            // The closeness grid's active mask carries `over` (see ratioHolds).
-            const float closeness_mm = float(params.r0_mm - node.s_mm);
-            if (node.over)
-              float_leaves[l]->setValueOn(it.pos(), closeness_mm);
-            else
-              float_leaves[l]->setValueOff(it.pos(), closeness_mm);
-            value = node.g;
-          } else {
-            if (!p.force) continue;
-            value = *p.force;
-          }
-          it.setValue(openvdb::Vec3s(float(value.x()), float(value.y()), float(value.z())));
-          it.setValueOn();
-        }
-      }
-    });
-    common::report(request.progress, double(batch + 1) / double(batches), "field");
-  }
-  openvdb::tools::pruneInactive(grid->tree());
-  // (closeness keeps its leaves: its inactive nodes hold values, those beyond open edges.)
-
-  VoxelStats& stats = impl_->stats;
-  stats.active_nodes = grid->activeVoxelCount();
-  const openvdb::CoordBBox active_box = grid->evalActiveVoxelBoundingBox();
-  stats.dense_box_nodes = active_box.empty() ? 0 : active_box.volume();
-  stats.memory_bytes = grid->memUsage() + (closeness ? closeness->memUsage() : 0);
-  stats.build_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  impl_->grid = std::move(grid);
-  impl_->closeness = std::move(closeness);
-  impl_->voxel_size_mm = h;
-  impl_->interpolation = request.interpolation;
-  impl_->stored = stored;
-  if (ratio) impl_->law = law;
-}
-
-VoxelField::~VoxelField() = default;
-VoxelField::VoxelField(VoxelField&&) noexcept = default;
-VoxelField& VoxelField::operator=(VoxelField&&) noexcept = default;
-
-const VoxelStats& VoxelField::stats() const { return impl_->stats; }
-double VoxelField::voxelSizeMm() const { return impl_->voxel_size_mm; }
-Interpolation VoxelField::interpolation() const { return impl_->interpolation; }
-StoredQuantity VoxelField::stored() const { return impl_->stored; }
 
 namespace {
 
@@ -433,43 +264,536 @@ bool ratioHolds(const double (&s)[8], const bool (&over)[8]) {
 
 }  // namespace
 
+
+namespace {
+
+using IndexGrid = openvdb::Int32Grid;
+constexpr int kBlockDim = kLeafDim + 1;                  ///< a leaf's nodes and the +1 layer
+constexpr int kBlockNodes = kBlockDim * kBlockDim * kBlockDim;  // 729
+constexpr int kBlockWords = (kBlockNodes + 63) / 64;     ///< bits of one flag per block node
+constexpr int kCellWords = Leaf::SIZE / 64;              ///< bits of one flag per leaf cell
+/// Offsets of a cell's 8 corners in a block (index bits: x 4, y 2, z 1, as cellCorners).
+constexpr int kCornerOffset[8] = {0,
+                                  1,
+                                  kBlockDim,
+                                  kBlockDim + 1,
+                                  kBlockDim * kBlockDim,
+                                  kBlockDim * kBlockDim + 1,
+                                  kBlockDim * kBlockDim + kBlockDim,
+                                  kBlockDim * kBlockDim + kBlockDim + 1};
+
+bool bit(const std::vector<std::uint64_t>& words, std::size_t i) {
+  return (words[i >> 6] >> (i & 63)) & 1u;
+}
+
+/// One level of the grid: the OpenVDB grids (build, save) and their query form, a block per
+/// leaf holding its 8³ nodes and the first layer of its +x, +y, +z neighbours (9³), so that every
+/// cell of the leaf reads its 8 corners from one place after one index lookup.
+struct Level {
+  double h_mm = 0.0;
+  Grid::Ptr grid;            ///< F (Force) or G = F / P(s) (PlaneRatio), world frame
+  FloatGrid::Ptr closeness;  ///< PlaneRatio: r0 - s (mm), same topology; background 0 (s = r0)
+  IndexGrid::Ptr block_of;   ///< leaf coordinate (node ijk >> 3) → block number; background -1
+  std::vector<std::array<float, 4>> nodes;  ///< per block: value xyz, closeness
+  std::vector<std::uint64_t> over;     ///< per block node: over/under the surface (ratioHolds)
+  std::vector<std::uint64_t> refined;  ///< per leaf cell: read the next level instead
+
+  std::size_t blocks() const { return nodes.size() / kBlockNodes; }
+  std::size_t memUsage() const {
+    return grid->memUsage() + (closeness ? closeness->memUsage() : 0) + block_of->memUsage() +
+           nodes.size() * sizeof(nodes[0]) + (over.size() + refined.size()) * 8;
+  }
+};
+
+/// Where a point falls at one level: its block, the cell's first node in it, the cell in the
+/// leaf and the fractions in the cell. False outside every block (zero field).
+struct CellRef {
+  std::size_t node0 = 0, cell = 0, block = 0;
+  Vec3 t;
+};
+
+bool locate(const Level& level, const IndexGrid::ConstAccessor& acc, const Vec3& x_mm,
+            CellRef& out) {
+  const Vec3 p = x_mm / level.h_mm;  // index space
+  const Vec3 base = p.array().floor();
+  const int i = int(base.x()), j = int(base.y()), k = int(base.z());
+  const int b = acc.getValue(openvdb::Coord(i >> 3, j >> 3, k >> 3));  // floor division by 8
+  if (b < 0) return false;
+  const int li = i & (kLeafDim - 1), lj = j & (kLeafDim - 1), lk = k & (kLeafDim - 1);
+  out.block = std::size_t(b);
+  out.node0 = out.block * kBlockNodes + std::size_t((li * kBlockDim + lj) * kBlockDim + lk);
+  out.cell = std::size_t((li * kLeafDim + lj) * kLeafDim + lk);
+  out.t = p - base;
+  return true;
+}
+
+/// The block form of a level's grids (Level::nodes, over; refined cleared).
+void makeBlocks(Level& level, bool ratio) {
+  std::vector<const Leaf*> leaves;
+  for (auto it = level.grid->tree().cbeginLeaf(); it; ++it) leaves.push_back(&*it);
+  level.block_of = IndexGrid::create(-1);
+  {
+    auto acc = level.block_of->getAccessor();
+    for (std::size_t b = 0; b < leaves.size(); ++b)
+      acc.setValueOn(leaves[b]->origin() >> 3, static_cast<int>(b));
+  }
+  level.nodes.assign(leaves.size() * kBlockNodes, {0.0f, 0.0f, 0.0f, 0.0f});
+  level.over.assign(leaves.size() * kBlockWords, 0);
+  level.refined.assign(leaves.size() * kCellWords, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
+    auto values = level.grid->getConstAccessor();
+    std::optional<FloatGrid::ConstAccessor> closeness;
+    if (ratio) closeness.emplace(level.closeness->getConstAccessor());
+    for (std::size_t b = range.begin(); b != range.end(); ++b) {
+      const openvdb::Coord o = leaves[b]->origin();
+      std::uint64_t* over = &level.over[b * kBlockWords];
+      for (int i = 0, n = 0; i < kBlockDim; ++i)
+        for (int j = 0; j < kBlockDim; ++j)
+          for (int k = 0; k < kBlockDim; ++k, ++n) {
+            const openvdb::Coord ijk = o.offsetBy(i, j, k);
+            const openvdb::Vec3s v = values.getValue(ijk);
+            float c = 0.0f;
+            if (ratio) {
+              c = closeness->getValue(ijk);
+              if (closeness->isValueOn(ijk)) over[n >> 6] |= std::uint64_t{1} << (n & 63);
+            }
+            level.nodes[b * kBlockNodes + n] = {v.x(), v.y(), v.z(), c};
+          }
+    }
+  });
+}
+
+/// The trilinear value of one level's cell (no refinement): F, or for the plane ratio
+/// P(s~)·G~ where ratioHolds, else the blend of the corner forces.
+Vec3 cellValue(const Level& level, const CellRef& cell, const std::optional<PlaneLaw>& law) {
+  const std::array<float, 4>* n = &level.nodes[cell.node0];
+  const Vec3& t = cell.t;
+  const double w[2][3] = {{1 - t.x(), 1 - t.y(), 1 - t.z()}, {t.x(), t.y(), t.z()}};
+  double weight[8];
+  for (int c = 0; c < 8; ++c) weight[c] = w[c >> 2][0] * w[(c >> 1) & 1][1] * w[c & 1][2];
+  if (!law) {
+    Vec3 f = Vec3::Zero();
+    for (int c = 0; c < 8; ++c) {
+      const auto& v = n[kCornerOffset[c]];
+      f += weight[c] * Vec3(v[0], v[1], v[2]);
+    }
+    return f;
+  }
+  double s[8];
+  bool over[8];
+  const std::size_t first = cell.node0 - cell.block * kBlockNodes;
+  for (int c = 0; c < 8; ++c) {
+    s[c] = law->r0_mm - n[kCornerOffset[c]][3];
+    over[c] = bit(level.over, cell.block * kBlockWords * 64 + first + kCornerOffset[c]);
+  }
+  Vec3 g = Vec3::Zero();
+  if (!ratioHolds(s, over)) {  // the node forces
+    for (int c = 0; c < 8; ++c) {
+      const auto& v = n[kCornerOffset[c]];
+      g += weight[c] * law->at(s[c]) * Vec3(v[0], v[1], v[2]);
+    }
+    return g;
+  }
+  double closeness = 0.0;
+  for (int c = 0; c < 8; ++c) {
+    const auto& v = n[kCornerOffset[c]];
+    g += weight[c] * Vec3(v[0], v[1], v[2]);
+    closeness += weight[c] * v[3];
+  }
+  return law->at(law->r0_mm - closeness) * g;
+}
+
+/// Per-thread query state: one index accessor per level.
+struct LevelAccessors {
+  std::vector<IndexGrid::ConstAccessor> index;
+};
+
+LevelAccessors accessorsOf(const std::vector<Level>& levels) {
+  LevelAccessors a;
+  for (const Level& level : levels) a.index.push_back(level.block_of->getConstAccessor());
+  return a;
+}
+
+/// The trilinear field at x: the finest level whose cell holds x and is not refined, reading
+/// at most `max_level` (the build tests a level before the next exists).
+Vec3 trilinearAt(const std::vector<Level>& levels, LevelAccessors& acc, const Vec3& x_mm,
+                 const std::optional<PlaneLaw>& law, std::size_t max_level) {
+  CellRef cell;
+  if (!locate(levels[0], acc.index[0], x_mm, cell)) return Vec3::Zero();
+  std::size_t l = 0;
+  while (l < max_level && l + 1 < levels.size() && bit(levels[l].refined, cell.block * 512 + cell.cell)) {
+    CellRef fine;
+    if (!locate(levels[l + 1], acc.index[l + 1], x_mm, fine)) break;
+    cell = fine;
+    ++l;
+  }
+  return cellValue(levels[l], cell, law);
+}
+
+}  // namespace
+
+struct VoxelField::Impl {
+  std::vector<Level> levels;  ///< [0]: h, then h/2, h/4, ... where refined
+  VoxelStats stats;
+  double voxel_size_mm = 0.0;
+  Interpolation interpolation = Interpolation::Trilinear;
+  StoredQuantity stored = StoredQuantity::Force;
+  std::optional<PlaneLaw> law;  ///< PlaneRatio
+};
+
+namespace {
+
+/// What the node values of every level are made from.
+struct NodeBuilder {
+  const DirectField::Index& index;
+  const VoxelRequest& request;
+  bool ratio;
+  double band_in_mm, reach_mm, over_mm, near_mm;
+  PlaneLaw law;
+
+  /// Computes the nodes of `origins` (leaves of a level of size h): all of a leaf's nodes, or
+  /// those on in `only`. Returns the level's grids (inactive nodes pruned from the value grid).
+  /// Progress between batches, from this thread only.
+  std::pair<Grid::Ptr, FloatGrid::Ptr> build(double h, const std::vector<openvdb::Coord>& origins,
+                                              const openvdb::MaskGrid* only,
+                                              const std::function<void(double)>& progress) const {
+    const ObstacleSamples& samples = index.samples;
+    const FieldParams& params = index.params;
+    auto grid = Grid::create(openvdb::Vec3s(0.0f));
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(h));
+    grid->setName(ratio ? "plane_ratio" : "force");
+    grid->setVectorType(openvdb::VEC_INVARIANT);
+    FloatGrid::Ptr closeness;
+    if (ratio) {
+      closeness = FloatGrid::create(0.0f);
+      closeness->setTransform(grid->transform().copy());
+      closeness->setName("plane_closeness");
+    }
+    std::vector<Leaf*> leaves;
+    std::vector<FloatLeaf*> float_leaves;
+    leaves.reserve(origins.size());
+    for (const auto& o : origins) {
+      leaves.push_back(grid->tree().touchLeaf(o));
+      if (ratio) float_leaves.push_back(closeness->tree().touchLeaf(o));
+    }
+    const std::size_t batches =
+        std::max<std::size_t>(1, std::min<std::size_t>(20, leaves.size() / 64));
+    for (std::size_t batch = 0; batch < batches; ++batch) {
+      const std::size_t begin = leaves.size() * batch / batches;
+      const std::size_t end = leaves.size() * (batch + 1) / batches;
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 1), [&](const auto& range) {
+        auto searcher = index.searcher();
+        std::optional<openvdb::MaskGrid::ConstAccessor> wanted;
+        if (only) wanted.emplace(only->getConstAccessor());
+        std::vector<std::size_t> near;
+        for (std::size_t l = range.begin(); l != range.end(); ++l) {
+          Leaf& leaf = *leaves[l];
+          const openvdb::Coord o = leaf.origin();
+          const Vec3 lo = Vec3(o.x(), o.y(), o.z()) * h;
+          const Vec3 hi = lo + Vec3::Constant((kLeafDim - 1) * h);
+          // Samples within reach of the leaf's nodes, gathered once; the surface rule's second
+          // sum, at a point lifted off the wall (rare: nodes within r_min or inside), searches
+          // the index.
+          near.clear();
+          index.forEachInBox(searcher, lo.array() - reach_mm, hi.array() + reach_mm,
+                             [&](std::size_t j) { near.push_back(j); });
+          for (auto it = leaf.beginValueAll(); it; ++it) {
+            const openvdb::Coord ijk = it.getCoord();
+            if (wanted && !wanted->isValueOn(ijk)) continue;
+            const Vec3 x(ijk.x() * h, ijk.y() * h, ijk.z() * h);
+            if (request.region_mm && !request.region_mm->contains(x)) continue;
+            auto for_each_near = [&](const Vec3& center, double radius, auto&& fn) {
+              if (center == x)
+                for (std::size_t j : near) fn(j);
+              else
+                index.forEachNear(searcher, center, radius, fn);
+            };
+            const detail::Probe p =
+                detail::probe(x, for_each_near, samples.points_mm, samples.normals,
+                              samples.weights, params, reach_mm);
+            if (p.nearest < 0 || (p.height_mm < -band_in_mm && overSurface(p, over_mm))) continue;
+            Vec3 value;
+            if (ratio) {
+              const RatioNode node =
+                  planeRatio(p, x, samples.points_mm[p.nearest], samples.normals[p.nearest], law,
+                             params.gain, over_mm, near_mm, [&](const Vec3& at) {
+                               return index.fieldAt(searcher, at).value_or(Vec3::Zero());
+                             });
+              // The closeness grid's active mask carries `over` (see ratioHolds).
+              const float closeness_mm = float(params.r0_mm - node.s_mm);
+              if (node.over)
+                float_leaves[l]->setValueOn(it.pos(), closeness_mm);
+              else
+                float_leaves[l]->setValueOff(it.pos(), closeness_mm);
+              value = node.g;
+            } else {
+              if (!p.force) continue;
+              value = *p.force;
+            }
+            it.setValue(openvdb::Vec3s(float(value.x()), float(value.y()), float(value.z())));
+            it.setValueOn();
+          }
+        }
+      });
+      if (progress) progress(double(batch + 1) / double(batches));
+    }
+    openvdb::tools::pruneInactive(grid->tree());
+    // (closeness keeps its leaves: its inactive nodes hold values, those beyond open edges.)
+    return {grid, closeness};
+  }
+};
+
+/// Cells of level 0 to test: every cell of a block with a non-zero corner (index coordinates).
+std::vector<openvdb::Coord> cellsWithValues(const Level& level) {
+  std::vector<openvdb::Coord> cells;
+  auto acc = level.block_of->getConstAccessor();
+  for (auto it = level.block_of->cbeginValueOn(); it; ++it) {
+    const std::size_t b = std::size_t(*it);
+    const openvdb::Coord o = it.getCoord() << 3;
+    for (int i = 0; i < kLeafDim; ++i)
+      for (int j = 0; j < kLeafDim; ++j)
+        for (int k = 0; k < kLeafDim; ++k) {
+          const std::size_t n0 = b * kBlockNodes + std::size_t((i * kBlockDim + j) * kBlockDim + k);
+          bool any = false;
+          for (int c = 0; c < 8 && !any; ++c) {
+            const auto& v = level.nodes[n0 + kCornerOffset[c]];
+            any = v[0] != 0.0f || v[1] != 0.0f || v[2] != 0.0f;
+          }
+          if (any) cells.push_back(o.offsetBy(i, j, k));
+        }
+  }
+  return cells;
+}
+
+}  // namespace
+
+VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
+    : impl_(std::make_unique<Impl>()) {
+  const auto start = std::chrono::steady_clock::now();
+  const DirectField::Index& index = direct.index();
+  const ObstacleSamples& samples = index.samples;
+  const FieldParams& params = index.params;
+  const double h = request.voxel_size_mm;
+  checkVoxelSize(h);
+  const StoredQuantity stored = storedOf(params, request);
+  const bool ratio = stored == StoredQuantity::PlaneRatio;
+  const double tolerance = request.refine_tolerance.value_or(params.refine_tolerance);
+  const int refine_levels = request.refine_levels.value_or(params.refine_levels);
+  if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
+    throw common::InputError("field.refine_tolerance: must be >= 0 (got " +
+                             std::to_string(tolerance) + ")");
+  if (refine_levels < 0 || refine_levels > 6)
+    throw common::InputError("field.refine_levels: must be in [0, 6] (got " +
+                             std::to_string(refine_levels) + ")");
+  if (tolerance > 0.0 && request.interpolation == Interpolation::Quadratic)
+    throw common::InputError(
+        "field.refine_tolerance: refinement is trilinear only (field.interpolation: quadratic)");
+  // Sideways reach of a sample (sub-triangle centroids: within 0.87 step of any surface point);
+  // closer to the surface than about one spacing the samples' field is not yet a plane's.
+  const NodeBuilder builder{index,
+                            request,
+                            ratio,
+                            insideBandMm(params, request),
+                            reachMm(params, request),
+                            params.sample_step_mm,
+                            request.plane_near_mm.value_or(2.0 * params.r_min_mm),
+                            PlaneLaw(params, weightPerMm2(samples, params))};
+  const double reach_mm = builder.reach_mm;
+
+  auto refuse = [&](const std::string& what, double nodes, double bytes_per_node) {
+    const double bytes = nodes * bytes_per_node;
+    if (bytes <= static_cast<double>(request.max_memory_bytes)) return;
+    throw common::InputError("voxel field at h = " + std::to_string(h) + " mm: " + what + " " +
+                             std::to_string(static_cast<long long>(nodes)) + " nodes (" +
+                             mib(bytes) + "), over the limit of " +
+                             mib(static_cast<double>(request.max_memory_bytes)) +
+                             "; use a coarser voxel size or a smaller region");
+  };
+  impl_->stats.estimated_nodes = estimateVoxelNodes(samples, params, request);
+  // The plane ratio adds a float to the Vec3f of a node.
+  const double value_bytes = ratio ? 16.0 : 12.0;
+  refuse("estimated", static_cast<double>(impl_->stats.estimated_nodes),
+         kVoxelBytesPerNode * value_bytes / 12.0);
+
+  // Candidate leaves (8³ nodes): those within reach of a sample, inside the region.
+  const Eigen::AlignedBox3d reach = reachBox(samples, params, request);
+  std::vector<openvdb::Coord> origins;
+  if (!reach.isEmpty()) {
+    const Vec3 lo_region = reach.min() / h, hi_region = reach.max() / h;
+    const double leaf_mm = kLeafDim * h;
+    for (const Vec3& q : samples.points_mm) {
+      const Vec3 lo = ((q.array() - reach_mm) / h).max(lo_region.array()).ceil();
+      const Vec3 hi = ((q.array() + reach_mm) / h).min(hi_region.array()).floor();
+      if ((lo.array() > hi.array()).any()) continue;
+      const openvdb::Coord a(int(lo.x()), int(lo.y()), int(lo.z()));
+      const openvdb::Coord b(int(hi.x()), int(hi.y()), int(hi.z()));
+      const openvdb::Coord la = a & ~(kLeafDim - 1), lb = b & ~(kLeafDim - 1);
+      for (int i = la.x(); i <= lb.x(); i += kLeafDim)
+        for (int j = la.y(); j <= lb.y(); j += kLeafDim)
+          for (int k = la.z(); k <= lb.z(); k += kLeafDim) {
+            // Distance from q to the leaf's node box.
+            const Vec3 box_lo = Vec3(i, j, k) * h;
+            const Vec3 nearest = q.cwiseMax(box_lo).cwiseMin(box_lo + Vec3::Constant(leaf_mm - h));
+            if ((nearest - q).squaredNorm() < reach_mm * reach_mm) origins.emplace_back(i, j, k);
+          }
+    }
+  }
+  std::sort(origins.begin(), origins.end());
+  origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
+  // Full leaves: the values of a node, masks and header.
+  refuse("candidate leaves hold", static_cast<double>(origins.size()) * Leaf::SIZE,
+         static_cast<double>(sizeof(Leaf)) / Leaf::SIZE * value_bytes / 12.0 + 12.0);
+
+  // Progress: level 0 up to 0.8 without refinement, 0.5 with.
+  const double level0_share = tolerance > 0.0 ? 0.5 : 1.0;
+  std::vector<Level>& levels = impl_->levels;
+  levels.emplace_back();
+  levels[0].h_mm = h;
+  std::tie(levels[0].grid, levels[0].closeness) = builder.build(h, origins, nullptr, [&](double f) {
+    common::report(request.progress, level0_share * f, "field");
+  });
+  makeBlocks(levels[0], ratio);
+  std::optional<PlaneLaw> law;
+  if (ratio) law = builder.law;
+
+  // Refinement: test cells at their centres against the exact field, split those that miss.
+  VoxelStats& stats = impl_->stats;
+  if (tolerance > 0.0 && refine_levels > 0) {
+    const double floor = kRefineFloorFraction * builder.law.at(2.0 * params.r_min_mm);
+    std::vector<openvdb::Coord> cells = cellsWithValues(levels[0]);
+    for (int l = 0; l < refine_levels && !cells.empty(); ++l) {
+      const double hl = levels[l].h_mm;
+      std::vector<char> split(cells.size(), 0);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size()), [&](const auto& range) {
+        auto searcher = index.searcher();
+        LevelAccessors acc = accessorsOf(levels);
+        for (std::size_t c = range.begin(); c != range.end(); ++c) {
+          const openvdb::Coord& ijk = cells[c];
+          const Vec3 x = (Vec3(ijk.x(), ijk.y(), ijk.z()) + Vec3::Constant(0.5)) * hl;
+          if (request.region_mm && !request.region_mm->contains(x)) continue;
+          const Vec3 exact = index.fieldAt(searcher, x).value_or(Vec3::Zero());
+          const Vec3 approx = trilinearAt(levels, acc, x, law, std::size_t(l));
+          split[c] = (approx - exact).norm() > tolerance * std::max(exact.norm(), floor);
+        }
+      });
+      stats.tested_cells += cells.size();
+      // Mark the split cells and gather the nodes of their halves.
+      auto fine_nodes = openvdb::MaskGrid::create(false);
+      std::vector<openvdb::Coord> next_cells;
+      {
+        auto mask = fine_nodes->getAccessor();
+        auto acc = levels[l].block_of->getConstAccessor();
+        for (std::size_t c = 0; c < cells.size(); ++c) {
+          if (!split[c]) continue;
+          const openvdb::Coord& ijk = cells[c];
+          CellRef ref;
+          const Vec3 x = (Vec3(ijk.x(), ijk.y(), ijk.z()) + Vec3::Constant(0.5)) * hl;
+          if (!locate(levels[l], acc, x, ref)) continue;
+          levels[l].refined[ref.block * kCellWords + (ref.cell >> 6)] |= std::uint64_t{1}
+                                                                          << (ref.cell & 63);
+          ++stats.refined_cells;
+          const openvdb::Coord fine = ijk << 1;
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+              for (int k = 0; k < 3; ++k) {
+                mask.setValueOn(fine.offsetBy(i, j, k));
+                if (i < 2 && j < 2 && k < 2) next_cells.push_back(fine.offsetBy(i, j, k));
+              }
+        }
+      }
+      if (next_cells.empty()) break;
+      std::vector<openvdb::Coord> fine_origins;
+      for (auto leaf = fine_nodes->tree().cbeginLeaf(); leaf; ++leaf)
+        fine_origins.push_back(leaf->origin());
+      refuse("refined level " + std::to_string(l + 1) + " holds",
+             double(fine_nodes->activeVoxelCount()) + double(stats.active_nodes),
+             kVoxelBytesPerNode * value_bytes / 12.0);
+      Level fine;
+      fine.h_mm = 0.5 * hl;
+      const double share_begin = level0_share + (1.0 - level0_share) * l / refine_levels;
+      const double share_end = level0_share + (1.0 - level0_share) * (l + 1) / refine_levels;
+      std::tie(fine.grid, fine.closeness) =
+          builder.build(fine.h_mm, fine_origins, fine_nodes.get(), [&](double f) {
+            common::report(request.progress, share_begin + (share_end - share_begin) * f,
+                           "field");
+          });
+      fine.grid->setName(fine.grid->getName() + "_level" + std::to_string(l + 1));
+      if (fine.closeness) fine.closeness->setName("plane_closeness_level" + std::to_string(l + 1));
+      makeBlocks(fine, ratio);
+      stats.refined_nodes += fine.grid->activeVoxelCount();
+      levels.push_back(std::move(fine));
+      cells = std::move(next_cells);
+    }
+  }
+
+  stats.levels = int(levels.size());
+  stats.active_nodes = 0;
+  stats.memory_bytes = 0;
+  for (const Level& level : levels) {
+    stats.active_nodes += level.grid->activeVoxelCount();
+    stats.memory_bytes += level.memUsage();
+  }
+  const openvdb::CoordBBox active_box = levels[0].grid->evalActiveVoxelBoundingBox();
+  stats.dense_box_nodes = active_box.empty() ? 0 : active_box.volume();
+  stats.build_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  impl_->voxel_size_mm = h;
+  impl_->interpolation = request.interpolation;
+  impl_->stored = stored;
+  impl_->law = law;
+  common::report(request.progress, 1.0, "field");
+}
+
+VoxelField::~VoxelField() = default;
+VoxelField::VoxelField(VoxelField&&) noexcept = default;
+VoxelField& VoxelField::operator=(VoxelField&&) noexcept = default;
+
+const VoxelStats& VoxelField::stats() const { return impl_->stats; }
+double VoxelField::voxelSizeMm() const { return impl_->voxel_size_mm; }
+Interpolation VoxelField::interpolation() const { return impl_->interpolation; }
+StoredQuantity VoxelField::stored() const { return impl_->stored; }
+
 void VoxelField::evaluate(std::span<const Vec3> points_mm, std::span<Vec3> forces) const {
   checkSpans(points_mm, forces);
   const Impl& impl = *impl_;
-  const double inv_h = 1.0 / impl.voxel_size_mm;
-  const bool quadratic = impl.interpolation == Interpolation::Quadratic;
+  const std::vector<Level>& levels = impl.levels;
   const bool ratio = impl.stored == StoredQuantity::PlaneRatio;
   // A sample costs tens of ns: below a few thousand points (one tool's nodes) threads cost more
   // than they give.
   constexpr std::size_t kSerialBelow = 4096;
+  if (impl.interpolation == Interpolation::Trilinear) {
+    parallelOverPoints(
+        points_mm.size(), [&] { return accessorsOf(levels); },
+        [&](std::size_t i, LevelAccessors& acc) {
+          forces[i] = trilinearAt(levels, acc, points_mm[i], impl.law, levels.size());
+        },
+        kSerialBelow);
+    return;
+  }
+  // Quadratic: OpenVDB's QuadraticSampler on the (single) level's grids.
+  const Level& level = levels[0];
+  const double inv_h = 1.0 / level.h_mm;
   parallelOverPoints(
       points_mm.size(),
       [&] {
-        Accessors a{impl.grid->getConstAccessor(), std::nullopt};
-        if (ratio) a.closeness.emplace(impl.closeness->getConstAccessor());
+        Accessors a{level.grid->getConstAccessor(), std::nullopt};
+        if (ratio) a.closeness.emplace(level.closeness->getConstAccessor());
         return a;
       },
       [&](std::size_t i, Accessors& acc) {
         const Vec3 p = points_mm[i] * inv_h;  // index space
+        const openvdb::Vec3R at(p.x(), p.y(), p.z());
+        openvdb::Vec3s v;
+        openvdb::tools::QuadraticSampler::sample(acc.grid, at, v);
+        if (!ratio) {
+          forces[i] = widen(v);
+          return;
+        }
         const Vec3 base = p.array().floor();
         const openvdb::Coord ijk(int(base.x()), int(base.y()), int(base.z()));
-        const Vec3 t = p - base;
         openvdb::Vec3s c[8];
-        if (!quadratic || ratio) {
-          if (!cellCorners(acc.grid, ijk, c)) {
-            forces[i] = Vec3::Zero();  // background at every corner
-            return;
-          }
-        }
-        if (!ratio) {
-          if (!quadratic) {
-            forces[i] = blend(c, t);
-            return;
-          }
-          openvdb::Vec3s v;
-          openvdb::tools::QuadraticSampler::sample(acc.grid, openvdb::Vec3R(p.x(), p.y(), p.z()),
-                                                   v);
-          forces[i] = widen(v);
+        if (!cellCorners(acc.grid, ijk, c)) {
+          forces[i] = Vec3::Zero();  // background at every corner
           return;
         }
         const PlaneLaw& law = *impl.law;
@@ -480,34 +804,24 @@ void VoxelField::evaluate(std::span<const Vec3> points_mm, std::span<Vec3> force
         for (int k = 0; k < 8; ++k) s[k] = law.r0_mm - cc[k];
         if (!ratioHolds(s, over)) {
           for (int k = 0; k < 8; ++k) c[k] *= float(law.at(s[k]));  // the node forces
-          forces[i] = blend(c, t);
+          forces[i] = blend(c, p - base);
           return;
         }
-        Vec3 g;
-        double closeness_mm;
-        if (quadratic) {
-          const openvdb::Vec3R at(p.x(), p.y(), p.z());
-          openvdb::Vec3s v;
-          openvdb::tools::QuadraticSampler::sample(acc.grid, at, v);
-          float cv = 0.0f;
-          openvdb::tools::QuadraticSampler::sample(*acc.closeness, at, cv);
-          g = widen(v);
-          closeness_mm = cv;
-        } else {
-          g = blend(c, t);
-          closeness_mm = blend(cc, t);
-        }
-        forces[i] = law.at(law.r0_mm - closeness_mm) * g;
+        float cv = 0.0f;
+        openvdb::tools::QuadraticSampler::sample(*acc.closeness, at, cv);
+        forces[i] = law.at(law.r0_mm - cv) * widen(v);
       },
       kSerialBelow);
 }
 
 std::vector<Vec3> VoxelField::activeNodes(std::size_t max_count) const {
   std::vector<Vec3> nodes;
-  const double h = impl_->voxel_size_mm;
-  for (auto it = impl_->grid->cbeginValueOn(); it && nodes.size() < max_count; ++it) {
-    const openvdb::Coord ijk = it.getCoord();
-    nodes.emplace_back(ijk.x() * h, ijk.y() * h, ijk.z() * h);
+  for (const Level& level : impl_->levels) {
+    const double h = level.h_mm;
+    for (auto it = level.grid->cbeginValueOn(); it && nodes.size() < max_count; ++it) {
+      const openvdb::Coord ijk = it.getCoord();
+      nodes.emplace_back(ijk.x() * h, ijk.y() * h, ijk.z() * h);
+    }
   }
   return nodes;
 }
@@ -515,18 +829,24 @@ std::vector<Vec3> VoxelField::activeNodes(std::size_t max_count) const {
 void VoxelField::save(const std::filesystem::path& file) const {
   initializeOpenVdb();
   openvdb::GridCPtrVec grids;
-  if (impl_->stored == StoredQuantity::PlaneRatio) {
-    // The node forces P(s)·G (what users look at), then the two stored grids.
-    Grid::Ptr force = impl_->grid->deepCopy();
-    force->setName("force");
-    auto closeness = impl_->closeness->getConstAccessor();
-    for (auto it = force->beginValueOn(); it; ++it) {
-      const double s = impl_->law->r0_mm - closeness.getValue(it.getCoord());
-      it.setValue(*it * float(impl_->law->at(s)));
+  for (std::size_t l = 0; l < impl_->levels.size(); ++l) {
+    const Level& level = impl_->levels[l];
+    const std::string suffix = l ? "_level" + std::to_string(l) : "";
+    if (impl_->stored == StoredQuantity::PlaneRatio) {
+      // The node forces P(s)·G (what users look at), then the two stored grids.
+      Grid::Ptr force = level.grid->deepCopy();
+      force->setName("force" + suffix);
+      auto closeness = level.closeness->getConstAccessor();
+      for (auto it = force->beginValueOn(); it; ++it) {
+        const double s = impl_->law->r0_mm - closeness.getValue(it.getCoord());
+        it.setValue(*it * float(impl_->law->at(s)));
+      }
+      grids.push_back(force);
+      grids.push_back(level.grid);
+      grids.push_back(level.closeness);
+    } else {
+      grids.push_back(level.grid);
     }
-    grids = {force, impl_->grid, impl_->closeness};
-  } else {
-    grids = {impl_->grid};
   }
   common::writeFileAtomically(
       file, [&](std::ofstream& out) { openvdb::io::Stream(out).write(grids); },

@@ -32,6 +32,16 @@ struct VoxelRequest {
   /// Only nodes in this world box (mm): the region the tool can reach. Default: everywhere the
   /// field can be non-zero.
   std::optional<Eigen::AlignedBox3d> region_mm;
+  /// Refinement where the grid misses (unset: FieldParams::refine_tolerance, refine_levels).
+  /// After a level is built, every cell with a non-zero corner (level 0) or inside a refined
+  /// cell (deeper) is tested at its centre: where |F_voxel - F_exact| > tolerance ·
+  /// max(|F_exact|, floor), floor = kRefineFloorFraction · P(2 r_min) (the plane law of
+  /// law.h: 0.5 % of the force 2 r_min off a wall), the cell's 3³ nodes at half the size are
+  /// built and queries inside it read the finer level (trilinear only; quadratic with a
+  /// tolerance > 0 is refused). Levels meet with a jump bounded by about the tolerance
+  /// (no hanging-node constraint). Costs one exact evaluation per tested cell.
+  std::optional<double> refine_tolerance;
+  std::optional<int> refine_levels;
   /// A build whose estimated memory (estimateVoxelNodes) exceeds this is refused (InputError).
   std::size_t max_memory_bytes = std::size_t{4} << 30;
   common::Progress progress;  ///< "field" fraction of leaves built
@@ -43,9 +53,16 @@ struct VoxelStats {
   std::size_t active_nodes = 0;     ///< nodes holding a value (the sparse grid)
   std::size_t dense_box_nodes =
       0;                         ///< nodes of a dense grid over the bounding box of the active ones
-  std::size_t memory_bytes = 0;  ///< OpenVDB's memUsage of the grid
+  std::size_t memory_bytes = 0;  ///< OpenVDB's memUsage of the grids + the query blocks
   double build_seconds = 0.0;
+  int levels = 1;                    ///< grid levels built (1: uniform)
+  std::size_t refined_cells = 0;     ///< cells split, all levels
+  std::size_t refined_nodes = 0;     ///< nodes of the finer levels (part of active_nodes)
+  std::size_t tested_cells = 0;      ///< cells tested against the exact field
 };
+
+/// The refinement floor: a fraction of the plane law at 2 r_min (VoxelRequest::refine_tolerance).
+inline constexpr double kRefineFloorFraction = 0.005;
 
 /// Upper bound of the nodes a build will make active, from the samples alone (no fine-grid
 /// allocation): the lesser of the dense box (samples padded by r0, clipped to the region) and
@@ -67,17 +84,19 @@ class VoxelField final : public ForceField {
   VoxelField(VoxelField&&) noexcept;
   VoxelField& operator=(VoxelField&&) noexcept;
 
-  /// Trilinear (OpenVDB BoxSampler) or quadratic (QuadraticSampler) interpolation; zero outside
-  /// the band.
+  /// Trilinear (the BoxSampler's weights, read from per-leaf blocks of 9³ nodes so that a cell's
+  /// 8 corners are one lookup) or quadratic (OpenVDB QuadraticSampler) interpolation; zero
+  /// outside the band. Refined cells read the finest level built there.
   void evaluate(std::span<const Vec3> points_mm, std::span<Vec3> forces) const override;
 
   const VoxelStats& stats() const;
   double voxelSizeMm() const;
   Interpolation interpolation() const;
   StoredQuantity stored() const;
-  /// World positions (mm) of the active nodes, at most `max_count` of them.
+  /// World positions (mm) of the active nodes of every level, at most `max_count` of them.
   std::vector<Vec3> activeNodes(std::size_t max_count = std::size_t(-1)) const;
-  /// Writes the grid (named "force") to a .vdb file atomically; Houdini and Blender open it.
+  /// Writes the grid (named "force"; finer levels "force_level1", ...) to a .vdb file
+  /// atomically; Houdini and Blender open it.
   void save(const std::filesystem::path& file) const;
 
  private:
