@@ -234,6 +234,12 @@ int variantTable(const std::string& backend, const std::vector<std::string>& wan
       {"no pinned staging", [](zb::EngineTuning& t) { t.pinned_staging = false; }},
       {"prepass 4", [](zb::EngineTuning& t) { t.prepass_stride = 4; }},
       {"prepass 16", [](zb::EngineTuning& t) { t.prepass_stride = 16; }},
+      {"prepass 32", [](zb::EngineTuning& t) { t.prepass_stride = 32; }},
+      {"prepass 16, no lowest first",
+       [](zb::EngineTuning& t) {
+         t.prepass_stride = 16;
+         t.lowest_first = false;
+       }},
       {"no prepass", [](zb::EngineTuning& t) { t.prepass_stride = 0; }},
       {"no capsule floor", [](zb::EngineTuning& t) { t.capsule_floor = false; }},
       {"all knobs off",

@@ -340,13 +340,12 @@ TEST(Culling, CapsuleFloorIsBelowEveryCutAndTightForABall) {
   std::uniform_real_distribution<double> u(-1, 1);
   const Grid grid = Grid::fromRegion(-8, -8, 8, 8, 48, 48);
   const GridView g = detail::makeGridView(grid, 2);
-  const std::vector<Tool> tools = {
-      Tool::ball(2, 8),
-      Tool::torus(3, 1, 10),
-      Tool::flat(2.5, 6),
-      Tool::fromMesh(analyticToolMesh(Tool::ball(2, 8), 32, 31)),
-      Tool::fromMesh(analyticToolMesh(Tool::torus(3, 1, 10), 40, 8)),
-      Tool::fromMesh(gridBottomTool())};
+  const std::vector<Tool> tools = {Tool::ball(2, 8),
+                                   Tool::torus(3, 1, 10),
+                                   Tool::flat(2.5, 6),
+                                   Tool::fromMesh(analyticToolMesh(Tool::ball(2, 8), 32, 31)),
+                                   Tool::fromMesh(analyticToolMesh(Tool::torus(3, 1, 10), 40, 8)),
+                                   Tool::fromMesh(gridBottomTool())};
   int hits = 0;
   for (const Tool& tool : tools) {
     const detail::ToolData data = detail::prepareTool(tool);
@@ -364,9 +363,8 @@ TEST(Culling, CapsuleFloorIsBelowEveryCutAndTightForABall) {
           lineOffset(g, pp, ix, iy, rx, ry);
           const Vec3f o = mulTransposed(pp.rot, Vec3f{rx, ry, 0.f});
           const float t = tool.kind == ToolKind::Mesh ? meshEntry(data.view, pp, o, FLT_MAX)
-                                                       : analyticEntry(data.view, o, pp.dir);
-          const float floor = capsuleFloor(
-              data.view, pp, segmentDistance(rx, ry, pp.cap_ax, pp.cap_ay, pp.cap_bx, pp.cap_by));
+                                                      : analyticEntry(data.view, o, pp.dir);
+          const float floor = capsuleLineFloor(data.view, pp, rx, ry);
           if (t == FLT_MAX) continue;
           ++hits;
           const float h = pp.tip_mm.z + t;
@@ -383,8 +381,16 @@ TEST(Culling, CapsuleFloorIsBelowEveryCutAndTightForABall) {
   const detail::ToolData ball = detail::prepareTool(Tool::ball(2, 8));
   const PreparedPosture pp = preparePosture(g, ball.view, pose(0, 0, 0, 0, 0, 1));
   for (double d : {0.0, 0.5, 1.0, 1.5, 1.9})
-    EXPECT_NEAR(capsuleFloor(ball.view, pp, float(d)), 2 - std::sqrt(4 - d * d), 1e-3) << d;
-  EXPECT_EQ(capsuleFloor(ball.view, pp, 2.1f), FLT_MAX);
+    EXPECT_NEAR(capsuleLineFloor(ball.view, pp, float(d), 0.f), 2 - std::sqrt(4 - d * d), 1e-3)
+        << d;
+  EXPECT_EQ(capsuleLineFloor(ball.view, pp, 2.1f, 0.f), FLT_MAX);
+  // ... and a tilted one's, along its lower edge: the ball's exact height, not the shank's.
+  const double c = std::sqrt(0.5);
+  const PreparedPosture tilted = preparePosture(g, ball.view, pose(0, 0, 0, c, 0, c));
+  for (double x : {-0.5, 0.0, 0.7, 1.4})  // ball centre at (√2, 0, √2): exact height below it
+    EXPECT_NEAR(capsuleLineFloor(ball.view, tilted, float(x), 0.f),
+                std::sqrt(2.0) - std::sqrt(4 - (x - std::sqrt(2.0)) * (x - std::sqrt(2.0))), 1e-3)
+        << x;
 }
 
 TEST(Mesh, TiltedSphereMeshHasNoHoles) {

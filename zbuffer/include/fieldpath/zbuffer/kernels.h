@@ -75,8 +75,8 @@ struct PreparedPosture {
   float sx, sy, sz;
   Vec3f inv_dir;  ///< 1/dir with zeros replaced by ±1e-30 (no 0·∞ in the slab test)
   // The tool's capsule (ToolView::cap_*) placed: its axis segment seen from above, a → b (mm,
-  // world xy relative to the tip), the segment's lowest world z, and a rounding margin (mm).
-  float cap_ax, cap_ay, cap_bx, cap_by, cap_zlow_mm, cap_margin_mm;
+  // world xy relative to the tip), the world z of its ends, and a rounding margin (mm).
+  float cap_ax, cap_ay, cap_bx, cap_by, cap_za_mm, cap_zb_mm, cap_margin_mm;
 };
 
 FIELDPATH_HD float safeInverse(float v) { return 1.f / (v == 0.f ? 1e-30f : v); }
@@ -164,7 +164,8 @@ FIELDPATH_HD PreparedPosture preparePosture(const GridView& g, const ToolView& t
   pp.cap_ay = c0 * j;
   pp.cap_bx = c1 * i;
   pp.cap_by = c1 * j;
-  pp.cap_zlow_mm = pose.tip_mm.z + minf(c0 * k, c1 * k);
+  pp.cap_za_mm = pose.tip_mm.z + c0 * k;
+  pp.cap_zb_mm = pose.tip_mm.z + c1 * k;
   pp.cap_margin_mm =
       1e-5f * (absf(pose.tip_mm.z) + tool.cap_radius_mm + absf(c0) + absf(c1)) + 1e-6f;
   return pp;
@@ -210,17 +211,67 @@ FIELDPATH_HD float rectSegmentDistance(float x0, float x1, float y0, float y1, f
   return minf(d, segmentDistance(x1, y1, ax, ay, bx, by));
 }
 
-/// Floor of the capsule's lower envelope over the points at grid-plane distance >= d_mm from its
-/// placed axis segment: a point of the capsule above such a point is at most
-/// sqrt(R² - d²) below the segment. FLT_MAX where the capsule does not reach (d >= R). The
-/// distance is shrunk and the floor lowered by the posture's margin, far more than the float
-/// rounding of d, of this expression and of the tool's own entry height, so the floor is never
-/// above a height lineCut can give.
-FIELDPATH_HD float capsuleFloor(const ToolView& tool, const PreparedPosture& pp, float d_mm) {
+/// Floor of the lower envelope of a ball of radius R (tool.cap_radius_mm) centred at height
+/// zc_mm, over the points at grid-plane distance >= d_mm from its centre: sqrt(R² - d²) below
+/// zc. FLT_MAX where it does not reach (d >= R). The distance is shrunk and the floor lowered by
+/// the posture's margin, far more than the float rounding of d, of this expression and of the
+/// tool's own entry height, so the floor is never above a height lineCut can give.
+FIELDPATH_HD float ballFloor(const ToolView& tool, const PreparedPosture& pp, float zc_mm,
+                             float d_mm) {
   const float r = tool.cap_radius_mm;
   const float d = maxf(d_mm * (1.f - 1e-5f) - pp.cap_margin_mm, 0.f);
   if (!(d < r)) return FLT_MAX;
-  return pp.cap_zlow_mm - sqrtf((r - d) * (r + d)) - pp.cap_margin_mm;
+  return zc_mm - sqrtf((r - d) * (r + d)) - pp.cap_margin_mm;
+}
+
+/// The capsule's lower envelope at the line (px, py) (mm, relative to the tip), less the margin:
+/// the minimum over the segment of z(s) - sqrt(ρ² - (s - along)²), with z linear along the
+/// segment and ρ² = R² - d⊥², is convex in s; its stationary point, clamped to the segment, is
+/// the minimum. ρ is inflated by the margin (no cancellation at the rim can raise the floor).
+FIELDPATH_HD float capsuleLineFloor(const ToolView& tool, const PreparedPosture& pp, float px,
+                                    float py) {
+  const float ex = pp.cap_bx - pp.cap_ax, ey = pp.cap_by - pp.cap_ay;
+  const float len = sqrtf(ex * ex + ey * ey);
+  const float m = pp.cap_margin_mm, r = tool.cap_radius_mm;
+  if (!(len > m)) {  // (nearly) vertical: one ball at the lower end
+    const float zc = minf(pp.cap_za_mm, pp.cap_zb_mm);
+    const float qx = pp.cap_za_mm <= pp.cap_zb_mm ? pp.cap_ax : pp.cap_bx;
+    const float qy = pp.cap_za_mm <= pp.cap_zb_mm ? pp.cap_ay : pp.cap_by;
+    const float dx = px - qx, dy = py - qy;
+    // the segment's other points are within len of q and no lower: shrink the distance by len
+    return ballFloor(tool, pp, zc, maxf(sqrtf(dx * dx + dy * dy) - len, 0.f));
+  }
+  const float ux = ex / len, uy = ey / len;
+  const float qx = px - pp.cap_ax, qy = py - pp.cap_ay;
+  const float along = qx * ux + qy * uy;
+  const float dperp = maxf(absf(qx * uy - qy * ux) * (1.f - 1e-5f) - m, 0.f);
+  if (!(dperp < r)) return FLT_MAX;
+  const float rho = sqrtf((r - dperp) * (r + dperp)) + m;
+  const float lo = maxf(0.f, along - rho), hi = minf(len, along + rho);
+  if (lo > hi) return FLT_MAX;
+  const float slope = (pp.cap_zb_mm - pp.cap_za_mm) / len;  // z per mm along the segment
+  const float s_star = along - slope * rho / sqrtf(1.f + slope * slope);
+  const float s = s_star < lo ? lo : (s_star > hi ? hi : s_star);
+  const float w = absf(s - along);
+  return pp.cap_za_mm + slope * s - sqrtf(maxf((rho - w) * (rho + w), 0.f)) - m;
+}
+
+/// The capsule's floor over the rectangle [x0, x1] × [y0, y1] (mm, relative to the tip): the
+/// segment cut in pieces, each a capsule at its lower end's height.
+FIELDPATH_HD float capsuleRectFloor(const ToolView& tool, const PreparedPosture& pp, float x0,
+                                    float x1, float y0, float y1) {
+  constexpr int kPieces = 4;
+  const float ex = pp.cap_bx - pp.cap_ax, ey = pp.cap_by - pp.cap_ay;
+  const float dz = pp.cap_zb_mm - pp.cap_za_mm;
+  float floor = FLT_MAX;
+  for (int k = 0; k < kPieces; ++k) {
+    const float u0 = float(k) / kPieces, u1 = float(k + 1) / kPieces;
+    const float d = rectSegmentDistance(x0, x1, y0, y1, pp.cap_ax + u0 * ex, pp.cap_ay + u0 * ey,
+                                        pp.cap_ax + u1 * ex, pp.cap_ay + u1 * ey);
+    const float zc = pp.cap_za_mm + minf(u0 * dz, u1 * dz);
+    floor = minf(floor, ballFloor(tool, pp, zc, d));
+  }
+  return floor;
 }
 
 /// World coordinates of line (ix, iy) relative to the tip, formed in double, rounded once.
@@ -438,8 +489,7 @@ FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const Prepar
     if (!(current_mm > floor_z)) return FLT_MAX;
   } else if (tool.cap_radius_mm > 0.f) {
     // a skip test only (no clamp): the margin keeps it below any height computed below
-    const float d = segmentDistance(rx, ry, pp.cap_ax, pp.cap_ay, pp.cap_bx, pp.cap_by);
-    if (!(current_mm > capsuleFloor(tool, pp, d))) return FLT_MAX;
+    if (!(current_mm > capsuleLineFloor(tool, pp, rx, ry))) return FLT_MAX;
   }
   const Vec3f o = mulTransposed(pp.rot, Vec3f{rx, ry, 0.f});
   float t;
@@ -468,8 +518,7 @@ FIELDPATH_HD float rectFloor(const GridView& g, const ToolView& tool, const Prep
   lineOffset(g, pp, ix1, iy1, bx, by);
   if (!(pp.vertical && tool.radial_bins > 0)) {
     if (!(tool.cap_radius_mm > 0.f)) return pp.lowest_z_mm;
-    const float d = rectSegmentDistance(ax, bx, ay, by, pp.cap_ax, pp.cap_ay, pp.cap_bx, pp.cap_by);
-    return maxf(pp.lowest_z_mm, capsuleFloor(tool, pp, d));
+    return maxf(pp.lowest_z_mm, capsuleRectFloor(tool, pp, ax, bx, ay, by));
   }
   const float rx = (ax <= 0.f && bx >= 0.f) ? 0.f : minf(absf(ax), absf(bx));
   const float ry = (ay <= 0.f && by >= 0.f) ? 0.f : minf(absf(ay), absf(by));
