@@ -226,20 +226,15 @@ int variantTable(const std::string& backend, const std::vector<std::string>& wan
       {"refresh 2^19", [](zb::EngineTuning& t) { t.refresh_postures = 1 << 19; }},
       {"tiles 8²", [](zb::EngineTuning& t) { t.tile_shift = 3; }},
       {"tiles 32²", [](zb::EngineTuning& t) { t.tile_shift = 5; }},
-      {"no lowest first", [](zb::EngineTuning& t) { t.lowest_first = false; }},
+      {"lowest first", [](zb::EngineTuning& t) { t.lowest_first = true; }},
       {"no small threads", [](zb::EngineTuning& t) { t.small_threads = false; }},
       {"no overlap", [](zb::EngineTuning& t) { t.overlap_upload = false; }},
       {"no vertical bins", [](zb::EngineTuning& t) { t.vertical_bins = false; }},
       {"no tile skip", [](zb::EngineTuning& t) { t.tile_skip = false; }},
       {"no pinned staging", [](zb::EngineTuning& t) { t.pinned_staging = false; }},
       {"prepass 4", [](zb::EngineTuning& t) { t.prepass_stride = 4; }},
-      {"prepass 16", [](zb::EngineTuning& t) { t.prepass_stride = 16; }},
+      {"prepass 8", [](zb::EngineTuning& t) { t.prepass_stride = 8; }},
       {"prepass 32", [](zb::EngineTuning& t) { t.prepass_stride = 32; }},
-      {"prepass 16, no lowest first",
-       [](zb::EngineTuning& t) {
-         t.prepass_stride = 16;
-         t.lowest_first = false;
-       }},
       {"no prepass", [](zb::EngineTuning& t) { t.prepass_stride = 0; }},
       {"no capsule floor", [](zb::EngineTuning& t) { t.capsule_floor = false; }},
       {"all knobs off",

@@ -77,6 +77,9 @@ struct PreparedPosture {
   // The tool's capsule (ToolView::cap_*) placed: its axis segment seen from above, a → b (mm,
   // world xy relative to the tip), the world z of its ends, and a rounding margin (mm).
   float cap_ax, cap_ay, cap_bx, cap_by, cap_za_mm, cap_zb_mm, cap_margin_mm;
+  // ... and, per posture once for every line: the segment's length seen from above (0 when
+  // within the margin: nearly vertical), its direction, z per mm along it, slope / sqrt(1 + slope²)
+  float cap_len_mm, cap_ux, cap_uy, cap_slope, cap_kstar;
 };
 
 FIELDPATH_HD float safeInverse(float v) { return 1.f / (v == 0.f ? 1e-30f : v); }
@@ -168,6 +171,13 @@ FIELDPATH_HD PreparedPosture preparePosture(const GridView& g, const ToolView& t
   pp.cap_zb_mm = pose.tip_mm.z + c1 * k;
   pp.cap_margin_mm =
       1e-5f * (absf(pose.tip_mm.z) + tool.cap_radius_mm + absf(c0) + absf(c1)) + 1e-6f;
+  const float ex = pp.cap_bx - pp.cap_ax, ey = pp.cap_by - pp.cap_ay;
+  const float len = sqrtf(ex * ex + ey * ey);
+  pp.cap_len_mm = len > pp.cap_margin_mm ? len : 0.f;
+  pp.cap_ux = pp.cap_len_mm > 0.f ? ex / len : 0.f;
+  pp.cap_uy = pp.cap_len_mm > 0.f ? ey / len : 0.f;
+  pp.cap_slope = pp.cap_len_mm > 0.f ? (pp.cap_zb_mm - pp.cap_za_mm) / len : 0.f;
+  pp.cap_kstar = pp.cap_slope / sqrtf(1.f + pp.cap_slope * pp.cap_slope);
   return pp;
 }
 
@@ -230,48 +240,34 @@ FIELDPATH_HD float ballFloor(const ToolView& tool, const PreparedPosture& pp, fl
 /// the minimum. ρ is inflated by the margin (no cancellation at the rim can raise the floor).
 FIELDPATH_HD float capsuleLineFloor(const ToolView& tool, const PreparedPosture& pp, float px,
                                     float py) {
-  const float ex = pp.cap_bx - pp.cap_ax, ey = pp.cap_by - pp.cap_ay;
-  const float len = sqrtf(ex * ex + ey * ey);
-  const float m = pp.cap_margin_mm, r = tool.cap_radius_mm;
-  if (!(len > m)) {  // (nearly) vertical: one ball at the lower end
-    const float zc = minf(pp.cap_za_mm, pp.cap_zb_mm);
-    const float qx = pp.cap_za_mm <= pp.cap_zb_mm ? pp.cap_ax : pp.cap_bx;
-    const float qy = pp.cap_za_mm <= pp.cap_zb_mm ? pp.cap_ay : pp.cap_by;
-    const float dx = px - qx, dy = py - qy;
-    // the segment's other points are within len of q and no lower: shrink the distance by len
-    return ballFloor(tool, pp, zc, maxf(sqrtf(dx * dx + dy * dy) - len, 0.f));
+  const float m = pp.cap_margin_mm, r = tool.cap_radius_mm, len = pp.cap_len_mm;
+  if (len == 0.f) {  // (nearly) vertical: one ball at the lower end
+    const bool a_low = pp.cap_za_mm <= pp.cap_zb_mm;
+    const float dx = px - (a_low ? pp.cap_ax : pp.cap_bx),
+                dy = py - (a_low ? pp.cap_ay : pp.cap_by);
+    // the segment's other points are within the margin of that end and no lower
+    return ballFloor(tool, pp, minf(pp.cap_za_mm, pp.cap_zb_mm),
+                     maxf(sqrtf(dx * dx + dy * dy) - m, 0.f));
   }
-  const float ux = ex / len, uy = ey / len;
   const float qx = px - pp.cap_ax, qy = py - pp.cap_ay;
-  const float along = qx * ux + qy * uy;
-  const float dperp = maxf(absf(qx * uy - qy * ux) * (1.f - 1e-5f) - m, 0.f);
+  const float along = qx * pp.cap_ux + qy * pp.cap_uy;
+  const float dperp = maxf(absf(qx * pp.cap_uy - qy * pp.cap_ux) * (1.f - 1e-5f) - m, 0.f);
   if (!(dperp < r)) return FLT_MAX;
   const float rho = sqrtf((r - dperp) * (r + dperp)) + m;
   const float lo = maxf(0.f, along - rho), hi = minf(len, along + rho);
   if (lo > hi) return FLT_MAX;
-  const float slope = (pp.cap_zb_mm - pp.cap_za_mm) / len;  // z per mm along the segment
-  const float s_star = along - slope * rho / sqrtf(1.f + slope * slope);
+  const float s_star = along - pp.cap_kstar * rho;
   const float s = s_star < lo ? lo : (s_star > hi ? hi : s_star);
   const float w = absf(s - along);
-  return pp.cap_za_mm + slope * s - sqrtf(maxf((rho - w) * (rho + w), 0.f)) - m;
+  return pp.cap_za_mm + pp.cap_slope * s - sqrtf(maxf((rho - w) * (rho + w), 0.f)) - m;
 }
 
-/// The capsule's floor over the rectangle [x0, x1] × [y0, y1] (mm, relative to the tip): the
-/// segment cut in pieces, each a capsule at its lower end's height.
+/// The capsule's floor over the rectangle [x0, x1] × [y0, y1] (mm, relative to the tip): a ball
+/// at the segment's lower end's height, at the rectangle's distance from the segment.
 FIELDPATH_HD float capsuleRectFloor(const ToolView& tool, const PreparedPosture& pp, float x0,
                                     float x1, float y0, float y1) {
-  constexpr int kPieces = 4;
-  const float ex = pp.cap_bx - pp.cap_ax, ey = pp.cap_by - pp.cap_ay;
-  const float dz = pp.cap_zb_mm - pp.cap_za_mm;
-  float floor = FLT_MAX;
-  for (int k = 0; k < kPieces; ++k) {
-    const float u0 = float(k) / kPieces, u1 = float(k + 1) / kPieces;
-    const float d = rectSegmentDistance(x0, x1, y0, y1, pp.cap_ax + u0 * ex, pp.cap_ay + u0 * ey,
-                                        pp.cap_ax + u1 * ex, pp.cap_ay + u1 * ey);
-    const float zc = pp.cap_za_mm + minf(u0 * dz, u1 * dz);
-    floor = minf(floor, ballFloor(tool, pp, zc, d));
-  }
-  return floor;
+  const float d = rectSegmentDistance(x0, x1, y0, y1, pp.cap_ax, pp.cap_ay, pp.cap_bx, pp.cap_by);
+  return ballFloor(tool, pp, minf(pp.cap_za_mm, pp.cap_zb_mm), d);
 }
 
 /// World coordinates of line (ix, iy) relative to the tip, formed in double, rounded once.

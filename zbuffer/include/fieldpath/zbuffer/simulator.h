@@ -70,7 +70,9 @@ using PostureSource = std::function<std::size_t(std::span<Posture> out)>;
 /// measured (bench/results/zbuffer-*.md); bench_zbuffer --variants times the others.
 struct EngineTuning {
   bool vertical_bins = true;   ///< vertical mesh postures: bin look-up instead of the BVH walk
-  bool lowest_first = true;    ///< each block's postures processed lowest point first
+  /// Each block's postures processed lowest point first. Off by default since the prepass: with
+  /// it, path order is faster on every case measured (bench/results/zbuffer-h200.md, run 14).
+  bool lowest_first = false;
   bool small_threads = true;   ///< CUDA: one thread per small-footprint posture, warps for the rest
   bool overlap_upload = true;  ///< CUDA: a block's upload overlaps the previous block's kernels
   bool tile_skip = true;       ///< footprint tiles whose lines the posture cannot lower skipped
@@ -82,7 +84,7 @@ struct EngineTuning {
   /// are refreshed and the whole block cuts: neighbours along a path cut nearly the same heights,
   /// so the lines start near their final height and the floors (radial, capsule) and tile skips
   /// turn most of the block's line visits away at one compare. 0 or 1: no prepass.
-  int prepass_stride = 8;
+  int prepass_stride = 16;
   /// Capsule floor (ToolView::cap_*) for lines and tiles without a radial floor (tilted postures,
   /// analytic tools).
   bool capsule_floor = true;
