@@ -226,7 +226,7 @@ int variantTable(const std::string& backend, const std::vector<std::string>& wan
       {"refresh 2^19", [](zb::EngineTuning& t) { t.refresh_postures = 1 << 19; }},
       {"tiles 8²", [](zb::EngineTuning& t) { t.tile_shift = 3; }},
       {"tiles 32²", [](zb::EngineTuning& t) { t.tile_shift = 5; }},
-      {"lowest first", [](zb::EngineTuning& t) { t.lowest_first = true; }},
+      {"no lowest first", [](zb::EngineTuning& t) { t.lowest_first = false; }},
       {"no small threads", [](zb::EngineTuning& t) { t.small_threads = false; }},
       {"no overlap", [](zb::EngineTuning& t) { t.overlap_upload = false; }},
       {"no vertical bins", [](zb::EngineTuning& t) { t.vertical_bins = false; }},
@@ -237,6 +237,7 @@ int variantTable(const std::string& backend, const std::vector<std::string>& wan
       {"prepass 32", [](zb::EngineTuning& t) { t.prepass_stride = 32; }},
       {"no prepass", [](zb::EngineTuning& t) { t.prepass_stride = 0; }},
       {"no capsule floor", [](zb::EngineTuning& t) { t.capsule_floor = false; }},
+      {"line batch 1", [](zb::EngineTuning& t) { t.line_batch = 1; }},
       {"all knobs off",
        [](zb::EngineTuning& t) {
          t = {false, false, false, false, false, false};

@@ -525,14 +525,15 @@ FIELDPATH_HD float rectFloor(const GridView& g, const ToolView& tool, const Prep
               pp.tip_mm.z + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]);
 }
 
-/// Visits the lines of the (culled) footprint tile by tile: tiles tile_first, tile_first +
-/// tile_step, ... in footprint order; a tile whose maximum (possibly stale-high) is at or below
-/// its rectangle's floor is skipped whole; of the others, lines first, first + step, ... get
-/// cut(ix, iy). Shared by the CPU loop (0, 1, 0, 1) and the CUDA warps (lanes, 32).
-template <class CutLine>
-FIELDPATH_HD void forEachLiveLine(const GridView& g, const ToolView& tool,
+/// Visits the tiles of the (culled) footprint: tiles tile_first, tile_first + tile_step, ... in
+/// footprint order; a tile whose maximum (possibly stale-high) is at or below its rectangle's
+/// floor is skipped whole; the others' rectangles (clipped to the footprint) go to
+/// visit(ix0, ix1, iy0, iy1). Shared by the CPU loop (0, 1) and the CUDA warps (blockIdx.y,
+/// gridDim.y).
+template <class VisitRect>
+FIELDPATH_HD void forEachLiveTile(const GridView& g, const ToolView& tool,
                                   const PreparedPosture& pp, const float* tile_max, bool skip,
-                                  int tile_first, int tile_step, int first, int step, CutLine cut) {
+                                  int tile_first, int tile_step, VisitRect visit) {
   const int tx0 = pp.ix0 >> g.tile_shift, tx1 = pp.ix1 >> g.tile_shift;
   const int ty0 = pp.iy0 >> g.tile_shift, ty1 = pp.iy1 >> g.tile_shift;
   const int tw = tx1 - tx0 + 1, tiles = tw * (ty1 - ty0 + 1);
@@ -546,9 +547,21 @@ FIELDPATH_HD void forEachLiveLine(const GridView& g, const ToolView& tool,
         ((ty + 1) << g.tile_shift) - 1 < pp.iy1 ? ((ty + 1) << g.tile_shift) - 1 : pp.iy1;
     if (skip && tile_max[ty * g.tiles_x + tx] <= rectFloor(g, tool, pp, ix0, ix1, iy0, iy1))
       continue;
-    const int w = ix1 - ix0 + 1, lines = w * (iy1 - iy0 + 1);
-    for (int l = first; l < lines; l += step) cut(ix0 + l % w, iy0 + l / w);
+    visit(ix0, ix1, iy0, iy1);
   }
+}
+
+/// The lines of the live tiles (forEachLiveTile): of each, lines first, first + step, ... get
+/// cut(ix, iy).
+template <class CutLine>
+FIELDPATH_HD void forEachLiveLine(const GridView& g, const ToolView& tool,
+                                  const PreparedPosture& pp, const float* tile_max, bool skip,
+                                  int tile_first, int tile_step, int first, int step, CutLine cut) {
+  forEachLiveTile(g, tool, pp, tile_max, skip, tile_first, tile_step,
+                  [&](int ix0, int ix1, int iy0, int iy1) {
+                    const int w = ix1 - ix0 + 1, lines = w * (iy1 - iy0 + 1);
+                    for (int l = first; l < lines; l += step) cut(ix0 + l % w, iy0 + l / w);
+                  });
 }
 
 /// True if the posture cannot lower any line: its lowest point is not below the highest height of

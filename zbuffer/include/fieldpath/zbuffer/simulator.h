@@ -69,10 +69,11 @@ using PostureSource = std::function<std::size_t(std::span<Posture> out)>;
 /// postures does not depend on their order or on which ones are culled). Defaults are the fastest
 /// measured (bench/results/zbuffer-*.md); bench_zbuffer --variants times the others.
 struct EngineTuning {
-  bool vertical_bins = true;   ///< vertical mesh postures: bin look-up instead of the BVH walk
-  /// Each block's postures processed lowest point first. Off by default since the prepass: with
-  /// it, path order is faster on every case measured (bench/results/zbuffer-h200.md, run 14).
-  bool lowest_first = false;
+  bool vertical_bins = true;  ///< vertical mesh postures: bin look-up instead of the BVH walk
+  /// Each block's postures processed lowest point first, where one footprint covers more than
+  /// 1/64 of the grid (a zoom); elsewhere the prepass gets the same culling and path order is
+  /// faster (bench/results/zbuffer-h200.md, run 16).
+  bool lowest_first = true;
   bool small_threads = true;   ///< CUDA: one thread per small-footprint posture, warps for the rest
   bool overlap_upload = true;  ///< CUDA: a block's upload overlaps the previous block's kernels
   bool tile_skip = true;       ///< footprint tiles whose lines the posture cannot lower skipped
@@ -88,6 +89,8 @@ struct EngineTuning {
   /// Capsule floor (ToolView::cap_*) for lines and tiles without a radial floor (tilted postures,
   /// analytic tools).
   bool capsule_floor = true;
+  /// CUDA: each lane loads the heights of this many of its lines before it cuts any (8 or 1).
+  int line_batch = 8;
 };
 
 struct SimulationRequest {
