@@ -237,7 +237,6 @@ int variantTable(const std::string& backend, const std::vector<std::string>& wan
       {"prepass 32", [](zb::EngineTuning& t) { t.prepass_stride = 32; }},
       {"no prepass", [](zb::EngineTuning& t) { t.prepass_stride = 0; }},
       {"no capsule floor", [](zb::EngineTuning& t) { t.capsule_floor = false; }},
-      {"line batch 1", [](zb::EngineTuning& t) { t.line_batch = 1; }},
       {"all knobs off",
        [](zb::EngineTuning& t) {
          t = {false, false, false, false, false, false};

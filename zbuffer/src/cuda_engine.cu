@@ -78,37 +78,19 @@ __device__ inline Posture postureAt(const Posture* postures, const std::uint32_t
 
 /// Lowers the live lines of the culled footprint: tiles tile_first, +tile_step, ...; lines first,
 /// +step, ... of each (the shared per-line code path of both backends is lineCut).
-/// `Batch`: lines of a tile a lane loads before it cuts any, so that their height loads are in
-/// flight together (one at a time, each lane waits a memory latency per line).
 /// `stats` (trace runs only, else null): lines visited and lines lowered, summed over the grid.
-template <int Batch>
 __device__ inline void cutLines(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
                                 const float* tile_max, bool skip, int tile_first, int tile_step,
                                 int first, int step, std::int32_t* keys,
                                 unsigned long long* stats) {
   unsigned visited = 0, lowered = 0;
-  forEachLiveTile(
-      g, tool, pp, tile_max, skip, tile_first, tile_step, [&](int ix0, int ix1, int iy0, int iy1) {
-        const int w = ix1 - ix0 + 1, lines = w * (iy1 - iy0 + 1);
-        for (int l0 = first; l0 < lines; l0 += Batch * step) {
-          std::int32_t current[Batch];
-#pragma unroll
-          for (int b = 0; b < Batch; ++b) {
-            const int l = l0 + b * step;
-            current[b] = l < lines ? keys[std::size_t(iy0 + l / w) * g.nx + ix0 + l % w] : INT_MIN;
-          }
-#pragma unroll
-          for (int b = 0; b < Batch; ++b) {
-            const int l = l0 + b * step;
-            if (l >= lines) break;
-            const int ix = ix0 + l % w, iy = iy0 + l / w;
-            const float z = lineCut(g, tool, pp, ix, iy, keyToFloat(current[b]));
-            ++visited;
-            if (z != FLT_MAX)
-              ++lowered, atomicMin(keys + std::size_t(iy) * g.nx + ix, floatToKey(z));
-          }
-        }
-      });
+  forEachLiveLine(g, tool, pp, tile_max, skip, tile_first, tile_step, first, step,
+                  [&](int ix, int iy) {
+                    std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
+                    const float z = lineCut(g, tool, pp, ix, iy, keyToFloat(*slot));
+                    ++visited;
+                    if (z != FLT_MAX) ++lowered, atomicMin(slot, floatToKey(z));
+                  });
   if (stats) {
     atomicAdd(stats, static_cast<unsigned long long>(visited));
     atomicAdd(stats + 1, static_cast<unsigned long long>(lowered));
@@ -126,7 +108,6 @@ __global__ void lowestKeyKernel(GridView g, ToolView tool, const Posture* postur
 
 /// One thread per posture: prepare, cull, cut a small footprint here; a large one is queued for
 /// largeKernel (its warp repeats the same preparation and cull, hence the same footprint).
-template <int Batch>
 __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
                             const std::uint32_t* order, int count, const float* tile_max,
                             std::int32_t* keys, unsigned long long* culled, int* queue, int* queued,
@@ -139,14 +120,13 @@ __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
     return;
   }
   if ((pp.ix1 - pp.ix0 + 1) * (pp.iy1 - pp.iy0 + 1) <= kSmallFootprintLines)
-    cutLines<Batch>(g, tool, pp, tile_max, skip, 0, 1, 0, 1, keys, stats);
+    cutLines(g, tool, pp, tile_max, skip, 0, 1, 0, 1, keys, stats);
   else
     queue[atomicAdd(queued, 1)] = k;
 }
 
 /// One warp per queued posture (split into gridDim.y chunks of lines when postures are few, as
 /// in a zoom): the lanes share the footprint's lines.
-template <int Batch>
 __global__ void largeKernel(GridView g, ToolView tool, const Posture* postures,
                             const std::uint32_t* order, const int* queue, const int* queued,
                             const float* tile_max, std::int32_t* keys, bool skip,
@@ -155,12 +135,10 @@ __global__ void largeKernel(GridView g, ToolView tool, const Posture* postures,
   if (q >= *queued) return;
   PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, queue[q]));
   if (cullPosture(g, tool, pp, tile_max)) return;
-  cutLines<Batch>(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, threadIdx.x & 31, 32, keys,
-                  stats);
+  cutLines(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, threadIdx.x & 31, 32, keys, stats);
 }
 
 /// One warp per posture, every footprint (the variant without small_threads).
-template <int Batch>
 __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
                            const std::uint32_t* order, int count, const float* tile_max,
                            std::int32_t* keys, unsigned long long* culled, bool skip,
@@ -172,8 +150,7 @@ __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
     if (culled && (threadIdx.x & 31) == 0 && blockIdx.y == 0) atomicAdd(culled, 1ull);
     return;
   }
-  cutLines<Batch>(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, threadIdx.x & 31, 32, keys,
-                  stats);
+  cutLines(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, threadIdx.x & 31, 32, keys, stats);
 }
 
 /// SIMSURF1's coarse kernel: one thread per posture, every triangle.
@@ -411,15 +388,6 @@ struct Engine::Impl {
   /// refreshed before each; `culled_count` (may be null) counts the culled postures.
   void chunks(const Posture* postures, const std::uint32_t* order, std::size_t count,
               unsigned long long* culled_count) {
-    if (options.line_batch > 1)
-      chunksBatched<8>(postures, order, count, culled_count);
-    else
-      chunksBatched<1>(postures, order, count, culled_count);
-  }
-
-  template <int B>
-  void chunksBatched(const Posture* postures, const std::uint32_t* order, std::size_t count,
-                     unsigned long long* culled_count) {
     cudaStream_t st = compute_stream;
     Impl& m = *this;
     const int tiles = m.grid.tiles_x * m.grid.tiles_y;
@@ -436,20 +404,20 @@ struct Engine::Impl {
       if (m.options.small_threads) {
         FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.queued, 0, sizeof(int), st));
         m.timed("small", st, [&] {
-          smallKernel<B><<<(chunk + 127) / 128, 128, 0, st>>>(
+          smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(
               m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, culled_count,
               m.queue, m.queued, m.options.tile_skip, m.stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
         m.timed("large", st, [&] {
-          largeKernel<B><<<warps, 32 * kWarpsPerBlock, 0, st>>>(
+          largeKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
               m.grid, m.tool, chunk_postures, chunk_order, m.queue, m.queued, m.tile_max, m.keys,
               m.options.tile_skip, m.stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
       } else {
         m.timed("warp", st, [&] {
-          warpKernel<B><<<warps, 32 * kWarpsPerBlock, 0, st>>>(
+          warpKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
               m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, culled_count,
               m.options.tile_skip, m.stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
@@ -589,7 +557,7 @@ void Engine::cut(const Posture* block, std::size_t count, bool coarse) {
     FIELDPATH_CUDA_CHECK(cudaGetLastError());
   } else {
     const int stride = m.options.prepass_stride;
-    if (stride > 1 && count >= 2 * std::size_t(stride)) {
+    if (stride > 1 && !m.options.lowest_first && count >= 2 * std::size_t(stride)) {
       // every stride-th posture in path order first (EngineTuning::prepass_stride), its order in
       // the other slot's scratch (same stream; the sort below reuses it after); culls not counted
       const int sparse = static_cast<int>((count + stride - 1) / stride);

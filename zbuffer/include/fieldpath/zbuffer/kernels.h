@@ -181,54 +181,14 @@ FIELDPATH_HD PreparedPosture preparePosture(const GridView& g, const ToolView& t
   return pp;
 }
 
-/// Distance (mm) in the grid plane from point p to the segment a → b.
-FIELDPATH_HD float segmentDistance(float px, float py, float ax, float ay, float bx, float by) {
-  const float ex = bx - ax, ey = by - ay, len2 = ex * ex + ey * ey;
-  float u = len2 > 0.f ? ((px - ax) * ex + (py - ay) * ey) / len2 : 0.f;
-  u = u < 0.f ? 0.f : (u > 1.f ? 1.f : u);
-  const float dx = px - (ax + u * ex), dy = py - (ay + u * ey);
-  return sqrtf(dx * dx + dy * dy);
-}
-
-/// Distance (mm) in the grid plane from the rectangle [x0, x1] × [y0, y1] to the segment a → b:
-/// 0 if they meet (Liang-Barsky clip), else attained at a vertex of one of the two.
-FIELDPATH_HD float rectSegmentDistance(float x0, float x1, float y0, float y1, float ax, float ay,
-                                       float bx, float by) {
-  const float dx = bx - ax, dy = by - ay;
-  const float p[4] = {-dx, dx, -dy, dy}, q[4] = {ax - x0, x1 - ax, ay - y0, y1 - ay};
-  float t0 = 0.f, t1 = 1.f;
-  bool meets = true;
-  for (int k = 0; k < 4; ++k) {
-    if (p[k] == 0.f) {
-      if (q[k] < 0.f) meets = false;
-    } else {
-      const float r = q[k] / p[k];
-      if (p[k] < 0.f)
-        t0 = maxf(t0, r);
-      else
-        t1 = minf(t1, r);
-    }
-  }
-  if (meets && t0 <= t1) return 0.f;
-  const auto pointRect = [&](float px, float py) {
-    const float ex = maxf(maxf(x0 - px, px - x1), 0.f), ey = maxf(maxf(y0 - py, py - y1), 0.f);
-    return sqrtf(ex * ex + ey * ey);
-  };
-  float d = minf(pointRect(ax, ay), pointRect(bx, by));
-  d = minf(d, segmentDistance(x0, y0, ax, ay, bx, by));
-  d = minf(d, segmentDistance(x1, y0, ax, ay, bx, by));
-  d = minf(d, segmentDistance(x0, y1, ax, ay, bx, by));
-  return minf(d, segmentDistance(x1, y1, ax, ay, bx, by));
-}
-
 /// Floor of the lower envelope of a ball of radius R (tool.cap_radius_mm) centred at height
 /// zc_mm, over the points at grid-plane distance >= d_mm from its centre: sqrt(R² - d²) below
 /// zc. FLT_MAX where it does not reach (d >= R). The distance is shrunk and the floor lowered by
 /// the posture's margin, far more than the float rounding of d, of this expression and of the
 /// tool's own entry height, so the floor is never above a height lineCut can give.
 FIELDPATH_HD float ballFloor(const ToolView& tool, const PreparedPosture& pp, float zc_mm,
-                             float d_mm) {
-  const float r = tool.cap_radius_mm;
+                             float d_mm, float grow_mm = 0.f) {
+  const float r = tool.cap_radius_mm + grow_mm;
   const float d = maxf(d_mm * (1.f - 1e-5f) - pp.cap_margin_mm, 0.f);
   if (!(d < r)) return FLT_MAX;
   return zc_mm - sqrtf((r - d) * (r + d)) - pp.cap_margin_mm;
@@ -238,16 +198,18 @@ FIELDPATH_HD float ballFloor(const ToolView& tool, const PreparedPosture& pp, fl
 /// the minimum over the segment of z(s) - sqrt(ρ² - (s - along)²), with z linear along the
 /// segment and ρ² = R² - d⊥², is convex in s; its stationary point, clamped to the segment, is
 /// the minimum. ρ is inflated by the margin (no cancellation at the rim can raise the floor).
+/// With the radius grown by g, it is a floor for every point within g of (px, py) too:
+/// (R+g)² - |p-q|² >= R² - |p'-q|² where |p'-p| <= g and |p'-q| <= R.
 FIELDPATH_HD float capsuleLineFloor(const ToolView& tool, const PreparedPosture& pp, float px,
-                                    float py) {
-  const float m = pp.cap_margin_mm, r = tool.cap_radius_mm, len = pp.cap_len_mm;
+                                    float py, float grow_mm = 0.f) {
+  const float m = pp.cap_margin_mm, r = tool.cap_radius_mm + grow_mm, len = pp.cap_len_mm;
   if (len == 0.f) {  // (nearly) vertical: one ball at the lower end
     const bool a_low = pp.cap_za_mm <= pp.cap_zb_mm;
     const float dx = px - (a_low ? pp.cap_ax : pp.cap_bx),
                 dy = py - (a_low ? pp.cap_ay : pp.cap_by);
     // the segment's other points are within the margin of that end and no lower
     return ballFloor(tool, pp, minf(pp.cap_za_mm, pp.cap_zb_mm),
-                     maxf(sqrtf(dx * dx + dy * dy) - m, 0.f));
+                     maxf(sqrtf(dx * dx + dy * dy) - m, 0.f), grow_mm);
   }
   const float qx = px - pp.cap_ax, qy = py - pp.cap_ay;
   const float along = qx * pp.cap_ux + qy * pp.cap_uy;
@@ -262,12 +224,13 @@ FIELDPATH_HD float capsuleLineFloor(const ToolView& tool, const PreparedPosture&
   return pp.cap_za_mm + pp.cap_slope * s - sqrtf(maxf((rho - w) * (rho + w), 0.f)) - m;
 }
 
-/// The capsule's floor over the rectangle [x0, x1] × [y0, y1] (mm, relative to the tip): a ball
-/// at the segment's lower end's height, at the rectangle's distance from the segment.
+/// The capsule's floor over the rectangle [x0, x1] × [y0, y1] (mm, relative to the tip): the
+/// line floor at its centre with the radius grown by its half-diagonal (one line's cost).
 FIELDPATH_HD float capsuleRectFloor(const ToolView& tool, const PreparedPosture& pp, float x0,
                                     float x1, float y0, float y1) {
-  const float d = rectSegmentDistance(x0, x1, y0, y1, pp.cap_ax, pp.cap_ay, pp.cap_bx, pp.cap_by);
-  return ballFloor(tool, pp, minf(pp.cap_za_mm, pp.cap_zb_mm), d);
+  const float hx = 0.5f * (x1 - x0), hy = 0.5f * (y1 - y0);
+  const float grow = sqrtf(hx * hx + hy * hy) * (1.f + 1e-5f) + pp.cap_margin_mm;
+  return capsuleLineFloor(tool, pp, x0 + hx, y0 + hy, grow);
 }
 
 /// World coordinates of line (ix, iy) relative to the tip, formed in double, rounded once.

@@ -84,13 +84,13 @@ struct EngineTuning {
   /// Every prepass_stride-th posture of a block (in path order) cuts first, then the tile maxima
   /// are refreshed and the whole block cuts: neighbours along a path cut nearly the same heights,
   /// so the lines start near their final height and the floors (radial, capsule) and tile skips
-  /// turn most of the block's line visits away at one compare. 0 or 1: no prepass.
+  /// turn most of the block's line visits away at one compare. 0 or 1: no prepass. Not where the
+  /// block is sorted lowest first (that order gets the same, and a zoom's few postures that
+  /// cover the grid would cut it twice).
   int prepass_stride = 16;
   /// Capsule floor (ToolView::cap_*) for lines and tiles without a radial floor (tilted postures,
   /// analytic tools).
   bool capsule_floor = true;
-  /// CUDA: each lane loads the heights of this many of its lines before it cuts any (8 or 1).
-  int line_batch = 8;
 };
 
 struct SimulationRequest {
