@@ -101,6 +101,7 @@ TEST_F(CpuVsCuda, EveryTuningVariantBitIdentical) {
     t.tile_shift = 2 + variant % 4;
     t.prepass_stride = variant % 3 == 1 ? 0 : 2 + variant % 7;
     t.capsule_floor = variant % 7 != 3;
+    t.group_postures = variant % 4 != 3;
     SCOPED_TRACE("variant " + std::to_string(variant));
     expectSameBits(g, small_mesh, p, Engine::Fast, t);
     if (variant % 4 == 2) expectSameBits(g, Tool::ball(0.8, 6), p, Engine::Fast, t);

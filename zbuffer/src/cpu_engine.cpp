@@ -48,7 +48,8 @@ class CpuEngine final : public BackendEngine {
       coarse(block);
       return;
     }
-    if (tuning_.prepass_stride > 1 && !tuning_.lowest_first && block.size() >= 2 * std::size_t(tuning_.prepass_stride)) {
+    if (tuning_.prepass_stride > 1 && !tuning_.lowest_first &&
+        block.size() >= 2 * std::size_t(tuning_.prepass_stride)) {
       // every stride-th posture in path order first (see EngineTuning::prepass_stride); its
       // culls are not counted (the main pass meets the same postures again)
       std::vector<std::uint32_t> sparse;

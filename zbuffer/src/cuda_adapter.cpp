@@ -33,7 +33,7 @@ cuda::ToolArrays arrays(const ToolData& tool, const ToolView& view) {
 
 cuda::Engine::Options options(const EngineTuning& t) {
   return {t.lowest_first,   t.small_threads,    t.overlap_upload, t.tile_skip,
-          t.pinned_staging, t.refresh_postures, t.prepass_stride};
+          t.pinned_staging, t.refresh_postures, t.prepass_stride, t.group_postures};
 }
 
 class CudaAdapter final : public BackendEngine {

@@ -153,6 +153,110 @@ __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
   cutLines(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, threadIdx.x & 31, 32, keys, stats);
 }
 
+/// Postures a warp cuts together (group kernel): consecutive postures of a path cut nearly the
+/// same lines, so each line's height is loaded once for the group, not once per posture.
+constexpr int kGroup = 8;
+
+/// One warp per kGroup consecutive postures: each lane < kGroup prepares and culls one posture
+/// into shared memory; then the lanes walk the live tiles of the group's union footprint, and for
+/// each line load its height once, apply every posture whose footprint holds the line (lineCut,
+/// running minimum) and store once. A posture's cut does not depend on the current height it is
+/// given, only whether it is returned, so the minimum (every bit) is the CPU's. A scattered group
+/// (union much larger than its footprints: a sorted block, ends of passes) is cut posture by
+/// posture instead.
+__global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
+                            const std::uint32_t* order, int count, const float* tile_max,
+                            std::int32_t* keys, unsigned long long* culled, bool skip,
+                            unsigned long long* stats) {
+  // raw storage: PreparedPosture's members have initialisers, which __shared__ cannot run
+  __shared__ alignas(
+      PreparedPosture) unsigned char storage[kWarpsPerBlock * kGroup * sizeof(PreparedPosture)];
+  PreparedPosture(*group)[kGroup] = reinterpret_cast<PreparedPosture(*)[kGroup]>(storage);
+  const int warp = threadIdx.x >> 5, lane = threadIdx.x & 31;
+  const int first = (blockIdx.x * kWarpsPerBlock + warp) * kGroup;
+  if (first >= count) return;  // warp-uniform
+  const int n = min(kGroup, count - first);
+  bool live = false;
+  int ix0 = INT_MAX, ix1 = INT_MIN, iy0 = INT_MAX, iy1 = INT_MIN;
+  long long area = 0;
+  if (lane < n) {
+    PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, first + lane));
+    live = !cullPosture(g, tool, pp, tile_max);
+    if (live) {
+      ix0 = pp.ix0, ix1 = pp.ix1, iy0 = pp.iy0, iy1 = pp.iy1;
+      area = (long long)(ix1 - ix0 + 1) * (iy1 - iy0 + 1);
+    } else if (culled && blockIdx.y == 0) {
+      atomicAdd(culled, 1ull);
+    }
+    group[warp][lane] = pp;
+  }
+  const unsigned live_mask = __ballot_sync(0xffffffffu, live);
+  if (!live_mask) return;
+  for (int o = 16; o > 0; o >>= 1) {
+    ix0 = min(ix0, __shfl_xor_sync(0xffffffffu, ix0, o));
+    iy0 = min(iy0, __shfl_xor_sync(0xffffffffu, iy0, o));
+    ix1 = max(ix1, __shfl_xor_sync(0xffffffffu, ix1, o));
+    iy1 = max(iy1, __shfl_xor_sync(0xffffffffu, iy1, o));
+    area += __shfl_xor_sync(0xffffffffu, area, o);
+  }
+  __syncwarp();
+  unsigned visited = 0, lowered = 0;
+  const long long union_area = (long long)(ix1 - ix0 + 1) * (iy1 - iy0 + 1);
+  if (union_area > 2 * area) {  // scattered: posture by posture, the lanes share its lines
+    for (unsigned mask = live_mask; mask; mask &= mask - 1) {
+      const PreparedPosture& pp = group[warp][__ffs(mask) - 1];
+      forEachLiveLine(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, lane, 32,
+                      [&](int ix, int iy) {
+                        std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
+                        const float z = lineCut(g, tool, pp, ix, iy, keyToFloat(*slot));
+                        ++visited;
+                        if (z != FLT_MAX) ++lowered, atomicMin(slot, floatToKey(z));
+                      });
+    }
+  } else {
+    const int tx0 = ix0 >> g.tile_shift, tx1 = ix1 >> g.tile_shift;
+    const int ty0 = iy0 >> g.tile_shift, ty1 = iy1 >> g.tile_shift;
+    const int tw = tx1 - tx0 + 1, tiles = tw * (ty1 - ty0 + 1);
+    for (int t = blockIdx.y; t < tiles; t += gridDim.y) {
+      const int tx = tx0 + t % tw, ty = ty0 + t / tw;
+      const int rx0 = max(tx << g.tile_shift, ix0), ry0 = max(ty << g.tile_shift, iy0);
+      const int rx1 = min(((tx + 1) << g.tile_shift) - 1, ix1);
+      const int ry1 = min(((ty + 1) << g.tile_shift) - 1, iy1);
+      if (skip) {  // skipped if no posture of the group can lower a line of it (lane-parallel)
+        float floor = FLT_MAX;
+        if (lane < n && ((live_mask >> lane) & 1u)) {
+          const PreparedPosture& pp = group[warp][lane];
+          const int a0 = max(rx0, pp.ix0), a1 = min(rx1, pp.ix1);
+          const int b0 = max(ry0, pp.iy0), b1 = min(ry1, pp.iy1);
+          if (a0 <= a1 && b0 <= b1) floor = rectFloor(g, tool, pp, a0, a1, b0, b1);
+        }
+        for (int o = 16; o > 0; o >>= 1)
+          floor = fminf(floor, __shfl_xor_sync(0xffffffffu, floor, o));
+        if (tile_max[ty * g.tiles_x + tx] <= floor) continue;
+      }
+      const int w = rx1 - rx0 + 1, lines = w * (ry1 - ry0 + 1);
+      for (int l = lane; l < lines; l += 32) {
+        const int ix = rx0 + l % w, iy = ry0 + l / w;
+        std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
+        const std::int32_t loaded = *slot;
+        float best = keyToFloat(loaded);
+        for (unsigned mask = live_mask; mask; mask &= mask - 1) {
+          const PreparedPosture& pp = group[warp][__ffs(mask) - 1];
+          if (ix < pp.ix0 || ix > pp.ix1 || iy < pp.iy0 || iy > pp.iy1) continue;
+          const float z = lineCut(g, tool, pp, ix, iy, best);
+          if (z != FLT_MAX) best = z;
+        }
+        ++visited;
+        if (floatToKey(best) < loaded) ++lowered, atomicMin(slot, floatToKey(best));
+      }
+    }
+  }
+  if (stats) {
+    atomicAdd(stats, static_cast<unsigned long long>(visited));
+    atomicAdd(stats + 1, static_cast<unsigned long long>(lowered));
+  }
+}
+
 /// SIMSURF1's coarse kernel: one thread per posture, every triangle.
 __global__ void coarseKernel(GridView g, ToolView tool, const Posture* postures, int count,
                              std::int32_t* keys) {
@@ -287,6 +391,7 @@ struct Engine::Impl {
   void* sort_temp = nullptr;
   std::size_t sort_temp_bytes = 0;
   std::size_t capacity = 0, lines = 0, refresh_every = 0;
+  bool use_groups = false;
   int slot = 0;
   cudaStream_t copy_stream = nullptr, compute_stream = nullptr;
   cudaEvent_t copied[2] = {nullptr, nullptr}, computed[2] = {nullptr, nullptr};
@@ -401,7 +506,17 @@ struct Engine::Impl {
       });
       const int splits = std::clamp(16384 / std::max(1, chunk), 1, 1024);
       const dim3 warps((chunk + kWarpsPerBlock - 1) / kWarpsPerBlock, splits);
-      if (m.options.small_threads) {
+      if (m.use_groups) {
+        const int groups = (chunk + kGroup - 1) / kGroup;
+        const dim3 blocks((groups + kWarpsPerBlock - 1) / kWarpsPerBlock,
+                          std::clamp(16384 / std::max(1, groups), 1, 1024));
+        m.timed("group", st, [&] {
+          groupKernel<<<blocks, 32 * kWarpsPerBlock, 0, st>>>(
+              m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, culled_count,
+              m.options.tile_skip, m.stats);
+          FIELDPATH_CUDA_CHECK(cudaGetLastError());
+        });
+      } else if (m.options.small_threads) {
         FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.queued, 0, sizeof(int), st));
         m.timed("small", st, [&] {
           smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(
@@ -523,6 +638,11 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(st));
   m.lines = lines;
   // (whether to sort lowest first is decided by the caller, simulate(), for both backends)
+  // Groups of consecutive postures where footprints are larger than a thread's; a thread per
+  // posture where they are smaller (its few lines are cut without sharing anything).
+  const double span_x = 2.0 * m.tool.hull_radius_mm / grid.dx_mm + 1.0,
+               span_y = 2.0 * m.tool.hull_radius_mm / grid.dy_mm + 1.0;
+  m.use_groups = options.group_postures && span_x * span_y > kSmallFootprintLines;
   // Tile maxima are refreshed between chunks. Lowest first, 2^17 postures per chunk: smaller
   // chunks cull more but leave the GPU half idle (2^15: case 3 378 ms, 2^17: 255 ms, 2^19: 259 ms).
   // In path order, refreshes pay less: lines/2 (case 7, 2^19: 42 ms, 2^17: 58 ms; run 9).

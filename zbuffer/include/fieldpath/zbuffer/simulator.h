@@ -91,6 +91,9 @@ struct EngineTuning {
   /// Capsule floor (ToolView::cap_*) for lines and tiles without a radial floor (tilted postures,
   /// analytic tools).
   bool capsule_floor = true;
+  /// CUDA, footprints larger than a thread's: a warp cuts 8 consecutive postures together, each
+  /// line's height loaded and stored once for the group.
+  bool group_postures = true;
 };
 
 struct SimulationRequest {
