@@ -36,6 +36,28 @@ std::vector<Posture> randomPostures(int count, unsigned seed, double extent) {
   return p;
 }
 
+/// A zigzag path over a wavy surface, consecutive postures 0.05 mm apart (what the group kernel
+/// takes in groups of 8), vertical or tilted along and across the path.
+std::vector<Posture> pathPostures(int count, double extent, bool tilted) {
+  std::vector<Posture> p;
+  const int passes = 12;
+  for (int k = 0; k < count; ++k) {
+    const int pass = k * passes / count;
+    const double u = double(k * passes % count) / count;
+    const double x = -extent + 2 * extent * (pass % 2 ? 1 - u : u);
+    const double y = -extent + 2 * extent * (pass + 0.5) / passes;
+    const double z = 0.5 * std::sin(x / 3) * std::cos(y / 4);
+    double i = 0, j = 0, kk = 1;
+    if (tilted) {
+      i = 0.3 * std::sin(x / 5);
+      j = 0.2 + 0.1 * std::cos(y / 3);
+    }
+    const double n = std::sqrt(i * i + j * j + kk * kk);
+    p.push_back({{float(x), float(y), float(z)}, {float(i / n), float(j / n), float(kk / n)}});
+  }
+  return p;
+}
+
 void expectSameBits(const Grid& g, const Tool& tool, const std::vector<Posture>& postures,
                     Engine engine, EngineTuning tuning = {}) {
   SimulationRequest req;
@@ -105,6 +127,28 @@ TEST_F(CpuVsCuda, EveryTuningVariantBitIdentical) {
     SCOPED_TRACE("variant " + std::to_string(variant));
     expectSameBits(g, small_mesh, p, Engine::Fast, t);
     if (variant % 4 == 2) expectSameBits(g, Tool::ball(0.8, 6), p, Engine::Fast, t);
+  }
+}
+
+TEST_F(CpuVsCuda, PathsCutInGroupsBitIdentical) {
+  // Large footprints along a path: the warps cut 8 consecutive postures together (and fall back
+  // to one at a time where a group is scattered); with and without groups and the prepass.
+  const Grid g = Grid::fromRegion(-20, -20, 20, 20, 200, 200);
+  const Tool mesh_ball = Tool::fromMesh(analyticToolMesh(Tool::ball(3, 10), 32, 31));
+  const Tool mesh_torus = Tool::fromMesh(analyticToolMesh(Tool::torus(3, 1, 12), 48, 8));
+  for (bool tilted : {false, true}) {
+    const auto p = pathPostures(6000, 16, tilted);
+    for (int variant = 0; variant < 4; ++variant) {
+      EngineTuning t;
+      t.group_postures = variant != 1;
+      t.prepass_stride = variant == 2 ? 0 : 16;
+      t.tile_skip = variant != 3;
+      SCOPED_TRACE(std::string(tilted ? "tilted" : "vertical") + " variant " +
+                   std::to_string(variant));
+      expectSameBits(g, mesh_ball, p, Engine::Fast, t);
+      expectSameBits(g, Tool::ball(3, 10), p, Engine::Fast, t);
+      if (variant == 0) expectSameBits(g, mesh_torus, p, Engine::Fast, t);
+    }
   }
 }
 
