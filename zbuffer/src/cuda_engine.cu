@@ -172,6 +172,7 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
   __shared__ alignas(
       PreparedPosture) unsigned char storage[kWarpsPerBlock * kGroup * sizeof(PreparedPosture)];
   PreparedPosture(*group)[kGroup] = reinterpret_cast<PreparedPosture(*)[kGroup]>(storage);
+  __shared__ float floors[kWarpsPerBlock][kGroup][32];  ///< per lane: each posture's line floor
   const int warp = threadIdx.x >> 5, lane = threadIdx.x & 31;
   const int first = (blockIdx.x * kWarpsPerBlock + warp) * kGroup;
   if (first >= count) return;  // warp-uniform
@@ -240,11 +241,31 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
         std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
         const std::int32_t loaded = *slot;
         float best = keyToFloat(loaded);
+        // The floors first, then the posture of the lowest floor: it nearly always cuts lowest,
+        // after which the others' floors turn them away without a triangle test.
+        float lowest = FLT_MAX;
+        int first_k = -1;
         for (unsigned mask = live_mask; mask; mask &= mask - 1) {
-          const PreparedPosture& pp = group[warp][__ffs(mask) - 1];
-          if (ix < pp.ix0 || ix > pp.ix1 || iy < pp.iy0 || iy > pp.iy1) continue;
-          const float z = lineCut(g, tool, pp, ix, iy, best);
+          const int k = __ffs(mask) - 1;
+          const PreparedPosture& pp = group[warp][k];
+          float f = FLT_MAX;
+          if (ix >= pp.ix0 && ix <= pp.ix1 && iy >= pp.iy0 && iy <= pp.iy1) {
+            float rx, ry;
+            lineOffset(g, pp, ix, iy, rx, ry);
+            f = lineFloors(tool, pp, rx, ry).skip_mm;
+          }
+          floors[warp][k][lane] = f;
+          if (f < lowest) lowest = f, first_k = k;
+        }
+        if (best > lowest) {
+          const float z = lineCut(g, tool, group[warp][first_k], ix, iy, best);
           if (z != FLT_MAX) best = z;
+          for (unsigned mask = live_mask & ~(1u << first_k); mask; mask &= mask - 1) {
+            const int k = __ffs(mask) - 1;
+            if (!(best > floors[warp][k][lane])) continue;
+            const float zk = lineCut(g, tool, group[warp][k], ix, iy, best);
+            if (zk != FLT_MAX) best = zk;
+          }
         }
         ++visited;
         if (floatToKey(best) < loaded) ++lowered, atomicMin(slot, floatToKey(best));
@@ -642,7 +663,10 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   // posture where they are smaller (its few lines are cut without sharing anything).
   const double span_x = 2.0 * m.tool.hull_radius_mm / grid.dx_mm + 1.0,
                span_y = 2.0 * m.tool.hull_radius_mm / grid.dy_mm + 1.0;
-  m.use_groups = options.group_postures && span_x * span_y > kSmallFootprintLines;
+  // Not where the block is sorted lowest first: its consecutive postures are scattered, and a
+  // zoom's few live ones need a warp each (Rz, run 18: 53 ms grouped, 12 not).
+  m.use_groups =
+      options.group_postures && !options.lowest_first && span_x * span_y > kSmallFootprintLines;
   // Tile maxima are refreshed between chunks. Lowest first, 2^17 postures per chunk: smaller
   // chunks cull more but leave the GPU half idle (2^15: case 3 378 ms, 2^17: 255 ms, 2^19: 259 ms).
   // In path order, refreshes pay less: lines/2 (case 7, 2^19: 42 ms, 2^17: 58 ms; run 9).

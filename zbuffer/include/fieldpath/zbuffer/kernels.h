@@ -430,26 +430,41 @@ FIELDPATH_HD float binnedEntry(const ToolView& tool, const PreparedPosture& pp, 
   return best;
 }
 
+/// The floors lineCut applies to the line at (rx, ry) from the tip (mm): `skip`, no height it
+/// gives is below it (FLT_MAX: it cannot reach the line); `clamp`, its heights are raised to it
+/// (the radial floor of a vertical mesh tool, so that a line at that floor is skipped without
+/// changing a bit; else the posture's lowest point). The capsule floor only skips: its margin
+/// keeps it below any height computed.
+struct LineFloors {
+  float skip_mm, clamp_mm;
+};
+FIELDPATH_HD LineFloors lineFloors(const ToolView& tool, const PreparedPosture& pp, float rx,
+                                   float ry) {
+  LineFloors f{pp.lowest_z_mm, pp.lowest_z_mm};
+  if (pp.vertical && tool.radial_bins > 0) {
+    const float rho = sqrtf(rx * rx + ry * ry);
+    if (!(rho <= tool.radial_max_mm)) return {FLT_MAX, FLT_MAX};
+    const int b = static_cast<int>(rho * tool.radial_inv_mm);
+    f.clamp_mm = f.skip_mm =
+        maxf(f.skip_mm,
+             pp.tip_mm.z + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]);
+  } else if (tool.cap_radius_mm > 0.f) {
+    f.skip_mm = maxf(f.skip_mm, capsuleLineFloor(tool, pp, rx, ry));
+  }
+  return f;
+}
+
 /// The height the posture would give line (ix, iy), or FLT_MAX if it cannot lower it below
 /// `current_mm`. Analytic and mesh tools; -0 folded to +0 so that both backends store equal bits.
+/// A height it returns does not depend on `current_mm` (the BVH is only pruned by it), so the
+/// minimum over postures is the same in any order and grouping.
 FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
                            int ix, int iy, float current_mm) {
   if (!(current_mm > pp.lowest_z_mm)) return FLT_MAX;
   float rx, ry;
   lineOffset(g, pp, ix, iy, rx, ry);
-  float floor_z = pp.lowest_z_mm;
-  if (pp.vertical && tool.radial_bins > 0) {
-    const float rho = sqrtf(rx * rx + ry * ry);
-    if (!(rho <= tool.radial_max_mm)) return FLT_MAX;
-    const int b = static_cast<int>(rho * tool.radial_inv_mm);
-    floor_z =
-        maxf(floor_z,
-             pp.tip_mm.z + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]);
-    if (!(current_mm > floor_z)) return FLT_MAX;
-  } else if (tool.cap_radius_mm > 0.f) {
-    // a skip test only (no clamp): the margin keeps it below any height computed below
-    if (!(current_mm > capsuleLineFloor(tool, pp, rx, ry))) return FLT_MAX;
-  }
+  const LineFloors floors = lineFloors(tool, pp, rx, ry);
+  if (!(current_mm > floors.skip_mm)) return FLT_MAX;
   const Vec3f o = mulTransposed(pp.rot, Vec3f{rx, ry, 0.f});
   float t;
   if (tool.kind == ToolKind::Mesh) {
@@ -460,7 +475,7 @@ FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const Prepar
     t = analyticEntry(tool, o, pp.dir);
   }
   if (t == FLT_MAX) return FLT_MAX;
-  const float h = maxf(pp.tip_mm.z + t, floor_z) + 0.f;
+  const float h = maxf(pp.tip_mm.z + t, floors.clamp_mm) + 0.f;
   return h < current_mm ? h : FLT_MAX;
 }
 

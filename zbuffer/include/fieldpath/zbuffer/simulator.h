@@ -80,7 +80,9 @@ struct EngineTuning {
   bool pinned_staging = true;  ///< CUDA: transfers through pinned buffers, host copies on all cores
   /// Postures between refreshes of the culling tiles' maxima; 0: chosen from the grid size.
   std::size_t refresh_postures = 0;
-  int tile_shift = 4;  ///< culling tiles of 2^shift × 2^shift lines, shift in [1, 8]
+  /// Culling tiles of 2^shift × 2^shift lines, shift in [1, 8]; 8 × 8 since the group kernel
+  /// (H200, run 18: case 8 400 ms vs 492 at 16 × 16, case 5 35 vs 42).
+  int tile_shift = 3;
   /// Every prepass_stride-th posture of a block (in path order) cuts first, then the tile maxima
   /// are refreshed and the whole block cuts: neighbours along a path cut nearly the same heights,
   /// so the lines start near their final height and the floors (radial, capsule) and tile skips
