@@ -225,6 +225,7 @@ int variantTable(const std::string& backend, const std::vector<std::string>& wan
       {"refresh 2^17", [](zb::EngineTuning& t) { t.refresh_postures = 1 << 17; }},
       {"refresh 2^19", [](zb::EngineTuning& t) { t.refresh_postures = 1 << 19; }},
       {"tiles 16²", [](zb::EngineTuning& t) { t.tile_shift = 4; }},
+      {"tiles 4²", [](zb::EngineTuning& t) { t.tile_shift = 2; }},
       {"tiles 32²", [](zb::EngineTuning& t) { t.tile_shift = 5; }},
       {"no lowest first", [](zb::EngineTuning& t) { t.lowest_first = false; }},
       {"no small threads", [](zb::EngineTuning& t) { t.small_threads = false; }},

@@ -172,7 +172,7 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
   __shared__ alignas(
       PreparedPosture) unsigned char storage[kWarpsPerBlock * kGroup * sizeof(PreparedPosture)];
   PreparedPosture(*group)[kGroup] = reinterpret_cast<PreparedPosture(*)[kGroup]>(storage);
-  __shared__ float floors[kWarpsPerBlock][kGroup][32];  ///< per lane: each posture's line floor
+  __shared__ LineFloors floors[kWarpsPerBlock][kGroup][32];  ///< per lane: each posture's
   const int warp = threadIdx.x >> 5, lane = threadIdx.x & 31;
   const int first = (blockIdx.x * kWarpsPerBlock + warp) * kGroup;
   if (first >= count) return;  // warp-uniform
@@ -248,23 +248,28 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
         for (unsigned mask = live_mask; mask; mask &= mask - 1) {
           const int k = __ffs(mask) - 1;
           const PreparedPosture& pp = group[warp][k];
-          float f = FLT_MAX;
+          LineFloors f{FLT_MAX, FLT_MAX};
           if (ix >= pp.ix0 && ix <= pp.ix1 && iy >= pp.iy0 && iy <= pp.iy1) {
             float rx, ry;
             lineOffset(g, pp, ix, iy, rx, ry);
-            f = lineFloors(tool, pp, rx, ry).skip_mm;
+            f = lineFloors(tool, pp, rx, ry);
           }
           floors[warp][k][lane] = f;
-          if (f < lowest) lowest = f, first_k = k;
+          if (f.skip_mm < lowest) lowest = f.skip_mm, first_k = k;
         }
         if (best > lowest) {
-          const float z = lineCut(g, tool, group[warp][first_k], ix, iy, best);
-          if (z != FLT_MAX) best = z;
-          for (unsigned mask = live_mask & ~(1u << first_k); mask; mask &= mask - 1) {
-            const int k = __ffs(mask) - 1;
-            if (!(best > floors[warp][k][lane])) continue;
-            const float zk = lineCut(g, tool, group[warp][k], ix, iy, best);
-            if (zk != FLT_MAX) best = zk;
+          for (unsigned mask = live_mask & ~(1u << first_k), k = first_k;;) {
+            const LineFloors f = floors[warp][k][lane];
+            if (best > f.skip_mm) {
+              const PreparedPosture& pp = group[warp][k];
+              float rx, ry;
+              lineOffset(g, pp, ix, iy, rx, ry);
+              const float z = lineCutAt(tool, pp, rx, ry, f, best);
+              if (z != FLT_MAX) best = z;
+            }
+            if (!mask) break;
+            k = __ffs(mask) - 1;
+            mask &= mask - 1;
           }
         }
         ++visited;

@@ -454,16 +454,13 @@ FIELDPATH_HD LineFloors lineFloors(const ToolView& tool, const PreparedPosture& 
   return f;
 }
 
-/// The height the posture would give line (ix, iy), or FLT_MAX if it cannot lower it below
-/// `current_mm`. Analytic and mesh tools; -0 folded to +0 so that both backends store equal bits.
-/// A height it returns does not depend on `current_mm` (the BVH is only pruned by it), so the
-/// minimum over postures is the same in any order and grouping.
-FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
-                           int ix, int iy, float current_mm) {
-  if (!(current_mm > pp.lowest_z_mm)) return FLT_MAX;
-  float rx, ry;
-  lineOffset(g, pp, ix, iy, rx, ry);
-  const LineFloors floors = lineFloors(tool, pp, rx, ry);
+/// The height the posture would give the line at (rx, ry) from the tip (mm) whose floors are
+/// `floors`, or FLT_MAX if it cannot lower it below `current_mm`. Analytic and mesh tools; -0
+/// folded to +0 so that both backends store equal bits. A height it returns does not depend on
+/// `current_mm` (the BVH is only pruned by it), so the minimum over postures is the same in any
+/// order and grouping.
+FIELDPATH_HD float lineCutAt(const ToolView& tool, const PreparedPosture& pp, float rx, float ry,
+                             LineFloors floors, float current_mm) {
   if (!(current_mm > floors.skip_mm)) return FLT_MAX;
   const Vec3f o = mulTransposed(pp.rot, Vec3f{rx, ry, 0.f});
   float t;
@@ -477,6 +474,15 @@ FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const Prepar
   if (t == FLT_MAX) return FLT_MAX;
   const float h = maxf(pp.tip_mm.z + t, floors.clamp_mm) + 0.f;
   return h < current_mm ? h : FLT_MAX;
+}
+
+/// lineCutAt for line (ix, iy): the shared per-line code path of both backends.
+FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
+                           int ix, int iy, float current_mm) {
+  if (!(current_mm > pp.lowest_z_mm)) return FLT_MAX;
+  float rx, ry;
+  lineOffset(g, pp, ix, iy, rx, ry);
+  return lineCutAt(tool, pp, rx, ry, lineFloors(tool, pp, rx, ry), current_mm);
 }
 
 /// A floor of the heights the posture can give the lines of the rectangle [ix0, ix1] × [iy0, iy1]:
