@@ -238,13 +238,14 @@ int variantTable(const std::string& backend, const std::vector<std::string>& wan
       {"prepass 32", [](zb::EngineTuning& t) { t.prepass_stride = 32; }},
       {"no prepass", [](zb::EngineTuning& t) { t.prepass_stride = 0; }},
       {"no capsule floor", [](zb::EngineTuning& t) { t.capsule_floor = false; }},
-      {"no groups", [](zb::EngineTuning& t) { t.group_postures = false; }},
+      {"no groups", [](zb::EngineTuning& t) { t.group_postures = 0; }},
+      {"groups of 16", [](zb::EngineTuning& t) { t.group_postures = 16; }},
       {"all knobs off",
        [](zb::EngineTuning& t) {
          t = {false, false, false, false, false, false};
          t.prepass_stride = 0;
          t.capsule_floor = false;
-         t.group_postures = false;
+         t.group_postures = 0;
        }},
   };
   std::printf("| case | P | grid |");

@@ -155,28 +155,28 @@ __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
 
 /// Postures a warp cuts together (group kernel): consecutive postures of a path cut nearly the
 /// same lines, so each line's height is loaded once for the group, not once per posture.
-constexpr int kGroup = 8;
 
-/// One warp per kGroup consecutive postures: each lane < kGroup prepares and culls one posture
-/// into shared memory; then the lanes walk the live tiles of the group's union footprint, and for
-/// each line load its height once, apply every posture whose footprint holds the line (lineCut,
-/// running minimum) and store once. A posture's cut does not depend on the current height it is
-/// given, only whether it is returned, so the minimum (every bit) is the CPU's. A scattered group
-/// (union much larger than its footprints: a sorted block, ends of passes) is cut posture by
+/// One warp per Group (<= 32) consecutive postures: each lane < Group prepares and culls one
+/// posture into shared memory; then the lanes walk the live tiles of the group's union footprint,
+/// and for each line load its height once, apply every posture whose footprint holds the line
+/// (lineCut, running minimum) and store once. A posture's cut does not depend on the current height
+/// it is given, only whether it is returned, so the minimum (every bit) is the CPU's. A scattered
+/// group (union much larger than its footprints: a sorted block, ends of passes) is cut posture by
 /// posture instead.
+template <int Group>
 __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
                             const std::uint32_t* order, int count, const float* tile_max,
                             std::int32_t* keys, unsigned long long* culled, bool skip,
                             unsigned long long* stats) {
   // raw storage: PreparedPosture's members have initialisers, which __shared__ cannot run
   __shared__ alignas(
-      PreparedPosture) unsigned char storage[kWarpsPerBlock * kGroup * sizeof(PreparedPosture)];
-  PreparedPosture(*group)[kGroup] = reinterpret_cast<PreparedPosture(*)[kGroup]>(storage);
-  __shared__ LineFloors floors[kWarpsPerBlock][kGroup][32];  ///< per lane: each posture's
+      PreparedPosture) unsigned char storage[kWarpsPerBlock * Group * sizeof(PreparedPosture)];
+  PreparedPosture(*group)[Group] = reinterpret_cast<PreparedPosture(*)[Group]>(storage);
+  __shared__ LineFloors floors[kWarpsPerBlock][Group][32];  ///< per lane: each posture's
   const int warp = threadIdx.x >> 5, lane = threadIdx.x & 31;
-  const int first = (blockIdx.x * kWarpsPerBlock + warp) * kGroup;
+  const int first = (blockIdx.x * kWarpsPerBlock + warp) * Group;
   if (first >= count) return;  // warp-uniform
-  const int n = min(kGroup, count - first);
+  const int n = min(Group, count - first);
   bool live = false;
   int ix0 = INT_MAX, ix1 = INT_MIN, iy0 = INT_MAX, iy1 = INT_MIN;
   long long area = 0;
@@ -533,16 +533,20 @@ struct Engine::Impl {
       const int splits = std::clamp(16384 / std::max(1, chunk), 1, 1024);
       const dim3 warps((chunk + kWarpsPerBlock - 1) / kWarpsPerBlock, splits);
       if (m.use_groups) {
-        const int groups = (chunk + kGroup - 1) / kGroup;
+        const int group = m.options.group_postures;
+        const int groups = (chunk + group - 1) / group;
         const dim3 blocks((groups + kWarpsPerBlock - 1) / kWarpsPerBlock,
                           std::clamp(16384 / std::max(1, groups), 1, 1024));
         m.timed("group", st, [&] {
-          groupKernel<<<blocks, 32 * kWarpsPerBlock, 0, st>>>(
+          const auto kernel = group > 8 ? groupKernel<16> : groupKernel<8>;
+          kernel<<<blocks, 32 * kWarpsPerBlock, 0, st>>>(
               m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, culled_count,
               m.options.tile_skip, m.stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
-      } else if (m.options.small_threads) {
+      } else if (m.options.small_threads && !m.options.lowest_first) {
+        // (sorted blocks go to a warp each in sorted order: the small kernel's queue would
+        // scramble it; case C, run 20: 25 ms, 140 through the queue)
         FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.queued, 0, sizeof(int), st));
         m.timed("small", st, [&] {
           smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(

@@ -40,7 +40,7 @@ class Engine {
          pinned_staging = true;
     std::size_t refresh_postures = 0;  ///< 0: from the grid size
     int prepass_stride = 0;            ///< see EngineTuning::prepass_stride
-    bool group_postures = true;        ///< see EngineTuning::group_postures
+    int group_postures = 8;            ///< see EngineTuning::group_postures
   };
   /// `heights_mm`: the initial heights (`lines` of them), or null: every line at `stock_mm`.
   Engine(const GridView& grid, const ToolArrays& tool, const float* heights_mm, float stock_mm,

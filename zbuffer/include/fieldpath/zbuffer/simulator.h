@@ -93,9 +93,10 @@ struct EngineTuning {
   /// Capsule floor (ToolView::cap_*) for lines and tiles without a radial floor (tilted postures,
   /// analytic tools).
   bool capsule_floor = true;
-  /// CUDA, footprints larger than a thread's: a warp cuts 8 consecutive postures together, each
-  /// line's height loaded and stored once for the group.
-  bool group_postures = true;
+  /// CUDA, footprints larger than a thread's, path order: a warp cuts this many consecutive
+  /// postures together (8 or 16), each line's height loaded and stored once for the group, its
+  /// postures tried lowest floor first. 0: a warp per posture.
+  int group_postures = 8;
 };
 
 struct SimulationRequest {
