@@ -240,8 +240,9 @@ void binDownFacing(ToolData& data, float pad) {
       rmax = std::max(rmax, std::sqrt(p[0] * p[0] + p[1] * p[1]));
     }
   const int rbins = 1024;
-  v.radial_max_mm = rmax * (1.f + 1e-5f) + pad;
-  v.radial_inv_mm = rbins / v.radial_max_mm;
+  const float radial_max_mm = rmax * (1.f + 1e-5f) + pad;
+  v.radial_max_mm2 = radial_max_mm * radial_max_mm;
+  v.radial_inv_mm2 = rbins / v.radial_max_mm2;
   data.radial_floor.assign(rbins, FLT_MAX);
   for (auto t : down) {
     const float* p = data.bvh_triangles.data() + 9 * t;
@@ -263,8 +264,9 @@ void binDownFacing(ToolData& data, float pad) {
     };
     const double s0 = side(0), s1 = side(1), s2 = side(2);
     if ((s0 >= 0 && s1 >= 0 && s2 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0)) rlo = 0;
-    const int b0 = std::max(0, static_cast<int>((rlo - pad) * v.radial_inv_mm) - 1);
-    const int b1 = std::min(rbins - 1, static_cast<int>((rhi + pad) * v.radial_inv_mm) + 1);
+    const double lo = std::max(0.0, rlo - pad), hi = rhi + pad;
+    const int b0 = std::max(0, static_cast<int>(lo * lo * v.radial_inv_mm2) - 1);
+    const int b1 = std::min(rbins - 1, static_cast<int>(hi * hi * v.radial_inv_mm2) + 1);
     for (int b = b0; b <= b1; ++b) data.radial_floor[b] = std::min(data.radial_floor[b], zmin);
   }
   // Made non-decreasing in the radius (each floor lowered to the smallest beyond it, still a
@@ -468,14 +470,15 @@ SimulationResult run(const SimulationRequest& request, std::size_t expected_post
   setup.heights_mm = request.initial_heights_mm;  // empty: every line at the stock
   setup.stock_mm = request.stock_mm;
   setup.tuning = request.tuning;
-  // Lowest first pays where one footprint covers much of the grid (a zoom: the first cut of a
-  // line is then nearly its last); elsewhere the prepass does that and path order keeps the
-  // neighbours of a path together (H200, run 16: case 3 105 ms in path order, 119 sorted;
-  // case 8 859 vs 1014; zooms Rz/Sz 13/32 ms sorted, 30/54 in path order).
+  // Lowest first pays where one footprint covers a quarter of the grid or more (a zoom: the first
+  // cut of a line is then nearly its last); elsewhere the prepass does that and path order keeps
+  // the neighbours of a path together (H200, runs 16-21: case 3 105 ms in path order, 119
+  // sorted; case 8 859 vs 1014; C (footprint 1/16 of the grid) 25 vs 177; zooms sorted: Fz 64
+  // vs 415, Rz 13 vs 30).
   const double span_x = 2.0 * setup.view.hull_radius_mm / grid.dx_mm + 1.0,
                span_y = 2.0 * setup.view.hull_radius_mm / grid.dy_mm + 1.0;
   setup.tuning.lowest_first =
-      request.tuning.lowest_first && span_x * span_y * 64.0 > double(grid.lineCount());
+      request.tuning.lowest_first && span_x * span_y * 4.0 > double(grid.lineCount());
 
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<detail::BackendEngine> engine =

@@ -54,7 +54,9 @@ struct ToolView {
   // the tool cannot lower be skipped after one table look-up.
   const float* radial_floor_mm = nullptr;
   std::int32_t radial_bins = 0;
-  float radial_inv_mm = 0, radial_max_mm = 0;
+  /// The annuli are even in the squared radius (no square root per line; a ball's floor is
+  /// linear in it): bin = int(ρ² · radial_inv_mm2), lines with ρ² > radial_max_mm2 missed.
+  float radial_inv_mm2 = 0, radial_max_mm2 = 0;
   // All kinds: a capsule that contains the tool, the points within cap_radius_mm of the axis
   // segment z in [cap_z0_mm, cap_z1_mm] (tool frame). Its lower envelope is a floor of the heights
   // any posture (tilted ones too) can give a line or a tile, at a square root's cost; 0: none.
@@ -442,9 +444,9 @@ FIELDPATH_HD LineFloors lineFloors(const ToolView& tool, const PreparedPosture& 
                                    float ry) {
   LineFloors f{pp.lowest_z_mm, pp.lowest_z_mm};
   if (pp.vertical && tool.radial_bins > 0) {
-    const float rho = sqrtf(rx * rx + ry * ry);
-    if (!(rho <= tool.radial_max_mm)) return {FLT_MAX, FLT_MAX};
-    const int b = static_cast<int>(rho * tool.radial_inv_mm);
+    const float rho2 = rx * rx + ry * ry;
+    if (!(rho2 <= tool.radial_max_mm2)) return {FLT_MAX, FLT_MAX};
+    const int b = static_cast<int>(rho2 * tool.radial_inv_mm2);
     f.clamp_mm = f.skip_mm =
         maxf(f.skip_mm,
              pp.tip_mm.z + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]);
@@ -502,9 +504,9 @@ FIELDPATH_HD float rectFloor(const GridView& g, const ToolView& tool, const Prep
   }
   const float rx = (ax <= 0.f && bx >= 0.f) ? 0.f : minf(absf(ax), absf(bx));
   const float ry = (ay <= 0.f && by >= 0.f) ? 0.f : minf(absf(ay), absf(by));
-  const float rho = sqrtf(rx * rx + ry * ry);
-  if (!(rho <= tool.radial_max_mm)) return FLT_MAX;
-  const int b = static_cast<int>(rho * tool.radial_inv_mm);
+  const float rho2 = rx * rx + ry * ry;
+  if (!(rho2 <= tool.radial_max_mm2)) return FLT_MAX;
+  const int b = static_cast<int>(rho2 * tool.radial_inv_mm2);
   return maxf(pp.lowest_z_mm,
               pp.tip_mm.z + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]);
 }

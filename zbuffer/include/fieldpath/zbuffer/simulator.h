@@ -70,8 +70,8 @@ using PostureSource = std::function<std::size_t(std::span<Posture> out)>;
 /// measured (bench/results/zbuffer-*.md); bench_zbuffer --variants times the others.
 struct EngineTuning {
   bool vertical_bins = true;  ///< vertical mesh postures: bin look-up instead of the BVH walk
-  /// Each block's postures processed lowest point first, where one footprint covers more than
-  /// 1/64 of the grid (a zoom); elsewhere the prepass gets the same culling and path order is
+  /// Each block's postures processed lowest point first, where one footprint covers a quarter of
+  /// the grid or more (a zoom); elsewhere the prepass gets the same culling and path order is
   /// faster (bench/results/zbuffer-h200.md, run 16).
   bool lowest_first = true;
   bool small_threads = true;   ///< CUDA: one thread per small-footprint posture, warps for the rest
