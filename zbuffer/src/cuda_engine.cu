@@ -173,7 +173,6 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
       PreparedPosture) unsigned char storage[kWarpsPerBlock * Group * sizeof(PreparedPosture)];
   PreparedPosture(*group)[Group] = reinterpret_cast<PreparedPosture(*)[Group]>(storage);
   __shared__ LineFloors floors[kWarpsPerBlock][Group][32];  ///< per lane: each posture's
-  __shared__ int queue_x[kWarpsPerBlock][64], queue_y[kWarpsPerBlock][64];  ///< lines to cut
   const int warp = threadIdx.x >> 5, lane = threadIdx.x & 31;
   const int first = (blockIdx.x * kWarpsPerBlock + warp) * Group;
   if (first >= count) return;  // warp-uniform
@@ -216,18 +215,34 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
                       });
     }
   } else {
-    // Lines where the group's lowest floor is below the height are queued and cut 32 at a time,
-    // a line per lane, so that the lanes run their triangle tests together (ncu, case 8: 13.6
-    // of 32 lanes active when each lane cut its own lines as it met them).
-    int queued = 0;  // warp-uniform
-    const auto cutQueued = [&](int entries) {
-      if (lane < entries) {
-        const int ix = queue_x[warp][lane], iy = queue_y[warp][lane];
+    const int tx0 = ix0 >> g.tile_shift, tx1 = ix1 >> g.tile_shift;
+    const int ty0 = iy0 >> g.tile_shift, ty1 = iy1 >> g.tile_shift;
+    const int tw = tx1 - tx0 + 1, tiles = tw * (ty1 - ty0 + 1);
+    for (int t = blockIdx.y; t < tiles; t += gridDim.y) {
+      const int tx = tx0 + t % tw, ty = ty0 + t / tw;
+      const int rx0 = max(tx << g.tile_shift, ix0), ry0 = max(ty << g.tile_shift, iy0);
+      const int rx1 = min(((tx + 1) << g.tile_shift) - 1, ix1);
+      const int ry1 = min(((ty + 1) << g.tile_shift) - 1, iy1);
+      if (skip) {  // skipped if no posture of the group can lower a line of it (lane-parallel)
+        float floor = FLT_MAX;
+        if (lane < n && ((live_mask >> lane) & 1u)) {
+          const PreparedPosture& pp = group[warp][lane];
+          const int a0 = max(rx0, pp.ix0), a1 = min(rx1, pp.ix1);
+          const int b0 = max(ry0, pp.iy0), b1 = min(ry1, pp.iy1);
+          if (a0 <= a1 && b0 <= b1) floor = rectFloor(g, tool, pp, a0, a1, b0, b1);
+        }
+        for (int o = 16; o > 0; o >>= 1)
+          floor = fminf(floor, __shfl_xor_sync(0xffffffffu, floor, o));
+        if (tile_max[ty * g.tiles_x + tx] <= floor) continue;
+      }
+      const int w = rx1 - rx0 + 1, lines = w * (ry1 - ry0 + 1);
+      for (int l = lane; l < lines; l += 32) {
+        const int ix = rx0 + l % w, iy = ry0 + l / w;
         std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
-        const std::int32_t loaded = *slot;  // fresher than at queueing
+        const std::int32_t loaded = *slot;
         float best = keyToFloat(loaded);
-        // the posture of the lowest floor first: it nearly always cuts lowest, after which the
-        // others' floors turn them away without a triangle test
+        // The floors first, then the posture of the lowest floor: it nearly always cuts lowest,
+        // after which the others' floors turn them away without a triangle test.
         float lowest = FLT_MAX;
         int first_k = -1;
         for (unsigned mask = live_mask; mask; mask &= mask - 1) {
@@ -257,69 +272,10 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
             mask &= mask - 1;
           }
         }
+        ++visited;
         if (floatToKey(best) < loaded) ++lowered, atomicMin(slot, floatToKey(best));
       }
-      __syncwarp();
-    };
-    const int tx0 = ix0 >> g.tile_shift, tx1 = ix1 >> g.tile_shift;
-    const int ty0 = iy0 >> g.tile_shift, ty1 = iy1 >> g.tile_shift;
-    const int tw = tx1 - tx0 + 1, tiles = tw * (ty1 - ty0 + 1);
-    for (int t = blockIdx.y; t < tiles; t += gridDim.y) {
-      const int tx = tx0 + t % tw, ty = ty0 + t / tw;
-      const int rx0 = max(tx << g.tile_shift, ix0), ry0 = max(ty << g.tile_shift, iy0);
-      const int rx1 = min(((tx + 1) << g.tile_shift) - 1, ix1);
-      const int ry1 = min(((ty + 1) << g.tile_shift) - 1, iy1);
-      if (skip) {  // skipped if no posture of the group can lower a line of it (lane-parallel)
-        float floor = FLT_MAX;
-        if (lane < n && ((live_mask >> lane) & 1u)) {
-          const PreparedPosture& pp = group[warp][lane];
-          const int a0 = max(rx0, pp.ix0), a1 = min(rx1, pp.ix1);
-          const int b0 = max(ry0, pp.iy0), b1 = min(ry1, pp.iy1);
-          if (a0 <= a1 && b0 <= b1) floor = rectFloor(g, tool, pp, a0, a1, b0, b1);
-        }
-        for (int o = 16; o > 0; o >>= 1)
-          floor = fminf(floor, __shfl_xor_sync(0xffffffffu, floor, o));
-        if (tile_max[ty * g.tiles_x + tx] <= floor) continue;
-      }
-      const int w = rx1 - rx0 + 1, lines = w * (ry1 - ry0 + 1);
-      for (int l0 = 0; l0 < lines; l0 += 32) {
-        const int l = l0 + lane;
-        bool need = false;
-        int ix = 0, iy = 0;
-        if (l < lines) {
-          ix = rx0 + l % w, iy = ry0 + l / w;
-          const float h = keyToFloat(keys[std::size_t(iy) * g.nx + ix]);
-          float lowest = FLT_MAX;  // the group's lowest floor at this line
-          for (unsigned mask = live_mask; mask; mask &= mask - 1) {
-            const PreparedPosture& pp = group[warp][__ffs(mask) - 1];
-            if (ix < pp.ix0 || ix > pp.ix1 || iy < pp.iy0 || iy > pp.iy1) continue;
-            float rx, ry;
-            lineOffset(g, pp, ix, iy, rx, ry);
-            lowest = fminf(lowest, lineFloors(tool, pp, rx, ry).skip_mm);
-          }
-          need = h > lowest;
-          ++visited;
-        }
-        const unsigned need_mask = __ballot_sync(0xffffffffu, need);
-        if (need) {
-          const int at = queued + __popc(need_mask & ((1u << lane) - 1));
-          queue_x[warp][at] = ix;
-          queue_y[warp][at] = iy;
-        }
-        queued += __popc(need_mask);
-        __syncwarp();
-        if (queued >= 32) {
-          cutQueued(32);
-          queued -= 32;
-          if (lane < queued) {
-            queue_x[warp][lane] = queue_x[warp][32 + lane];
-            queue_y[warp][lane] = queue_y[warp][32 + lane];
-          }
-          __syncwarp();
-        }
-      }
     }
-    cutQueued(queued);
   }
   if (stats) {
     atomicAdd(stats, static_cast<unsigned long long>(visited));
