@@ -22,6 +22,9 @@ struct StudyOptions {
   std::string voxels = "2,1,0.5";
   std::string interpolations = "trilinear,quadratic";
   std::string stored = "force,plane_ratio";
+  std::string refine;  ///< percent per voxel size; empty: no refined variants
+  int refine_levels = 2;
+  double sample_step_mm = 0.0;  ///< > 0: overrides the scene's field.sample_step
   bool no_brute_force = false;
   double line_step_mm = 0.05;
   int repeats = 1;
@@ -33,10 +36,15 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
   request.voxel_sizes_mm = parseVoxelSizes(o.voxels, "--voxels");
   request.interpolations = parseInterpolations(o.interpolations, "--interp");
   request.stored = parseStored(o.stored, "--stored");
+  if (!o.refine.empty())
+    request.refine_tolerances =
+        parseRefineTolerances(o.refine, request.voxel_sizes_mm.size(), "--refine");
+  request.refine_levels = o.refine_levels;
   request.brute_force = !o.no_brute_force;
   request.line_step_mm = o.line_step_mm;
   request.repeats = o.repeats;
   request.job = impellerJob(loadScene(o.scene));
+  if (o.sample_step_mm > 0.0) request.job.field.sample_step_mm = o.sample_step_mm;
   request.progress = makeProgressLine(global.quiet);
   const StudyResult result = runStudy(request);
   const std::filesystem::path dir = o.out;
@@ -69,6 +77,15 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--stored", options->stored,
                   "What voxel nodes store: force, plane_ratio or both, comma-separated")
       ->capture_default_str();
+  cmd->add_option("--refine", options->refine,
+                  "Refinement tolerances, %, one per voxel size (0: none): adds a refined "
+                  "trilinear variant of that size per stored quantity");
+  cmd->add_option("--refine-levels", options->refine_levels,
+                  "Levels below the voxel size the refined variants may go")
+      ->capture_default_str();
+  cmd->add_option("--sample-step", options->sample_step_mm,
+                  "Obstacle sampling step, mm, instead of the scene's field.sample_step")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--no-brute-force", options->no_brute_force,
                 "Skip the every-point direct sum (slow on large scenes)");
   cmd->add_option("--line-step", options->line_step_mm, "Sampling of the study lines, mm")
@@ -77,14 +94,19 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   cmd->add_option("--out", options->out, "Output folder")->required();
   cmd->callback([options, &global] {
-    std::ostringstream line_step;
+    std::ostringstream line_step, sample_step;
     line_step << options->line_step_mm;
-    std::string command_line = "fieldpath study " + options->scene + " --voxels " +
-                               options->voxels + " --interp " + options->interpolations +
-                               " --stored " + options->stored +
-                               (options->no_brute_force ? " --no-brute-force" : "") + " --repeat " +
-                               std::to_string(options->repeats) + " --line-step " +
-                               line_step.str() + " --out " + options->out;
+    sample_step << options->sample_step_mm;
+    std::string command_line =
+        "fieldpath study " + options->scene + " --voxels " + options->voxels + " --interp " +
+        options->interpolations + " --stored " + options->stored +
+        (options->refine.empty() ? std::string()
+                                 : " --refine " + options->refine + " --refine-levels " +
+                                       std::to_string(options->refine_levels)) +
+        (options->sample_step_mm > 0.0 ? " --sample-step " + sample_step.str() : std::string()) +
+        (options->no_brute_force ? " --no-brute-force" : "") + " --repeat " +
+        std::to_string(options->repeats) + " --line-step " + line_step.str() + " --out " +
+        options->out;
     run(*options, global, command_line);
   });
 }

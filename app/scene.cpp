@@ -183,9 +183,9 @@ void readHolder(const Reader& r, const YAML::Node& node, geometry::HolderProfile
 }
 
 void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
-  r.expectMap(
-      node, "field",
-      {"r0", "r_min", "gain", "sample_step", "weights", "voxel_size", "interpolation", "stored"});
+  r.expectMap(node, "field",
+              {"r0", "r_min", "gain", "sample_step", "weights", "voxel_size", "interpolation",
+               "stored", "refine_tolerance", "refine_levels"});
   if (node["r0"]) f.r0_mm = r.positive(node["r0"], "field.r0");
   if (node["r_min"]) f.r_min_mm = r.positive(node["r_min"], "field.r_min");
   if (!(f.r_min_mm < f.r0_mm)) {
@@ -210,6 +210,18 @@ void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
     f.stored = r.word(node["stored"], "field.stored", {"plane_ratio", "force"}) == "force"
                    ? field::StoredQuantity::Force
                    : field::StoredQuantity::PlaneRatio;
+  if (node["refine_tolerance"]) {
+    f.refine_tolerance = r.number(node["refine_tolerance"], "field.refine_tolerance");
+    if (!(f.refine_tolerance >= 0.0) || !std::isfinite(f.refine_tolerance))
+      r.fail(node["refine_tolerance"], "field.refine_tolerance",
+             "must be >= 0 (a fraction; 0: no refinement)");
+  }
+  if (node["refine_levels"]) {
+    const double levels = r.number(node["refine_levels"], "field.refine_levels");
+    if (!(levels >= 0.0 && levels <= 6.0) || levels != std::floor(levels))
+      r.fail(node["refine_levels"], "field.refine_levels", "must be an integer in [0, 6]");
+    f.refine_levels = static_cast<int>(levels);
+  }
 }
 
 void readDynamics(const Reader& r, const YAML::Node& node, dynamics::DynamicsParams& d) {

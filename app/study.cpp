@@ -213,23 +213,48 @@ std::string StudyVariant::name() const {
   std::ostringstream s;
   s << "voxel " << voxel_size_mm << " mm " << interpolationName(interpolation) << ' '
     << storedName(stored);
+  if (refine_tolerance > 0.0)
+    s << " refined " << 100 * refine_tolerance << " % to "
+      << voxel_size_mm / double(1 << refine_levels) << " mm";
   return s.str();
 }
 
-std::vector<double> parseVoxelSizes(const std::string& text, const std::string& key) {
-  std::vector<double> sizes;
+namespace {
+/// "a,b,c" → finite numbers accepted by `ok`; InputError naming `key` and `what` otherwise
+/// (an empty list or a trailing comma included).
+template <class Ok>
+std::vector<double> parseNumbers(const std::string& text, const std::string& key, Ok&& ok,
+                                 const std::string& what) {
+  std::vector<double> values;
   std::stringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
     char* end = nullptr;
-    const double h = std::strtod(item.c_str(), &end);
-    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(h) || h <= 0.0)
-      throw InputError(key + ": '" + item + "' is not a voxel size > 0 mm (e.g. 2,1,0.5)");
-    sizes.push_back(h);
+    const double v = std::strtod(item.c_str(), &end);
+    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(v) || !ok(v))
+      throw InputError(key + ": '" + item + "' is not " + what);
+    values.push_back(v);
   }
-  if (sizes.empty() || text.back() == ',')
-    throw InputError(key + ": give voxel sizes separated by commas (e.g. 2,1,0.5)");
-  return sizes;
+  if (values.empty() || text.back() == ',')
+    throw InputError(key + ": give " + what + ", separated by commas");
+  return values;
+}
+}  // namespace
+
+std::vector<double> parseVoxelSizes(const std::string& text, const std::string& key) {
+  return parseNumbers(
+      text, key, [](double h) { return h > 0.0; }, "voxel sizes > 0 mm (e.g. 2,1,0.5)");
+}
+
+std::vector<double> parseRefineTolerances(const std::string& text, std::size_t sizes,
+                                          const std::string& key) {
+  std::vector<double> tolerances = parseNumbers(
+      text, key, [](double pct) { return pct >= 0.0; }, "tolerances >= 0 % (e.g. 7.5,2.5,0.5)");
+  if (tolerances.size() != sizes)
+    throw InputError(key + ": give one tolerance (%) per voxel size (" + std::to_string(sizes) +
+                     ")");
+  for (double& t : tolerances) t /= 100.0;
+  return tolerances;
 }
 
 namespace {
@@ -278,10 +303,22 @@ StudyResult runStudy(const StudyRequest& request) {
   std::vector<StudyVariant> variants;
   if (request.brute_force) variants.push_back({pathgen::FieldMode::BruteForce});
   variants.push_back({pathgen::FieldMode::Direct});
-  for (double h : request.voxel_sizes_mm)
+  if (!request.refine_tolerances.empty() &&
+      request.refine_tolerances.size() != request.voxel_sizes_mm.size())
+    throw InputError("--refine: give one tolerance per voxel size");
+  if (request.refine_levels < 1 || request.refine_levels > 6)
+    throw InputError("--refine-levels: must be in [1, 6]");
+  for (std::size_t k = 0; k < request.voxel_sizes_mm.size(); ++k) {
+    const double h = request.voxel_sizes_mm[k];
     for (field::StoredQuantity stored : request.stored)
       for (field::Interpolation interp : request.interpolations)
         variants.push_back({pathgen::FieldMode::Voxel, h, interp, stored});
+    const double tolerance = request.refine_tolerances.empty() ? 0.0 : request.refine_tolerances[k];
+    if (tolerance > 0.0)
+      for (field::StoredQuantity stored : request.stored)
+        variants.push_back({pathgen::FieldMode::Voxel, h, field::Interpolation::Trilinear, stored,
+                            tolerance, request.refine_levels});
+  }
 
   // Shares of the progress bar: each path run, then the error evaluation.
   const double runs_end = 0.85;
@@ -300,6 +337,8 @@ StudyResult runStudy(const StudyRequest& request) {
       job.field.voxel_size_mm = variants[i].voxel_size_mm;
       job.field.interpolation = variants[i].interpolation;
       job.field.stored = variants[i].stored;
+      job.field.refine_tolerance = variants[i].refine_tolerance;
+      job.field.refine_levels = variants[i].refine_levels;
     }
     job.progress = scaled(request.progress, share(i), share(i + 1), variants[i].name());
     StudyRow row;
@@ -319,6 +358,7 @@ StudyResult runStudy(const StudyRequest& request) {
       row.failure = e.what();
       row.times = {kNaN, kNaN, kNaN, kNaN, kNaN};
       row.total_s = row.speedup_vs_brute = row.speedup_vs_direct = kNaN;
+      row.path_speedup_vs_direct = kNaN;
       row.tilt_max_deg = row.tilt_rms_deg = row.tilt_middle_max_deg = kNaN;
       row.min_clearance_mm = row.max_tilt_deg = kNaN;
       runs.emplace_back();
@@ -345,6 +385,7 @@ StudyResult runStudy(const StudyRequest& request) {
   // ---- speed-ups and tilt differences --------------------------------------------------------
   const double brute_total = request.brute_force ? result.rows[0].total_s : kNaN;
   const double direct_total = result.rows[direct_row].total_s;
+  const double direct_path = result.rows[direct_row].times.steering_s;
   result.middle_pass = static_cast<int>(direct_run.passes.size()) / 2;
   for (const pathgen::GeneratedPosture& g : direct_run.postures)
     if (g.pass == result.middle_pass) result.tilt_s_mm.push_back(g.s_mm);
@@ -356,6 +397,7 @@ StudyResult runStudy(const StudyRequest& request) {
     }
     row.speedup_vs_brute = brute_total / row.total_s;
     row.speedup_vs_direct = direct_total / row.total_s;
+    row.path_speedup_vs_direct = direct_path / row.times.steering_s;
     const auto& postures = runs[i].postures;
     if (postures.size() != direct_run.postures.size())
       throw std::logic_error("study: " + row.variant.name() + " has " +
@@ -435,6 +477,8 @@ StudyResult runStudy(const StudyRequest& request) {
       voxel_request.voxel_size_mm = row.variant.voxel_size_mm;
       voxel_request.interpolation = row.variant.interpolation;
       voxel_request.stored = row.variant.stored;
+      voxel_request.refine_tolerance = row.variant.refine_tolerance;
+      voxel_request.refine_levels = row.variant.refine_levels;
       // The region generate used; for a failed run, the direct run's padded by two voxels as
       // generate pads it.
       Eigen::AlignedBox3d region = direct_run.reach_box_mm;
@@ -445,6 +489,8 @@ StudyResult runStudy(const StudyRequest& request) {
       row.active_nodes = voxels->stats().active_nodes;
       row.dense_box_nodes = voxels->stats().dense_box_nodes;
       row.voxel_memory_bytes = voxels->stats().memory_bytes;
+      row.refined_nodes = voxels->stats().refined_nodes;
+      row.levels = voxels->stats().levels;
       approx = std::move(voxels);
     } else if (row.variant.mode == pathgen::FieldMode::BruteForce) {
       approx = std::make_unique<field::BruteForceField>(direct.samples(), job.field);
@@ -518,9 +564,10 @@ double maxForceError(const StudyRow& row) {
 
 std::string csvText(const StudyResult& r) {
   std::ostringstream s;
-  s << "variant,mode,voxel_mm,interpolation,stored,status,active_nodes,dense_box_nodes,voxel_"
-       "memory_mb,"
+  s << "variant,mode,voxel_mm,interpolation,stored,refine_tolerance_pct,levels,status,active_"
+       "nodes,refined_nodes,dense_box_nodes,voxel_memory_mb,"
        "field_s,path_s,clearance_s,total_s,speedup_vs_brute,speedup_vs_direct,"
+       "path_speedup_vs_direct,"
        "line_a_max_pct,line_a_rms_pct,line_b_max_pct,line_b_rms_pct,nodes_max_pct,nodes_rms_pct,"
        "max_force_error_pct,nodes_max_scaled_pct,moment_max_pct,moment_rms_pct,tilt_max_deg,tilt_"
        "rms_deg,tilt_middle_max_deg,"
@@ -531,12 +578,13 @@ std::string csvText(const StudyResult& r) {
     s << v.name() << ',' << fieldModeName(v.mode) << ','
       << (v.isVoxel() ? number(v.voxel_size_mm) : "0") << ','
       << (v.isVoxel() ? interpolationName(v.interpolation) : "exact") << ','
-      << (v.isVoxel() ? storedName(v.stored) : "exact") << ','
-      << (row.failure.empty() ? "ok" : "failed") << ',' << row.active_nodes << ','
-      << row.dense_box_nodes << ',' << number(row.voxel_memory_bytes / 1e6) << ','
-      << number(row.times.field_s) << ',' << number(row.times.steering_s) << ','
-      << number(row.times.clearance_s) << ',' << number(row.total_s) << ','
-      << number(row.speedup_vs_brute) << ',' << number(row.speedup_vs_direct) << ','
+      << (v.isVoxel() ? storedName(v.stored) : "exact") << ',' << number(100 * v.refine_tolerance)
+      << ',' << row.levels << ',' << (row.failure.empty() ? "ok" : "failed") << ','
+      << row.active_nodes << ',' << row.refined_nodes << ',' << row.dense_box_nodes << ','
+      << number(row.voxel_memory_bytes / 1e6) << ',' << number(row.times.field_s) << ','
+      << number(row.times.steering_s) << ',' << number(row.times.clearance_s) << ','
+      << number(row.total_s) << ',' << number(row.speedup_vs_brute) << ','
+      << number(row.speedup_vs_direct) << ',' << number(row.path_speedup_vs_direct) << ','
       << number(100 * row.line_a.relative.max_relative) << ','
       << number(100 * row.line_a.relative.rms_relative) << ','
       << number(100 * row.line_b.relative.max_relative) << ','
@@ -604,7 +652,8 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
     << "`\n\n"
     << "Job: " << r.postures << " postures on " << fixed(r.path_length_mm, 1)
     << " mm of path, middle pass " << r.middle_pass + 1 << " plotted; " << r.tool_nodes
-    << " tool + holder nodes; " << r.obstacle_points << " obstacle points; voxel region (what tool"
+    << " tool + holder nodes; " << r.obstacle_points << " obstacle points (blades sampled every "
+    << r.field.sample_step_mm << " mm; seed 004: 1 mm, 5100 points); voxel region (what tool"
     << " + holder can reach) " << fixed(r.reach_box_cm3, 0) << " cm³; r0 = " << r.field.r0_mm
     << " mm, r_min = " << r.field.r_min_mm << " mm, clearance = " << r.clearance_mm << " mm.\n\n"
     << "## Definitions\n\n"
@@ -635,14 +684,16 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
     << "- **Tilt difference**: `|θ_tilt,v - θ_tilt,d|` at every posture of every pass.\n\n";
 
   s << "## Table 1: cost\n\n"
-    << "| variant | active nodes | dense-box nodes | memory MB | field s | path s | total s |"
-       " × vs brute | × vs direct | clearance s | solver steps | RHS evals |\n"
-    << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+    << "| variant | active nodes | of them refined | dense-box nodes | memory MB | field s |"
+       " path s | total s | × vs brute | × vs direct (total) | × vs direct (path only) |"
+       " clearance s | solver steps | RHS evals |\n"
+    << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const StudyRow& row : r.rows)
-    s << "| " << row.variant.name() << " | " << row.active_nodes << " | " << row.dense_box_nodes
-      << " | " << fixed(row.voxel_memory_bytes / 1e6, 1) << " | " << fixed(row.times.field_s, 3)
-      << " | " << fixed(row.times.steering_s, 3) << " | " << fixed(row.total_s, 3) << " | "
-      << fixed(row.speedup_vs_brute, 1) << " | " << fixed(row.speedup_vs_direct, 2) << " | "
+    s << "| " << row.variant.name() << " | " << row.active_nodes << " | " << row.refined_nodes
+      << " | " << row.dense_box_nodes << " | " << fixed(row.voxel_memory_bytes / 1e6, 1) << " | "
+      << fixed(row.times.field_s, 3) << " | " << fixed(row.times.steering_s, 3) << " | "
+      << fixed(row.total_s, 3) << " | " << fixed(row.speedup_vs_brute, 1) << " | "
+      << fixed(row.speedup_vs_direct, 2) << " | " << fixed(row.path_speedup_vs_direct, 2) << " | "
       << fixed(row.times.clearance_s, 2) << " | " << row.solver_steps << " | " << row.rhs_evals
       << " |\n";
   s << "\n**Published (seed 004 Table 1; Matlab on a Xeon E5-1620 @ 3.6 GHz, other hardware, "
@@ -697,40 +748,50 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
     s << "\n";
   }
 
-  // Targets of issue 7, best interpolation per voxel size.
+  // Targets of issue 7, best variant per voxel size, uniform and refined apart.
   s << "\n## Targets (issue 7)\n\n"
-    << "Per voxel size, the variant with the least max force error and the one with the least"
-    << " tilt difference (variants whose path failed are left out).\n\n"
-    << "| voxel | least force error | max force error % (target) | met |"
+    << "Per voxel size and grid (uniform, or refined where its error estimate exceeds the"
+    << " tolerance), the variant with the least max force error and the one with the least tilt"
+    << " difference (variants whose path failed are left out).\n\n"
+    << "| voxel | grid | least force error | max force error % (target) | met |"
        " least tilt difference | tilt diff max ° (target) | met |\n"
-    << "|---|---|---:|---|---|---:|---|\n";
-  for (const Target& t : kTargets) {
-    const StudyRow *force = nullptr, *tilt = nullptr;
-    for (const StudyRow& row : r.rows) {
-      if (!row.variant.isVoxel() || !row.failure.empty() ||
-          std::abs(row.variant.voxel_size_mm - t.h_mm) > 1e-9)
-        continue;
-      if (!force || maxForceError(row) < maxForceError(*force)) force = &row;
-      if (!tilt || row.tilt_max_deg < tilt->tilt_max_deg) tilt = &row;
+    << "|---|---|---|---:|---|---|---:|---|\n";
+  for (const Target& t : kTargets)
+    for (const bool refined : {false, true}) {
+      const StudyRow *force = nullptr, *tilt = nullptr;
+      for (const StudyRow& row : r.rows) {
+        if (!row.variant.isVoxel() || !row.failure.empty() ||
+            std::abs(row.variant.voxel_size_mm - t.h_mm) > 1e-9 ||
+            (row.variant.refine_tolerance > 0.0) != refined)
+          continue;
+        if (!force || maxForceError(row) < maxForceError(*force)) force = &row;
+        if (!tilt || row.tilt_max_deg < tilt->tilt_max_deg) tilt = &row;
+      }
+      if (!force) continue;
+      const bool force_met = 100 * maxForceError(*force) <= t.force_pct;
+      const bool tilt_met = tilt->tilt_max_deg <= t.tilt_deg;
+      s << "| " << t.h_mm << " mm | " << (refined ? "refined" : "uniform") << " | "
+        << force->variant.name() << " | " << fixed(100 * maxForceError(*force), 3) << " (≤ "
+        << t.force_pct << ") | " << (force_met ? "yes" : "**no**") << " | " << tilt->variant.name()
+        << " | " << fixed(tilt->tilt_max_deg, 4) << " (≤ " << t.tilt_deg << ") | "
+        << (tilt_met ? "yes" : "**no**") << " |\n";
     }
-    if (!force) continue;
-    const bool force_met = 100 * maxForceError(*force) <= t.force_pct;
-    const bool tilt_met = tilt->tilt_max_deg <= t.tilt_deg;
-    s << "| " << t.h_mm << " mm | " << force->variant.name() << " | "
-      << fixed(100 * maxForceError(*force), 3) << " (≤ " << t.force_pct << ") | "
-      << (force_met ? "yes" : "**no**") << " | " << tilt->variant.name() << " | "
-      << fixed(tilt->tilt_max_deg, 4) << " (≤ " << t.tilt_deg << ") | "
-      << (tilt_met ? "yes" : "**no**") << " |\n";
+  // Speed: path only (the field built once per part, seed 004 Table 1 keeps it apart) and total.
+  const StudyRow *by_path = nullptr, *by_total = nullptr;
+  for (const StudyRow& row : r.rows) {
+    if (!row.variant.isVoxel() || !row.failure.empty() || maxForceError(row) > 0.01) continue;
+    if (!by_path || row.path_speedup_vs_direct > by_path->path_speedup_vs_direct) by_path = &row;
+    if (!by_total || row.speedup_vs_direct > by_total->speedup_vs_direct) by_total = &row;
   }
-  const StudyRow* fastest = nullptr;
-  for (const StudyRow& row : r.rows)
-    if (row.variant.isVoxel() && row.failure.empty() && maxForceError(row) <= 0.01 &&
-        (!fastest || row.total_s < fastest->total_s))
-      fastest = &row;
-  s << "\nSpeed at ≤ 1 % max force error (target ≥ 10× the indexed direct path): ";
-  if (fastest)
-    s << fastest->variant.name() << ", " << fixed(fastest->speedup_vs_direct, 2) << "× ("
-      << (fastest->speedup_vs_direct >= 10 ? "met" : "**not met**") << ").\n";
+  s << "\nSpeed at ≤ 1 % max force error (target: the voxel path ≥ 10× the indexed direct path"
+    << " in the same run): ";
+  if (by_path)
+    s << "path only, best " << by_path->variant.name() << ": "
+      << fixed(by_path->path_speedup_vs_direct, 2) << "× ("
+      << (by_path->path_speedup_vs_direct >= 10 ? "met" : "**not met**")
+      << "); total (field build + path), best " << by_total->variant.name() << ": "
+      << fixed(by_total->speedup_vs_direct, 2) << "× ("
+      << (by_total->speedup_vs_direct >= 10 ? "met" : "**not met**") << ").\n";
   else
     s << "no voxel variant reaches 1 % (**not met**).\n";
   for (const StudyRow& row : r.rows)

@@ -50,9 +50,14 @@ struct StudyVariant {
   double voxel_size_mm = 0.0;  ///< voxel mode only
   field::Interpolation interpolation = field::Interpolation::Trilinear;
   field::StoredQuantity stored = field::StoredQuantity::Force;  ///< what the voxel nodes hold
+  /// Refinement (field::VoxelRequest::refine_tolerance, as a fraction; 0: a uniform grid) and
+  /// the levels below voxel_size_mm it may go.
+  double refine_tolerance = 0.0;
+  int refine_levels = 0;
 
   bool isVoxel() const { return mode == pathgen::FieldMode::Voxel; }
-  /// "brute force", "direct", "voxel 2 mm trilinear force" (tables, plots).
+  /// "brute force", "direct", "voxel 2 mm trilinear force", "voxel 2 mm trilinear plane_ratio
+  /// refined 7.5 % to 0.25 mm" (tables, plots).
   std::string name() const;
 };
 
@@ -64,6 +69,10 @@ struct StudyRequest {
                                                       field::Interpolation::Quadratic};
   std::vector<field::StoredQuantity> stored = {field::StoredQuantity::Force,
                                                field::StoredQuantity::PlaneRatio};
+  /// Per voxel size (same order, same count, or empty): a refinement tolerance (fraction) for
+  /// an extra variant of that size, trilinear, for each stored quantity; 0 adds none.
+  std::vector<double> refine_tolerances;
+  int refine_levels = 2;       ///< levels below the voxel size the refined variants may go
   bool brute_force = true;     ///< run the seed's every-point direct sum (slow on big scenes)
   double line_step_mm = 0.05;  ///< sampling of the study lines
   int repeats = 1;             ///< runs per variant; times are their medians
@@ -86,10 +95,13 @@ struct StudyRow {
   std::size_t active_nodes = 0;     ///< voxel nodes holding a value (0 for direct methods)
   std::size_t dense_box_nodes = 0;  ///< nodes of a dense grid over their bounding box
   std::size_t voxel_memory_bytes = 0;
+  std::size_t refined_nodes = 0;   ///< of active_nodes, those of the finer levels
+  int levels = 0;                  ///< voxel grid levels built (1: uniform)
   pathgen::StageTimes times;       ///< of generateImpellerPath for this variant
   double total_s = 0.0;            ///< field_s + steering_s: what the seed's "temps total" counts
   double speedup_vs_brute = 0.0;   ///< brute total / this total; NaN when brute force was skipped
   double speedup_vs_direct = 0.0;  ///< indexed direct total / this total
+  double path_speedup_vs_direct = 0.0;  ///< indexed direct path (steering) / this path
   ForceError line_a, line_b, nodes;
   ForceError moment;  ///< of τ = Σ (x_i - C) × F(x_i) per posture of the direct path
   double tilt_max_deg = 0.0, tilt_rms_deg = 0.0;  ///< |tilt - tilt_direct| over every posture
@@ -143,6 +155,10 @@ void writeStudy(const StudyResult& result, const std::filesystem::path& dir,
 bool plotStudy(const std::filesystem::path& dir, std::string* message);
 
 /// "2,1,0.5" → {2, 1, 0.5}; "trilinear,quadratic" → interpolations. Throw InputError naming `key`.
+/// "7.5,2.5,0.5" (percent) → refinement tolerances as fractions, one per voxel size (`sizes`
+/// of them); 0 is allowed (no refined variant of that size). Throws InputError naming `key`.
+std::vector<double> parseRefineTolerances(const std::string& text, std::size_t sizes,
+                                          const std::string& key);
 std::vector<double> parseVoxelSizes(const std::string& text, const std::string& key);
 std::vector<field::Interpolation> parseInterpolations(const std::string& text,
                                                       const std::string& key);

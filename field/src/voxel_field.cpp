@@ -264,23 +264,22 @@ bool ratioHolds(const double (&s)[8], const bool (&over)[8]) {
 
 }  // namespace
 
-
 namespace {
 
 using IndexGrid = openvdb::Int32Grid;
-constexpr int kBlockDim = kLeafDim + 1;                  ///< a leaf's nodes and the +1 layer
+constexpr int kBlockDim = kLeafDim + 1;                         ///< a leaf's nodes and the +1 layer
 constexpr int kBlockNodes = kBlockDim * kBlockDim * kBlockDim;  // 729
-constexpr int kBlockWords = (kBlockNodes + 63) / 64;     ///< bits of one flag per block node
-constexpr int kCellWords = Leaf::SIZE / 64;              ///< bits of one flag per leaf cell
+constexpr int kBlockWords = (kBlockNodes + 63) / 64;            ///< bits of one flag per block node
+constexpr int kCellWords = Leaf::SIZE / 64;                     ///< bits of one flag per leaf cell
 /// Offsets of a cell's 8 corners in a block (index bits: x 4, y 2, z 1, as cellCorners).
 constexpr int kCornerOffset[8] = {0,
                                   1,
                                   kBlockDim,
                                   kBlockDim + 1,
-                                  kBlockDim * kBlockDim,
-                                  kBlockDim * kBlockDim + 1,
-                                  kBlockDim * kBlockDim + kBlockDim,
-                                  kBlockDim * kBlockDim + kBlockDim + 1};
+                                  kBlockDim* kBlockDim,
+                                  kBlockDim* kBlockDim + 1,
+                                  kBlockDim* kBlockDim + kBlockDim,
+                                  kBlockDim* kBlockDim + kBlockDim + 1};
 
 bool bit(const std::vector<std::uint64_t>& words, std::size_t i) {
   return (words[i >> 6] >> (i & 63)) & 1u;
@@ -295,8 +294,8 @@ struct Level {
   FloatGrid::Ptr closeness;  ///< PlaneRatio: r0 - s (mm), same topology; background 0 (s = r0)
   IndexGrid::Ptr block_of;   ///< leaf coordinate (node ijk >> 3) → block number; background -1
   std::vector<std::array<float, 4>> nodes;  ///< per block: value xyz, closeness
-  std::vector<std::uint64_t> over;     ///< per block node: over/under the surface (ratioHolds)
-  std::vector<std::uint64_t> refined;  ///< per leaf cell: read the next level instead
+  std::vector<std::uint64_t> over;          ///< per block node: over/under the surface (ratioHolds)
+  std::vector<std::uint64_t> refined;       ///< per leaf cell: read the next level instead
 
   std::size_t blocks() const { return nodes.size() / kBlockNodes; }
   std::size_t memUsage() const {
@@ -312,8 +311,11 @@ struct CellRef {
   Vec3 t;
 };
 
-bool locate(const Level& level, const IndexGrid::ConstAccessor& acc, const Vec3& x_mm,
-            CellRef& out) {
+/// Index lookups without registering with the tree (the trees are not changed once built): an
+/// evaluate call makes one per level, and a registered accessor costs a concurrent-map insert.
+using IndexAccessor = IndexGrid::ConstUnsafeAccessor;
+
+bool locate(const Level& level, const IndexAccessor& acc, const Vec3& x_mm, CellRef& out) {
   const Vec3 p = x_mm / level.h_mm;  // index space
   const Vec3 base = p.array().floor();
   const int i = int(base.x()), j = int(base.y()), k = int(base.z());
@@ -380,14 +382,21 @@ Vec3 cellValue(const Level& level, const CellRef& cell, const std::optional<Plan
     return f;
   }
   double s[8];
-  bool over[8];
-  const std::size_t first = cell.node0 - cell.block * kBlockNodes;
+  bool under = false;
   for (int c = 0; c < 8; ++c) {
     s[c] = law->r0_mm - n[kCornerOffset[c]][3];
-    over[c] = bit(level.over, cell.block * kBlockWords * 64 + first + kCornerOffset[c]);
+    under |= s[c] < 0.0;
   }
   Vec3 g = Vec3::Zero();
-  if (!ratioHolds(s, over)) {  // the node forces
+  bool holds = true;
+  if (under) {  // the over/under flags only matter with a corner under the surface
+    bool over[8];
+    const std::size_t first =
+        cell.block * kBlockWords * 64 + (cell.node0 - cell.block * kBlockNodes);
+    for (int c = 0; c < 8; ++c) over[c] = bit(level.over, first + kCornerOffset[c]);
+    holds = ratioHolds(s, over);
+  }
+  if (!holds) {  // the node forces
     for (int c = 0; c < 8; ++c) {
       const auto& v = n[kCornerOffset[c]];
       g += weight[c] * law->at(s[c]) * Vec3(v[0], v[1], v[2]);
@@ -405,29 +414,91 @@ Vec3 cellValue(const Level& level, const CellRef& cell, const std::optional<Plan
 
 /// Per-thread query state: one index accessor per level.
 struct LevelAccessors {
-  std::vector<IndexGrid::ConstAccessor> index;
+  std::vector<IndexAccessor> index;
 };
 
 LevelAccessors accessorsOf(const std::vector<Level>& levels) {
   LevelAccessors a;
-  for (const Level& level : levels) a.index.push_back(level.block_of->getConstAccessor());
+  a.index.reserve(levels.size());
+  for (const Level& level : levels) a.index.push_back(level.block_of->getConstUnsafeAccessor());
   return a;
 }
 
-/// The trilinear field at x: the finest level whose cell holds x and is not refined, reading
-/// at most `max_level` (the build tests a level before the next exists).
-Vec3 trilinearAt(const std::vector<Level>& levels, LevelAccessors& acc, const Vec3& x_mm,
-                 const std::optional<PlaneLaw>& law, std::size_t max_level) {
-  CellRef cell;
-  if (!locate(levels[0], acc.index[0], x_mm, cell)) return Vec3::Zero();
-  std::size_t l = 0;
-  while (l < max_level && l + 1 < levels.size() && bit(levels[l].refined, cell.block * 512 + cell.cell)) {
+/// The cell that holds x at the finest level there (not refined), and that level; false
+/// outside every block.
+bool finestCell(const std::vector<Level>& levels, LevelAccessors& acc, const Vec3& x_mm,
+                CellRef& cell, std::size_t& level) {
+  if (!locate(levels[0], acc.index[0], x_mm, cell)) return false;
+  level = 0;
+  while (level + 1 < levels.size() &&
+         bit(levels[level].refined, cell.block * Leaf::SIZE + cell.cell)) {
     CellRef fine;
-    if (!locate(levels[l + 1], acc.index[l + 1], x_mm, fine)) break;
+    if (!locate(levels[level + 1], acc.index[level + 1], x_mm, fine)) break;
     cell = fine;
-    ++l;
+    ++level;
   }
+  return true;
+}
+
+/// The trilinear field at x: the finest level whose cell holds x and is not refined.
+Vec3 trilinearAt(const std::vector<Level>& levels, LevelAccessors& acc, const Vec3& x_mm,
+                 const std::optional<PlaneLaw>& law) {
+  CellRef cell;
+  std::size_t l = 0;
+  if (!finestCell(levels, acc, x_mm, cell, l)) return Vec3::Zero();
   return cellValue(levels[l], cell, law);
+}
+
+/// Hanging nodes: the nodes of a new finer level that lie on a face, edge or corner of a cell
+/// of the level above that is not split (or not built) take the value the levels above give
+/// there (the trilinear blend of value and closeness, which on a face is the face's bilinear
+/// blend, itself exact on the finer nodes of that face). The field is then continuous across
+/// the levels' boundaries (the blend of corner forces of the few cells under open edges aside):
+/// no jump for the ODE solver to resolve. Nodes inside split cells keep their exact values.
+void matchCoarserLevels(Level& fine, const std::vector<Level>& coarser, bool ratio) {
+  const Level& parent = coarser.back();
+  LevelAccessors acc = accessorsOf(coarser);
+  std::optional<FloatGrid::Accessor> closeness;
+  if (ratio) closeness.emplace(fine.closeness->getAccessor());
+  for (auto it = fine.grid->beginValueOn(); it; ++it) {
+    const openvdb::Coord f = it.getCoord();
+    if ((f.x() & 1) && (f.y() & 1) && (f.z() & 1)) continue;  // inside one parent cell
+    // The parent cells that share this node: one or two along each axis.
+    bool hanging = false;
+    for (int c = 0; c < 8 && !hanging; ++c) {
+      openvdb::Coord cell;
+      bool valid = true;
+      for (int a = 0; a < 3; ++a) {
+        const int side = (c >> a) & 1;
+        if (f[a] & 1) {
+          if (side) valid = false;  // one parent cell along this axis
+          cell[a] = (f[a] - 1) >> 1;
+        } else {
+          cell[a] = (f[a] >> 1) - side;
+        }
+      }
+      if (!valid) continue;
+      const Vec3 centre = (Vec3(cell.x(), cell.y(), cell.z()) + Vec3::Constant(0.5)) * parent.h_mm;
+      CellRef ref;
+      hanging = !locate(parent, acc.index.back(), centre, ref) ||
+                !bit(parent.refined, ref.block * Leaf::SIZE + ref.cell);
+    }
+    if (!hanging) continue;
+    const Vec3 x = Vec3(f.x(), f.y(), f.z()) * fine.h_mm;
+    CellRef cell;
+    std::size_t l = 0;
+    if (!finestCell(coarser, acc, x, cell, l)) continue;
+    const std::array<float, 4>* n = &coarser[l].nodes[cell.node0];
+    const Vec3& t = cell.t;
+    double v[4] = {0, 0, 0, 0};
+    for (int c = 0; c < 8; ++c) {
+      const double w =
+          (c & 4 ? t.x() : 1 - t.x()) * (c & 2 ? t.y() : 1 - t.y()) * (c & 1 ? t.z() : 1 - t.z());
+      for (int k = 0; k < 4; ++k) v[k] += w * n[kCornerOffset[c]][k];
+    }
+    it.setValue(openvdb::Vec3s(float(v[0]), float(v[1]), float(v[2])));
+    if (closeness) closeness->setValueOnly(f, float(v[3]));
+  }
 }
 
 }  // namespace
@@ -455,8 +526,8 @@ struct NodeBuilder {
   /// those on in `only`. Returns the level's grids (inactive nodes pruned from the value grid).
   /// Progress between batches, from this thread only.
   std::pair<Grid::Ptr, FloatGrid::Ptr> build(double h, const std::vector<openvdb::Coord>& origins,
-                                              const openvdb::MaskGrid* only,
-                                              const std::function<void(double)>& progress) const {
+                                             const openvdb::MaskGrid* only,
+                                             const std::function<void(double)>& progress) const {
     const ObstacleSamples& samples = index.samples;
     const FieldParams& params = index.params;
     auto grid = Grid::create(openvdb::Vec3s(0.0f));
@@ -509,8 +580,8 @@ struct NodeBuilder {
                 index.forEachNear(searcher, center, radius, fn);
             };
             const detail::Probe p =
-                detail::probe(x, for_each_near, samples.points_mm, samples.normals,
-                              samples.weights, params, reach_mm);
+                detail::probe(x, for_each_near, samples.points_mm, samples.normals, samples.weights,
+                              params, reach_mm);
             if (p.nearest < 0 || (p.height_mm < -band_in_mm && overSurface(p, over_mm))) continue;
             Vec3 value;
             if (ratio) {
@@ -541,6 +612,81 @@ struct NodeBuilder {
     // (closeness keeps its leaves: its inactive nodes hold values, those beyond open edges.)
     return {grid, closeness};
   }
+};
+
+/// The trilinear error of a cell estimated from its nodes alone: at each corner, along each axis
+/// with both neighbours built, the second difference of what is interpolated (s and G for the
+/// plane ratio, F for the stored force) over 8 (linear interpolation's error is h²/8 |f''|),
+/// turned into a force error: |dP/ds|·|G|·|Δ²s| + P(s)·|Δ²G|, or |Δ²F|. The cell's value is
+/// the largest corner error over max(least corner force, floor).
+class CurvatureProbe {
+ public:
+  CurvatureProbe(const Level& level, const std::optional<PlaneLaw>& law, double floor)
+      : values_(level.grid->getConstAccessor()), law_(law), floor_(floor) {
+    if (law) closeness_.emplace(level.closeness->getConstAccessor());
+  }
+
+  double cellError(const openvdb::Coord& cell) {
+    double worst = 0.0, sum = 0.0;
+    int built = 0;
+    for (int c = 0; c < 8; ++c) {
+      const Node n = node(cell.offsetBy(c >> 2, (c >> 1) & 1, c & 1));
+      if (!n.built) continue;
+      worst = std::max(worst, n.error);
+      sum += n.force;
+      ++built;
+    }
+    if (!built) return 0.0;
+    return worst / std::max(sum / built, floor_);
+  }
+
+ private:
+  struct Node {
+    bool built = false;
+    double force = 0.0, error = 0.0;
+  };
+  struct Read {
+    bool built;
+    double s;
+    Vec3 v;
+  };
+  Read read(const openvdb::Coord& ijk) {
+    const openvdb::Vec3s v = values_.getValue(ijk);
+    return {values_.isValueOn(ijk), law_ ? law_->r0_mm - closeness_->getValue(ijk) : 0.0,
+            Vec3(v.x(), v.y(), v.z())};
+  }
+  Node node(const openvdb::Coord& ijk) {
+    const Read at = read(ijk);
+    Node out;
+    if (!at.built) return out;
+    out.built = true;
+    double slope = 0.0;
+    if (law_) {
+      constexpr double kStepMm = 1e-4;
+      out.force = law_->at(at.s) * at.v.norm();
+      slope = std::abs(law_->at(std::abs(at.s) + kStepMm) - law_->at(std::abs(at.s) - kStepMm)) /
+              (2 * kStepMm);
+    } else {
+      out.force = at.v.norm();
+    }
+    for (int a = 0; a < 3; ++a) {
+      openvdb::Coord lo = ijk, hi = ijk;
+      lo[a] -= 1;
+      hi[a] += 1;
+      const Read m = read(lo), p = read(hi);
+      if (!m.built || !p.built) continue;
+      const Vec3 dv = m.v - 2.0 * at.v + p.v;
+      const double e =
+          law_ ? slope * at.v.norm() * std::abs(m.s - 2.0 * at.s + p.s) + law_->at(at.s) * dv.norm()
+               : dv.norm();
+      out.error = std::max(out.error, e / 8.0);
+    }
+    return out;
+  }
+  Grid::ConstAccessor values_;
+  std::optional<FloatGrid::ConstAccessor> closeness_;
+  const std::optional<PlaneLaw>& law_;
+  double floor_;
 };
 
 /// Cells of level 0 to test: every cell of a block with a non-zero corner (index coordinates).
@@ -596,7 +742,8 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
                             insideBandMm(params, request),
                             reachMm(params, request),
                             params.sample_step_mm,
-                            request.plane_near_mm.value_or(2.0 * params.r_min_mm),
+                            request.plane_near_mm.value_or(
+                                (tolerance > 0.0 ? kRefinedNearFactor : 2.0) * params.r_min_mm),
                             PlaneLaw(params, weightPerMm2(samples, params))};
   const double reach_mm = builder.reach_mm;
 
@@ -656,7 +803,7 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
   std::optional<PlaneLaw> law;
   if (ratio) law = builder.law;
 
-  // Refinement: test cells at their centres against the exact field, split those that miss.
+  // Refinement: estimate each candidate cell's error from its nodes, split those that miss.
   VoxelStats& stats = impl_->stats;
   if (tolerance > 0.0 && refine_levels > 0) {
     const double floor = kRefineFloorFraction * builder.law.at(2.0 * params.r_min_mm);
@@ -665,15 +812,12 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
       const double hl = levels[l].h_mm;
       std::vector<char> split(cells.size(), 0);
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size()), [&](const auto& range) {
-        auto searcher = index.searcher();
-        LevelAccessors acc = accessorsOf(levels);
+        CurvatureProbe curvature(levels[std::size_t(l)], law, floor);
         for (std::size_t c = range.begin(); c != range.end(); ++c) {
           const openvdb::Coord& ijk = cells[c];
           const Vec3 x = (Vec3(ijk.x(), ijk.y(), ijk.z()) + Vec3::Constant(0.5)) * hl;
           if (request.region_mm && !request.region_mm->contains(x)) continue;
-          const Vec3 exact = index.fieldAt(searcher, x).value_or(Vec3::Zero());
-          const Vec3 approx = trilinearAt(levels, acc, x, law, std::size_t(l));
-          split[c] = (approx - exact).norm() > tolerance * std::max(exact.norm(), floor);
+          split[c] = curvature.cellError(ijk) > tolerance;
         }
       });
       stats.tested_cells += cells.size();
@@ -682,7 +826,7 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
       std::vector<openvdb::Coord> next_cells;
       {
         auto mask = fine_nodes->getAccessor();
-        auto acc = levels[l].block_of->getConstAccessor();
+        auto acc = levels[l].block_of->getConstUnsafeAccessor();
         for (std::size_t c = 0; c < cells.size(); ++c) {
           if (!split[c]) continue;
           const openvdb::Coord& ijk = cells[c];
@@ -690,7 +834,7 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
           const Vec3 x = (Vec3(ijk.x(), ijk.y(), ijk.z()) + Vec3::Constant(0.5)) * hl;
           if (!locate(levels[l], acc, x, ref)) continue;
           levels[l].refined[ref.block * kCellWords + (ref.cell >> 6)] |= std::uint64_t{1}
-                                                                          << (ref.cell & 63);
+                                                                         << (ref.cell & 63);
           ++stats.refined_cells;
           const openvdb::Coord fine = ijk << 1;
           for (int i = 0; i < 3; ++i)
@@ -705,20 +849,22 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
       std::vector<openvdb::Coord> fine_origins;
       for (auto leaf = fine_nodes->tree().cbeginLeaf(); leaf; ++leaf)
         fine_origins.push_back(leaf->origin());
-      refuse("refined level " + std::to_string(l + 1) + " holds",
-             double(fine_nodes->activeVoxelCount()) + double(stats.active_nodes),
-             kVoxelBytesPerNode * value_bytes / 12.0);
+      // All levels so far and the new one, at the estimate's bytes per node (×2: the blocks).
+      double built_nodes = double(fine_nodes->activeVoxelCount());
+      for (const Level& level : levels) built_nodes += double(level.grid->activeVoxelCount());
+      refuse("refined level " + std::to_string(l + 1) + " makes", built_nodes,
+             2.0 * kVoxelBytesPerNode * value_bytes / 12.0);
       Level fine;
       fine.h_mm = 0.5 * hl;
       const double share_begin = level0_share + (1.0 - level0_share) * l / refine_levels;
       const double share_end = level0_share + (1.0 - level0_share) * (l + 1) / refine_levels;
       std::tie(fine.grid, fine.closeness) =
           builder.build(fine.h_mm, fine_origins, fine_nodes.get(), [&](double f) {
-            common::report(request.progress, share_begin + (share_end - share_begin) * f,
-                           "field");
+            common::report(request.progress, share_begin + (share_end - share_begin) * f, "field");
           });
       fine.grid->setName(fine.grid->getName() + "_level" + std::to_string(l + 1));
       if (fine.closeness) fine.closeness->setName("plane_closeness_level" + std::to_string(l + 1));
+      matchCoarserLevels(fine, levels, ratio);
       makeBlocks(fine, ratio);
       stats.refined_nodes += fine.grid->activeVoxelCount();
       levels.push_back(std::move(fine));
@@ -765,7 +911,7 @@ void VoxelField::evaluate(std::span<const Vec3> points_mm, std::span<Vec3> force
     parallelOverPoints(
         points_mm.size(), [&] { return accessorsOf(levels); },
         [&](std::size_t i, LevelAccessors& acc) {
-          forces[i] = trilinearAt(levels, acc, points_mm[i], impl.law, levels.size());
+          forces[i] = trilinearAt(levels, acc, points_mm[i], impl.law);
         },
         kSerialBelow);
     return;

@@ -98,6 +98,10 @@ TEST(StudyOptions, ParsesListsAndRejectsBadOnes) {
             std::vector<field::StoredQuantity>{field::StoredQuantity::PlaneRatio});
   EXPECT_THROW(parseStored("force,", "--stored"), common::InputError);
   EXPECT_THROW(parseStored("ratio", "--stored"), common::InputError);
+  EXPECT_EQ(parseRefineTolerances("7.5,2.5,0", 3, "--refine"),
+            (std::vector<double>{0.075, 0.025, 0.0}));
+  for (const char* bad : {"", "7.5", "7.5,2.5,", "7.5,-1,0", "7.5,x,0", "7.5,nan,0"})
+    EXPECT_THROW(parseRefineTolerances(bad, 3, "--refine"), common::InputError) << bad;
 }
 
 TEST_F(StudyTest, BruteForceEqualsTheIndexedDirectField) {
@@ -163,6 +167,36 @@ TEST_F(StudyTest, ErrorsShrinkWithTheVoxelSize) {
   }
 }
 
+TEST(StudyRefinement, RefinedVariantBeatsItsUniformGridAndIsCountedApart) {
+  // The small job at 2 mm, uniform and refined at 5 % down to 1 mm (plane ratio, trilinear).
+  StudyRequest request;
+  request.job = smallJob();
+  request.voxel_sizes_mm = {2.0};
+  request.interpolations = {field::Interpolation::Trilinear};
+  request.stored = {field::StoredQuantity::PlaneRatio};
+  request.refine_tolerances = {0.05};
+  request.refine_levels = 1;
+  request.brute_force = false;
+  request.line_step_mm = 0.2;
+  const StudyResult result = runStudy(request);
+  ASSERT_EQ(result.rows.size(), 3u);  // direct, uniform, refined
+  const StudyRow& uniform = result.rows[1];
+  const StudyRow& refined = result.rows[2];
+  EXPECT_EQ(uniform.variant.name(), "voxel 2 mm trilinear plane_ratio");
+  EXPECT_EQ(refined.variant.name(), "voxel 2 mm trilinear plane_ratio refined 5 % to 1 mm");
+  EXPECT_EQ(refined.failure, "");
+  EXPECT_EQ(uniform.levels, 1);
+  EXPECT_EQ(refined.levels, 2);
+  EXPECT_GT(refined.refined_nodes, 0u);
+  EXPECT_EQ(refined.active_nodes, uniform.active_nodes + refined.refined_nodes);
+  EXPECT_LT(refined.nodes.relative.max_relative, uniform.nodes.relative.max_relative);
+  EXPECT_LT(refined.nodes.relative.rms_relative, uniform.nodes.relative.rms_relative);
+  EXPECT_LT(refined.line_a.relative.max_relative, uniform.line_a.relative.max_relative);
+  EXPECT_LT(refined.tilt_rms_deg, uniform.tilt_rms_deg);
+  EXPECT_GT(refined.path_speedup_vs_direct, 0.0);
+  EXPECT_EQ(refined.colliding, 0u);
+}
+
 /// The small job as a scene file.
 constexpr const char* kSmallScene = R"(obstacles:
   - impeller: { u_range: [0.55, 0.8], passes_v: [0.3, 0.7], chord_tol: 0.5 }
@@ -197,6 +231,9 @@ TEST(StudyCommand, BadInputIsExitOneWithNoOutputs) {
   dir.write("scene.yaml", kSmallScene);
   EXPECT_EQ(test::runFieldpath(dir, "study scene.yaml --voxels 2,0 --out study").exit_code, 1);
   EXPECT_EQ(test::runFieldpath(dir, "study scene.yaml --interp cubic --out study").exit_code, 1);
+  EXPECT_EQ(
+      test::runFieldpath(dir, "study scene.yaml --voxels 2,1 --refine 5 --out study").exit_code, 1);
+  EXPECT_EQ(test::runFieldpath(dir, "study scene.yaml --sample-step 0 --out study").exit_code, 1);
   EXPECT_EQ(test::runFieldpath(dir, "study missing.yaml --out study").exit_code, 1);
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "study"));
 }

@@ -25,9 +25,9 @@ struct FieldParams {
   Interpolation interpolation = Interpolation::Trilinear;
   StoredQuantity stored = StoredQuantity::PlaneRatio;  ///< what voxel nodes hold
   /// Voxel refinement (scene `field.refine_tolerance`, `field.refine_levels`): a cell whose
-  /// trilinear value at its centre misses the exact field by more than this fraction of it is
-  /// split in 2³ at the next level, down to `refine_levels` levels below voxel_size; 0: a
-  /// uniform grid (voxel_field.h VoxelRequest).
+  /// estimated trilinear error exceeds this fraction of its force is split in 2³ at half the
+  /// size, down to `refine_levels` levels below voxel_size; 0: a uniform grid (voxel_field.h
+  /// VoxelRequest::refine_tolerance says how the error is estimated).
   double refine_tolerance = 0.0;
   int refine_levels = 2;
 };

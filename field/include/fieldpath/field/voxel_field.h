@@ -21,7 +21,10 @@ struct VoxelRequest {
   std::optional<StoredQuantity> stored;
   /// PlaneRatio: nodes over the sampled surface closer than this (mm) and those under it hold
   /// the continuation of the field this far above the surface, not their own (voxel_field.cpp
-  /// planeRatio); unset: 2 r_min (closer in, a sampled wall's field is far from a plane's).
+  /// planeRatio); unset: 2 r_min (closer in, a sampled wall's field is far from a plane's), or
+  /// kRefinedNearFactor · r_min with refinement, whose fine cells follow the samples' ripple
+  /// further in (impeller, samples 0.5 mm apart, 1 mm refined to 2.5 %: line b 0.6 → 0.34 % at
+  /// 0.5-1 mm from the wall; bench/results/study/study.md).
   std::optional<double> plane_near_mm;
   /// Depth of the band of nodes kept inside obstacles (where the surface rule of law.h pushes a
   /// node out); negative: for PlaneRatio max(2 h + r_min, r0), as deep as the direct field
@@ -33,13 +36,16 @@ struct VoxelRequest {
   /// field can be non-zero.
   std::optional<Eigen::AlignedBox3d> region_mm;
   /// Refinement where the grid misses (unset: FieldParams::refine_tolerance, refine_levels).
-  /// After a level is built, every cell with a non-zero corner (level 0) or inside a refined
-  /// cell (deeper) is tested at its centre: where |F_voxel - F_exact| > tolerance ·
-  /// max(|F_exact|, floor), floor = kRefineFloorFraction · P(2 r_min) (the plane law of
-  /// law.h: 0.5 % of the force 2 r_min off a wall), the cell's 3³ nodes at half the size are
-  /// built and queries inside it read the finer level (trilinear only; quadratic with a
-  /// tolerance > 0 is refused). Levels meet with a jump bounded by about the tolerance
-  /// (no hanging-node constraint). Costs one exact evaluation per tested cell.
+  /// After a level is built, every cell with a non-zero corner (level 0) or inside a split cell
+  /// (deeper) gets an error estimate from its nodes alone (no exact evaluation): at each corner
+  /// and along each axis, the second difference of what is interpolated (s and G of the plane
+  /// ratio, or F) over 8 — linear interpolation's error h²/8·|f''| — as a force error,
+  /// |dP/ds|·|G|·|Δ²s| + P(s)·|Δ²G| (or |Δ²F|); the largest over the corners, divided by
+  /// max(mean corner |F|, floor), floor = kRefineFloorFraction · P(2 r_min) (law.h PlaneLaw).
+  /// Where that exceeds the tolerance the cell's 3³ nodes at half the size are built from the
+  /// exact law and queries inside it read the finer level. Trilinear only (quadratic with a
+  /// tolerance > 0 is refused). Levels meet with a jump of about the tolerance (no hanging-node
+  /// constraint).
   std::optional<double> refine_tolerance;
   std::optional<int> refine_levels;
   /// A build whose estimated memory (estimateVoxelNodes) exceeds this is refused (InputError).
@@ -55,12 +61,14 @@ struct VoxelStats {
       0;                         ///< nodes of a dense grid over the bounding box of the active ones
   std::size_t memory_bytes = 0;  ///< OpenVDB's memUsage of the grids + the query blocks
   double build_seconds = 0.0;
-  int levels = 1;                    ///< grid levels built (1: uniform)
-  std::size_t refined_cells = 0;     ///< cells split, all levels
-  std::size_t refined_nodes = 0;     ///< nodes of the finer levels (part of active_nodes)
-  std::size_t tested_cells = 0;      ///< cells tested against the exact field
+  int levels = 1;                 ///< grid levels built (1: uniform)
+  std::size_t refined_cells = 0;  ///< cells split, all levels
+  std::size_t refined_nodes = 0;  ///< nodes of the finer levels (part of active_nodes)
+  std::size_t tested_cells = 0;   ///< cells given an error estimate
 };
 
+/// Nodes of a refined grid follow the field down to this many r_min over the surface.
+inline constexpr double kRefinedNearFactor = 1.4;
 /// The refinement floor: a fraction of the plane law at 2 r_min (VoxelRequest::refine_tolerance).
 inline constexpr double kRefineFloorFraction = 0.005;
 
