@@ -200,6 +200,30 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
     iy1 = max(iy1, __shfl_xor_sync(0xffffffffu, iy1, o));
     area += __shfl_xor_sync(0xffffffffu, area, o);
   }
+  // A floor for the whole group on a line, where every live posture is vertical and the tool has
+  // radial floors: the lowest tip plus the radial floor at the line's distance from the box of
+  // the tips (shrunk by far more than the rounding of each posture's own line radius). No
+  // posture's own floor is below it, so a line at or under it is left after one look-up.
+  float tx_lo = FLT_MAX, tx_hi = -FLT_MAX, ty_lo = FLT_MAX, ty_hi = -FLT_MAX, tz_lo = FLT_MAX;
+  int all_vertical = 1;
+  if (live) {
+    const PreparedPosture& pp = group[warp][lane];
+    tx_lo = tx_hi = pp.tip_mm.x;
+    ty_lo = ty_hi = pp.tip_mm.y;
+    tz_lo = pp.tip_mm.z;
+    all_vertical = pp.vertical;
+  }
+  for (int o = 16; o > 0; o >>= 1) {
+    tx_lo = fminf(tx_lo, __shfl_xor_sync(0xffffffffu, tx_lo, o));
+    tx_hi = fmaxf(tx_hi, __shfl_xor_sync(0xffffffffu, tx_hi, o));
+    ty_lo = fminf(ty_lo, __shfl_xor_sync(0xffffffffu, ty_lo, o));
+    ty_hi = fmaxf(ty_hi, __shfl_xor_sync(0xffffffffu, ty_hi, o));
+    tz_lo = fminf(tz_lo, __shfl_xor_sync(0xffffffffu, tz_lo, o));
+  }
+  const bool group_floor = __all_sync(0xffffffffu, all_vertical) && tool.radial_bins > 0;
+  const float pad_mm =
+      1e-5f * (fabsf(tx_lo) + fabsf(tx_hi) + fabsf(ty_lo) + fabsf(ty_hi) + tool.hull_radius_mm) +
+      1e-6f;
   __syncwarp();
   unsigned visited = 0, lowered = 0;
   const long long union_area = (long long)(ix1 - ix0 + 1) * (iy1 - iy0 + 1);
@@ -241,6 +265,19 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
         std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
         const std::int32_t loaded = *slot;
         float best = keyToFloat(loaded);
+        ++visited;
+        if (group_floor) {
+          const float x = static_cast<float>(g.x0_mm + (ix + 0.5) * g.dx_mm);
+          const float y = static_cast<float>(g.y0_mm + (iy + 0.5) * g.dy_mm);
+          const float dx = fmaxf(fmaxf(tx_lo - x, x - tx_hi) - pad_mm, 0.f);
+          const float dy = fmaxf(fmaxf(ty_lo - y, y - ty_hi) - pad_mm, 0.f);
+          const float rho2 = (dx * dx + dy * dy) * (1.f - 1e-5f);
+          if (!(rho2 <= tool.radial_max_mm2)) continue;
+          const int b = static_cast<int>(rho2 * tool.radial_inv_mm2);
+          if (!(best >
+                tz_lo + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]))
+            continue;
+        }
         // The floors first, then the posture of the lowest floor: it nearly always cuts lowest,
         // after which the others' floors turn them away without a triangle test.
         float lowest = FLT_MAX;
@@ -272,7 +309,6 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
             mask &= mask - 1;
           }
         }
-        ++visited;
         if (floatToKey(best) < loaded) ++lowered, atomicMin(slot, floatToKey(best));
       }
     }
