@@ -580,9 +580,7 @@ struct Engine::Impl {
               m.options.tile_skip, m.stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
-      } else if (m.options.small_threads && !m.options.lowest_first) {
-        // (sorted blocks go to a warp each in sorted order: the small kernel's queue would
-        // scramble it; case C, run 20: 25 ms, 140 through the queue)
+      } else if (m.options.small_threads) {
         FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.queued, 0, sizeof(int), st));
         m.timed("small", st, [&] {
           smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(
@@ -709,7 +707,7 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   const double span_x = 2.0 * m.tool.hull_radius_mm / grid.dx_mm + 1.0,
                span_y = 2.0 * m.tool.hull_radius_mm / grid.dy_mm + 1.0;
   // Not where the block is sorted lowest first: its consecutive postures are scattered, and a
-  // zoom's few live ones need a warp each (Rz, run 18: 53 ms grouped, 12 not).
+  // zoom's few live ones need a warp each (Rz, run 19: 53 ms grouped, 12 not).
   m.use_groups =
       options.group_postures && !options.lowest_first && span_x * span_y > kSmallFootprintLines;
   // Tile maxima are refreshed between chunks. Lowest first, 2^17 postures per chunk: smaller

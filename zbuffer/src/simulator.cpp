@@ -472,9 +472,9 @@ SimulationResult run(const SimulationRequest& request, std::size_t expected_post
   setup.tuning = request.tuning;
   // Lowest first pays where one footprint covers a quarter of the grid or more (a zoom: the first
   // cut of a line is then nearly its last); elsewhere the prepass does that and path order keeps
-  // the neighbours of a path together (H200, runs 16-21: case 3 105 ms in path order, 119
-  // sorted; case 8 859 vs 1014; C (footprint 1/16 of the grid) 25 vs 177; zooms sorted: Fz 64
-  // vs 415, Rz 13 vs 30).
+  // the neighbours of a path together (bench/results/zbuffer-h200.md, runs 13-22: path order vs
+  // sorted, case 3 105 vs 119 ms, case 8 859 vs 1014, C (a footprint is 1/16 of its grid) 25 vs
+  // 177; zooms sorted vs path order: Fz 64 vs 415, Rz 13 vs 30).
   const double span_x = 2.0 * setup.view.hull_radius_mm / grid.dx_mm + 1.0,
                span_y = 2.0 * setup.view.hull_radius_mm / grid.dy_mm + 1.0;
   setup.tuning.lowest_first =

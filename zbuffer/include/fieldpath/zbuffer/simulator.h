@@ -72,7 +72,7 @@ struct EngineTuning {
   bool vertical_bins = true;  ///< vertical mesh postures: bin look-up instead of the BVH walk
   /// Each block's postures processed lowest point first, where one footprint covers a quarter of
   /// the grid or more (a zoom); elsewhere the prepass gets the same culling and path order is
-  /// faster (bench/results/zbuffer-h200.md, run 16).
+  /// faster (bench/results/zbuffer-h200.md, run 17).
   bool lowest_first = true;
   bool small_threads = true;   ///< CUDA: one thread per small-footprint posture, warps for the rest
   bool overlap_upload = true;  ///< CUDA: a block's upload overlaps the previous block's kernels
@@ -81,7 +81,7 @@ struct EngineTuning {
   /// Postures between refreshes of the culling tiles' maxima; 0: chosen from the grid size.
   std::size_t refresh_postures = 0;
   /// Culling tiles of 2^shift × 2^shift lines, shift in [1, 8]; 8 × 8 since the group kernel
-  /// (H200, run 18: case 8 400 ms vs 492 at 16 × 16, case 5 35 vs 42).
+  /// (H200, run 19: case 8 400 ms vs 492 at 16 × 16, case 5 35 vs 42).
   int tile_shift = 3;
   /// Every prepass_stride-th posture of a block (in path order) cuts first, then the tile maxima
   /// are refreshed and the whole block cuts: neighbours along a path cut nearly the same heights,
