@@ -145,7 +145,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
       ztop = std::max(ztop, p.tip_mm.z());
     }
     if (o->region.empty()) {
-      const double margin = zb::detail::prepareTool(req.tool).view.hull_radius_mm;
+      const double margin = zb::toolReach(req.tool);
       req.grid =
           zb::Grid::fromRegion(xmin - margin, ymin - margin, xmax + margin, ymax + margin, nx, ny);
     } else {

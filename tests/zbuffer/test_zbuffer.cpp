@@ -393,6 +393,15 @@ TEST(Culling, CapsuleFloorIsBelowEveryCutAndTightForABall) {
         << x;
 }
 
+TEST(Tool, ReachIsTheRadiusThatHoldsTheTool) {
+  EXPECT_EQ(toolReach(Tool::torus(3, 1, 12)), 3.0);
+  // a revolved mesh's vertices lie on the profile: the largest radius is the tool's
+  const Tool mesh = Tool::fromMesh(analyticToolMesh(Tool::ball(2, 8), 32, 31));
+  EXPECT_NEAR(toolReach(mesh), 2.0, 1e-6);
+  EXPECT_NEAR(toolReach(Tool::fromMesh(gridBottomTool())),
+              detail::prepareTool(Tool::fromMesh(gridBottomTool())).view.hull_radius_mm, 1e-5);
+}
+
 TEST(Mesh, TiltedSphereMeshHasNoHoles) {
   // Inside the silhouette (by a margin) every line must be lowered, for random tilts.
   const Tool ana = Tool::ball(2, 6);  // the shank covers the upper half of the ball

@@ -544,4 +544,12 @@ SimulationResult simulate(const SimulationRequest& request, std::span<const Post
   });
 }
 
+double toolReach(const Tool& tool) {
+  if (tool.kind != ToolKind::Mesh) return tool.radius_mm;
+  double reach = 0;
+  for (const auto& p : tool.mesh.vertices)
+    reach = std::max(reach, std::sqrt(double(p.x) * p.x + double(p.y) * p.y));
+  return reach;
+}
+
 }  // namespace fieldpath::zbuffer

@@ -51,6 +51,10 @@ struct Tool {
   static Tool fromMesh(ToolMesh mesh);
 };
 
+/// The radius (mm, about the tool's axis) that contains the whole tool: how far from a posture's
+/// tip its cut can reach on the grid. Cheap: no BVH is built.
+double toolReach(const Tool& tool);
+
 enum class Backend { Auto, Cpu, Cuda };
 /// Fast: per posture, only the lines under the tool (analytic envelope, or the line in the tool
 /// frame through a BVH of the mesh) plus conservative culling. Coarse: SIMSURF1's algorithm (one
