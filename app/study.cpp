@@ -196,7 +196,12 @@ std::string machineDescription() {
     }
     if (line.rfind("processor", 0) == 0) ++cores;
   }
-  return model + ", " + std::to_string(cores) + " logical cores";
+  std::string load;
+  std::ifstream loadavg("/proc/loadavg");
+  std::string one, five, fifteen;
+  if (loadavg >> one >> five >> fifteen)
+    load = ", load average at the end " + one + " " + five + " " + fifteen;
+  return model + ", " + std::to_string(cores) + " logical cores" + load;
 }
 
 }  // namespace
