@@ -175,6 +175,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
       ->capture_default_str();
   cmd->callback([options, &global] {
+    const zbuffer::Backend backend = zbuffer::backendFromName(options->backend, "--backend");
     const Scene scene = loadScene(options->scene);
     const pathgen::GenerateRequest job = impellerJob(scene);
     const std::vector<geometry::Posture> postures = geometry::readClFile(options->path);
@@ -207,9 +208,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                                   band.min().y() - margin + ny * options->spacing_mm, nx, ny);
     zbuffer::checkGridFits(sim.grid);
     sim.tool = zbuffer::Tool::ball(job.tool.radius_mm, job.tool.length_mm);
-    sim.backend = options->backend == "cpu"    ? zbuffer::Backend::Cpu
-                  : options->backend == "cuda" ? zbuffer::Backend::Cuda
-                                               : zbuffer::Backend::Auto;
+    sim.backend = backend;
     std::vector<float> nominal(sim.grid.lineCount());
     std::vector<char> in_band(sim.grid.lineCount());
     for (int iy = 0; iy < ny; ++iy) {

@@ -121,14 +121,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
 
   cmd->callback([o, &global] {
     zb::SimulationRequest req;
-    if (o->backend == "auto")
-      req.backend = zb::Backend::Auto;
-    else if (o->backend == "cpu")
-      req.backend = zb::Backend::Cpu;
-    else if (o->backend == "cuda")
-      req.backend = zb::Backend::Cuda;
-    else
-      throw InputError("--backend '" + o->backend + "': expected auto, cpu or cuda");
+    req.backend = zb::backendFromName(o->backend, "--backend");
     if (req.backend == zb::Backend::Cuda && !zb::cudaAvailable())
       throw InputError("--backend cuda: no CUDA device available (built without CUDA or no GPU)");
 

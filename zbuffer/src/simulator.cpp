@@ -88,6 +88,12 @@ const char* backendName(Backend backend) {
   return "?";
 }
 
+Backend backendFromName(const std::string& name, const std::string& key) {
+  for (Backend b : {Backend::Auto, Backend::Cpu, Backend::Cuda})
+    if (name == backendName(b)) return b;
+  throw InputError(key + " '" + name + "': expected auto, cpu or cuda");
+}
+
 namespace detail {
 
 GridView makeGridView(const Grid& grid, int tile_shift) {

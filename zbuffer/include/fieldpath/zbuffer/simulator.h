@@ -62,6 +62,8 @@ enum class Backend { Auto, Cpu, Cuda };
 enum class Engine { Fast, Coarse };
 
 const char* backendName(Backend backend);
+/// The backend named `name` (auto, cpu, cuda); common::InputError naming `key` otherwise.
+Backend backendFromName(const std::string& name, const std::string& key = "backend");
 /// True if a CUDA device can be used (built with CUDA and cudaGetDeviceCount succeeds with >= 1).
 bool cudaAvailable();
 
