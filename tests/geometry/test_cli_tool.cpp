@@ -1,14 +1,11 @@
-#include <sys/wait.h>
-
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include <gtest/gtest.h>
 
 #include "fieldpath/geometry/mesh_io.h"
+#include "run_fieldpath.h"
 #include "temp_files.h"
 
 namespace fs = std::filesystem;
@@ -16,26 +13,7 @@ using fieldpath::geometry::test_files::tempPath;
 
 namespace {
 
-struct ProcessResult {
-  int exit_code;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-/// Runs the built `fieldpath` with `args` (shell words), capturing exit code, stdout and stderr.
-ProcessResult runFieldpath(const std::string& args) {
-  const fs::path out = tempPath("cli.out"), err = tempPath("cli.err");
-  const std::string cmd = std::string("'") + FIELDPATH_EXE + "' " + args + " >'" + out.string() +
-                          "' 2>'" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
-}
+using fieldpath::test::runFieldpath;
 
 std::size_t lines(const std::string& s) {
   return static_cast<std::size_t>(std::count(s.begin(), s.end(), '\n'));
@@ -45,7 +23,7 @@ std::size_t lines(const std::string& s) {
 
 TEST(CliTool, WritesAClosedMesh) {
   const fs::path out = tempPath("cli_tool.stl");
-  const ProcessResult r = runFieldpath(
+  const fieldpath::test::Outcome r = runFieldpath(
       "tool --shape ball:3:12 --holder 12:5,30:5 --tol 0.01 --out '" + out.string() + "'");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(lines(r.out), 1u) << r.out;
@@ -59,7 +37,8 @@ TEST(CliTool, BadInputIsOneLineAndExitOne) {
   for (const std::string args :
        {"--shape cone:3", "--shape ball:3 --tol 0", "--shape ball:3 --tol -1",
         "--shape ball:3 --holder 5:1", "--shape torus:3:4"}) {
-    const ProcessResult r = runFieldpath("tool " + args + " --out '" + out.string() + "'");
+    const fieldpath::test::Outcome r =
+        runFieldpath("tool " + args + " --out '" + out.string() + "'");
     EXPECT_EQ(r.exit_code, 1) << args;
     EXPECT_EQ(lines(r.err), 1u) << args << ": " << r.err;
     EXPECT_TRUE(r.out.empty()) << args;

@@ -1,21 +1,19 @@
 /// The impeller example end to end through the built `fieldpath` binary: golden summary,
 /// generate → .cl → check round trip, APT read back, bad scenes → exit 1 naming the pass or key.
 #include <algorithm>
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "fieldpath/geometry/cl_file.h"
+#include "run_fieldpath.h"
 
 namespace fs = std::filesystem;
 using fieldpath::geometry::Posture;
@@ -24,20 +22,15 @@ namespace {
 
 const fs::path kScene = fs::path(FIELDPATH_SOURCE_DIR) / "examples/impeller/scene.yaml";
 
+/// stdout and stderr of `fieldpath --quiet ARGS` together (the tests search both).
 struct Outcome {
   int exit_code;
-  std::string output;  ///< stdout and stderr
+  std::string output;
 };
 
 Outcome run(const std::string& args) {
-  const std::string command = std::string("'") + FIELDPATH_BIN + "' --quiet " + args + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  std::string output;
-  std::array<char, 4096> buffer;
-  while (std::size_t n = fread(buffer.data(), 1, buffer.size(), pipe))
-    output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+  const fieldpath::test::Outcome r = fieldpath::test::runFieldpath(args);
+  return {r.exit_code, r.output()};
 }
 
 nlohmann::json readJson(const fs::path& file) {

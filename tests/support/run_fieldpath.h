@@ -1,0 +1,73 @@
+#pragma once
+/// Running the built `fieldpath` as a user runs it, from the tests of any module (FIELDPATH_EXE is
+/// the test target's compile definition), and scratch folders for what it reads and writes.
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+
+namespace fieldpath::test {
+
+/// A fresh folder under the system temp folder, removed at the end of the test.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    path_ = std::filesystem::temp_directory_path() /
+            ("fieldpath_test_" + std::to_string(rd()) + std::to_string(rd()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  const std::filesystem::path& path() const { return path_; }
+  /// Writes `text` to `name` (sub-folders created) and returns the full path.
+  std::filesystem::path write(const std::string& name, const std::string& text) const {
+    const auto file = path_ / name;
+    std::filesystem::create_directories(file.parent_path());
+    std::ofstream(file) << text;
+    return file;
+  }
+
+ private:
+  std::filesystem::path path_;
+};
+
+inline std::string slurp(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Exit code, stdout and stderr of a run of the built `fieldpath`.
+struct Outcome {
+  int exit_code;
+  std::string out, err;
+  std::string output() const { return out + err; }
+};
+
+/// Runs `fieldpath --quiet ARGS` (shell words) in `dir`.
+inline Outcome runFieldpath(const TempDir& dir, const std::string& args) {
+  const auto out = dir.path() / "stdout.txt", err = dir.path() / "stderr.txt";
+  const std::string command = "cd '" + dir.path().string() + "' && '" FIELDPATH_EXE "' --quiet " +
+                              args + " > '" + out.string() + "' 2> '" + err.string() + "'";
+  const int status = std::system(command.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+}
+
+/// The same in a scratch folder of its own (for arguments that are absolute paths).
+inline Outcome runFieldpath(const std::string& args) {
+  const TempDir scratch;
+  return runFieldpath(scratch, args);
+}
+
+}  // namespace fieldpath::test
