@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/geometry/cl_file.h"
+#include "fieldpath/geometry/units.h"
 #include "impeller_job.h"
 #include "progress.h"
 #include "scene.h"
@@ -20,7 +21,7 @@
 namespace fieldpath::app {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+using geometry::kRadToDeg;
 
 nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& job,
                           const pathgen::GenerateResult& r) {

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "fieldpath/common/stats.h"
+#include "fieldpath/geometry/units.h"
 #include "fieldpath/pathgen/generate.h"
 #include "impeller_job.h"
 #include "scene.h"
@@ -30,7 +31,7 @@ using namespace fieldpath;
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+using fieldpath::geometry::kRadToDeg;
 
 using common::median;
 

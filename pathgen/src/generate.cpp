@@ -13,6 +13,7 @@
 #include "fieldpath/field/sampling.h"
 #include "fieldpath/field/voxel_field.h"
 #include "fieldpath/geometry/tool_model.h"
+#include "fieldpath/geometry/units.h"
 
 namespace fieldpath::pathgen {
 namespace {
@@ -20,7 +21,7 @@ namespace {
 using common::InputError;
 using Clock = std::chrono::steady_clock;
 
-constexpr double kDegToRad = std::numbers::pi / 180.0;
+using geometry::kDegToRad;
 /// Tool + holder nodes aimed at (seed 004: "le maillage outil comporte 500 nœuds").
 constexpr double kTargetNodes = 500.0;
 

@@ -8,13 +8,14 @@
 #include <tuple>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/geometry/units.h"
 
 namespace fieldpath::pathgen {
 namespace {
 
 using common::InputError;
 
-constexpr double kDegToRad = std::numbers::pi / 180.0;
+using geometry::kDegToRad;
 /// Longest mesh cell side, mm: right triangles of 1 mm legs are sampled once each by the field at
 /// a 1 mm step (sampling.h), and FCL's hierarchies stay tight.
 constexpr double kMaxEdgeMm = 1.0;
