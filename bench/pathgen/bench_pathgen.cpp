@@ -16,7 +16,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <numbers>
 #include <string>
 #include <thread>
 #include <vector>
