@@ -6,7 +6,8 @@
 /// height error of both against the exact (analytic tool) result. Prints a markdown table.
 ///
 ///   bench_zbuffer [--backend cpu|cuda] [--cases 1,2,R,...|all] [--reps N] [--peer-limit P]
-///                 [--no-exact] [--variants]
+///                 [--no-exact] [--variants] [--tile-shift S]
+/// --tile-shift: culling tiles of 2^S × 2^S lines instead of the default (--variants start there).
 /// --variants: instead of the main table, the fast engine's median ms with each EngineTuning knob
 /// turned off in turn (the same heights, bit for bit, are checked on the way).
 #include <algorithm>
@@ -189,6 +190,8 @@ zb::Tool analyticTool(const Case& c) {
                  : zb::Tool::ball(c.radius_mm, c.length_mm);
 }
 
+int g_tile_shift = 0;  ///< --tile-shift; 0: EngineTuning's default
+
 zb::SimulationRequest caseRequest(const Case& c, const zb::Tool& tool, zb::Backend be) {
   zb::SimulationRequest req;
   req.grid = c.zoom[2] > c.zoom[0]
@@ -198,6 +201,7 @@ zb::SimulationRequest caseRequest(const Case& c, const zb::Tool& tool, zb::Backe
   req.backend = be;
   req.tool = tool;
   req.block_postures = std::size_t{1} << 22;
+  if (g_tile_shift > 0) req.tuning.tile_shift = g_tile_shift;
   return req;
 }
 
@@ -329,12 +333,14 @@ int main(int argc, char** argv) {
       peer_limit = std::stoull(value());
     else if (a == "--no-exact")
       exact = false;
+    else if (a == "--tile-shift")
+      g_tile_shift = std::stoi(value());
     else if (a == "--variants")
       variants = true;
     else {
       std::fprintf(stderr,
                    "usage: %s [--backend cpu|cuda] [--cases 1,2,R,...|all] [--reps N] "
-                   "[--peer-limit P] [--no-exact] [--variants]\n",
+                   "[--peer-limit P] [--no-exact] [--variants] [--tile-shift S]\n",
                    argv[0]);
       return 1;
     }
