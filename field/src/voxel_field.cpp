@@ -787,11 +787,12 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
   }
   std::sort(origins.begin(), origins.end());
   origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
-  // Full leaves: the values of a node, masks and header.
+  // Full leaves: the values of a node, masks and header, and the query block (9³ × 16 bytes).
   refuse("candidate leaves hold", static_cast<double>(origins.size()) * Leaf::SIZE,
-         static_cast<double>(sizeof(Leaf)) / Leaf::SIZE * value_bytes / 12.0 + 12.0);
+         static_cast<double>(sizeof(Leaf)) / Leaf::SIZE * value_bytes / 12.0 + 12.0 +
+             16.0 * kBlockNodes / Leaf::SIZE);
 
-  // Progress: level 0 up to 0.8 without refinement, 0.5 with.
+  // Progress: level 0 takes the whole bar without refinement, half of it with.
   const double level0_share = tolerance > 0.0 ? 0.5 : 1.0;
   std::vector<Level>& levels = impl_->levels;
   levels.emplace_back();
@@ -849,11 +850,11 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
       std::vector<openvdb::Coord> fine_origins;
       for (auto leaf = fine_nodes->tree().cbeginLeaf(); leaf; ++leaf)
         fine_origins.push_back(leaf->origin());
-      // All levels so far and the new one, at the estimate's bytes per node (×2: the blocks).
+      // All levels so far and the new one, at the estimate's bytes per node.
       double built_nodes = double(fine_nodes->activeVoxelCount());
       for (const Level& level : levels) built_nodes += double(level.grid->activeVoxelCount());
       refuse("refined level " + std::to_string(l + 1) + " makes", built_nodes,
-             2.0 * kVoxelBytesPerNode * value_bytes / 12.0);
+             kVoxelBytesPerNode * value_bytes / 12.0);
       Level fine;
       fine.h_mm = 0.5 * hl;
       const double share_begin = level0_share + (1.0 - level0_share) * l / refine_levels;
