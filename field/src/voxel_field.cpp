@@ -293,6 +293,11 @@ struct Level {
   Grid::Ptr grid;            ///< F (Force) or G = F / P(s) (PlaneRatio), world frame
   FloatGrid::Ptr closeness;  ///< PlaneRatio: r0 - s (mm), same topology; background 0 (s = r0)
   IndexGrid::Ptr block_of;   ///< leaf coordinate (node ijk >> 3) → block number; background -1
+  /// The same as a dense array over the leaves' bounding box (when it has at most
+  /// kDenseIndexMax entries; empty otherwise): a query outside the box is rejected by three
+  /// compares, one inside costs one load instead of a walk down the tree.
+  std::vector<std::int32_t> dense;
+  openvdb::Coord dense_lo, dense_dim;
   std::vector<std::array<float, 4>> nodes;  ///< per block: value xyz, closeness
   std::vector<std::uint64_t> over;          ///< per block node: over/under the surface (ratioHolds)
   std::vector<std::uint64_t> refined;       ///< per leaf cell: read the next level instead
@@ -300,7 +305,8 @@ struct Level {
   std::size_t blocks() const { return nodes.size() / kBlockNodes; }
   std::size_t memUsage() const {
     return grid->memUsage() + (closeness ? closeness->memUsage() : 0) + block_of->memUsage() +
-           nodes.size() * sizeof(nodes[0]) + (over.size() + refined.size()) * 8;
+           dense.size() * sizeof(dense[0]) + nodes.size() * sizeof(nodes[0]) +
+           (over.size() + refined.size()) * 8;
   }
 };
 
@@ -315,11 +321,26 @@ struct CellRef {
 /// evaluate call makes one per level, and a registered accessor costs a concurrent-map insert.
 using IndexAccessor = IndexGrid::ConstUnsafeAccessor;
 
+/// Entries of Level::dense at most (64 MiB).
+constexpr std::size_t kDenseIndexMax = std::size_t{16} << 20;
+
 bool locate(const Level& level, const IndexAccessor& acc, const Vec3& x_mm, CellRef& out) {
   const Vec3 p = x_mm / level.h_mm;  // index space
   const Vec3 base = p.array().floor();
   const int i = int(base.x()), j = int(base.y()), k = int(base.z());
-  const int b = acc.getValue(openvdb::Coord(i >> 3, j >> 3, k >> 3));  // floor division by 8
+  const openvdb::Coord leaf(i >> 3, j >> 3, k >> 3);  // floor division by 8
+  int b;
+  if (!level.dense.empty()) {
+    const openvdb::Coord d = leaf - level.dense_lo;
+    if (unsigned(d.x()) >= unsigned(level.dense_dim.x()) ||
+        unsigned(d.y()) >= unsigned(level.dense_dim.y()) ||
+        unsigned(d.z()) >= unsigned(level.dense_dim.z()))
+      return false;
+    b = level.dense[(std::size_t(d.x()) * level.dense_dim.y() + d.y()) * level.dense_dim.z() +
+                    d.z()];
+  } else {
+    b = acc.getValue(leaf);
+  }
   if (b < 0) return false;
   const int li = i & (kLeafDim - 1), lj = j & (kLeafDim - 1), lk = k & (kLeafDim - 1);
   out.block = std::size_t(b);
@@ -334,6 +355,21 @@ void makeBlocks(Level& level, bool ratio) {
   std::vector<const Leaf*> leaves;
   for (auto it = level.grid->tree().cbeginLeaf(); it; ++it) leaves.push_back(&*it);
   level.block_of = IndexGrid::create(-1);
+  level.dense.clear();
+  if (!leaves.empty()) {
+    openvdb::CoordBBox box;
+    for (const Leaf* leaf : leaves) box.expand(leaf->origin() >> 3);
+    const openvdb::Coord dim = box.dim();
+    if (double(dim.x()) * dim.y() * dim.z() <= double(kDenseIndexMax)) {
+      level.dense_lo = box.min();
+      level.dense_dim = dim;
+      level.dense.assign(std::size_t(dim.x()) * dim.y() * dim.z(), -1);
+      for (std::size_t b = 0; b < leaves.size(); ++b) {
+        const openvdb::Coord d = (leaves[b]->origin() >> 3) - box.min();
+        level.dense[(std::size_t(d.x()) * dim.y() + d.y()) * dim.z() + d.z()] = int(b);
+      }
+    }
+  }
   {
     auto acc = level.block_of->getAccessor();
     for (std::size_t b = 0; b < leaves.size(); ++b)
