@@ -492,7 +492,7 @@ FIELDPATH_HD float lineCut(const GridView& g, const ToolView& tool, const Prepar
 /// whose highest line is at or below it is skipped whole without changing a bit. Vertical mesh
 /// tools: the radial floor at the rectangle's smallest line radius (the table is non-decreasing,
 /// and each line's float radius is at least that one: the same monotone float expressions).
-/// Other postures and tools: the capsule's floor at the rectangle's distance from its segment.
+/// Other postures and tools: the capsule's floor over the rectangle (capsuleRectFloor).
 FIELDPATH_HD float rectFloor(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
                              int ix0, int ix1, int iy0, int iy1) {
   float ax, ay, bx, by;
