@@ -253,12 +253,14 @@ int variantTable(const std::string& backend, const std::vector<std::string>& wan
       {"no capsule floor", [](zb::EngineTuning& t) { t.capsule_floor = false; }},
       {"no groups", [](zb::EngineTuning& t) { t.group_postures = 0; }},
       {"groups of 16", [](zb::EngineTuning& t) { t.group_postures = 16; }},
+      {"no live tiles", [](zb::EngineTuning& t) { t.live_tiles = false; }},
       {"all knobs off",
        [](zb::EngineTuning& t) {
          t = {false, false, false, false, false, false};
          t.prepass_stride = 0;
          t.capsule_floor = false;
          t.group_postures = 0;
+         t.live_tiles = false;
        }},
   };
   bool all_same = true;  // every variant of every case the same bits; else exit 1

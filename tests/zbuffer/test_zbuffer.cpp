@@ -325,6 +325,7 @@ TEST(Tuning, EveryVariantGivesTheSameBits) {
     req.tuning.tile_shift = 2 + variant % 3;
     req.tuning.prepass_stride = variant % 2 ? 0 : 3 + variant;
     req.tuning.capsule_floor = variant % 3 != 1;
+    req.tuning.live_tiles = variant % 4 != 2;
     req.block_postures = variant == 3 || variant == 6 ? 97 : 1 << 20;
     const auto h = simulate(req, postures).heights_mm;
     if (first.empty()) first = h;
@@ -391,6 +392,54 @@ TEST(Culling, CapsuleFloorIsBelowEveryCutAndTightForABall) {
     EXPECT_NEAR(capsuleLineFloor(ball.view, tilted, float(x), 0.f),
                 std::sqrt(2.0) - std::sqrt(4 - (x - std::sqrt(2.0)) * (x - std::sqrt(2.0))), 1e-3)
         << x;
+}
+
+TEST(Culling, RadialFloorIsBelowEveryVerticalCutAndTight) {
+  // The radial floor of a vertical line (the table entry of its float ρ²) must never be above the
+  // height the binned triangle test gives it: lineCut clamps to it and skips lines at or under it.
+  // It is the exact least height of the triangles' planes over each annulus, so for a ball mesh it
+  // must also be within a few µm of the sphere (its lowest vertex per triangle was ~100 µm off).
+  std::mt19937 rng(43);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const GridView g = detail::makeGridView(Grid::fromRegion(-1, -1, 1, 1, 4, 4));
+  const auto floorAt = [](const ToolView& v, float x, float y) {
+    const float rho2 = x * x + y * y;
+    if (!(rho2 <= v.radial_max_mm2)) return FLT_MAX;
+    const int b = static_cast<int>(rho2 * v.radial_inv_mm2);
+    return v.radial_floor_mm[std::min(b, v.radial_bins - 1)];
+  };
+  int hits = 0;
+  for (const Tool& tool : {Tool::fromMesh(gridBottomTool()),
+                           Tool::fromMesh(analyticToolMesh(Tool::torus(5, 1, 25), 127, 100)),
+                           Tool::fromMesh(analyticToolMesh(Tool::ball(2, 8), 32, 31)),
+                           Tool::fromMesh(analyticToolMesh(Tool::ball(5, 20), 79, 78))}) {
+    const detail::ToolData data = detail::prepareTool(tool);
+    ASSERT_GT(data.view.radial_bins, 0);
+    const PreparedPosture pp = preparePosture(g, data.view, pose(0, 0, 0, 0, 0, 1));
+    const float reach = data.view.hull_radius_mm * 1.05f;
+    for (int k = 0; k < 40000; ++k) {
+      Vec3f o{float(reach * u(rng)), float(reach * u(rng)), 0.f};
+      if (k % 4 == 0) o = {std::round(o.x * 4) / 4, std::round(o.y * 4) / 4, 0.f};  // on edges
+      if (k % 4 == 1) {  // on a vertex of the mesh
+        const auto& vs = tool.mesh.vertices;
+        const Vec3f p = vs[std::size_t(k) % vs.size()];
+        o = {p.x, p.y, 0.f};
+      }
+      const float t = binnedEntry(data.view, pp, o);
+      if (t == FLT_MAX) continue;
+      ++hits;
+      ASSERT_LE(floorAt(data.view, o.x, o.y), t)
+          << "tool radius " << tool.radius_mm << " at " << o.x << "," << o.y;
+    }
+  }
+  EXPECT_GT(hits, 50000);
+  const detail::ToolData ball =
+      detail::prepareTool(Tool::fromMesh(analyticToolMesh(Tool::ball(2, 8), 32, 31)));
+  for (double rho : {0.0, 0.2, 0.5, 0.9, 1.2, 1.5}) {
+    const double sphere = 2 - std::sqrt(4 - rho * rho);
+    const float floor = floorAt(ball.view, float(rho), 0.f);
+    EXPECT_GE(floor, sphere - 5e-3 * (rho + 0.1)) << rho;  // within the annulus width × slope
+  }
 }
 
 TEST(Tool, ReachIsTheRadiusThatHoldsTheTool) {

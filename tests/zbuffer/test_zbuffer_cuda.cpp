@@ -124,6 +124,7 @@ TEST_F(CpuVsCuda, EveryTuningVariantBitIdentical) {
     t.prepass_stride = variant % 3 == 1 ? 0 : 2 + variant % 7;
     t.capsule_floor = variant % 7 != 3;
     t.group_postures = variant % 4 == 3 ? 0 : (variant % 2 ? 16 : 8);
+    t.live_tiles = variant % 6 != 5;
     SCOPED_TRACE("variant " + std::to_string(variant));
     expectSameBits(g, small_mesh, p, Engine::Fast, t);
     if (variant % 4 == 2) expectSameBits(g, Tool::ball(0.8, 6), p, Engine::Fast, t);
@@ -143,6 +144,7 @@ TEST_F(CpuVsCuda, PathsCutInGroupsBitIdentical) {
       t.group_postures = variant == 1 ? 0 : (variant == 3 ? 16 : 8);
       t.prepass_stride = variant == 2 ? 0 : 16;
       t.tile_skip = variant != 3;
+      t.live_tiles = variant != 2;
       SCOPED_TRACE(std::string(tilted ? "tilted" : "vertical") + " variant " +
                    std::to_string(variant));
       expectSameBits(g, mesh_ball, p, Engine::Fast, t);

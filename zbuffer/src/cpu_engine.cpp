@@ -86,7 +86,10 @@ class CpuEngine final : public BackendEngine {
 #pragma omp parallel for schedule(static)
     for (long p = 0; p < n; ++p)
       keyed[p] = (std::uint64_t{lowestKey(g, tool, block[p])} << 32) | std::uint64_t(p);
-    std::sort(keyed.begin(), keyed.end());
+    // those that miss the grid (a zoom's nearly all) go last in any order: sort only the others
+    const auto miss = std::partition(keyed.begin(), keyed.end(),
+                                     [](std::uint64_t k) { return (k >> 32) != 0xffffffffu; });
+    std::sort(keyed.begin(), miss);
     for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<std::uint32_t>(keyed[k]);
     return order;
   }
@@ -111,21 +114,35 @@ class CpuEngine final : public BackendEngine {
     const GridView g = grid_;
     const ToolView tool = view_;
     float* h = heights_.data();
-    const float* tiles = tile_max_.data();
-    const bool skip = tuning_.tile_skip;
+    float* tiles = tile_max_.data();
+    const bool skip = tuning_.tile_skip, live = tuning_.live_tiles;
     std::size_t culled = 0;
 #pragma omp parallel for schedule(dynamic, 16) reduction(+ : culled)
     for (long k = long(begin); k < long(end); ++k) {
-      PreparedPosture pp = preparePosture(g, tool, block[order[k]]);
+      const Posture pose = block[order[k]];
+      if (missesGrid(g, tool, pose)) {  // a zoom's nearly all: no preparation
+        ++culled;
+        continue;
+      }
+      PreparedPosture pp = preparePosture(g, tool, pose);
       if (cullPosture(g, tool, pp, tiles)) {
         ++culled;
         continue;
       }
-      forEachLiveLine(g, tool, pp, tiles, skip, 0, 1, 0, 1, [&](int ix, int iy) {
-        float& slot = h[std::size_t(iy) * g.nx + ix];
-        const float z = lineCut(g, tool, pp, ix, iy, loadRelaxed(slot));
-        if (z != FLT_MAX) atomicLower(slot, z);
-      });
+      const auto top = [&](int tile) { return readTileMax(tiles, tile); };
+      forEachLiveTile(
+          g, tool, pp, skip, 0, 1, top, [&](int ix0, int ix1, int iy0, int iy1, int tile) {
+            float highest = -FLT_MAX;  // the lines' heights after this posture (or lower)
+            for (int iy = iy0; iy <= iy1; ++iy)
+              for (int ix = ix0; ix <= ix1; ++ix) {
+                float& slot = h[std::size_t(iy) * g.nx + ix];
+                const float current = loadRelaxed(slot);
+                const float z = lineCut(g, tool, pp, ix, iy, current);
+                if (z != FLT_MAX) atomicLower(slot, z);
+                highest = std::max(highest, z != FLT_MAX ? z : current);
+              }
+            if (live && wholeTile(g, ix0, ix1, iy0, iy1)) atomicLower(tiles[tile], highest);
+          });
     }
     return culled;
   }

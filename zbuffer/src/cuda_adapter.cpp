@@ -32,8 +32,8 @@ cuda::ToolArrays arrays(const ToolData& tool, const ToolView& view) {
 }
 
 cuda::Engine::Options options(const EngineTuning& t) {
-  return {t.lowest_first,   t.small_threads,    t.overlap_upload, t.tile_skip,
-          t.pinned_staging, t.refresh_postures, t.prepass_stride, t.group_postures};
+  return {t.lowest_first,     t.small_threads,  t.overlap_upload, t.tile_skip, t.pinned_staging,
+          t.refresh_postures, t.prepass_stride, t.group_postures, t.live_tiles};
 }
 
 class CudaAdapter final : public BackendEngine {

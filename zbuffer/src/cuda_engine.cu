@@ -76,20 +76,56 @@ __device__ inline Posture postureAt(const Posture* postures, const std::uint32_t
   return postures[order ? order[k] : std::uint32_t(k)];
 }
 
+/// Lowers a tile's maximum to `highest` (a bound of its lines' heights; see readTileMax): a
+/// compare-and-swap loop, as there is no float atomicMin.
+__device__ inline void lowerTileMax(float* tile_max, int tile, float highest) {
+  int* slot = reinterpret_cast<int*>(tile_max + tile);
+  int seen = *slot;
+  while (__int_as_float(seen) > highest) {
+    const int was = atomicCAS(slot, seen, __float_as_int(highest));
+    if (was == seen) break;
+    seen = was;
+  }
+}
+
+/// The largest of the warp's values, on every lane.
+__device__ inline float warpMax(float v) {
+  for (int o = 16; o > 0; o >>= 1) v = fmaxf(v, __shfl_xor_sync(0xffffffffu, v, o));
+  return v;
+}
+
 /// Lowers the live lines of the culled footprint: tiles tile_first, +tile_step, ...; lines first,
-/// +step, ... of each (the shared per-line code path of both backends is lineCut).
-/// `stats` (trace runs only, else null): lines visited and lines lowered, summed over the grid.
+/// +step, ... of each (the shared per-line code path of both backends is lineCut). Warp: the 32
+/// lanes share each tile (one lane reads its maximum for all, so that they take the same tiles);
+/// else one thread cuts every line. `live`: a tile cut whole has its maximum lowered
+/// (EngineTuning::live_tiles). `stats` (trace runs only, else null): lines visited and lowered.
+template <bool Warp>
 __device__ inline void cutLines(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
-                                const float* tile_max, bool skip, int tile_first, int tile_step,
-                                int first, int step, std::int32_t* keys,
+                                float* tile_max, bool skip, bool live, int tile_first,
+                                int tile_step, int first, int step, std::int32_t* keys,
                                 unsigned long long* stats) {
   unsigned visited = 0, lowered = 0;
-  forEachLiveLine(g, tool, pp, tile_max, skip, tile_first, tile_step, first, step,
-                  [&](int ix, int iy) {
-                    std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
-                    const float z = lineCut(g, tool, pp, ix, iy, keyToFloat(*slot));
-                    ++visited;
-                    if (z != FLT_MAX) ++lowered, atomicMin(slot, floatToKey(z));
+  const auto top = [&](int tile) {
+    const float m = readTileMax(tile_max, tile);
+    return Warp ? __shfl_sync(0xffffffffu, m, 0) : m;
+  };
+  forEachLiveTile(g, tool, pp, skip, tile_first, tile_step, top,
+                  [&](int ix0, int ix1, int iy0, int iy1, int tile) {
+                    const int w = ix1 - ix0 + 1, lines = w * (iy1 - iy0 + 1);
+                    float highest = -FLT_MAX;
+                    for (int l = first; l < lines; l += step) {
+                      const int ix = ix0 + l % w, iy = iy0 + l / w;
+                      std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
+                      const float current = keyToFloat(*slot);
+                      const float z = lineCut(g, tool, pp, ix, iy, current);
+                      ++visited;
+                      if (z != FLT_MAX) ++lowered, atomicMin(slot, floatToKey(z));
+                      highest = fmaxf(highest, z != FLT_MAX ? z : current);
+                    }
+                    if (live && wholeTile(g, ix0, ix1, iy0, iy1)) {
+                      if (Warp) highest = warpMax(highest);
+                      if (!Warp || first == 0) lowerTileMax(tile_max, tile, highest);
+                    }
                   });
   if (stats) {
     atomicAdd(stats, static_cast<unsigned long long>(visited));
@@ -109,9 +145,9 @@ __global__ void lowestKeyKernel(GridView g, ToolView tool, const Posture* postur
 /// One thread per posture: prepare, cull, cut a small footprint here; a large one is queued for
 /// largeKernel (its warp repeats the same preparation and cull, hence the same footprint).
 __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
-                            const std::uint32_t* order, int count, const float* tile_max,
+                            const std::uint32_t* order, int count, float* tile_max,
                             std::int32_t* keys, unsigned long long* culled, int* queue, int* queued,
-                            bool skip, unsigned long long* stats) {
+                            bool skip, bool live, unsigned long long* stats) {
   const int k = blockIdx.x * blockDim.x + threadIdx.x;
   if (k >= count) return;
   PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, k));
@@ -120,7 +156,7 @@ __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
     return;
   }
   if ((pp.ix1 - pp.ix0 + 1) * (pp.iy1 - pp.iy0 + 1) <= kSmallFootprintLines)
-    cutLines(g, tool, pp, tile_max, skip, 0, 1, 0, 1, keys, stats);
+    cutLines<false>(g, tool, pp, tile_max, skip, live, 0, 1, 0, 1, keys, stats);
   else
     queue[atomicAdd(queued, 1)] = k;
 }
@@ -129,19 +165,20 @@ __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
 /// in a zoom): the lanes share the footprint's lines.
 __global__ void largeKernel(GridView g, ToolView tool, const Posture* postures,
                             const std::uint32_t* order, const int* queue, const int* queued,
-                            const float* tile_max, std::int32_t* keys, bool skip,
+                            float* tile_max, std::int32_t* keys, bool skip, bool live,
                             unsigned long long* stats) {
   const int q = blockIdx.x * kWarpsPerBlock + (threadIdx.x >> 5);
   if (q >= *queued) return;
   PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, queue[q]));
   if (cullPosture(g, tool, pp, tile_max)) return;
-  cutLines(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, threadIdx.x & 31, 32, keys, stats);
+  cutLines<true>(g, tool, pp, tile_max, skip, live, blockIdx.y, gridDim.y, threadIdx.x & 31, 32,
+                 keys, stats);
 }
 
 /// One warp per posture, every footprint (the variant without small_threads).
 __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
-                           const std::uint32_t* order, int count, const float* tile_max,
-                           std::int32_t* keys, unsigned long long* culled, bool skip,
+                           const std::uint32_t* order, int count, float* tile_max,
+                           std::int32_t* keys, unsigned long long* culled, bool skip, bool live,
                            unsigned long long* stats) {
   const int k = blockIdx.x * kWarpsPerBlock + (threadIdx.x >> 5);
   if (k >= count) return;
@@ -150,7 +187,8 @@ __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
     if (culled && (threadIdx.x & 31) == 0 && blockIdx.y == 0) atomicAdd(culled, 1ull);
     return;
   }
-  cutLines(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, threadIdx.x & 31, 32, keys, stats);
+  cutLines<true>(g, tool, pp, tile_max, skip, live, blockIdx.y, gridDim.y, threadIdx.x & 31, 32,
+                 keys, stats);
 }
 
 /// Postures a warp cuts together (group kernel): consecutive postures of a path cut nearly the
@@ -165,9 +203,9 @@ __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
 /// posture instead.
 template <int Group>
 __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
-                            const std::uint32_t* order, int count, const float* tile_max,
+                            const std::uint32_t* order, int count, float* tile_max,
                             std::int32_t* keys, unsigned long long* culled, bool skip,
-                            unsigned long long* stats) {
+                            bool live_tiles, unsigned long long* stats) {
   // raw storage: PreparedPosture's members have initialisers, which __shared__ cannot run
   __shared__ alignas(
       PreparedPosture) unsigned char storage[kWarpsPerBlock * Group * sizeof(PreparedPosture)];
@@ -228,16 +266,9 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
   unsigned visited = 0, lowered = 0;
   const long long union_area = (long long)(ix1 - ix0 + 1) * (iy1 - iy0 + 1);
   if (union_area > 2 * area) {  // scattered: posture by posture, the lanes share its lines
-    for (unsigned mask = live_mask; mask; mask &= mask - 1) {
-      const PreparedPosture& pp = group[warp][__ffs(mask) - 1];
-      forEachLiveLine(g, tool, pp, tile_max, skip, blockIdx.y, gridDim.y, lane, 32,
-                      [&](int ix, int iy) {
-                        std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
-                        const float z = lineCut(g, tool, pp, ix, iy, keyToFloat(*slot));
-                        ++visited;
-                        if (z != FLT_MAX) ++lowered, atomicMin(slot, floatToKey(z));
-                      });
-    }
+    for (unsigned mask = live_mask; mask; mask &= mask - 1)
+      cutLines<true>(g, tool, group[warp][__ffs(mask) - 1], tile_max, skip, live_tiles, blockIdx.y,
+                     gridDim.y, lane, 32, keys, stats);
   } else {
     const int tx0 = ix0 >> g.tile_shift, tx1 = ix1 >> g.tile_shift;
     const int ty0 = iy0 >> g.tile_shift, ty1 = iy1 >> g.tile_shift;
@@ -247,6 +278,7 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
       const int rx0 = max(tx << g.tile_shift, ix0), ry0 = max(ty << g.tile_shift, iy0);
       const int rx1 = min(((tx + 1) << g.tile_shift) - 1, ix1);
       const int ry1 = min(((ty + 1) << g.tile_shift) - 1, iy1);
+      const int tile = ty * g.tiles_x + tx;
       if (skip) {  // skipped if no posture of the group can lower a line of it (lane-parallel)
         float floor = FLT_MAX;
         if (lane < n && ((live_mask >> lane) & 1u)) {
@@ -257,26 +289,32 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
         }
         for (int o = 16; o > 0; o >>= 1)
           floor = fminf(floor, __shfl_xor_sync(0xffffffffu, floor, o));
-        if (tile_max[ty * g.tiles_x + tx] <= floor) continue;
+        // one lane's read for all: the lanes take the same tiles
+        if (__shfl_sync(0xffffffffu, readTileMax(tile_max, tile), 0) <= floor) continue;
       }
       const int w = rx1 - rx0 + 1, lines = w * (ry1 - ry0 + 1);
+      float highest = -FLT_MAX;  // the lane's lines' heights after the group (or lower)
       for (int l = lane; l < lines; l += 32) {
         const int ix = rx0 + l % w, iy = ry0 + l / w;
         std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
         const std::int32_t loaded = *slot;
         float best = keyToFloat(loaded);
         ++visited;
+        bool reach = true;  // false: no posture of the group can lower the line
         if (group_floor) {
           const float x = static_cast<float>(g.x0_mm + (ix + 0.5) * g.dx_mm);
           const float y = static_cast<float>(g.y0_mm + (iy + 0.5) * g.dy_mm);
           const float dx = fmaxf(fmaxf(tx_lo - x, x - tx_hi) - pad_mm, 0.f);
           const float dy = fmaxf(fmaxf(ty_lo - y, y - ty_hi) - pad_mm, 0.f);
           const float rho2 = (dx * dx + dy * dy) * (1.f - 1e-5f);
-          if (!(rho2 <= tool.radial_max_mm2)) continue;
           const int b = static_cast<int>(rho2 * tool.radial_inv_mm2);
-          if (!(best >
-                tz_lo + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]))
-            continue;
+          reach =
+              rho2 <= tool.radial_max_mm2 &&
+              best > tz_lo + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1];
+        }
+        if (!reach) {
+          highest = fmaxf(highest, best);
+          continue;
         }
         // The floors first, then the posture of the lowest floor: it nearly always cuts lowest,
         // after which the others' floors turn them away without a triangle test.
@@ -310,6 +348,11 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
           }
         }
         if (floatToKey(best) < loaded) ++lowered, atomicMin(slot, floatToKey(best));
+        highest = fmaxf(highest, best);
+      }
+      if (live_tiles && wholeTile(g, rx0, rx1, ry0, ry1)) {
+        highest = warpMax(highest);
+        if (lane == 0) lowerTileMax(tile_max, tile, highest);
       }
     }
   }
@@ -577,7 +620,7 @@ struct Engine::Impl {
           const auto kernel = group > 8 ? groupKernel<16> : groupKernel<8>;
           kernel<<<blocks, 32 * kWarpsPerBlock, 0, st>>>(
               m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, culled_count,
-              m.options.tile_skip, m.stats);
+              m.options.tile_skip, m.options.live_tiles, m.stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
       } else if (m.options.small_threads) {
@@ -585,20 +628,20 @@ struct Engine::Impl {
         m.timed("small", st, [&] {
           smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(
               m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, culled_count,
-              m.queue, m.queued, m.options.tile_skip, m.stats);
+              m.queue, m.queued, m.options.tile_skip, m.options.live_tiles, m.stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
         m.timed("large", st, [&] {
           largeKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
               m.grid, m.tool, chunk_postures, chunk_order, m.queue, m.queued, m.tile_max, m.keys,
-              m.options.tile_skip, m.stats);
+              m.options.tile_skip, m.options.live_tiles, m.stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
       } else {
         m.timed("warp", st, [&] {
           warpKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
               m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, culled_count,
-              m.options.tile_skip, m.stats);
+              m.options.tile_skip, m.options.live_tiles, m.stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
       }

@@ -41,6 +41,7 @@ class Engine {
     std::size_t refresh_postures = 0;  ///< 0: from the grid size
     int prepass_stride = 0;            ///< see EngineTuning::prepass_stride
     int group_postures = 8;            ///< see EngineTuning::group_postures
+    bool live_tiles = true;            ///< see EngineTuning::live_tiles
   };
   /// `heights_mm`: the initial heights (`lines` of them), or null: every line at `stock_mm`.
   Engine(const GridView& grid, const ToolArrays& tool, const float* heights_mm, float stock_mm,

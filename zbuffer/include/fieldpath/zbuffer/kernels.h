@@ -511,15 +511,38 @@ FIELDPATH_HD float rectFloor(const GridView& g, const ToolView& tool, const Prep
               pp.tip_mm.z + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]);
 }
 
+/// A tile maximum as read while other work items may lower it (lowerTileMax): a relaxed atomic
+/// load on the CPU, a plain load on the GPU. Any value read bounds the tile's heights from then on:
+/// heights only decrease.
+FIELDPATH_HD float readTileMax(const float* tile_max, int tile) {
+#ifdef __CUDA_ARCH__
+  return tile_max[tile];
+#else
+  float v;
+  __atomic_load(tile_max + tile, &v, __ATOMIC_RELAXED);
+  return v;
+#endif
+}
+
+/// True if lines [ix0, ix1] × [iy0, iy1] are all the lines of their tile (clipped to the grid):
+/// the highest height after cutting them bounds the tile (live tile maxima).
+FIELDPATH_HD bool wholeTile(const GridView& g, int ix0, int ix1, int iy0, int iy1) {
+  const int mask = (1 << g.tile_shift) - 1;
+  const int xe = (ix0 | mask) < g.nx - 1 ? (ix0 | mask) : g.nx - 1;
+  const int ye = (iy0 | mask) < g.ny - 1 ? (iy0 | mask) : g.ny - 1;
+  return (ix0 & mask) == 0 && (iy0 & mask) == 0 && ix1 == xe && iy1 == ye;
+}
+
 /// Visits the tiles of the (culled) footprint: tiles tile_first, tile_first + tile_step, ... in
-/// footprint order; a tile whose maximum (possibly stale-high) is at or below its rectangle's
-/// floor is skipped whole; the others' rectangles (clipped to the footprint) go to
-/// visit(ix0, ix1, iy0, iy1). Shared by the CPU loop (0, 1) and the CUDA warps (blockIdx.y,
-/// gridDim.y).
-template <class VisitRect>
+/// footprint order; a tile whose maximum top(tile) (possibly stale-high) is at or below its
+/// rectangle's floor is skipped whole; the others' rectangles (clipped to the footprint) go to
+/// visit(ix0, ix1, iy0, iy1, tile). Shared by the CPU loop (0, 1) and the CUDA threads and warps
+/// (blockIdx.y, gridDim.y); `top` reads the tile maximum (readTileMax, or one lane's read shared by
+/// a warp so that its lanes take the same tiles).
+template <class TileTop, class VisitRect>
 FIELDPATH_HD void forEachLiveTile(const GridView& g, const ToolView& tool,
-                                  const PreparedPosture& pp, const float* tile_max, bool skip,
-                                  int tile_first, int tile_step, VisitRect visit) {
+                                  const PreparedPosture& pp, bool skip, int tile_first,
+                                  int tile_step, TileTop top, VisitRect visit) {
   const int tx0 = pp.ix0 >> g.tile_shift, tx1 = pp.ix1 >> g.tile_shift;
   const int ty0 = pp.iy0 >> g.tile_shift, ty1 = pp.iy1 >> g.tile_shift;
   const int tw = tx1 - tx0 + 1, tiles = tw * (ty1 - ty0 + 1);
@@ -531,23 +554,10 @@ FIELDPATH_HD void forEachLiveTile(const GridView& g, const ToolView& tool,
         ((tx + 1) << g.tile_shift) - 1 < pp.ix1 ? ((tx + 1) << g.tile_shift) - 1 : pp.ix1;
     const int iy1 =
         ((ty + 1) << g.tile_shift) - 1 < pp.iy1 ? ((ty + 1) << g.tile_shift) - 1 : pp.iy1;
-    if (skip && tile_max[ty * g.tiles_x + tx] <= rectFloor(g, tool, pp, ix0, ix1, iy0, iy1))
-      continue;
-    visit(ix0, ix1, iy0, iy1);
+    const int tile = ty * g.tiles_x + tx;
+    if (skip && top(tile) <= rectFloor(g, tool, pp, ix0, ix1, iy0, iy1)) continue;
+    visit(ix0, ix1, iy0, iy1, tile);
   }
-}
-
-/// The lines of the live tiles (forEachLiveTile): of each, lines first, first + step, ... get
-/// cut(ix, iy).
-template <class CutLine>
-FIELDPATH_HD void forEachLiveLine(const GridView& g, const ToolView& tool,
-                                  const PreparedPosture& pp, const float* tile_max, bool skip,
-                                  int tile_first, int tile_step, int first, int step, CutLine cut) {
-  forEachLiveTile(g, tool, pp, tile_max, skip, tile_first, tile_step,
-                  [&](int ix0, int ix1, int iy0, int iy1) {
-                    const int w = ix1 - ix0 + 1, lines = w * (iy1 - iy0 + 1);
-                    for (int l = first; l < lines; l += step) cut(ix0 + l % w, iy0 + l / w);
-                  });
 }
 
 /// True if the posture cannot lower any line: its lowest point is not below the highest height of
@@ -561,8 +571,11 @@ FIELDPATH_HD bool cullPosture(const GridView& g, const ToolView& tool, PreparedP
   const int ty0 = pp.iy0 >> g.tile_shift, ty1 = pp.iy1 >> g.tile_shift;
   float top = -FLT_MAX;
   for (int ty = ty0; ty <= ty1; ++ty)
-    for (int tx = tx0; tx <= tx1; ++tx) top = maxf(top, tile_max_mm[ty * g.tiles_x + tx]);
+    for (int tx = tx0; tx <= tx1; ++tx)
+      top = maxf(top, readTileMax(tile_max_mm, ty * g.tiles_x + tx));
   if (pp.lowest_z_mm >= top) return true;
+  // a footprint clipped by the grid (a zoom) may lie where the tool is far above its lowest point
+  if (rectFloor(g, tool, pp, pp.ix0, pp.ix1, pp.iy0, pp.iy1) >= top) return true;
   const float i = pp.rot.m[0][2], j = pp.rot.m[1][2], k = pp.rot.m[2][2];
   if (k > 1e-3f) {
     const float margin =
@@ -576,15 +589,33 @@ FIELDPATH_HD bool cullPosture(const GridView& g, const ToolView& tool, PreparedP
   return false;
 }
 
-/// Sort key of a posture for lowest-first processing: its lowest point as an unsigned key that
-/// orders like the float (postures that miss the grid last). Processing a block lowest first
+/// True if the tool, whatever its axis, stays off the grid's lines: the ball about the tip that
+/// holds it (radius from the hull, grown by far more than any rounding) misses the lines' box.
+/// A zoom's postures are mostly such; this costs a few compares instead of a preparePosture.
+FIELDPATH_HD bool missesGrid(const GridView& g, const ToolView& tool, Posture pose) {
+  const float zr = maxf(absf(tool.hull_zmin_mm), absf(tool.hull_zmax_mm));
+  const float reach = sqrtf(tool.hull_radius_mm * tool.hull_radius_mm + zr * zr) * 1.001f +
+                      1e-4f * (absf(pose.tip_mm.x) + absf(pose.tip_mm.y)) + 1e-3f;
+  const double x0 = g.x0_mm + 0.5 * g.dx_mm, x1 = g.x0_mm + (g.nx - 0.5) * g.dx_mm;
+  const double y0 = g.y0_mm + 0.5 * g.dy_mm, y1 = g.y0_mm + (g.ny - 0.5) * g.dy_mm;
+  return pose.tip_mm.x + reach < x0 || pose.tip_mm.x - reach > x1 || pose.tip_mm.y + reach < y0 ||
+         pose.tip_mm.y - reach > y1;
+}
+
+/// Sort key of a posture for lowest-first processing: its lowest point over the grid (the floor of
+/// its footprint's lines) as an unsigned key that orders like the float (postures that miss the
+/// grid last). Processing a block lowest first
 /// makes the first cut of a line nearly its final one, so later (higher) postures are culled by
 /// the tile maxima or skipped per line at one compare; the minimum, hence every bit, is the same.
 FIELDPATH_HD std::uint32_t lowestKey(const GridView& g, const ToolView& tool, Posture pose) {
+  if (missesGrid(g, tool, pose)) return 0xffffffffu;
   const PreparedPosture pp = preparePosture(g, tool, pose);
   if (pp.ix0 > pp.ix1 || pp.iy0 > pp.iy1) return 0xffffffffu;
+  // over the grid only: in a zoom, the postures that cut its lines lowest come first
+  const float lowest = maxf(pp.lowest_z_mm, rectFloor(g, tool, pp, pp.ix0, pp.ix1, pp.iy0, pp.iy1));
+  if (lowest == FLT_MAX) return 0xffffffffu;
   std::int32_t bits;
-  memcpy(&bits, &pp.lowest_z_mm, 4);
+  memcpy(&bits, &lowest, 4);
   return static_cast<std::uint32_t>(orderedBits(bits)) ^ 0x80000000u;
 }
 

@@ -103,6 +103,11 @@ struct EngineTuning {
   /// postures together (8 or 16), each line's height loaded and stored once for the group, its
   /// postures tried lowest floor first. 0: a warp per posture.
   int group_postures = 8;
+  /// Live tile maxima: a work item that has cut every line of a tile lowers the tile's maximum to
+  /// the highest height it left there, so later postures skip the tile without waiting for the
+  /// next refresh (a zoom's few postures each cover the whole grid: without it they all met
+  /// the stock's maxima).
+  bool live_tiles = true;
 };
 
 struct SimulationRequest {
