@@ -301,9 +301,9 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
         float best = keyToFloat(loaded);
         ++visited;
         bool reach = true;  // false: no posture of the group can lower the line
+        const double xd = lineX(g, ix), yd = lineY(g, iy);  // once for every posture
         if (group_floor) {
-          const float x = static_cast<float>(g.x0_mm + (ix + 0.5) * g.dx_mm);
-          const float y = static_cast<float>(g.y0_mm + (iy + 0.5) * g.dy_mm);
+          const float x = static_cast<float>(xd), y = static_cast<float>(yd);
           const float dx = fmaxf(fmaxf(tx_lo - x, x - tx_hi) - pad_mm, 0.f);
           const float dy = fmaxf(fmaxf(ty_lo - y, y - ty_hi) - pad_mm, 0.f);
           const float rho2 = (dx * dx + dy * dy) * (1.f - 1e-5f);
@@ -326,7 +326,7 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
           LineFloors f{FLT_MAX, FLT_MAX};
           if (ix >= pp.ix0 && ix <= pp.ix1 && iy >= pp.iy0 && iy <= pp.iy1) {
             float rx, ry;
-            lineOffset(g, pp, ix, iy, rx, ry);
+            lineOffsetAt(xd, yd, pp, rx, ry);
             f = lineFloors(tool, pp, rx, ry);
           }
           floors[warp][k][lane] = f;
@@ -338,7 +338,7 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
             if (best > f.skip_mm) {
               const PreparedPosture& pp = group[warp][k];
               float rx, ry;
-              lineOffset(g, pp, ix, iy, rx, ry);
+              lineOffsetAt(xd, yd, pp, rx, ry);
               const float z = lineCutAt(tool, pp, rx, ry, f, best);
               if (z != FLT_MAX) best = z;
             }

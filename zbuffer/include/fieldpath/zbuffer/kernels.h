@@ -235,13 +235,22 @@ FIELDPATH_HD float capsuleRectFloor(const ToolView& tool, const PreparedPosture&
   return capsuleLineFloor(tool, pp, x0 + hx, y0 + hy, grow);
 }
 
+/// World coordinates (double, mm) of line (ix, iy).
+FIELDPATH_HD double lineX(const GridView& g, int ix) { return g.x0_mm + (ix + 0.5) * g.dx_mm; }
+FIELDPATH_HD double lineY(const GridView& g, int iy) { return g.y0_mm + (iy + 0.5) * g.dy_mm; }
+
+/// The line at world (xd, yd) (lineX, lineY) relative to the tip, rounded once: the same bits
+/// as lineOffset, for a caller that offsets one line from several postures.
+FIELDPATH_HD void lineOffsetAt(double xd, double yd, const PreparedPosture& pp, float& rx,
+                               float& ry) {
+  rx = static_cast<float>(xd - static_cast<double>(pp.tip_mm.x));
+  ry = static_cast<float>(yd - static_cast<double>(pp.tip_mm.y));
+}
+
 /// World coordinates of line (ix, iy) relative to the tip, formed in double, rounded once.
 FIELDPATH_HD void lineOffset(const GridView& g, const PreparedPosture& pp, int ix, int iy,
                              float& rx, float& ry) {
-  const double xd = g.x0_mm + (ix + 0.5) * g.dx_mm;
-  const double yd = g.y0_mm + (iy + 0.5) * g.dy_mm;
-  rx = static_cast<float>(xd - static_cast<double>(pp.tip_mm.x));
-  ry = static_cast<float>(yd - static_cast<double>(pp.tip_mm.y));
+  lineOffsetAt(lineX(g, ix), lineY(g, iy), pp, rx, ry);
 }
 
 /// Smallest t with o + t d inside the infinite cylinder x²+y² <= R² (tool frame); returns false if
