@@ -15,7 +15,6 @@
 #include "impeller_job.h"
 #include "progress.h"
 #include "scene.h"
-#include "study.h"
 
 namespace fieldpath::app {
 namespace {
@@ -47,7 +46,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
   const auto& box = r.reach_box_mm;
   return {
       {"scene", scene.file.string()},
-      {"field_mode", job.nominal ? "nominal" : fieldModeName(job.mode)},
+      {"field_mode", job.nominal ? "nominal" : pathgen::fieldModeNames(job.mode).id},
       {"voxel_size_mm", job.mode == pathgen::FieldMode::Voxel && !job.nominal
                             ? json(job.field.voxel_size_mm)
                             : json(nullptr)},

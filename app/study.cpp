@@ -207,16 +207,10 @@ std::string machineDescription() {
 }  // namespace
 
 std::string StudyVariant::name() const {
-  switch (mode) {
-    case pathgen::FieldMode::BruteForce:
-      return "brute force";
-    case pathgen::FieldMode::Direct:
-      return "direct";
-    case pathgen::FieldMode::Voxel:
-      break;
-  }
+  const char* label = pathgen::fieldModeNames(mode).label;
+  if (!isVoxel()) return label;
   std::ostringstream s;
-  s << "voxel " << voxel_size_mm << " mm " << interpolationName(interpolation) << ' '
+  s << label << ' ' << voxel_size_mm << " mm " << interpolationName(interpolation) << ' '
     << storedName(stored);
   if (refine_tolerance > 0.0)
     s << " refined " << 100 * refine_tolerance << " % to "
@@ -580,7 +574,7 @@ std::string csvText(const StudyResult& r) {
        "colliding,max_tilt_deg,solver_steps,rhs_evals\n";
   for (const StudyRow& row : r.rows) {
     const StudyVariant& v = row.variant;
-    s << v.name() << ',' << fieldModeName(v.mode) << ','
+    s << v.name() << ',' << pathgen::fieldModeNames(v.mode).id << ','
       << (v.isVoxel() ? number(v.voxel_size_mm) : "0") << ','
       << (v.isVoxel() ? interpolationName(v.interpolation) : "exact") << ','
       << (v.isVoxel() ? storedName(v.stored) : "exact") << ',' << number(100 * v.refine_tolerance)

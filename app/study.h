@@ -31,19 +31,6 @@ using geometry::Vec3;
 /// Points where |F_d| is below this fraction of the set's max are left out of relative errors.
 inline constexpr double kErrorFloorFraction = 0.01;
 
-/// "voxel" | "direct" | "brute_force": the field mode as report.json and study.csv name it.
-inline const char* fieldModeName(pathgen::FieldMode mode) {
-  switch (mode) {
-    case pathgen::FieldMode::Voxel:
-      return "voxel";
-    case pathgen::FieldMode::Direct:
-      return "direct";
-    case pathgen::FieldMode::BruteForce:
-      return "brute_force";
-  }
-  return "?";
-}
-
 /// One way of computing the field.
 struct StudyVariant {
   pathgen::FieldMode mode = pathgen::FieldMode::Voxel;

@@ -25,6 +25,25 @@ namespace fieldpath::pathgen {
 /// peer).
 enum class FieldMode { Voxel, Direct, BruteForce };
 
+/// The two names of a FieldMode, written once: `id` as report.json and study.csv write it,
+/// `label` for tables and plots (the study prefixes a voxel variant's size and settings).
+struct FieldModeNames {
+  const char* id;
+  const char* label;
+};
+
+constexpr FieldModeNames fieldModeNames(FieldMode mode) {
+  switch (mode) {
+    case FieldMode::Voxel:
+      return {"voxel", "voxel"};
+    case FieldMode::Direct:
+      return {"direct", "direct"};
+    case FieldMode::BruteForce:
+      return {"brute_force", "brute force"};
+  }
+  return {"?", "?"};
+}
+
 struct GenerateRequest {
   ImpellerParams impeller;
   /// Obstacles besides the impeller's two blades (world frame, mm), e.g. scene `- mesh:` entries.
