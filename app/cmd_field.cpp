@@ -83,9 +83,8 @@ Obstacles loadObstacles(const FieldOptions& o) {
 }
 
 field::VoxelRequest voxelRequest(const FieldOptions& o, const Scene& scene, bool quiet) {
-  field::VoxelRequest request;
-  request.voxel_size_mm = o.voxel_mm > 0.0 ? o.voxel_mm : scene.field.voxel_size_mm;
-  request.interpolation = scene.field.interpolation;
+  field::VoxelRequest request(scene.field.voxel);
+  if (o.voxel_mm > 0.0) request.voxel_size_mm = o.voxel_mm;
   if (!o.interpolation.empty())
     request.interpolation = o.interpolation == "quadratic" ? field::Interpolation::Quadratic
                                                            : field::Interpolation::Trilinear;

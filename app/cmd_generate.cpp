@@ -48,7 +48,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"scene", scene.file.string()},
       {"field_mode", job.nominal ? "nominal" : pathgen::fieldModeNames(job.mode).id},
       {"voxel_size_mm", job.mode == pathgen::FieldMode::Voxel && !job.nominal
-                            ? json(job.field.voxel_size_mm)
+                            ? json(job.field.voxel.voxel_size_mm)
                             : json(nullptr)},
       {"nominal", job.nominal},
       {"postures", r.postures.size()},
@@ -123,7 +123,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     pathgen::GenerateRequest job = impellerJob(scene);
     job.mode = options->direct ? pathgen::FieldMode::Direct : pathgen::FieldMode::Voxel;
     // 0: not given (positiveFinite rejects anything else that is not > 0).
-    if (options->voxel_mm != 0.0) job.field.voxel_size_mm = options->voxel_mm;
+    if (options->voxel_mm != 0.0) job.field.voxel.voxel_size_mm = options->voxel_mm;
     job.nominal = options->nominal;
     job.progress = makeProgressLine(global.quiet);
     const pathgen::GenerateResult result = pathgen::generateImpellerPath(job);

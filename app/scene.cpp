@@ -200,19 +200,20 @@ void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
     f.weights = r.word(node["weights"], "field.weights", {"area", "unit"}) == "area"
                     ? field::Weights::Area
                     : field::Weights::Unit;
-  if (node["voxel_size"]) f.voxel_size_mm = r.positive(node["voxel_size"], "field.voxel_size");
+  if (node["voxel_size"])
+    f.voxel.voxel_size_mm = r.positive(node["voxel_size"], "field.voxel_size");
   if (node["interpolation"])
-    f.interpolation = r.word(node["interpolation"], "field.interpolation",
-                             {"trilinear", "quadratic"}) == "trilinear"
-                          ? field::Interpolation::Trilinear
-                          : field::Interpolation::Quadratic;
+    f.voxel.interpolation = r.word(node["interpolation"], "field.interpolation",
+                                   {"trilinear", "quadratic"}) == "trilinear"
+                                ? field::Interpolation::Trilinear
+                                : field::Interpolation::Quadratic;
   if (node["stored"])
-    f.stored = r.word(node["stored"], "field.stored", {"plane_ratio", "force"}) == "force"
-                   ? field::StoredQuantity::Force
-                   : field::StoredQuantity::PlaneRatio;
+    f.voxel.stored = r.word(node["stored"], "field.stored", {"plane_ratio", "force"}) == "force"
+                         ? field::StoredQuantity::Force
+                         : field::StoredQuantity::PlaneRatio;
   if (node["refine_tolerance"]) {
-    f.refine_tolerance = r.number(node["refine_tolerance"], "field.refine_tolerance");
-    if (!(f.refine_tolerance >= 0.0) || !std::isfinite(f.refine_tolerance))
+    f.voxel.refine_tolerance = r.number(node["refine_tolerance"], "field.refine_tolerance");
+    if (!(f.voxel.refine_tolerance >= 0.0) || !std::isfinite(f.voxel.refine_tolerance))
       r.fail(node["refine_tolerance"], "field.refine_tolerance",
              "must be >= 0 (a fraction; 0: no refinement)");
   }
@@ -220,7 +221,7 @@ void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
     const double levels = r.number(node["refine_levels"], "field.refine_levels");
     if (!(levels >= 0.0 && levels <= 6.0) || levels != std::floor(levels))
       r.fail(node["refine_levels"], "field.refine_levels", "must be an integer in [0, 6]");
-    f.refine_levels = static_cast<int>(levels);
+    f.voxel.refine_levels = static_cast<int>(levels);
   }
 }
 

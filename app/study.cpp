@@ -210,11 +210,11 @@ std::string StudyVariant::name() const {
   const char* label = pathgen::fieldModeNames(mode).label;
   if (!isVoxel()) return label;
   std::ostringstream s;
-  s << label << ' ' << voxel_size_mm << " mm " << interpolationName(interpolation) << ' '
-    << storedName(stored);
-  if (refine_tolerance > 0.0)
-    s << " refined " << 100 * refine_tolerance << " % to "
-      << voxel_size_mm / double(1 << refine_levels) << " mm";
+  s << label << ' ' << voxel.voxel_size_mm << " mm " << interpolationName(voxel.interpolation)
+    << ' ' << storedName(voxel.stored);
+  if (voxel.refine_tolerance > 0.0)
+    s << " refined " << 100 * voxel.refine_tolerance << " % to "
+      << voxel.voxel_size_mm / double(1 << voxel.refine_levels) << " mm";
   return s.str();
 }
 
@@ -311,12 +311,13 @@ StudyResult runStudy(const StudyRequest& request) {
     const double h = request.voxel_sizes_mm[k];
     for (field::StoredQuantity stored : request.stored)
       for (field::Interpolation interp : request.interpolations)
-        variants.push_back({pathgen::FieldMode::Voxel, h, interp, stored});
+        variants.push_back({pathgen::FieldMode::Voxel, {h, interp, stored, 0.0, 0}});
     const double tolerance = request.refine_tolerances.empty() ? 0.0 : request.refine_tolerances[k];
     if (tolerance > 0.0)
       for (field::StoredQuantity stored : request.stored)
-        variants.push_back({pathgen::FieldMode::Voxel, h, field::Interpolation::Trilinear, stored,
-                            tolerance, request.refine_levels});
+        variants.push_back(
+            {pathgen::FieldMode::Voxel,
+             {h, field::Interpolation::Trilinear, stored, tolerance, request.refine_levels}});
   }
 
   // Shares of the progress bar: each path run, then the error evaluation.
@@ -332,13 +333,7 @@ StudyResult runStudy(const StudyRequest& request) {
     pathgen::GenerateRequest job = request.job;
     job.mode = variants[i].mode;
     job.nominal = false;
-    if (variants[i].isVoxel()) {
-      job.field.voxel_size_mm = variants[i].voxel_size_mm;
-      job.field.interpolation = variants[i].interpolation;
-      job.field.stored = variants[i].stored;
-      job.field.refine_tolerance = variants[i].refine_tolerance;
-      job.field.refine_levels = variants[i].refine_levels;
-    }
+    if (variants[i].isVoxel()) job.field.voxel = variants[i].voxel;
     job.progress = scaled(request.progress, share(i), share(i + 1), variants[i].name());
     StudyRow row;
     row.variant = variants[i];
@@ -472,17 +467,12 @@ StudyResult runStudy(const StudyRequest& request) {
                    runs_end + (1.0 - runs_end) * double(i) / double(result.rows.size()), "errors");
     std::unique_ptr<field::ForceField> approx;
     if (row.variant.isVoxel()) {
-      field::VoxelRequest voxel_request;
-      voxel_request.voxel_size_mm = row.variant.voxel_size_mm;
-      voxel_request.interpolation = row.variant.interpolation;
-      voxel_request.stored = row.variant.stored;
-      voxel_request.refine_tolerance = row.variant.refine_tolerance;
-      voxel_request.refine_levels = row.variant.refine_levels;
+      field::VoxelRequest voxel_request(row.variant.voxel);
       // The region generate used; for a failed run, the direct run's padded by two voxels as
       // generate pads it.
       Eigen::AlignedBox3d region = direct_run.reach_box_mm;
-      region.min().array() -= 2 * row.variant.voxel_size_mm;
-      region.max().array() += 2 * row.variant.voxel_size_mm;
+      region.min().array() -= 2 * row.variant.voxel.voxel_size_mm;
+      region.max().array() += 2 * row.variant.voxel.voxel_size_mm;
       voxel_request.region_mm = row.failure.empty() ? runs[i].reach_box_mm : region;
       auto voxels = std::make_unique<field::VoxelField>(direct, voxel_request);
       row.active_nodes = voxels->stats().active_nodes;
@@ -575,11 +565,12 @@ std::string csvText(const StudyResult& r) {
   for (const StudyRow& row : r.rows) {
     const StudyVariant& v = row.variant;
     s << v.name() << ',' << pathgen::fieldModeNames(v.mode).id << ','
-      << (v.isVoxel() ? number(v.voxel_size_mm) : "0") << ','
-      << (v.isVoxel() ? interpolationName(v.interpolation) : "exact") << ','
-      << (v.isVoxel() ? storedName(v.stored) : "exact") << ',' << number(100 * v.refine_tolerance)
-      << ',' << row.levels << ',' << (row.failure.empty() ? "ok" : "failed") << ','
-      << row.active_nodes << ',' << row.refined_nodes << ',' << row.dense_box_nodes << ','
+      << (v.isVoxel() ? number(v.voxel.voxel_size_mm) : "0") << ','
+      << (v.isVoxel() ? interpolationName(v.voxel.interpolation) : "exact") << ','
+      << (v.isVoxel() ? storedName(v.voxel.stored) : "exact") << ','
+      << number(100 * v.voxel.refine_tolerance) << ',' << row.levels << ','
+      << (row.failure.empty() ? "ok" : "failed") << ',' << row.active_nodes << ','
+      << row.refined_nodes << ',' << row.dense_box_nodes << ','
       << number(row.voxel_memory_bytes / 1e6) << ',' << number(row.times.field_s) << ','
       << number(row.times.steering_s) << ',' << number(row.times.clearance_s) << ','
       << number(row.total_s) << ',' << number(row.speedup_vs_brute) << ','
@@ -760,8 +751,8 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
       const StudyRow *force = nullptr, *tilt = nullptr;
       for (const StudyRow& row : r.rows) {
         if (!row.variant.isVoxel() || !row.failure.empty() ||
-            std::abs(row.variant.voxel_size_mm - t.h_mm) > 1e-9 ||
-            (row.variant.refine_tolerance > 0.0) != refined)
+            std::abs(row.variant.voxel.voxel_size_mm - t.h_mm) > 1e-9 ||
+            (row.variant.voxel.refine_tolerance > 0.0) != refined)
           continue;
         if (!force || maxForceError(row) < maxForceError(*force)) force = &row;
         if (!tilt || row.tilt_max_deg < tilt->tilt_max_deg) tilt = &row;
@@ -801,8 +792,8 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
   std::vector<double> sizes;
   for (const StudyRow& row : r.rows)
     if (row.variant.isVoxel() &&
-        std::find(sizes.begin(), sizes.end(), row.variant.voxel_size_mm) == sizes.end())
-      sizes.push_back(row.variant.voxel_size_mm);
+        std::find(sizes.begin(), sizes.end(), row.variant.voxel.voxel_size_mm) == sizes.end())
+      sizes.push_back(row.variant.voxel.voxel_size_mm);
   s << "\n## Why stored force misses the targets (closed form: a plane wall)\n\n"
     << "Across a plane wall the field is `π·gain·(r0 - d)² / (d·r0²)` (law.h): it rises like 1/d"
     << " towards the wall and fades like (r0 - d)² at r0, so with r0 = " << r.field.r0_mm

@@ -34,13 +34,9 @@ inline constexpr double kErrorFloorFraction = 0.01;
 /// One way of computing the field.
 struct StudyVariant {
   pathgen::FieldMode mode = pathgen::FieldMode::Voxel;
-  double voxel_size_mm = 0.0;  ///< voxel mode only
-  field::Interpolation interpolation = field::Interpolation::Trilinear;
-  field::StoredQuantity stored = field::StoredQuantity::Force;  ///< what the voxel nodes hold
-  /// Refinement (field::VoxelRequest::refine_tolerance, as a fraction; 0: a uniform grid) and
-  /// the levels below voxel_size_mm it may go.
-  double refine_tolerance = 0.0;
-  int refine_levels = 0;
+  /// Voxel mode only: size, interpolation, what the nodes hold, refinement (a fraction; 0: a
+  /// uniform grid) and the levels below the size it may go.
+  field::VoxelSettings voxel;
 
   bool isVoxel() const { return mode == pathgen::FieldMode::Voxel; }
   /// "brute force", "direct", "voxel 2 mm trilinear force", "voxel 2 mm trilinear plane_ratio

@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
     pathgen::GenerateRequest request = job;
     request.mode = v.mode;
     request.nominal = v.nominal;
-    if (v.voxel_mm > 0) request.field.voxel_size_mm = v.voxel_mm;
+    if (v.voxel_mm > 0) request.field.voxel.voxel_size_mm = v.voxel_mm;
     std::vector<double> field, steering, clearance, total;
     Row row{v, {}};
     const int n = v.mode == pathgen::FieldMode::BruteForce ? 1 : repeats;

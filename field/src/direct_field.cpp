@@ -24,8 +24,8 @@ void validate(const FieldParams& p) {
   if (!std::isfinite(p.gain)) bad("gain", "must be finite", p.gain);
   if (!(p.sample_step_mm > 0.0) || !std::isfinite(p.sample_step_mm))
     bad("sample_step", "must be > 0", p.sample_step_mm);
-  if (!(p.voxel_size_mm > 0.0) || !std::isfinite(p.voxel_size_mm))
-    bad("voxel_size", "must be > 0", p.voxel_size_mm);
+  if (!(p.voxel.voxel_size_mm > 0.0) || !std::isfinite(p.voxel.voxel_size_mm))
+    bad("voxel_size", "must be > 0", p.voxel.voxel_size_mm);
 }
 
 namespace {

@@ -33,15 +33,11 @@ constexpr int kLeafDim = static_cast<int>(Leaf::DIM);  // 8 nodes a side
 using FloatGrid = openvdb::FloatGrid;
 using FloatLeaf = FloatGrid::TreeType::LeafNodeType;
 
-StoredQuantity storedOf(const FieldParams& params, const VoxelRequest& request) {
-  return request.stored.value_or(params.stored);
-}
-
 /// How far from a sample nodes are built (mm): r0, plus for the plane ratio a shell one cell
 /// diagonal beyond it, whose nodes carry the plane height past r0 (so that a cell straddling
 /// r0 interpolates s linearly through it instead of towards the zero background).
 double reachMm(const FieldParams& params, const VoxelRequest& request) {
-  return storedOf(params, request) == StoredQuantity::PlaneRatio
+  return request.stored == StoredQuantity::PlaneRatio
              ? params.r0_mm + std::sqrt(3.0) * request.voxel_size_mm
              : params.r0_mm;
 }
@@ -57,8 +53,7 @@ double weightPerMm2(const ObstacleSamples& samples, const FieldParams& params) {
 double insideBandMm(const FieldParams& params, const VoxelRequest& request) {
   if (request.inside_band_mm >= 0.0) return request.inside_band_mm;
   const double cells_mm = 2.0 * request.voxel_size_mm + params.r_min_mm;
-  return storedOf(params, request) == StoredQuantity::PlaneRatio ? std::max(cells_mm, params.r0_mm)
-                                                                 : cells_mm;
+  return request.stored == StoredQuantity::PlaneRatio ? std::max(cells_mm, params.r0_mm) : cells_mm;
 }
 
 void checkVoxelSize(double h_mm) {
@@ -757,10 +752,10 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
   const FieldParams& params = index.params;
   const double h = request.voxel_size_mm;
   checkVoxelSize(h);
-  const StoredQuantity stored = storedOf(params, request);
+  const StoredQuantity stored = request.stored;
   const bool ratio = stored == StoredQuantity::PlaneRatio;
-  const double tolerance = request.refine_tolerance.value_or(params.refine_tolerance);
-  const int refine_levels = request.refine_levels.value_or(params.refine_levels);
+  const double tolerance = request.refine_tolerance;
+  const int refine_levels = request.refine_levels;
   if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
     throw common::InputError("field.refine_tolerance: must be >= 0 (got " +
                              std::to_string(tolerance) + ")");

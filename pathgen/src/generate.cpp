@@ -152,7 +152,7 @@ GenerateResult generateImpellerPath(const GenerateRequest& request) {
   std::unique_ptr<field::VoxelField> voxels;
   std::unique_ptr<field::BruteForceField> brute;
   const field::ForceField* force = nullptr;
-  const double h = request.field.voxel_size_mm;
+  const double h = request.field.voxel.voxel_size_mm;
   result.reach_box_mm = reachBox(result.passes, nodes, r, request.dynamics, lead_rad,
                                  request.mode == FieldMode::Voxel ? 2 * h : 0.0);
   if (!request.nominal) {
@@ -166,9 +166,7 @@ GenerateResult generateImpellerPath(const GenerateRequest& request) {
       force = brute.get();
     }
     if (request.mode == FieldMode::Voxel) {
-      field::VoxelRequest voxel_request;
-      voxel_request.voxel_size_mm = h;
-      voxel_request.interpolation = request.field.interpolation;
+      field::VoxelRequest voxel_request(request.field.voxel);
       voxel_request.region_mm = result.reach_box_mm;
       voxel_request.progress = scaled(request.progress, 0.0, 0.3, "field");
       voxels = std::make_unique<field::VoxelField>(*direct, voxel_request);

@@ -66,8 +66,8 @@ path:
   EXPECT_EQ(s.field.gain, 2.5);
   EXPECT_EQ(s.field.sample_step_mm, 0.8);
   EXPECT_EQ(s.field.weights, field::Weights::Unit);
-  EXPECT_EQ(s.field.voxel_size_mm, 0.4);
-  EXPECT_EQ(s.field.interpolation, field::Interpolation::Quadratic);
+  EXPECT_EQ(s.field.voxel.voxel_size_mm, 0.4);
+  EXPECT_EQ(s.field.voxel.interpolation, field::Interpolation::Quadratic);
   EXPECT_EQ(s.dynamics.inertia, 2.0);
   EXPECT_EQ(s.dynamics.damping, 3.0);
   EXPECT_EQ(s.dynamics.stiffness, 4.0);
@@ -92,9 +92,9 @@ TEST(Scene, DefaultsComeFromTheParamsStructs) {
   const field::FieldParams f;
   EXPECT_EQ(s.field.r0_mm, f.r0_mm);
   EXPECT_EQ(s.field.r_min_mm, f.r_min_mm);
-  EXPECT_EQ(s.field.voxel_size_mm, f.voxel_size_mm);
+  EXPECT_EQ(s.field.voxel.voxel_size_mm, f.voxel.voxel_size_mm);
   EXPECT_EQ(s.field.weights, f.weights);
-  EXPECT_EQ(s.field.interpolation, f.interpolation);
+  EXPECT_EQ(s.field.voxel.interpolation, f.voxel.interpolation);
   EXPECT_LT(s.dynamics.damping, 0.0);  // critical
   EXPECT_EQ(s.path.passes, pathgen::PathParams{}.passes);
   EXPECT_EQ(s.tool.radius_mm, geometry::ToolSpec{}.radius_mm);

@@ -77,8 +77,8 @@ TEST(Law, HeldAtRMinAndFiniteOnTheSample) {
   for (double r : {p.r_min_mm, 0.2, 0.1, 1e-3, 1e-9, 0.0}) {
     EXPECT_EQ(phi(r, p.r0_mm, p.r_min_mm), held) << r;
     const Vec3 x = q + r * Vec3(0.6, 0.0, 0.8);
-    const Vec3 f = sampleForce(x, q, n, 1.0, p);
-    EXPECT_NEAR(f.norm(), p.gain * held, 1e-12 * held) << r;
+    const Vec3 f = sampleTerm(x - q, (x - q).squaredNorm(), n, 1.0, p);  // the sum's own term
+    EXPECT_NEAR(f.norm(), held, 1e-12 * held) << r;
     EXPECT_NEAR(f.normalized().dot(r > 0 ? Vec3(0.6, 0.0, 0.8) : n), 1.0, 1e-12) << r;
   }
   // The whole field near the sample: finite, bounded by the held value, pointing out.
@@ -217,5 +217,5 @@ TEST(Law, BadParametersAreInputErrors) {
   using fieldpath::common::InputError;
   EXPECT_THROW(DirectField(s, with([](FieldParams& p) { p.r0_mm = -1; })), InputError);
   EXPECT_THROW(DirectField(s, with([](FieldParams& p) { p.r_min_mm = 5; })), InputError);
-  EXPECT_THROW(DirectField(s, with([](FieldParams& p) { p.voxel_size_mm = 0; })), InputError);
+  EXPECT_THROW(DirectField(s, with([](FieldParams& p) { p.voxel.voxel_size_mm = 0; })), InputError);
 }

@@ -33,16 +33,15 @@ inline double phi(double r_mm, double r0_mm, double r_min_mm) {
   return (1.0 / r - 1.0 / r0_mm) / (r * r);
 }
 
-/// The contribution of one sample (eq. 1, without the surface rule): gain · w · φ(r) · u, world
-/// frame. u = (x - q)/r, or the sample's unit outward normal where x = q exactly.
-inline Vec3 sampleForce(const Vec3& x_mm, const Vec3& q_mm, const Vec3& normal, double weight,
-                        const FieldParams& params) {
-  const Vec3 d = x_mm - q_mm;
-  const double r2 = d.squaredNorm();
-  if (r2 >= params.r0_mm * params.r0_mm) return Vec3::Zero();
-  const double r = std::sqrt(r2);
-  const Vec3 u = r > 0.0 ? Vec3(d / r) : normal;
-  return params.gain * weight * phi(r, params.r0_mm, params.r_min_mm) * u;
+/// One sample's term of eq. 1 before the gain (without the surface rule): w · φ(r) · u, world
+/// frame, for d = x - q (mm) and r2 = |d|² (the sum has it already: it tracks the nearest sample
+/// with it). u = d / r, or the sample's unit outward normal where x = q exactly; zero from r0 on
+/// (φ is). The one evaluation of a sample's force, summed by probe() below.
+inline Vec3 sampleTerm(const Vec3& d_mm, double r2_mm2, const Vec3& normal, double weight,
+                       const FieldParams& params) {
+  const double r = std::sqrt(r2_mm2);
+  const Vec3 u = r > 0.0 ? Vec3(d_mm / r) : normal;
+  return (weight * phi(r, params.r0_mm, params.r_min_mm)) * u;
 }
 
 /// Magnitude of the field of an infinite plane of area-weighted samples at distance d (mm) on its
@@ -110,10 +109,8 @@ Probe probe(const Vec3& x_mm, ForEachNear&& for_each_near, const P& points, cons
         *nearest_sq = r2;
         *nearest = static_cast<long>(j);
       }
-      if (r2 >= r0_sq) return;
-      const double r = std::sqrt(r2);
-      const Vec3 u = r > 0.0 ? Vec3(d / r) : Vec3(normals[j]);
-      f += (weights[j] * phi(r, params.r0_mm, params.r_min_mm)) * u;
+      if (r2 >= r0_sq) return;  // sampleTerm is zero there; skip its sqrt
+      f += sampleTerm(d, r2, normals[j], weights[j], params);
     });
     return f;
   };

@@ -15,21 +15,27 @@ enum class Interpolation { Trilinear, Quadratic };  ///< voxel sampler
 ///   through r0; the same at the nodes. One more float a node and a second lookup.
 enum class StoredQuantity { Force, PlaneRatio };
 
+/// How the field is sampled on voxels (scene `field.voxel_size`, `interpolation`, `stored`,
+/// `refine_tolerance`, `refine_levels`), written once: FieldParams holds the scene's, a
+/// VoxelRequest (voxel_field.h) starts from them and adds how to build.
+struct VoxelSettings {
+  double voxel_size_mm = 0.5;  ///< h of the sparse grid
+  Interpolation interpolation = Interpolation::Trilinear;
+  StoredQuantity stored = StoredQuantity::PlaneRatio;  ///< what voxel nodes hold
+  /// Voxel refinement: a cell whose estimated trilinear error exceeds this fraction of its
+  /// force is split in 2³ at half the size, down to `refine_levels` levels below voxel_size_mm;
+  /// 0: a uniform grid (voxel_field.h VoxelRequest says how the error is estimated).
+  double refine_tolerance = 0.0;
+  int refine_levels = 2;
+};
+
 struct FieldParams {
   double r0_mm = 5.0;           ///< neighbourhood of eq. 1: φ = 0 for r >= r0
   double r_min_mm = 0.25;       ///< φ held at φ(r_min) below this distance
   double gain = 1.0;            ///< scales the whole field
   double sample_step_mm = 1.0;  ///< obstacle sampling spacing
   Weights weights = Weights::Area;
-  double voxel_size_mm = 0.5;  ///< h of the sparse grid
-  Interpolation interpolation = Interpolation::Trilinear;
-  StoredQuantity stored = StoredQuantity::PlaneRatio;  ///< what voxel nodes hold
-  /// Voxel refinement (scene `field.refine_tolerance`, `field.refine_levels`): a cell whose
-  /// estimated trilinear error exceeds this fraction of its force is split in 2³ at half the
-  /// size, down to `refine_levels` levels below voxel_size; 0: a uniform grid (voxel_field.h
-  /// VoxelRequest::refine_tolerance says how the error is estimated).
-  double refine_tolerance = 0.0;
-  int refine_levels = 2;
+  VoxelSettings voxel;  ///< `generate --direct` and the direct fields ignore it
 };
 
 }  // namespace fieldpath::field

@@ -14,11 +14,25 @@
 
 namespace fieldpath::field {
 
-struct VoxelRequest {
-  double voxel_size_mm = 0.5;  ///< h; nodes at (i h, j h, k h), world frame
-  Interpolation interpolation = Interpolation::Trilinear;
-  /// What the nodes hold; unset: the DirectField's FieldParams::stored (the scene's).
-  std::optional<StoredQuantity> stored;
+/// A build: the voxel settings (h: nodes at (i h, j h, k h), world frame; what they hold; the
+/// interpolation; the refinement) and how to build. VoxelRequest(params.voxel) starts from the
+/// scene's settings; a default one has FieldParams' defaults.
+///
+/// Refinement where the grid misses (refine_tolerance > 0, down to refine_levels levels below
+/// h): after a level is built, every cell with a non-zero corner (level 0) or inside a split cell
+/// (deeper) gets an error estimate from its nodes alone (no exact evaluation): at each corner
+/// and along each axis, the second difference of what is interpolated (s and G of the plane
+/// ratio, or F) over 8 — linear interpolation's error h²/8·|f''| — as a force error,
+/// |dP/ds|·|G|·|Δ²s| + P(s)·|Δ²G| (or |Δ²F|); the largest over the corners, divided by
+/// max(mean corner |F|, floor), floor = kRefineFloorFraction · P(2 r_min) (law.h PlaneLaw).
+/// Where that exceeds the tolerance the cell's 3³ nodes at half the size are built from the
+/// exact law and queries inside it read the finer level; fine nodes on a face shared with an
+/// unsplit cell (hanging nodes) take the coarser level's value, so the field is continuous
+/// across levels. Trilinear only (quadratic with a tolerance > 0 is refused).
+struct VoxelRequest : VoxelSettings {
+  VoxelRequest() = default;
+  explicit VoxelRequest(const VoxelSettings& settings) : VoxelSettings(settings) {}
+
   /// PlaneRatio: nodes over the sampled surface closer than this (mm) and those under it hold
   /// the continuation of the field this far above the surface, not their own (voxel_field.cpp
   /// planeRatio); unset: 2 r_min (closer in, a sampled wall's field is far from a plane's), or
@@ -35,19 +49,6 @@ struct VoxelRequest {
   /// Only nodes in this world box (mm): the region the tool can reach. Default: everywhere the
   /// field can be non-zero.
   std::optional<Eigen::AlignedBox3d> region_mm;
-  /// Refinement where the grid misses (unset: FieldParams::refine_tolerance, refine_levels).
-  /// After a level is built, every cell with a non-zero corner (level 0) or inside a split cell
-  /// (deeper) gets an error estimate from its nodes alone (no exact evaluation): at each corner
-  /// and along each axis, the second difference of what is interpolated (s and G of the plane
-  /// ratio, or F) over 8 — linear interpolation's error h²/8·|f''| — as a force error,
-  /// |dP/ds|·|G|·|Δ²s| + P(s)·|Δ²G| (or |Δ²F|); the largest over the corners, divided by
-  /// max(mean corner |F|, floor), floor = kRefineFloorFraction · P(2 r_min) (law.h PlaneLaw).
-  /// Where that exceeds the tolerance the cell's 3³ nodes at half the size are built from the
-  /// exact law and queries inside it read the finer level. Trilinear only (quadratic with a
-  /// tolerance > 0 is refused). Levels meet with a jump of about the tolerance (no hanging-node
-  /// constraint).
-  std::optional<double> refine_tolerance;
-  std::optional<int> refine_levels;
   /// A build whose estimated memory (estimateVoxelNodes) exceeds this is refused (InputError).
   std::size_t max_memory_bytes = std::size_t{4} << 30;
   common::Progress progress;  ///< "field" fraction of leaves built
