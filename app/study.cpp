@@ -8,7 +8,6 @@
 #include <fstream>
 #include <iomanip>
 #include <limits>
-#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -20,6 +19,7 @@
 #include "fieldpath/field/sampling.h"
 #include "fieldpath/field/voxel_field.h"
 #include "fieldpath/geometry/tool_model.h"
+#include "fieldpath/geometry/units.h"
 #include "fieldpath/pathgen/clearance.h"
 #include "fieldpath/pathgen/impeller.h"
 
@@ -31,7 +31,7 @@ namespace fieldpath::app {
 namespace {
 
 using common::InputError;
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+using geometry::kRadToDeg;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 /// A study-line point as a tiny ball for the exact (FCL) wall distance, mm.
 constexpr double kPointRadiusMm = 1e-6;
