@@ -56,7 +56,10 @@ __global__ void strideOrderKernel(std::uint32_t* order, int count, int stride) {
   if (k < count) order[k] = std::uint32_t(k) * std::uint32_t(stride);
 }
 
-__global__ void tileMaxKernel(GridView g, const std::int32_t* keys, float* tile_max) {
+/// The tiles' maxima from the heights: the chunk's fixed copy (culling, footprints) and the live
+/// one (tile skips, lowered as tiles are cut whole).
+__global__ void tileMaxKernel(GridView g, const std::int32_t* keys, float* tile_max,
+                              float* tile_live) {
   const int t = blockIdx.x * blockDim.x + threadIdx.x;
   if (t >= g.tiles_x * g.tiles_y) return;
   const int tx = t % g.tiles_x, ty = t / g.tiles_x;
@@ -64,7 +67,7 @@ __global__ void tileMaxKernel(GridView g, const std::int32_t* keys, float* tile_
   std::int32_t m = INT_MIN;
   for (int iy = ty << g.tile_shift; iy < iy1; ++iy)
     for (int ix = tx << g.tile_shift; ix < ix1; ++ix) m = max(m, keys[std::size_t(iy) * g.nx + ix]);
-  tile_max[t] = keyToFloat(m);
+  tile_max[t] = tile_live[t] = keyToFloat(m);
 }
 
 /// Footprints of at most this many lines are cut by one thread (few lines per posture, as in a
@@ -101,12 +104,12 @@ __device__ inline float warpMax(float v) {
 /// (EngineTuning::live_tiles). `stats` (trace runs only, else null): lines visited and lowered.
 template <bool Warp>
 __device__ inline void cutLines(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
-                                float* tile_max, bool skip, bool live, int tile_first,
+                                float* tile_live, bool skip, bool live, int tile_first,
                                 int tile_step, int first, int step, std::int32_t* keys,
                                 unsigned long long* stats) {
   unsigned visited = 0, lowered = 0;
   const auto top = [&](int tile) {
-    const float m = readTileMax(tile_max, tile);
+    const float m = readTileMax(tile_live, tile);
     return Warp ? __shfl_sync(0xffffffffu, m, 0) : m;
   };
   forEachLiveTile(g, tool, pp, skip, tile_first, tile_step, top,
@@ -124,7 +127,7 @@ __device__ inline void cutLines(const GridView& g, const ToolView& tool, const P
                     }
                     if (live && wholeTile(g, ix0, ix1, iy0, iy1)) {
                       if (Warp) highest = warpMax(highest);
-                      if (!Warp || first == 0) lowerTileMax(tile_max, tile, highest);
+                      if (!Warp || first == 0) lowerTileMax(tile_live, tile, highest);
                     }
                   });
   if (stats) {
@@ -145,9 +148,10 @@ __global__ void lowestKeyKernel(GridView g, ToolView tool, const Posture* postur
 /// One thread per posture: prepare, cull, cut a small footprint here; a large one is queued for
 /// largeKernel (its warp repeats the same preparation and cull, hence the same footprint).
 __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
-                            const std::uint32_t* order, int count, float* tile_max,
-                            std::int32_t* keys, unsigned long long* culled, int* queue, int* queued,
-                            bool skip, bool live, unsigned long long* stats) {
+                            const std::uint32_t* order, int count, const float* tile_max,
+                            float* tile_live, std::int32_t* keys, unsigned long long* culled,
+                            int* queue, int* queued, bool skip, bool live,
+                            unsigned long long* stats) {
   const int k = blockIdx.x * blockDim.x + threadIdx.x;
   if (k >= count) return;
   PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, k));
@@ -156,7 +160,7 @@ __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
     return;
   }
   if ((pp.ix1 - pp.ix0 + 1) * (pp.iy1 - pp.iy0 + 1) <= kSmallFootprintLines)
-    cutLines<false>(g, tool, pp, tile_max, skip, live, 0, 1, 0, 1, keys, stats);
+    cutLines<false>(g, tool, pp, tile_live, skip, live, 0, 1, 0, 1, keys, stats);
   else
     queue[atomicAdd(queued, 1)] = k;
 }
@@ -165,21 +169,21 @@ __global__ void smallKernel(GridView g, ToolView tool, const Posture* postures,
 /// in a zoom): the lanes share the footprint's lines.
 __global__ void largeKernel(GridView g, ToolView tool, const Posture* postures,
                             const std::uint32_t* order, const int* queue, const int* queued,
-                            float* tile_max, std::int32_t* keys, bool skip, bool live,
-                            unsigned long long* stats) {
+                            const float* tile_max, float* tile_live, std::int32_t* keys, bool skip,
+                            bool live, unsigned long long* stats) {
   const int q = blockIdx.x * kWarpsPerBlock + (threadIdx.x >> 5);
   if (q >= *queued) return;
   PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, queue[q]));
   if (cullPosture(g, tool, pp, tile_max)) return;
-  cutLines<true>(g, tool, pp, tile_max, skip, live, blockIdx.y, gridDim.y, threadIdx.x & 31, 32,
+  cutLines<true>(g, tool, pp, tile_live, skip, live, blockIdx.y, gridDim.y, threadIdx.x & 31, 32,
                  keys, stats);
 }
 
 /// One warp per posture, every footprint (the variant without small_threads).
 __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
-                           const std::uint32_t* order, int count, float* tile_max,
-                           std::int32_t* keys, unsigned long long* culled, bool skip, bool live,
-                           unsigned long long* stats) {
+                           const std::uint32_t* order, int count, const float* tile_max,
+                           float* tile_live, std::int32_t* keys, unsigned long long* culled,
+                           bool skip, bool live, unsigned long long* stats) {
   const int k = blockIdx.x * kWarpsPerBlock + (threadIdx.x >> 5);
   if (k >= count) return;
   PreparedPosture pp = preparePosture(g, tool, postureAt(postures, order, k));
@@ -187,7 +191,7 @@ __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
     if (culled && (threadIdx.x & 31) == 0 && blockIdx.y == 0) atomicAdd(culled, 1ull);
     return;
   }
-  cutLines<true>(g, tool, pp, tile_max, skip, live, blockIdx.y, gridDim.y, threadIdx.x & 31, 32,
+  cutLines<true>(g, tool, pp, tile_live, skip, live, blockIdx.y, gridDim.y, threadIdx.x & 31, 32,
                  keys, stats);
 }
 
@@ -203,9 +207,9 @@ __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
 /// posture instead.
 template <int Group>
 __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
-                            const std::uint32_t* order, int count, float* tile_max,
-                            std::int32_t* keys, unsigned long long* culled, bool skip,
-                            bool live_tiles, unsigned long long* stats) {
+                            const std::uint32_t* order, int count, const float* tile_max,
+                            float* tile_live, std::int32_t* keys, unsigned long long* culled,
+                            bool skip, bool live_tiles, unsigned long long* stats) {
   // raw storage: PreparedPosture's members have initialisers, which __shared__ cannot run
   __shared__ alignas(
       PreparedPosture) unsigned char storage[kWarpsPerBlock * Group * sizeof(PreparedPosture)];
@@ -267,7 +271,7 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
   const long long union_area = (long long)(ix1 - ix0 + 1) * (iy1 - iy0 + 1);
   if (union_area > 2 * area) {  // scattered: posture by posture, the lanes share its lines
     for (unsigned mask = live_mask; mask; mask &= mask - 1)
-      cutLines<true>(g, tool, group[warp][__ffs(mask) - 1], tile_max, skip, live_tiles, blockIdx.y,
+      cutLines<true>(g, tool, group[warp][__ffs(mask) - 1], tile_live, skip, live_tiles, blockIdx.y,
                      gridDim.y, lane, 32, keys, stats);
   } else {
     const int tx0 = ix0 >> g.tile_shift, tx1 = ix1 >> g.tile_shift;
@@ -290,7 +294,7 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
         for (int o = 16; o > 0; o >>= 1)
           floor = fminf(floor, __shfl_xor_sync(0xffffffffu, floor, o));
         // one lane's read for all: the lanes take the same tiles
-        if (__shfl_sync(0xffffffffu, readTileMax(tile_max, tile), 0) <= floor) continue;
+        if (__shfl_sync(0xffffffffu, readTileMax(tile_live, tile), 0) <= floor) continue;
       }
       const int w = rx1 - rx0 + 1, lines = w * (ry1 - ry0 + 1);
       float highest = -FLT_MAX;  // the lane's lines' heights after the group (or lower)
@@ -352,7 +356,7 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
       }
       if (live_tiles && wholeTile(g, rx0, rx1, ry0, ry1)) {
         highest = warpMax(highest);
-        if (lane == 0) lowerTileMax(tile_max, tile, highest);
+        if (lane == 0) lowerTileMax(tile_live, tile, highest);
       }
     }
   }
@@ -486,7 +490,10 @@ struct Engine::Impl {
   std::shared_ptr<const DeviceTool> device_tool;
   Options options;
   std::int32_t* keys = nullptr;
-  float* tile_max = nullptr;
+  // Tile maxima, refreshed before each chunk: a fixed copy for culling and footprints, which the
+  // blocks that split a posture's tiles (gridDim.y) must see alike, and a live copy for the tile
+  // skips, lowered during the chunk (EngineTuning::live_tiles).
+  float *tile_max = nullptr, *tile_live = nullptr;
   unsigned long long* culled = nullptr;
   int* queued = nullptr;
   // per-block buffers, two of each so that one block uploads while the other computes
@@ -606,7 +613,7 @@ struct Engine::Impl {
       const std::uint32_t* chunk_order = order ? order + begin : nullptr;
       const Posture* chunk_postures = order ? postures : postures + begin;
       m.timed("tile max", st, [&] {
-        tileMaxKernel<<<(tiles + 255) / 256, 256, 0, st>>>(m.grid, m.keys, m.tile_max);
+        tileMaxKernel<<<(tiles + 255) / 256, 256, 0, st>>>(m.grid, m.keys, m.tile_max, m.tile_live);
         FIELDPATH_CUDA_CHECK(cudaGetLastError());
       });
       const int splits = std::clamp(16384 / std::max(1, chunk), 1, 1024);
@@ -619,29 +626,29 @@ struct Engine::Impl {
         m.timed("group", st, [&] {
           const auto kernel = group > 8 ? groupKernel<16> : groupKernel<8>;
           kernel<<<blocks, 32 * kWarpsPerBlock, 0, st>>>(
-              m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, culled_count,
-              m.options.tile_skip, m.options.live_tiles, m.stats);
+              m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.tile_live, m.keys,
+              culled_count, m.options.tile_skip, m.options.live_tiles, m.stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
       } else if (m.options.small_threads) {
         FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.queued, 0, sizeof(int), st));
         m.timed("small", st, [&] {
           smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(
-              m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, culled_count,
-              m.queue, m.queued, m.options.tile_skip, m.options.live_tiles, m.stats);
+              m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.tile_live, m.keys,
+              culled_count, m.queue, m.queued, m.options.tile_skip, m.options.live_tiles, m.stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
         m.timed("large", st, [&] {
           largeKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
-              m.grid, m.tool, chunk_postures, chunk_order, m.queue, m.queued, m.tile_max, m.keys,
-              m.options.tile_skip, m.options.live_tiles, m.stats);
+              m.grid, m.tool, chunk_postures, chunk_order, m.queue, m.queued, m.tile_max,
+              m.tile_live, m.keys, m.options.tile_skip, m.options.live_tiles, m.stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
       } else {
         m.timed("warp", st, [&] {
           warpKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
-              m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.keys, culled_count,
-              m.options.tile_skip, m.options.live_tiles, m.stats);
+              m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.tile_live, m.keys,
+              culled_count, m.options.tile_skip, m.options.live_tiles, m.stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
       }
@@ -652,9 +659,10 @@ struct Engine::Impl {
     if (copy_stream) cudaStreamSynchronize(copy_stream);
     if (!compute_stream) return;
     cudaStreamSynchronize(compute_stream);
-    for (void* p : {static_cast<void*>(keys), static_cast<void*>(tile_max),
-                    static_cast<void*>(culled), static_cast<void*>(queued),
-                    static_cast<void*>(queue), sort_temp, static_cast<void*>(stats)})
+    for (void* p :
+         {static_cast<void*>(keys), static_cast<void*>(tile_max), static_cast<void*>(tile_live),
+          static_cast<void*>(culled), static_cast<void*>(queued), static_cast<void*>(queue),
+          sort_temp, static_cast<void*>(stats)})
       if (p) cudaFreeAsync(p, compute_stream);
     for (int k = 0; k < 2; ++k) {
       for (void* p : {static_cast<void*>(postures[k]), static_cast<void*>(sort_keys[k]),
@@ -734,6 +742,7 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   }
   FIELDPATH_CUDA_CHECK(cudaGetLastError());
   deviceAlloc(m.tile_max, std::max(1, grid.tiles_x * grid.tiles_y), st);
+  deviceAlloc(m.tile_live, std::max(1, grid.tiles_x * grid.tiles_y), st);
   deviceAlloc(m.culled, 1, st);
   FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.culled, 0, sizeof(unsigned long long), st));
   deviceAlloc(m.queued, 1, st);
