@@ -441,7 +441,7 @@ StudyResult runStudy(const StudyRequest& request) {
   for (const pathgen::GeneratedPosture& g : direct_run.postures) {
     const Eigen::Isometry3d placed = geometry::toolToWorld(g.posture);
     for (const Vec3& n : tool_nodes) sets.nodes_mm.push_back(placed * n);
-    sets.centres_mm.push_back(g.posture.tip_mm + job.tool.radius_mm * g.posture.axis);
+    sets.centres_mm.push_back(geometry::ballCentre(g.posture, job.tool.radius_mm));
   }
   sets.nodes_per_posture = tool_nodes.size();
   result.node_points = sets.nodes_mm.size();

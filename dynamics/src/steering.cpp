@@ -140,8 +140,7 @@ class SteeringSystem final : public detail::OdeSystem {
     out.tilt_torque = m.tilt_torque;
     out.moment = m.moment;
     const Vec3 axis = axisFromAngles(frames.local, y[0], y[1]);
-    out.posture.axis = axis;
-    out.posture.tip_mm = frames.pass.centre_mm - request_.ball_radius_mm * axis;
+    out.posture = geometry::ballEndPosture(frames.pass.centre_mm, axis, request_.ball_radius_mm);
     out.clearance_mm = std::numeric_limits<double>::quiet_NaN();
     if (request_.clearance) {
       if (!request_.field) placeNodes(offsets_mm_, frames.pass.centre_mm, axis, nodes_mm_);

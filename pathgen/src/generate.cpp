@@ -79,8 +79,8 @@ Eigen::AlignedBox3d reachBox(const std::vector<Pass>& passes, const std::vector<
       const PassSample& s = pass.samples[i];
       const dynamics::LocalFrame frame{s.feed, s.normal, s.binormal, false};
       for (const auto& [lead, tilt] : corners) {
-        const geometry::Posture p =
-            ballPosture(s.centre_mm, dynamics::axisFromAngles(frame, lead, tilt), ball_radius_mm);
+        const geometry::Posture p = geometry::ballEndPosture(
+            s.centre_mm, dynamics::axisFromAngles(frame, lead, tilt), ball_radius_mm);
         const Eigen::Isometry3d placed = geometry::toolToWorld(p);
         for (const Vec3& n : nodes) box.extend(placed * n);
       }
@@ -191,7 +191,7 @@ GenerateResult generateImpellerPath(const GenerateRequest& request) {
         g.pass = pass.index;
         g.s_mm = s.s_mm;
         g.lead_rad = lead_rad;
-        g.posture = ballPosture(s.centre_mm, nominalAxis(s, lead_rad), r);
+        g.posture = geometry::ballEndPosture(s.centre_mm, nominalAxis(s, lead_rad), r);
         result.postures.push_back(g);
       }
       common::report(request.progress, end, label);

@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <sstream>
 #include <string>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/dynamics/frame.h"
 
 namespace fieldpath::pathgen {
 namespace {
@@ -98,14 +98,8 @@ PassSample sampleAt(const Impeller& impeller, const Pass& pass, double s_mm) {
 }
 
 Vec3 nominalAxis(const PassSample& sample, double lead_rad) {
-  return (std::cos(lead_rad) * sample.normal + std::sin(lead_rad) * sample.feed).normalized();
-}
-
-geometry::Posture ballPosture(const Vec3& centre_mm, const Vec3& axis, double ball_radius_mm) {
-  geometry::Posture p;
-  p.axis = axis.normalized();
-  p.tip_mm = centre_mm - ball_radius_mm * p.axis;
-  return p;
+  const dynamics::LocalFrame frame{sample.feed, sample.normal, sample.binormal, false};
+  return dynamics::axisFromAngles(frame, lead_rad, 0.0).normalized();
 }
 
 std::vector<geometry::Posture> nominalPostures(std::span<const Pass> passes, double lead_rad,
@@ -113,7 +107,8 @@ std::vector<geometry::Posture> nominalPostures(std::span<const Pass> passes, dou
   std::vector<geometry::Posture> out;
   for (const Pass& pass : passes)
     for (const PassSample& s : pass.samples)
-      out.push_back(ballPosture(s.centre_mm, nominalAxis(s, lead_rad), ball_radius_mm));
+      out.push_back(
+          geometry::ballEndPosture(s.centre_mm, nominalAxis(s, lead_rad), ball_radius_mm));
   return out;
 }
 

@@ -89,3 +89,22 @@ TEST(Posture, TransformRoundTripsPoints) {
     EXPECT_LT((back.axis - p.axis).norm(), 1e-14);
   }
 }
+
+// Closed form: the ball centre sits at (0, 0, R) in the tool frame, so toolToWorld places it at
+// C, and the tip is R below it along the axis.
+TEST(Posture, BallEndTipIsTheCentreLessRAlongTheAxis) {
+  std::mt19937_64 rng(6);
+  std::uniform_real_distribution<double> u(-100, 100);
+  const double radius_mm = 3.0;
+  for (int t = 0; t < 200; ++t) {
+    const Vec3 centre(u(rng), u(rng), u(rng));
+    const Vec3 a = randomUnit(rng);
+    const Posture p = ballEndPosture(centre, a, radius_mm);
+    EXPECT_EQ(p.axis, a);
+    EXPECT_LT((toolToWorld(p) * Vec3(0, 0, radius_mm) - centre).norm(), 1e-12);
+    EXPECT_NEAR((p.tip_mm - centre).norm(), radius_mm, 1e-12);
+    EXPECT_LT((ballCentre(p, radius_mm) - centre).norm(), 1e-12);
+  }
+  const Posture upright = ballEndPosture(Vec3(1, 2, 3), Vec3::UnitZ(), radius_mm);
+  EXPECT_EQ(upright.tip_mm, Vec3(1, 2, 0));
+}

@@ -17,6 +17,21 @@ struct Posture {
   bool has_spindle = false;
 };
 
+/// The posture of a ball-end tool whose ball centre is C (mm, world frame), `axis` a unit: tip
+/// p = C − R a (the ball centre sits at (0, 0, R) in the tool frame). Not normalised here: the
+/// callers' axes are unit by construction, and a second normalisation would move the last bit.
+inline Posture ballEndPosture(const Vec3& centre_mm, const Vec3& axis, double ball_radius_mm) {
+  Posture p;
+  p.axis = axis;
+  p.tip_mm = centre_mm - ball_radius_mm * axis;
+  return p;
+}
+
+/// The ball centre C = p + R a of a ball-end posture (mm, world frame).
+inline Vec3 ballCentre(const Posture& posture, double ball_radius_mm) {
+  return posture.tip_mm + ball_radius_mm * posture.axis;
+}
+
 /// Minimal rotation (about e_z × a) that maps e_z onto `axis` (normalised first).
 /// Exact as a → e_z: uses 1/(1+k), and for k < 0 the equivalent (1-k)/(i²+j²), which has no
 /// cancellation near -e_z. a = -e_z exactly: rotation by π about x (diag(1,-1,-1)).

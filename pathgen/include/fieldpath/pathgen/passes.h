@@ -42,11 +42,9 @@ PassSample sampleAt(const Impeller& impeller, const Pass& pass, double s_mm);
 std::vector<Pass> impellerPasses(const Impeller& impeller, const PathParams& path,
                                  double ball_radius_mm);
 
-/// Nominal axis of a sample: n turned by `lead_rad` about b (towards f).
+/// Nominal axis of a sample: n turned by `lead_rad` about b (towards f), i.e.
+/// dynamics::axisFromAngles of the sample's frame with no tilt.
 Vec3 nominalAxis(const PassSample& sample, double lead_rad);
-
-/// Tip of a ball-end posture: p = C - R a (DESIGN.md).
-geometry::Posture ballPosture(const Vec3& centre_mm, const Vec3& axis, double ball_radius_mm);
 
 /// The nominal (untilted) postures of all passes, in order.
 std::vector<geometry::Posture> nominalPostures(std::span<const Pass> passes, double lead_rad,
