@@ -75,6 +75,37 @@ TEST(Clearance, BoxToolBesideAWallClosedForm) {
   EXPECT_EQ(ok.min_obstacle, 1);
 }
 
+// A posture whose tool touches or crosses an obstacle (fcl::collide) is reported as colliding
+// with clearance exactly 0 and the obstacle it meets, wherever on the tool the contact is.
+TEST(Clearance, CollidingPostureIsZeroAndNamesTheObstacle) {
+  const TriangleMesh tool = box(Vec3(-1, -1, 0), Vec3(1, 1, 10));
+  const std::vector<TriangleMesh> obstacles = {wall(-20.0), wall(5.0)};
+  const pathgen::ClearanceChecker checker(tool, obstacles);
+  Posture crossing;  // x ∈ [3.5, 5.5] along the whole length
+  crossing.tip_mm = Vec3(4.5, 0, 0);
+  Posture touching;  // the face x = 5 lies on the wall
+  touching.tip_mm = Vec3(4, 0, 0);
+  Posture shank;  // tip 4 mm clear; tilted 0.6 rad the top far corner reaches x ≈ 6.5
+  shank.axis = Vec3(std::sin(0.6), 0, std::cos(0.6));
+  ASSERT_GT(10 * std::sin(0.6) + std::cos(0.6), 5.0);
+  for (const Posture& p : {crossing, touching, shank}) {
+    int nearest = -1;
+    EXPECT_EQ(checker.clearance(p, &nearest), 0.0);
+    EXPECT_EQ(nearest, 1);
+  }
+  Posture clear;
+  clear.tip_mm = Vec3(2, 0, 0);  // 2 mm from the wall
+  const auto result = checker.check(std::vector<Posture>{clear, shank, clear, touching, crossing});
+  EXPECT_EQ(result.colliding, 3u);
+  EXPECT_EQ(result.first_colliding, 1u);
+  EXPECT_EQ(result.min_clearance_mm, 0.0);
+  EXPECT_EQ(result.min_index, 1u);
+  EXPECT_EQ(result.min_obstacle, 1);
+  ASSERT_EQ(result.clearance_mm.size(), 5u);
+  for (std::size_t i : {1u, 3u, 4u}) EXPECT_EQ(result.clearance_mm[i], 0.0) << i;
+  for (std::size_t i : {0u, 2u}) EXPECT_NEAR(result.clearance_mm[i], 2.0, 1e-9) << i;
+}
+
 TEST(Clearance, EmptyMeshIsBadInput) {
   const std::vector<TriangleMesh> obstacles = {TriangleMesh{}};
   EXPECT_THROW(pathgen::ClearanceChecker(box(Vec3(-1, -1, 0), Vec3(1, 1, 1)), obstacles),
