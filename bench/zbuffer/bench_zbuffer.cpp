@@ -6,8 +6,9 @@
 /// height error of both against the exact (analytic tool) result. Prints a markdown table.
 ///
 ///   bench_zbuffer [--backend cpu|cuda] [--cases 1,2,R,...|all] [--reps N] [--peer-limit P]
-///                 [--no-exact] [--variants] [--tile-shift S]
+///                 [--no-exact] [--variants] [--tile-shift S] [--block P]
 /// --tile-shift: culling tiles of 2^S × 2^S lines instead of the default (--variants start there).
+/// --block: postures per streamed block (default 2^22).
 /// --variants: instead of the main table, the fast engine's median ms with each EngineTuning knob
 /// turned off in turn (the same heights, bit for bit, are checked on the way).
 #include <algorithm>
@@ -190,7 +191,8 @@ zb::Tool analyticTool(const Case& c) {
                  : zb::Tool::ball(c.radius_mm, c.length_mm);
 }
 
-int g_tile_shift = 0;  ///< --tile-shift; 0: EngineTuning's default
+int g_tile_shift = 0;                        ///< --tile-shift; 0: EngineTuning's default
+std::size_t g_block = std::size_t{1} << 22;  ///< --block: postures per streamed block
 
 zb::SimulationRequest caseRequest(const Case& c, const zb::Tool& tool, zb::Backend be) {
   zb::SimulationRequest req;
@@ -200,7 +202,7 @@ zb::SimulationRequest caseRequest(const Case& c, const zb::Tool& tool, zb::Backe
   req.stock_mm = float(std::abs(c.surface.amp1) + std::abs(c.surface.amp2) + 3);
   req.backend = be;
   req.tool = tool;
-  req.block_postures = std::size_t{1} << 22;
+  req.block_postures = g_block;
   if (g_tile_shift > 0) req.tuning.tile_shift = g_tile_shift;
   return req;
 }
@@ -337,12 +339,14 @@ int main(int argc, char** argv) {
       exact = false;
     else if (a == "--tile-shift")
       g_tile_shift = std::stoi(value());
+    else if (a == "--block")
+      g_block = std::stoul(value());
     else if (a == "--variants")
       variants = true;
     else {
       std::fprintf(stderr,
                    "usage: %s [--backend cpu|cuda] [--cases 1,2,R,...|all] [--reps N] "
-                   "[--peer-limit P] [--no-exact] [--variants] [--tile-shift S]\n",
+                   "[--peer-limit P] [--no-exact] [--variants] [--tile-shift S] [--block P]\n",
                    argv[0]);
       return 1;
     }

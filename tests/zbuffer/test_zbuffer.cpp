@@ -442,6 +442,46 @@ TEST(Culling, RadialFloorIsBelowEveryVerticalCutAndTight) {
   }
 }
 
+TEST(Culling, FloatOffsetFloorsAreBelowTheExactOnes) {
+  // The group kernel ranks postures by floors formed from float offsets (offsetNear); each must
+  // be at or below the floor lineCut applies with the exact offsets, far from the origin (large
+  // coordinates, few bits left for the offset), across zero and with lines and tips on both sides.
+  std::mt19937 rng(47);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const std::vector<Tool> tools = {Tool::fromMesh(analyticToolMesh(Tool::ball(5, 20), 79, 78)),
+                                   Tool::ball(2, 8), Tool::torus(3, 1, 10)};
+  int compared = 0, tight = 0;
+  for (double origin : {0.0, -4.0, 997.0, -1999.5, 123456.0}) {
+    const Grid grid = Grid::fromRegion(origin - 8, origin - 8, origin + 8, origin + 8, 160, 160);
+    const GridView g = detail::makeGridView(grid, 3);
+    for (const Tool& tool : tools) {
+      const detail::ToolData data = detail::prepareTool(tool);
+      for (int k = 0; k < 40; ++k) {
+        const bool vertical = k % 2 == 0;
+        const Posture p = pose(origin + 6 * u(rng), origin + 6 * u(rng), u(rng),
+                               vertical ? 0.0 : 0.5 * u(rng), vertical ? 0.0 : 0.5 * u(rng), 1);
+        const PreparedPosture pp = preparePosture(g, data.view, p);
+        for (int iy = pp.iy0; iy <= pp.iy1; iy += 3)
+          for (int ix = pp.ix0; ix <= pp.ix1; ix += 3) {
+            float rx, ry;
+            lineOffset(g, pp, ix, iy, rx, ry);
+            const float exact = lineFloors(data.view, pp, rx, ry).skip_mm;
+            float eps = 0.f;
+            const float ax = offsetNear(splitCoord(lineX(g, ix)), pp.tip_mm.x, eps);
+            const float ay = offsetNear(splitCoord(lineY(g, iy)), pp.tip_mm.y, eps);
+            const float near = lineFloorNear(data.view, pp, ax, ay, eps);
+            ASSERT_LE(near, exact) << "origin " << origin << " tool " << int(tool.kind)
+                                   << " line " << ix << "," << iy;
+            ++compared;
+            tight += exact == FLT_MAX ? near == FLT_MAX : exact - near < 1e-3f;
+          }
+      }
+    }
+  }
+  EXPECT_GT(compared, 50000);
+  EXPECT_GT(tight, compared * 9 / 10);  // a floor that low would turn nothing away
+}
+
 TEST(Tool, ReachIsTheRadiusThatHoldsTheTool) {
   EXPECT_EQ(toolReach(Tool::torus(3, 1, 12)), 3.0);
   // a revolved mesh's vertices lie on the profile: the largest radius is the tool's

@@ -34,6 +34,9 @@ void checkCuda(cudaError_t err, const char* what, const char* file, int line) {
 #define FIELDPATH_CUDA_CHECK(call) checkCuda((call), #call, __FILE__, __LINE__)
 
 constexpr int kWarpsPerBlock = 4;
+/// Trace counters (FIELDPATH_ZB_TRACE): lines visited, lowered; the group kernel's lines past its
+/// group floor, exact cuts, tiles cut and skipped.
+constexpr int kStats = 6;
 
 __device__ inline float keyToFloat(std::int32_t key) { return __int_as_float(orderedBits(key)); }
 __device__ inline std::int32_t floatToKey(float h) { return orderedBits(__float_as_int(h)); }
@@ -214,7 +217,7 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
   __shared__ alignas(
       PreparedPosture) unsigned char storage[kWarpsPerBlock * Group * sizeof(PreparedPosture)];
   PreparedPosture(*group)[Group] = reinterpret_cast<PreparedPosture(*)[Group]>(storage);
-  __shared__ LineFloors floors[kWarpsPerBlock][Group][32];  ///< per lane: each posture's
+  __shared__ float floors[kWarpsPerBlock][Group][32];  ///< per lane: each posture's (lineFloorNear)
   const int warp = threadIdx.x >> 5, lane = threadIdx.x & 31;
   const int first = (blockIdx.x * kWarpsPerBlock + warp) * Group;
   if (first >= count) return;  // warp-uniform
@@ -267,7 +270,7 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
       1e-5f * (fabsf(tx_lo) + fabsf(tx_hi) + fabsf(ty_lo) + fabsf(ty_hi) + tool.hull_radius_mm) +
       1e-6f;
   __syncwarp();
-  unsigned visited = 0, lowered = 0;
+  unsigned visited = 0, lowered = 0, reached = 0, exact = 0, tiles_cut = 0, tiles_skipped = 0;
   const long long union_area = (long long)(ix1 - ix0 + 1) * (iy1 - iy0 + 1);
   if (union_area > 2 * area) {  // scattered: posture by posture, the lanes share its lines
     for (unsigned mask = live_mask; mask; mask &= mask - 1)
@@ -294,8 +297,12 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
         for (int o = 16; o > 0; o >>= 1)
           floor = fminf(floor, __shfl_xor_sync(0xffffffffu, floor, o));
         // one lane's read for all: the lanes take the same tiles
-        if (__shfl_sync(0xffffffffu, readTileMax(tile_live, tile), 0) <= floor) continue;
+        if (__shfl_sync(0xffffffffu, readTileMax(tile_live, tile), 0) <= floor) {
+          ++tiles_skipped;
+          continue;
+        }
       }
+      ++tiles_cut;
       const int w = rx1 - rx0 + 1, lines = w * (ry1 - ry0 + 1);
       float highest = -FLT_MAX;  // the lane's lines' heights after the group (or lower)
       for (int l = lane; l < lines; l += 32) {
@@ -305,9 +312,12 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
         float best = keyToFloat(loaded);
         ++visited;
         bool reach = true;  // false: no posture of the group can lower the line
-        const double xd = lineX(g, ix), yd = lineY(g, iy);  // once for every posture
+        // the line's coordinates once for every posture: in double for the exact cuts, split
+        // for the floors (offsetNear: float only, no conversion per posture)
+        const double xd = lineX(g, ix), yd = lineY(g, iy);
+        const SplitCoord xs = splitCoord(xd), ys = splitCoord(yd);
         if (group_floor) {
-          const float x = static_cast<float>(xd), y = static_cast<float>(yd);
+          const float x = xs.hi, y = ys.hi;
           const float dx = fmaxf(fmaxf(tx_lo - x, x - tx_hi) - pad_mm, 0.f);
           const float dy = fmaxf(fmaxf(ty_lo - y, y - ty_hi) - pad_mm, 0.f);
           const float rho2 = (dx * dx + dy * dy) * (1.f - 1e-5f);
@@ -320,30 +330,33 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
           highest = fmaxf(highest, best);
           continue;
         }
-        // The floors first, then the posture of the lowest floor: it nearly always cuts lowest,
-        // after which the others' floors turn them away without a triangle test.
+        ++reached;
+        // The floors first (from float offsets: a floor of each posture's exact one), then the
+        // posture of the lowest floor: it nearly always cuts lowest, after which the others'
+        // floors turn them away without a triangle test.
         float lowest = FLT_MAX;
         int first_k = -1;
         for (unsigned mask = live_mask; mask; mask &= mask - 1) {
           const int k = __ffs(mask) - 1;
           const PreparedPosture& pp = group[warp][k];
-          LineFloors f{FLT_MAX, FLT_MAX};
+          float f = FLT_MAX;
           if (ix >= pp.ix0 && ix <= pp.ix1 && iy >= pp.iy0 && iy <= pp.iy1) {
-            float rx, ry;
-            lineOffsetAt(xd, yd, pp, rx, ry);
-            f = lineFloors(tool, pp, rx, ry);
+            float eps = 0.f;
+            const float rx = offsetNear(xs, pp.tip_mm.x, eps),
+                        ry = offsetNear(ys, pp.tip_mm.y, eps);
+            f = lineFloorNear(tool, pp, rx, ry, eps);
           }
           floors[warp][k][lane] = f;
-          if (f.skip_mm < lowest) lowest = f.skip_mm, first_k = k;
+          if (f < lowest) lowest = f, first_k = k;
         }
         if (best > lowest) {
           for (unsigned mask = live_mask & ~(1u << first_k), k = first_k;;) {
-            const LineFloors f = floors[warp][k][lane];
-            if (best > f.skip_mm) {
+            if (best > floors[warp][k][lane]) {  // then the exact offsets and floors
               const PreparedPosture& pp = group[warp][k];
               float rx, ry;
               lineOffsetAt(xd, yd, pp, rx, ry);
-              const float z = lineCutAt(tool, pp, rx, ry, f, best);
+              const float z = lineCutAt(tool, pp, rx, ry, lineFloors(tool, pp, rx, ry), best);
+              ++exact;
               if (z != FLT_MAX) best = z;
             }
             if (!mask) break;
@@ -360,9 +373,13 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
       }
     }
   }
-  if (stats) {
-    atomicAdd(stats, static_cast<unsigned long long>(visited));
-    atomicAdd(stats + 1, static_cast<unsigned long long>(lowered));
+  if (stats) {  // one atomic per counter per warp (per lane, they serialised case 8's trace)
+    const unsigned counts[kStats] = {visited, lowered, reached, exact, tiles_cut, tiles_skipped};
+    for (int c = 0; c < kStats; ++c) {
+      // tiles are counted by every lane alike: lane 0's count
+      const unsigned sum = c < 4 ? __reduce_add_sync(0xffffffffu, counts[c]) : counts[c];
+      if (lane == 0) atomicAdd(stats + c, static_cast<unsigned long long>(sum));
+    }
   }
 }
 
@@ -547,13 +564,15 @@ struct Engine::Impl {
       cudaEventDestroy(mk.end);
     }
     marks.clear();
-    unsigned long long counts[2] = {0, 0};
+    unsigned long long counts[kStats] = {};
     FIELDPATH_CUDA_CHECK(cudaMemcpy(counts, stats, sizeof counts, cudaMemcpyDeviceToHost));
     std::fprintf(
-        stderr, "trace: wall since engine start %.2f ms; lines visited %llu, lowered %llu\n",
+        stderr,
+        "trace: wall since engine start %.2f ms; lines visited %llu, lowered %llu; grouped: past "
+        "the group floor %llu, exact cuts %llu, tiles cut %llu, skipped %llu\n",
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - created)
             .count(),
-        counts[0], counts[1]);
+        counts[0], counts[1], counts[2], counts[3], counts[4], counts[5]);
     for (const auto& [name, t] : total)
       std::fprintf(stderr, "trace:   %-10s %9.2f ms in %d launches\n", name.c_str(), t.first,
                    t.second);
@@ -747,8 +766,8 @@ Engine::Engine(const GridView& grid, const ToolArrays& tool, const float* height
   FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.culled, 0, sizeof(unsigned long long), st));
   deviceAlloc(m.queued, 1, st);
   if (m.trace) {
-    deviceAlloc(m.stats, 2, st);
-    FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.stats, 0, 2 * sizeof(unsigned long long), st));
+    deviceAlloc(m.stats, kStats, st);
+    FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.stats, 0, kStats * sizeof(unsigned long long), st));
   }
   // the host arrays may go once this returns
   FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(st));

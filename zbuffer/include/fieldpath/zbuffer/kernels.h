@@ -465,6 +465,47 @@ FIELDPATH_HD LineFloors lineFloors(const ToolView& tool, const PreparedPosture& 
   return f;
 }
 
+/// A line's world coordinate split for cheap offsets from many tips: hi = float(x), lo =
+/// float(x - hi) (x from lineX / lineY).
+struct SplitCoord {
+  float hi, lo;
+};
+FIELDPATH_HD SplitCoord splitCoord(double x) {
+  const float hi = static_cast<float>(x);
+  return {hi, static_cast<float>(x - static_cast<double>(hi))};
+}
+
+/// The offset of a split coordinate from a tip coordinate t in float only: (hi - t) + lo, which
+/// differs from lineOffset's float(x - t) by at most a few ulps of the offset (hi - t is exact
+/// where the two are within a factor 2 of each other, and where they are not, both are within
+/// a few times the offset). `err` grows by a bound on that difference.
+FIELDPATH_HD float offsetNear(SplitCoord c, float t, float& err) {
+  const float r = (c.hi - t) + c.lo;
+  err += 1e-6f * (absf(r) + absf(c.lo)) + 1e-30f;
+  return r;
+}
+
+/// A floor of lineFloors(tool, pp, rx, ry).skip_mm at the line whose exact offsets (lineOffset)
+/// are within eps_mm of (rx, ry): the radial floor at the radius shrunk by eps (the table is
+/// non-decreasing and the float expressions monotone), or the capsule floor with its radius grown
+/// by eps (a floor for every point within eps). Lets the group kernel rank and turn away postures
+/// without forming each offset in double.
+FIELDPATH_HD float lineFloorNear(const ToolView& tool, const PreparedPosture& pp, float rx,
+                                 float ry, float eps_mm) {
+  if (pp.vertical && tool.radial_bins > 0) {
+    const float ax = maxf(absf(rx) - eps_mm, 0.f), ay = maxf(absf(ry) - eps_mm, 0.f);
+    const float rho2 = ax * ax + ay * ay;
+    if (!(rho2 <= tool.radial_max_mm2)) return FLT_MAX;
+    const int b = static_cast<int>(rho2 * tool.radial_inv_mm2);
+    return maxf(
+        pp.lowest_z_mm,
+        pp.tip_mm.z + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]);
+  }
+  if (tool.cap_radius_mm > 0.f)
+    return maxf(pp.lowest_z_mm, capsuleLineFloor(tool, pp, rx, ry, eps_mm));
+  return pp.lowest_z_mm;
+}
+
 /// The height the posture would give the line at (rx, ry) from the tip (mm) whose floors are
 /// `floors`, or FLT_MAX if it cannot lower it below `current_mm`. Analytic and mesh tools; -0
 /// folded to +0 so that both backends store equal bits. A height it returns does not depend on
