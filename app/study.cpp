@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iomanip>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 
@@ -320,32 +321,138 @@ StudyResult runStudy(const StudyRequest& request) {
              {h, field::Interpolation::Trilinear, stored, tolerance, request.refine_levels}});
   }
 
-  // Shares of the progress bar: each path run, then the error evaluation.
-  const double runs_end = 0.85;
-  const auto share = [&](std::size_t i) { return runs_end * double(i) / double(variants.size()); };
+  // Shares of the progress bar: each variant's path run and its error evaluation.
+  const auto share = [&](std::size_t i) { return double(i) / double(variants.size()); };
+  const std::size_t direct_row = request.brute_force ? 1 : 0;
 
   StudyResult result;
   result.field = request.job.field;
   result.clearance_mm = request.job.clearance_mm;
   result.repeats = request.repeats;
+  const pathgen::GenerateRequest& job = request.job;
+
+  // ---- force errors: the exact field, the lines, the nodes along the direct path ------------
+  // Set up once the direct path exists (it precedes every voxel variant); each voxel variant is
+  // then measured right after its run, with the field its path was steered by (built once, and
+  // freed before the next variant's).
+  std::unique_ptr<field::DirectField> direct;
+  ErrorSets sets;
+  auto prepareErrors = [&](const pathgen::GenerateResult& direct_run) {
+    const pathgen::Impeller impeller(job.impeller);
+    const std::vector<geometry::TriangleMesh> obstacles =
+        pathgen::obstacleMeshes(impeller, job.extra_obstacles);
+    const pathgen::ClearanceChecker checker(
+        geometry::toolMesh(job.tool, job.holder, pathgen::kClearanceMeshTolMm), obstacles);
+    direct = std::make_unique<field::DirectField>(
+        field::sampleObstacles(obstacles, job.field.sample_step_mm, job.field.weights), job.field);
+
+    const auto& u_range = job.impeller.u_range;
+    const double u_mid = 0.5 * (u_range[0] + u_range[1]);
+    result.line_a =
+        makeLine("a",
+                 "along the channel (u " + number(u_range[0]) + " to " + number(u_range[1]) +
+                     ", the passes' range), mid blade height, r0/2 off the left blade",
+                 lineAPoints(impeller, 0.5 * job.field.r0_mm, request.line_step_mm), checker);
+    result.line_b = makeLine(
+        "b", "across the channel at u = " + number(u_mid) + ", mid blade height, wall to wall",
+        lineBPoints(impeller, u_mid, request.line_step_mm), checker);
+
+    std::vector<Vec3> tool_nodes;
+    for (const auto& node : geometry::surfaceNodes(
+             job.tool, job.holder, pathgen::defaultNodeSpacingMm(job.tool, job.holder)))
+      tool_nodes.push_back(node.position_mm);
+    for (const pathgen::GeneratedPosture& g : direct_run.postures) {
+      const Eigen::Isometry3d placed = geometry::toolToWorld(g.posture);
+      for (const Vec3& n : tool_nodes) sets.nodes_mm.push_back(placed * n);
+      sets.centres_mm.push_back(geometry::ballCentre(g.posture, job.tool.radius_mm));
+    }
+    sets.nodes_per_posture = tool_nodes.size();
+    result.node_points = sets.nodes_mm.size();
+    sets.nodes_direct = evaluate(*direct, sets.nodes_mm);
+    sets.nodes_counted.assign(sets.nodes_mm.size(), 1);
+    sets.moments_direct = sets.moments(sets.nodes_direct);
+    sets.moments_counted.assign(sets.moments_direct.size(), 1);
+    for (StudyLine* line : {&result.line_a, &result.line_b}) {
+      auto& counted = line == &result.line_a ? sets.line_a_counted : sets.line_b_counted;
+      auto& exact = line == &result.line_a ? sets.line_a_direct : sets.line_b_direct;
+      exact = evaluate(*direct, line->points_mm);
+      counted.clear();
+      for (std::size_t i = 0; i < exact.size(); ++i) {
+        line->direct_magnitude.push_back(exact[i].norm());
+        counted.push_back(line->wall_distance_mm[i] >= job.clearance_mm &&
+                          direct_run.reach_box_mm.contains(line->points_mm[i]));
+      }
+    }
+  };
+  // Row i's errors, rows in order (the lines keep one entry per row). `voxels`: the field of
+  // its path, or null (a failed run: built here over the region generate would have used).
+  auto measureErrors = [&](StudyRow& row, const pathgen::GenerateResult& run,
+                           const Eigen::AlignedBox3d& direct_reach_mm,
+                           std::shared_ptr<const field::VoxelField> voxels) {
+    std::unique_ptr<field::ForceField> brute;
+    if (row.variant.isVoxel() && !voxels) {
+      field::VoxelRequest voxel_request(row.variant.voxel);
+      Eigen::AlignedBox3d region = direct_reach_mm;  // padded by two voxels as generate pads it
+      region.min().array() -= 2 * row.variant.voxel.voxel_size_mm;
+      region.max().array() += 2 * row.variant.voxel.voxel_size_mm;
+      voxel_request.region_mm = row.failure.empty() ? run.reach_box_mm : region;
+      voxels = std::make_shared<field::VoxelField>(*direct, voxel_request);
+    }
+    if (voxels) {
+      row.active_nodes = voxels->stats().active_nodes;
+      row.dense_box_nodes = voxels->stats().dense_box_nodes;
+      row.voxel_memory_bytes = voxels->stats().memory_bytes;
+      row.refined_nodes = voxels->stats().refined_nodes;
+      row.levels = voxels->stats().levels;
+    } else if (row.variant.mode == pathgen::FieldMode::BruteForce) {
+      brute = std::make_unique<field::BruteForceField>(direct->samples(), job.field);
+    }
+    const field::ForceField* approx = voxels ? voxels.get() : brute.get();
+    const field::ForceField& f = approx ? *approx : *direct;
+    for (StudyLine* line : {&result.line_a, &result.line_b}) {
+      const bool is_a = line == &result.line_a;
+      const std::vector<Vec3> forces = evaluate(f, line->points_mm);
+      std::vector<double> magnitude, per_point;
+      for (const Vec3& v : forces) magnitude.push_back(v.norm());
+      (is_a ? row.line_a : row.line_b) =
+          forceError(forces, is_a ? sets.line_a_direct : sets.line_b_direct,
+                     is_a ? sets.line_a_counted : sets.line_b_counted, &per_point);
+      line->magnitude.push_back(std::move(magnitude));
+      line->relative_error.push_back(std::move(per_point));
+    }
+    const std::vector<Vec3> node_forces = approx ? evaluate(f, sets.nodes_mm) : sets.nodes_direct;
+    row.nodes = forceError(node_forces, sets.nodes_direct, sets.nodes_counted, nullptr);
+    row.moment =
+        forceError(sets.moments(node_forces), sets.moments_direct, sets.moments_counted, nullptr);
+  };
+
   std::vector<pathgen::GenerateResult> runs;
   for (std::size_t i = 0; i < variants.size(); ++i) {
-    pathgen::GenerateRequest job = request.job;
-    job.mode = variants[i].mode;
-    job.nominal = false;
-    if (variants[i].isVoxel()) job.field.voxel = variants[i].voxel;
-    job.progress = scaled(request.progress, share(i), share(i + 1), variants[i].name());
+    pathgen::GenerateRequest variant_job = job;
+    variant_job.mode = variants[i].mode;
+    variant_job.nominal = false;
+    variant_job.keep_voxels = variants[i].isVoxel();
+    if (variants[i].isVoxel()) variant_job.field.voxel = variants[i].voxel;
+    const double run_end = share(i) + 0.8 * (share(i + 1) - share(i));
+    variant_job.progress = scaled(request.progress, share(i), run_end, variants[i].name());
     StudyRow row;
     row.variant = variants[i];
     try {
-      runs.push_back(pathgen::generateImpellerPath(job));
+      runs.push_back(pathgen::generateImpellerPath(variant_job));
       // Timings: the median of `repeats` runs (the machine may be shared); the path is the first.
       std::vector<pathgen::StageTimes> times = {runs.back().times};
-      for (int k = 1; k < request.repeats; ++k) {
-        job.progress = {};
-        times.push_back(pathgen::generateImpellerPath(job).times);
-      }
+      variant_job.progress = {};
+      variant_job.keep_voxels = false;
+      for (int k = 1; k < request.repeats; ++k)
+        times.push_back(pathgen::generateImpellerPath(variant_job).times);
       runs.back().times = medianTimes(times);
+      row.times = runs.back().times;
+      row.total_s = row.times.field_s + row.times.steering_s;
+      row.min_clearance_mm = runs.back().clearance.min_clearance_mm;
+      row.colliding = runs.back().clearance.colliding;
+      row.max_tilt_deg = runs.back().max_tilt_deg;
+      row.solver_steps = runs.back().solver_steps;
+      row.rhs_evals = runs.back().rhs_evals;
     } catch (const InputError& e) {
       // An approximate field may steer the axis out of the scene's limits: that is a result.
       if (variants[i].mode == pathgen::FieldMode::Direct) throw;
@@ -356,19 +463,15 @@ StudyResult runStudy(const StudyRequest& request) {
       row.tilt_max_deg = row.tilt_rms_deg = row.tilt_middle_max_deg = kNaN;
       row.min_clearance_mm = row.max_tilt_deg = kNaN;
       runs.emplace_back();
-      result.rows.push_back(row);
-      continue;
     }
-    row.times = runs.back().times;
-    row.total_s = row.times.field_s + row.times.steering_s;
-    row.min_clearance_mm = runs.back().clearance.min_clearance_mm;
-    row.colliding = runs.back().clearance.colliding;
-    row.max_tilt_deg = runs.back().max_tilt_deg;
-    row.solver_steps = runs.back().solver_steps;
-    row.rhs_evals = runs.back().rhs_evals;
     result.rows.push_back(row);
+    if (i < direct_row) continue;  // the brute-force row is measured with the direct one
+    common::report(request.progress, run_end, "errors");
+    if (i == direct_row) prepareErrors(runs[i]);
+    for (std::size_t k = i == direct_row ? 0 : i; k <= i; ++k)
+      measureErrors(result.rows[k], runs[k], runs[direct_row].reach_box_mm,
+                    std::move(runs[k].voxels));
   }
-  const std::size_t direct_row = request.brute_force ? 1 : 0;
   const pathgen::GenerateResult& direct_run = runs[direct_row];
   result.postures = direct_run.postures.size();
   result.tool_nodes = direct_run.tool_nodes;
@@ -409,97 +512,6 @@ StudyResult runStudy(const StudyRequest& request) {
     }
     row.tilt_rms_deg = postures.empty() ? 0.0 : std::sqrt(sum_sq / double(postures.size()));
     result.tilt_deg.push_back(std::move(tilt));
-  }
-
-  // ---- force errors: the exact field, the lines, the nodes along the direct path ------------
-  common::report(request.progress, runs_end, "errors");
-  const pathgen::GenerateRequest& job = request.job;
-  const pathgen::Impeller impeller(job.impeller);
-  const std::vector<geometry::TriangleMesh> obstacles =
-      pathgen::obstacleMeshes(impeller, job.extra_obstacles);
-  const pathgen::ClearanceChecker checker(
-      geometry::toolMesh(job.tool, job.holder, pathgen::kClearanceMeshTolMm), obstacles);
-  const field::DirectField direct(
-      field::sampleObstacles(obstacles, job.field.sample_step_mm, job.field.weights), job.field);
-
-  const auto& u_range = job.impeller.u_range;
-  const double u_mid = 0.5 * (u_range[0] + u_range[1]);
-  result.line_a =
-      makeLine("a",
-               "along the channel (u " + number(u_range[0]) + " to " + number(u_range[1]) +
-                   ", the passes' range), mid blade height, r0/2 off the left blade",
-               lineAPoints(impeller, 0.5 * job.field.r0_mm, request.line_step_mm), checker);
-  result.line_b = makeLine(
-      "b", "across the channel at u = " + number(u_mid) + ", mid blade height, wall to wall",
-      lineBPoints(impeller, u_mid, request.line_step_mm), checker);
-
-  ErrorSets sets;
-  std::vector<Vec3> tool_nodes;
-  for (const auto& node : geometry::surfaceNodes(
-           job.tool, job.holder, pathgen::defaultNodeSpacingMm(job.tool, job.holder)))
-    tool_nodes.push_back(node.position_mm);
-  for (const pathgen::GeneratedPosture& g : direct_run.postures) {
-    const Eigen::Isometry3d placed = geometry::toolToWorld(g.posture);
-    for (const Vec3& n : tool_nodes) sets.nodes_mm.push_back(placed * n);
-    sets.centres_mm.push_back(geometry::ballCentre(g.posture, job.tool.radius_mm));
-  }
-  sets.nodes_per_posture = tool_nodes.size();
-  result.node_points = sets.nodes_mm.size();
-  sets.nodes_direct = evaluate(direct, sets.nodes_mm);
-  sets.nodes_counted.assign(sets.nodes_mm.size(), 1);
-  sets.moments_direct = sets.moments(sets.nodes_direct);
-  sets.moments_counted.assign(sets.moments_direct.size(), 1);
-  for (StudyLine* line : {&result.line_a, &result.line_b}) {
-    auto& counted = line == &result.line_a ? sets.line_a_counted : sets.line_b_counted;
-    auto& exact = line == &result.line_a ? sets.line_a_direct : sets.line_b_direct;
-    exact = evaluate(direct, line->points_mm);
-    counted.clear();
-    for (std::size_t i = 0; i < exact.size(); ++i) {
-      line->direct_magnitude.push_back(exact[i].norm());
-      counted.push_back(line->wall_distance_mm[i] >= job.clearance_mm &&
-                        direct_run.reach_box_mm.contains(line->points_mm[i]));
-    }
-  }
-
-  for (std::size_t i = 0; i < result.rows.size(); ++i) {
-    StudyRow& row = result.rows[i];
-    common::report(request.progress,
-                   runs_end + (1.0 - runs_end) * double(i) / double(result.rows.size()), "errors");
-    std::unique_ptr<field::ForceField> approx;
-    if (row.variant.isVoxel()) {
-      field::VoxelRequest voxel_request(row.variant.voxel);
-      // The region generate used; for a failed run, the direct run's padded by two voxels as
-      // generate pads it.
-      Eigen::AlignedBox3d region = direct_run.reach_box_mm;
-      region.min().array() -= 2 * row.variant.voxel.voxel_size_mm;
-      region.max().array() += 2 * row.variant.voxel.voxel_size_mm;
-      voxel_request.region_mm = row.failure.empty() ? runs[i].reach_box_mm : region;
-      auto voxels = std::make_unique<field::VoxelField>(direct, voxel_request);
-      row.active_nodes = voxels->stats().active_nodes;
-      row.dense_box_nodes = voxels->stats().dense_box_nodes;
-      row.voxel_memory_bytes = voxels->stats().memory_bytes;
-      row.refined_nodes = voxels->stats().refined_nodes;
-      row.levels = voxels->stats().levels;
-      approx = std::move(voxels);
-    } else if (row.variant.mode == pathgen::FieldMode::BruteForce) {
-      approx = std::make_unique<field::BruteForceField>(direct.samples(), job.field);
-    }
-    const field::ForceField& f = approx ? *approx : static_cast<const field::ForceField&>(direct);
-    for (StudyLine* line : {&result.line_a, &result.line_b}) {
-      const bool is_a = line == &result.line_a;
-      const std::vector<Vec3> forces = evaluate(f, line->points_mm);
-      std::vector<double> magnitude, per_point;
-      for (const Vec3& v : forces) magnitude.push_back(v.norm());
-      (is_a ? row.line_a : row.line_b) =
-          forceError(forces, is_a ? sets.line_a_direct : sets.line_b_direct,
-                     is_a ? sets.line_a_counted : sets.line_b_counted, &per_point);
-      line->magnitude.push_back(std::move(magnitude));
-      line->relative_error.push_back(std::move(per_point));
-    }
-    const std::vector<Vec3> node_forces = approx ? evaluate(f, sets.nodes_mm) : sets.nodes_direct;
-    row.nodes = forceError(node_forces, sets.nodes_direct, sets.nodes_counted, nullptr);
-    row.moment =
-        forceError(sets.moments(node_forces), sets.moments_direct, sets.moments_counted, nullptr);
   }
   common::report(request.progress, 1.0, "done");
   return result;

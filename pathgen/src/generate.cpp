@@ -149,7 +149,7 @@ GenerateResult generateImpellerPath(const GenerateRequest& request) {
   // ---- field -----------------------------------------------------------------------------------
   const auto field_start = Clock::now();
   std::unique_ptr<field::DirectField> direct;
-  std::unique_ptr<field::VoxelField> voxels;
+  std::shared_ptr<field::VoxelField> voxels;
   std::unique_ptr<field::BruteForceField> brute;
   const field::ForceField* force = nullptr;
   const double h = request.field.voxel.voxel_size_mm;
@@ -169,7 +169,7 @@ GenerateResult generateImpellerPath(const GenerateRequest& request) {
       field::VoxelRequest voxel_request(request.field.voxel);
       voxel_request.region_mm = result.reach_box_mm;
       voxel_request.progress = scaled(request.progress, 0.0, 0.3, "field");
-      voxels = std::make_unique<field::VoxelField>(*direct, voxel_request);
+      voxels = std::make_shared<field::VoxelField>(*direct, voxel_request);
       result.voxel_nodes = voxels->stats().active_nodes;
       result.voxel_memory_bytes = voxels->stats().memory_bytes;
       force = voxels.get();
@@ -255,6 +255,7 @@ GenerateResult generateImpellerPath(const GenerateRequest& request) {
   }
   result.times.clearance_s = seconds(clearance_start);
   result.times.total_s = seconds(start);
+  if (request.keep_voxels) result.voxels = std::move(voxels);
   return result;
 }
 

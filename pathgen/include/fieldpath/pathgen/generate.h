@@ -3,6 +3,7 @@
 /// the benchmark share it): passes → field (direct or voxels) → steered tool axis per pass →
 /// exact clearance of every posture.
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +19,10 @@
 #include "fieldpath/pathgen/impeller.h"
 #include "fieldpath/pathgen/params.h"
 #include "fieldpath/pathgen/passes.h"
+
+namespace fieldpath::field {
+class VoxelField;
+}
 
 namespace fieldpath::pathgen {
 
@@ -58,6 +63,9 @@ struct GenerateRequest {
   FieldMode mode = FieldMode::Voxel;
   /// Nominal path: the axis stays on the nominal angles (no field, no dynamics).
   bool nominal = false;
+  /// Hand the voxel field the path was steered by back in GenerateResult::voxels (the study
+  /// measures its error without building it a second time).
+  bool keep_voxels = false;
   common::Progress progress;  ///< "field", "pass k/n", "clearance"
 };
 
@@ -86,6 +94,8 @@ struct GenerateResult {
   std::size_t tool_triangles = 0;   ///< of the clearance mesh
   std::size_t voxel_nodes = 0;      ///< active nodes (voxel mode)
   std::size_t voxel_memory_bytes = 0;
+  /// The voxel field of the path (voxel mode with GenerateRequest::keep_voxels), else null.
+  std::shared_ptr<const field::VoxelField> voxels;
   Eigen::AlignedBox3d reach_box_mm;  ///< region of the voxels: what tool + holder can reach
   double path_length_mm = 0;         ///< sum of the pass lengths (ball centre)
   double max_tilt_deg = 0, max_lead_deg = 0;  ///< largest |angle| on the path
