@@ -255,6 +255,7 @@ int variantTable(const std::string& backend, const std::vector<std::string>& wan
       {"no capsule floor", [](zb::EngineTuning& t) { t.capsule_floor = false; }},
       {"no groups", [](zb::EngineTuning& t) { t.group_postures = 0; }},
       {"groups of 16", [](zb::EngineTuning& t) { t.group_postures = 16; }},
+      {"groups of 32", [](zb::EngineTuning& t) { t.group_postures = 32; }},
       {"no live tiles", [](zb::EngineTuning& t) { t.live_tiles = false; }},
       {"all knobs off",
        [](zb::EngineTuning& t) {

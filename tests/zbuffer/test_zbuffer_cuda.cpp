@@ -141,7 +141,7 @@ TEST_F(CpuVsCuda, PathsCutInGroupsBitIdentical) {
     const auto p = pathPostures(6000, 16, tilted);
     for (int variant = 0; variant < 4; ++variant) {
       EngineTuning t;
-      t.group_postures = variant == 1 ? 0 : (variant == 3 ? 16 : 8);
+      t.group_postures = variant == 1 ? 0 : (variant == 3 ? 16 : (variant == 2 ? 32 : 8));
       t.prepass_stride = variant == 2 ? 0 : 16;
       t.tile_skip = variant != 3;
       t.live_tiles = variant != 2;

@@ -208,11 +208,34 @@ __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
 /// it is given, only whether it is returned, so the minimum (every bit) is the CPU's. A scattered
 /// group (union much larger than its footprints: a sorted block, ends of passes) is cut posture by
 /// posture instead.
+/// The box of a group's tips (world xy, mm), its lowest tip z and a pad (far more than the
+/// rounding of any posture's own line radius).
+struct TipBox {
+  float x_lo, x_hi, y_lo, y_hi, z_lo, pad_mm;
+};
+
+/// The group floor (vertical postures, radial floors) over the world rectangle [x0, x1] × [y0, y1]
+/// (mm): the lowest tip plus the radial floor at the rectangle's distance from the tips' box,
+/// shrunk by the pad; FLT_MAX beyond the tool's reach. No posture of the group gives a line there
+/// a height below it.
+__device__ inline float groupFloor(const ToolView& tool, const TipBox& box, float x0, float x1,
+                                   float y0, float y1) {
+  const float dx = fmaxf(fmaxf(box.x_lo - x1, x0 - box.x_hi) - box.pad_mm, 0.f);
+  const float dy = fmaxf(fmaxf(box.y_lo - y1, y0 - box.y_hi) - box.pad_mm, 0.f);
+  const float rho2 = (dx * dx + dy * dy) * (1.f - 1e-5f);
+  if (!(rho2 <= tool.radial_max_mm2)) return FLT_MAX;
+  const int b = static_cast<int>(rho2 * tool.radial_inv_mm2);
+  return box.z_lo + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1];
+}
+
+#ifndef FIELDPATH_GROUP_MIN_BLOCKS
+#define FIELDPATH_GROUP_MIN_BLOCKS 8
+#endif
 template <int Group>
-__global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
-                            const std::uint32_t* order, int count, const float* tile_max,
-                            float* tile_live, std::int32_t* keys, unsigned long long* culled,
-                            bool skip, bool live_tiles, unsigned long long* stats) {
+__global__ void __launch_bounds__(32 * kWarpsPerBlock, FIELDPATH_GROUP_MIN_BLOCKS)
+    groupKernel(GridView g, ToolView tool, const Posture* postures, const std::uint32_t* order,
+                int count, const float* tile_max, float* tile_live, std::int32_t* keys,
+                unsigned long long* culled, bool skip, bool live_tiles, unsigned long long* stats) {
   // raw storage: PreparedPosture's members have initialisers, which __shared__ cannot run
   __shared__ alignas(
       PreparedPosture) unsigned char storage[kWarpsPerBlock * Group * sizeof(PreparedPosture)];
@@ -266,9 +289,14 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
     tz_lo = fminf(tz_lo, __shfl_xor_sync(0xffffffffu, tz_lo, o));
   }
   const bool group_floor = __all_sync(0xffffffffu, all_vertical) && tool.radial_bins > 0;
-  const float pad_mm =
+  const TipBox box{
+      tx_lo,
+      tx_hi,
+      ty_lo,
+      ty_hi,
+      tz_lo,
       1e-5f * (fabsf(tx_lo) + fabsf(tx_hi) + fabsf(ty_lo) + fabsf(ty_hi) + tool.hull_radius_mm) +
-      1e-6f;
+          1e-6f};
   __syncwarp();
   unsigned visited = 0, lowered = 0, reached = 0, exact = 0, tiles_cut = 0, tiles_skipped = 0;
   const long long union_area = (long long)(ix1 - ix0 + 1) * (iy1 - iy0 + 1);
@@ -286,7 +314,19 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
       const int rx1 = min(((tx + 1) << g.tile_shift) - 1, ix1);
       const int ry1 = min(((ty + 1) << g.tile_shift) - 1, iy1);
       const int tile = ty * g.tiles_x + tx;
-      if (skip) {  // skipped if no posture of the group can lower a line of it (lane-parallel)
+      // skipped if no posture of the group can lower a line of it: first the group floor at the
+      // tile's distance from the tips' box (all lanes alike), then each posture's (lane-parallel)
+      const float tile_top =
+          skip ? __shfl_sync(0xffffffffu, readTileMax(tile_live, tile), 0) : FLT_MAX;
+      if (skip && group_floor &&
+          !(tile_top > groupFloor(tool, box, static_cast<float>(lineX(g, rx0)),
+                                  static_cast<float>(lineX(g, rx1)),
+                                  static_cast<float>(lineY(g, ry0)),
+                                  static_cast<float>(lineY(g, ry1))))) {
+        ++tiles_skipped;
+        continue;
+      }
+      if (skip) {
         float floor = FLT_MAX;
         if (lane < n && ((live_mask >> lane) & 1u)) {
           const PreparedPosture& pp = group[warp][lane];
@@ -296,8 +336,7 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
         }
         for (int o = 16; o > 0; o >>= 1)
           floor = fminf(floor, __shfl_xor_sync(0xffffffffu, floor, o));
-        // one lane's read for all: the lanes take the same tiles
-        if (__shfl_sync(0xffffffffu, readTileMax(tile_live, tile), 0) <= floor) {
+        if (tile_top <= floor) {  // one lane's read for all: the lanes take the same tiles
           ++tiles_skipped;
           continue;
         }
@@ -316,16 +355,7 @@ __global__ void groupKernel(GridView g, ToolView tool, const Posture* postures,
         // for the floors (offsetNear: float only, no conversion per posture)
         const double xd = lineX(g, ix), yd = lineY(g, iy);
         const SplitCoord xs = splitCoord(xd), ys = splitCoord(yd);
-        if (group_floor) {
-          const float x = xs.hi, y = ys.hi;
-          const float dx = fmaxf(fmaxf(tx_lo - x, x - tx_hi) - pad_mm, 0.f);
-          const float dy = fmaxf(fmaxf(ty_lo - y, y - ty_hi) - pad_mm, 0.f);
-          const float rho2 = (dx * dx + dy * dy) * (1.f - 1e-5f);
-          const int b = static_cast<int>(rho2 * tool.radial_inv_mm2);
-          reach =
-              rho2 <= tool.radial_max_mm2 &&
-              best > tz_lo + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1];
-        }
+        if (group_floor) reach = best > groupFloor(tool, box, xs.hi, xs.hi, ys.hi, ys.hi);
         if (!reach) {
           highest = fmaxf(highest, best);
           continue;
@@ -643,7 +673,8 @@ struct Engine::Impl {
         const dim3 blocks((groups + kWarpsPerBlock - 1) / kWarpsPerBlock,
                           std::clamp(16384 / std::max(1, groups), 1, 1024));
         m.timed("group", st, [&] {
-          const auto kernel = group > 8 ? groupKernel<16> : groupKernel<8>;
+          const auto kernel =
+              group > 16 ? groupKernel<32> : (group > 8 ? groupKernel<16> : groupKernel<8>);
           kernel<<<blocks, 32 * kWarpsPerBlock, 0, st>>>(
               m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.tile_live, m.keys,
               culled_count, m.options.tile_skip, m.options.live_tiles, m.stats);

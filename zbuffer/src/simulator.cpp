@@ -545,8 +545,8 @@ SimulationResult run(const SimulationRequest& request, std::size_t expected_post
   if (request.tuning.prepass_stride < 0)
     throw InputError("tuning: prepass_stride must be 0 (off) or positive");
   if (request.tuning.group_postures != 0 && request.tuning.group_postures != 8 &&
-      request.tuning.group_postures != 16)
-    throw InputError("tuning: group_postures must be 0 (off), 8 or 16");
+      request.tuning.group_postures != 16 && request.tuning.group_postures != 32)
+    throw InputError("tuning: group_postures must be 0 (off), 8, 16 or 32");
   detail::EngineSetup setup;
   setup.grid = detail::makeGridView(grid, shift);
   setup.tool = preparedTool(request.tool);  // shared, never copied: the view points into it
