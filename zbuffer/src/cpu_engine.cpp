@@ -5,6 +5,7 @@
 #include <atomic>
 
 #include "fieldpath/zbuffer/simulator.h"
+#include "host_memory.h"
 
 namespace fieldpath::zbuffer::detail {
 namespace {
@@ -30,6 +31,7 @@ class CpuEngine final : public BackendEngine {
         tile_max_(std::size_t(setup.grid.tiles_x) * setup.grid.tiles_y) {
     const GridView& grid = setup.grid;
     const EngineTuning& tuning = setup.tuning;
+    heights_ = reserveHuge<float>(std::size_t(grid.nx) * grid.ny);
     if (setup.heights_mm.empty())
       heights_.assign(std::size_t(grid.nx) * grid.ny, setup.stock_mm);
     else

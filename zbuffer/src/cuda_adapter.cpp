@@ -3,6 +3,7 @@
 
 #include "cuda_engine.h"
 #include "fieldpath/zbuffer/simulator.h"
+#include "host_memory.h"
 
 namespace fieldpath::zbuffer {
 
@@ -46,7 +47,11 @@ class CudaAdapter final : public BackendEngine {
     // A large output vector is zeroed (and its pages faulted in) by another thread while the
     // device works: 400 MB for a 10000² grid is ~0.1 s of one core.
     if (lines_ >= (std::size_t{1} << 24))
-      output_ = std::async(std::launch::async, [n = lines_] { return std::vector<float>(n); });
+      output_ = std::async(std::launch::async, [n = lines_] {
+        std::vector<float> v = reserveHuge<float>(n);
+        v.resize(n);
+        return v;
+      });
   }
 
   void cut(std::span<const Posture> block, Engine engine) override {

@@ -475,10 +475,13 @@ void releasePinned(void* p) {
   pinnedFree().push_back(p);
 }
 
-/// memcpy on all cores (one thread moves ~10 GB/s, less than the PCIe link).
+/// memcpy on a few cores: one thread moves ~7 GB/s, four ~20 (the PCIe link takes 52). Not on
+/// all of them: where one core is busy (the output's pages being faulted in by another thread),
+/// a static split over all waits for the descheduled one (H100 machine, 96 MB: 2 ms alone, 44
+/// ms beside that thread with 16 threads, 3.6 ms with 4; bench/results/zbuffer-h100.md, run 30).
 void parallelCopy(void* dst, const void* src, std::size_t bytes) {
   const long parts = bytes >= (std::size_t{1} << 20) ? 16 : 1;
-#pragma omp parallel for schedule(static) if (parts > 1)
+#pragma omp parallel for schedule(dynamic) num_threads(4) if (parts > 1)
   for (long k = 0; k < parts; ++k) {
     const std::size_t a = bytes * std::size_t(k) / std::size_t(parts),
                       b = bytes * std::size_t(k + 1) / std::size_t(parts);
