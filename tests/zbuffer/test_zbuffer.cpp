@@ -15,6 +15,7 @@
 #endif
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/zbuffer/engine.h"
 #include "fieldpath/zbuffer/outputs.h"
 #include "fieldpath/zbuffer/simulator.h"
 #include "fieldpath/zbuffer/tool_mesh.h"
@@ -470,8 +471,8 @@ TEST(Culling, FloatOffsetFloorsAreBelowTheExactOnes) {
             const float ax = offsetNear(splitCoord(lineX(g, ix)), pp.tip_mm.x, eps);
             const float ay = offsetNear(splitCoord(lineY(g, iy)), pp.tip_mm.y, eps);
             const float near = lineFloorNear(data.view, pp, ax, ay, eps);
-            ASSERT_LE(near, exact) << "origin " << origin << " tool " << int(tool.kind)
-                                   << " line " << ix << "," << iy;
+            ASSERT_LE(near, exact)
+                << "origin " << origin << " tool " << int(tool.kind) << " line " << ix << "," << iy;
             ++compared;
             tight += exact == FLT_MAX ? near == FLT_MAX : exact - near < 1e-3f;
           }
@@ -480,6 +481,44 @@ TEST(Culling, FloatOffsetFloorsAreBelowTheExactOnes) {
   }
   EXPECT_GT(compared, 50000);
   EXPECT_GT(tight, compared * 9 / 10);  // a floor that low would turn nothing away
+}
+
+TEST(Culling, CutDoesNotDependOnTheHeightItIsGiven) {
+  // The CUDA group kernel hands each posture the running minimum of the group, not the stored
+  // height; its bits equal the CPU's only if a cut, when it returns a height, returns the same one
+  // whatever height above it it was given (the BVH walk is pruned by that height, with a slack).
+  std::mt19937 rng(53);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const GridView g = detail::makeGridView(Grid::fromRegion(-6, -6, 6, 6, 96, 96), 3);
+  int checked = 0;
+  for (const Tool& tool :
+       {Tool::fromMesh(analyticToolMesh(Tool::ball(2, 8), 32, 31)),
+        Tool::fromMesh(analyticToolMesh(Tool::torus(3, 1, 10), 40, 8)), Tool::torus(3, 1, 10)}) {
+    const detail::ToolData data = detail::prepareTool(tool);
+    for (int k = 0; k < 30; ++k) {
+      const bool vertical = k % 3 == 0;
+      const PreparedPosture pp = preparePosture(
+          g, data.view,
+          pose(2 * u(rng), 2 * u(rng), u(rng), vertical ? 0 : u(rng), vertical ? 0 : u(rng), 1));
+      for (int iy = pp.iy0; iy <= pp.iy1; iy += 2)
+        for (int ix = pp.ix0; ix <= pp.ix1; ix += 2) {
+          float rx, ry;
+          lineOffset(g, pp, ix, iy, rx, ry);
+          const LineFloors f = lineFloors(data.view, pp, rx, ry);
+          const float free = lineCutAt(data.view, pp, rx, ry, f, FLT_MAX);
+          if (free == FLT_MAX) continue;
+          for (float given : {std::nextafter(free, FLT_MAX), free + 1e-4f, free + 0.5f}) {
+            const float h = lineCutAt(data.view, pp, rx, ry, f, given);
+            ASSERT_EQ(std::memcmp(&h, &free, 4), 0)
+                << "tool " << int(tool.kind) << " given " << given << ": " << h << " vs " << free;
+            ++checked;
+          }
+          // and at or below it, no height
+          ASSERT_EQ(lineCutAt(data.view, pp, rx, ry, f, free), FLT_MAX);
+        }
+    }
+  }
+  EXPECT_GT(checked, 10000);
 }
 
 TEST(Tool, ReachIsTheRadiusThatHoldsTheTool) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 
+#include "fieldpath/zbuffer/engine.h"
 #include "fieldpath/zbuffer/simulator.h"
 #include "host_memory.h"
 

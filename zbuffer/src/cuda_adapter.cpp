@@ -2,6 +2,7 @@
 #include <future>
 
 #include "cuda_engine.h"
+#include "fieldpath/zbuffer/engine.h"
 #include "fieldpath/zbuffer/simulator.h"
 #include "host_memory.h"
 

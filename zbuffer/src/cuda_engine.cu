@@ -658,50 +658,49 @@ struct Engine::Impl {
   void chunks(const Posture* postures, const std::uint32_t* order, std::size_t count,
               unsigned long long* culled_count) {
     cudaStream_t st = compute_stream;
-    Impl& m = *this;
-    const int tiles = m.grid.tiles_x * m.grid.tiles_y;
-    for (std::size_t begin = 0; begin < count; begin += m.refresh_every) {
-      const int chunk = static_cast<int>(std::min(m.refresh_every, count - begin));
+    const int tiles = grid.tiles_x * grid.tiles_y;
+    for (std::size_t begin = 0; begin < count; begin += refresh_every) {
+      const int chunk = static_cast<int>(std::min(refresh_every, count - begin));
       const std::uint32_t* chunk_order = order ? order + begin : nullptr;
       const Posture* chunk_postures = order ? postures : postures + begin;
-      m.timed("tile max", st, [&] {
-        tileMaxKernel<<<(tiles + 255) / 256, 256, 0, st>>>(m.grid, m.keys, m.tile_max, m.tile_live);
+      timed("tile max", st, [&] {
+        tileMaxKernel<<<(tiles + 255) / 256, 256, 0, st>>>(grid, keys, tile_max, tile_live);
         FIELDPATH_CUDA_CHECK(cudaGetLastError());
       });
       const int splits = std::clamp(16384 / std::max(1, chunk), 1, 1024);
       const dim3 warps((chunk + kWarpsPerBlock - 1) / kWarpsPerBlock, splits);
-      if (m.use_groups) {
-        const int group = m.options.group_postures;
+      if (use_groups) {
+        const int group = options.group_postures;
         const int groups = (chunk + group - 1) / group;
         const dim3 blocks((groups + kWarpsPerBlock - 1) / kWarpsPerBlock,
                           std::clamp(16384 / std::max(1, groups), 1, 1024));
-        m.timed("group", st, [&] {
+        timed("group", st, [&] {
           const auto kernel =
               group > 16 ? groupKernel<32> : (group > 8 ? groupKernel<16> : groupKernel<8>);
           kernel<<<blocks, 32 * kWarpsPerBlock, 0, st>>>(
-              m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.tile_live, m.keys,
-              culled_count, m.options.tile_skip, m.options.live_tiles, m.stats);
+              grid, tool, chunk_postures, chunk_order, chunk, tile_max, tile_live, keys,
+              culled_count, options.tile_skip, options.live_tiles, stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
-      } else if (m.options.small_threads) {
-        FIELDPATH_CUDA_CHECK(cudaMemsetAsync(m.queued, 0, sizeof(int), st));
-        m.timed("small", st, [&] {
+      } else if (options.small_threads) {
+        FIELDPATH_CUDA_CHECK(cudaMemsetAsync(queued, 0, sizeof(int), st));
+        timed("small", st, [&] {
           smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(
-              m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.tile_live, m.keys,
-              culled_count, m.queue, m.queued, m.options.tile_skip, m.options.live_tiles, m.stats);
+              grid, tool, chunk_postures, chunk_order, chunk, tile_max, tile_live, keys,
+              culled_count, queue, queued, options.tile_skip, options.live_tiles, stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
-        m.timed("large", st, [&] {
+        timed("large", st, [&] {
           largeKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
-              m.grid, m.tool, chunk_postures, chunk_order, m.queue, m.queued, m.tile_max,
-              m.tile_live, m.keys, m.options.tile_skip, m.options.live_tiles, m.stats);
+              grid, tool, chunk_postures, chunk_order, queue, queued, tile_max, tile_live, keys,
+              options.tile_skip, options.live_tiles, stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
       } else {
-        m.timed("warp", st, [&] {
+        timed("warp", st, [&] {
           warpKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
-              m.grid, m.tool, chunk_postures, chunk_order, chunk, m.tile_max, m.tile_live, m.keys,
-              culled_count, m.options.tile_skip, m.options.live_tiles, m.stats);
+              grid, tool, chunk_postures, chunk_order, chunk, tile_max, tile_live, keys,
+              culled_count, options.tile_skip, options.live_tiles, stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
       }

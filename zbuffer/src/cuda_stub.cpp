@@ -1,6 +1,7 @@
 /// Built when CUDA is not: the CUDA backend reports itself absent.
 #include <stdexcept>
 
+#include "fieldpath/zbuffer/engine.h"
 #include "fieldpath/zbuffer/simulator.h"
 
 namespace fieldpath::zbuffer {

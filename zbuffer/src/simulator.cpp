@@ -1,3 +1,4 @@
+#include "fieldpath/zbuffer/engine.h"
 #include "fieldpath/zbuffer/simulator.h"
 
 #include <unistd.h>
