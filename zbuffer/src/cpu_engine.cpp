@@ -51,23 +51,25 @@ class CpuEngine final : public BackendEngine {
       coarse(block);
       return;
     }
-    if (tuning_.prepass_stride > 1 && !tuning_.lowest_first &&
-        block.size() >= 2 * std::size_t(tuning_.prepass_stride)) {
+    // `count` postures, at(k) the k-th, in chunks with the tile maxima refreshed before each
+    const auto pass = [&](std::size_t count, auto at) {
+      std::size_t culled = 0;
+      for (std::size_t begin = 0; begin < count; begin += refresh_every_) {
+        refreshTiles();
+        culled += fast(at, begin, std::min(count, begin + refresh_every_));
+      }
+      return culled;
+    };
+    const std::size_t stride = std::size_t(std::max(tuning_.prepass_stride, 0));
+    if (stride > 1 && !tuning_.lowest_first && block.size() >= 2 * stride)
       // every stride-th posture in path order first (see EngineTuning::prepass_stride); its
       // culls are not counted (the main pass meets the same postures again)
-      std::vector<std::uint32_t> sparse;
-      for (std::size_t k = 0; k < block.size(); k += std::size_t(tuning_.prepass_stride))
-        sparse.push_back(static_cast<std::uint32_t>(k));
-      for (std::size_t begin = 0; begin < sparse.size(); begin += refresh_every_) {
-        refreshTiles();
-        fast(block, sparse, begin, std::min(sparse.size(), begin + refresh_every_));
-      }
-    }
-    const std::vector<std::uint32_t> order = processingOrder(block);
-    for (std::size_t begin = 0; begin < block.size(); begin += refresh_every_) {
-      refreshTiles();
-      const std::size_t end = std::min(block.size(), begin + refresh_every_);
-      culled_ += fast(block, order, begin, end);
+      pass((block.size() + stride - 1) / stride, [&](std::size_t k) { return block[k * stride]; });
+    if (tuning_.lowest_first) {
+      const std::vector<std::uint32_t> order = lowestFirstOrder(block);
+      culled_ += pass(block.size(), [&](std::size_t k) { return block[order[k]]; });
+    } else {
+      culled_ += pass(block.size(), [&](std::size_t k) { return block[k]; });
     }
   }
 
@@ -75,13 +77,9 @@ class CpuEngine final : public BackendEngine {
   std::size_t culled() override { return culled_; }
 
  private:
-  /// Indices of the block's postures in processing order (lowest point first, see lowestKey).
-  std::vector<std::uint32_t> processingOrder(std::span<const Posture> block) const {
+  /// Indices of the block's postures, lowest point over the grid first (see lowestKey).
+  std::vector<std::uint32_t> lowestFirstOrder(std::span<const Posture> block) const {
     std::vector<std::uint32_t> order(block.size());
-    if (!tuning_.lowest_first) {
-      for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<std::uint32_t>(k);
-      return order;
-    }
     std::vector<std::uint64_t> keyed(block.size());
     const GridView g = grid_;
     const ToolView tool = view_;
@@ -112,8 +110,9 @@ class CpuEngine final : public BackendEngine {
       }
   }
 
-  std::size_t fast(std::span<const Posture> block, const std::vector<std::uint32_t>& order,
-                   std::size_t begin, std::size_t end) {
+  /// Cuts postures at(begin) ... at(end - 1) in parallel; returns how many were culled.
+  template <class PostureAt>
+  std::size_t fast(PostureAt at, std::size_t begin, std::size_t end) {
     const GridView g = grid_;
     const ToolView tool = view_;
     float* h = heights_.data();
@@ -122,7 +121,7 @@ class CpuEngine final : public BackendEngine {
     std::size_t culled = 0;
 #pragma omp parallel for schedule(dynamic, 16) reduction(+ : culled)
     for (long k = long(begin); k < long(end); ++k) {
-      const Posture pose = block[order[k]];
+      const Posture pose = at(std::size_t(k));
       if (missesGrid(g, tool, pose)) {  // a zoom's nearly all: no preparation
         ++culled;
         continue;
