@@ -521,6 +521,34 @@ TEST(Culling, CutDoesNotDependOnTheHeightItIsGiven) {
   EXPECT_GT(checked, 10000);
 }
 
+TEST(Culling, MissesGridOnlyWhereTheFootprintIsEmpty) {
+  // missesGrid turns postures away before any preparation (a zoom's nearly all): it may say so
+  // only where the tool's footprint holds no line, for any axis, near the grid's edges too.
+  std::mt19937 rng(59);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const GridView g = detail::makeGridView(Grid::fromRegion(100, 100, 100.3, 100.3, 64, 64), 3);
+  int misses = 0, near = 0;
+  for (const Tool& tool : {Tool::ball(3, 12), Tool::torus(5, 1, 25),
+                           Tool::fromMesh(analyticToolMesh(Tool::ball(3, 12), 32, 31))}) {
+    const detail::ToolData data = detail::prepareTool(tool);
+    for (int k = 0; k < 20000; ++k) {
+      const double spread = k % 2 ? 14.0 : 30.0;
+      const Posture p = pose(100.15 + spread * u(rng), 100.15 + spread * u(rng), u(rng), u(rng),
+                             u(rng), k % 5 == 0 ? 0.0 : std::abs(u(rng)) + 1e-3);
+      const bool miss = missesGrid(g, data.view, p);
+      const PreparedPosture pp = preparePosture(g, data.view, p);
+      const bool empty = pp.ix0 > pp.ix1 || pp.iy0 > pp.iy1;
+      if (miss)
+        ASSERT_TRUE(empty) << "tool " << int(tool.kind) << " tip " << p.tip_mm.x << ","
+                           << p.tip_mm.y;
+      misses += miss;
+      near += !miss && empty;
+    }
+  }
+  EXPECT_GT(misses, 10000);  // it does turn most far postures away
+  EXPECT_GT(near, 100);      // and is conservative near the edge
+}
+
 TEST(Tool, ReachIsTheRadiusThatHoldsTheTool) {
   EXPECT_EQ(toolReach(Tool::torus(3, 1, 12)), 3.0);
   // a revolved mesh's vertices lie on the profile: the largest radius is the tool's
