@@ -5,6 +5,7 @@
 /// then chunks of postures between tile-maximum refreshes; one thread per small-footprint
 /// posture, one warp per large one.
 #include <cuda_runtime.h>
+#include <omp.h>
 
 #include <cub/device/device_radix_sort.cuh>
 
@@ -475,13 +476,17 @@ void releasePinned(void* p) {
   pinnedFree().push_back(p);
 }
 
-/// memcpy on a few cores: one thread moves ~7 GB/s, four ~20 (the PCIe link takes 52). Not on
-/// all of them: where one core is busy (the output's pages being faulted in by another thread),
-/// a static split over all waits for the descheduled one (H100 machine, 96 MB: 2 ms alone, 44
-/// ms beside that thread with 16 threads, 3.6 ms with 4; bench/results/zbuffer-h100.md, run 30).
+/// memcpy on all cores but two: one thread moves ~7 GB/s, 16 alone ~48 (the PCIe link takes 52).
+/// Two are left for the caller's other threads (the output's pages being faulted in): with one
+/// core short, the split waits for the descheduled thread (H100 machine, 96 MB: 2 ms on 16
+/// threads alone, 44 ms beside that thread; bench/results/zbuffer-h100.md, runs 30-32).
+int copyThreads() {
+  static const int threads = std::clamp(omp_get_num_procs() - 2, 1, 16);
+  return threads;
+}
 void parallelCopy(void* dst, const void* src, std::size_t bytes) {
-  const long parts = bytes >= (std::size_t{1} << 20) ? 16 : 1;
-#pragma omp parallel for schedule(dynamic) num_threads(4) if (parts > 1)
+  const long parts = bytes >= (std::size_t{1} << 20) ? 32 : 1;
+#pragma omp parallel for schedule(dynamic) num_threads(copyThreads()) if (parts > 1)
   for (long k = 0; k < parts; ++k) {
     const std::size_t a = bytes * std::size_t(k) / std::size_t(parts),
                       b = bytes * std::size_t(k + 1) / std::size_t(parts);
