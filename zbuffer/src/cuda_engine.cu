@@ -659,9 +659,11 @@ struct Engine::Impl {
   }
 
   /// Cuts `count` postures (in `order`, or as they come), chunk by chunk with the tile maxima
-  /// refreshed before each; `culled_count` (may be null) counts the culled postures.
+  /// refreshed before each; `culled_count` (may be null) counts the culled postures. `prepass`:
+  /// the trace counts the cutting kernels' time as the prepass's, not the main pass's.
   void chunks(const Posture* postures, const std::uint32_t* order, std::size_t count,
-              unsigned long long* culled_count) {
+              unsigned long long* culled_count, bool prepass = false) {
+    const auto stage = [&](const char* main_pass) { return prepass ? "prepass" : main_pass; };
     cudaStream_t st = compute_stream;
     const int tiles = grid.tiles_x * grid.tiles_y;
     for (std::size_t begin = 0; begin < count; begin += refresh_every) {
@@ -679,7 +681,7 @@ struct Engine::Impl {
         const int groups = (chunk + group - 1) / group;
         const dim3 blocks((groups + kWarpsPerBlock - 1) / kWarpsPerBlock,
                           std::clamp(16384 / std::max(1, groups), 1, 1024));
-        timed("group", st, [&] {
+        timed(stage("group"), st, [&] {
           const auto kernel =
               group > 16 ? groupKernel<32> : (group > 8 ? groupKernel<16> : groupKernel<8>);
           kernel<<<blocks, 32 * kWarpsPerBlock, 0, st>>>(
@@ -689,20 +691,20 @@ struct Engine::Impl {
         });
       } else if (options.small_threads) {
         FIELDPATH_CUDA_CHECK(cudaMemsetAsync(queued, 0, sizeof(int), st));
-        timed("small", st, [&] {
+        timed(stage("small"), st, [&] {
           smallKernel<<<(chunk + 127) / 128, 128, 0, st>>>(
               grid, tool, chunk_postures, chunk_order, chunk, tile_max, tile_live, keys,
               culled_count, queue, queued, options.tile_skip, options.live_tiles, stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
-        timed("large", st, [&] {
+        timed(stage("large"), st, [&] {
           largeKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
               grid, tool, chunk_postures, chunk_order, queue, queued, tile_max, tile_live, keys,
               options.tile_skip, options.live_tiles, stats);
           FIELDPATH_CUDA_CHECK(cudaGetLastError());
         });
       } else {
-        timed("warp", st, [&] {
+        timed(stage("warp"), st, [&] {
           warpKernel<<<warps, 32 * kWarpsPerBlock, 0, st>>>(
               grid, tool, chunk_postures, chunk_order, chunk, tile_max, tile_live, keys,
               culled_count, options.tile_skip, options.live_tiles, stats);
@@ -858,11 +860,9 @@ void Engine::cut(const Posture* block, std::size_t count, bool coarse) {
       // the other slot's scratch (same stream; the sort below reuses it after); culls not counted
       const int sparse = static_cast<int>((count + stride - 1) / stride);
       std::uint32_t* sparse_order = m.sort_index[s ^ 1];
-      m.timed("prepass", st, [&] {
-        strideOrderKernel<<<(sparse + 255) / 256, 256, 0, st>>>(sparse_order, sparse, stride);
-        FIELDPATH_CUDA_CHECK(cudaGetLastError());
-        m.chunks(postures, sparse_order, std::size_t(sparse), nullptr);
-      });
+      strideOrderKernel<<<(sparse + 255) / 256, 256, 0, st>>>(sparse_order, sparse, stride);
+      FIELDPATH_CUDA_CHECK(cudaGetLastError());
+      m.chunks(postures, sparse_order, std::size_t(sparse), nullptr, /*prepass=*/true);
     }
     const std::uint32_t* order = nullptr;
     if (m.options.lowest_first) {
