@@ -486,7 +486,8 @@ int copyThreads() {
 }
 void parallelCopy(void* dst, const void* src, std::size_t bytes) {
   const long parts = bytes >= (std::size_t{1} << 20) ? 32 : 1;
-#pragma omp parallel for schedule(dynamic) num_threads(copyThreads()) if (parts > 1)
+  const int threads = copyThreads();
+#pragma omp parallel for schedule(dynamic) num_threads(threads) if (parts > 1)
   for (long k = 0; k < parts; ++k) {
     const std::size_t a = bytes * std::size_t(k) / std::size_t(parts),
                       b = bytes * std::size_t(k + 1) / std::size_t(parts);
