@@ -404,10 +404,7 @@ TEST(Culling, RadialFloorIsBelowEveryVerticalCutAndTight) {
   std::uniform_real_distribution<double> u(-1, 1);
   const GridView g = detail::makeGridView(Grid::fromRegion(-1, -1, 1, 1, 4, 4));
   const auto floorAt = [](const ToolView& v, float x, float y) {
-    const float rho2 = x * x + y * y;
-    if (!(rho2 <= v.radial_max_mm2)) return FLT_MAX;
-    const int b = static_cast<int>(rho2 * v.radial_inv_mm2);
-    return v.radial_floor_mm[std::min(b, v.radial_bins - 1)];
+    return radialFloor(v, x * x + y * y);
   };
   int hits = 0;
   for (const Tool& tool : {Tool::fromMesh(gridBottomTool()),

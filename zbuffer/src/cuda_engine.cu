@@ -224,9 +224,8 @@ __device__ inline float groupFloor(const ToolView& tool, const TipBox& box, floa
   const float dx = fmaxf(fmaxf(box.x_lo - x1, x0 - box.x_hi) - box.pad_mm, 0.f);
   const float dy = fmaxf(fmaxf(box.y_lo - y1, y0 - box.y_hi) - box.pad_mm, 0.f);
   const float rho2 = (dx * dx + dy * dy) * (1.f - 1e-5f);
-  if (!(rho2 <= tool.radial_max_mm2)) return FLT_MAX;
-  const int b = static_cast<int>(rho2 * tool.radial_inv_mm2);
-  return box.z_lo + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1];
+  const float r = radialFloor(tool, rho2);
+  return r == FLT_MAX ? FLT_MAX : box.z_lo + r;
 }
 
 #ifndef FIELDPATH_GROUP_MIN_BLOCKS

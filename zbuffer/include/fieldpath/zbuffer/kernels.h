@@ -441,6 +441,15 @@ FIELDPATH_HD float binnedEntry(const ToolView& tool, const PreparedPosture& pp, 
   return best;
 }
 
+/// The radial floor table (vertical mesh postures) at squared distance rho2_mm2 from the axis: a
+/// tool-frame z below which no down-facing triangle lies; FLT_MAX beyond the tool's reach (or in
+/// an annulus that no triangle meets).
+FIELDPATH_HD float radialFloor(const ToolView& tool, float rho2_mm2) {
+  if (!(rho2_mm2 <= tool.radial_max_mm2)) return FLT_MAX;
+  const int b = static_cast<int>(rho2_mm2 * tool.radial_inv_mm2);
+  return tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1];
+}
+
 /// The floors lineCut applies to the line at (rx, ry) from the tip (mm): `skip`, no height it
 /// gives is below it (FLT_MAX: it cannot reach the line); `clamp`, its heights are raised to it
 /// (the radial floor of a vertical mesh tool, so that a line at that floor is skipped without
@@ -453,12 +462,9 @@ FIELDPATH_HD LineFloors lineFloors(const ToolView& tool, const PreparedPosture& 
                                    float ry) {
   LineFloors f{pp.lowest_z_mm, pp.lowest_z_mm};
   if (pp.vertical && tool.radial_bins > 0) {
-    const float rho2 = rx * rx + ry * ry;
-    if (!(rho2 <= tool.radial_max_mm2)) return {FLT_MAX, FLT_MAX};
-    const int b = static_cast<int>(rho2 * tool.radial_inv_mm2);
-    f.clamp_mm = f.skip_mm =
-        maxf(f.skip_mm,
-             pp.tip_mm.z + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]);
+    const float r = radialFloor(tool, rx * rx + ry * ry);
+    if (r == FLT_MAX) return {FLT_MAX, FLT_MAX};
+    f.clamp_mm = f.skip_mm = maxf(f.skip_mm, pp.tip_mm.z + r);
   } else if (tool.cap_radius_mm > 0.f) {
     f.skip_mm = maxf(f.skip_mm, capsuleLineFloor(tool, pp, rx, ry));
   }
@@ -494,12 +500,8 @@ FIELDPATH_HD float lineFloorNear(const ToolView& tool, const PreparedPosture& pp
                                  float ry, float eps_mm) {
   if (pp.vertical && tool.radial_bins > 0) {
     const float ax = maxf(absf(rx) - eps_mm, 0.f), ay = maxf(absf(ry) - eps_mm, 0.f);
-    const float rho2 = ax * ax + ay * ay;
-    if (!(rho2 <= tool.radial_max_mm2)) return FLT_MAX;
-    const int b = static_cast<int>(rho2 * tool.radial_inv_mm2);
-    return maxf(
-        pp.lowest_z_mm,
-        pp.tip_mm.z + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]);
+    const float r = radialFloor(tool, ax * ax + ay * ay);
+    return r == FLT_MAX ? FLT_MAX : maxf(pp.lowest_z_mm, pp.tip_mm.z + r);
   }
   if (tool.cap_radius_mm > 0.f)
     return maxf(pp.lowest_z_mm, capsuleLineFloor(tool, pp, rx, ry, eps_mm));
@@ -554,11 +556,8 @@ FIELDPATH_HD float rectFloor(const GridView& g, const ToolView& tool, const Prep
   }
   const float rx = (ax <= 0.f && bx >= 0.f) ? 0.f : minf(absf(ax), absf(bx));
   const float ry = (ay <= 0.f && by >= 0.f) ? 0.f : minf(absf(ay), absf(by));
-  const float rho2 = rx * rx + ry * ry;
-  if (!(rho2 <= tool.radial_max_mm2)) return FLT_MAX;
-  const int b = static_cast<int>(rho2 * tool.radial_inv_mm2);
-  return maxf(pp.lowest_z_mm,
-              pp.tip_mm.z + tool.radial_floor_mm[b < tool.radial_bins ? b : tool.radial_bins - 1]);
+  const float r = radialFloor(tool, rx * rx + ry * ry);
+  return r == FLT_MAX ? FLT_MAX : maxf(pp.lowest_z_mm, pp.tip_mm.z + r);
 }
 
 /// A tile maximum as read while other work items may lower it (lowerTileMax): a relaxed atomic
