@@ -100,7 +100,7 @@ struct EngineTuning {
   /// analytic tools).
   bool capsule_floor = true;
   /// CUDA, footprints larger than a thread's, path order: a warp cuts this many consecutive
-  /// postures together (8 or 16), each line's height loaded and stored once for the group, its
+  /// postures together (8, 16 or 32), each line's height loaded and stored once for the group, its
   /// postures tried lowest floor first. 0: a warp per posture.
   int group_postures = 8;
   /// Live tile maxima: a work item that has cut every line of a tile lowers the tile's maximum to
