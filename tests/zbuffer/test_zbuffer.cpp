@@ -546,6 +546,60 @@ TEST(Culling, MissesGridOnlyWhereTheFootprintIsEmpty) {
   EXPECT_GT(near, 100);      // and is conservative near the edge
 }
 
+TEST(Culling, GroupFloorIsBelowEveryPostureFloorOfTheGroup) {
+  // The CUDA group kernel turns a line (or a tile) away for a whole group of vertical postures
+  // with groupFloor: the lowest tip plus the radial floor at the distance from the tips' box. It
+  // must be at or below each posture's own floor (lineFloors, exact offsets) on every line, far
+  // from the origin too.
+  std::mt19937 rng(67);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int compared = 0;
+  for (const Tool& tool : {Tool::fromMesh(analyticToolMesh(Tool::ball(5, 20), 79, 78)),
+                           Tool::fromMesh(analyticToolMesh(Tool::torus(5, 1, 25), 127, 100))}) {
+    const detail::ToolData data = detail::prepareTool(tool);
+    for (double origin : {0.0, 997.0, -1999.5, 123456.0}) {
+      const GridView g = detail::makeGridView(
+          Grid::fromRegion(origin - 8, origin - 8, origin + 8, origin + 8, 80, 80), 3);
+      for (int group = 0; group < 10; ++group) {
+        const double x = origin + 2 * u(rng), y = origin + 2 * u(rng), z = u(rng);
+        std::vector<PreparedPosture> pps;
+        TipBox box{FLT_MAX, -FLT_MAX, FLT_MAX, -FLT_MAX, FLT_MAX, 0.f};
+        for (int k = 0; k < 8; ++k) {  // a path's neighbours: 0.05 mm apart, z drifting
+          const PreparedPosture pp = preparePosture(
+              g, data.view, pose(x + 0.05 * k, y + 0.01 * k * u(rng), z + 0.01 * u(rng), 0, 0, 1));
+          box = {std::min(box.x_lo, pp.tip_mm.x), std::max(box.x_hi, pp.tip_mm.x),
+                 std::min(box.y_lo, pp.tip_mm.y), std::max(box.y_hi, pp.tip_mm.y),
+                 std::min(box.z_lo, pp.tip_mm.z), 0.f};
+          pps.push_back(pp);
+        }
+        box.pad_mm = tipBoxPad(box, data.view);
+        for (int iy = 0; iy < g.ny; iy += 2)
+          for (int ix = 0; ix < g.nx; ix += 2) {
+            const float lx = static_cast<float>(lineX(g, ix)),
+                        ly = static_cast<float>(lineY(g, iy));
+            const float gf = groupFloor(data.view, box, lx, lx, ly, ly);
+            for (const PreparedPosture& pp : pps) {
+              float rx, ry;
+              lineOffset(g, pp, ix, iy, rx, ry);
+              ASSERT_LE(gf, lineFloors(data.view, pp, rx, ry).skip_mm)
+                  << "origin " << origin << " line " << ix << "," << iy;
+              ++compared;
+            }
+            // a tile of lines around it: below every line's floor in it
+            const int x1 = std::min(ix + 7, g.nx - 1), y1 = std::min(iy + 7, g.ny - 1);
+            const float tf = groupFloor(data.view, box, lx, static_cast<float>(lineX(g, x1)), ly,
+                                        static_cast<float>(lineY(g, y1)));
+            float rx, ry;
+            lineOffset(g, pps[3], x1, y1, rx, ry);
+            ASSERT_LE(tf, lineFloors(data.view, pps[3], rx, ry).skip_mm);
+            ASSERT_LE(tf, gf);
+          }
+      }
+    }
+  }
+  EXPECT_GT(compared, 100000);
+}
+
 TEST(Tool, ReachIsTheRadiusThatHoldsTheTool) {
   EXPECT_EQ(toolReach(Tool::torus(3, 1, 12)), 3.0);
   // a revolved mesh's vertices lie on the profile: the largest radius is the tool's

@@ -64,7 +64,8 @@ class CpuEngine final : public BackendEngine {
     if (stride > 1 && !tuning_.lowest_first && block.size() >= 2 * stride)
       // every stride-th posture in path order first (see EngineTuning::prepass_stride); its
       // culls are not counted (the main pass meets the same postures again)
-      pass((block.size() + stride - 1) / stride, [&](std::size_t k) { return block[k * stride]; });
+      (void)pass((block.size() + stride - 1) / stride,
+                 [&](std::size_t k) { return block[k * stride]; });  // culls not counted
     if (tuning_.lowest_first) {
       const std::vector<std::uint32_t> order = lowestFirstOrder(block);
       culled_ += pass(block.size(), [&](std::size_t k) { return block[order[k]]; });

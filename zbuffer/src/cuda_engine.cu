@@ -95,9 +95,20 @@ __device__ inline void lowerTileMax(float* tile_max, int tile, float highest) {
   }
 }
 
-/// The largest of the warp's values, on every lane.
-__device__ inline float warpMax(float v) {
-  for (int o = 16; o > 0; o >>= 1) v = fmaxf(v, __shfl_xor_sync(0xffffffffu, v, o));
+/// The least / largest / sum of the warp's values, on every lane (all 32 lanes must call).
+template <class T>
+__device__ inline T warpMin(T v) {
+  for (int o = 16; o > 0; o >>= 1) v = min(v, __shfl_xor_sync(0xffffffffu, v, o));
+  return v;
+}
+template <class T>
+__device__ inline T warpMax(T v) {
+  for (int o = 16; o > 0; o >>= 1) v = max(v, __shfl_xor_sync(0xffffffffu, v, o));
+  return v;
+}
+template <class T>
+__device__ inline T warpSum(T v) {
+  for (int o = 16; o > 0; o >>= 1) v += __shfl_xor_sync(0xffffffffu, v, o);
   return v;
 }
 
@@ -199,40 +210,20 @@ __global__ void warpKernel(GridView g, ToolView tool, const Posture* postures,
                  keys, stats);
 }
 
-/// Postures a warp cuts together (group kernel): consecutive postures of a path cut nearly the
-/// same lines, so each line's height is loaded once for the group, not once per posture.
+/// Blocks per SM the group kernel is built for: 64 registers a thread, 50 % occupancy (8 rather
+/// than the compiler's 80 registers: 4-5 % on cases 3, 5 and 8 on the H100; bench/results/
+/// zbuffer-h100.md, run 30).
+constexpr int kGroupMinBlocks = 8;
 
-/// One warp per Group (<= 32) consecutive postures: each lane < Group prepares and culls one
-/// posture into shared memory; then the lanes walk the live tiles of the group's union footprint,
-/// and for each line load its height once, apply every posture whose footprint holds the line
-/// (lineCut, running minimum) and store once. A posture's cut does not depend on the current height
-/// it is given, only whether it is returned, so the minimum (every bit) is the CPU's. A scattered
-/// group (union much larger than its footprints: a sorted block, ends of passes) is cut posture by
-/// posture instead.
-/// The box of a group's tips (world xy, mm), its lowest tip z and a pad (far more than the
-/// rounding of any posture's own line radius).
-struct TipBox {
-  float x_lo, x_hi, y_lo, y_hi, z_lo, pad_mm;
-};
-
-/// The group floor (vertical postures, radial floors) over the world rectangle [x0, x1] × [y0, y1]
-/// (mm): the lowest tip plus the radial floor at the rectangle's distance from the tips' box,
-/// shrunk by the pad; FLT_MAX beyond the tool's reach. No posture of the group gives a line there
-/// a height below it.
-__device__ inline float groupFloor(const ToolView& tool, const TipBox& box, float x0, float x1,
-                                   float y0, float y1) {
-  const float dx = fmaxf(fmaxf(box.x_lo - x1, x0 - box.x_hi) - box.pad_mm, 0.f);
-  const float dy = fmaxf(fmaxf(box.y_lo - y1, y0 - box.y_hi) - box.pad_mm, 0.f);
-  const float rho2 = (dx * dx + dy * dy) * (1.f - 1e-5f);
-  const float r = radialFloor(tool, rho2);
-  return r == FLT_MAX ? FLT_MAX : box.z_lo + r;
-}
-
-#ifndef FIELDPATH_GROUP_MIN_BLOCKS
-#define FIELDPATH_GROUP_MIN_BLOCKS 8
-#endif
+/// One warp per Group (<= 32) consecutive postures of a path, which cut nearly the same lines:
+/// each lane < Group prepares and culls one posture into shared memory; then the lanes walk the
+/// live tiles of the group's union footprint, and for each line load its height once, apply every
+/// posture whose footprint holds the line (lineCut, running minimum) and store once. A posture's
+/// cut does not depend on the current height it is given, only whether it is returned, so the
+/// minimum (every bit) is the CPU's. A scattered group (union much larger than its footprints: a
+/// sorted block, ends of passes) is cut posture by posture instead.
 template <int Group>
-__global__ void __launch_bounds__(32 * kWarpsPerBlock, FIELDPATH_GROUP_MIN_BLOCKS)
+__global__ void __launch_bounds__(32 * kWarpsPerBlock, kGroupMinBlocks)
     groupKernel(GridView g, ToolView tool, const Posture* postures, const std::uint32_t* order,
                 int count, const float* tile_max, float* tile_live, std::int32_t* keys,
                 unsigned long long* culled, bool skip, bool live_tiles, unsigned long long* stats) {
@@ -261,13 +252,8 @@ __global__ void __launch_bounds__(32 * kWarpsPerBlock, FIELDPATH_GROUP_MIN_BLOCK
   }
   const unsigned live_mask = __ballot_sync(0xffffffffu, live);
   if (!live_mask) return;
-  for (int o = 16; o > 0; o >>= 1) {
-    ix0 = min(ix0, __shfl_xor_sync(0xffffffffu, ix0, o));
-    iy0 = min(iy0, __shfl_xor_sync(0xffffffffu, iy0, o));
-    ix1 = max(ix1, __shfl_xor_sync(0xffffffffu, ix1, o));
-    iy1 = max(iy1, __shfl_xor_sync(0xffffffffu, iy1, o));
-    area += __shfl_xor_sync(0xffffffffu, area, o);
-  }
+  ix0 = warpMin(ix0), iy0 = warpMin(iy0), ix1 = warpMax(ix1), iy1 = warpMax(iy1);
+  area = warpSum(area);
   // A floor for the whole group on a line, where every live posture is vertical and the tool has
   // radial floors: the lowest tip plus the radial floor at the line's distance from the box of
   // the tips (shrunk by far more than the rounding of each posture's own line radius). No
@@ -281,22 +267,11 @@ __global__ void __launch_bounds__(32 * kWarpsPerBlock, FIELDPATH_GROUP_MIN_BLOCK
     tz_lo = pp.tip_mm.z;
     all_vertical = pp.vertical;
   }
-  for (int o = 16; o > 0; o >>= 1) {
-    tx_lo = fminf(tx_lo, __shfl_xor_sync(0xffffffffu, tx_lo, o));
-    tx_hi = fmaxf(tx_hi, __shfl_xor_sync(0xffffffffu, tx_hi, o));
-    ty_lo = fminf(ty_lo, __shfl_xor_sync(0xffffffffu, ty_lo, o));
-    ty_hi = fmaxf(ty_hi, __shfl_xor_sync(0xffffffffu, ty_hi, o));
-    tz_lo = fminf(tz_lo, __shfl_xor_sync(0xffffffffu, tz_lo, o));
-  }
+  tx_lo = warpMin(tx_lo), tx_hi = warpMax(tx_hi), ty_lo = warpMin(ty_lo), ty_hi = warpMax(ty_hi);
+  tz_lo = warpMin(tz_lo);
   const bool group_floor = __all_sync(0xffffffffu, all_vertical) && tool.radial_bins > 0;
-  const TipBox box{
-      tx_lo,
-      tx_hi,
-      ty_lo,
-      ty_hi,
-      tz_lo,
-      1e-5f * (fabsf(tx_lo) + fabsf(tx_hi) + fabsf(ty_lo) + fabsf(ty_hi) + tool.hull_radius_mm) +
-          1e-6f};
+  TipBox box{tx_lo, tx_hi, ty_lo, ty_hi, tz_lo, 0.f};
+  box.pad_mm = tipBoxPad(box, tool);
   __syncwarp();
   unsigned visited = 0, lowered = 0, reached = 0, exact = 0, tiles_cut = 0, tiles_skipped = 0;
   const long long union_area = (long long)(ix1 - ix0 + 1) * (iy1 - iy0 + 1);
@@ -334,8 +309,7 @@ __global__ void __launch_bounds__(32 * kWarpsPerBlock, FIELDPATH_GROUP_MIN_BLOCK
           const int b0 = max(ry0, pp.iy0), b1 = min(ry1, pp.iy1);
           if (a0 <= a1 && b0 <= b1) floor = rectFloor(g, tool, pp, a0, a1, b0, b1);
         }
-        for (int o = 16; o > 0; o >>= 1)
-          floor = fminf(floor, __shfl_xor_sync(0xffffffffu, floor, o));
+        floor = warpMin(floor);
         if (tile_top <= floor) {  // one lane's read for all: the lanes take the same tiles
           ++tiles_skipped;
           continue;
@@ -379,7 +353,7 @@ __global__ void __launch_bounds__(32 * kWarpsPerBlock, FIELDPATH_GROUP_MIN_BLOCK
           floors[warp][k][lane] = f;
           if (f < lowest) lowest = f, first_k = k;
         }
-        if (best > lowest) {
+        if (first_k >= 0 && best > lowest) {  // (none: every floor FLT_MAX, best +inf)
           for (unsigned mask = live_mask & ~(1u << first_k), k = first_k;;) {
             if (best > floors[warp][k][lane]) {  // then the exact offsets and floors
               const PreparedPosture& pp = group[warp][k];

@@ -19,8 +19,9 @@ std::vector<T> reserveHuge(std::size_t n) {
   v.reserve(n);
 #ifdef MADV_HUGEPAGE
   constexpr std::uintptr_t kHuge = std::uintptr_t{2} << 20;
-  const auto begin = (reinterpret_cast<std::uintptr_t>(v.data()) + kHuge - 1) & ~(kHuge - 1);
-  const auto end = reinterpret_cast<std::uintptr_t>(v.data() + n) & ~(kHuge - 1);
+  const auto data = reinterpret_cast<std::uintptr_t>(v.data());  // reserved, not yet sized
+  const auto begin = (data + kHuge - 1) & ~(kHuge - 1);
+  const auto end = (data + n * sizeof(T)) & ~(kHuge - 1);
   if (n * sizeof(T) >= 4 * kHuge && end > begin)
     madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
 #endif

@@ -442,8 +442,10 @@ FIELDPATH_HD float binnedEntry(const ToolView& tool, const PreparedPosture& pp, 
 }
 
 /// The radial floor table (vertical mesh postures) at squared distance rho2_mm2 from the axis: a
-/// tool-frame z below which no down-facing triangle lies; FLT_MAX beyond the tool's reach (or in
-/// an annulus that no triangle meets).
+/// tool-frame z below which no down-facing triangle lies; FLT_MAX beyond the outermost triangle.
+/// The table is non-decreasing in the radius (each floor lowered to the least beyond it), so the
+/// floor at a smaller radius bounds every larger one: lineFloorNear, rectFloor and groupFloor
+/// rely on it.
 FIELDPATH_HD float radialFloor(const ToolView& tool, float rho2_mm2) {
   if (!(rho2_mm2 <= tool.radial_max_mm2)) return FLT_MAX;
   const int b = static_cast<int>(rho2_mm2 * tool.radial_inv_mm2);
@@ -506,6 +508,31 @@ FIELDPATH_HD float lineFloorNear(const ToolView& tool, const PreparedPosture& pp
   if (tool.cap_radius_mm > 0.f)
     return maxf(pp.lowest_z_mm, capsuleLineFloor(tool, pp, rx, ry, eps_mm));
   return pp.lowest_z_mm;
+}
+
+/// The box of a group of vertical postures' tips (world xy, mm), its lowest tip z and a pad (far
+/// more than the rounding of any posture's own line radius).
+struct TipBox {
+  float x_lo, x_hi, y_lo, y_hi, z_lo, pad_mm;
+};
+
+/// The box's pad for `tool`: relative to the coordinates' size, far above float rounding.
+FIELDPATH_HD float tipBoxPad(const TipBox& b, const ToolView& tool) {
+  return 1e-5f * (absf(b.x_lo) + absf(b.x_hi) + absf(b.y_lo) + absf(b.y_hi) + tool.hull_radius_mm) +
+         1e-6f;
+}
+
+/// The group floor (vertical postures, radial floors) over the world rectangle [x0, x1] × [y0, y1]
+/// (mm): the lowest tip plus the radial floor at the rectangle's distance from the tips' box,
+/// shrunk by the pad; FLT_MAX beyond the tool's reach. No posture of the group gives a line there
+/// a height below it (the CUDA group kernel turns lines and tiles away with it).
+FIELDPATH_HD float groupFloor(const ToolView& tool, const TipBox& box, float x0, float x1, float y0,
+                              float y1) {
+  const float dx = maxf(maxf(box.x_lo - x1, x0 - box.x_hi) - box.pad_mm, 0.f);
+  const float dy = maxf(maxf(box.y_lo - y1, y0 - box.y_hi) - box.pad_mm, 0.f);
+  const float rho2 = (dx * dx + dy * dy) * (1.f - 1e-5f);
+  const float r = radialFloor(tool, rho2);
+  return r == FLT_MAX ? FLT_MAX : box.z_lo + r;
 }
 
 /// The height the posture would give the line at (rx, ry) from the tip (mm) whose floors are
@@ -653,9 +680,9 @@ FIELDPATH_HD bool missesGrid(const GridView& g, const ToolView& tool, Posture po
 
 /// Sort key of a posture for lowest-first processing: its lowest point over the grid (the floor of
 /// its footprint's lines) as an unsigned key that orders like the float (postures that miss the
-/// grid last). Processing a block lowest first
-/// makes the first cut of a line nearly its final one, so later (higher) postures are culled by
-/// the tile maxima or skipped per line at one compare; the minimum, hence every bit, is the same.
+/// grid last). Processing a block lowest first makes the first cut of a line nearly its final
+/// one, so later (higher) postures are culled by the tile maxima or skipped per line at one
+/// compare; the minimum, hence every bit, is the same.
 FIELDPATH_HD std::uint32_t lowestKey(const GridView& g, const ToolView& tool, Posture pose) {
   if (missesGrid(g, tool, pose)) return 0xffffffffu;
   const PreparedPosture pp = preparePosture(g, tool, pose);
