@@ -600,6 +600,34 @@ TEST(Culling, GroupFloorIsBelowEveryPostureFloorOfTheGroup) {
   EXPECT_GT(compared, 100000);
 }
 
+TEST(Culling, WholeTileMeansEveryLineOfTheTile) {
+  // A tile's maximum is lowered only by a work item that cut all of its lines (wholeTile): the
+  // interior tiles' full rectangles, the edge tiles clipped by the grid (nx, ny not multiples of
+  // the tile), and nothing less.
+  const GridView g = detail::makeGridView(Grid::fromRegion(0, 0, 1, 1, 21, 13), 3);  // 8 × 8 tiles
+  EXPECT_TRUE(wholeTile(g, 0, 7, 0, 7));
+  EXPECT_TRUE(wholeTile(g, 8, 15, 8, 12));   // last row of tiles: lines 8..12 only
+  EXPECT_TRUE(wholeTile(g, 16, 20, 0, 7));   // last column: lines 16..20
+  EXPECT_TRUE(wholeTile(g, 16, 20, 8, 12));  // the corner
+  EXPECT_FALSE(wholeTile(g, 0, 6, 0, 7));    // a line short
+  EXPECT_FALSE(wholeTile(g, 1, 7, 0, 7));
+  EXPECT_FALSE(wholeTile(g, 0, 7, 0, 6));
+  EXPECT_FALSE(wholeTile(g, 16, 19, 8, 12));
+  EXPECT_FALSE(wholeTile(g, 8, 15, 8, 11));
+  // every rectangle of lines inside one tile: whole exactly when it holds all the tile's lines
+  for (int tx = 0; tx < g.tiles_x; ++tx)
+    for (int ty = 0; ty < g.tiles_y; ++ty) {
+      const int x0 = tx * 8, x1 = std::min(x0 + 7, g.nx - 1), y0 = ty * 8,
+                y1 = std::min(y0 + 7, g.ny - 1);
+      for (int a = x0; a <= x1; ++a)
+        for (int b = a; b <= x1; ++b)
+          for (int c = y0; c <= y1; ++c)
+            for (int d = c; d <= y1; ++d)
+              ASSERT_EQ(wholeTile(g, a, b, c, d), a == x0 && b == x1 && c == y0 && d == y1)
+                  << a << "-" << b << " × " << c << "-" << d;
+    }
+}
+
 TEST(Tool, ReachIsTheRadiusThatHoldsTheTool) {
   EXPECT_EQ(toolReach(Tool::torus(3, 1, 12)), 3.0);
   // a revolved mesh's vertices lie on the profile: the largest radius is the tool's
