@@ -18,10 +18,6 @@ inline void atomicLower(float& slot, float value) {
   }
 }
 
-inline float loadRelaxed(float& slot) {
-  return std::atomic_ref<float>(slot).load(std::memory_order_relaxed);
-}
-
 class CpuEngine final : public BackendEngine {
  public:
   explicit CpuEngine(const EngineSetup& setup)
@@ -135,15 +131,10 @@ class CpuEngine final : public BackendEngine {
       const auto top = [&](int tile) { return readTileMax(tiles, tile); };
       forEachLiveTile(
           g, tool, pp, skip, 0, 1, top, [&](int ix0, int ix1, int iy0, int iy1, int tile) {
-            float highest = -FLT_MAX;  // the lines' heights after this posture (or lower)
-            for (int iy = iy0; iy <= iy1; ++iy)
-              for (int ix = ix0; ix <= ix1; ++ix) {
-                float& slot = h[std::size_t(iy) * g.nx + ix];
-                const float current = loadRelaxed(slot);
-                const float z = lineCut(g, tool, pp, ix, iy, current);
-                if (z != FLT_MAX) atomicLower(slot, z);
-                highest = std::max(highest, z != FLT_MAX ? z : current);
-              }
+            const float highest = cutRect(
+                g, tool, pp, ix0, ix1, iy0, iy1, 0, 1,
+                [&](int ix, int iy) { return loadRelaxed(&h[std::size_t(iy) * g.nx + ix]); },
+                [&](int ix, int iy, float z) { atomicLower(h[std::size_t(iy) * g.nx + ix], z); });
             if (live && wholeTile(g, ix0, ix1, iy0, iy1)) atomicLower(tiles[tile], highest);
           });
     }

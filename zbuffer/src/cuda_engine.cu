@@ -129,25 +129,27 @@ __device__ inline void cutLines(const GridView& g, const ToolView& tool, const P
   };
   forEachLiveTile(g, tool, pp, skip, tile_first, tile_step, top,
                   [&](int ix0, int ix1, int iy0, int iy1, int tile) {
-                    const int w = ix1 - ix0 + 1, lines = w * (iy1 - iy0 + 1);
-                    float highest = -FLT_MAX;
-                    for (int l = first; l < lines; l += step) {
-                      const int ix = ix0 + l % w, iy = iy0 + l / w;
-                      std::int32_t* slot = keys + std::size_t(iy) * g.nx + ix;
-                      const float current = keyToFloat(*slot);
-                      const float z = lineCut(g, tool, pp, ix, iy, current);
-                      ++visited;
-                      if (z != FLT_MAX) ++lowered, atomicMin(slot, floatToKey(z));
-                      highest = fmaxf(highest, z != FLT_MAX ? z : current);
-                    }
+                    float highest = cutRect(
+                        g, tool, pp, ix0, ix1, iy0, iy1, first, step,
+                        [&](int ix, int iy) {
+                          ++visited;
+                          return keyToFloat(keys[std::size_t(iy) * g.nx + ix]);
+                        },
+                        [&](int ix, int iy, float z) {
+                          ++lowered;
+                          atomicMin(keys + std::size_t(iy) * g.nx + ix, floatToKey(z));
+                        });
                     if (live && wholeTile(g, ix0, ix1, iy0, iy1)) {
                       if (Warp) highest = warpMax(highest);
                       if (!Warp || first == 0) lowerTileMax(tile_live, tile, highest);
                     }
                   });
-  if (stats) {
-    atomicAdd(stats, static_cast<unsigned long long>(visited));
-    atomicAdd(stats + 1, static_cast<unsigned long long>(lowered));
+  if (stats) {  // a warp's counts in one atomic each
+    if (Warp) visited = warpSum(visited), lowered = warpSum(lowered);
+    if (!Warp || first == 0) {
+      atomicAdd(stats, static_cast<unsigned long long>(visited));
+      atomicAdd(stats + 1, static_cast<unsigned long long>(lowered));
+    }
   }
 }
 

@@ -587,17 +587,20 @@ FIELDPATH_HD float rectFloor(const GridView& g, const ToolView& tool, const Prep
   return r == FLT_MAX ? FLT_MAX : maxf(pp.lowest_z_mm, pp.tip_mm.z + r);
 }
 
-/// A tile maximum as read while other work items may lower it (lowerTileMax): a relaxed atomic
-/// load on the CPU, a plain load on the GPU. Any value read bounds the tile's heights from then on:
-/// heights only decrease.
-FIELDPATH_HD float readTileMax(const float* tile_max, int tile) {
+/// A height or tile maximum as read while other work items may lower it: a relaxed atomic load on
+/// the CPU, a plain load on the GPU (the CUDA backend keeps heights as ordered keys and reads them
+/// itself). Any value read bounds the line or tile from then on: heights only decrease.
+FIELDPATH_HD float loadRelaxed(const float* slot) {
 #ifdef __CUDA_ARCH__
-  return tile_max[tile];
+  return *slot;
 #else
   float v;
-  __atomic_load(tile_max + tile, &v, __ATOMIC_RELAXED);
+  __atomic_load(slot, &v, __ATOMIC_RELAXED);
   return v;
 #endif
+}
+FIELDPATH_HD float readTileMax(const float* tile_max, int tile) {
+  return loadRelaxed(tile_max + tile);
 }
 
 /// True if lines [ix0, ix1] × [iy0, iy1] are all the lines of their tile (clipped to the grid):
@@ -634,6 +637,32 @@ FIELDPATH_HD void forEachLiveTile(const GridView& g, const ToolView& tool,
     if (skip && top(tile) <= rectFloor(g, tool, pp, ix0, ix1, iy0, iy1)) continue;
     visit(ix0, ix1, iy0, iy1, tile);
   }
+}
+
+/// Cuts lines first, first + step, ... of the rectangle [ix0, ix1] × [iy0, iy1] (row by row) with
+/// lineCut: height(ix, iy) reads a line's current height, lower(ix, iy, z) lowers it to z. Returns
+/// the highest height the visited lines are left at or under (a bound for the tile when they are
+/// all of its lines: wholeTile). The per-rectangle loop of the CPU engine (0, 1) and of the CUDA
+/// threads and warps (lane, 32).
+template <class Height, class Lower>
+FIELDPATH_HD float cutRect(const GridView& g, const ToolView& tool, const PreparedPosture& pp,
+                           int ix0, int ix1, int iy0, int iy1, int first, int step, Height height,
+                           Lower lower) {
+  float highest = -FLT_MAX;
+  const auto cut = [&](int ix, int iy) {
+    const float current = height(ix, iy);
+    const float z = lineCut(g, tool, pp, ix, iy, current);
+    if (z != FLT_MAX) lower(ix, iy, z);
+    highest = maxf(highest, z != FLT_MAX ? z : current);
+  };
+  if (first == 0 && step == 1) {  // one work item takes every line: no division per line
+    for (int iy = iy0; iy <= iy1; ++iy)
+      for (int ix = ix0; ix <= ix1; ++ix) cut(ix, iy);
+  } else {
+    const int w = ix1 - ix0 + 1, lines = w * (iy1 - iy0 + 1);
+    for (int l = first; l < lines; l += step) cut(ix0 + l % w, iy0 + l / w);
+  }
+  return highest;
 }
 
 /// True if the posture cannot lower any line: its lowest point is not below the highest height of
