@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <random>
 
 #ifdef FIELDPATH_TEST_ZLIB
@@ -538,6 +539,30 @@ TEST(Culling, MissesGridOnlyWhereTheFootprintIsEmpty) {
       if (miss)
         ASSERT_TRUE(empty) << "tool " << int(tool.kind) << " tip " << p.tip_mm.x << ","
                            << p.tip_mm.y;
+      // and, independently of the footprint code, no point of the placed tool's cylinder
+      // (radius R about the axis, z from 0 to L: it holds the solid) is over the lines' box
+      if (miss && tool.kind != ToolKind::Mesh) {
+        const double ax = p.axis.x, ay = p.axis.y, az = p.axis.z;
+        const double n = std::sqrt(ax * ax + ay * ay + az * az);
+        const double a[3] = {ax / n, ay / n, az / n};
+        const double e[3] = {std::abs(a[0]) < 0.9 ? 1.0 : 0.0, std::abs(a[0]) < 0.9 ? 0.0 : 1.0, 0};
+        double b1[3] = {a[1] * e[2] - a[2] * e[1], a[2] * e[0] - a[0] * e[2],
+                        a[0] * e[1] - a[1] * e[0]};
+        const double m = std::sqrt(b1[0] * b1[0] + b1[1] * b1[1] + b1[2] * b1[2]);
+        for (double& c : b1) c /= m;
+        const double b2[3] = {a[1] * b1[2] - a[2] * b1[1], a[2] * b1[0] - a[0] * b1[2],
+                              a[0] * b1[1] - a[1] * b1[0]};
+        const double x0 = 100 + 0.5 * g.dx_mm, x1 = 100.3 - 0.5 * g.dx_mm;
+        for (int s = 0; s <= 8; ++s)
+          for (int c = 0; c < 32; ++c) {
+            const double z = tool.length_mm * s / 8, th = 2 * std::numbers::pi * c / 32;
+            const double r = tool.radius_mm, ct = r * std::cos(th), st = r * std::sin(th);
+            const double px = p.tip_mm.x + z * a[0] + ct * b1[0] + st * b2[0];
+            const double py = p.tip_mm.y + z * a[1] + ct * b1[1] + st * b2[1];
+            ASSERT_FALSE(px >= x0 && px <= x1 && py >= x0 && py <= x1)
+                << "tool " << int(tool.kind) << " point " << px << "," << py << " over the lines";
+          }
+      }
       misses += miss;
       near += !miss && empty;
     }
