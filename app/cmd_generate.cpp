@@ -1,5 +1,7 @@
-/// `fieldpath generate SCENE [--direct | --voxel H] [--nominal] --out DIR`: the impeller path
-/// (path.cl, path.apt, angles.csv, report.json), written only once the whole job has succeeded.
+/// `fieldpath generate SCENE [--direct | --voxel H] [--nominal] --out DIR`: the path of a scene,
+/// passes joined by links (path.cl, path.apt, angles.csv, report.json), written only once the
+/// whole job has succeeded.
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -12,7 +14,7 @@
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/units.h"
-#include "impeller_job.h"
+#include "job.h"
 #include "progress.h"
 #include "scene.h"
 
@@ -36,10 +38,11 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       colliding += g.clearance_mm <= 0.0;
     }
     passes.push_back({{"pass", pass.index + 1},
-                      {"v", pass.v},
+                      {"source", pass.label},
+                      {"v", jsonNumber(pass.v)},
                       {"length_mm", pass.length_mm},
                       {"postures", postures},
-                      {"min_clearance_mm", min_clearance},
+                      {"min_clearance_mm", jsonNumber(min_clearance)},
                       {"max_tilt_deg", max_tilt},
                       {"colliding_postures", colliding}});
   }
@@ -51,7 +54,8 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
                             ? json(job.field.voxel.voxel_size_mm)
                             : json(nullptr)},
       {"nominal", job.nominal},
-      {"postures", r.postures.size()},
+      {"postures", r.path.postures.size()},
+      {"pass_postures", r.postures.size()},
       {"passes", r.passes.size()},
       {"path_length_mm", r.path_length_mm},
       {"times_s",
@@ -70,7 +74,28 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
        {{"min", {box.min().x(), box.min().y(), box.min().z()}},
         {"max", {box.max().x(), box.max().y(), box.max().z()}},
         {"volume_cm3", box.volume() / 1000.0}}},
-      {"clearance", clearanceJson(r.clearance, job.clearance_mm)},
+      {"clearance", clearanceJson(r.clearance, job.clearance_mm, pathgen::kClearanceMeshTolMm)},
+      {"motions", motionsJson(r.motions, job.clearance_mm, pathgen::MotionRequest{}.resolution_mm)},
+      {"links",
+       {{"links", r.path.count(geometry::PathBlock::Kind::Link)},
+        {"link_postures", r.link_postures},
+        {"retract_mm", job.links.retract_mm},
+        {"safe_z_mm", r.safe_z_mm},
+        {"safe_z", job.links.safe_z_mm ? "given" : "auto: highest mesh point + clearance + 2 mm"},
+        {"max_turn_deg", pathgen::kMaxLinkTurnDeg}}},
+      {"limits",
+       {{"on_limit",
+         job.dynamics.on_limit == dynamics::LimitPolicy::Clamp ? "clamp" : "fail"},
+        {"max_tilt_deg", job.dynamics.max_tilt_deg},
+        {"max_lead_deg", job.dynamics.max_lead_deg},
+        {"limited_postures", r.limited_postures},
+        {"limited_colliding", r.limited_colliding},
+        {"first_limited",
+         r.first_limited == pathgen::ClearanceResult::npos
+             ? json(nullptr)
+             : json({{"posture", r.postures[r.first_limited].output},
+                     {"pass", r.postures[r.first_limited].pass + 1},
+                     {"s_mm", r.postures[r.first_limited].s_mm}})}}},
       {"max_tilt_deg", r.max_tilt_deg},
       {"max_lead_deg", r.max_lead_deg},
       {"solver",
@@ -83,13 +108,15 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
   };
 }
 
+/// One row per pass posture; `posture` is its index in path.cl (links are not rows).
 std::string anglesCsv(const pathgen::GenerateResult& r) {
   std::ostringstream csv;
-  csv << "s_mm,pass,lead_deg,tilt_deg,moment,nearest_mm\n";
+  csv << "s_mm,pass,lead_deg,tilt_deg,moment,nearest_mm,posture,limited\n";
   csv.precision(9);
   for (const auto& g : r.postures)
     csv << g.s_mm << ',' << g.pass + 1 << ',' << g.lead_rad * kRadToDeg << ','
-        << g.tilt_rad * kRadToDeg << ',' << g.moment << ',' << g.clearance_mm << '\n';
+        << g.tilt_rad * kRadToDeg << ',' << g.moment << ',' << g.clearance_mm << ',' << g.output
+        << ',' << (g.limited ? 1 : 0) << '\n';
   return csv.str();
 }
 
@@ -98,10 +125,10 @@ std::string anglesCsv(const pathgen::GenerateResult& r) {
 void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
   auto* cmd = app.add_subcommand(
       "generate",
-      "Generate the impeller path of a scene: isoparametric passes on the hub, tool axis "
-      "steered by the repulsive field (CVODE), exact clearance (FCL). Writes path.cl, path.apt, "
-      "angles.csv, "
-      "report.json");
+      "Generate the path of a scene: passes from its nominal path (path.nominal) or the "
+      "parametric impeller's hub, tool axis steered by the repulsive field (CVODE), passes "
+      "joined by links, every posture and motion checked (FCL). Writes path.cl, path.apt, "
+      "angles.csv, report.json");
   struct Options {
     std::string scene, out;
     bool direct = false, nominal = false;
@@ -120,37 +147,41 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--out", options->out, "Output folder")->required();
   cmd->callback([options, &global] {
     const Scene scene = loadScene(options->scene);
-    pathgen::GenerateRequest job = impellerJob(scene);
+    pathgen::GenerateRequest job = sceneJob(scene);
     job.mode = options->direct ? pathgen::FieldMode::Direct : pathgen::FieldMode::Voxel;
     // 0: not given (positiveFinite rejects anything else that is not > 0).
     if (options->voxel_mm != 0.0) job.field.voxel.voxel_size_mm = options->voxel_mm;
     job.nominal = options->nominal;
     job.progress = makeProgressLine(global.quiet);
-    const pathgen::GenerateResult result = pathgen::generateImpellerPath(job);
+    const pathgen::GenerateResult result = pathgen::generatePath(job);
 
     // Every output is computed; now write them (each atomically).
     const std::filesystem::path out = options->out;
-    std::vector<geometry::Posture> postures;
-    for (const auto& g : result.postures) postures.push_back(g.posture);
     const std::string what = job.nominal ? "nominal path" : "field path";
-    geometry::writeClFile(out / "path.cl", postures,
+    geometry::writeClFile(out / "path.cl", result.path,
                           "fieldpath generate " + scene.file.string() + " (" + what +
-                              "): x y z i j k, tool tip and axis, mm");
+                              "): x y z i j k, tool tip and axis, mm\n"
+                              "`# pass K` blocks are cut at the feed, `# link` blocks are rapid "
+                              "moves between them; `# limit`: an angle limit held there");
     geometry::AptHeader header;
-    header.part_name = "IMPELLER";
+    header.part_name = scene.file.stem().string();
+    for (char& c : header.part_name) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
     header.tool = job.tool;
     header.feed_mm_per_min = job.dynamics.feed_mm_per_min;
-    geometry::writeAptFile(out / "path.apt", postures, header);
+    geometry::writeAptFile(out / "path.apt", result.path, header);
     common::writeTextAtomically(out / "angles.csv", anglesCsv(result));
     common::writeTextAtomically(out / "report.json", reportJson(scene, job, result).dump(2) + "\n");
 
     const auto& c = result.clearance;
+    const auto& m = result.motions;
     std::printf(
-        "%s: %zu postures on %zu passes, %.1f mm; max tilt %.2f deg, max lead %.2f deg; min "
-        "clearance %.3f mm (required %.3f), %zu colliding postures; %.2f s -> %s\n",
+        "%s: %zu postures on %zu passes (%.1f mm) + %zu link postures; max tilt %.2f deg, max "
+        "lead %.2f deg, %zu postures held at a limit; min clearance %.3f mm (required %.3f), "
+        "%zu colliding postures, %zu colliding motions (of %zu, min >= %.3f mm); %.2f s -> %s\n",
         what.c_str(), result.postures.size(), result.passes.size(), result.path_length_mm,
-        result.max_tilt_deg, result.max_lead_deg, c.min_clearance_mm, job.clearance_mm, c.colliding,
-        result.times.total_s, out.string().c_str());
+        result.link_postures, result.max_tilt_deg, result.max_lead_deg, result.limited_postures,
+        c.min_clearance_mm, job.clearance_mm, c.colliding, m.colliding, m.motions,
+        m.min_clearance_mm, result.times.total_s, out.string().c_str());
   });
 }
 

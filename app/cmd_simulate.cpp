@@ -109,7 +109,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--tool", o->tool,
                   "Mesh file (tip at origin, axis +z) or ball:R[:L] | torus:R:r[:L] | flat:R[:L]")
       ->required();
-  cmd->add_option("--path", o->path, "Path file (.cl: x y z i j k per line)")->required();
+  cmd->add_option("--path", o->path, "Path file: .cl (x y z i j k per line), APT (.apt/.cls) or .npy (N×6/7 float32/64)")->required();
   cmd->add_option("--grid", o->grid, "Lines NXxNY")->capture_default_str();
   cmd->add_option("--region", o->region,
                   "x0,y0,x1,y1 mm (default: the tips' XY range plus the tool radius)");
@@ -127,7 +127,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
 
     const auto [nx, ny] = parseGrid(o->grid);
     req.tool = parseTool(o->tool);
-    const std::vector<geometry::Posture> path = geometry::readClFile(o->path);
+    const std::vector<geometry::Posture> path = geometry::readPathFile(o->path).postures;
     const std::vector<zb::Posture> postures = toZbuffer(path);
     double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX, ztop = -DBL_MAX;
     for (const auto& p : path) {

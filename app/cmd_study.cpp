@@ -9,7 +9,7 @@
 
 #include "commands.h"
 #include "errors.h"
-#include "impeller_job.h"
+#include "job.h"
 #include "progress.h"
 #include "scene.h"
 #include "study.h"
@@ -43,7 +43,13 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
   request.brute_force = !o.no_brute_force;
   request.line_step_mm = o.line_step_mm;
   request.repeats = o.repeats;
-  request.job = impellerJob(loadScene(o.scene));
+  const Scene scene = loadScene(o.scene);
+  if (!scene.impeller_model || !scene.guide_impeller)
+    throw InputError(scene.file.string() +
+                     ": guide: study runs on the parametric impeller (`guide: { impeller: hub }` "
+                     "with `- impeller:` among the obstacles): its lines a and b cross its channel");
+  request.job = sceneJob(scene);
+  request.impeller = scene.impeller_model->params();
   if (o.sample_step_mm > 0.0) request.job.field.sample_step_mm = o.sample_step_mm;
   request.progress = makeProgressLine(global.quiet);
   const StudyResult result = runStudy(request);

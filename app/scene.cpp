@@ -120,7 +120,7 @@ class Reader {
 struct MeshLoad {
   YAML::Node node;
   std::string key;
-  bool guide;
+  bool part;
 };
 
 void readObstacles(const Reader& r, const YAML::Node& node, Scene& scene,
@@ -142,16 +142,11 @@ void readObstacles(const Reader& r, const YAML::Node& node, Scene& scene,
   }
 }
 
-void readGuide(const Reader& r, const YAML::Node& node, Scene& scene,
-               std::vector<MeshLoad>& loads) {
-  r.expectMap(node, "guide", {"mesh", "impeller"});
-  if (node.size() != 1) r.fail(node, "guide", "expected exactly one of mesh, impeller");
-  if (node["mesh"]) {
-    scene.guide_file = r.path(node["mesh"], "guide.mesh");
-    loads.push_back({node["mesh"], "guide.mesh", true});
-  } else {
-    scene.guide_impeller = node["impeller"];
-  }
+/// `guide: { impeller: hub }`: the parametric impeller's hub as the part.
+void readGuide(const Reader& r, const YAML::Node& node, Scene& scene) {
+  r.expectMap(node, "guide", {"impeller"});
+  if (!node["impeller"]) r.fail(node, "guide", "expected `{ impeller: hub }`");
+  scene.guide_impeller = node["impeller"];
 }
 
 void readTool(const Reader& r, const YAML::Node& node, geometry::ToolSpec& tool) {
@@ -228,7 +223,7 @@ void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
 void readDynamics(const Reader& r, const YAML::Node& node, dynamics::DynamicsParams& d) {
   r.expectMap(node, "dynamics",
               {"inertia", "damping", "stiffness", "feed", "rtol", "atol", "max_tilt_deg",
-               "max_lead_deg", "integrator"});
+               "max_lead_deg", "on_limit", "integrator"});
   if (node["inertia"]) d.inertia = r.positive(node["inertia"], "dynamics.inertia");
   if (node["damping"]) {
     if (node["damping"].IsScalar() && node["damping"].Scalar() == "critical")
@@ -249,6 +244,10 @@ void readDynamics(const Reader& r, const YAML::Node& node, dynamics::DynamicsPar
   };
   if (node["max_tilt_deg"]) d.max_tilt_deg = angle("max_tilt_deg");
   if (node["max_lead_deg"]) d.max_lead_deg = angle("max_lead_deg");
+  if (node["on_limit"])
+    d.on_limit = r.word(node["on_limit"], "dynamics.on_limit", {"clamp", "fail"}) == "clamp"
+                     ? dynamics::LimitPolicy::Clamp
+                     : dynamics::LimitPolicy::Fail;
   if (node["integrator"])
     d.integrator = r.word(node["integrator"], "dynamics.integrator", {"bdf", "erk"}) == "bdf"
                        ? dynamics::Integrator::Bdf
@@ -256,18 +255,38 @@ void readDynamics(const Reader& r, const YAML::Node& node, dynamics::DynamicsPar
 }
 
 void readPath(const Reader& r, const YAML::Node& node, pathgen::PathParams& p) {
-  r.expectMap(node, "path", {"passes", "step", "lead_deg"});
+  r.expectMap(node, "path", {"nominal", "passes", "step", "lead_deg", "pass_gap"});
   if (node["passes"]) {
     const double passes = r.number(
         node["passes"], "path.passes",
         [](double v) { return v >= 1.0 && v == std::floor(v) && v <= 1e6; }, "a whole number >= 1");
     p.passes = static_cast<int>(passes);
   }
-  if (node["step"]) p.step_mm = r.positive(node["step"], "path.step");
+  if (node["step"]) {
+    p.step_mm = r.positive(node["step"], "path.step");
+    p.step_given = true;
+  }
   if (node["lead_deg"])
     p.lead_deg = r.number(
         node["lead_deg"], "path.lead_deg", [](double v) { return std::abs(v) < 90.0; },
         "in (-90, 90)");
+  if (node["pass_gap"]) p.pass_gap_mm = r.positive(node["pass_gap"], "path.pass_gap");
+}
+
+void readLinks(const Reader& r, const YAML::Node& node, pathgen::LinkParams& links) {
+  r.expectMap(node, "links", {"retract", "safe_z"});
+  if (node["retract"])
+    links.retract_mm = r.number(
+        node["retract"], "links.retract", [](double v) { return v >= 0.0 && v <= 1e4; },
+        "a distance in [0, 10000] mm");
+  if (node["safe_z"]) {
+    if (node["safe_z"].IsScalar() && node["safe_z"].Scalar() == "auto")
+      links.safe_z_mm.reset();
+    else
+      links.safe_z_mm = r.number(
+          node["safe_z"], "links.safe_z", [](double v) { return std::abs(v) <= 1e6; },
+          "`auto` or a height in mm");
+  }
 }
 
 }  // namespace
@@ -288,14 +307,21 @@ Scene loadScene(const std::filesystem::path& file) {
   const Reader r(file);
   if (!root.IsMap()) r.fail(root, "scene", "expected a map of keys (obstacles, guide, tool, ...)");
   r.expectMap(root, "",
-              {"obstacles", "guide", "tool", "holder", "clearance", "field", "dynamics", "path"});
+              {"obstacles", "part", "guide", "tool", "holder", "clearance", "field", "dynamics",
+               "path", "links"});
 
   Scene scene;
   scene.file = file;
   std::vector<MeshLoad> loads;
   if (!root["obstacles"]) r.fail(root, "obstacles", "missing (the surfaces that repel the tool)");
   readObstacles(r, root["obstacles"], scene, loads);
-  if (root["guide"]) readGuide(r, root["guide"], scene, loads);
+  if (root["part"] && root["guide"])
+    r.fail(root["guide"], "guide", "give either `part: FILE` or `guide: { impeller: hub }`");
+  if (root["part"]) {
+    scene.part_file = r.path(root["part"], "part");
+    loads.push_back({root["part"], "part", true});
+  }
+  if (root["guide"]) readGuide(r, root["guide"], scene);
   if (root["tool"]) readTool(r, root["tool"], scene.tool);
   if (root["holder"]) readHolder(r, root["holder"], scene.holder);
   if (root["clearance"])
@@ -304,13 +330,24 @@ Scene loadScene(const std::filesystem::path& file) {
   if (root["field"]) readField(r, root["field"], scene.field);
   if (root["dynamics"]) readDynamics(r, root["dynamics"], scene.dynamics);
   if (root["path"]) readPath(r, root["path"], scene.path);
+  if (root["links"]) readLinks(r, root["links"], scene.links);
 
   // Meshes last: every key is checked before the slow part.
   for (const MeshLoad& load : loads) {
-    if (load.guide)
-      scene.guide = r.mesh(load.node, load.key);
+    if (load.part)
+      scene.part = r.mesh(load.node, load.key);
     else
       scene.obstacles.push_back(r.mesh(load.node, load.key));
+  }
+  if (root["path"] && root["path"]["nominal"]) {
+    const YAML::Node node = root["path"]["nominal"];
+    const auto file = r.path(node, "path.nominal");
+    try {
+      scene.nominal = geometry::readPathFile(file);
+    } catch (const InputError& e) {
+      // The path file's own message names its line; say which key led there.
+      r.fail(node, "path.nominal", e.what());
+    }
   }
   if (scene.impeller || scene.guide_impeller) resolveImpeller(scene);
   return scene;

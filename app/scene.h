@@ -11,6 +11,7 @@
 
 #include "fieldpath/dynamics/params.h"
 #include "fieldpath/field/params.h"
+#include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/geometry/tool.h"
 #include "fieldpath/pathgen/impeller.h"
@@ -26,9 +27,10 @@ struct Scene {
   std::vector<geometry::TriangleMesh> obstacles;
   std::vector<std::filesystem::path> obstacle_files;  ///< the `- mesh:` files, resolved
 
-  /// `guide:` the machined surface: `{ mesh: FILE }`, loaded here, or `{ impeller: ... }`.
-  std::optional<geometry::TriangleMesh> guide;
-  std::optional<std::filesystem::path> guide_file;
+  /// `part:` the machined surface (a mesh file, loaded here), or the impeller's hub with
+  /// `guide: { impeller: hub }` (once resolveImpeller has run). Never repels.
+  std::optional<geometry::TriangleMesh> part;
+  std::optional<std::filesystem::path> part_file;
 
   /// `obstacles: - impeller: {...}`: the node as written, for resolveImpeller.
   std::optional<YAML::Node> impeller;
@@ -43,6 +45,9 @@ struct Scene {
   field::FieldParams field;           ///< `field:`
   dynamics::DynamicsParams dynamics;  ///< `dynamics:`
   pathgen::PathParams path;           ///< `path:`
+  /// `path.nominal:` the nominal path file (.cl, APT, .npy), read here: the passes' source.
+  std::optional<geometry::PathFile> nominal;
+  pathgen::LinkParams links;  ///< `links:`
 };
 
 /// Reads `file`, checks every key and value, loads the mesh files and, where the scene names the
@@ -52,7 +57,7 @@ struct Scene {
 /// cannot be loaded.
 Scene loadScene(const std::filesystem::path& file);
 
-/// Turns scene.impeller / scene.guide_impeller into meshes (obstacles, guide) and
+/// Turns scene.impeller / scene.guide_impeller into meshes (obstacles, part) and
 /// scene.impeller_model. Lives in scene_impeller.cpp (the impeller's owner replaces it).
 void resolveImpeller(Scene& scene);
 

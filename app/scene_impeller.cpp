@@ -5,7 +5,6 @@
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/pathgen/generate.h"
-#include "impeller_job.h"
 #include "scene.h"
 
 namespace fieldpath::app {
@@ -92,33 +91,14 @@ void resolveImpeller(Scene& scene) {
   } catch (const InputError& e) {
     throw InputError(where(scene, node) + "obstacles." + e.what());
   }
-  for (auto& blade : pathgen::obstacleMeshes(*scene.impeller_model))
+  for (auto& blade : pathgen::bladeMeshes(*scene.impeller_model))
     scene.obstacles.push_back(std::move(blade));
   if (scene.guide_impeller) {
     const YAML::Node& guide = *scene.guide_impeller;
     if (!guide.IsScalar() || guide.Scalar() != "hub")
       throw InputError(where(scene, guide) + "guide.impeller: expected `hub`");
-    scene.guide = scene.impeller_model->hubMesh();
+    scene.part = scene.impeller_model->hubMesh();
   }
-}
-
-pathgen::GenerateRequest impellerJob(const Scene& scene) {
-  if (!scene.impeller_model || !scene.guide_impeller)
-    throw InputError(
-        scene.file.string() +
-        ": guide: generate and check need `guide: { impeller: hub }` with the impeller "
-        "among the obstacles (the passes follow its hub)");
-  pathgen::GenerateRequest job;
-  job.impeller = scene.impeller_model->params();
-  // resolveImpeller appended the two blades last; the meshes before them are the extra obstacles.
-  job.extra_obstacles.assign(scene.obstacles.begin(), scene.obstacles.end() - 2);
-  job.path = scene.path;
-  job.field = scene.field;
-  job.dynamics = scene.dynamics;
-  job.tool = scene.tool;
-  job.holder = scene.holder;
-  job.clearance_mm = scene.clearance_mm;
-  return job;
 }
 
 }  // namespace fieldpath::app

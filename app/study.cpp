@@ -338,15 +338,14 @@ StudyResult runStudy(const StudyRequest& request) {
   std::unique_ptr<field::DirectField> direct;
   ErrorSets sets;
   auto prepareErrors = [&](const pathgen::GenerateResult& direct_run) {
-    const pathgen::Impeller impeller(job.impeller);
-    const std::vector<geometry::TriangleMesh> obstacles =
-        pathgen::obstacleMeshes(impeller, job.extra_obstacles);
+    const pathgen::Impeller impeller(request.impeller);
+    const std::vector<geometry::TriangleMesh>& obstacles = job.obstacles;
     const pathgen::ClearanceChecker checker(
         geometry::toolMesh(job.tool, job.holder, pathgen::kClearanceMeshTolMm), obstacles);
     direct = std::make_unique<field::DirectField>(
         field::sampleObstacles(obstacles, job.field.sample_step_mm, job.field.weights), job.field);
 
-    const auto& u_range = job.impeller.u_range;
+    const auto& u_range = request.impeller.u_range;
     const double u_mid = 0.5 * (u_range[0] + u_range[1]);
     result.line_a =
         makeLine("a",
@@ -431,6 +430,7 @@ StudyResult runStudy(const StudyRequest& request) {
     pathgen::GenerateRequest variant_job = job;
     variant_job.mode = variants[i].mode;
     variant_job.nominal = false;
+    variant_job.passes_only = true;  // the variants are compared on the passes' postures
     variant_job.keep_voxels = variants[i].isVoxel();
     if (variants[i].isVoxel()) variant_job.field.voxel = variants[i].voxel;
     const double run_end = share(i) + 0.8 * (share(i + 1) - share(i));
@@ -438,13 +438,13 @@ StudyResult runStudy(const StudyRequest& request) {
     StudyRow row;
     row.variant = variants[i];
     try {
-      runs.push_back(pathgen::generateImpellerPath(variant_job));
+      runs.push_back(pathgen::generatePath(variant_job));
       // Timings: the median of `repeats` runs (the machine may be shared); the path is the first.
       std::vector<pathgen::StageTimes> times = {runs.back().times};
       variant_job.progress = {};
       variant_job.keep_voxels = false;
       for (int k = 1; k < request.repeats; ++k)
-        times.push_back(pathgen::generateImpellerPath(variant_job).times);
+        times.push_back(pathgen::generatePath(variant_job).times);
       runs.back().times = medianTimes(times);
       row.times = runs.back().times;
       row.total_s = row.times.field_s + row.times.steering_s;

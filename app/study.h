@@ -45,8 +45,11 @@ struct StudyVariant {
 };
 
 struct StudyRequest {
-  /// The scene's job; mode, voxel size and interpolation are set per variant.
+  /// The scene's job (on the parametric impeller); mode, voxel size and interpolation are set per
+  /// variant.
   pathgen::GenerateRequest job;
+  /// The impeller of the job (the study lines a and b run along and across its channel).
+  pathgen::ImpellerParams impeller;
   std::vector<double> voxel_sizes_mm = {2.0, 1.0, 0.5};
   std::vector<field::Interpolation> interpolations = {field::Interpolation::Trilinear,
                                                       field::Interpolation::Quadratic};
@@ -80,7 +83,7 @@ struct StudyRow {
   std::size_t voxel_memory_bytes = 0;
   std::size_t refined_nodes = 0;   ///< of active_nodes, those of the finer levels
   int levels = 0;                  ///< voxel grid levels built (1: uniform)
-  pathgen::StageTimes times;       ///< of generateImpellerPath for this variant
+  pathgen::StageTimes times;       ///< of generatePath for this variant
   double total_s = 0.0;            ///< field_s + steering_s: what the seed's "temps total" counts
   double speedup_vs_brute = 0.0;   ///< brute total / this total; NaN when brute force was skipped
   double speedup_vs_direct = 0.0;  ///< indexed direct total / this total
@@ -124,7 +127,7 @@ struct StudyResult {
 };
 
 /// Runs every variant. Throws common::InputError for bad settings (empty or non-positive
-/// --voxels), and what generateImpellerPath throws.
+/// --voxels), and what generatePath throws.
 StudyResult runStudy(const StudyRequest& request);
 
 /// Writes study.csv, study.md, lines.csv and tilt.csv into `dir` (each atomically).

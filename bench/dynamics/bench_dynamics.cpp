@@ -155,7 +155,7 @@ int main(int argc, char** argv) {
   request.nodes_tool_frame_mm = nodes;
   request.ball_radius_mm = kBallRadius;
   request.step_mm = 0.5;
-  request.on_limit = dynamics::LimitPolicy::Clamp;  // every variant runs the whole path
+  request.params.on_limit = dynamics::LimitPolicy::Clamp;  // every variant runs the whole path
 
   std::printf(
       "# bench_dynamics: %d passes, %.0f mm of path, %zu tool+holder nodes (spacing %.1f mm), "

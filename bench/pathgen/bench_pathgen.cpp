@@ -23,7 +23,7 @@
 #include "fieldpath/common/stats.h"
 #include "fieldpath/geometry/units.h"
 #include "fieldpath/pathgen/generate.h"
-#include "impeller_job.h"
+#include "job.h"
 #include "scene.h"
 
 using namespace fieldpath;
@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
     }
   }
   const app::Scene scene = app::loadScene(scene_file);
-  const pathgen::GenerateRequest job = app::impellerJob(scene);
+  const pathgen::GenerateRequest job = app::sceneJob(scene);
 
   std::vector<Variant> variants = {{"direct", pathgen::FieldMode::Direct},
                                    {"voxel 2 mm", pathgen::FieldMode::Voxel, 2.0},
@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
     Row row{v, {}};
     const int n = v.mode == pathgen::FieldMode::BruteForce ? 1 : repeats;
     for (int r = 0; r < n; ++r) {
-      row.last = pathgen::generateImpellerPath(request);
+      row.last = pathgen::generatePath(request);
       field.push_back(row.last.times.field_s);
       steering.push_back(row.last.times.steering_s);
       clearance.push_back(row.last.times.clearance_s);

@@ -72,6 +72,11 @@ void validate(const Pass& pass, const SteeringRequest& request) {
               p.max_lead_deg);
   requireThat(std::isfinite(request.step_mm) && request.step_mm > 0.0, "path.step", "> 0",
               request.step_mm);
+  const auto& stations = request.output_s_mm;
+  for (std::size_t i = 0; i < stations.size(); ++i)
+    requireThat(std::isfinite(stations[i]) && (i == 0 ? stations[i] == 0.0 : stations[i] > stations[i - 1]) &&
+                    stations[i] <= pass.length_mm,
+                "output station (mm)", "0 first, increasing, within the pass", stations[i]);
   requireThat(std::isfinite(request.ball_radius_mm) && request.ball_radius_mm > 0.0, "tool.radius",
               "> 0", request.ball_radius_mm);
   requireThat(std::isfinite(pass.length_mm) && pass.length_mm >= 0.0, "pass length (mm)", ">= 0",
@@ -292,13 +297,19 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
           : detail::makeCvodeBdf(system, kStateSize, 0.0, y.data(), settings);
 
   SteeringResult result;
-  const auto intervals = static_cast<long>(std::ceil(pass.length_mm / request.step_mm - 1e-9));
-  result.samples.reserve(static_cast<std::size_t>(intervals) + 1);
+  std::vector<double> stations = request.output_s_mm;
+  if (stations.empty()) {
+    const auto intervals = static_cast<long>(std::ceil(pass.length_mm / request.step_mm - 1e-9));
+    for (long k = 0; k <= intervals; ++k)
+      stations.push_back(std::min(static_cast<double>(k) * request.step_mm, pass.length_mm));
+  }
+  const long intervals = static_cast<long>(stations.size()) - 1;
+  result.samples.reserve(stations.size());
   const double max_change_rad_per_mm = request.max_angle_change_deg_per_mm / kDegPerRad;
   const long report_every = std::max(1L, intervals / 100);
 
   for (long k = 0; k <= intervals; ++k) {
-    const double s_mm = std::min(static_cast<double>(k) * request.step_mm, pass.length_mm);
+    const double s_mm = stations[static_cast<std::size_t>(k)];
     if (k > 0) {
       double t_reached_s = 0.0;
       const int flag = integrator->advance(s_mm / v, y.data(), t_reached_s);
@@ -311,7 +322,7 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
         break;
       }
     }
-    LimitCheck check = checkAngles(request.params, request.on_limit, y);
+    LimitCheck check = checkAngles(request.params, request.params.on_limit, y);
     if (check.clamped) integrator->restart(s_mm / v, y.data());
     PostureSample sample = system.sample(s_mm, y);
     sample.limited = check.clamped;
@@ -327,7 +338,7 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
                                      std::abs(sample.tilt_rad - prev.tilt_rad));
       if (ds_mm > 0.0 && change > max_change_rad_per_mm * ds_mm) {
         sample.limited = true;
-        if (request.on_limit == LimitPolicy::Report) {
+        if (request.params.on_limit == LimitPolicy::Fail) {
           std::ostringstream msg;
           msg.precision(4);
           msg << "axis turned " << change / ds_mm * kDegPerRad << "°/mm, over the limit of "

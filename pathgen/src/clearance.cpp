@@ -1,6 +1,7 @@
 #include "fieldpath/pathgen/clearance.h"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include <fcl/geometry/bvh/BVH_model.h>
@@ -37,18 +38,27 @@ std::shared_ptr<Model> buildModel(const geometry::TriangleMesh& mesh, const std:
 struct ClearanceChecker::Impl {
   std::shared_ptr<Model> tool;
   std::vector<std::shared_ptr<Model>> obstacles;
+  double chord_tol_mm = 0.0;
+  double reach_mm = 0.0;
 };
 
 ClearanceChecker::ClearanceChecker(const geometry::TriangleMesh& tool_mesh,
-                                   std::span<const geometry::TriangleMesh> obstacles) {
+                                   std::span<const geometry::TriangleMesh> obstacles,
+                                   double tool_chord_tol_mm) {
+  if (!std::isfinite(tool_chord_tol_mm) || tool_chord_tol_mm < 0.0)
+    throw common::InputError("tool mesh chordal tolerance: must be finite and >= 0");
   auto impl = std::make_shared<Impl>();
   impl->tool = buildModel(tool_mesh, "tool mesh");
   for (size_t i = 0; i < obstacles.size(); ++i)
-    impl->obstacles.push_back(buildModel(obstacles[i], "obstacle " + std::to_string(i)));
+    impl->obstacles.push_back(buildModel(obstacles[i], "obstacle " + std::to_string(i + 1)));
+  impl->chord_tol_mm = tool_chord_tol_mm;
+  for (const auto& v : tool_mesh.vertices) impl->reach_mm = std::max(impl->reach_mm, v.norm());
   impl_ = std::move(impl);
 }
 
 std::size_t ClearanceChecker::obstacleCount() const { return impl_->obstacles.size(); }
+double ClearanceChecker::toolChordTolMm() const { return impl_->chord_tol_mm; }
+double ClearanceChecker::toolReachMm() const { return impl_->reach_mm; }
 
 namespace {
 
@@ -85,8 +95,9 @@ double nearestObstacle(const Model& model, const fcl::Transform3d& pose,
 
 double ClearanceChecker::clearance(const geometry::Posture& posture, int* obstacle) const {
   const Eigen::Isometry3d placed = geometry::toolToWorld(posture);
-  return nearestObstacle(*impl_->tool, fcl::Transform3d(placed.matrix()), impl_->obstacles,
-                         obstacle);
+  const double d = nearestObstacle(*impl_->tool, fcl::Transform3d(placed.matrix()),
+                                   impl_->obstacles, obstacle);
+  return std::max(0.0, d - impl_->chord_tol_mm);
 }
 
 double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double radius_mm,
@@ -141,6 +152,121 @@ ClearanceResult ClearanceChecker::check(std::span<const geometry::Posture> postu
     }
   }
   if (request.per_posture) result.clearance_mm = std::move(distance);
+  return result;
+}
+
+}  // namespace fieldpath::pathgen
+
+namespace fieldpath::pathgen {
+namespace {
+
+/// The pose at fraction t of the motion a → b: tip linear, axis linear and renormalised (for
+/// opposite axes, turned through the plane of the first axis and any perpendicular).
+geometry::Posture interpolate(const geometry::Posture& a, const geometry::Posture& b, double t) {
+  geometry::Posture p;
+  p.tip_mm = (1 - t) * a.tip_mm + t * b.tip_mm;
+  Vec3 axis = (1 - t) * a.axis + t * b.axis;
+  if (axis.norm() < 1e-9) axis = a.axis.unitOrthogonal();
+  p.axis = axis.normalized();
+  return p;
+}
+
+double angleBetween(const Vec3& a, const Vec3& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+}  // namespace
+
+MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> postures,
+                                            const MotionRequest& request,
+                                            const common::Progress& progress) const {
+  MotionResult result;
+  result.motions = postures.empty() ? 0 : postures.size() - 1;
+  std::vector<double> ends(postures.size());
+  std::vector<double> bound(result.motions);
+  std::vector<char> touched(result.motions, 0);
+  std::vector<std::size_t> samples(result.motions, 0);
+  const double reach = impl_->reach_mm;
+  const double resolution = std::max(1e-6, request.resolution_mm);
+  double stop_mm = request.required_mm;
+  auto motion = [&](std::size_t i) {
+    const geometry::Posture& a = postures[i];
+    const geometry::Posture& b = postures[i + 1];
+    struct Piece {
+      double t0, t1, d0, d1;
+      geometry::Posture p0, p1;
+    };
+    std::vector<Piece> stack = {{0.0, 1.0, ends[i], ends[i + 1], a, b}};
+    double lowest = std::numeric_limits<double>::infinity();
+    while (!stack.empty()) {
+      const Piece piece = stack.back();
+      stack.pop_back();
+      const double reach_mm = (piece.p1.tip_mm - piece.p0.tip_mm).norm() +
+                              reach * angleBetween(piece.p0.axis, piece.p1.axis);
+      const double certain =
+          std::min({piece.d0, piece.d1, 0.5 * (piece.d0 + piece.d1 - reach_mm)});
+      if (certain >= stop_mm || reach_mm <= 2 * resolution) {
+        lowest = std::min(lowest, std::max(0.0, certain));
+        continue;
+      }
+      const double tm = 0.5 * (piece.t0 + piece.t1);
+      const geometry::Posture pm = interpolate(a, b, tm);
+      const double raw = nearestObstacle(
+          *impl_->tool, fcl::Transform3d(geometry::toolToWorld(pm).matrix()), impl_->obstacles,
+          nullptr);
+      ++samples[i];
+      if (raw <= 0.0) {  // the meshes touch: so do the true solids (the mesh is inside the tool)
+        touched[i] = 1;
+        lowest = 0.0;
+        break;
+      }
+      const double dm = std::max(0.0, raw - impl_->chord_tol_mm);
+      stack.push_back({piece.t0, tm, piece.d0, dm, piece.p0, pm});
+      stack.push_back({tm, piece.t1, dm, piece.d1, pm, piece.p1});
+    }
+    bound[i] = lowest;
+  };
+  // The postures' own clearances first (the ends of every motion), unless given.
+  const size_t batch = std::max<size_t>(1, request.batch);
+  if (request.posture_clearance_mm.size() == postures.size())
+    std::copy(request.posture_clearance_mm.begin(), request.posture_clearance_mm.end(),
+              ends.begin());
+  else
+  for (size_t begin = 0; begin < postures.size(); begin += batch) {
+    const size_t end = std::min(postures.size(), begin + batch);
+    tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i) ends[i] = clearance(postures[i]);
+    });
+    common::report(progress, 0.3 * end / postures.size(), "motions");
+  }
+  // Refine each motion until its bound reaches the required clearance or, where the path comes
+  // closer, within kTightenMm of the closest posture: the reported minimum is then tight too.
+  double closest_mm = std::numeric_limits<double>::infinity();
+  for (double d : ends) closest_mm = std::min(closest_mm, d);
+  stop_mm = std::max(request.required_mm, closest_mm - request.tighten_mm);
+  for (size_t begin = 0; begin < result.motions; begin += batch) {
+    const size_t end = std::min(result.motions, begin + batch);
+    tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i) motion(i);
+    });
+    common::report(progress, 0.3 + 0.7 * end / result.motions, "motions");
+  }
+  for (size_t i = 0; i < result.motions; ++i) {
+    result.samples += samples[i];
+    if (touched[i] || bound[i] <= 0.0) {
+      ++result.colliding;
+      if (result.first_colliding == MotionResult::npos) result.first_colliding = i;
+    }
+    if (bound[i] < request.required_mm) {
+      ++result.under_required;
+      if (result.first_under_required == MotionResult::npos) result.first_under_required = i;
+    }
+    if (bound[i] < result.min_clearance_mm) {
+      result.min_clearance_mm = bound[i];
+      result.min_index = i;
+    }
+  }
+  result.clearance_mm = std::move(bound);
   return result;
 }
 

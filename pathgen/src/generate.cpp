@@ -49,10 +49,9 @@ void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>
     const double d = checker.ballClearance(centres, ball_radius_mm, &at, &obstacle);
     if (d < clearance_mm) {
       std::ostringstream msg;
-      msg << "pass " << pass.index + 1 << " (v = " << pass.v
-          << "): at s = " << pass.samples[at].s_mm << " mm the ball is " << d
+      msg << pass.label << ": at s = " << pass.samples[at].s_mm << " mm the ball is " << d
           << " mm from obstacle " << obstacle + 1 << ", less than `clearance` = " << clearance_mm
-          << " mm: the channel is narrower than the ball there (impeller.passes_v, width_in/out)";
+          << " mm: the channel is narrower than the ball there";
       throw InputError(msg.str());
     }
   }
@@ -93,11 +92,16 @@ Eigen::AlignedBox3d reachBox(const std::vector<Pass>& passes, const std::vector<
 
 }  // namespace
 
-std::vector<geometry::TriangleMesh> obstacleMeshes(
-    const Impeller& impeller, const std::vector<geometry::TriangleMesh>& extra) {
-  std::vector<geometry::TriangleMesh> meshes = {impeller.bladeMesh(0), impeller.bladeMesh(1)};
-  meshes.insert(meshes.end(), extra.begin(), extra.end());
-  return meshes;
+std::vector<geometry::TriangleMesh> bladeMeshes(const Impeller& impeller) {
+  return {impeller.bladeMesh(0), impeller.bladeMesh(1)};
+}
+
+void useImpeller(GenerateRequest& job, const Impeller& impeller) {
+  job.passes = impellerPasses(impeller, job.path, job.tool.radius_mm);
+  std::vector<geometry::TriangleMesh> obstacles = bladeMeshes(impeller);
+  obstacles.insert(obstacles.end(), job.obstacles.begin(), job.obstacles.end());
+  job.obstacles = std::move(obstacles);
+  job.part = impeller.hubMesh();
 }
 
 double defaultNodeSpacingMm(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder) {
@@ -115,7 +119,7 @@ double defaultNodeSpacingMm(const geometry::ToolSpec& tool, const geometry::Hold
   return std::sqrt(area / kTargetNodes);
 }
 
-GenerateResult generateImpellerPath(const GenerateRequest& request) {
+GenerateResult generatePath(const GenerateRequest& request) {
   const auto start = Clock::now();
   GenerateResult result;
   const geometry::ToolSpec& tool = request.tool;
@@ -128,15 +132,15 @@ GenerateResult generateImpellerPath(const GenerateRequest& request) {
   const double r = tool.radius_mm;
   const double lead_rad = request.path.lead_deg * kDegToRad;
 
-  // ---- setup: geometry, passes, clearance hierarchies ----------------------------------------
-  const Impeller impeller(request.impeller);
-  result.passes = impellerPasses(impeller, request.path, r);
-  const std::vector<geometry::TriangleMesh> obstacles =
-      obstacleMeshes(impeller, request.extra_obstacles);
+  // ---- setup: passes, clearance hierarchies ---------------------------------------------------
+  result.passes = request.passes;
+  if (result.passes.empty()) throw InputError("path: no passes to machine");
+  const std::vector<geometry::TriangleMesh>& obstacles = request.obstacles;
+  if (obstacles.empty()) throw InputError("obstacles: none given (the surfaces that repel)");
   const geometry::TriangleMesh tool_mesh =
       geometry::toolMesh(tool, request.holder, kClearanceMeshTolMm);
   result.tool_triangles = tool_mesh.triangles.size();
-  const ClearanceChecker checker(tool_mesh, obstacles);
+  const ClearanceChecker checker(tool_mesh, obstacles, kClearanceMeshTolMm);
   checkBallClearance(checker, result.passes, r, request.clearance_mm);
   std::vector<Vec3> nodes;
   for (const auto& node :
@@ -199,8 +203,8 @@ GenerateResult generateImpellerPath(const GenerateRequest& request) {
     }
     dynamics::Pass dyn_pass;
     dyn_pass.length_mm = pass.length_mm;
-    dyn_pass.frameAt = [&impeller, &pass, lead_rad](double s_mm) {
-      const PassSample s = sampleAt(impeller, pass, s_mm);
+    dyn_pass.frameAt = [&pass, lead_rad](double s_mm) {
+      const PassSample s = pass.at(s_mm);
       dynamics::PassFrame frame;
       frame.centre_mm = s.centre_mm;
       frame.feed = s.feed;
@@ -213,13 +217,19 @@ GenerateResult generateImpellerPath(const GenerateRequest& request) {
     steer.nodes_tool_frame_mm = nodes;
     steer.ball_radius_mm = r;
     steer.params = request.dynamics;
-    steer.step_mm = pass.samples.size() > 1 ? pass.samples[1].s_mm : pass.length_mm;
+    // The pass's own stations (even steps, or a nominal path's postures one for one); the solver
+    // never steps over more than the longest gap between them.
+    double gap_mm = 0.0;
+    for (std::size_t i = 0; i < pass.samples.size(); ++i) {
+      steer.output_s_mm.push_back(pass.samples[i].s_mm);
+      if (i > 0) gap_mm = std::max(gap_mm, pass.samples[i].s_mm - pass.samples[i - 1].s_mm);
+    }
+    steer.step_mm = gap_mm > 0.0 ? gap_mm : pass.length_mm;
     steer.progress = scaled(request.progress, begin, end, label);
     const dynamics::SteeringResult steered = dynamics::steerPass(dyn_pass, steer);
     if (steered.status != dynamics::Status::Ok) {
       std::ostringstream msg;
-      msg << label << " (v = " << pass.v << "): " << dynamics::toString(steered.status) << ": "
-          << steered.message;
+      msg << pass.label << ": " << dynamics::toString(steered.status) << ": " << steered.message;
       throw InputError(msg.str());
     }
     for (const dynamics::PostureSample& s : steered.samples) {
@@ -229,7 +239,11 @@ GenerateResult generateImpellerPath(const GenerateRequest& request) {
       g.lead_rad = s.lead_rad;
       g.tilt_rad = s.tilt_rad;
       g.moment = s.moment.norm();
+      g.limited = s.limited;
       g.posture = s.posture;
+      if (g.limited && result.first_limited == ClearanceResult::npos)
+        result.first_limited = result.postures.size();
+      result.limited_postures += g.limited;
       result.postures.push_back(g);
     }
     const dynamics::SolverStats& st = steered.stats;
@@ -241,17 +255,56 @@ GenerateResult generateImpellerPath(const GenerateRequest& request) {
   }
   result.times.steering_s = seconds(steer_start);
 
-  // ---- exact clearance -------------------------------------------------------------------------
+  // ---- links, then the exact clearance of every posture and motion ----------------------------
   const auto clearance_start = Clock::now();
-  std::vector<geometry::Posture> postures;
-  postures.reserve(result.postures.size());
-  for (const GeneratedPosture& g : result.postures) postures.push_back(g.posture);
-  result.clearance = checker.check(postures, {}, scaled(request.progress, 0.9, 1.0, "clearance"));
-  for (size_t i = 0; i < result.postures.size(); ++i) {
-    GeneratedPosture& g = result.postures[i];
-    g.clearance_mm = result.clearance.clearance_mm[i];
+  std::vector<std::vector<geometry::Posture>> pass_postures(result.passes.size());
+  for (const GeneratedPosture& g : result.postures) pass_postures[g.pass].push_back(g.posture);
+  if (request.passes_only) {
+    for (const auto& postures : pass_postures)
+      for (const auto& p : postures) result.path.postures.push_back(p);
+    result.path = geometry::singlePass(std::move(result.path.postures));
+  } else {
+    LinkRequest links;
+    links.params = request.links;
+    links.tool = tool;
+    links.holder = request.holder;
+    if (request.links.safe_z_mm) {
+      links.safe_z_mm = *request.links.safe_z_mm;
+    } else {
+      std::vector<geometry::TriangleMesh> meshes = obstacles;
+      if (request.part) meshes.push_back(*request.part);
+      links.safe_z_mm = autoSafeZ(meshes, request.clearance_mm);
+    }
+    result.safe_z_mm = links.safe_z_mm;
+    result.path = linkPasses(pass_postures, links);
+  }
+  // Where each pass posture landed in the output path.
+  {
+    std::size_t next = 0;
+    for (const geometry::PathBlock& block : result.path.blocks) {
+      if (block.kind == geometry::PathBlock::Kind::Link) {
+        result.link_postures += block.size();
+        continue;
+      }
+      for (std::size_t i = block.begin; i < block.end; ++i) result.postures[next++].output = i;
+    }
+  }
+  for (const GeneratedPosture& g : result.postures)
+    if (g.limited) result.path.limited.push_back(g.output);
+  result.clearance = checker.check(result.path.postures, {},
+                                   scaled(request.progress, 0.9, 0.93, "clearance"));
+  if (!request.passes_only) {
+    MotionRequest motions;
+    motions.required_mm = request.clearance_mm;
+    motions.posture_clearance_mm = result.clearance.clearance_mm;
+    result.motions = checker.checkMotions(result.path.postures, motions,
+                                          scaled(request.progress, 0.93, 1.0, "motions"));
+  }
+  for (GeneratedPosture& g : result.postures) {
+    g.clearance_mm = result.clearance.clearance_mm[g.output];
     result.max_tilt_deg = std::max(result.max_tilt_deg, std::abs(g.tilt_rad) / kDegToRad);
     result.max_lead_deg = std::max(result.max_lead_deg, std::abs(g.lead_rad) / kDegToRad);
+    result.limited_colliding += g.limited && g.clearance_mm <= 0.0;
   }
   result.times.clearance_s = seconds(clearance_start);
   result.times.total_s = seconds(start);

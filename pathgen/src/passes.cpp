@@ -1,6 +1,7 @@
 #include "fieldpath/pathgen/passes.h"
 
 #include <algorithm>
+#include <memory>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -19,6 +20,14 @@ constexpr int kDense = 8192;
 Vec3 ballCentre(const Impeller& impeller, double u, double v, double radius_mm) {
   return impeller.hub(u, v) + radius_mm * impeller.hubNormal(u, v);
 }
+
+/// Arc length → u, dense and increasing: the stations at any s by inverse interpolation.
+struct ArcTable {
+  std::vector<double> s_mm, u;
+};
+
+PassSample impellerSample(const Impeller& impeller, const ArcTable& table, double v,
+                          double radius_mm, double length_mm, double s_mm);
 
 }  // namespace
 
@@ -47,18 +56,26 @@ std::vector<Pass> impellerPasses(const Impeller& impeller, const PathParams& pat
     pass.v = path.passes == 1 ? 0.5 * (v_first + v_last)
                               : v_first + (v_last - v_first) * k / (path.passes - 1);
     auto centre = [&](double u) { return ballCentre(impeller, u, pass.v, r); };
+    std::ostringstream label;
+    label << "pass " << k + 1 << " (v = " << pass.v << ")";
+    pass.label = label.str();
 
     pass.ball_radius_mm = r;
-    pass.table_s_mm.resize(kDense + 1);
-    pass.table_u.resize(kDense + 1);
+    auto table = std::make_shared<ArcTable>();
+    table->s_mm.resize(kDense + 1);
+    table->u.resize(kDense + 1);
     Vec3 prev = centre(u0);
     for (int i = 0; i <= kDense; ++i) {
-      pass.table_u[i] = u0 + (u1 - u0) * i / kDense;
-      const Vec3 c = centre(pass.table_u[i]);
-      pass.table_s_mm[i] = i == 0 ? 0.0 : pass.table_s_mm[i - 1] + (c - prev).norm();
+      table->u[i] = u0 + (u1 - u0) * i / kDense;
+      const Vec3 c = centre(table->u[i]);
+      table->s_mm[i] = i == 0 ? 0.0 : table->s_mm[i - 1] + (c - prev).norm();
       prev = c;
     }
-    pass.length_mm = pass.table_s_mm.back();
+    pass.length_mm = table->s_mm.back();
+    pass.at = [model = std::make_shared<const Impeller>(impeller), table, v = pass.v, r,
+               length = pass.length_mm](double s_mm) {
+      return impellerSample(*model, *table, v, r, length, s_mm);
+    };
     if (!(pass.length_mm >= path.step_mm)) {
       std::ostringstream msg;
       msg << "pass " << k + 1 << " (v = " << pass.v << "): empty: its length " << pass.length_mm
@@ -69,26 +86,29 @@ std::vector<Pass> impellerPasses(const Impeller& impeller, const PathParams& pat
     const int intervals = static_cast<int>(std::ceil(pass.length_mm / path.step_mm - 1e-9));
     pass.samples.reserve(intervals + 1);
     for (int j = 0; j <= intervals; ++j)
-      pass.samples.push_back(sampleAt(impeller, pass, pass.length_mm * j / intervals));
+      pass.samples.push_back(pass.at(pass.length_mm * j / intervals));
     passes.push_back(std::move(pass));
   }
   return passes;
 }
 
-PassSample sampleAt(const Impeller& impeller, const Pass& pass, double s_mm) {
-  const auto& s_table = pass.table_s_mm;
-  const auto& u_table = pass.table_u;
+namespace {
+
+PassSample impellerSample(const Impeller& impeller, const ArcTable& table, double v,
+                          double radius_mm, double length_mm, double s_mm) {
+  const auto& s_table = table.s_mm;
+  const auto& u_table = table.u;
   PassSample sample;
-  sample.s_mm = std::clamp(s_mm, 0.0, pass.length_mm);
+  sample.s_mm = std::clamp(s_mm, 0.0, length_mm);
   // u at this arc length: linear inverse interpolation in the dense table.
   const auto it = std::lower_bound(s_table.begin(), s_table.end(), sample.s_mm);
   const size_t i = std::clamp<size_t>(it - s_table.begin(), 1, s_table.size() - 1);
   const double span = s_table[i] - s_table[i - 1];
   const double w = span > 0.0 ? (sample.s_mm - s_table[i - 1]) / span : 0.0;
   sample.u = u_table[i - 1] + w * (u_table[i] - u_table[i - 1]);
-  auto centre = [&](double u) { return ballCentre(impeller, u, pass.v, pass.ball_radius_mm); };
-  sample.normal = impeller.hubNormal(sample.u, pass.v);
-  sample.centre_mm = impeller.hub(sample.u, pass.v) + pass.ball_radius_mm * sample.normal;
+  auto centre = [&](double u) { return ballCentre(impeller, u, v, radius_mm); };
+  sample.normal = impeller.hubNormal(sample.u, v);
+  sample.centre_mm = impeller.hub(sample.u, v) + radius_mm * sample.normal;
   constexpr double du = 1e-5;
   Vec3 tangent = centre(sample.u + du) - centre(sample.u - du);
   tangent -= tangent.dot(sample.normal) * sample.normal;  // exactly ⟂ n despite rounding
@@ -96,6 +116,8 @@ PassSample sampleAt(const Impeller& impeller, const Pass& pass, double s_mm) {
   sample.binormal = sample.normal.cross(sample.feed);
   return sample;
 }
+
+}  // namespace
 
 Vec3 nominalAxis(const PassSample& sample, double lead_rad) {
   const dynamics::LocalFrame frame{sample.feed, sample.normal, sample.binormal, false};

@@ -18,7 +18,7 @@ TEST(Scene, ReadsEveryKey) {
 obstacles:
   - mesh: ../meshes/left.stl
   - mesh: ../meshes/right.stl
-guide: { mesh: ../meshes/hub.stl }
+part: ../meshes/hub.stl
 tool: { shape: torus, radius: 4, corner_radius: 1, length: 30 }
 holder: [[40, 6], [55, 6], [55.5, 12], [90, 12]]
 clearance: 0.7
@@ -50,8 +50,8 @@ path:
   EXPECT_EQ(s.obstacle_files[0], dir.path() / "jobs/../meshes/left.stl");
   EXPECT_EQ(s.obstacles[0].triangles.size(), 2u);
   EXPECT_DOUBLE_EQ(s.obstacles[1].vertices[0].z(), 5.0);
-  ASSERT_TRUE(s.guide.has_value());
-  EXPECT_DOUBLE_EQ(s.guide->vertices[0].z(), -3.0);
+  ASSERT_TRUE(s.part.has_value());
+  EXPECT_DOUBLE_EQ(s.part->vertices[0].z(), -3.0);
   EXPECT_FALSE(s.impeller.has_value());
   EXPECT_EQ(s.tool.shape, geometry::ToolShape::Torus);
   EXPECT_EQ(s.tool.radius_mm, 4.0);
@@ -88,7 +88,7 @@ TEST(Scene, DefaultsComeFromTheParamsStructs) {
   const app::Scene s = app::loadScene(
       dir.write("s.yaml", "obstacles:\n  - mesh: wall.stl\ndynamics: { damping: critical }\n"));
   EXPECT_EQ(s.obstacles.size(), 1u);
-  EXPECT_FALSE(s.guide.has_value());
+  EXPECT_FALSE(s.part.has_value());
   const field::FieldParams f;
   EXPECT_EQ(s.field.r0_mm, f.r0_mm);
   EXPECT_EQ(s.field.r_min_mm, f.r_min_mm);
@@ -148,7 +148,11 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
        4},
       {"obstacles:\n  - mesh: wall.stl\ndynamics:\n  integrator: rk4\n", "dynamics.integrator", 4},
       {"obstacles:\n  - mesh: wall.stl\npath:\n  passes: 2.5\n", "path.passes", 4},
-      {"obstacles:\n  - mesh: wall.stl\nguide: { mesh: hub.stl }\n", "guide.mesh", 3},
+      {"obstacles:\n  - mesh: wall.stl\npart: hub.stl\n", "part", 3},
+      {"obstacles:\n  - mesh: wall.stl\npath: { nominal: none.cl }\n", "path.nominal", 3},
+      {"obstacles:\n  - mesh: wall.stl\ndynamics: { on_limit: stop }\n", "dynamics.on_limit", 3},
+      {"obstacles:\n  - mesh: wall.stl\nlinks: { retract: -1 }\n", "links.retract", 3},
+      {"obstacles:\n  - mesh: wall.stl\nlinks: { safe_z: high }\n", "links.safe_z", 3},
       {"obstacles:\n  - mesh: wall.stl\nfield: { r0: [5\n", "YAML syntax", 0},
   };
   for (const Case& c : cases) {

@@ -20,11 +20,16 @@ namespace fieldpath::app {
 namespace {
 
 /// A short stretch of the impeller channel: three short passes, coarse blade meshes.
+pathgen::ImpellerParams smallImpeller() {
+  pathgen::ImpellerParams impeller;
+  impeller.u_range = {0.55, 0.8};
+  impeller.passes_v = {0.3, 0.7};
+  impeller.chord_tol_mm = 0.5;
+  return impeller;
+}
+
 pathgen::GenerateRequest smallJob() {
   pathgen::GenerateRequest job;
-  job.impeller.u_range = {0.55, 0.8};
-  job.impeller.passes_v = {0.3, 0.7};
-  job.impeller.chord_tol_mm = 0.5;
   job.path.passes = 3;
   job.path.step_mm = 2.0;
   job.field.sample_step_mm = 1.0;
@@ -40,6 +45,7 @@ pathgen::GenerateRequest smallJob() {
   job.dynamics.rtol = 1.0e-4;
   job.dynamics.atol = 1.0e-7;
   job.clearance_mm = 0.5;
+  pathgen::useImpeller(job, pathgen::Impeller(smallImpeller()));
   return job;
 }
 
@@ -155,6 +161,7 @@ void errorsShrinkWithTheVoxelSize(const StudyResult& result) {
 TEST(Study, SmallJobExactMethodsAgreeCsvIsFiniteErrorsShrink) {
   StudyRequest request;
   request.job = smallJob();
+  request.impeller = smallImpeller();
   request.voxel_sizes_mm = {2.0, 1.0, 0.5};
   request.interpolations = {field::Interpolation::Trilinear};
   request.stored = {field::StoredQuantity::Force, field::StoredQuantity::PlaneRatio};
@@ -182,6 +189,7 @@ TEST(StudyRefinement, RefinedVariantBeatsItsUniformGridAndIsCountedApart) {
   // The small job at 2 mm, uniform and refined at 5 % down to 1 mm (plane ratio, trilinear).
   StudyRequest request;
   request.job = smallJob();
+  request.impeller = smallImpeller();
   request.voxel_sizes_mm = {2.0};
   request.interpolations = {field::Interpolation::Trilinear};
   request.stored = {field::StoredQuantity::PlaneRatio};

@@ -482,6 +482,7 @@ TEST(Limits, TiltLimitIsReportedWithThePathPosition) {
   const auto wall = wallAt(4.0);
   SteeringRequest request = requestFor(wall.get());
   request.params.max_tilt_deg = 3.0;  // the wall wants 4.6°
+  request.params.on_limit = LimitPolicy::Fail;
   const SteeringResult result = steerPass(straightPass(300.0), request);
   ASSERT_EQ(result.status, Status::TiltLimit);
   EXPECT_NE(result.message.find("s = "), std::string::npos) << result.message;
@@ -496,7 +497,7 @@ TEST(Limits, ClampHoldsTheAxisAtTheLimit) {
   const auto wall = wallAt(4.0);
   SteeringRequest request = requestFor(wall.get());
   request.params.max_tilt_deg = 3.0;
-  request.on_limit = LimitPolicy::Clamp;
+  request.params.on_limit = LimitPolicy::Clamp;
   const SteeringResult result = runToleranceStable(straightPass(300.0), request);
   ASSERT_EQ(result.status, Status::Ok) << result.message;
   EXPECT_GT(result.clamped_samples, 0);
@@ -508,6 +509,7 @@ TEST(Limits, ClampHoldsTheAxisAtTheLimit) {
 
 TEST(Limits, AngleChangePerMmIsReported) {
   SteeringRequest request = requestFor(nullptr);
+  request.params.on_limit = LimitPolicy::Fail;
   request.initial_tilt_rad = 0.2;
   request.max_angle_change_deg_per_mm = 0.1;  // the free return turns ≈ 0.35°/mm at its fastest
   const SteeringResult result = steerPass(straightPass(100.0), request);

@@ -13,14 +13,15 @@ namespace {
 
 GenerateRequest flatJob() {
   GenerateRequest job;
-  job.impeller = test::flatChannel();
-  job.impeller.width_in_mm = job.impeller.width_out_mm = 44;  // walls 20 mm from the passes
-  job.impeller.passes_v = {0.45, 0.55};
+  ImpellerParams impeller = test::flatChannel();
+  impeller.width_in_mm = impeller.width_out_mm = 44;  // walls 20 mm from the passes
+  impeller.passes_v = {0.45, 0.55};
   job.path.passes = 2;
   job.path.step_mm = 1.0;
   job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
   job.holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
   job.mode = FieldMode::Direct;
+  useImpeller(job, Impeller(impeller));
   return job;
 }
 
@@ -29,10 +30,10 @@ GenerateRequest flatJob() {
 // Closed form: walls beyond r0 of every node exert no force, so the steered path is the nominal
 // one — axis on the hub normal (+z), tip = C - R a on the hub (z = 0), tilt and lead 0.
 TEST(Generate, NoForceGivesTheNominalPath) {
-  const GenerateResult field = generateImpellerPath(flatJob());
+  const GenerateResult field = generatePath(flatJob());
   GenerateRequest nominal_job = flatJob();
   nominal_job.nominal = true;
-  const GenerateResult nominal = generateImpellerPath(nominal_job);
+  const GenerateResult nominal = generatePath(nominal_job);
   ASSERT_EQ(field.postures.size(), nominal.postures.size());
   ASSERT_EQ(field.postures.size(), 2u * 73u);  // 72 mm at 1 mm, ends included
   for (size_t i = 0; i < field.postures.size(); ++i) {
@@ -55,11 +56,11 @@ TEST(Generate, NoForceGivesTheNominalPath) {
 TEST(Generate, BadToolAndClearanceNameTheirKey) {
   GenerateRequest job = flatJob();
   job.tool.shape = geometry::ToolShape::Flat;
-  EXPECT_THROW(generateImpellerPath(job), common::InputError);
+  EXPECT_THROW(generatePath(job), common::InputError);
   job = flatJob();
   job.clearance_mm = -1;
   try {
-    generateImpellerPath(job);
+    generatePath(job);
     FAIL();
   } catch (const common::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("clearance"), std::string::npos);

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <sstream>
 
@@ -133,11 +134,9 @@ void checkGridFits(const Grid& grid, std::size_t available_bytes) {
   }
 }
 
-std::vector<float> stockFromPart(const Grid& grid, std::span<const Vec3f> vertices,
-                                 std::span<const std::array<std::uint32_t, 3>> triangles) {
+std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
+                           std::span<const std::array<std::uint32_t, 3>> triangles) {
   if (triangles.empty()) throw InputError("part: mesh has no triangles");
-  float zmin = FLT_MAX;
-  for (const auto& v : vertices) zmin = std::min(zmin, v.z);
   const GridView g = detail::makeGridView(grid);
   std::vector<float> top(grid.lineCount(), -FLT_MAX);
   for (const auto& t : triangles) {
@@ -150,7 +149,17 @@ std::vector<float> stockFromPart(const Grid& grid, std::span<const Vec3f> vertic
                    });
   }
   for (auto& h : top)
-    if (h == -FLT_MAX) h = zmin;
+    if (h == -FLT_MAX) h = std::numeric_limits<float>::quiet_NaN();
+  return top;
+}
+
+std::vector<float> stockFromPart(const Grid& grid, std::span<const Vec3f> vertices,
+                                 std::span<const std::array<std::uint32_t, 3>> triangles) {
+  std::vector<float> top = partTop(grid, vertices, triangles);
+  float zmin = FLT_MAX;
+  for (const auto& v : vertices) zmin = std::min(zmin, v.z);
+  for (auto& h : top)
+    if (std::isnan(h)) h = zmin;
   return top;
 }
 

@@ -4,7 +4,13 @@
 
 namespace fieldpath::dynamics {
 
-enum class Integrator { Bdf, Erk };  ///< CVODE BDF (default) or ARKODE ERK (explicit reference)
+enum class Integrator { Bdf, Erk };
+
+/// `on_limit`: what to do when an output sample leaves the configured angle limits.
+enum class LimitPolicy {
+  Clamp,  ///< `clamp`: hold the angle at the limit (rate zeroed, solver restarted); flagged
+  Fail,   ///< `fail`: stop; status TiltLimit / RateLimit and a message naming the arc length
+};  ///< CVODE BDF (default) or ARKODE ERK (explicit reference)
 
 /// Torques are in the field's unit times mm (τ = Σ (x_i - C) × F(x_i)); time in seconds.
 struct DynamicsParams {
@@ -19,6 +25,7 @@ struct DynamicsParams {
   double max_tilt_deg = 35.0;
   double max_lead_deg = 20.0;
   Integrator integrator = Integrator::Bdf;
+  LimitPolicy on_limit = LimitPolicy::Clamp;
 
   /// c, with the critical default resolved.
   double effectiveDamping() const {

@@ -34,12 +34,6 @@ struct Pass {
   std::function<PassFrame(double s_mm)> frameAt;
 };
 
-/// What to do when an output sample leaves the configured limits.
-enum class LimitPolicy {
-  Report,  ///< stop; status TiltLimit / RateLimit and a message naming the arc length
-  Clamp,   ///< hold the angle at the limit (rate zeroed, solver restarted); the sample is flagged
-};
-
 struct SteeringRequest {
   const field::ForceField* field = nullptr;  ///< not owned; null = no field (free response)
   /// Tool + holder nodes, tool frame (tip at 0, axis +z), mm; not owned.
@@ -47,11 +41,13 @@ struct SteeringRequest {
   double ball_radius_mm = 3.0;  ///< R: the ball centre is at (0, 0, R) in the tool frame
   DynamicsParams params;
   double step_mm = 0.5;  ///< arc length between output samples (the last one lands on length_mm)
+  /// Output stations instead (mm, from 0, increasing, within the pass), e.g. a nominal path's
+  /// postures one for one; `step_mm` then only bounds the solver's step.
+  std::vector<double> output_s_mm;
   std::optional<double> initial_lead_rad;  ///< default: nominal θ0(0)
   std::optional<double> initial_tilt_rad;  ///< default: nominal θ0(0)
   double initial_lead_rate_rad_per_s = 0.0;
   double initial_tilt_rate_rad_per_s = 0.0;
-  LimitPolicy on_limit = LimitPolicy::Report;
   /// Between output samples, either angle; 0 = unchecked.
   double max_angle_change_deg_per_mm = 0.0;
   /// Solver step budget per output interval. BDF needs a few hundred to resolve a stiff start at
@@ -72,7 +68,7 @@ struct PostureSample {
   Vec3 moment = Vec3::Zero();                   ///< M about the ball centre, world frame
   double clearance_mm = 0.0;                    ///< from SteeringRequest::clearance, else NaN
   geometry::Posture posture;                    ///< tip = C - R a, axis a
-  bool limited = false;                         ///< clamped (LimitPolicy::Clamp) or rate over limit
+  bool limited = false;                         ///< clamped (params.on_limit Clamp) or rate over limit
 };
 
 /// Solver counters, summed over restarts (clamps).
@@ -87,7 +83,7 @@ struct SolverStats {
 
 enum class Status {
   Ok,
-  TiltLimit,     ///< an angle left [-max, max] (LimitPolicy::Report)
+  TiltLimit,     ///< an angle left [-max, max] (LimitPolicy::Fail)
   RateLimit,     ///< an angle changed faster than max_angle_change_deg_per_mm (Report)
   SolverFailed,  ///< the integrator gave up (step budget, convergence, non-finite moment)
 };

@@ -1,6 +1,9 @@
 #pragma once
-/// Path files (DESIGN.md "Conventions of data"): `.cl` (x y z i j k [spindle_rad] per line, `#`
-/// comments) and APT CLDATA.
+/// Path files (DESIGN.md "Conventions of data", "Passes from a nominal path", "Links and motion"):
+/// `.cl` (x y z i j k [spindle_rad] per line, `#` comments, `# pass K` / `# link` block markers),
+/// APT CLDATA (`GOTO/`, `RAPID` before link moves, `$` continuations, `$$` comments) and NumPy
+/// `.npy` (float32 | float64, shape N×6 or N×7, C order).
+#include <cstddef>
 #include <filesystem>
 #include <span>
 #include <string>
@@ -12,14 +15,61 @@
 
 namespace fieldpath::geometry {
 
-/// Reads a `.cl` file. Axes off unit length by < 1e-3 are normalised. Throws common::InputError
-/// "FILE:LINE: reason" for non-finite numbers, short/long lines, zero or non-unit axes, garbage,
-/// and "FILE: reason" for a missing file or one without postures.
+/// A run of consecutive postures [begin, end) of a path: a cutting pass or a link between passes.
+struct PathBlock {
+  enum class Kind { Pass, Link };
+  Kind kind = Kind::Pass;
+  std::size_t begin = 0, end = 0;
+  std::size_t size() const { return end - begin; }
+  bool operator==(const PathBlock&) const = default;
+};
+
+/// A path as read from (or written to) a file: its postures and how they are grouped.
+struct PathFile {
+  std::filesystem::path file;  ///< where it was read from (for messages)
+  std::vector<Posture> postures;
+  /// In order, covering [0, postures.size()) without gaps; empty blocks are never stored. A file
+  /// without markers is one pass block. `.cl`: `# pass ...` and blank lines start a pass block,
+  /// `# link` a link block. APT: a GOTO after `RAPID` is a link posture, the others pass ones.
+  std::vector<PathBlock> blocks;
+  /// Per posture: the 1-based line of its record (`.cl`, APT), or its 0-based row (`.npy`).
+  std::vector<std::size_t> lines;
+  bool rows = false;  ///< `lines` are `.npy` rows
+  /// Postures whose `.cl` line carries the comment `# limit ...` (generate marks the postures where
+  /// an angle limit held), sorted.
+  std::vector<std::size_t> limited;
+
+  /// "FILE:LINE" or "FILE: row R" of posture i, for messages.
+  std::string where(std::size_t i) const;
+  /// Number of blocks of a kind.
+  std::size_t count(PathBlock::Kind kind) const;
+};
+
+/// Reads a path by its extension: `.npy`, `.apt` / `.cls` (APT CLDATA), anything else `.cl`.
+/// Throws common::InputError naming the file and the line (or row) for every defect: non-finite
+/// numbers, short/long lines, zero or non-unit axes (axes off unit length by < 1e-3 are
+/// normalised), garbage, a missing file, a file without postures; `.npy`: a dtype other than
+/// float32/float64, a shape other than N×6 / N×7, Fortran order, a truncated or padded file.
+PathFile readPathFile(const std::filesystem::path& file);
+
+/// The readers behind readPathFile, by format whatever the extension.
+PathFile readClPath(const std::filesystem::path& file);
+PathFile readAptPath(const std::filesystem::path& file);
+PathFile readNpyPath(const std::filesystem::path& file);
+
+/// The postures of a `.cl` file (readClPath(file).postures).
 std::vector<Posture> readClFile(const std::filesystem::path& file);
+/// The GOTO postures of an APT file, links included (readAptPath(file).postures).
+std::vector<Posture> readAptFile(const std::filesystem::path& file);
 
 /// Writes a `.cl` file atomically, numbers in shortest round-trip form (reading it back gives the
-/// same doubles). The spindle column is written for postures with has_spindle. `comment` lines are
-/// prefixed with "# ".
+/// same doubles): `comment` lines prefixed with "# ", then `# pass K` (K from 1) before each pass
+/// block and `# link` before each link block (no markers when the path is one pass block), and
+/// `  # limit` after the postures listed in `path.limited`. The spindle column is written for
+/// postures with has_spindle.
+void writeClFile(const std::filesystem::path& file, const PathFile& path,
+                 std::string_view comment = {});
+/// One pass of `postures`.
 void writeClFile(const std::filesystem::path& file, std::span<const Posture> postures,
                  std::string_view comment = {});
 
@@ -29,13 +79,18 @@ struct AptHeader {
   double feed_mm_per_min = 1000;
 };
 
-/// Writes APT CLDATA atomically: PARTNO, UNITS/MM, MULTAX/ON, CUTTER/d,r,e,f,a,b,h, FEDRAT/, one
-/// GOTO/x,y,z,i,j,k per posture, FINI.
+/// Writes APT CLDATA atomically: PARTNO, UNITS/MM, MULTAX/ON, CUTTER/d,r,e,f,a,b,h, then per
+/// block `FEDRAT/MMPM,f` before a pass's GOTOs and `RAPID` before each link GOTO, FINI.
+void writeAptFile(const std::filesystem::path& file, const PathFile& path,
+                  const AptHeader& header);
+/// One pass of `postures`.
 void writeAptFile(const std::filesystem::path& file, std::span<const Posture> postures,
                   const AptHeader& header);
 
-/// Reads the GOTO records of an APT file back (for round-trip tests). Throws common::InputError
-/// "FILE:LINE: reason".
-std::vector<Posture> readAptFile(const std::filesystem::path& file);
+/// Writes `.npy` (float64, N×6, or N×7 if any posture has a spindle angle) atomically.
+void writeNpyFile(const std::filesystem::path& file, std::span<const Posture> postures);
+
+/// One pass block over `postures` (a path without markers).
+PathFile singlePass(std::vector<Posture> postures);
 
 }  // namespace fieldpath::geometry

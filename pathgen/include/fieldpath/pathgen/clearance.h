@@ -21,6 +21,41 @@ struct ClearanceRequest {
   std::size_t batch = 256;
 };
 
+/// Every motion between consecutive postures (tip and axis interpolated linearly, the axis
+/// renormalised), checked by adaptive sampling with a certified bound: tool + holder are a solid
+/// of revolution about the axis, so between two poses every point of it moves at most
+/// D = |Δtip| + ρ_max Δθ (ρ_max: the farthest point from the tip, Δθ: the angle between the
+/// axes), and the distance to the obstacles is 1-Lipschitz in that motion. Over a sub-motion
+/// whose ends are d0 and d1 away the distance is at least (d0 + d1 - D) / 2. Sub-motions are
+/// halved until that bound reaches max(required_mm, closest posture − tighten_mm), a sample
+/// touches, or D ≤ 2 `resolution_mm`: the smallest bound is within tighten_mm of the true minimum
+/// wherever that is above required_mm.
+struct MotionRequest {
+  double required_mm = 0.0;     ///< stop refining a motion once certified at this clearance
+  double resolution_mm = 0.005;  ///< halve sub-motions no shorter (in D) than 2 × this
+  double tighten_mm = 0.01;      ///< see above
+  /// Postures per progress report (and per parallel batch).
+  std::size_t batch = 256;
+  /// The postures' clearances if known (ClearanceResult::clearance_mm), else computed here.
+  std::span<const double> posture_clearance_mm;
+};
+
+struct MotionResult {
+  static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
+  std::size_t motions = 0;
+  /// Lower bound of the clearance over all motions, mm (0 when one touches).
+  double min_clearance_mm = std::numeric_limits<double>::infinity();
+  std::size_t min_index = npos;  ///< motion i: posture i → i + 1
+  /// Motions where a sample touches or the bound cannot exclude contact at the resolution.
+  std::size_t colliding = 0;
+  std::size_t first_colliding = npos;
+  /// Motions whose bound stays below `required_mm` (colliding ones included).
+  std::size_t under_required = 0;
+  std::size_t first_under_required = npos;
+  std::size_t samples = 0;           ///< distance queries between the postures
+  std::vector<double> clearance_mm;  ///< per motion: its lower bound, mm
+};
+
 struct ClearanceResult {
   static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
   std::size_t postures = 0;
@@ -37,18 +72,27 @@ struct ClearanceResult {
 /// Copies share the built hierarchies; queries are const and thread-safe.
 class ClearanceChecker {
  public:
-  /// Builds the hierarchies once. Throws common::InputError for an empty mesh.
+  /// Builds the hierarchies once. Throws common::InputError for an empty mesh. Reported
+  /// clearances are the mesh distances less `tool_chord_tol_mm`: a faceted tool whose vertices
+  /// lie on the true surface is inside it by up to its chordal error, so they are never
+  /// optimistic (DESIGN.md "Links and motion").
   ClearanceChecker(const geometry::TriangleMesh& tool_mesh,
-                   std::span<const geometry::TriangleMesh> obstacles);
+                   std::span<const geometry::TriangleMesh> obstacles,
+                   double tool_chord_tol_mm = 0.0);
 
-  /// Distance (mm) from the placed tool to the nearest obstacle, 0 if they touch or intersect;
-  /// `obstacle` (optional) receives its index.
+  /// Distance (mm) from the placed tool to the nearest obstacle less the chordal tolerance, 0 if
+  /// they touch or intersect; `obstacle` (optional) receives its index.
   double clearance(const geometry::Posture& posture, int* obstacle = nullptr) const;
 
   /// Every posture, in parallel (TBB); progress is reported between batches.
   ClearanceResult check(std::span<const geometry::Posture> postures,
                         const ClearanceRequest& request = {},
                         const common::Progress& progress = {}) const;
+
+  /// Every motion between consecutive postures (see MotionRequest), in parallel (TBB).
+  MotionResult checkMotions(std::span<const geometry::Posture> postures,
+                            const MotionRequest& request = {},
+                            const common::Progress& progress = {}) const;
 
   /// Smallest distance (mm) from a ball of `radius_mm` at each centre (world frame) to the
   /// obstacles, 0 if one touches; `at` and `obstacle` receive where. The ball of a ball-end mill
@@ -57,6 +101,9 @@ class ClearanceChecker {
                        std::size_t* at = nullptr, int* obstacle = nullptr) const;
 
   std::size_t obstacleCount() const;
+  double toolChordTolMm() const;
+  /// Farthest point of the tool mesh from its tip (mm): ρ_max of the motion bound.
+  double toolReachMm() const;
 
  private:
   struct Impl;

@@ -1,7 +1,7 @@
 #pragma once
-/// The whole job of `fieldpath generate` on the impeller, as a library call (the CLI, the tests and
-/// the benchmark share it): passes → field (direct or voxels) → steered tool axis per pass →
-/// exact clearance of every posture.
+/// The whole job of `fieldpath generate`, as a library call (the CLI, the study, the tests and the
+/// benchmark share it): passes (from the impeller or a nominal path) → field (direct or voxels) →
+/// steered tool axis per pass → links → exact clearance of every posture and motion.
 #include <cstddef>
 #include <memory>
 #include <optional>
@@ -16,7 +16,9 @@
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/geometry/tool.h"
 #include "fieldpath/pathgen/clearance.h"
+#include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/pathgen/impeller.h"
+#include "fieldpath/pathgen/links.h"
 #include "fieldpath/pathgen/params.h"
 #include "fieldpath/pathgen/passes.h"
 
@@ -50,10 +52,14 @@ constexpr FieldModeNames fieldModeNames(FieldMode mode) {
 }
 
 struct GenerateRequest {
-  ImpellerParams impeller;
-  /// Obstacles besides the impeller's two blades (world frame, mm), e.g. scene `- mesh:` entries.
-  std::vector<geometry::TriangleMesh> extra_obstacles;
-  PathParams path;
+  /// The passes, from their source: impellerPasses() (useImpeller) or nominalPasses().
+  std::vector<Pass> passes;
+  /// Surfaces that repel and that nothing may touch (world frame, mm).
+  std::vector<geometry::TriangleMesh> obstacles;
+  /// The machined surface (never repels): counted for the links' travel plane.
+  std::optional<geometry::TriangleMesh> part;
+  PathParams path;  ///< lead_deg (the passes are already made)
+  LinkParams links;
   field::FieldParams field;
   dynamics::DynamicsParams dynamics;
   geometry::ToolSpec tool;
@@ -63,19 +69,27 @@ struct GenerateRequest {
   FieldMode mode = FieldMode::Voxel;
   /// Nominal path: the axis stays on the nominal angles (no field, no dynamics).
   bool nominal = false;
+  /// Skip the links and the motion check (the study compares the passes' postures only).
+  bool passes_only = false;
   /// Hand the voxel field the path was steered by back in GenerateResult::voxels (the study
   /// measures its error without building it a second time).
   bool keep_voxels = false;
-  common::Progress progress;  ///< "field", "pass k/n", "clearance"
+  common::Progress progress;  ///< "field", "pass k/n", "clearance", "motions"
 };
 
-/// One output posture with what the dynamics and the clearance check say about it.
+/// The parametric impeller as the job's source: its passes (from job.path and the tool radius),
+/// its two blades before job's other obstacles, its hub as job.part.
+void useImpeller(GenerateRequest& job, const Impeller& impeller);
+
+/// One output posture of a pass with what the dynamics and the clearance check say about it.
 struct GeneratedPosture {
   int pass = 0;       ///< 0-based
   double s_mm = 0.0;  ///< arc length along the pass
   double lead_rad = 0.0, tilt_rad = 0.0;
   double moment = 0.0;        ///< |M| of the field about the ball centre (0 for the nominal path)
   double clearance_mm = 0.0;  ///< exact (FCL) nearest distance to the obstacles; 0 if colliding
+  bool limited = false;       ///< an angle limit held here (dynamics.on_limit: clamp)
+  std::size_t output = 0;     ///< index of this posture in GenerateResult::path
   geometry::Posture posture;
 };
 
@@ -85,9 +99,17 @@ struct StageTimes {
 };
 
 struct GenerateResult {
-  std::vector<GeneratedPosture> postures;  ///< all passes, in order
+  std::vector<GeneratedPosture> postures;  ///< the passes' postures, in order
   std::vector<Pass> passes;
-  ClearanceResult clearance;
+  /// The output path: passes joined by links (blocks), postures flagged where a limit held.
+  geometry::PathFile path;
+  ClearanceResult clearance;  ///< of every posture of `path` (links included)
+  MotionResult motions;       ///< of every motion of `path`
+  double safe_z_mm = 0.0;     ///< the links' travel plane
+  std::size_t link_postures = 0;
+  std::size_t limited_postures = 0;            ///< where dynamics.on_limit held an angle
+  std::size_t limited_colliding = 0;           ///< of those, colliding ones
+  std::size_t first_limited = ClearanceResult::npos;  ///< index into `postures`
   StageTimes times;
   std::size_t obstacle_points = 0;  ///< field samples
   std::size_t tool_nodes = 0;       ///< tool + holder nodes of the moment
@@ -107,14 +129,15 @@ struct GenerateResult {
 /// holder get ≈ 500 nodes.
 double defaultNodeSpacingMm(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder);
 
-/// Runs the job. Throws common::InputError for bad settings (naming the key), for a pass whose
-/// ball comes closer to a blade than `clearance` ("pass 2 (v = ...): ... channel narrower than the
-/// ball"), and when the dynamics leaves its limits (naming the pass and arc length).
-GenerateResult generateImpellerPath(const GenerateRequest& request);
+/// Runs the job: field, steering pass by pass, links, clearance of every posture and motion.
+/// Throws common::InputError for bad settings (naming the key), for a pass whose ball comes
+/// closer to an obstacle than `clearance` ("pass 2 (...): ... narrower than the ball"), and,
+/// with dynamics.on_limit: fail, when the dynamics leaves its limits (naming the pass and arc
+/// length).
+GenerateResult generatePath(const GenerateRequest& request);
 
-/// The obstacles of a job: the impeller's blades (0 = left, 1 = right), then the extra ones.
-std::vector<geometry::TriangleMesh> obstacleMeshes(
-    const Impeller& impeller, const std::vector<geometry::TriangleMesh>& extra = {});
+/// The impeller's two blades (0 = left, 1 = right).
+std::vector<geometry::TriangleMesh> bladeMeshes(const Impeller& impeller);
 
 /// Chordal tolerance of the tool + holder mesh used for the exact clearance, mm.
 inline constexpr double kClearanceMeshTolMm = 0.02;

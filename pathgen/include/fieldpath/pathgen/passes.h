@@ -1,46 +1,69 @@
 #pragma once
-/// Nominal passes on the impeller hub (seed 004 §3.2): ball-centre curves are the isoparametric
-/// curves v = const of the hub offset by the ball radius, C(u) = S(u, v) + R n(u, v), parametrised
-/// by arc length and stepped evenly at no more than `step` mm (both ends included). At each sample
-/// the frame f (feed tangent, unit), n (hub normal, unit, ⟂ f exactly since dC/du ⟂ n), b = n × f.
+/// Passes: the ball-centre curves the dynamics follow, with their frames, from one of two sources
+/// (DESIGN.md "Scene files"):
+/// - the parametric impeller (seed 004 §3.2): isoparametric curves v = const of the hub offset by
+///   the ball radius, C(u) = S(u, v) + R n(u, v), parametrised by arc length;
+/// - a nominal path file (any part): the ball centres C = p + R a of its postures, split into
+///   passes at markers and gaps, frames from the polyline (DESIGN.md "Passes from a nominal path").
+/// At each station the frame f (feed tangent, unit), n (surface normal or the nominal axis made
+/// orthogonal to f, unit), b = n × f.
+#include <functional>
+#include <limits>
 #include <span>
+#include <string>
 #include <vector>
 
+#include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/posture.h"
 #include "fieldpath/pathgen/impeller.h"
 #include "fieldpath/pathgen/params.h"
 
 namespace fieldpath::pathgen {
 
-/// One output station of a pass. mm and unit vectors, world frame.
+/// One station of a pass. mm and unit vectors, world frame.
 struct PassSample {
   double s_mm = 0.0;  ///< arc length of the ball-centre curve from the pass start
-  double u = 0.0;     ///< hub parameter along the channel
-  Vec3 centre_mm;     ///< ball centre C(s)
-  Vec3 feed;          ///< f
-  Vec3 normal;        ///< n, hub normal at the contact point
-  Vec3 binormal;      ///< b = n × f
+  /// Source parameter: the impeller's u, or the fractional index of the nominal posture.
+  double u = 0.0;
+  Vec3 centre_mm;  ///< ball centre C(s)
+  Vec3 feed;       ///< f
+  Vec3 normal;     ///< n
+  Vec3 binormal;   ///< b = n × f
 };
 
 struct Pass {
-  int index = 0;  ///< 0-based
-  double v = 0.0;
+  int index = 0;      ///< 0-based
+  std::string label;  ///< for messages: "pass 3 (v = 0.44)", "pass 3 (nominal.cl:120)"
+  double v = std::numeric_limits<double>::quiet_NaN();  ///< the impeller's v (NaN otherwise)
   double ball_radius_mm = 0.0;
   double length_mm = 0.0;
-  std::vector<PassSample> samples;  ///< output stations, s = 0 ... length_mm evenly
-  /// Arc length → u table (dense, increasing), for sampleAt at any s.
-  std::vector<double> table_s_mm, table_u;
+  std::vector<PassSample> samples;  ///< output stations, s = 0 ... length_mm
+  /// The station at any s in [0, length_mm] (clamped): cheap, deterministic, thread-safe, so the
+  /// dynamics can call it at every solver stage.
+  std::function<PassSample(double s_mm)> at;
 };
 
-/// The station of `pass` at arc length s_mm (clamped to [0, length]); cheap (a table lookup and
-/// one evaluation of the hub), so the dynamics can call it at every solver stage.
-PassSample sampleAt(const Impeller& impeller, const Pass& pass, double s_mm);
-
 /// The `passes` passes at v evenly spread over impeller.passes_v, covering u_range, for a ball
-/// of `ball_radius_mm`. Throws common::InputError naming `path.passes`, `path.step` or the pass
-/// ("pass 3: empty ...") for a pass shorter than one step.
+/// of `ball_radius_mm`, stepped evenly at no more than `path.step` (both ends included). Throws
+/// common::InputError naming `path.passes`, `path.step` or the pass ("pass 3: empty ...") for a
+/// pass shorter than one step.
 std::vector<Pass> impellerPasses(const Impeller& impeller, const PathParams& path,
                                  double ball_radius_mm);
+
+/// The passes of a nominal path: its pass blocks (link blocks dropped), each split where two
+/// consecutive tips are farther apart than `path.pass_gap` (0: 4 × the block's median step);
+/// consecutive postures with the same ball centre are dropped (counted in `repeated`). Stations:
+/// the postures one for one, or every `path.step` mm when `path.step_given`. Throws
+/// common::InputError naming the file and line for a pass with fewer than two distinct postures
+/// and for a posture whose feed runs along its axis (no frame).
+std::vector<Pass> nominalPasses(const geometry::PathFile& path, const PathParams& params,
+                                double ball_radius_mm, std::size_t* repeated = nullptr);
+
+/// Posture ranges [begin, end) of the passes of a path: its pass blocks (link blocks dropped),
+/// each split where two consecutive tips are farther apart than `pass_gap_mm` (0: 4 × the
+/// block's median step).
+std::vector<std::pair<std::size_t, std::size_t>> passRanges(const geometry::PathFile& path,
+                                                            double pass_gap_mm);
 
 /// Nominal axis of a sample: n turned by `lead_rad` about b (towards f), i.e.
 /// dynamics::axisFromAngles of the sample's frame with no tilt.

@@ -145,6 +145,11 @@ std::size_t estimateHostBytes(const Grid& grid);
 /// (default: half the physical memory).
 void checkGridFits(const Grid& grid, std::size_t available_bytes = 0);
 
+/// The highest up-facing point of a part mesh on each line (world frame, mm); NaN where the line
+/// misses the part.
+std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
+                           std::span<const std::array<std::uint32_t, 3>> triangles);
+
 /// Stock as the top of a part mesh (world frame, mm): the highest up-facing point on each line;
 /// lines that miss the part start at its lowest z.
 std::vector<float> stockFromPart(const Grid& grid, std::span<const Vec3f> vertices,

@@ -1,0 +1,38 @@
+#include "job.h"
+
+#include "fieldpath/common/errors.h"
+
+namespace fieldpath::app {
+
+pathgen::GenerateRequest sceneJob(const Scene& scene) {
+  using common::InputError;
+  const std::string where = scene.file.string() + ": ";
+  const bool impeller = scene.impeller_model && scene.guide_impeller;
+  if (scene.nominal && impeller)
+    throw InputError(where +
+                     "path.nominal: the passes come from one source: a nominal path file or the "
+                     "parametric impeller's hub (`guide: { impeller: hub }`), not both");
+  if (!scene.nominal && !impeller)
+    throw InputError(where +
+                     "path.nominal: missing: generate needs the nominal path (`path: { nominal: "
+                     "FILE }`, .cl, APT or .npy) or the parametric impeller (`guide: { impeller: "
+                     "hub }` with `- impeller:` among the obstacles)");
+  pathgen::GenerateRequest job;
+  job.path = scene.path;
+  job.links = scene.links;
+  job.field = scene.field;
+  job.dynamics = scene.dynamics;
+  job.tool = scene.tool;
+  job.holder = scene.holder;
+  job.clearance_mm = scene.clearance_mm;
+  job.obstacles = scene.obstacles;  // the impeller's blades included (resolveImpeller)
+  job.part = scene.part;
+  if (job.tool.shape != geometry::ToolShape::Ball)
+    throw InputError(where + "tool.shape: the passes are for a ball-end mill (shape: ball)");
+  job.passes = impeller ? pathgen::impellerPasses(*scene.impeller_model, job.path,
+                                                  job.tool.radius_mm)
+                        : pathgen::nominalPasses(*scene.nominal, job.path, job.tool.radius_mm);
+  return job;
+}
+
+}  // namespace fieldpath::app

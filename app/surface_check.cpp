@@ -1,0 +1,299 @@
+#include "surface_check.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <limits>
+#include <string>
+
+#include "fieldpath/common/atomic_file.h"
+#include "fieldpath/common/errors.h"
+#include "fieldpath/pathgen/passes.h"
+#include "fieldpath/zbuffer/outputs.h"
+#include "to_zbuffer.h"
+
+namespace fieldpath::app {
+namespace {
+
+using geometry::Vec3;
+using Vec2 = Eigen::Vector2d;
+
+/// Marks the lines inside triangle (a, b, c) (plan view, mm).
+void markTriangle(const zbuffer::Grid& grid, const Vec2& a, const Vec2& b, const Vec2& c,
+                  std::vector<char>& mask) {
+  const double area = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+  if (std::abs(area) < 1e-12) return;
+  const Vec2 lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
+  const int ix0 = std::max(0, static_cast<int>(std::floor((lo.x() - grid.x0_mm) / grid.dx_mm - 0.5)));
+  const int ix1 = std::min(grid.nx - 1, static_cast<int>(std::ceil((hi.x() - grid.x0_mm) / grid.dx_mm - 0.5)));
+  const int iy0 = std::max(0, static_cast<int>(std::floor((lo.y() - grid.y0_mm) / grid.dy_mm - 0.5)));
+  const int iy1 = std::min(grid.ny - 1, static_cast<int>(std::ceil((hi.y() - grid.y0_mm) / grid.dy_mm - 0.5)));
+  auto edge = [](const Vec2& p, const Vec2& q, const Vec2& x) {
+    return (q - p).x() * (x - p).y() - (q - p).y() * (x - p).x();
+  };
+  for (int iy = iy0; iy <= iy1; ++iy)
+    for (int ix = ix0; ix <= ix1; ++ix) {
+      const Vec2 x(grid.x0_mm + (ix + 0.5) * grid.dx_mm, grid.y0_mm + (iy + 0.5) * grid.dy_mm);
+      const double e0 = edge(a, b, x), e1 = edge(b, c, x), e2 = edge(c, a, x);
+      if ((e0 >= 0 && e1 >= 0 && e2 >= 0) || (e0 <= 0 && e1 <= 0 && e2 <= 0))
+        mask[static_cast<std::size_t>(iy) * grid.nx + ix] = 1;
+    }
+}
+
+/// A pass's ball centres in plan, resampled at `count` points evenly in arc length.
+std::vector<Vec2> resampled(const std::vector<Vec2>& line, std::size_t count) {
+  std::vector<double> s(line.size(), 0.0);
+  for (std::size_t i = 1; i < line.size(); ++i) s[i] = s[i - 1] + (line[i] - line[i - 1]).norm();
+  std::vector<Vec2> out;
+  std::size_t j = 1;
+  for (std::size_t k = 0; k < count; ++k) {
+    const double target = s.back() * k / std::max<std::size_t>(1, count - 1);
+    while (j + 1 < s.size() && s[j] < target) ++j;
+    const double span = s[j] - s[j - 1];
+    const double w = span > 0 ? std::clamp((target - s[j - 1]) / span, 0.0, 1.0) : 0.0;
+    out.push_back((1 - w) * line[j - 1] + w * line[j]);
+  }
+  return out;
+}
+
+/// The machined band: strips between consecutive passes that are neighbours (their facing points
+/// at most `neighbour_mm` apart on average), and a strip of ±R/2 along a pass with no neighbour.
+std::vector<char> machinedBand(const zbuffer::Grid& grid, const geometry::PathFile& path,
+                               double radius_mm) {
+  std::vector<std::vector<Vec2>> passes;
+  for (const auto& [begin, end] : pathgen::passRanges(path, 0.0)) {
+    std::vector<Vec2> line;
+    for (std::size_t i = begin; i < end; ++i) {
+      const Vec3 c = geometry::ballCentre(path.postures[i], radius_mm);
+      if (line.empty() || (Vec2(c.x(), c.y()) - line.back()).norm() > 1e-9) line.emplace_back(c.x(), c.y());
+    }
+    if (line.size() >= 2) passes.push_back(std::move(line));
+  }
+  std::vector<char> mask(grid.lineCount(), 0);
+  const double neighbour_mm = 4.0 * radius_mm;
+  std::vector<char> has_neighbour(passes.size(), 0);
+  for (std::size_t k = 0; k + 1 < passes.size(); ++k) {
+    const std::size_t n = std::max(passes[k].size(), passes[k + 1].size());
+    std::vector<Vec2> a = resampled(passes[k], n), b = resampled(passes[k + 1], n);
+    double forward = 0, backward = 0;
+    for (std::size_t j = 0; j < n; ++j) {
+      forward += (a[j] - b[j]).norm();
+      backward += (a[j] - b[n - 1 - j]).norm();
+    }
+    if (backward < forward) std::reverse(b.begin(), b.end());  // a zig-zag path
+    if (std::min(forward, backward) / n > neighbour_mm) continue;
+    has_neighbour[k] = has_neighbour[k + 1] = 1;
+    for (std::size_t j = 0; j + 1 < n; ++j) {
+      markTriangle(grid, a[j], a[j + 1], b[j + 1], mask);
+      markTriangle(grid, a[j], b[j + 1], b[j], mask);
+    }
+  }
+  for (std::size_t k = 0; k < passes.size(); ++k) {
+    if (has_neighbour[k]) continue;
+    const auto& line = passes[k];
+    for (std::size_t j = 0; j + 1 < line.size(); ++j) {
+      const Vec2 d = (line[j + 1] - line[j]).normalized();
+      const Vec2 side = 0.5 * radius_mm * Vec2(-d.y(), d.x());
+      markTriangle(grid, line[j] - side, line[j + 1] - side, line[j + 1] + side, mask);
+      markTriangle(grid, line[j] - side, line[j + 1] + side, line[j] + side, mask);
+    }
+  }
+  return mask;
+}
+
+/// 3 × 5 pixel glyphs for the legend of deviation.png: digits, '-', '.', 'u', 'm'.
+const char* glyph(char c) {
+  switch (c) {
+    case '0':
+      return "111101101101111";
+    case '1':
+      return "010110010010111";
+    case '2':
+      return "111001111100111";
+    case '3':
+      return "111001111001111";
+    case '4':
+      return "101101111001001";
+    case '5':
+      return "111100111001111";
+    case '6':
+      return "111100111101111";
+    case '7':
+      return "111001001001001";
+    case '8':
+      return "111101111101111";
+    case '9':
+      return "111101111001111";
+    case '-':
+      return "000000111000000";
+    case '.':
+      return "000000000000010";
+    case 'u':
+      return "000000101101111";
+    case 'm':
+      return "000000111111101";
+    default:
+      return "000000000000000";
+  }
+}
+
+struct Image {
+  int width, height;
+  std::vector<std::uint8_t> rgb;
+  void set(int x, int y, std::array<std::uint8_t, 3> c) {
+    if (x < 0 || y < 0 || x >= width || y >= height) return;
+    std::copy(c.begin(), c.end(), rgb.begin() + 3 * (static_cast<std::size_t>(y) * width + x));
+  }
+  void text(int x, int y, const std::string& s, int scale) {
+    for (char ch : s) {
+      const char* g = glyph(ch);
+      for (int r = 0; r < 5; ++r)
+        for (int c = 0; c < 3; ++c)
+          if (g[r * 3 + c] == '1')
+            for (int dy = 0; dy < scale; ++dy)
+              for (int dx = 0; dx < scale; ++dx)
+                set(x + c * scale + dx, y + r * scale + dy, {0, 0, 0});
+      x += 4 * scale;
+    }
+  }
+};
+
+/// Diverging colours: blue for gouge (down to -gouge_scale), white at 0, red for scallop.
+std::array<std::uint8_t, 3> deviationColour(double dev_um, double gouge_scale_um,
+                                            double scallop_scale_um) {
+  const double t = dev_um < 0 ? std::min(1.0, -dev_um / gouge_scale_um)
+                              : std::min(1.0, dev_um / scallop_scale_um);
+  const auto fade = static_cast<std::uint8_t>(255.0 * (1.0 - t));
+  return dev_um < 0 ? std::array<std::uint8_t, 3>{fade, fade, 255}
+                    : std::array<std::uint8_t, 3>{255, fade, fade};
+}
+
+std::string microns(double um) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.0fum", um);
+  return text;
+}
+
+}  // namespace
+
+void writeDeviationPng(const std::filesystem::path& file, const SurfaceResult& stats) {
+  const zbuffer::Grid& grid = stats.grid;
+  const std::vector<float>& dev_um = stats.deviation_um;
+  const int max_side = 1200;
+  const int k =
+      std::max(1, static_cast<int>(std::ceil(std::max(grid.nx, grid.ny) / double(max_side))));
+  const int map_w = grid.nx / k, map_h = grid.ny / k;
+  const int scale = std::max(2, map_h / 120), bar_w = 12 * scale, legend_w = bar_w + 28 * scale;
+  Image img{map_w + legend_w, std::max(map_h, 60 * scale), {}};
+  img.rgb.assign(static_cast<std::size_t>(img.width) * img.height * 3, 255);
+  const double gouge_scale = std::max(1.0, stats.max_gouge_um);
+  const double scallop_scale = std::max(1.0, stats.max_scallop_um);
+  for (int py = 0; py < map_h; ++py) {
+    for (int px = 0; px < map_w; ++px) {
+      const int ix = px * k, iy = (map_h - 1 - py) * k;
+      const float d = dev_um[static_cast<std::size_t>(iy) * grid.nx + ix];
+      img.set(px, py,
+              std::isnan(d) ? std::array<std::uint8_t, 3>{200, 200, 200}
+                            : deviationColour(d, gouge_scale, scallop_scale));
+    }
+  }
+  // Colour bar: top = max scallop, middle = 0, bottom = max gouge.
+  const int bar_x = map_w + 4 * scale, bar_top = 4 * scale, bar_h = img.height - 8 * scale;
+  for (int y = 0; y < bar_h; ++y) {
+    const double t = 1.0 - 2.0 * y / (bar_h - 1);  // +1 top, -1 bottom
+    const double dev = t >= 0 ? t * scallop_scale : t * gouge_scale;
+    for (int x = 0; x < bar_w; ++x)
+      img.set(bar_x + x, bar_top + y, deviationColour(dev, gouge_scale, scallop_scale));
+  }
+  const int label_x = bar_x + bar_w + 2 * scale;
+  img.text(label_x, bar_top, microns(scallop_scale), scale);
+  img.text(label_x, bar_top + bar_h / 2 - 3 * scale, "0um", scale);
+  img.text(label_x, bar_top + bar_h - 5 * scale, microns(-gouge_scale), scale);
+  const std::string png = zbuffer::encodePng(img.width, img.height, img.rgb);
+  common::writeTextAtomically(file, png);
+}
+
+SurfaceResult checkSurface(const SurfaceRequest& request) {
+  const geometry::TriangleMesh& part = *request.part;
+  const geometry::PathFile& path = *request.path;
+  const double radius = request.tool.radius_mm;
+  // The region: the passes' ball centres in plan, padded by the tool radius, within the part.
+  Eigen::AlignedBox2d passes_box, part_box;
+  for (const auto& [begin, end] : pathgen::passRanges(path, 0.0))
+    for (std::size_t i = begin; i < end; ++i) {
+      const Vec3 c = geometry::ballCentre(path.postures[i], radius);
+      passes_box.extend(Vec2(c.x(), c.y()));
+    }
+  for (const Vec3& v : part.vertices) part_box.extend(Vec2(v.x(), v.y()));
+  passes_box.min().array() -= radius;
+  passes_box.max().array() += radius;
+  const Eigen::AlignedBox2d region = passes_box.intersection(part_box);
+  if (region.isEmpty() || !(region.sizes().minCoeff() > 0.0))
+    throw common::InputError(path.file.string() +
+                             ": the passes do not pass over the part (`part` mesh): no surface "
+                             "to check");
+  SurfaceResult result;
+  double spacing = request.spacing_mm;
+  const double area = region.sizes().x() * region.sizes().y();
+  if (area / (spacing * spacing) > static_cast<double>(kMaxSurfaceLines)) {
+    spacing = std::sqrt(area / static_cast<double>(kMaxSurfaceLines));
+    result.coarsened = true;
+  }
+  const int nx = std::max(2, static_cast<int>(std::ceil(region.sizes().x() / spacing)));
+  const int ny = std::max(2, static_cast<int>(std::ceil(region.sizes().y() / spacing)));
+  zbuffer::SimulationRequest sim;
+  sim.grid = zbuffer::Grid::fromRegion(region.min().x(), region.min().y(),
+                                       region.min().x() + nx * spacing,
+                                       region.min().y() + ny * spacing, nx, ny);
+  zbuffer::checkGridFits(sim.grid);
+  sim.tool = request.tool.shape == geometry::ToolShape::Ball
+                 ? zbuffer::Tool::ball(radius, request.tool.length_mm)
+             : request.tool.shape == geometry::ToolShape::Torus
+                 ? zbuffer::Tool::torus(radius, request.tool.corner_radius_mm, request.tool.length_mm)
+                 : zbuffer::Tool::flat(radius, request.tool.length_mm);
+  sim.backend = request.backend;
+  const zbuffer::ToolMesh part_mesh = toZbuffer(part);
+  const std::vector<float> nominal = zbuffer::partTop(sim.grid, part_mesh.vertices, part_mesh.triangles);
+  float top = -std::numeric_limits<float>::infinity();
+  for (float h : nominal)
+    if (!std::isnan(h)) top = std::max(top, h);
+  sim.initial_heights_mm = nominal;
+  for (float& h : sim.initial_heights_mm) h = (std::isnan(h) ? top : h) + kStockAllowanceMm;
+  sim.progress = request.progress;
+  sim.expected_postures = path.postures.size();
+  const zbuffer::SimulationResult simulated = zbuffer::simulate(sim, toZbuffer(path.postures));
+  result.grid = sim.grid;
+  result.gouge_tolerance_um = request.gouge_tolerance_um;
+  result.backend = simulated.backend;
+  result.simulation_s = simulated.seconds;
+  result.in_band = machinedBand(sim.grid, path, radius);
+  result.deviation_um.assign(sim.grid.lineCount(), std::numeric_limits<float>::quiet_NaN());
+  double sum = 0, sum2 = 0, min_dev = 0, max_dev = 0;
+  for (std::size_t i = 0; i < nominal.size(); ++i) {
+    if (std::isnan(nominal[i])) {
+      result.in_band[i] = 0;
+      continue;
+    }
+    const double d = 1000.0 * (double(simulated.heights_mm[i]) - double(nominal[i]));
+    result.deviation_um[i] = static_cast<float>(d);
+    ++result.part_lines;
+    min_dev = std::min(min_dev, d);
+    result.gouged_lines += d < -request.gouge_tolerance_um;
+    if (!result.in_band[i]) continue;
+    ++result.band_lines;
+    sum += d;
+    sum2 += d * d;
+    max_dev = std::max(max_dev, d);
+  }
+  if (result.band_lines > 0) {
+    result.mean_um = sum / result.band_lines;
+    result.rms_um = std::sqrt(sum2 / result.band_lines);
+  }
+  result.max_gouge_um = std::max(0.0, -min_dev);
+  result.max_scallop_um = max_dev;
+  return result;
+}
+
+}  // namespace fieldpath::app

@@ -1,0 +1,59 @@
+#pragma once
+/// The machined surface of a path against its part (`check`, DESIGN.md): the Z-buffer simulates
+/// the path's postures over the part's region, starting a stock allowance above the part, and
+/// every line is compared with the part's own height: gouge (below) and scallop (above), µm.
+#include <cstddef>
+#include <filesystem>
+#include <vector>
+
+#include "fieldpath/common/progress.h"
+#include "fieldpath/geometry/cl_file.h"
+#include "fieldpath/geometry/mesh.h"
+#include "fieldpath/geometry/tool.h"
+#include "fieldpath/zbuffer/simulator.h"
+
+namespace fieldpath::app {
+
+/// Initial stock above the part, mm: lines no tool reaches stay this far above it.
+inline constexpr float kStockAllowanceMm = 2.0f;
+/// Deviation below the part that counts as a gouge by default, µm. The part is a mesh: where it is
+/// concave its facets lie above the true surface by up to its chordal error (the impeller's hub
+/// mesh: 10 µm; measured there: 1.3 µm), so an exact cut reads as a shallow gouge.
+inline constexpr double kGougeToleranceUm = 5.0;
+/// Lines at most; a finer `spacing` over a larger region is coarsened (and says so).
+inline constexpr std::size_t kMaxSurfaceLines = 6'000'000;
+
+struct SurfaceRequest {
+  const geometry::TriangleMesh* part = nullptr;
+  const geometry::PathFile* path = nullptr;
+  geometry::ToolSpec tool;
+  double spacing_mm = 0.05;  ///< line spacing asked for
+  double gouge_tolerance_um = kGougeToleranceUm;
+  zbuffer::Backend backend = zbuffer::Backend::Auto;
+  common::Progress progress;
+};
+
+struct SurfaceResult {
+  zbuffer::Grid grid;
+  /// Per line: machined height − part height, µm; NaN where the line misses the part.
+  std::vector<float> deviation_um;
+  /// Per line: in the machined band (between consecutive neighbouring passes, or near a lone
+  /// pass), where scallops count.
+  std::vector<char> in_band;
+  std::size_t part_lines = 0, band_lines = 0;
+  std::size_t gouged_lines = 0;  ///< anywhere on the part, deeper than the tolerance
+  double gouge_tolerance_um = kGougeToleranceUm;
+  double max_gouge_um = 0, max_scallop_um = 0, mean_um = 0, rms_um = 0;  ///< scallop stats: band
+  zbuffer::Backend backend = zbuffer::Backend::Cpu;
+  double simulation_s = 0;
+  bool coarsened = false;  ///< the spacing was widened to stay within kMaxSurfaceLines
+};
+
+/// Simulates and compares. Throws common::InputError for a path whose passes miss the part.
+SurfaceResult checkSurface(const SurfaceRequest& request);
+
+/// deviation.png: the map (row 0 = largest y, grey off the part) with a colour bar and its scale
+/// in µm on the right.
+void writeDeviationPng(const std::filesystem::path& file, const SurfaceResult& surface);
+
+}  // namespace fieldpath::app

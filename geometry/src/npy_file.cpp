@@ -1,0 +1,191 @@
+/// Postures as NumPy `.npy` (DESIGN.md command line): float32 or float64, little-endian, shape
+/// N×6 (x y z i j k) or N×7 (+ spindle angle, rad), C order. Anything else is refused with one
+/// line naming the file; a bad row names the row.
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <optional>
+
+#include "fieldpath/common/atomic_file.h"
+#include "fieldpath/geometry/cl_file.h"
+#include "path_text.h"
+
+namespace fieldpath::geometry {
+namespace {
+
+using namespace detail;
+using common::InputError;
+
+constexpr char kMagic[] = "\x93NUMPY";
+constexpr std::size_t kMagicSize = 6;
+
+[[noreturn]] void bad(const std::filesystem::path& file, const std::string& why) {
+  throw InputError(file.string() + ": " + why);
+}
+
+/// The text after `'key':` in a NumPy header dict, up to the end of the value (a quoted string,
+/// a parenthesised tuple, or a bare word).
+std::optional<std::string> headerValue(std::string_view header, std::string_view key) {
+  for (const char quote : {'\'', '"'}) {
+    const std::string quoted_key = std::string(1, quote) + std::string(key) + quote;
+    auto at = header.find(quoted_key);
+    if (at == std::string_view::npos) continue;
+    at = header.find(':', at + quoted_key.size());
+    if (at == std::string_view::npos) return std::nullopt;
+    std::string_view rest = trimmed(header.substr(at + 1));
+    if (rest.empty()) return std::nullopt;
+    if (rest.front() == '\'' || rest.front() == '"') {
+      const auto end = rest.find(rest.front(), 1);
+      if (end == std::string_view::npos) return std::nullopt;
+      return std::string(rest.substr(1, end - 1));
+    }
+    if (rest.front() == '(') {
+      const auto end = rest.find(')');
+      if (end == std::string_view::npos) return std::nullopt;
+      return std::string(rest.substr(1, end - 1));
+    }
+    const auto end = rest.find_first_of(",}");
+    return std::string(trimmed(rest.substr(0, end)));
+  }
+  return std::nullopt;
+}
+
+/// "(N, 6)" → {N, 6}; throws for anything but two non-negative integers.
+std::vector<std::uint64_t> parseShape(const std::filesystem::path& file, const std::string& text) {
+  std::vector<std::uint64_t> shape;
+  std::string_view rest(text);
+  while (!trimmed(rest).empty()) {
+    const auto comma = rest.find(',');
+    const std::string_view item = trimmed(rest.substr(0, comma));
+    if (!item.empty()) {
+      std::uint64_t value = 0;
+      const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
+      if (ec != std::errc() || end != item.data() + item.size())
+        bad(file, "npy shape (" + text + ") is not a list of sizes");
+      shape.push_back(value);
+    }
+    if (comma == std::string_view::npos) break;
+    rest = rest.substr(comma + 1);
+  }
+  return shape;
+}
+
+}  // namespace
+
+PathFile readNpyPath(const std::filesystem::path& file) {
+  requireRegularFile(file);
+  std::ifstream in(file, std::ios::binary);
+  if (!in) bad(file, "cannot open for reading");
+  std::error_code ec;
+  const std::uint64_t file_size = std::filesystem::file_size(file, ec);
+  if (ec) bad(file, "cannot read its size");
+
+  char prefix[12] = {};
+  in.read(prefix, 10);
+  if (in.gcount() != 10 || std::memcmp(prefix, kMagic, kMagicSize) != 0)
+    bad(file, "not a NumPy .npy file (no \\x93NUMPY magic)");
+  const int major = static_cast<unsigned char>(prefix[6]);
+  std::uint64_t header_size = 0, offset = 10;
+  if (major == 1) {
+    header_size = static_cast<unsigned char>(prefix[8]) |
+                  (static_cast<std::uint64_t>(static_cast<unsigned char>(prefix[9])) << 8);
+  } else if (major == 2 || major == 3) {
+    in.read(prefix + 10, 2);
+    if (in.gcount() != 2) bad(file, "truncated npy header");
+    for (int b = 0; b < 4; ++b)
+      header_size |= static_cast<std::uint64_t>(static_cast<unsigned char>(prefix[8 + b])) << (8 * b);
+    offset = 12;
+  } else {
+    bad(file, "npy format version " + std::to_string(major) + " is not supported (1, 2 or 3)");
+  }
+  if (header_size > 65536 || offset + header_size > file_size) bad(file, "truncated npy header");
+  std::string header(header_size, '\0');
+  in.read(header.data(), static_cast<std::streamsize>(header_size));
+  if (static_cast<std::uint64_t>(in.gcount()) != header_size) bad(file, "truncated npy header");
+
+  const auto descr = headerValue(header, "descr");
+  const auto fortran = headerValue(header, "fortran_order");
+  const auto shape_text = headerValue(header, "shape");
+  if (!descr || !fortran || !shape_text)
+    bad(file, "npy header lacks descr, fortran_order or shape");
+  std::size_t item = 0;
+  if (*descr == "<f8" || *descr == "=f8")
+    item = 8;
+  else if (*descr == "<f4" || *descr == "=f4")
+    item = 4;
+  else
+    bad(file, "npy dtype '" + *descr + "': expected float32 or float64, little-endian (<f4, <f8)");
+  if (*fortran != "False") bad(file, "npy array in Fortran order: expected C order");
+  const std::vector<std::uint64_t> shape = parseShape(file, *shape_text);
+  if (shape.size() != 2 || (shape[1] != 6 && shape[1] != 7))
+    bad(file, "npy shape (" + *shape_text + "): expected N×6 (x y z i j k) or N×7 (+ spindle)");
+  const std::uint64_t rows = shape[0], columns = shape[1];
+  if (rows == 0) bad(file, "no postures (shape (0, " + std::to_string(columns) + "))");
+  const std::uint64_t data_size = file_size - offset - header_size;
+  if (rows > data_size / (columns * item) || rows * columns * item != data_size)
+    bad(file, "npy data is " + std::to_string(data_size) + " bytes, shape (" +
+                  std::to_string(rows) + ", " + std::to_string(columns) + ") needs " +
+                  std::to_string(rows * columns * item) + (rows * columns * item > data_size
+                                                               ? " (truncated file)"
+                                                               : " (trailing bytes)"));
+
+  PathFile path;
+  path.file = file;
+  path.rows = true;
+  path.postures.reserve(rows);
+  path.lines.reserve(rows);
+  std::vector<char> buffer(columns * item);
+  for (std::uint64_t r = 0; r < rows; ++r) {
+    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    if (static_cast<std::size_t>(in.gcount()) != buffer.size()) bad(file, "truncated npy data");
+    double v[7];
+    for (std::size_t c = 0; c < columns; ++c) {
+      if (item == 8) {
+        std::memcpy(&v[c], buffer.data() + 8 * c, 8);
+      } else {
+        float f;
+        std::memcpy(&f, buffer.data() + 4 * c, 4);
+        v[c] = f;
+      }
+      if (!std::isfinite(v[c]))
+        bad(file, "row " + std::to_string(r) + ", column " + std::to_string(c) + ": not finite");
+    }
+    const std::string where = file.string() + ": row " + std::to_string(r);
+    Posture p;
+    p.tip_mm = Vec3(v[0], v[1], v[2]);
+    p.axis = checkedAxis(Vec3(v[3], v[4], v[5]), where);
+    p.has_spindle = columns == 7;
+    p.spindle_rad = p.has_spindle ? v[6] : 0.0;
+    path.postures.push_back(p);
+    path.lines.push_back(r);
+  }
+  path.blocks.push_back({PathBlock::Kind::Pass, 0, path.postures.size()});
+  return path;
+}
+
+void writeNpyFile(const std::filesystem::path& file, std::span<const Posture> postures) {
+  bool spindle = false;
+  for (const Posture& p : postures) spindle = spindle || p.has_spindle;
+  const std::size_t columns = spindle ? 7 : 6;
+  std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (" +
+                       std::to_string(postures.size()) + ", " + std::to_string(columns) + "), }";
+  // Pad with spaces so that the data starts on a 64-byte boundary; the header ends with '\n'.
+  while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+  header += '\n';
+  std::string bytes(kMagic, kMagicSize);
+  bytes += '\x01';
+  bytes += '\x00';
+  bytes += static_cast<char>(header.size() & 0xff);
+  bytes += static_cast<char>((header.size() >> 8) & 0xff);
+  bytes += header;
+  for (const Posture& p : postures) {
+    const double values[] = {p.tip_mm.x(), p.tip_mm.y(), p.tip_mm.z(), p.axis.x(),
+                             p.axis.y(),   p.axis.z(),   p.spindle_rad};
+    bytes.append(reinterpret_cast<const char*>(values), columns * sizeof(double));
+  }
+  common::writeFileAtomically(
+      file, [&](std::ofstream& out) { out.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); },
+      std::ios::out | std::ios::binary);
+}
+
+}  // namespace fieldpath::geometry

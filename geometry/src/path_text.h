@@ -1,0 +1,125 @@
+#pragma once
+/// Helpers shared by the path readers and writers (.cl, APT, .npy): errors naming the file and
+/// line, strict number parsing, the axis check, shortest round-trip numbers.
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <vector>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/geometry/cl_file.h"
+
+namespace fieldpath::geometry::detail {
+
+/// Axes whose length is off 1 by no more than this are taken as they are (a few ulps: rounding of
+/// an already normalised vector), so a written file reads back bit for bit.
+inline constexpr double kUnitAsIs = 8 * std::numeric_limits<double>::epsilon();
+/// Axes off unit length by less than this are normalised; the others are rejected (DESIGN.md).
+inline constexpr double kUnitTolerance = 1e-3;
+
+/// "FILE:LINE: why" (`where` already formatted, e.g. by PathFile::where).
+[[noreturn]] inline void failAt(const std::string& where, const std::string& why) {
+  throw common::InputError(where + ": " + why);
+}
+
+[[noreturn]] inline void fail(const std::filesystem::path& file, std::size_t line,
+                              const std::string& why) {
+  failAt(file.string() + ":" + std::to_string(line), why);
+}
+
+/// Printable form of a token for an error message (garbage bytes shown as \xNN, long tokens cut).
+inline std::string quoted(std::string_view token) {
+  std::string s = "'";
+  for (std::size_t i = 0; i < token.size() && i < 32; ++i) {
+    const auto c = static_cast<unsigned char>(token[i]);
+    if (std::isprint(c)) {
+      s += static_cast<char>(c);
+    } else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02X", c);
+      s += hex;
+    }
+  }
+  return s + (token.size() > 32 ? "...'" : "'");
+}
+
+/// Parses a whole token (an optional leading '+' allowed) as a finite double.
+inline double parseFinite(std::string_view token, const std::filesystem::path& file,
+                          std::size_t line) {
+  std::string_view digits = token;
+  if (!digits.empty() && digits.front() == '+') digits.remove_prefix(1);
+  double value = 0;
+  const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+  if (ec == std::errc::result_out_of_range) fail(file, line, quoted(token) + " is out of range");
+  if (ec != std::errc() || end != digits.data() + digits.size())
+    fail(file, line, quoted(token) + " is not a number");
+  if (!std::isfinite(value)) fail(file, line, quoted(token) + " is not finite");
+  return value;
+}
+
+/// The axis as read: unit (or normalised when off by < 1e-3); otherwise an error at `where`.
+inline Vec3 checkedAxis(const Vec3& axis, const std::string& where) {
+  const double length = axis.norm();
+  if (!(length > 0.0)) failAt(where, "zero tool axis");
+  if (!std::isfinite(length)) failAt(where, "tool axis is not finite");
+  if (std::abs(length - 1.0) >= kUnitTolerance) {
+    std::ostringstream why;
+    why << "tool axis is not a unit vector (length " << length << ")";
+    failAt(where, why.str());
+  }
+  return std::abs(length - 1.0) <= kUnitAsIs ? axis : Vec3(axis / length);
+}
+
+/// Splits on whitespace (a `\r` of CRLF files included).
+inline std::vector<std::string_view> splitWhitespace(std::string_view text) {
+  std::vector<std::string_view> tokens;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    const std::size_t start = i;
+    while (i < text.size() && !std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    if (i > start) tokens.push_back(text.substr(start, i - start));
+  }
+  return tokens;
+}
+
+inline std::string_view trimmed(std::string_view text) {
+  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front())))
+    text.remove_prefix(1);
+  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back())))
+    text.remove_suffix(1);
+  return text;
+}
+
+/// Shortest decimal form that reads back as the same double.
+inline void appendNumber(std::string& out, double value) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  out.append(buffer, result.ptr);
+}
+
+/// Throws "FILE: reason" unless `file` is a regular file.
+inline void requireRegularFile(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec))
+    throw common::InputError(file.string() + ": no such file");
+}
+
+/// Appends posture index `i` to the block list: a new block when `kind` differs from the last
+/// block's or `split` is set.
+inline void addToBlocks(std::vector<PathBlock>& blocks, PathBlock::Kind kind, bool split,
+                        std::size_t i) {
+  if (blocks.empty() || split || blocks.back().kind != kind)
+    blocks.push_back({kind, i, i + 1});
+  else
+    blocks.back().end = i + 1;
+}
+
+}  // namespace fieldpath::geometry::detail

@@ -1,0 +1,45 @@
+#pragma once
+/// Links between passes (DESIGN.md "Links and motion"): the output must be safe to run. Each pass
+/// is entered and left along its tool axis; between passes the tool travels in a plane above every
+/// mesh with the axis turned smoothly.
+#include <span>
+#include <vector>
+
+#include "fieldpath/geometry/cl_file.h"
+#include "fieldpath/geometry/mesh.h"
+#include "fieldpath/geometry/tool.h"
+#include "fieldpath/pathgen/params.h"
+
+namespace fieldpath::pathgen {
+
+using geometry::Vec3;
+
+/// Largest turn of the axis between two link postures (DESIGN.md: no step over 5°).
+inline constexpr double kMaxLinkTurnDeg = 5.0;
+/// `safe_z: auto`: this far above the highest mesh point, plus the clearance (mm).
+inline constexpr double kSafeZMarginMm = 2.0;
+
+/// Lowest z of tool + holder relative to the tip when the axis is `axis` (mm, ≤ 0 for a tool
+/// pointing down): the lowest of the cutting end's corner circle and of every profile station.
+double lowestPointBelowTip(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
+                           const Vec3& axis);
+
+/// `safe_z: auto`: the highest vertex of `meshes` + `clearance_mm` + kSafeZMarginMm.
+double autoSafeZ(std::span<const geometry::TriangleMesh> meshes, double clearance_mm);
+
+struct LinkRequest {
+  LinkParams params;
+  double safe_z_mm = 0.0;  ///< resolved: nothing of tool + holder goes below it while travelling
+  geometry::ToolSpec tool;
+  geometry::HolderProfile holder;
+};
+
+/// The whole output path: an approach link before the first pass (down its axis from the travel
+/// plane), a link between consecutive passes (retract along the axis, up to the travel plane,
+/// across with the axis turned by ≤ kMaxLinkTurnDeg per posture, down the next axis) and a
+/// departure after the last one. Throws common::InputError naming `links.` keys when a pass ends
+/// or starts with an axis too close to horizontal to leave along it, or for bad settings.
+geometry::PathFile linkPasses(std::span<const std::vector<geometry::Posture>> passes,
+                              const LinkRequest& request);
+
+}  // namespace fieldpath::pathgen

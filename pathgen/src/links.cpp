@@ -1,0 +1,141 @@
+#include "fieldpath/pathgen/links.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "fieldpath/common/errors.h"
+
+namespace fieldpath::pathgen {
+namespace {
+
+using common::InputError;
+using geometry::PathBlock;
+using geometry::Posture;
+
+/// An axis must rise at least this much (its z component) to be left along: sin 5°.
+constexpr double kMinAxisRise = 0.0872;
+
+/// Unit vector at fraction t of the great-circle arc from a to b (a, b unit, not opposite).
+Vec3 slerp(const Vec3& a, const Vec3& b, double t) {
+  const double angle = std::acos(std::clamp(a.dot(b), -1.0, 1.0));
+  if (angle < 1e-12) return a;
+  const double sa = std::sin(angle);
+  return (std::sin((1 - t) * angle) / sa * a + std::sin(t * angle) / sa * b).normalized();
+}
+
+Posture at(const Vec3& tip, const Vec3& axis) {
+  Posture p;
+  p.tip_mm = tip;
+  p.axis = axis;
+  return p;
+}
+
+/// Distance along `axis` from `tip` to where the tip reaches `z_mm` (never less than `retract`).
+double climb(const Posture& p, double z_mm, double retract_mm, const char* which, int pass) {
+  if (p.axis.z() < kMinAxisRise) {
+    std::ostringstream msg;
+    msg.precision(3);
+    msg << "links: pass " << pass << " " << which << " with the tool axis "
+        << std::acos(std::clamp(p.axis.z(), -1.0, 1.0)) * 180.0 / M_PI
+        << " deg from vertical: it cannot be " << (which[0] == 'e' ? "left" : "entered")
+        << " along its axis from the travel plane (links.safe_z)";
+    throw InputError(msg.str());
+  }
+  return std::max(retract_mm, (z_mm - p.tip_mm.z()) / p.axis.z());
+}
+
+}  // namespace
+
+double lowestPointBelowTip(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
+                           const Vec3& axis) {
+  const double cos_t = std::clamp(axis.normalized().z(), -1.0, 1.0);
+  const double sin_t = std::sqrt(std::max(0.0, 1.0 - cos_t * cos_t));
+  // A circle of radius ρ at height z above the tip (tool frame) reaches z cos - ρ sin below.
+  const double c = geometry::cornerRadius(tool);
+  double lowest = c * cos_t - (tool.radius_mm - c) * sin_t - c;  // the cutting end
+  auto station = [&](double z, double radius) {
+    lowest = std::min(lowest, z * cos_t - radius * sin_t);
+  };
+  station(c, tool.radius_mm);
+  station(tool.length_mm, tool.radius_mm);
+  for (const auto& s : holder) station(s.z_mm, s.radius_mm);
+  return lowest;
+}
+
+double autoSafeZ(std::span<const geometry::TriangleMesh> meshes, double clearance_mm) {
+  double top = -std::numeric_limits<double>::infinity();
+  for (const auto& mesh : meshes)
+    for (const auto& v : mesh.vertices) top = std::max(top, v.z());
+  if (!std::isfinite(top)) throw InputError("links.safe_z: auto needs at least one mesh vertex");
+  return top + clearance_mm + kSafeZMarginMm;
+}
+
+geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
+                              const LinkRequest& request) {
+  const LinkParams& params = request.params;
+  if (!std::isfinite(params.retract_mm) || params.retract_mm < 0.0)
+    throw InputError("links.retract: must be a finite distance >= 0 mm");
+  if (!std::isfinite(request.safe_z_mm)) throw InputError("links.safe_z: must be finite");
+  geometry::PathFile out;
+  auto add = [&](PathBlock::Kind kind, const Posture& p) {
+    if (kind == PathBlock::Kind::Link && !out.postures.empty() &&
+        (out.postures.back().tip_mm - p.tip_mm).norm() < 1e-9 &&
+        (out.postures.back().axis - p.axis).norm() < 1e-12)
+      return;  // e.g. the travel plane reached by the retract itself
+    if (out.blocks.empty() || out.blocks.back().kind != kind)
+      out.blocks.push_back({kind, out.postures.size(), out.postures.size()});
+    out.postures.push_back(p);
+    ++out.blocks.back().end;
+  };
+  // The tip's height in the travel plane for an axis turning from a to b: the whole tool and
+  // holder stay above safe_z at every axis on the way.
+  auto travelTipZ = [&](const Vec3& a, const Vec3& b) {
+    double lowest = 0.0;
+    for (int k = 0; k <= 32; ++k)
+      lowest = std::min(lowest, lowestPointBelowTip(request.tool, request.holder, slerp(a, b, k / 32.0)));
+    return request.safe_z_mm - lowest;
+  };
+  const auto link = PathBlock::Kind::Link;
+  for (std::size_t k = 0; k < passes.size(); ++k) {
+    const std::vector<Posture>& pass = passes[k];
+    if (pass.empty()) continue;
+    const Posture& first = pass.front();
+    const int number = static_cast<int>(k) + 1;
+    // Down into pass k: from the travel plane (the approach for the first pass, the end of the
+    // link otherwise) along its first axis to `retract` above its start.
+    const Vec3 from_axis = k == 0 ? first.axis : passes[k - 1].back().axis;
+    const double z = travelTipZ(from_axis, first.axis);
+    if (k == 0) {
+      const double down = climb(first, z, params.retract_mm, "starts", number);
+      add(link, at(first.tip_mm + down * first.axis, first.axis));
+    } else {
+      const Posture& last = passes[k - 1].back();
+      const double up = climb(last, z, params.retract_mm, "ends", number - 1);
+      const double down = climb(first, z, params.retract_mm, "starts", number);
+      add(link, at(last.tip_mm + params.retract_mm * last.axis, last.axis));
+      const Vec3 a = last.tip_mm + up * last.axis, b = first.tip_mm + down * first.axis;
+      const double turn_deg =
+          std::acos(std::clamp(last.axis.dot(first.axis), -1.0, 1.0)) * 180.0 / M_PI;
+      const int steps = std::max(1, static_cast<int>(std::ceil(turn_deg / kMaxLinkTurnDeg)));
+      for (int j = 0; j <= steps; ++j) {
+        const double t = static_cast<double>(j) / steps;
+        add(link, at((1 - t) * a + t * b, slerp(last.axis, first.axis, t)));
+      }
+    }
+    add(link, at(first.tip_mm + params.retract_mm * first.axis, first.axis));
+    for (const Posture& p : pass) add(PathBlock::Kind::Pass, p);
+  }
+  // Departure: back along the last axis to the travel plane.
+  if (!out.postures.empty()) {
+    const Posture& last = out.postures.back();
+    const Posture final_posture = last;
+    const double up = climb(final_posture, travelTipZ(final_posture.axis, final_posture.axis),
+                            params.retract_mm, "ends", static_cast<int>(passes.size()));
+    add(link, at(final_posture.tip_mm + params.retract_mm * final_posture.axis, final_posture.axis));
+    add(link, at(final_posture.tip_mm + up * final_posture.axis, final_posture.axis));
+  }
+  return out;
+}
+
+}  // namespace fieldpath::pathgen

@@ -1,0 +1,182 @@
+/// Passes from a nominal path file (DESIGN.md "Passes from a nominal path"): the ball centres
+/// C = p + R a of the postures form a polyline per pass; the frame at a posture is the polyline's
+/// unit tangent (central differences, one-sided at the ends) and the nominal axis made orthogonal
+/// to it; between postures both are interpolated linearly (and re-orthonormalised), so the
+/// dynamics sees a continuous frame.
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <sstream>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/pathgen/passes.h"
+
+namespace fieldpath::pathgen {
+namespace {
+
+using common::InputError;
+using geometry::PathBlock;
+using geometry::PathFile;
+
+/// Ball centres closer than this are one posture repeated (mm).
+constexpr double kRepeatMm = 1e-9;
+/// The nominal axis must be at least this far from the feed direction (sin of 0.5°): closer, the
+/// frame's normal is the rounding noise of a projection.
+constexpr double kMinAxisToFeedSin = 0.0087;
+
+/// The vertices of one pass: ball centres, arc lengths, tangents, normals.
+struct Polyline {
+  std::vector<double> s_mm;
+  std::vector<Vec3> centre_mm, tangent, normal;
+};
+
+PassSample vertexSample(const Polyline& line, std::size_t i) {
+  PassSample sample;
+  sample.s_mm = line.s_mm[i];
+  sample.u = static_cast<double>(i);
+  sample.centre_mm = line.centre_mm[i];
+  sample.feed = line.tangent[i];
+  sample.normal = line.normal[i];
+  sample.binormal = sample.normal.cross(sample.feed);
+  return sample;
+}
+
+/// The station at arc length s: exact at the vertices, linear in between.
+PassSample polylineSample(const Polyline& line, double s_mm) {
+  const auto& s = line.s_mm;
+  s_mm = std::clamp(s_mm, 0.0, s.back());
+  const auto it = std::lower_bound(s.begin(), s.end(), s_mm);
+  const std::size_t j = static_cast<std::size_t>(it - s.begin());
+  if (j < s.size() && s[j] == s_mm) return vertexSample(line, j);
+  const std::size_t i = j - 1;  // s[i] < s_mm < s[j]
+  const double w = (s_mm - s[i]) / (s[j] - s[i]);
+  PassSample sample;
+  sample.s_mm = s_mm;
+  sample.u = static_cast<double>(i) + w;
+  sample.centre_mm = (1 - w) * line.centre_mm[i] + w * line.centre_mm[j];
+  Vec3 feed = (1 - w) * line.tangent[i] + w * line.tangent[j];
+  if (feed.norm() < 1e-9) feed = line.centre_mm[j] - line.centre_mm[i];  // a reversal
+  sample.feed = feed.normalized();
+  Vec3 normal = (1 - w) * line.normal[i] + w * line.normal[j];
+  normal -= normal.dot(sample.feed) * sample.feed;
+  if (normal.norm() < kMinAxisToFeedSin) normal = line.normal[i] - line.normal[i].dot(sample.feed) * sample.feed;
+  sample.normal = normal.normalized();
+  sample.binormal = sample.normal.cross(sample.feed);
+  return sample;
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values.empty() ? 0.0 : values[values.size() / 2];
+}
+
+}  // namespace
+
+std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path,
+                                                            double pass_gap_mm) {
+  std::vector<std::pair<std::size_t, std::size_t>> ranges;
+  for (const PathBlock& block : path.blocks) {
+    if (block.kind != PathBlock::Kind::Pass) continue;
+    std::vector<double> steps;
+    for (std::size_t i = block.begin + 1; i < block.end; ++i) {
+      const double d = (path.postures[i].tip_mm - path.postures[i - 1].tip_mm).norm();
+      if (d > kRepeatMm) steps.push_back(d);
+    }
+    const double gap = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(steps);
+    std::size_t begin = block.begin;
+    for (std::size_t i = block.begin + 1; i < block.end; ++i) {
+      if (gap > 0.0 && (path.postures[i].tip_mm - path.postures[i - 1].tip_mm).norm() > gap) {
+        ranges.emplace_back(begin, i);
+        begin = i;
+      }
+    }
+    ranges.emplace_back(begin, block.end);
+  }
+  return ranges;
+}
+
+std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
+                                double ball_radius_mm, std::size_t* repeated) {
+  if (!std::isfinite(params.pass_gap_mm) || params.pass_gap_mm < 0.0)
+    throw InputError("path.pass_gap: must be a finite distance >= 0 mm (0: automatic)");
+  if (params.step_given && (!std::isfinite(params.step_mm) || params.step_mm <= 0.0))
+    throw InputError("path.step: must be a finite number > 0");
+  if (!std::isfinite(params.lead_deg) || std::abs(params.lead_deg) >= 60.0)
+    throw InputError("path.lead_deg: must be a finite angle with |lead| < 60 deg");
+  if (!std::isfinite(ball_radius_mm) || ball_radius_mm <= 0.0)
+    throw InputError("tool.radius: must be > 0");
+  const double r = ball_radius_mm;
+  std::size_t dropped = 0;
+  std::vector<Pass> passes;
+  for (const auto& [begin, end] : passRanges(path, params.pass_gap_mm)) {
+    const int number = static_cast<int>(passes.size()) + 1;
+    // Distinct postures of the pass (consecutive repeats of a ball centre dropped).
+    std::vector<std::size_t> kept;
+    for (std::size_t i = begin; i < end; ++i) {
+      const Vec3 c = geometry::ballCentre(path.postures[i], r);
+      if (!kept.empty() && (c - geometry::ballCentre(path.postures[kept.back()], r)).norm() <= kRepeatMm) {
+        ++dropped;
+        continue;
+      }
+      kept.push_back(i);
+    }
+    if (kept.size() < 2) {
+      std::ostringstream msg;
+      msg << path.where(begin) << ": pass " << number << " has "
+          << (end - begin == 1 ? "a single posture"
+                               : std::to_string(end - begin) + " postures at one place")
+          << ": a pass needs two distinct postures (passes break at `# pass`, blank lines, "
+             "RAPID moves and gaps over path.pass_gap)";
+      throw InputError(msg.str());
+    }
+    auto line = std::make_shared<Polyline>();
+    const std::size_t n = kept.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      line->centre_mm.push_back(geometry::ballCentre(path.postures[kept[k]], r));
+      line->s_mm.push_back(k == 0 ? 0.0
+                                  : line->s_mm.back() +
+                                        (line->centre_mm[k] - line->centre_mm[k - 1]).norm());
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 == n ? n - 1 : k + 1;
+      Vec3 tangent = line->centre_mm[b] - line->centre_mm[a];
+      if (tangent.norm() <= kRepeatMm)  // a reversal: C(k+1) = C(k-1)
+        tangent = line->centre_mm[k + 1 == n ? k : k + 1] - line->centre_mm[k + 1 == n ? k - 1 : k];
+      tangent.normalize();
+      const Vec3& axis = path.postures[kept[k]].axis;
+      const Vec3 normal = axis - axis.dot(tangent) * tangent;
+      if (normal.norm() < kMinAxisToFeedSin) {
+        std::ostringstream msg;
+        msg.precision(3);
+        msg << path.where(kept[k]) << ": the feed direction runs along the tool axis (angle "
+            << std::acos(std::min(1.0, std::abs(axis.dot(tangent)))) * 180.0 / M_PI
+            << " deg): no frame for the dynamics (a plunge belongs in a link, after RAPID or "
+               "`# link`)";
+        throw InputError(msg.str());
+      }
+      line->tangent.push_back(tangent);
+      line->normal.push_back(normal.normalized());
+    }
+    Pass pass;
+    pass.index = number - 1;
+    pass.label = "pass " + std::to_string(number) + " (" + path.where(begin) + ")";
+    pass.ball_radius_mm = r;
+    pass.length_mm = line->s_mm.back();
+    pass.at = [line](double s_mm) { return polylineSample(*line, s_mm); };
+    if (params.step_given) {
+      const int intervals =
+          std::max(1, static_cast<int>(std::ceil(pass.length_mm / params.step_mm - 1e-9)));
+      for (int j = 0; j <= intervals; ++j)
+        pass.samples.push_back(pass.at(pass.length_mm * j / intervals));
+    } else {
+      for (std::size_t k = 0; k < n; ++k) pass.samples.push_back(vertexSample(*line, k));
+    }
+    passes.push_back(std::move(pass));
+  }
+  if (passes.empty())
+    throw InputError(path.file.string() + ": no pass (every block is a `# link` or RAPID move)");
+  if (repeated) *repeated = dropped;
+  return passes;
+}
+
+}  // namespace fieldpath::pathgen
