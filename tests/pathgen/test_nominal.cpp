@@ -1,0 +1,303 @@
+/// Passes from a nominal path file: pass breaks (markers, blank lines, gaps, APT RAPID), frames at
+/// degenerate postures, marked path files read back bit for bit, links, and motions checked
+/// between clear postures.
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/geometry/cl_file.h"
+#include "fieldpath/geometry/tool_model.h"
+#include "fieldpath/pathgen/clearance.h"
+#include "fieldpath/pathgen/links.h"
+#include "fieldpath/pathgen/passes.h"
+#include "run_fieldpath.h"
+
+using namespace fieldpath;
+using namespace fieldpath::pathgen;
+using geometry::PathBlock;
+using geometry::PathFile;
+using geometry::Posture;
+using test::TempDir;
+
+namespace {
+
+constexpr double kR = 3.0;
+
+/// "x y z 0 0 1" lines along x at height z, every `step` mm from x0 to x1.
+std::string straightLines(double x0, double x1, double step, double y, double z = 0.0) {
+  std::string text;
+  for (double x = x0; x <= x1 + 1e-9; x += step)
+    text += std::to_string(x) + " " + std::to_string(y) + " " + std::to_string(z) + " 0 0 1\n";
+  return text;
+}
+
+/// The InputError message of `f`, or "" if it did not throw one.
+template <class F>
+std::string errorOf(F&& f) {
+  try {
+    f();
+  } catch (const common::InputError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+}  // namespace
+
+TEST(PathBlocks, ClMarkersBlankLinesAndLinksMakeBlocks) {
+  TempDir dir;
+  const auto file = dir.write("p.cl", "# header\n# pass 1\n" + straightLines(0, 2, 1, 0) +
+                                          "# link\n5 5 20 0 0 1\n# pass 2\n" +
+                                          straightLines(0, 1, 1, 4) + "\n" +
+                                          straightLines(0, 1, 1, 8));
+  const PathFile path = geometry::readPathFile(file);
+  ASSERT_EQ(path.postures.size(), 8u);
+  const std::vector<PathBlock> expected = {{PathBlock::Kind::Pass, 0, 3},
+                                           {PathBlock::Kind::Link, 3, 4},
+                                           {PathBlock::Kind::Pass, 4, 6},
+                                           {PathBlock::Kind::Pass, 6, 8}};
+  EXPECT_EQ(path.blocks, expected);
+  EXPECT_EQ(path.lines[3], 7u);  // the line of the link posture
+  // Nominal passes drop the link: three passes.
+  EXPECT_EQ(nominalPasses(path, PathParams{}, kR).size(), 3u);
+}
+
+TEST(PathBlocks, AptRapidMovesAreLinksAndRecordsAreReadPast) {
+  TempDir dir;
+  const auto file = dir.write("p.apt",
+                              "PARTNO/TEST $$ a comment\nUNITS/MM\nMULTAX/ON\nLOAD/TOOL,1\n"
+                              "SPINDL/RPM,12000,CLW\nFEDRAT/MMPM,800\n"
+                              "GOTO / 0, 0, 0, 0, 0, 1\nGOTO/1,0,0,$\n 0,0,1\nGOTO/2,0,0\n"
+                              "RAPID\nGOTO/2,0,20,0,0,1\nRAPID\nGOTO/0,5,20,0,0,1\n"
+                              "FEDRAT/MMPM,800\nGOTO/0,5,0,0,0,1\nGOTO/1,5,0,0,0,1\n"
+                              "COOLNT/ON\nEND-OF-PATH\nFINI\n");
+  const PathFile path = geometry::readPathFile(file);
+  const std::vector<PathBlock> expected = {{PathBlock::Kind::Pass, 0, 3},
+                                           {PathBlock::Kind::Link, 3, 5},
+                                           {PathBlock::Kind::Pass, 5, 7}};
+  EXPECT_EQ(path.blocks, expected);
+  EXPECT_EQ(path.postures[2].axis, Eigen::Vector3d::UnitZ());  // a 3-value GOTO keeps the axis
+  EXPECT_EQ(path.lines[1], 8u);                                // the record's first line
+  EXPECT_EQ(nominalPasses(path, PathParams{}, kR).size(), 2u);
+}
+
+TEST(PathBlocks, GapsSplitPassesAtFourMedianSteps) {
+  // Steps of 0.5 mm, then a jump of 2.1 mm (> 4 × 0.5): two passes; with pass_gap 3: one.
+  const std::string text = straightLines(0, 5, 0.5, 0) + straightLines(7.1, 10, 0.5, 0);
+  TempDir dir;
+  const PathFile path = geometry::readPathFile(dir.write("g.cl", text));
+  ASSERT_EQ(path.blocks.size(), 1u);
+  const auto passes = nominalPasses(path, PathParams{}, kR);
+  ASSERT_EQ(passes.size(), 2u);
+  EXPECT_EQ(passes[0].samples.size(), 11u);
+  EXPECT_NEAR(passes[0].length_mm, 5.0, 1e-9);
+  PathParams wide;
+  wide.pass_gap_mm = 3.0;
+  EXPECT_EQ(nominalPasses(path, wide, kR).size(), 1u);
+}
+
+TEST(NominalPasses, FramesFollowThePolylineAndKeepPosturesOneForOne) {
+  // A circle of radius 20 in the plane z = 0, axis +z: f the tangent, n = +z, C = p + R e_z.
+  std::string text;
+  for (int k = 0; k <= 40; ++k) {
+    const double t = k * 0.05;
+    text += std::to_string(20 * std::cos(t)) + " " + std::to_string(20 * std::sin(t)) + " 0 0 0 1\n";
+  }
+  TempDir dir;
+  const PathFile path = geometry::readPathFile(dir.write("c.cl", text));
+  const auto passes = nominalPasses(path, PathParams{}, kR);
+  ASSERT_EQ(passes.size(), 1u);
+  ASSERT_EQ(passes[0].samples.size(), 41u);
+  for (std::size_t k = 0; k < 41; ++k) {
+    const PassSample& s = passes[0].samples[k];
+    const double t = k * 0.05;
+    EXPECT_NEAR((s.centre_mm - (path.postures[k].tip_mm + kR * Eigen::Vector3d::UnitZ())).norm(), 0, 1e-12);
+    EXPECT_NEAR((s.normal - Eigen::Vector3d::UnitZ()).norm(), 0, 1e-12);
+    // Central differences of a circle: the tangent exactly, away from the ends.
+    if (k > 0 && k < 40)
+      EXPECT_NEAR((s.feed - Eigen::Vector3d(-std::sin(t), std::cos(t), 0)).norm(), 0, 1e-6);
+    EXPECT_NEAR(s.binormal.norm(), 1.0, 1e-12);
+  }
+  // Between postures the frame stays orthonormal and finite.
+  for (double s_mm = 0; s_mm <= passes[0].length_mm; s_mm += 0.137) {
+    const PassSample s = passes[0].at(s_mm);
+    EXPECT_NEAR(s.feed.norm(), 1, 1e-12);
+    EXPECT_NEAR(s.feed.dot(s.normal), 0, 1e-12);
+  }
+  // With path.step the pass is resampled evenly.
+  PathParams step;
+  step.step_given = true;
+  step.step_mm = 0.25;
+  const auto resampled = nominalPasses(path, step, kR);
+  EXPECT_EQ(resampled[0].samples.size(),
+            static_cast<std::size_t>(std::ceil(resampled[0].length_mm / 0.25 - 1e-9)) + 1);
+}
+
+TEST(NominalPasses, DegeneratePosturesAreClearErrorsNamingTheLine) {
+  TempDir dir;
+  // Feed along the axis (a plunge) on line 3.
+  const auto plunge = dir.write("plunge.cl", "0 0 0 1 0 0\n1 0 0 1 0 0\n2 0 0 1 0 0\n");
+  const std::string m1 = errorOf([&] { nominalPasses(geometry::readPathFile(plunge), {}, kR); });
+  EXPECT_NE(m1.find("plunge.cl:1:"), std::string::npos) << m1;
+  EXPECT_NE(m1.find("along the tool axis"), std::string::npos) << m1;
+  // A pass of two identical postures.
+  const auto twice = dir.write("twice.cl", straightLines(0, 3, 1, 0) + "# pass\n5 5 0 0 0 1\n5 5 0 0 0 1\n");
+  const std::string m2 = errorOf([&] { nominalPasses(geometry::readPathFile(twice), {}, kR); });
+  EXPECT_NE(m2.find("twice.cl:6:"), std::string::npos) << m2;
+  EXPECT_NE(m2.find("pass 2"), std::string::npos) << m2;
+  // One posture.
+  const auto one = dir.write("one.cl", "1 2 3 0 0 1\n");
+  const std::string m3 = errorOf([&] { nominalPasses(geometry::readPathFile(one), {}, kR); });
+  EXPECT_NE(m3.find("one.cl:1:"), std::string::npos) << m3;
+  // Repeated postures inside a pass are dropped and counted, the rest keeps finite frames.
+  const auto repeated = dir.write("rep.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n1 0 0 0 0 1\n2 0 0 0 0 1\n");
+  std::size_t dropped = 0;
+  const auto passes = nominalPasses(geometry::readPathFile(repeated), {}, kR, &dropped);
+  EXPECT_EQ(dropped, 1u);
+  ASSERT_EQ(passes[0].samples.size(), 3u);
+  for (const auto& s : passes[0].samples) EXPECT_TRUE(s.feed.allFinite() && s.normal.allFinite());
+}
+
+TEST(PathFiles, MarkedClAndNpyReadBackBitForBit) {
+  PathFile path;
+  for (int i = 0; i < 9; ++i) {
+    Posture p;
+    p.tip_mm = {0.1 * i + 1.0 / 3.0, -7.25 + i * 1e-7, 12.0 / 7.0};
+    p.axis = Eigen::Vector3d(0.1, -0.2 * i, 1.0).normalized();
+    path.postures.push_back(p);
+  }
+  path.blocks = {{PathBlock::Kind::Link, 0, 2}, {PathBlock::Kind::Pass, 2, 5},
+                 {PathBlock::Kind::Link, 5, 6}, {PathBlock::Kind::Pass, 6, 9}};
+  path.limited = {3, 7};
+  TempDir dir;
+  geometry::writeClFile(dir.path() / "m.cl", path, "a test\nof markers");
+  const PathFile back = geometry::readPathFile(dir.path() / "m.cl");
+  EXPECT_EQ(back.blocks, path.blocks);
+  EXPECT_EQ(back.limited, path.limited);
+  geometry::writeNpyFile(dir.path() / "m.npy", path.postures);
+  const PathFile npy = geometry::readPathFile(dir.path() / "m.npy");
+  geometry::AptHeader header;
+  geometry::writeAptFile(dir.path() / "m.apt", path, header);
+  const PathFile apt = geometry::readPathFile(dir.path() / "m.apt");
+  EXPECT_EQ(apt.blocks, path.blocks);
+  for (const PathFile* read : {&back, &npy, &apt}) {
+    ASSERT_EQ(read->postures.size(), path.postures.size());
+    for (std::size_t i = 0; i < path.postures.size(); ++i)
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_TRUE(sameBits(read->postures[i].tip_mm[c], path.postures[i].tip_mm[c]));
+        EXPECT_TRUE(sameBits(read->postures[i].axis[c], path.postures[i].axis[c]));
+      }
+  }
+  // Written again, the .cl file is the same text.
+  geometry::writeClFile(dir.path() / "m2.cl", back, "a test\nof markers");
+  EXPECT_EQ(test::slurp(dir.path() / "m.cl"), test::slurp(dir.path() / "m2.cl"));
+}
+
+TEST(PathFiles, BadNpyFilesAreOneLineErrors) {
+  TempDir dir;
+  std::vector<Posture> postures(3);
+  geometry::writeNpyFile(dir.path() / "good.npy", postures);
+  const std::string good = test::slurp(dir.path() / "good.npy");
+  auto variant = [&](const std::string& name, std::string bytes) {
+    const auto file = dir.path() / name;
+    std::ofstream(file, std::ios::binary) << bytes;
+    return errorOf([&] { geometry::readPathFile(file); });
+  };
+  auto replaced = [&](const std::string& from, const std::string& to) {
+    std::string s = good;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  EXPECT_NE(variant("trunc.npy", good.substr(0, good.size() - 8)).find("truncated"), std::string::npos);
+  EXPECT_NE(variant("dtype.npy", replaced("<f8", "<i8")).find("dtype"), std::string::npos);
+  EXPECT_NE(variant("fortran.npy", replaced("False", "True ")).find("Fortran"), std::string::npos);
+  EXPECT_NE(variant("shape.npy", replaced("(3, 6)", "(6, 3)")).find("shape"), std::string::npos);
+  EXPECT_NE(variant("magic.npy", "hello").find("magic"), std::string::npos);
+  std::string nan = good;
+  const double q = std::nan("");
+  std::memcpy(nan.data() + nan.size() - 8, &q, 8);
+  EXPECT_NE(variant("nan.npy", nan).find("row 2"), std::string::npos);
+  std::string zero = good;  // row 0 has the axis (0, 0, 1): zero it
+  std::memset(zero.data() + (good.size() - 3 * 48) + 40, 0, 8);
+  EXPECT_NE(variant("zero.npy", zero).find("row 0: zero tool axis"), std::string::npos);
+}
+
+TEST(Links, LeaveAlongTheAxisTravelAboveSafeZAndTurnInSmallSteps) {
+  geometry::ToolSpec tool{geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
+  const geometry::HolderProfile holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
+  // Closed form: a vertical axis's lowest point is the tip; tilted by t, the holder's rim.
+  EXPECT_NEAR(lowestPointBelowTip(tool, holder, Eigen::Vector3d::UnitZ()), 0.0, 1e-12);
+  const double t = 30 * M_PI / 180;
+  const Eigen::Vector3d tilted(std::sin(t), 0, std::cos(t));
+  EXPECT_NEAR(lowestPointBelowTip(tool, holder, tilted),
+              std::min(3 * std::cos(t) - 3, 40 * std::cos(t) - 6 * std::sin(t)), 1e-12);
+  std::vector<std::vector<Posture>> passes(2);
+  for (int i = 0; i <= 4; ++i) {
+    passes[0].push_back({Eigen::Vector3d(i, 0, 0), tilted, 0.0, false});
+    passes[1].push_back({Eigen::Vector3d(4 - i, 10, 0), Eigen::Vector3d(0, -0.5, 1).normalized(), 0.0, false});
+  }
+  LinkRequest request;
+  request.safe_z_mm = 25.0;
+  request.tool = tool;
+  request.holder = holder;
+  const PathFile out = linkPasses(passes, request);
+  ASSERT_EQ(out.blocks.size(), 5u);  // link, pass, link, pass, link
+  EXPECT_EQ(out.blocks[0].kind, PathBlock::Kind::Link);
+  EXPECT_EQ(out.blocks[1].size(), 5u);
+  for (const PathBlock& block : out.blocks) {
+    if (block.kind != PathBlock::Kind::Link) continue;
+    for (std::size_t i = block.begin; i < block.end; ++i) {
+      const Posture& p = out.postures[i];
+      if (i > block.begin) {
+        const double turn = std::acos(std::min(1.0, p.axis.dot(out.postures[i - 1].axis)));
+        EXPECT_LE(turn, kMaxLinkTurnDeg * M_PI / 180 + 1e-12);
+      }
+    }
+  }
+  // The travel between the passes: every posture of the middle link but its first and last two
+  // (retract, climb / descent, approach) has the whole tool above safe_z.
+  const PathBlock& middle = out.blocks[2];
+  for (std::size_t i = middle.begin + 1; i + 1 < middle.end; ++i)
+    EXPECT_GE(out.postures[i].tip_mm.z() + lowestPointBelowTip(tool, holder, out.postures[i].axis),
+              25.0 - 1e-9);
+  // The first link posture after a pass is `retract` along its last axis.
+  EXPECT_NEAR((out.postures[middle.begin].tip_mm - (passes[0].back().tip_mm + 10 * tilted)).norm(), 0, 1e-12);
+}
+
+TEST(Motions, AThinWallBetweenTwoClearPosturesIsACollidingMotion) {
+  // A wall 0.2 mm thick (x in [4.9, 5.1]), 10 mm high; the tool jumps over it from x = 0 to 10 at
+  // a height where the ball goes through it, both ends 4.9 - 3 = 1.9 mm clear.
+  geometry::TriangleMesh wall;
+  const double x0 = 4.9, x1 = 5.1;
+  for (double x : {x0, x1})
+    for (double y : {-20.0, 20.0})
+      for (double z : {0.0, 10.0}) wall.vertices.emplace_back(x, y, z);
+  const int faces[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                            {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  for (const auto& f : faces) wall.triangles.emplace_back(f[0], f[1], f[2]);
+  const geometry::ToolSpec tool{geometry::ToolShape::Ball, 3.0, 0.0, 20.0};
+  const ClearanceChecker checker(geometry::toolMesh(tool, {}, 0.02), {&wall, 1}, 0.02);
+  const std::vector<Posture> jump = {{Eigen::Vector3d(0, 0, 2), Eigen::Vector3d::UnitZ(), 0, false},
+                                     {Eigen::Vector3d(10, 0, 2), Eigen::Vector3d::UnitZ(), 0, false}};
+  const ClearanceResult at_postures = checker.check(jump);
+  EXPECT_EQ(at_postures.colliding, 0u);
+  EXPECT_NEAR(at_postures.min_clearance_mm, 1.9 - 0.02, 0.03);
+  MotionRequest request;
+  request.required_mm = 0.5;
+  const MotionResult motions = checker.checkMotions(jump, request);
+  EXPECT_EQ(motions.colliding, 1u);
+  EXPECT_EQ(motions.first_colliding, 0u);
+  // Above the wall the same motion is clear, and its bound is within 0.01 mm of the closest
+  // approach (the ball's bottom passes 2 mm above the wall's top: 2 - 0.02).
+  const std::vector<Posture> over = {{Eigen::Vector3d(0, 0, 12), Eigen::Vector3d::UnitZ(), 0, false},
+                                     {Eigen::Vector3d(10, 0, 12), Eigen::Vector3d::UnitZ(), 0, false}};
+  const MotionResult clear = checker.checkMotions(over, request);
+  EXPECT_EQ(clear.colliding, 0u);
+  EXPECT_LE(clear.min_clearance_mm, 2.0 - 0.02 + 1e-9);
+  EXPECT_GE(clear.min_clearance_mm, 2.0 - 0.02 - 0.011 - 0.005);
+}
