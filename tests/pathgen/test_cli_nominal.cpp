@@ -1,0 +1,178 @@
+/// Jobs from meshes and a nominal path file through the built `fieldpath`, as a user runs them:
+/// the same nominal path as .cl, APT and .npy gives the same path.cl; limits clamped on a stiff
+/// scene give a path and a count; bad nominal paths and meshes are one-line errors, no outputs.
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "fieldpath/geometry/cl_file.h"
+#include "fieldpath/geometry/mesh_io.h"
+#include "fieldpath/pathgen/generate.h"
+#include "fieldpath/pathgen/impeller.h"
+#include "run_fieldpath.h"
+
+namespace fs = std::filesystem;
+using namespace fieldpath;
+using geometry::PathBlock;
+using geometry::PathFile;
+using test::TempDir;
+
+namespace {
+
+const fs::path kImpellerScene = fs::path(FIELDPATH_SOURCE_DIR) / "examples/impeller/scene.yaml";
+
+/// The scene keys shared by these jobs (the impeller example's tool, holder and settings).
+std::string sceneText(const std::string& nominal, const std::string& extra = "") {
+  return "obstacles:\n  - mesh: blades.stl\npart: hub.stl\n"
+         "tool: { shape: ball, radius: 3, length: 40 }\n"
+         "holder: [[40, 6], [55, 6], [55, 12], [90, 12]]\nclearance: 0.5\n"
+         "path: { nominal: " + nominal + " }\n" + extra;
+}
+
+/// The impeller's blades and hub as STL, and its nominal path (from `generate --nominal`) as .cl
+/// with its links, APT with RAPID links, and .npy (pass postures only: passes split at the gaps).
+class MeshJob : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = std::make_unique<TempDir>();
+    const pathgen::Impeller impeller{pathgen::ImpellerParams{}};
+    geometry::TriangleMesh blades = impeller.bladeMesh(0);
+    const geometry::TriangleMesh right = impeller.bladeMesh(1);
+    const int offset = static_cast<int>(blades.vertices.size());
+    blades.vertices.insert(blades.vertices.end(), right.vertices.begin(), right.vertices.end());
+    for (auto t : right.triangles) blades.triangles.push_back(t + Eigen::Vector3i::Constant(offset));
+    geometry::saveMesh(blades, dir_->path() / "blades.stl");
+    geometry::saveMesh(impeller.hubMesh(), dir_->path() / "hub.stl");
+    const auto r = test::runFieldpath(*dir_, "generate '" + kImpellerScene.string() +
+                                                 "' --nominal --out nominal_run");
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    const PathFile run = geometry::readPathFile(dir_->path() / "nominal_run/path.cl");
+    geometry::writeClFile(dir_->path() / "nominal.cl", run, "the impeller's nominal path");
+    geometry::AptHeader header;
+    geometry::writeAptFile(dir_->path() / "nominal.apt", run, header);
+    std::vector<geometry::Posture> cutting;
+    for (const PathBlock& b : run.blocks)
+      if (b.kind == PathBlock::Kind::Pass)
+        cutting.insert(cutting.end(), run.postures.begin() + b.begin, run.postures.begin() + b.end);
+    geometry::writeNpyFile(dir_->path() / "nominal.npy", cutting);
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+
+  /// `generate` of the scene naming `nominal`; path.cl without its first comment line (which
+  /// names the scene file).
+  static std::string generated(const std::string& nominal, nlohmann::json* report = nullptr) {
+    const std::string scene = "scene_" + fs::path(nominal).extension().string().substr(1) + ".yaml";
+    dir_->write(scene, sceneText(nominal));
+    const std::string out = "out_" + scene;
+    const auto r = test::runFieldpath(*dir_, "generate " + scene + " --out " + out);
+    EXPECT_EQ(r.exit_code, 0) << r.output();
+    if (report) *report = nlohmann::json::parse(test::slurp(dir_->path() / out / "report.json"));
+    const std::string text = test::slurp(dir_->path() / out / "path.cl");
+    return text.substr(text.find('\n') + 1);
+  }
+  static inline std::unique_ptr<TempDir> dir_;
+};
+
+}  // namespace
+
+TEST_F(MeshJob, ClAptAndNpyNominalPathsGiveTheSamePathBitForBit) {
+  nlohmann::json report;
+  const std::string from_cl = generated("nominal.cl", &report);
+  EXPECT_EQ(generated("nominal.apt"), from_cl);
+  EXPECT_EQ(generated("nominal.npy"), from_cl);
+  // The job on meshes: 7 passes, the field path clear at every posture and motion, links made.
+  EXPECT_EQ(report["passes"].get<int>(), 7);
+  EXPECT_EQ(report["clearance"]["colliding_postures"].get<int>(), 0);
+  EXPECT_EQ(report["motions"]["colliding_motions"].get<int>(), 0);
+  EXPECT_GE(report["motions"]["min_mm"].get<double>(), 0.5);
+  EXPECT_EQ(report["links"]["links"].get<int>(), 8);
+  EXPECT_NE(from_cl.find("# link"), std::string::npos);
+}
+
+TEST_F(MeshJob, CheckComparesWithThePartMesh) {
+  generated("nominal.cl");
+  const auto r = test::runFieldpath(
+      *dir_, "check scene_cl.yaml --path out_scene_cl.yaml/path.cl --spacing 0.2 --out checked");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const auto check = nlohmann::json::parse(test::slurp(dir_->path() / "checked/check.json"));
+  EXPECT_EQ(check["motions"]["colliding_motions"].get<int>(), 0);
+  EXPECT_GT(check["surface"]["band_lines"].get<int>(), 10000);
+  EXPECT_EQ(check["surface"]["gouged_lines"].get<int>(), 0);
+  EXPECT_GT(check["surface"]["max_scallop_um"].get<double>(), 100.0);
+  EXPECT_TRUE(fs::exists(dir_->path() / "checked/deviation.png"));
+  EXPECT_TRUE(fs::exists(dir_->path() / "checked/clearance.csv"));
+}
+
+TEST_F(MeshJob, BadNominalPathsAndMeshesAreOneLineErrorsWithNoOutputs) {
+  dir_->write("one.cl", "0 0 0 0 0 1\n");
+  dir_->write("twice.cl", "0 -8 0 0 0 1\n1 -8 0 0 0 1\n2 -8 0 0 0 1\n# pass\n5 0 1 0 0 1\n5 0 1 0 0 1\n");
+  dir_->write("plunge.cl", "0 -8 0 1 0 0\n1 -8 0 1 0 0\n2 -8 0 1 0 0\n");
+  dir_->write("empty.stl", "solid empty\nendsolid empty\n");
+  struct Case {
+    std::string scene, expected;
+  };
+  const Case cases[] = {
+      {sceneText("one.cl"), "one.cl:1"},
+      {sceneText("twice.cl"), "twice.cl:5"},
+      {sceneText("plunge.cl"), "plunge.cl:1"},
+      {sceneText("missing.cl"), "missing.cl"},
+      {"obstacles:\n  - mesh: empty.stl\npart: hub.stl\npath: { nominal: nominal.cl }\n",
+       "empty.stl"},
+      {"obstacles:\n  - mesh: blades.stl\npart: nothere.stl\npath: { nominal: nominal.cl }\n",
+       "nothere.stl"},
+  };
+  for (const Case& c : cases) {
+    dir_->write("bad.yaml", c.scene);
+    fs::remove_all(dir_->path() / "bad_out");
+    const auto r = test::runFieldpath(*dir_, "generate bad.yaml --out bad_out");
+    const std::string output = r.output();
+    EXPECT_EQ(r.exit_code, 1) << c.expected << ": " << output;
+    EXPECT_EQ(std::count(output.begin(), output.end(), '\n'), 1) << output;
+    EXPECT_NE(output.find(c.expected), std::string::npos) << output;
+    EXPECT_FALSE(fs::exists(dir_->path() / "bad_out")) << c.expected;
+  }
+}
+
+// A stiff scene whose tilt runs into max_lead_deg: with on_limit clamp (the default) a path and
+// a count of the postures held at the limit; with fail, exit 1 naming the pass and no outputs.
+TEST(StiffScene, ClampGivesAPathAndACountFailStops) {
+  TempDir dir;
+  std::string scene = test::slurp(kImpellerScene);
+  auto set = [&](const std::string& key, const std::string& value) {
+    const auto at = scene.find(key + ":");
+    ASSERT_NE(at, std::string::npos) << key;
+    const auto end = scene.find_first_of("#\n", at);
+    scene.replace(at, end - at, key + ": " + value + " ");
+  };
+  set("width_out", "18");
+  set("passes_v", "[0.3, 0.75]");  // the ball still fits the narrower outlet
+  set("stiffness", "100");
+  set("inertia", "1e-4");
+  set("gain", "50");
+  dir.write("stiff.yaml", scene);
+  const auto clamp = test::runFieldpath(dir, "generate stiff.yaml --out clamp");
+  ASSERT_EQ(clamp.exit_code, 0) << clamp.output();
+  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "clamp/report.json"));
+  EXPECT_GT(report["limits"]["limited_postures"].get<int>(), 0);
+  EXPECT_FALSE(report["limits"]["first_limited"].is_null());
+  EXPECT_LE(report["max_lead_deg"].get<double>(), 20.0 + 1e-9);
+  EXPECT_LE(report["max_tilt_deg"].get<double>(), 35.0 + 1e-9);
+  EXPECT_NE(test::slurp(dir.path() / "clamp/path.cl").find("# limit"), std::string::npos);
+  // check reads the marks and says whether those postures collide.
+  const auto checked = test::runFieldpath(dir, "check stiff.yaml --path clamp/path.cl --spacing 0.3");
+  ASSERT_EQ(checked.exit_code, 0) << checked.output();
+  EXPECT_NE(checked.out.find("held at an angle limit"), std::string::npos) << checked.out;
+
+  scene += "\n";
+  set("max_lead_deg", "20\n  on_limit: fail");
+  dir.write("stiff.yaml", scene);
+  const auto fail = test::runFieldpath(dir, "generate stiff.yaml --out fail");
+  EXPECT_EQ(fail.exit_code, 1) << fail.output();
+  EXPECT_NE(fail.output().find("pass "), std::string::npos) << fail.output();
+  EXPECT_FALSE(fs::exists(dir.path() / "fail"));
+}
