@@ -3,18 +3,18 @@
 path a CAM system would write for it. Usage: make_part.py OUT_DIR [--no-check]
 
 Writes into OUT_DIR (each file written to a temporary name, then renamed into place):
-  hub.stl       the part: the hub, a surface of revolution about +z, z = h(r) for r in [R_IN, R_OUT],
-                rising towards the axis with a concave (fillet-like) profile; an open sheet, normals up
+  hub.stl       the part: the hub, a surface of revolution about +z, z = h(r), r in [R_IN, R_OUT],
+                rising towards the axis, concave (fillet-like) profile; an open sheet, normals up
   blades.stl    the obstacles: N_BLADES closed, outward-oriented blade solids standing on the hub,
                 wrapped about z along r (WRAP_DEG) and leaning sideways towards +theta (the ruling
                 turned from the hub normal across the camber line by LEAN_IN_DEG at the inlet to
                 LEAN_OUT_DEG at the outlet, so the blades twist); all of them in one file
-  nominal.cl    the nominal path, ball-end R = 3 mm, axis on the hub normal: `x y z i j k` (tool tip,
+  nominal.cl    the nominal path, ball-end R = 3 mm, axis on the hub normal: `x y z i j k` (tip,
                 unit axis tip -> spindle) per line, `# pass K` before each pass
   nominal.apt   the same postures as APT CLDATA, RAPID links between passes
   nominal.npy   the same postures, float64, shape (N, 6), no links
 
-Passes: every channel between two adjacent blades; in each, PASSES_V gives the fraction v of the
+Passes: the channels in CHANNELS (between blades k and k + 1); in each, PASSES_V gives the fraction v of the
 angular gap between the two blade walls where they meet the hub (v = 0 on the wall of the blade
 at the lower angle, which leans over the channel); each pass runs from the inlet (R_IN + margin) to
 the outlet (R_OUT - margin), postures evenly spaced along the ball-centre arc.
@@ -51,7 +51,10 @@ BLADE_STATIONS = (97, 9)   # blade mesh stations along t (inlet to outlet) and a
 
 # ---- the nominal path ------------------------------------------------------------------------
 BALL_R_MM = 3.0            # ball-end mill radius
-PASSES_V = (0.18, 0.34, 0.5, 0.66, 0.82)  # fractions of the angular gap between the walls at the hub
+CHANNELS = (0,)            # the channels machined (k: between blade k and k + 1): a finishing job
+                           # on one channel, repeated by rotation on the machine
+PASSES_V = tuple(0.18 + 0.64 * i / 29 for i in range(30))  # fractions of the angular gap
+                           # between the walls (hub): 30 passes, stepover 0.7-1.4 mm
 MARGIN_MM = 2.5            # passes run over r in [R_IN + MARGIN, R_OUT - MARGIN] (contact radius)
 STEP_MM = 0.65             # largest spacing of postures along the ball-centre arc
 APT_LIFT_MM = 20.0         # the APT links: up the tool axis by this at a pass end, down at the next
@@ -117,7 +120,8 @@ def hub_signed_distance(points):
 
 # ---- blades: a ruled camber surface, thickened along its normal -----------------------------
 def camber_angle(t):
-    """Camber line angle (rad) of blade 0 at t = (r - R_IN) / L: 0 at the inlet, WRAP at the outlet."""
+    """Camber line angle (rad) of blade 0 at t = (r - R_IN) / L: 0 at the inlet, WRAP at the
+    outlet."""
     return math.radians(WRAP_DEG) * 0.5 * (t + t * t)
 
 
@@ -181,11 +185,12 @@ def camber_offset(t, w, k, offset_mm):
 # ---- meshes ----------------------------------------------------------------------------------
 def hub_mesh():
     """Triangles (T, 3, 3) of the hub annulus, normals up; stations sized for CHORD_TOL_MM."""
-    # circumferential chord error r (1 - cos(dphi/2)) <= 0.5 tol at R_OUT; meridional sagitta
-    # dr^2 h'' / 8 <= 0.4 tol (the arc is longer but flatter where the hub is steep)
+    # circumferential chord error r (1 - cos(dphi/2)) <= 0.5 tol at R_OUT (chords below the hub);
+    # meridional chords lie above the concave profile by dr^2 h'' / 8 vertically, kept <= 0.2 tol
+    # so that a ball on the true hub sits < 5 um into the mesh (check's gouge tolerance)
     dphi = 2.0 * math.acos(1.0 - 0.5 * CHORD_TOL_MM / R_OUT_MM)
     n_phi = N_BLADES * math.ceil(2.0 * math.pi / dphi / N_BLADES)
-    n_r = math.ceil(L_MM / math.sqrt(8.0 * 0.4 * CHORD_TOL_MM / HUB_CURVATURE))
+    n_r = math.ceil(L_MM / math.sqrt(8.0 * 0.2 * CHORD_TOL_MM / HUB_CURVATURE))
     r = np.linspace(R_IN_MM, R_OUT_MM, n_r + 1)
     phi = np.linspace(0.0, 2.0 * math.pi, n_phi, endpoint=False)
     grid = hub_point(r[:, None], phi[None, :])                 # (n_r + 1, n_phi, 3)
@@ -331,7 +336,7 @@ def nominal_passes():
     wall0 = np.interp(rho, rho_p, phi_p)
     wall1 = np.interp(rho, rho_m, phi_m) + 2.0 * math.pi / N_BLADES
     passes = []
-    for k in range(N_BLADES):
+    for k in CHANNELS:
         for v in PASSES_V:
             phi = wall0 + v * (wall1 - wall0) + 2.0 * math.pi * k / N_BLADES
             centre = hub_point(rho, phi) + BALL_R_MM * hub_normal(rho, phi)
@@ -473,6 +478,8 @@ def summarise(passes, reports, hub_tris, blade_tris):
     centroid = hub_tris.mean(axis=1)
     hub_err = max(np.abs(hub_signed_distance(edge_mid)).max(),
                   np.abs(hub_signed_distance(centroid)).max())
+    probes = np.concatenate([edge_mid, centroid])
+    hub_above = (probes[:, 2] - hub_height(np.hypot(probes[:, 0], probes[:, 1]))).max()
     n_t, n_w = BLADE_STATIONS
     # blade chord: mesh edge midpoints along t against the surface at the mid parameter
     t_mid = (np.arange(n_t - 1) + 0.5) / (n_t - 1)
@@ -486,7 +493,7 @@ def summarise(passes, reports, hub_tris, blade_tris):
                            for k in range(N_BLADES)])
     tip_h, foot_h = hub_signed_distance(tips), hub_signed_distance(feet)
     print(f"hub: {len(hub_tris)} triangles, chordal error {hub_err:.4f} mm (edge midpoints, "
-          f"centroids)")
+          f"centroids), mesh above the surface by <= {1000 * hub_above:.1f} um vertically")
     print(f"blades: {len(blade_tris)} triangles, {N_BLADES} shells, closed and outward: "
           f"{all(closed_and_oriented(blade_mesh(k, n_t, n_w)) for k in range(N_BLADES))}, "
           f"volume {signed_volume(blade_tris):.0f} mm^3; chord along t {blade_err:.4f} mm; "
@@ -512,7 +519,8 @@ def summarise(passes, reports, hub_tris, blade_tris):
     colliding = [r for r in reports if nearest(r) <= 0.0]
     short = [r for r in reports if nearest(r) < CLEARANCE_MM]
     by_kind = {kind: sum(r[kind] <= 0.0 for r in reports) for kind in ("ball", "shank", "holder")}
-    print(f"nominal tool + holder <-> blades: min {min(ball.min(), body.min()):.3f} mm (< 0: overlap "
+    print(f"nominal tool + holder <-> blades: min {min(ball.min(), body.min()):.3f} mm (< 0: "
+          f"overlap "
           f"depth, capped at the piece radius); {len(colliding)} postures collide "
           f"({', '.join(f'{k} {v}' for k, v in by_kind.items())}), on passes "
           f"{sorted({r['pass'] for r in colliding})}; {len(short)} below the {CLEARANCE_MM} mm "

@@ -7,6 +7,35 @@
 #include "fieldpath/common/errors.h"
 
 namespace fieldpath::field {
+namespace {
+
+/// One point at the centroid of each piece of triangle (a, b, c) halved at its longest edge until
+/// every edge is at most 1.5 steps: points proportional to its length, not to its length squared.
+void sampleSliver(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& normal, double step_mm,
+                  Weights weights, ObstacleSamples& out, int depth = 0) {
+  const double ab = (b - a).norm(), bc = (c - b).norm(), ca = (a - c).norm();
+  const double longest = std::max({ab, bc, ca});
+  if (longest <= 1.5 * step_mm || depth >= 40) {
+    const double area = 0.5 * (b - a).cross(c - a).norm();
+    out.add((a + b + c) / 3.0, normal, weights == Weights::Area ? area : 1.0);
+    return;
+  }
+  if (longest == ab) {
+    const Vec3 m = 0.5 * (a + b);
+    sampleSliver(a, m, c, normal, step_mm, weights, out, depth + 1);
+    sampleSliver(m, b, c, normal, step_mm, weights, out, depth + 1);
+  } else if (longest == bc) {
+    const Vec3 m = 0.5 * (b + c);
+    sampleSliver(a, b, m, normal, step_mm, weights, out, depth + 1);
+    sampleSliver(a, m, c, normal, step_mm, weights, out, depth + 1);
+  } else {
+    const Vec3 m = 0.5 * (c + a);
+    sampleSliver(a, b, m, normal, step_mm, weights, out, depth + 1);
+    sampleSliver(m, b, c, normal, step_mm, weights, out, depth + 1);
+  }
+}
+
+}  // namespace
 
 ObstacleSamples sampleObstacles(std::span<const geometry::TriangleMesh> meshes, double step_mm,
                                 Weights weights) {
@@ -30,6 +59,13 @@ ObstacleSamples sampleObstacles(std::span<const geometry::TriangleMesh> meshes, 
       const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
       const int n = std::max(1, static_cast<int>(std::ceil(std::max(std::sqrt(area) / step_mm,
                                                                     longest / (1.5 * step_mm)))));
+      if (double(n) * n > 2.0 * std::max(1.0, area / (step_mm * step_mm))) {
+        // A sliver (CAD tessellations are full of them): the n×n split would put n² points on
+        // little area. Halve it at its longest edge instead, until no edge exceeds 1.5 steps.
+        sampleSliver(a, b, c, normal, step_mm, weights, out);
+        out.area_mm2 += area;
+        continue;
+      }
       // Sub-triangles of the n×n split in barycentric steps e1 = (b-a)/n, e2 = (c-a)/n: "up" ones
       // have centroid a + (i + 1/3) e1 + (j + 1/3) e2 (i + j <= n-1), "down" ones
       // a + (i + 2/3) e1 + (j + 2/3) e2 (i + j <= n-2). All have area / n².
