@@ -34,9 +34,7 @@ void appendGoto(std::string& text, const Posture& p) {
 }  // namespace
 
 PathFile readAptPath(const std::filesystem::path& file) {
-  requireRegularFile(file);
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open for reading");
+  std::ifstream in = openPathFile(file);
   PathFile path;
   path.file = file;
   bool rapid = false;  // RAPID seen: the next motion is a link

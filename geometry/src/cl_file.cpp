@@ -59,9 +59,7 @@ PathFile readPathFile(const std::filesystem::path& file) {
 }
 
 PathFile readClPath(const std::filesystem::path& file) {
-  requireRegularFile(file);
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open for reading");
+  std::ifstream in = openPathFile(file);
   PathFile path;
   path.file = file;
   PathBlock::Kind next_kind = PathBlock::Kind::Pass;

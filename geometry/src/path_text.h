@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -110,6 +111,14 @@ inline void requireRegularFile(const std::filesystem::path& file) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec))
     throw common::InputError(file.string() + ": no such file");
+}
+
+/// Opens a path file for reading: "FILE: no such file" / "FILE: cannot open for reading".
+inline std::ifstream openPathFile(const std::filesystem::path& file) {
+  requireRegularFile(file);
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw common::InputError(file.string() + ": cannot open for reading");
+  return in;
 }
 
 /// Appends posture index `i` to the block list: a new block when `kind` differs from the last
