@@ -6,6 +6,7 @@
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/geometry/cl_file.h"
+#include "path_chunks.h"
 #include "path_text.h"
 
 namespace fieldpath::geometry {
@@ -31,21 +32,33 @@ void appendGoto(std::string& text, const Posture& p) {
   text.back() = '\n';
 }
 
-}  // namespace
+/// A line's content without its `$$` comment and surrounding blanks.
+std::string_view aptContent(std::string_view line) {
+  if (const auto comment = line.find("$$"); comment != std::string_view::npos)
+    line = line.substr(0, comment);
+  return trimmed(line);
+}
 
-PathFile readAptPath(const std::filesystem::path& file) {
-  std::ifstream in = openPathFile(file);
-  PathFile path;
-  path.file = file;
+/// What one chunk of an APT file leaves to the chunks around it.
+struct AptChunk {
+  PathChunk postures;
+  bool first_without_rapid = false;  ///< its first GOTO had no RAPID before it in this chunk
+  bool trailing_rapid = false;       ///< a RAPID after its last GOTO (or anywhere, if none)
+  std::size_t inherit_axis = 0;      ///< leading 3-number GOTOs: they keep an earlier chunk's axis
+};
+
+void parseAptChunk(std::string_view text, std::size_t first_line,
+                   const std::filesystem::path& file, AptChunk& out) {
   bool rapid = false;  // RAPID seen: the next motion is a link
-  std::string text;
+  bool own_axis = false;  // a 6-number GOTO seen in this chunk
   std::string record;  // a statement, with `$` continuation lines joined
-  std::size_t record_line = 0;
-  for (std::size_t line = 1; std::getline(in, text); ++line) {
-    std::string_view content(text);
-    if (const auto comment = content.find("$$"); comment != std::string_view::npos)
-      content = content.substr(0, comment);
-    content = trimmed(content);
+  std::size_t record_line = 0, line = first_line;
+  PathChunk& chunk = out.postures;
+  for (std::size_t pos = 0; pos < text.size(); ++line) {
+    std::size_t nl = text.find('\n', pos);
+    if (nl == std::string_view::npos) nl = text.size();
+    const std::string_view content = aptContent(text.substr(pos, nl - pos));
+    pos = nl + 1;
     if (record.empty()) record_line = line;
     if (!content.empty() && content.back() == '$') {
       record += content.substr(0, content.size() - 1);
@@ -62,30 +75,91 @@ PathFile readAptPath(const std::filesystem::path& file) {
       continue;
     }
     if (major != "GOTO" || slash == std::string::npos) continue;
-    std::vector<double> v;
+    double v[6];
+    std::size_t count = 0;
     const std::string_view rest = std::string_view(statement).substr(slash + 1);
     for (std::size_t start = 0; start <= rest.size();) {
       const auto comma = std::min(rest.find(',', start), rest.size());
       const auto tokens = splitWhitespace(rest.substr(start, comma - start));
       if (tokens.size() != 1) fail(file, record_line, "GOTO: expected comma-separated numbers");
-      v.push_back(parseFinite(tokens[0], file, record_line));
+      const double value = parseFinite(tokens[0], file, record_line);
+      if (count < 6) v[count] = value;
+      ++count;
       start = comma + 1;
     }
-    if (v.size() != 6 && v.size() != 3)
-      fail(file, record_line, "GOTO: " + std::to_string(v.size()) + " numbers, need x,y,z[,i,j,k]");
+    if (count != 6 && count != 3)
+      fail(file, record_line, "GOTO: " + std::to_string(count) + " numbers, need x,y,z[,i,j,k]");
+    const auto where = [&] { return file.string() + ":" + std::to_string(record_line); };
     Posture p;
     p.tip_mm = Vec3(v[0], v[1], v[2]);
-    // A 3-number GOTO keeps the previous axis (APT modal behaviour).
-    p.axis = v.size() == 6 ? checkedAxis(Vec3(v[3], v[4], v[5]),
-                                         file.string() + ":" + std::to_string(record_line))
-                           : (path.postures.empty() ? Vec3::UnitZ() : path.postures.back().axis);
-    addToBlocks(path.blocks, rapid ? PathBlock::Kind::Link : PathBlock::Kind::Pass, false,
-                path.postures.size());
+    checkTip(p.tip_mm, where);
+    // A 3-number GOTO keeps the previous axis (APT modal behaviour); before this chunk's first
+    // 6-number GOTO, that axis is an earlier chunk's (filled in when the chunks are joined).
+    if (count == 6) {
+      p.axis = checkedAxis(Vec3(v[3], v[4], v[5]), where);
+      own_axis = true;
+    } else {
+      p.axis = chunk.postures.empty() ? Vec3::UnitZ() : chunk.postures.back().axis;
+      if (!own_axis) ++out.inherit_axis;
+    }
+    if (chunk.postures.empty()) out.first_without_rapid = !rapid;
+    if (rapid) chunk.links.push_back(chunk.postures.size());
     rapid = false;
-    path.postures.push_back(p);
-    path.lines.push_back(record_line);
+    chunk.postures.push_back(p);
+    chunk.lines.push_back(record_line);
   }
-  if (path.postures.empty()) throw InputError(file.string() + ": no GOTO records");
+  out.trailing_rapid = rapid;
+}
+
+}  // namespace
+
+PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& options) {
+  const MappedFile mapped(file);
+  const std::string_view text = mapped.text();
+  const std::vector<TextChunk> pieces =
+      splitAtLines(text, options.chunk_bytes, [](std::string_view line) {
+        const std::string_view content = aptContent(line);
+        return !content.empty() && content.back() == '$';
+      });
+  std::vector<AptChunk> chunks(pieces.size());
+  forEachChunk(pieces.size(), options.threads, [&](std::size_t i) {
+    const TextChunk& c = pieces[i];
+    parseAptChunk(text.substr(c.begin, c.end - c.begin), c.first_line, file, chunks[i]);
+  });
+  // What crosses chunk boundaries: a RAPID pending, and the axis of 3-number GOTOs.
+  std::vector<std::size_t> link_postures;
+  bool pending = false;
+  std::size_t offset = 0;
+  const Posture* last = nullptr;
+  for (AptChunk& c : chunks) {
+    auto& postures = c.postures.postures;
+    if (postures.empty()) {
+      pending = pending || c.trailing_rapid;
+      continue;
+    }
+    if (c.first_without_rapid && pending) link_postures.push_back(offset);
+    for (std::size_t k : c.postures.links) link_postures.push_back(offset + k);
+    for (std::size_t k = 0; k < c.inherit_axis; ++k)
+      postures[k].axis = last ? last->axis : Vec3::UnitZ();
+    pending = c.trailing_rapid;
+    offset += postures.size();
+    last = &postures.back();
+  }
+  PathFile path;
+  path.file = file;
+  if (offset == 0) throw InputError(file.string() + ": no GOTO records");
+  // Blocks: runs of link postures between pass runs.
+  std::size_t next = 0;
+  for (std::size_t i : link_postures) {
+    if (i > next) path.blocks.push_back({PathBlock::Kind::Pass, next, i});
+    addToBlocks(path.blocks, PathBlock::Kind::Link, false, i);
+    next = i + 1;
+  }
+  if (next < offset) path.blocks.push_back({PathBlock::Kind::Pass, next, offset});
+  std::vector<PathChunk> parts;
+  parts.reserve(chunks.size());
+  for (AptChunk& c : chunks) parts.push_back(std::move(c.postures));
+  concatenate(parts, options.threads, path);
   return path;
 }
 

@@ -4,6 +4,7 @@
 
 #include "fieldpath/common/atomic_file.h"
 
+#include "path_chunks.h"
 #include "path_text.h"
 
 namespace fieldpath::geometry {
@@ -50,63 +51,207 @@ PathFile singlePass(std::vector<Posture> postures) {
   return path;
 }
 
-PathFile readPathFile(const std::filesystem::path& file) {
-  std::string ext = file.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".npy") return readNpyPath(file);
-  if (ext == ".apt" || ext == ".cls") return readAptPath(file);
-  return readClPath(file);
+PathFile readPathFile(const std::filesystem::path& file, const PathReadOptions& options) {
+  switch (pathFormatOf(file)) {
+    case PathFormat::Npy:
+      return readNpyPath(file, options);
+    case PathFormat::Apt:
+      return readAptPath(file, options);
+    case PathFormat::Cl:
+      break;
+  }
+  return readClPath(file, options);
 }
 
-PathFile readClPath(const std::filesystem::path& file) {
-  std::ifstream in = openPathFile(file);
-  PathFile path;
-  path.file = file;
-  PathBlock::Kind next_kind = PathBlock::Kind::Pass;
-  bool split = true;  // the next posture starts a block
-  std::string text;
-  for (std::size_t line = 1; std::getline(in, text); ++line) {
-    std::string_view content(text), comment;
+PathFormat pathFormatOf(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".npy") return PathFormat::Npy;
+  if (ext == ".apt" || ext == ".cls") return PathFormat::Apt;
+  return PathFormat::Cl;
+}
+
+namespace {
+
+inline bool isBlank(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f' || c == '\n';
+}
+
+/// Parses the `.cl` lines of one chunk. `Out` takes the postures (`add`), the block markers
+/// (`mark`, with the kind of the next block) and the `# limit` notes (`limit`, after the posture).
+template <class Out>
+void parseClChunk(std::string_view text, std::size_t first_line, const std::filesystem::path& file,
+                  Out& out) {
+  std::size_t line = first_line;
+  for (std::size_t pos = 0; pos < text.size(); ++line) {
+    std::size_t nl = text.find('\n', pos);
+    if (nl == std::string_view::npos) nl = text.size();
+    std::string_view content = text.substr(pos, nl - pos), comment;
+    pos = nl + 1;
+    bool has_comment = false;
     if (const auto hash = content.find('#'); hash != std::string_view::npos) {
       comment = content.substr(hash + 1);
       content = content.substr(0, hash);
+      has_comment = true;
     }
-    const auto tokens = splitWhitespace(content);
-    if (tokens.empty()) {
-      const Marker marker = comment.data() ? markerOf(comment) : Marker::None;
-      if (!comment.data() || marker == Marker::Pass) {  // a blank line or `# pass ...`
-        next_kind = PathBlock::Kind::Pass;
-        split = true;
-      } else if (marker == Marker::Link) {
-        next_kind = PathBlock::Kind::Link;
-        split = true;
+    // Up to 8 tokens kept (7 are allowed), all counted: the count is checked before the numbers.
+    std::string_view tokens[8];
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < content.size();) {
+      while (i < content.size() && isBlank(content[i])) ++i;
+      const std::size_t start = i;
+      while (i < content.size() && !isBlank(content[i])) ++i;
+      if (i > start) {
+        if (count < 8) tokens[count] = content.substr(start, i - start);
+        ++count;
       }
+    }
+    if (count == 0) {
+      const Marker marker = has_comment ? markerOf(comment) : Marker::None;
+      if (!has_comment || marker == Marker::Pass)  // a blank line or `# pass ...`
+        out.mark(PathBlock::Kind::Pass);
+      else if (marker == Marker::Link)
+        out.mark(PathBlock::Kind::Link);
       continue;
     }
-    if (tokens.size() < 6)
+    if (count < 6)
+      fail(file, line, "short line: " + std::to_string(count) + " numbers, need x y z i j k");
+    if (count > 7)
       fail(file, line,
-           "short line: " + std::to_string(tokens.size()) + " numbers, need x y z i j k");
-    if (tokens.size() > 7)
-      fail(file, line,
-           "too many columns: " + std::to_string(tokens.size()) +
-               ", expected x y z i j k [spindle]");
+           "too many columns: " + std::to_string(count) + ", expected x y z i j k [spindle]");
     double v[7];
-    for (std::size_t c = 0; c < tokens.size(); ++c) v[c] = parseFinite(tokens[c], file, line);
+    for (std::size_t c = 0; c < count; ++c) v[c] = parseFinite(tokens[c], file, line);
+    const auto where = [&] { return file.string() + ":" + std::to_string(line); };
     Posture p;
     p.tip_mm = Vec3(v[0], v[1], v[2]);
-    p.axis = checkedAxis(Vec3(v[3], v[4], v[5]), file.string() + ":" + std::to_string(line));
-    p.has_spindle = tokens.size() == 7;
+    checkTip(p.tip_mm, where);
+    p.axis = checkedAxis(Vec3(v[3], v[4], v[5]), where);
+    p.has_spindle = count == 7;
     p.spindle_rad = p.has_spindle ? v[6] : 0.0;
-    const std::size_t i = path.postures.size();
-    addToBlocks(path.blocks, next_kind, split, i);
-    split = false;
-    if (comment.data() && isLimitNote(comment)) path.limited.push_back(i);
-    path.postures.push_back(p);
-    path.lines.push_back(line);
+    out.add(p, line);
+    if (has_comment && isLimitNote(comment)) out.limit();
   }
-  if (in.bad()) throw InputError(file.string() + ": read error");
+}
+
+/// A chunk as PathFile keeps it.
+struct FullOut {
+  PathChunk& chunk;
+  void add(const Posture& p, std::size_t line) {
+    chunk.postures.push_back(p);
+    chunk.lines.push_back(line);
+  }
+  void mark(PathBlock::Kind kind) { chunk.marks.push_back({chunk.postures.size(), kind}); }
+  void limit() { chunk.limited.push_back(chunk.postures.size() - 1); }
+};
+
+/// Only the postures, rounded to float.
+struct CompactOut {
+  std::vector<CompactPosture>& postures;
+  void add(const Posture& p, std::size_t) { postures.push_back(compact(p)); }
+  void mark(PathBlock::Kind) {}
+  void limit() {}
+};
+
+/// The blocks of a `.cl` file from its marks: a block starts at posture 0 and at every posture a
+/// mark (a marker or a blank line) comes before; the last mark before a posture gives its kind.
+std::vector<PathBlock> clBlocks(const std::vector<PathChunk>& chunks, std::size_t postures) {
+  std::vector<PathBlock> blocks;
+  if (postures == 0) return blocks;
+  blocks.push_back({PathBlock::Kind::Pass, 0, postures});
+  std::size_t offset = 0;
+  for (const PathChunk& chunk : chunks) {
+    for (const BlockMark& m : chunk.marks) {
+      const std::size_t i = offset + m.posture;
+      if (i >= postures) break;  // marks after the last posture
+      if (blocks.back().begin == i) {
+        blocks.back().kind = m.kind;
+      } else {
+        blocks.back().end = i;
+        blocks.push_back({m.kind, i, postures});
+      }
+    }
+    offset += chunk.postures.size();
+  }
+  return blocks;
+}
+
+}  // namespace
+
+PathFile readClPath(const std::filesystem::path& file, const PathReadOptions& options) {
+  const MappedFile mapped(file);
+  const std::string_view text = mapped.text();
+  const std::vector<TextChunk> pieces = splitAtLines(text, options.chunk_bytes);
+  std::vector<PathChunk> chunks(pieces.size());
+  forEachChunk(pieces.size(), options.threads, [&](std::size_t i) {
+    const TextChunk& c = pieces[i];
+    PathChunk& chunk = chunks[i];
+    chunk.postures.reserve((c.end - c.begin) / 40 + 1);
+    chunk.lines.reserve((c.end - c.begin) / 40 + 1);
+    FullOut out{chunk};
+    parseClChunk(text.substr(c.begin, c.end - c.begin), c.first_line, file, out);
+  });
+  PathFile path;
+  path.file = file;
+  // Blocks from the marks (few: a pass or link each) before the chunks are emptied.
+  std::size_t total = 0;
+  for (const PathChunk& c : chunks) total += c.postures.size();
+  path.blocks = clBlocks(chunks, total);
+  concatenate(chunks, options.threads, path);
   if (path.postures.empty()) throw InputError(file.string() + ": no postures (empty path file)");
   return path;
+}
+
+namespace detail {
+
+/// Hands a PathFile's postures over in chunks (APT: cross-record state makes a compact scan
+/// of its own not worth it).
+std::size_t handOver(const PathFile& path, const PathReadOptions& options,
+                     const PostureChunkSink& sink) {
+  const std::size_t per_chunk = std::max<std::size_t>(1, options.chunk_bytes / 24);
+  const std::size_t n = (path.postures.size() + per_chunk - 1) / per_chunk;
+  if (sink.begin) sink.begin(n);
+  forEachChunk(n, options.threads, [&](std::size_t i) {
+    const std::size_t begin = i * per_chunk, end = std::min(path.postures.size(), begin + per_chunk);
+    std::vector<CompactPosture> out(end - begin);
+    for (std::size_t k = begin; k < end; ++k) out[k - begin] = compact(path.postures[k]);
+    sink.chunk(i, out);
+  });
+  return path.postures.size();
+}
+
+std::size_t scanNpy(const std::filesystem::path& file, const PathReadOptions& options,
+                    const PostureChunkSink& sink);
+
+}  // namespace detail
+
+std::size_t scanPathFile(const std::filesystem::path& file, const PathReadOptions& options,
+                         const PostureChunkSink& sink) {
+  switch (pathFormatOf(file)) {
+    case PathFormat::Npy:
+      return scanNpy(file, options, sink);
+    case PathFormat::Apt:
+      return handOver(readAptPath(file, options), options, sink);
+    case PathFormat::Cl:
+      break;
+  }
+  const MappedFile mapped(file);
+  const std::string_view text = mapped.text();
+  const std::vector<TextChunk> pieces = splitAtLines(text, options.chunk_bytes);
+  if (sink.begin) sink.begin(pieces.size());
+  std::vector<std::size_t> counts(pieces.size(), 0);
+  forEachChunk(pieces.size(), options.threads, [&](std::size_t i) {
+    const TextChunk& c = pieces[i];
+    std::vector<CompactPosture> postures;
+    postures.reserve((c.end - c.begin) / 40 + 1);
+    CompactOut out{postures};
+    parseClChunk(text.substr(c.begin, c.end - c.begin), c.first_line, file, out);
+    counts[i] = postures.size();
+    sink.chunk(i, postures);
+  });
+  std::size_t total = 0;
+  for (std::size_t n : counts) total += n;
+  if (total == 0) throw InputError(file.string() + ": no postures (empty path file)");
+  return total;
 }
 
 std::vector<Posture> readClFile(const std::filesystem::path& file) {

@@ -8,6 +8,7 @@
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/geometry/cl_file.h"
+#include "path_chunks.h"
 #include "path_text.h"
 
 namespace fieldpath::geometry {
@@ -70,38 +71,31 @@ std::vector<std::uint64_t> parseShape(const std::filesystem::path& file, const s
   return shape;
 }
 
-}  // namespace
+/// A checked `.npy` posture array: where its rows start in the mapped file and their layout.
+struct NpyRows {
+  const char* data = nullptr;
+  std::uint64_t rows = 0, columns = 0;
+  std::size_t item = 0;  ///< 4 (float32) or 8 (float64)
+};
 
-PathFile readNpyPath(const std::filesystem::path& file) {
-  requireRegularFile(file);
-  std::ifstream in(file, std::ios::binary);
-  if (!in) bad(file, "cannot open for reading");
-  std::error_code ec;
-  const std::uint64_t file_size = std::filesystem::file_size(file, ec);
-  if (ec) bad(file, "cannot read its size");
-
-  char prefix[12] = {};
-  in.read(prefix, 10);
-  if (in.gcount() != 10 || std::memcmp(prefix, kMagic, kMagicSize) != 0)
+NpyRows checkedRows(const std::filesystem::path& file, std::string_view bytes) {
+  const std::uint64_t file_size = bytes.size();
+  if (file_size < 10 || std::memcmp(bytes.data(), kMagic, kMagicSize) != 0)
     bad(file, "not a NumPy .npy file (no \\x93NUMPY magic)");
-  const int major = static_cast<unsigned char>(prefix[6]);
+  const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(bytes[i]); };
+  const int major = byte(6);
   std::uint64_t header_size = 0, offset = 10;
   if (major == 1) {
-    header_size = static_cast<unsigned char>(prefix[8]) |
-                  (static_cast<std::uint64_t>(static_cast<unsigned char>(prefix[9])) << 8);
+    header_size = byte(8) | (static_cast<std::uint64_t>(byte(9)) << 8);
   } else if (major == 2 || major == 3) {
-    in.read(prefix + 10, 2);
-    if (in.gcount() != 2) bad(file, "truncated npy header");
-    for (int b = 0; b < 4; ++b)
-      header_size |= static_cast<std::uint64_t>(static_cast<unsigned char>(prefix[8 + b])) << (8 * b);
+    if (file_size < 12) bad(file, "truncated npy header");
+    for (int b = 0; b < 4; ++b) header_size |= static_cast<std::uint64_t>(byte(8 + b)) << (8 * b);
     offset = 12;
   } else {
     bad(file, "npy format version " + std::to_string(major) + " is not supported (1, 2 or 3)");
   }
   if (header_size > 65536 || offset + header_size > file_size) bad(file, "truncated npy header");
-  std::string header(header_size, '\0');
-  in.read(header.data(), static_cast<std::streamsize>(header_size));
-  if (static_cast<std::uint64_t>(in.gcount()) != header_size) bad(file, "truncated npy header");
+  const std::string_view header = bytes.substr(offset, header_size);
 
   const auto descr = headerValue(header, "descr");
   const auto fortran = headerValue(header, "fortran_order");
@@ -128,40 +122,79 @@ PathFile readNpyPath(const std::filesystem::path& file) {
                   std::to_string(rows * columns * item) + (rows * columns * item > data_size
                                                                ? " (truncated file)"
                                                                : " (trailing bytes)"));
+  return {bytes.data() + offset + header_size, rows, columns, item};
+}
 
+/// Row r as a posture, checked like a `.cl` line ("FILE: row R: ...").
+Posture rowPosture(const std::filesystem::path& file, const NpyRows& a, std::uint64_t r) {
+  double v[7];
+  const char* row = a.data + r * a.columns * a.item;
+  for (std::size_t c = 0; c < a.columns; ++c) {
+    if (a.item == 8) {
+      std::memcpy(&v[c], row + 8 * c, 8);
+    } else {
+      float f;
+      std::memcpy(&f, row + 4 * c, 4);
+      v[c] = f;
+    }
+    if (!std::isfinite(v[c]))
+      bad(file, "row " + std::to_string(r) + ", column " + std::to_string(c) + ": not finite");
+  }
+  const auto where = [&] { return file.string() + ": row " + std::to_string(r); };
+  Posture p;
+  p.tip_mm = Vec3(v[0], v[1], v[2]);
+  checkTip(p.tip_mm, where);
+  p.axis = checkedAxis(Vec3(v[3], v[4], v[5]), where);
+  p.has_spindle = a.columns == 7;
+  p.spindle_rad = p.has_spindle ? v[6] : 0.0;
+  return p;
+}
+
+/// Rows per parallel piece: about `chunk_bytes` of the file.
+std::uint64_t rowsPerChunk(const NpyRows& a, const PathReadOptions& options) {
+  return std::max<std::uint64_t>(1, options.chunk_bytes / (a.columns * a.item));
+}
+
+}  // namespace
+
+PathFile readNpyPath(const std::filesystem::path& file, const PathReadOptions& options) {
+  const MappedFile mapped(file);
+  const NpyRows a = checkedRows(file, mapped.text());
   PathFile path;
   path.file = file;
   path.rows = true;
-  path.postures.reserve(rows);
-  path.lines.reserve(rows);
-  std::vector<char> buffer(columns * item);
-  for (std::uint64_t r = 0; r < rows; ++r) {
-    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-    if (static_cast<std::size_t>(in.gcount()) != buffer.size()) bad(file, "truncated npy data");
-    double v[7];
-    for (std::size_t c = 0; c < columns; ++c) {
-      if (item == 8) {
-        std::memcpy(&v[c], buffer.data() + 8 * c, 8);
-      } else {
-        float f;
-        std::memcpy(&f, buffer.data() + 4 * c, 4);
-        v[c] = f;
-      }
-      if (!std::isfinite(v[c]))
-        bad(file, "row " + std::to_string(r) + ", column " + std::to_string(c) + ": not finite");
+  path.postures.resize(a.rows);
+  path.lines.resize(a.rows);
+  const std::uint64_t per = rowsPerChunk(a, options);
+  forEachChunk((a.rows + per - 1) / per, options.threads, [&](std::size_t i) {
+    for (std::uint64_t r = i * per; r < std::min(a.rows, (i + 1) * per); ++r) {
+      path.postures[r] = rowPosture(file, a, r);
+      path.lines[r] = r;
     }
-    const std::string where = file.string() + ": row " + std::to_string(r);
-    Posture p;
-    p.tip_mm = Vec3(v[0], v[1], v[2]);
-    p.axis = checkedAxis(Vec3(v[3], v[4], v[5]), where);
-    p.has_spindle = columns == 7;
-    p.spindle_rad = p.has_spindle ? v[6] : 0.0;
-    path.postures.push_back(p);
-    path.lines.push_back(r);
-  }
+  });
   path.blocks.push_back({PathBlock::Kind::Pass, 0, path.postures.size()});
   return path;
 }
+
+namespace detail {
+
+std::size_t scanNpy(const std::filesystem::path& file, const PathReadOptions& options,
+                    const PostureChunkSink& sink) {
+  const MappedFile mapped(file);
+  const NpyRows a = checkedRows(file, mapped.text());
+  const std::uint64_t per = rowsPerChunk(a, options);
+  const std::size_t chunks = (a.rows + per - 1) / per;
+  if (sink.begin) sink.begin(chunks);
+  forEachChunk(chunks, options.threads, [&](std::size_t i) {
+    const std::uint64_t begin = i * per, end = std::min(a.rows, begin + per);
+    std::vector<CompactPosture> out(end - begin);
+    for (std::uint64_t r = begin; r < end; ++r) out[r - begin] = compact(rowPosture(file, a, r));
+    sink.chunk(i, out);
+  });
+  return a.rows;
+}
+
+}  // namespace detail
 
 void writeNpyFile(const std::filesystem::path& file, std::span<const Posture> postures) {
   bool spindle = false;

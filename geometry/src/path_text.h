@@ -65,15 +65,17 @@ inline double parseFinite(std::string_view token, const std::filesystem::path& f
   return value;
 }
 
-/// The axis as read: unit (or normalised when off by < 1e-3); otherwise an error at `where`.
-inline Vec3 checkedAxis(const Vec3& axis, const std::string& where) {
+/// The axis as read: unit (or normalised when off by < 1e-3); otherwise an error at `where()`
+/// (a callable giving "FILE:LINE", built only on failure: this runs once per posture).
+template <class Where>
+Vec3 checkedAxis(const Vec3& axis, const Where& where) {
   const double length = axis.norm();
-  if (!(length > 0.0)) failAt(where, "zero tool axis");
-  if (!std::isfinite(length)) failAt(where, "tool axis is not finite");
+  if (!(length > 0.0)) failAt(where(), "zero tool axis");
+  if (!std::isfinite(length)) failAt(where(), "tool axis is not finite");
   if (std::abs(length - 1.0) >= kUnitTolerance) {
     std::ostringstream why;
     why << "tool axis is not a unit vector (length " << length << ")";
-    failAt(where, why.str());
+    failAt(where(), why.str());
   }
   return std::abs(length - 1.0) <= kUnitAsIs ? axis : Vec3(axis / length);
 }

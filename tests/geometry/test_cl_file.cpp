@@ -46,7 +46,7 @@ std::vector<Posture> randomPostures(std::size_t n, bool spindle) {
     p.spindle_rad = spindle ? u(rng) / 100 : 0.0;
   }
   // Awkward but valid numbers.
-  out[0].tip_mm = Vec3(-0.0, 1e-300, 1.7976931348623157e308);
+  out[0].tip_mm = Vec3(-0.0, 1e-300, -1e6);  // 1e6 mm: the largest coordinate a path may hold
   out[0].axis = Vec3::UnitZ();
   out[1].tip_mm = Vec3(0.1, 1.0 / 3.0, 5e-324);
   out[1].axis = -Vec3::UnitZ();

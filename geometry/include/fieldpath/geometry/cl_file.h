@@ -5,6 +5,7 @@
 /// `.npy` (float32 | float64, shape N×6 or N×7, C order).
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -45,17 +46,56 @@ struct PathFile {
   std::size_t count(PathBlock::Kind kind) const;
 };
 
-/// Reads a path by its extension: `.npy`, `.apt` / `.cls` (APT CLDATA), anything else `.cl`.
+/// How path files are read: on all cores (`threads` 0), the text cut at line ends into chunks of
+/// about `chunk_bytes` (`.npy`: rows of that many bytes) parsed in parallel. The result, and every
+/// error message, is the same whatever the two are.
+struct PathReadOptions {
+  unsigned threads = 0;
+  std::size_t chunk_bytes = std::size_t{4} << 20;
+};
+
+enum class PathFormat { Cl, Apt, Npy };
+/// By extension: `.npy`, `.apt` / `.cls` (APT CLDATA), anything else `.cl`.
+PathFormat pathFormatOf(const std::filesystem::path& file);
+
+/// Reads a path by its extension (pathFormatOf).
 /// Throws common::InputError naming the file and the line (or row) for every defect: non-finite
 /// numbers, short/long lines, zero or non-unit axes (axes off unit length by < 1e-3 are
-/// normalised), garbage, a missing file, a file without postures; `.npy`: a dtype other than
-/// float32/float64, a shape other than N×6 / N×7, Fortran order, a truncated or padded file.
-PathFile readPathFile(const std::filesystem::path& file);
+/// normalised), a tip coordinate beyond +-1e6 mm, garbage, a missing file, a file without
+/// postures; `.npy`: a dtype other than float32/float64, a shape other than N×6 / N×7, Fortran
+/// order, a truncated or padded file. Where a file has several defects, the first in file order.
+PathFile readPathFile(const std::filesystem::path& file, const PathReadOptions& options = {});
 
 /// The readers behind readPathFile, by format whatever the extension.
-PathFile readClPath(const std::filesystem::path& file);
-PathFile readAptPath(const std::filesystem::path& file);
-PathFile readNpyPath(const std::filesystem::path& file);
+PathFile readClPath(const std::filesystem::path& file, const PathReadOptions& options = {});
+PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& options = {});
+PathFile readNpyPath(const std::filesystem::path& file, const PathReadOptions& options = {});
+
+/// A posture as the Z-buffer takes it: tip (mm) and unit axis rounded to float, 24 bytes.
+struct CompactPosture {
+  float tip_mm[3];
+  float axis[3];
+};
+inline CompactPosture compact(const Posture& p) {
+  return {{float(p.tip_mm.x()), float(p.tip_mm.y()), float(p.tip_mm.z())},
+          {float(p.axis.x()), float(p.axis.y()), float(p.axis.z())}};
+}
+
+/// Where scanPathFile hands the postures over.
+struct PostureChunkSink {
+  /// Called once, before any chunk, with the number of chunks.
+  std::function<void(std::size_t chunks)> begin;
+  /// Called once per chunk from worker threads, in any order (chunk indices follow the file,
+  /// from 0), with the chunk's postures in file order.
+  std::function<void(std::size_t chunk, std::span<const CompactPosture> postures)> chunk;
+};
+
+/// The postures of a path file, compact, without keeping the whole PathFile: for big files.
+/// The same postures as compact(readPathFile(file).postures[i]), bit for bit, and the same
+/// errors (thrown after every worker stopped; chunks before the error may have been handed
+/// over). Returns the number of postures.
+std::size_t scanPathFile(const std::filesystem::path& file, const PathReadOptions& options,
+                         const PostureChunkSink& sink);
 
 /// The postures of a `.cl` file (readClPath(file).postures).
 std::vector<Posture> readClFile(const std::filesystem::path& file);
