@@ -17,6 +17,7 @@
 #include "commands.h"
 #include "errors.h"
 #include "fieldpath/common/atomic_file.h"
+#include "fieldpath/common/csv.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/pathgen/clearance.h"
@@ -47,8 +48,8 @@ std::string clearanceCsv(const geometry::PathFile& path, const pathgen::Clearanc
       const bool limited = next_limited < path.limited.size() && path.limited[next_limited] == i;
       csv << i << ',' << (is_pass ? "pass" : "link") << ',';
       if (is_pass) csv << pass;
-      csv << ',' << c.clearance_mm[i] << ',';
-      if (i < m.clearance_mm.size()) csv << m.clearance_mm[i];
+      csv << ',' << common::csvNumber(c.clearance_mm[i]) << ',';
+      if (i < m.clearance_mm.size()) csv << common::csvNumber(m.clearance_mm[i]);
       csv << ',' << (limited ? 1 : 0) << '\n';
     }
   }
@@ -111,6 +112,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   cmd->callback([options, &global] {
     const zbuffer::Backend backend = zbuffer::backendFromName(options->backend, "--backend");
+    if (!options->out.empty()) common::checkOutputDirectory(options->out, "--out");
     const Scene scene = loadScene(options->scene);
     const geometry::PathFile path = geometry::readPathFile(options->path);
     const common::Progress progress = makeProgressLine(global.quiet);

@@ -11,6 +11,8 @@
 
 #include "commands.h"
 #include "errors.h"
+#include "fieldpath/common/atomic_file.h"
+#include "fieldpath/common/limits.h"
 #include "fieldpath/field/direct_field.h"
 #include "fieldpath/field/voxel_field.h"
 #include "progress.h"
@@ -61,7 +63,7 @@ struct FieldOptions {
   std::string interpolation;  ///< "" : the scene's
   std::string out;
   std::string save_field;
-  double max_memory_mib = 4096.0;
+  double max_memory_mib = 0.0;  ///< 0: the global --max-memory (common::memoryLimitBytes)
 };
 
 /// The scene's obstacle samples and the exact field over them.
@@ -72,6 +74,9 @@ struct Obstacles {
 };
 
 Obstacles loadObstacles(const FieldOptions& o) {
+  // The sub-command's --max-memory (MiB) is the limit of every estimate, the scene's included.
+  if (o.max_memory_mib > 0.0)
+    common::setMemoryLimitBytes(static_cast<std::size_t>(o.max_memory_mib * 1024.0 * 1024.0));
   Obstacles result{loadScene(o.scene), nullptr, 0.0};
   const auto start = std::chrono::steady_clock::now();
   const Scene& s = result.scene;
@@ -88,7 +93,9 @@ field::VoxelRequest voxelRequest(const FieldOptions& o, const Scene& scene, bool
   if (!o.interpolation.empty())
     request.interpolation = o.interpolation == "quadratic" ? field::Interpolation::Quadratic
                                                            : field::Interpolation::Trilinear;
-  request.max_memory_bytes = static_cast<std::size_t>(o.max_memory_mib * 1024.0 * 1024.0);
+  request.max_memory_bytes = o.max_memory_mib > 0.0
+                                 ? static_cast<std::size_t>(o.max_memory_mib * 1024.0 * 1024.0)
+                                 : common::memoryLimitBytes();
   request.progress = makeProgressLine(quiet);
   return request;
 }
@@ -124,6 +131,7 @@ void probe(const FieldOptions& o, const GlobalOptions& global) {
 }
 
 void build(const FieldOptions& o, const GlobalOptions& global) {
+  common::checkOutputFile(o.out, "--out");  // before the work, not after
   const Obstacles obstacles = loadObstacles(o);
   const field::VoxelRequest request = voxelRequest(o, obstacles.scene, global.quiet);
   const field::VoxelField voxel(*obstacles.direct, request);

@@ -12,6 +12,8 @@
 
 #include "commands.h"
 #include "fieldpath/common/atomic_file.h"
+#include "fieldpath/common/csv.h"
+#include "estimates.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/units.h"
 #include "job.h"
@@ -114,8 +116,10 @@ std::string anglesCsv(const pathgen::GenerateResult& r) {
   csv << "s_mm,pass,lead_deg,tilt_deg,moment,nearest_mm,posture,limited\n";
   csv.precision(9);
   for (const auto& g : r.postures)
-    csv << g.s_mm << ',' << g.pass + 1 << ',' << g.lead_rad * kRadToDeg << ','
-        << g.tilt_rad * kRadToDeg << ',' << g.moment << ',' << g.clearance_mm << ',' << g.output
+    csv << common::csvNumber(g.s_mm) << ',' << g.pass + 1 << ','
+        << common::csvNumber(g.lead_rad * kRadToDeg) << ','
+        << common::csvNumber(g.tilt_rad * kRadToDeg) << ',' << common::csvNumber(g.moment) << ','
+        << common::csvNumber(g.clearance_mm) << ',' << g.output
         << ',' << (g.limited ? 1 : 0) << '\n';
   return csv.str();
 }
@@ -146,11 +150,15 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                 "The nominal path: axis on the hub normal (+ lead), no field, no dynamics");
   cmd->add_option("--out", options->out, "Output folder")->required();
   cmd->callback([options, &global] {
+    common::checkOutputDirectory(options->out, "--out");  // before the work, not after
     const Scene scene = loadScene(options->scene);
     pathgen::GenerateRequest job = sceneJob(scene);
     job.mode = options->direct ? pathgen::FieldMode::Direct : pathgen::FieldMode::Voxel;
     // 0: not given (positiveFinite rejects anything else that is not > 0).
     if (options->voxel_mm != 0.0) job.field.voxel.voxel_size_mm = options->voxel_mm;
+    if (job.mode == pathgen::FieldMode::Voxel && !job.nominal)
+      checkVoxelSize(scene, job.field.voxel.voxel_size_mm,
+                     options->voxel_mm != 0.0 ? "--voxel" : "field.voxel_size");
     job.nominal = options->nominal;
     job.progress = makeProgressLine(global.quiet);
     const pathgen::GenerateResult result = pathgen::generatePath(job);

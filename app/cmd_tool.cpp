@@ -3,6 +3,7 @@
 
 #include "commands.h"
 #include "errors.h"
+#include "fieldpath/common/atomic_file.h"
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/geometry/mesh_io.h"
 #include "fieldpath/geometry/tool_model.h"
@@ -27,6 +28,7 @@ void addToolCommand(CLI::App& app, const GlobalOptions& /*global*/) {
   cmd->add_option("--tol", options->tol_mm, "Chordal tolerance, mm")->capture_default_str();
   cmd->add_option("--out", options->out, "Output mesh (.stl binary, .obj, .ply)")->required();
   cmd->callback([options] {
+    common::checkOutputFile(options->out, "--out");
     const geometry::ToolSpec tool = geometry::parseToolSpec(options->shape);
     const geometry::HolderProfile holder = geometry::parseHolderProfile(options->holder);
     if (!(options->tol_mm > 0) || !(options->tol_mm < tool.radius_mm))

@@ -1,18 +1,41 @@
 /// fieldpath: collision-free 5-axis ball-end paths through a repulsive field, and their proof.
+#include <csignal>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
 #include "errors.h"
+#include "fieldpath/common/atomic_file.h"
+#include "fieldpath/common/limits.h"
 
 #ifndef FIELDPATH_VERSION
 #define FIELDPATH_VERSION "unknown"
 #endif
 
+namespace {
+/// SIGINT/SIGTERM: remove the temporaries being written (no partial file under any name), then
+/// die of the signal as usual (SA_RESETHAND restored the default action).
+extern "C" void removeTemporariesAndDie(int signal_number) {
+  fieldpath::common::removeTemporariesNow();
+  std::raise(signal_number);
+}
+
+void installSignalHandlers() {
+  struct sigaction action {};
+  action.sa_handler = removeTemporariesAndDie;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESETHAND;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace fieldpath::app;
+  installSignalHandlers();
   CLI::App app{
       "fieldpath: collision-free 5-axis ball-end milling paths (repulsive field), "
       "clearance check and Z-buffer machining simulation"};
@@ -23,6 +46,15 @@ int main(int argc, char** argv) {
   // Options a sub-command does not know fall through to this level, so `fieldpath simulate ...
   // --quiet` works as well as `fieldpath --quiet simulate ...`. Sub-commands inherit the setting.
   app.fallthrough();
+  std::string max_memory;
+  app.add_option("--max-memory", max_memory,
+                 "Refuse work whose estimated memory exceeds this (e.g. 512M, 4G; default: the "
+                 "machine's available memory)");
+  app.parse_complete_callback([&max_memory] {
+    if (!max_memory.empty())
+      fieldpath::common::setMemoryLimitBytes(
+          fieldpath::common::parseMemorySize(max_memory, "--max-memory"));
+  });
 
   addToolCommand(app, global);
   addSimulateCommand(app, global);
@@ -42,6 +74,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fieldpath: error: %s\n", e.what());
     return 1;
   } catch (const std::exception& e) {
+  } catch (const std::filesystem::filesystem_error& e) {
+    // Reading or writing a path the user gave (an --out that is a file, a directory without
+    // permission, a full disk): their environment, not our bug.
+    std::fprintf(stderr, "fieldpath: error: %s\n", e.what());
+    return 1;
     std::fprintf(stderr, "fieldpath: internal error: %s\n", e.what());
     return 2;
   }

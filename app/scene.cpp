@@ -10,6 +10,7 @@
 #include "fieldpath/common/errors.h"
 #include "fieldpath/geometry/mesh_io.h"
 #include "fieldpath/geometry/tool_model.h"
+#include "estimates.h"
 
 namespace fieldpath::app {
 namespace {
@@ -350,6 +351,7 @@ Scene loadScene(const std::filesystem::path& file) {
     }
   }
   if (scene.impeller || scene.guide_impeller) resolveImpeller(scene);
+  checkSceneSize(scene);  // before any command's heavy work
   return scene;
 }
 

@@ -5,6 +5,7 @@
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/pathgen/generate.h"
+#include "estimates.h"
 #include "scene.h"
 
 namespace fieldpath::app {
@@ -91,6 +92,7 @@ void resolveImpeller(Scene& scene) {
   } catch (const InputError& e) {
     throw InputError(where(scene, node) + "obstacles." + e.what());
   }
+  checkImpellerSize(*scene.impeller_model, where(scene, node));  // before the meshes are made
   for (auto& blade : pathgen::bladeMeshes(*scene.impeller_model))
     scene.obstacles.push_back(std::move(blade));
   if (scene.guide_impeller) {

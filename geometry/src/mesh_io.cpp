@@ -2,7 +2,10 @@
 
 #include <array>
 #include <cctype>
+#include <cmath>
 #include <exception>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <unordered_map>
 
@@ -13,6 +16,7 @@
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/limits.h"
 
 namespace fieldpath::geometry {
 namespace {
@@ -63,13 +67,50 @@ void fillScene(aiScene& scene, const TriangleMesh& mesh) {
   }
 }
 
+/// assimp's loaders trust what a file's header says: a PLY header without `end_header` loops
+/// forever (assimp 5.2, found by tests/fuzz fuzz_mesh) and element counts size its allocations.
+/// So a PLY header is read here first: it must end within 64 KiB and each element count must fit
+/// in the file (every element takes at least one byte).
+void checkPlyHeader(const std::filesystem::path& file, std::uintmax_t size) {
+  std::ifstream in(file, std::ios::binary);
+  char magic[4] = {};
+  in.read(magic, 4);
+  if (in.gcount() < 4 || std::string(magic, 3) != "ply" || (magic[3] != '\n' && magic[3] != '\r'))
+    return;  // not a PLY file: assimp decides
+  std::string line;
+  std::size_t read = 4, number = 1;
+  while (std::getline(in, line)) {
+    ++number;
+    read += line.size() + 1;
+    if (read > (std::size_t{64} << 10)) break;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line == "end_header") return;
+    if (line.rfind("element ", 0) == 0) {
+      std::istringstream words(line.substr(8));
+      std::string name;
+      double count = -1;
+      words >> name >> count;
+      if (!words || count < 0 || count > static_cast<double>(size))
+        throw InputError(file.string() + ":" + std::to_string(number) +
+                         ": PLY element count does not fit in the file: " + line);
+    }
+  }
+  throw InputError(file.string() + ": PLY header without `end_header` in its first 64 KiB");
+}
+
 }  // namespace
 
 TriangleMesh loadMesh(const std::filesystem::path& file) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec))
     throw InputError(file.string() + ": no such file");
-  if (std::filesystem::file_size(file, ec) == 0) throw InputError(file.string() + ": empty file");
+  const std::uintmax_t size = std::filesystem::file_size(file, ec);
+  if (ec || size == 0) throw InputError(file.string() + ": empty file");
+  // assimp's scene, our joined copy and the hash that joins them: about 16 bytes per file byte
+  // (a binary STL's 50-byte facet becomes 3 aiVector3D, a face, 3 map entries, 1.5 vertices).
+  common::requireMemory(file.string(), 16.0 * static_cast<double>(size), "mesh file of " +
+                        std::to_string(size >> 20) + " MiB");
+  checkPlyHeader(file, size);
 
   Assimp::Importer importer;
   // Points and lines are dropped; polygons are split into triangles; node transforms applied.
@@ -77,7 +118,9 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
                               aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   const aiScene* scene = nullptr;
   try {
-    scene = importer.ReadFile(file.string(), aiProcess_Triangulate | aiProcess_SortByPType |
+    // ValidateDataStructure runs first: assimp's other steps index faces unchecked (a PLY face naming
+    // a vertex that does not exist crashed Triangulate; tests/fuzz fuzz_mesh).
+    scene = importer.ReadFile(file.string(), aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_SortByPType |
                                                  aiProcess_PreTransformVertices);
   } catch (const std::exception& e) {
     throw InputError(file.string() + ": cannot read mesh: " + e.what());
@@ -97,6 +140,11 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
     std::vector<int> remap(in->mNumVertices);
     for (unsigned i = 0; i < in->mNumVertices; ++i) {
       const aiVector3D& v = in->mVertices[i];
+      if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) ||
+          std::abs(v.x) > common::kMaxCoordinateMm || std::abs(v.y) > common::kMaxCoordinateMm ||
+          std::abs(v.z) > common::kMaxCoordinateMm)
+        throw InputError(file.string() + ": vertex " + std::to_string(i + 1) +
+                         " is not finite or beyond +-1e6 mm");
       const auto [it, added] =
           index_of.try_emplace({v.x, v.y, v.z}, static_cast<int>(mesh.vertices.size()));
       if (added) mesh.vertices.emplace_back(v.x, v.y, v.z);
@@ -105,6 +153,10 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
     for (unsigned f = 0; f < in->mNumFaces; ++f) {
       const aiFace& face = in->mFaces[f];
       if (face.mNumIndices != 3) continue;
+      for (unsigned k = 0; k < 3; ++k)
+        if (face.mIndices[k] >= in->mNumVertices)
+          throw InputError(file.string() + ": face " + std::to_string(f + 1) +
+                           " names a vertex that does not exist");
       mesh.triangles.emplace_back(remap[face.mIndices[0]], remap[face.mIndices[1]],
                                   remap[face.mIndices[2]]);
     }

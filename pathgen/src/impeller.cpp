@@ -1,12 +1,14 @@
 #include "fieldpath/pathgen/impeller.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <sstream>
 #include <tuple>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/limits.h"
 #include "fieldpath/geometry/units.h"
 
 namespace fieldpath::pathgen {
@@ -28,6 +30,9 @@ std::string fmt(double value) {
 void requireFinite(double value, const char* key) {
   if (!std::isfinite(value))
     throw InputError(std::string("impeller.") + key + ": must be a finite number");
+  if (std::abs(value) > common::kMaxCoordinateMm)
+    throw InputError(std::string("impeller.") + key + ": " + fmt(value) +
+                     " is beyond +-1e6 (mm: outside any machine)");
 }
 
 void requirePositive(double value, const char* key) {
@@ -41,8 +46,10 @@ void requirePositive(double value, const char* key) {
 /// largest second derivatives (estimated on a fine sample); each term gets a third of the budget.
 /// Cells are also at most `max_edge_mm` long (by the chord) so that triangles stay well shaped
 /// for the field's sampling. `flip` reverses the winding (the normal is P_a × P_b otherwise).
-geometry::TriangleMesh gridMesh(const std::function<Vec3(double, double)>& p, double tol_mm,
-                                double max_edge_mm, bool flip) {
+/// The cells (na, nb) of gridMesh's grid over [0, 1]², from a probe of P's second derivatives and
+/// lengths alone (cheap: the size of a mesh is known before it is made).
+std::array<int, 2> gridCells(const std::function<Vec3(double, double)>& p, double tol_mm,
+                             double max_edge_mm) {
   constexpr int kProbe = 48;
   const double d = 1.0 / kProbe;
   double m_aa = 1e-12, m_bb = 1e-12, m_ab = 1e-12;
@@ -79,7 +86,12 @@ geometry::TriangleMesh gridMesh(const std::function<Vec3(double, double)>& p, do
   constexpr int kMaxCells = 4000;
   const int na = std::clamp(static_cast<int>(std::ceil(1.0 / ha)), 1, kMaxCells);
   const int nb = std::clamp(static_cast<int>(std::ceil(1.0 / hb)), 1, kMaxCells);
+  return {na, nb};
+}
 
+geometry::TriangleMesh gridMesh(const std::function<Vec3(double, double)>& p, double tol_mm,
+                                double max_edge_mm, bool flip) {
+  const auto [na, nb] = gridCells(p, tol_mm, max_edge_mm);
   geometry::TriangleMesh mesh;
   mesh.vertices.reserve(static_cast<size_t>(na + 1) * (nb + 1));
   for (int i = 0; i <= na; ++i)
@@ -120,6 +132,9 @@ Impeller::Impeller(const ImpellerParams& params) : params_(params) {
   requireFinite(p.hub_dish_mm, "hub_dish");
   requirePositive(p.blade_height_mm, "blade_height");
   requirePositive(p.chord_tol_mm, "chord_tol");
+  // Far below any machine's accuracy: a smaller tolerance only makes meshes too large to keep.
+  if (p.chord_tol_mm < 1e-4)
+    throw InputError("impeller.chord_tol: must be >= 0.0001 mm (got " + fmt(p.chord_tol_mm) + ")");
   for (const auto& [key, pair] : {std::pair{"lean_left_deg", p.lean_left_deg},
                                   std::pair{"lean_right_deg", p.lean_right_deg}}) {
     for (double lean : pair) {
@@ -237,6 +252,19 @@ double Impeller::minGapMm(double* at_u) const {
     }
   }
   return best;
+}
+
+std::size_t Impeller::meshTriangleCount() const {
+  std::size_t count = 0;
+  const auto add = [&count](const std::array<int, 2>& cells) {
+    count += 2 * static_cast<std::size_t>(cells[0]) * static_cast<std::size_t>(cells[1]);
+  };
+  add(gridCells([this](double u, double v) { return hub(u, v); }, params_.chord_tol_mm,
+                kMaxEdgeMm));
+  for (int side = 0; side < 2; ++side)
+    add(gridCells([this, side](double u, double t) { return blade(side, u, t); },
+                  params_.chord_tol_mm, kMaxEdgeMm));
+  return count;
 }
 
 geometry::TriangleMesh Impeller::hubMesh() const {

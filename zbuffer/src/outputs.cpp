@@ -138,8 +138,16 @@ void writeHeightsNpy(const std::filesystem::path& file, const Grid& grid,
 void writeHeightsJson(const std::filesystem::path& file, const Grid& grid) {
   std::ostringstream os;
   os.precision(17);
-  os << "{\"origin\":[" << grid.x0_mm << "," << grid.y0_mm << "],\"spacing\":[" << grid.dx_mm << ","
-     << grid.dy_mm << "],\"shape\":[" << grid.ny << "," << grid.nx << "]}\n";
+  // JSON has no inf / nan: such a number is written as null (Grid::fromRegion refuses them, so
+  // this is a guard, not a format).
+  const auto number = [&os](double v) -> std::ostream& {
+    return std::isfinite(v) ? os << v : os << "null";
+  };
+  os << "{\"origin\":[";
+  number(grid.x0_mm) << ",";
+  number(grid.y0_mm) << "],\"spacing\":[";
+  number(grid.dx_mm) << ",";
+  number(grid.dy_mm) << "],\"shape\":[" << grid.ny << "," << grid.nx << "]}\n";
   common::writeTextAtomically(file, os.str());
 }
 

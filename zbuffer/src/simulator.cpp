@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/limits.h"
 
 namespace fieldpath::zbuffer {
 
@@ -22,6 +23,9 @@ Grid Grid::fromRegion(double x0_mm, double y0_mm, double x1_mm, double y1_mm, in
   if (!std::isfinite(x0_mm) || !std::isfinite(y0_mm) || !std::isfinite(x1_mm) ||
       !std::isfinite(y1_mm))
     throw InputError("region: non-finite coordinate");
+  for (const double v : {x0_mm, y0_mm, x1_mm, y1_mm})
+    if (std::abs(v) > common::kMaxCoordinateMm)
+      throw InputError("region: coordinate " + std::to_string(v) + " mm is beyond +-1e6 mm (outside any machine)");
   if (!(x1_mm > x0_mm) || !(y1_mm > y0_mm))
     throw InputError("region: zero or negative area (need x0 < x1 and y0 < y1)");
   if (nx <= 0 || ny <= 0)
@@ -34,6 +38,11 @@ Grid Grid::fromRegion(double x0_mm, double y0_mm, double x1_mm, double y1_mm, in
   g.ny = ny;
   g.dx_mm = (x1_mm - x0_mm) / nx;
   g.dy_mm = (y1_mm - y0_mm) / ny;
+  // A spacing that rounds to nothing next to the origin would stack lines on one another.
+  const double tiny = 1e-12 * std::max({1.0, std::abs(x0_mm), std::abs(y0_mm), std::abs(x1_mm), std::abs(y1_mm)});
+  if (!(g.dx_mm > tiny) || !(g.dy_mm > tiny) || !std::isfinite(g.dx_mm) || !std::isfinite(g.dy_mm))
+    throw InputError("region: degenerate grid spacing " + std::to_string(g.dx_mm) + " x " +
+                     std::to_string(g.dy_mm) + " mm");
   return g;
 }
 
@@ -119,17 +128,13 @@ std::size_t estimateHostBytes(const Grid& grid) {
 }
 
 void checkGridFits(const Grid& grid, std::size_t available_bytes) {
-  if (available_bytes == 0) {
-    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-    available_bytes =
-        pages > 0 && page > 0 ? std::size_t(pages) * std::size_t(page) / 2 : (std::size_t{4} << 30);
-  }
+  if (available_bytes == 0) available_bytes = common::memoryLimitBytes();  // --max-memory
   const std::size_t need = estimateHostBytes(grid);
   if (need > available_bytes || grid.lineCount() > (std::size_t{1} << 31)) {
     std::ostringstream os;
     os << "grid " << grid.nx << "x" << grid.ny << " is too large: it needs about "
        << need / (1 << 20) << " MiB of memory, " << available_bytes / (1 << 20)
-       << " MiB available (and at most 2^31 lines)";
+       << " MiB available (and at most 2^31 lines; --max-memory)";
     throw InputError(os.str());
   }
 }

@@ -1,33 +1,150 @@
 #pragma once
 /// Outputs are written to a temporary name beside the target and renamed into place, so an
-/// interrupted run never leaves a truncated file under the final name (DESIGN.md).
+/// interrupted run never leaves a truncated file under the final name (DESIGN.md). The temporaries
+/// being written are listed where a SIGINT/SIGTERM handler can remove them
+/// (removeTemporariesNow(), installed by the CLI's main()).
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <stdexcept>
 #include <string>
+
+#include "fieldpath/common/errors.h"
 
 namespace fieldpath::common {
 
-/// Calls `write(stream)` on a temporary file beside `path`, then renames it to `path`.
-/// Throws std::runtime_error (naming the path) if the file cannot be written; the temporary is
-/// removed on any failure, including an exception thrown by `write`.
+namespace detail {
+
+/// One temporary being written. `state`: 0 free, 1 being claimed, 2 live (path valid).
+struct TemporarySlot {
+  std::atomic<int> state{0};
+  char path[4096];
+};
+inline constexpr int kTemporarySlots = 64;
+inline TemporarySlot temporary_slots[kTemporarySlots];
+
+/// Lists `path` for removal on a signal; returns its slot, or -1 when every slot is taken or the
+/// name is too long (the file is then still written atomically, just not removed on a signal).
+inline int listTemporary(const std::string& path) {
+  if (path.size() >= sizeof(TemporarySlot::path)) return -1;
+  for (int i = 0; i < kTemporarySlots; ++i) {
+    int expected = 0;
+    if (temporary_slots[i].state.compare_exchange_strong(expected, 1)) {
+      std::memcpy(temporary_slots[i].path, path.c_str(), path.size() + 1);
+      temporary_slots[i].state.store(2);
+      return i;
+    }
+  }
+  return -1;
+}
+
+inline void unlistTemporary(int slot) {
+  if (slot >= 0) temporary_slots[slot].state.store(0);
+}
+
+/// Unlists the temporary slot when the write ends, however it ends.
+struct TemporaryListing {
+  int slot;
+  ~TemporaryListing() { unlistTemporary(slot); }
+};
+
+/// "what FILE: strerror(errno)" for a failed system call on a user's output path.
+inline std::string systemReason(int error) { return error != 0 ? std::strerror(error) : "unknown error"; }
+
+}  // namespace detail
+
+/// Removes every temporary being written. Async-signal-safe (lock-free atomics and unlink only):
+/// call it from a SIGINT/SIGTERM handler before re-raising the signal.
+inline void removeTemporariesNow() noexcept {
+  for (auto& slot : detail::temporary_slots)
+    if (slot.state.load() == 2) ::unlink(slot.path);
+}
+
+/// Makes `dir` (and its parents) a directory for outputs. Throws InputError (one line naming the
+/// path) when it exists as something else or cannot be created (permissions, read-only file
+/// system) — a user's mistake, never an internal error.
+inline void createOutputDirectory(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  if (dir.empty()) return;
+  std::error_code ec;
+  if (fs::is_directory(dir, ec)) return;
+  if (fs::exists(dir, ec)) throw InputError(dir.string() + ": exists and is not a directory");
+  fs::create_directories(dir, ec);
+  if (ec) throw InputError(dir.string() + ": cannot create the directory: " + ec.message());
+}
+
+/// Checks, before any work, that `dir` can become an output directory: it is a writable
+/// directory, or it does not exist and its nearest existing parent is a writable directory.
+/// Creates nothing (a refused run leaves no files). Throws InputError "OPTION DIR: why".
+inline void checkOutputDirectory(const std::filesystem::path& dir, const std::string& option) {
+  namespace fs = std::filesystem;
+  const std::string name = option.empty() ? dir.string() : option + " " + dir.string();
+  if (dir.empty()) throw InputError(name + ": empty directory name");
+  std::error_code ec;
+  fs::path at = fs::absolute(dir, ec);
+  if (ec) throw InputError(name + ": " + ec.message());
+  // The nearest existing ancestor (the path itself if it exists).
+  while (!fs::exists(fs::symlink_status(at, ec)) && at.has_parent_path() && at != at.parent_path())
+    at = at.parent_path();
+  if (at == fs::absolute(dir, ec)) {
+    if (!fs::is_directory(at, ec)) throw InputError(name + ": exists and is not a directory");
+  } else if (!fs::is_directory(at, ec)) {
+    throw InputError(name + ": cannot be created: " + at.string() + " is not a directory");
+  }
+  if (::access(at.c_str(), W_OK | X_OK) != 0)
+    throw InputError(name + ": cannot write in " + at.string() + ": " +
+                     detail::systemReason(errno));
+}
+
+/// Checks that an output file `file` can be written (its directory can exist, the name is not a
+/// directory). Throws InputError "OPTION FILE: why".
+inline void checkOutputFile(const std::filesystem::path& file, const std::string& option) {
+  namespace fs = std::filesystem;
+  const std::string name = option.empty() ? file.string() : option + " " + file.string();
+  std::error_code ec;
+  if (file.empty() || !file.has_filename()) throw InputError(name + ": expected a file name");
+  if (fs::is_directory(file, ec)) throw InputError(name + ": is a directory, expected a file name");
+  const fs::path parent = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  checkOutputDirectory(parent, option);
+}
+
+/// Calls `write(stream)` on a temporary file beside `path` (`.NAME.tmp-PID`), then renames it to
+/// `path`. Throws InputError (one line naming the path and the system's reason: no permission, disk
+/// full, not a directory) if the file cannot be written; the temporary is removed on any failure,
+/// including an exception thrown by `write`, and by removeTemporariesNow() on a signal.
 inline void writeFileAtomically(const std::filesystem::path& path,
                                 const std::function<void(std::ofstream&)>& write,
                                 std::ios::openmode mode = std::ios::out) {
   namespace fs = std::filesystem;
-  if (path.has_parent_path()) fs::create_directories(path.parent_path());
-  const fs::path tmp = path.string() + ".tmp";
+  if (path.has_parent_path()) createOutputDirectory(path.parent_path());
+  const fs::path tmp = path.parent_path() / ("." + path.filename().string() + ".tmp-" +
+                                             std::to_string(static_cast<long>(::getpid())));
+  const detail::TemporaryListing listing{detail::listTemporary(tmp.string())};
   try {
     {
+      errno = 0;
       std::ofstream out(tmp, mode | std::ios::trunc);
-      if (!out) throw std::runtime_error("cannot open " + tmp.string() + " for writing");
+      if (!out)
+        throw InputError(path.string() + ": cannot open for writing: " +
+                         detail::systemReason(errno));
       write(out);
+      errno = 0;
       out.flush();
-      if (!out) throw std::runtime_error("cannot write " + tmp.string());
+      if (!out) throw InputError(path.string() + ": cannot write: " + detail::systemReason(errno));
+      out.close();
+      if (out.fail())
+        throw InputError(path.string() + ": cannot write: " + detail::systemReason(errno));
     }
-    fs::rename(tmp, path);
+    std::error_code ec;
+    if (fs::is_directory(path, ec))
+      throw InputError(path.string() + ": is a directory, cannot write a file there");
+    fs::rename(tmp, path, ec);
+    if (ec) throw InputError(path.string() + ": cannot rename into place: " + ec.message());
   } catch (...) {
     std::error_code ec;
     fs::remove(tmp, ec);

@@ -74,6 +74,9 @@ class Impeller {
   /// Hub: normals up. Blades: open sheets, normals into the channel.
   geometry::TriangleMesh hubMesh() const;
   geometry::TriangleMesh bladeMesh(int side) const;
+  /// Triangles of hubMesh() + both bladeMesh(), computed without making them (for the memory
+  /// estimate made before any mesh is allocated).
+  std::size_t meshTriangleCount() const;
 
  private:
   ImpellerParams params_;

@@ -1,0 +1,180 @@
+#include "estimates.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/common/limits.h"
+#include "fieldpath/field/voxel_field.h"
+
+namespace fieldpath::app {
+namespace {
+
+using common::InputError;
+using geometry::Vec3;
+
+std::string fmt(double value) {
+  std::ostringstream s;
+  s.precision(3);
+  s << value;
+  return s.str();
+}
+
+/// Axis-aligned box of the obstacles' vertices, mm.
+struct Box {
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 hi = Vec3::Constant(-std::numeric_limits<double>::infinity());
+  bool empty() const { return !(lo.x() <= hi.x()); }
+  double diagonal() const { return empty() ? 0.0 : (hi - lo).norm(); }
+};
+
+Box obstacleBox(const Scene& scene) {
+  Box box;
+  for (const auto& mesh : scene.obstacles)
+    for (const auto& v : mesh.vertices) {
+      box.lo = box.lo.cwiseMin(v);
+      box.hi = box.hi.cwiseMax(v);
+    }
+  return box;
+}
+
+double obstacleArea(const Scene& scene) {
+  double area = 0.0;
+  for (const auto& mesh : scene.obstacles)
+    for (const auto& t : mesh.triangles) {
+      const int n = static_cast<int>(mesh.vertices.size());
+      if (t[0] < 0 || t[1] < 0 || t[2] < 0 || t[0] >= n || t[1] >= n || t[2] >= n) continue;
+      const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+      area += 0.5 * (b - a).cross(c - a).norm();
+    }
+  return area;
+}
+
+/// Ball-centre arc length of the output passes, mm (what `path.step` divides), and how many.
+struct PassLength {
+  double total_mm = 0.0;
+  std::size_t passes = 0;
+  std::size_t input_postures = 0;
+};
+
+PassLength passLength(const Scene& scene) {
+  PassLength out;
+  if (scene.impeller_model && scene.guide_impeller) {
+    // Passes are iso-v curves of the hub offset by the ball radius: their length is that of the
+    // hub curve give or take the offset's curvature (≤ 2 × here for any sane radius).
+    const auto& p = scene.impeller_model->params();
+    double longest = 0.0;
+    for (double v : {p.passes_v[0], p.passes_v[1], 0.5 * (p.passes_v[0] + p.passes_v[1])}) {
+      double length = 0.0;
+      constexpr int kSamples = 256;
+      for (int i = 0; i < kSamples; ++i) {
+        const double u0 = p.u_range[0] + (p.u_range[1] - p.u_range[0]) * i / kSamples;
+        const double u1 = p.u_range[0] + (p.u_range[1] - p.u_range[0]) * (i + 1) / kSamples;
+        length += (scene.impeller_model->hub(u1, v) - scene.impeller_model->hub(u0, v)).norm();
+      }
+      longest = std::max(longest, length);
+    }
+    out.passes = static_cast<std::size_t>(scene.path.passes);
+    out.total_mm = 2.0 * longest * out.passes;
+  } else if (scene.nominal) {
+    const auto& postures = scene.nominal->postures;
+    out.input_postures = postures.size();
+    out.passes = std::max<std::size_t>(1, scene.nominal->blocks.size());
+    for (std::size_t i = 1; i < postures.size(); ++i) {
+      const double step = (postures[i].tip_mm - postures[i - 1].tip_mm).norm();
+      if (std::isfinite(step)) out.total_mm += step;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+double sampleCount(const Scene& scene, double step_mm) {
+  // As field/sampling.h: each triangle cut into n² sub-triangles of area <= step² and edges
+  // <= 1.5 step; degenerate triangles skipped.
+  double count = 0.0;
+  for (const auto& mesh : scene.obstacles)
+    for (const auto& t : mesh.triangles) {
+      const int nv = static_cast<int>(mesh.vertices.size());
+      if (t[0] < 0 || t[1] < 0 || t[2] < 0 || t[0] >= nv || t[1] >= nv || t[2] >= nv) continue;
+      const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
+      const double area = 0.5 * (b - a).cross(c - a).norm();
+      if (!(area > 0.0)) continue;
+      const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+      const double n =
+          std::max({1.0, std::ceil(std::sqrt(area) / step_mm), std::ceil(longest / (1.5 * step_mm))});
+      count += n * n;
+    }
+  return count;
+}
+
+void checkImpellerSize(const pathgen::Impeller& impeller, const std::string& where) {
+  const double triangles = static_cast<double>(impeller.meshTriangleCount());
+  common::requireMemory(where + "obstacles.impeller.chord_tol",
+                        triangles * kBytesPerMeshTriangle,
+                        fmt(triangles) + " triangles in the hub and blade meshes at chord_tol " +
+                            fmt(impeller.params().chord_tol_mm) + " mm");
+}
+
+void checkSceneSize(const Scene& scene) {
+  const std::string where = scene.file.string() + ": ";
+  double triangles = 0.0;
+  for (const auto& mesh : scene.obstacles) triangles += static_cast<double>(mesh.triangles.size());
+  if (scene.part) triangles += static_cast<double>(scene.part->triangles.size());
+  common::requireMemory(where + "obstacles", triangles * kBytesPerMeshTriangle,
+                        fmt(triangles) + " mesh triangles with their collision hierarchies");
+
+  // field.sample_step against the obstacles' area.
+  const double samples = sampleCount(scene, scene.field.sample_step_mm);
+  common::requireMemory(where + "field.sample_step", samples * kBytesPerSample,
+                        fmt(samples) + " obstacle samples at " +
+                            fmt(scene.field.sample_step_mm) + " mm");
+
+  // field.r0 against the obstacles' extent: beyond it every sample acts on every node, the field
+  // is no longer local and its cost (nodes × samples within r0) grows with r0³ for nothing.
+  const Box box = obstacleBox(scene);
+  if (!box.empty()) {
+    for (int k = 0; k < 3; ++k)
+      for (double v : {box.lo[k], box.hi[k]})
+        if (std::abs(v) > common::kMaxCoordinateMm)
+          throw InputError(where + "obstacles: a vertex at " + fmt(v) +
+                           " mm is beyond +-1e6 mm (outside any machine)");
+    // The tool + holder reach from the tip: the farthest a node can be from the path.
+    double reach = scene.tool.length_mm;
+    for (const auto& station : scene.holder) reach = std::max(reach, station.z_mm);
+    const double limit = box.diagonal() + reach;
+    if (scene.field.r0_mm > limit)
+      throw InputError(where + "field.r0: " + fmt(scene.field.r0_mm) +
+                       " mm exceeds the obstacles' extent plus the tool's reach (" + fmt(limit) +
+                       " mm): every sample would act on every node at a cost growing as r0^3");
+  }
+
+  // Output postures: path.step against the passes' length (and path.passes).
+  const PassLength length = passLength(scene);
+  if (length.total_mm > 0.0 && (scene.path.step_given || scene.impeller_model)) {
+    const double postures = length.total_mm / scene.path.step_mm + 2.0 * length.passes +
+                            static_cast<double>(length.input_postures);
+    const std::string key = scene.guide_impeller ? "path.step (with path.passes)" : "path.step";
+    common::requireMemory(where + key, postures * kBytesPerPosture,
+                          fmt(postures) + " postures: " + fmt(length.total_mm) +
+                              " mm of passes every " + fmt(scene.path.step_mm) + " mm");
+  }
+}
+
+void checkVoxelSize(const Scene& scene, double voxel_mm, const std::string& key) {
+  const Box box = obstacleBox(scene);
+  if (box.empty() || !(voxel_mm > 0.0)) return;
+  const double r0 = scene.field.r0_mm;
+  const Vec3 size = (box.hi - box.lo).array() + 2.0 * r0;
+  const double box_volume = size.x() * size.y() * size.z();
+  const double shell_volume = obstacleArea(scene) * 2.0 * r0;
+  const double nodes = std::min(box_volume, shell_volume) / (voxel_mm * voxel_mm * voxel_mm);
+  common::requireMemory(scene.file.string() + ": " + key, nodes * field::kVoxelBytesPerNode,
+                        fmt(nodes) + " voxel nodes within r0 = " + fmt(r0) + " mm of the obstacles at h = " +
+                            fmt(voxel_mm) + " mm");
+}
+
+}  // namespace fieldpath::app

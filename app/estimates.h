@@ -1,0 +1,41 @@
+#pragma once
+/// Size estimates of a scene's job, made from its keys before the heavy work allocates anything
+/// (DESIGN.md: "sizes are estimated before allocation and refused with the estimate"). Each check
+/// throws common::InputError "SCENE: KEY: needs about E of memory (...), limit L (--max-memory)"
+/// naming the key that drives the size, against common::memoryLimitBytes().
+#include <cstddef>
+#include <string>
+
+#include "fieldpath/pathgen/impeller.h"
+#include "scene.h"
+
+namespace fieldpath::app {
+
+/// Bytes a mesh triangle costs once loaded: the mesh itself (≈ 30 B) and FCL's OBBRSS hierarchy
+/// over it (two nodes of ≈ 250 B per triangle), rounded up.
+inline constexpr double kBytesPerMeshTriangle = 600.0;
+/// Bytes an obstacle sample costs: point, normal, weight (56 B) grown by push_back (× 2) and the
+/// point index, rounded up.
+inline constexpr double kBytesPerSample = 128.0;
+/// Bytes an output posture costs through generate: the steered posture with its angles, the path
+/// and its APT / CSV text, the clearance and motion results, rounded up.
+inline constexpr double kBytesPerPosture = 512.0;
+
+/// The parametric impeller's meshes (driven by `chord_tol` and the dimensions), before they are
+/// made. `where` is "SCENE:LINE: ".
+void checkImpellerSize(const pathgen::Impeller& impeller, const std::string& where);
+
+/// What loadScene can know once the meshes are loaded: the obstacle samples (`field.sample_step`
+/// against the obstacles' area), `field.r0` against the obstacles' extent, and the output
+/// postures (`path.step`, `path.passes` against the passes' length).
+void checkSceneSize(const Scene& scene);
+
+/// The uniform voxel grid of `field.voxel_size` (or `--voxel`) = `voxel_mm`: the shell within r0
+/// of the obstacles, at most their box padded by r0 (the field module estimates refinement).
+/// `key` names where h came from.
+void checkVoxelSize(const Scene& scene, double voxel_mm, const std::string& key);
+
+/// The obstacle samples at `step_mm` (the count sampleObstacles makes, to the sample).
+double sampleCount(const Scene& scene, double step_mm);
+
+}  // namespace fieldpath::app

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# CI smoke fuzz: each parser target for a short time (FUZZ_SECONDS, default 15) on its seed
+# corpus; fails on any crash, hang, leak or sanitizer report. Skipped (exit 0, with a line) where
+# clang 14 or libFuzzer is missing. fuzz_scene is left to scripts/fuzz.sh (it needs the whole
+# project built with sanitizers: too slow for CI); FUZZ_SCENE=1 adds it.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export LSAN_OPTIONS="suppressions=$PWD/tests/fuzz/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
+seconds=${FUZZ_SECONDS:-15}
+if ! command -v clang++-14 >/dev/null || ! ls /usr/lib/llvm-14/lib/clang/14*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
+  echo "fuzz_smoke: skipped (no clang++-14 with libFuzzer)"
+  exit 0
+fi
+targets=(fuzz_cl fuzz_apt fuzz_npy fuzz_mesh fuzz_tool fuzz_cli)
+[ "${FUZZ_SCENE:-0}" = 1 ] && targets+=(fuzz_scene)
+bash scripts/fuzz_build.sh "${targets[@]}"
+for t in "${targets[@]}"; do
+  scratch=$(mktemp -d)
+  # A fresh working corpus: CI runs are independent of earlier ones.
+  if ! "build-fuzz/bin/$t" "$scratch" "tests/fuzz/corpus/$t" -max_total_time="$seconds" \
+      -timeout=10 -rss_limit_mb=2048 -max_len=8192 -artifact_prefix="$scratch/" \
+      -print_final_stats=1 >"$scratch/log" 2>&1; then
+    echo "fuzz_smoke: $t FAILED; its log:" >&2
+    tail -40 "$scratch/log" >&2
+    exit 1
+  fi
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$scratch/log" | grep -o '[0-9]*$' || echo '?')
+  echo "fuzz_smoke: $t ok ($runs inputs in ${seconds} s)"
+  rm -rf "$scratch"
+done
