@@ -5,6 +5,7 @@
 #include <cmath>
 #include <exception>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <string>
 #include <unordered_map>
@@ -113,19 +114,17 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
   checkPlyHeader(file, size);
 
   Assimp::Importer importer;
-  // Points and lines are dropped; polygons are split into triangles; node transforms applied.
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
-                              aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   const aiScene* scene = nullptr;
   try {
-    // ValidateDataStructure runs first: assimp's other steps index faces unchecked (a PLY face naming
-    // a vertex that does not exist crashed Triangulate; tests/fuzz fuzz_mesh).
-    scene = importer.ReadFile(file.string(), aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_SortByPType |
-                                                 aiProcess_PreTransformVertices);
+    // No post-processing but validation: assimp's steps trust the loaders' output and abort
+    // (ai_assert in Triangulate) or crash on malformed files (found by tests/fuzz fuzz_mesh), so
+    // polygons are split and node transforms applied below, with every index checked.
+    scene = importer.ReadFile(file.string(), aiProcess_ValidateDataStructure);
   } catch (const std::exception& e) {
     throw InputError(file.string() + ": cannot read mesh: " + e.what());
   }
-  if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0) {
+  if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 ||
+      scene->mRootNode == nullptr) {
     const std::string why = importer.GetErrorString();
     throw InputError(file.string() + ": cannot read mesh" +
                      (why.empty() ? std::string() : ": " + why));
@@ -134,12 +133,10 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
   // Identical positions are joined across faces and meshes (STL stores every corner per face).
   TriangleMesh mesh;
   std::unordered_map<std::array<ai_real, 3>, int, PositionHash> index_of;
-  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-    const aiMesh* in = scene->mMeshes[m];
-    if ((in->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0) continue;
+  const auto addMesh = [&](const aiMesh* in, const aiMatrix4x4& transform) {
     std::vector<int> remap(in->mNumVertices);
     for (unsigned i = 0; i < in->mNumVertices; ++i) {
-      const aiVector3D& v = in->mVertices[i];
+      const aiVector3D v = transform * in->mVertices[i];
       if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) ||
           std::abs(v.x) > common::kMaxCoordinateMm || std::abs(v.y) > common::kMaxCoordinateMm ||
           std::abs(v.z) > common::kMaxCoordinateMm)
@@ -152,15 +149,30 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
     }
     for (unsigned f = 0; f < in->mNumFaces; ++f) {
       const aiFace& face = in->mFaces[f];
-      if (face.mNumIndices != 3) continue;
-      for (unsigned k = 0; k < 3; ++k)
+      if (face.mNumIndices < 3 || face.mIndices == nullptr) continue;  // points and lines
+      for (unsigned k = 0; k < face.mNumIndices; ++k)
         if (face.mIndices[k] >= in->mNumVertices)
           throw InputError(file.string() + ": face " + std::to_string(f + 1) +
                            " names a vertex that does not exist");
-      mesh.triangles.emplace_back(remap[face.mIndices[0]], remap[face.mIndices[1]],
-                                  remap[face.mIndices[2]]);
+      // Polygons as fans from their first corner (CAD exports write convex ones).
+      for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)
+        mesh.triangles.emplace_back(remap[face.mIndices[0]], remap[face.mIndices[k]],
+                                    remap[face.mIndices[k + 1]]);
     }
-  }
+  };
+  // Every mesh where the node tree places it (what aiProcess_PreTransformVertices did).
+  const std::function<void(const aiNode*, const aiMatrix4x4&, int)> walk =
+      [&](const aiNode* node, const aiMatrix4x4& parent, int depth) {
+        if (node == nullptr) return;
+        if (depth > 256) throw InputError(file.string() + ": node tree deeper than 256");
+        const aiMatrix4x4 transform = parent * node->mTransformation;
+        for (unsigned i = 0; i < node->mNumMeshes; ++i)
+          if (node->mMeshes[i] < scene->mNumMeshes && scene->mMeshes[node->mMeshes[i]] != nullptr)
+            addMesh(scene->mMeshes[node->mMeshes[i]], transform);
+        for (unsigned c = 0; c < node->mNumChildren; ++c)
+          walk(node->mChildren[c], transform, depth + 1);
+      };
+  walk(scene->mRootNode, aiMatrix4x4(), 0);
   if (mesh.triangles.empty()) throw InputError(file.string() + ": no triangles in the mesh file");
   return mesh;
 }
