@@ -1,5 +1,4 @@
 /// fieldpath: collision-free 5-axis ball-end paths through a repulsive field, and their proof.
-#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -15,27 +14,9 @@
 #define FIELDPATH_VERSION "unknown"
 #endif
 
-namespace {
-/// SIGINT/SIGTERM: remove the temporaries being written (no partial file under any name), then
-/// die of the signal as usual (SA_RESETHAND restored the default action).
-extern "C" void removeTemporariesAndDie(int signal_number) {
-  fieldpath::common::removeTemporariesNow();
-  std::raise(signal_number);
-}
-
-void installSignalHandlers() {
-  struct sigaction action {};
-  action.sa_handler = removeTemporariesAndDie;
-  sigemptyset(&action.sa_mask);
-  action.sa_flags = SA_RESETHAND;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
-}
-}  // namespace
-
 int main(int argc, char** argv) {
   using namespace fieldpath::app;
-  installSignalHandlers();
+  fieldpath::common::installTemporaryCleanupOnSignals();  // no partial outputs on Ctrl-C
   CLI::App app{
       "fieldpath: collision-free 5-axis ball-end milling paths (repulsive field), "
       "clearance check and Z-buffer machining simulation"};
@@ -73,13 +54,13 @@ int main(int argc, char** argv) {
   } catch (const InputError& e) {
     std::fprintf(stderr, "fieldpath: error: %s\n", e.what());
     return 1;
-  } catch (const std::exception& e) {
   } catch (const std::filesystem::filesystem_error& e) {
     // Reading or writing a path the user gave (an --out that is a file, a directory without
     // permission, a full disk): their environment, not our bug.
     std::fprintf(stderr, "fieldpath: error: %s\n", e.what());
     return 1;
     std::fprintf(stderr, "fieldpath: internal error: %s\n", e.what());
+  } catch (const std::exception& e) {
     return 2;
   }
   return 0;

@@ -3,6 +3,7 @@
 /// interrupted run never leaves a truncated file under the final name (DESIGN.md). The temporaries
 /// being written are listed where a SIGINT/SIGTERM handler can remove them
 /// (removeTemporariesNow(), installed by the CLI's main()).
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -63,6 +64,24 @@ inline std::string systemReason(int error) { return error != 0 ? std::strerror(e
 inline void removeTemporariesNow() noexcept {
   for (auto& slot : detail::temporary_slots)
     if (slot.state.load() == 2) ::unlink(slot.path);
+}
+
+namespace detail {
+extern "C" inline void removeTemporariesAndDie(int signal_number) {
+  removeTemporariesNow();
+  ::raise(signal_number);  // SA_RESETHAND restored the default action: die of the signal
+}
+}  // namespace detail
+
+/// SIGINT/SIGTERM remove the temporaries being written (no partial file under any name), then
+/// end the process by the signal as usual. The CLI's main() installs it first thing.
+inline void installTemporaryCleanupOnSignals() {
+  struct sigaction action {};
+  action.sa_handler = detail::removeTemporariesAndDie;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESETHAND;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
 }
 
 /// Makes `dir` (and its parents) a directory for outputs. Throws InputError (one line naming the
