@@ -4,6 +4,7 @@
 #include <limits>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <string>
 
@@ -261,16 +262,31 @@ HolderProfile parseHolderProfile(std::string_view text) {
   return holder;
 }
 
+namespace {
+/// Tools and holders longer or wider than this (mm) are no spindle's: refused as typos before
+/// they size meshes, node sets and reach boxes.
+constexpr double kMaxToolSizeMm = 1e4;
+
+std::string shortNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
+}  // namespace
+
 void validateToolSpec(const ToolSpec& tool) {
   if (!std::isfinite(tool.radius_mm) || !(tool.radius_mm > 0))
     throw InputError("tool radius must be > 0");
+  for (const double v : {tool.radius_mm, tool.length_mm, tool.corner_radius_mm})
+    if (std::abs(v) > kMaxToolSizeMm)
+      throw InputError("tool size " + shortNumber(v) + " mm is beyond " +
+                       shortNumber(kMaxToolSizeMm) + " mm (no spindle takes it)");
   if (tool.shape == ToolShape::Torus &&
       !(tool.corner_radius_mm > 0 && tool.corner_radius_mm <= tool.radius_mm))
     throw InputError("corner radius must be in (0, R]");
   const double end_mm = cornerRadius(tool);
   if (!std::isfinite(tool.length_mm) || !(tool.length_mm >= end_mm) || !(tool.length_mm > 0))
-    throw InputError("tool length must cover the cutting end (>= " + std::to_string(end_mm) +
-                     " mm)");
+    throw InputError("tool length must cover the cutting end (>= " + shortNumber(end_mm) + " mm)");
 }
 
 void validateHolderProfile(const HolderProfile& holder) {
@@ -278,6 +294,10 @@ void validateHolderProfile(const HolderProfile& holder) {
     const HolderStation& s = holder[i];
     if (!std::isfinite(s.z_mm) || !std::isfinite(s.radius_mm) || !(s.radius_mm > 0))
       throw InputError("station " + std::to_string(i) + ": z must be finite and radius > 0");
+    if (std::abs(s.z_mm) > kMaxToolSizeMm || s.radius_mm > kMaxToolSizeMm)
+      throw InputError("station " + std::to_string(i) + ": " + shortNumber(s.z_mm) + ":" +
+                       shortNumber(s.radius_mm) + " is beyond " + shortNumber(kMaxToolSizeMm) +
+                       " mm (no spindle takes it)");
     if (i > 0 && !(s.z_mm > holder[i - 1].z_mm) &&
         !(s.z_mm == holder[i - 1].z_mm && s.radius_mm != holder[i - 1].radius_mm))
       throw InputError("station " + std::to_string(i) +
@@ -312,7 +332,7 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
   const double triangles_estimate = 2 * rings * (2 * kPi / angularStep(max_rho_mm, sagitta_mm) + 8);
   if (triangles_estimate > kMaxTriangles)
     throw InputError(
-        "chordal tolerance " + std::to_string(chord_tol_mm) + " mm is too fine: about " +
+        "chordal tolerance " + shortNumber(chord_tol_mm) + " mm is too fine: about " +
         std::to_string(static_cast<long long>(triangles_estimate)) + " triangles (limit " +
         std::to_string(static_cast<long long>(kMaxTriangles)) + ")");
 

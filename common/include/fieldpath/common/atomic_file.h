@@ -4,6 +4,7 @@
 /// being written are listed where a SIGINT/SIGTERM handler can remove them
 /// (removeTemporariesNow(), installed by the CLI's main()).
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -118,6 +119,15 @@ inline void checkOutputDirectory(const std::filesystem::path& dir, const std::st
   if (::access(at.c_str(), W_OK | X_OK) != 0)
     throw InputError(name + ": cannot write in " + at.string() + ": " +
                      detail::systemReason(errno));
+  // access() says yes to root everywhere and knows nothing of /proc or read-only mounts: where
+  // the directory does not exist yet, make it and take it away again (nothing is left).
+  if (at != fs::absolute(dir, ec)) {
+    // The first missing component below the existing ancestor.
+    const fs::path first = at / *fs::absolute(dir, ec).lexically_relative(at).begin();
+    if (::mkdir(first.c_str(), 0777) != 0)
+      throw InputError(name + ": cannot be created: " + detail::systemReason(errno));
+    ::rmdir(first.c_str());
+  }
 }
 
 /// Checks that an output file `file` can be written (its directory can exist, the name is not a
