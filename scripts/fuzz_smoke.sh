@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# CI smoke fuzz: each parser target for a short time (FUZZ_SECONDS, default 15) on its seed
+# CI smoke fuzz: each parser target for a short time (FUZZ_SECONDS, default 10) on its seed
 # corpus; fails on any crash, hang, leak or sanitizer report. Skipped (exit 0, with a line) where
 # clang 14 or libFuzzer is missing. fuzz_scene is left to scripts/fuzz.sh (it needs the whole
 # project built with sanitizers: too slow for CI); FUZZ_SCENE=1 adds it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export LSAN_OPTIONS="suppressions=$PWD/tests/fuzz/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
-seconds=${FUZZ_SECONDS:-15}
+seconds=${FUZZ_SECONDS:-10}
 if ! command -v clang++-14 >/dev/null || ! ls /usr/lib/llvm-14/lib/clang/14*/lib/linux/libclang_rt.fuzzer-x86_64.a >/dev/null 2>&1; then
   echo "fuzz_smoke: skipped (no clang++-14 with libFuzzer)"
   exit 0
