@@ -11,7 +11,8 @@ if ! command -v clang++-14 >/dev/null || ! ls /usr/lib/llvm-14/lib/clang/14*/lib
   echo "fuzz_smoke: skipped (no clang++-14 with libFuzzer)"
   exit 0
 fi
-targets=(fuzz_cl fuzz_apt fuzz_npy fuzz_mesh fuzz_tool fuzz_cli)
+targets=(fuzz_cl fuzz_apt fuzz_npy fuzz_mesh fuzz_tool)
+[ -f app/cli_parse.cpp ] && targets+=(fuzz_cli)  # the CLI parsers, once in their own file
 [ "${FUZZ_SCENE:-0}" = 1 ] && targets+=(fuzz_scene)
 bash scripts/fuzz_build.sh "${targets[@]}"
 for t in "${targets[@]}"; do
