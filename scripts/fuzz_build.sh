@@ -15,6 +15,8 @@ if [ ! -f build-fuzz/CMakeCache.txt ]; then
     -DFIELDPATH_BUILD_BENCH=OFF -DFIELDPATH_WITH_CUDA=OFF >/dev/null
 fi
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(fuzz_cl fuzz_apt fuzz_npy fuzz_mesh fuzz_tool)
-[ -f app/cli_parse.cpp ] && targets+=(fuzz_cli)  # the CLI parsers, once in their own file
+if [ ${#targets[@]} -eq 0 ]; then
+  targets=(fuzz_cl fuzz_apt fuzz_npy fuzz_mesh fuzz_tool)
+  [ -f app/cli_parse.cpp ] && targets+=(fuzz_cli)  # the CLI parsers, once in their own file
+fi
 cmake --build build-fuzz -j"${FIELDPATH_JOBS:-2}" --target "${targets[@]}"
