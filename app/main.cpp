@@ -59,8 +59,8 @@ int main(int argc, char** argv) {
     // permission, a full disk): their environment, not our bug.
     std::fprintf(stderr, "fieldpath: error: %s\n", e.what());
     return 1;
-    std::fprintf(stderr, "fieldpath: internal error: %s\n", e.what());
   } catch (const std::exception& e) {
+    std::fprintf(stderr, "fieldpath: internal error: %s\n", e.what());
     return 2;
   }
   return 0;
