@@ -38,5 +38,6 @@ void addFieldCommand(CLI::App& app, const GlobalOptions& global);
 void addGenerateCommand(CLI::App& app, const GlobalOptions& global);
 void addCheckCommand(CLI::App& app, const GlobalOptions& global);
 void addStudyCommand(CLI::App& app, const GlobalOptions& global);
+void addViewCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace fieldpath::app

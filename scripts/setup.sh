@@ -10,6 +10,7 @@ packages=(
   libsundials-dev libtbb-dev libcli11-dev libyaml-cpp-dev nlohmann-json3-dev zlib1g-dev
   libgtest-dev googletest libbenchmark-dev
   python3-matplotlib python3-numpy
+  chromium libjs-three
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -3,7 +3,7 @@
 #   OUT_DIR/part/     scene.yaml (a copy of this folder's) and what make_part.py writes beside it:
 #                     hub.stl, blades.stl, nominal.cl, nominal.apt, nominal.npy
 #   OUT_DIR/field/    generate (voxel field) + check: path.cl, path.apt, angles.csv, report.json,
-#                     check.json, deviation.png
+#                     check.json, deviation.png; view.html: the job in 3-D (open it in a browser)
 #   OUT_DIR/nominal/  the same for the nominal path (axis on the hub normal): the collisions the
 #                     field avoids
 set -euo pipefail
@@ -17,4 +17,7 @@ scene="$out/part/scene.yaml"
 "$bin" check "$scene" --path "$out/field/path.cl" --out "$out/field"
 "$bin" generate "$scene" --nominal --out "$out/nominal"
 "$bin" check "$scene" --path "$out/nominal/path.cl" --out "$out/nominal"
-echo "mesh_impeller: outputs in $out (part/, field/, nominal/)"
+for p in field nominal; do
+  "$bin" view "$scene" --path "$out/$p/path.cl" --check "$out/$p" --out "$out/$p/view.html"
+done
+echo "mesh_impeller: outputs in $out (part/, field/, nominal/; field/view.html)"
