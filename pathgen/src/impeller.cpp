@@ -91,7 +91,8 @@ std::array<int, 2> gridCells(const std::function<Vec3(double, double)>& p, doubl
 
 geometry::TriangleMesh gridMesh(const std::function<Vec3(double, double)>& p, double tol_mm,
                                 double max_edge_mm, bool flip) {
-  const auto [na, nb] = gridCells(p, tol_mm, max_edge_mm);
+  const std::array<int, 2> cells = gridCells(p, tol_mm, max_edge_mm);
+  const int na = cells[0], nb = cells[1];  // not a structured binding: clang 14 cannot capture one
   geometry::TriangleMesh mesh;
   mesh.vertices.reserve(static_cast<size_t>(na + 1) * (nb + 1));
   for (int i = 0; i <= na; ++i)
