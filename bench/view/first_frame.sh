@@ -13,7 +13,7 @@ for page in "$@"; do
   frames=(); contexts=()
   for ((i = 0; i < runs; ++i)); do
     profile=$(mktemp -d)
-    dom=$("$chromium" --headless --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader \
+    dom=$("$chromium" --headless --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader --disable-dev-shm-usage \
       --window-size=800,650 --virtual-time-budget=5000 --user-data-dir="$profile" --dump-dom \
       "file://$page" 2>/dev/null)
     rm -rf "$profile"

@@ -338,7 +338,8 @@ struct Browser {
     const std::string command =
         "timeout 120 '" + exe +
         "' --headless --no-sandbox --use-angle=swiftshader "
-        "--enable-unsafe-swiftshader --window-size=800,650 --virtual-time-budget=5000 "
+        "--enable-unsafe-swiftshader --disable-dev-shm-usage --window-size=800,650 "
+        "--virtual-time-budget=5000 "
         "--enable-logging=stderr --v=0 --user-data-dir='" +
         profile.string() + "' " + mode + " '" + url + "' > '" + out.string() + "' 2> '" +
         err.string() + "'";
