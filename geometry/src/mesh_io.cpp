@@ -68,32 +68,53 @@ void fillScene(aiScene& scene, const TriangleMesh& mesh) {
   }
 }
 
-/// assimp's loaders trust what a file's header says: a PLY header without `end_header` loops
-/// forever (assimp 5.2, found by tests/fuzz fuzz_mesh) and element counts size its allocations.
-/// So a PLY header is read here first: it must end within 64 KiB and each element count must fit
-/// in the file (every element takes at least one byte).
+/// assimp's PLY loader trusts what a header says and loops forever on some malformed ones (no
+/// `end_header`; a `plyply` first line; found by tests/fuzz fuzz_mesh), and element counts size its
+/// allocations. So whatever assimp would take for PLY (the extension, or `ply` at the start) must
+/// have a header of the standard's grammar, read here first: `ply`, one `format` line of the
+/// three, `element NAME COUNT` with counts that fit in the file (every element takes at least one
+/// byte), `property ...`, `comment ...`, `obj_info ...`, and `end_header` within 64 KiB.
 void checkPlyHeader(const std::filesystem::path& file, std::uintmax_t size) {
   std::ifstream in(file, std::ios::binary);
-  char magic[4] = {};
-  in.read(magic, 4);
-  if (in.gcount() < 4 || std::string(magic, 3) != "ply" || (magic[3] != '\n' && magic[3] != '\r'))
-    return;  // not a PLY file: assimp decides
+  char magic[3] = {};
+  in.read(magic, 3);
+  const bool looks_ply = in.gcount() == 3 && std::string(magic, 3) == "ply";
+  if (!looks_ply && lowerExtension(file) != ".ply") return;  // assimp decides
+  in.seekg(0);
+  const auto refuse = [&](std::size_t number, const std::string& why) {
+    throw InputError(file.string() + ":" + std::to_string(number) + ": PLY header: " + why);
+  };
   std::string line;
-  std::size_t read = 4, number = 1;
+  std::size_t read = 0, number = 0;
+  bool format = false;
   while (std::getline(in, line)) {
     ++number;
     read += line.size() + 1;
     if (read > (std::size_t{64} << 10)) break;
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line == "end_header") return;
-    if (line.rfind("element ", 0) == 0) {
-      std::istringstream words(line.substr(8));
+    std::istringstream words(line);
+    std::string word;
+    words >> word;
+    if (number == 1) {
+      if (line != "ply") refuse(number, "the first line must be `ply`");
+    } else if (word == "format") {
+      std::string kind, version;
+      words >> kind >> version;
+      if (format || version != "1.0" ||
+          (kind != "ascii" && kind != "binary_little_endian" && kind != "binary_big_endian"))
+        refuse(number, "expected one `format ascii|binary_little_endian|binary_big_endian 1.0`");
+      format = true;
+    } else if (word == "element") {
       std::string name;
       double count = -1;
       words >> name >> count;
-      if (!words || count < 0 || count > static_cast<double>(size))
-        throw InputError(file.string() + ":" + std::to_string(number) +
-                         ": PLY element count does not fit in the file: " + line);
+      if (!words || count < 0 || count != std::floor(count) || count > static_cast<double>(size))
+        refuse(number, "element count does not fit in the file: " + line);
+    } else if (word == "end_header") {
+      if (!format) refuse(number, "no `format` line");
+      return;
+    } else if (word != "property" && word != "comment" && word != "obj_info") {
+      refuse(number, "unexpected line '" + line.substr(0, 40) + "'");
     }
   }
   throw InputError(file.string() + ": PLY header without `end_header` in its first 64 KiB");

@@ -60,6 +60,15 @@ TEST(FuzzRegressions, PlyWithMisspeltPropertyDoesNotAbort) {
   }
 }
 
+// fuzz_mesh timeout-a86c8e3a: `plyply` as the first line (assimp still takes it for PLY) and a
+// broken binary body: assimp seeked forever.
+TEST(FuzzRegressions, PlyWithAStrangeFirstLineDoesNotHang) {
+  expectRefusedQuickly("plyply.mesh",
+                       "plyply\nformat binary_little_endian 2.e0eml\ne\xff\xff\x02ply\nformat "
+                       "binary_little_endian 1.0\nelement vertex 3\nproperty float "
+                       "x\xff\xff\xff\xffoperty float y\nprope\nproperty float rt["s);
+}
+
 // Found while building the hostile-input table: a PLY whose element count the file cannot hold
 // would size assimp's allocations from the header.
 TEST(FuzzRegressions, PlyElementCountBeyondTheFileIsRefused) {
