@@ -27,7 +27,7 @@ const char* kPathApt =
 
 std::string npyPath() {
   std::string header = "{'descr': '<f8', 'fortran_order': False, 'shape': (3, 6), }";
-  header.append(64 - 10 - header.size() - 1, ' ');
+  header.append((64 - (10 + header.size() + 1) % 64) % 64, ' ');  // data aligned to 64 bytes
   header += '\n';
   std::string out("\x93NUMPY\x01\x00", 8);
   out += static_cast<char>(header.size());

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -26,6 +27,10 @@ inline const std::filesystem::path& scratchDir() {
         std::filesystem::is_directory("/dev/shm", ec) ? "/dev/shm" : std::filesystem::temp_directory_path();
     auto d = base / ("fieldpath-fuzz-" + std::to_string(::getpid()));
     std::filesystem::create_directories(d);
+    std::atexit([] {  // libFuzzer ends by exit(): leave no scratch directory behind
+      std::error_code ignored;
+      std::filesystem::remove_all(scratchDir(), ignored);
+    });
     // Every estimate is checked against this: a fuzzer must not be able to ask for gigabytes.
     common::setMemoryLimitBytes(std::size_t{256} << 20);
     return d;
