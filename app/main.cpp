@@ -43,7 +43,6 @@ int main(int argc, char** argv) {
   addGenerateCommand(app, global);
   addCheckCommand(app, global);
   addStudyCommand(app, global);
-  addViewCommand(app, global);
 
   try {
     app.parse(argc, argv);
@@ -53,14 +52,17 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fieldpath: error: %s (see --help)\n", e.what());
     return 1;
   } catch (const InputError& e) {
+    fieldpath::common::removeWrittenOutputs();  // a failed run leaves no partial set of outputs
     std::fprintf(stderr, "fieldpath: error: %s\n", e.what());
     return 1;
   } catch (const std::filesystem::filesystem_error& e) {
     // Reading or writing a path the user gave (an --out that is a file, a directory without
     // permission, a full disk): their environment, not our bug.
+    fieldpath::common::removeWrittenOutputs();
     std::fprintf(stderr, "fieldpath: error: %s\n", e.what());
     return 1;
   } catch (const std::exception& e) {
+    fieldpath::common::removeWrittenOutputs();
     std::fprintf(stderr, "fieldpath: internal error: %s\n", e.what());
     return 2;
   }

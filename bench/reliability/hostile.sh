@@ -8,7 +8,7 @@ set -uo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 fp=$(realpath "${1:-$root/build/bin/fieldpath}")
 w=$(mktemp -d)
-trap 'rm -rf "$w"' EXIT
+trap 'umount "$w/full" 2>/dev/null; rm -rf "$w"' EXIT
 cd "$w"
 
 # ---- fixtures ---------------------------------------------------------------------------------
@@ -64,7 +64,8 @@ echo "|---|---|---|---|---|---|---|---|---|"
 row() {
   local what=$1 expect=$2; shift 2
   n=$((n + 1))
-  rm -rf out
+  local outdir=${OUTDIR:-out}
+  rm -rf out "$outdir"
   local start end
   start=$(date +%s.%N)
   /usr/bin/time -f "%M" -o mem.txt timeout 60 "$fp" --quiet "$@" > stdout.txt 2> stderr.txt
@@ -75,7 +76,7 @@ row() {
   mem=$(( $(tail -1 mem.txt) / 1024 ))
   lines=$(wc -l < stderr.txt)
   files=0
-  [ -d out ] && files=$(find out -type f | wc -l)
+  [ -d "$outdir" ] && files=$(find "$outdir" -type f | wc -l)
   msg=$(head -c 220 stderr.txt | head -1 | sed 's/|/\\|/g')
   [ "$code" = 1 ] || ok=no
   [ "$lines" = 1 ] || ok=no
@@ -135,6 +136,11 @@ row "--path .npy of int32" "int.npy" simulate --tool ball:3 --path int.npy --out
 row "--path APT GOTO with 2 numbers" "short.apt:1" simulate --tool ball:3 --path short.apt --out out
 row "--part empty mesh" "empty.stl" simulate --tool ball:3 --path ok.cl --part empty.stl --out out
 row "--out is a file (simulate under a file)" "afile" simulate --tool ball:3 --path ok.cl --out afile/sub
+# A full disk: a 1 MiB tmpfs (where this may mount one), a 1000x1000 simulation (4 MB of heights).
+mkdir -p full
+if mount -t tmpfs -o size=1m tmpfs full 2>/dev/null; then
+  OUTDIR=full/out row "full disk (1 MiB tmpfs)" "No space left on device" simulate --tool ball:3 --path ok.cl --grid 1000x1000 --out full/out
+fi
 # tool, field, check, study
 row "tool --tol 1e-12" "tolerance" tool --shape ball:3 --tol 1e-12 --out out/t.stl
 row "tool --holder 40:6,30:6 (goes down)" "holder" tool --shape ball:3 --holder 40:6,30:6 --out out/t.stl

@@ -100,6 +100,16 @@ TEST(AtomicOutput, SignalDuringAWriteLeavesNothing) {
   EXPECT_EQ(filesUnder(dir.path() / "out"), std::vector<std::string>{"big.bin"});
 }
 
+// A run that fails after some outputs were written (a full disk at the third) takes them away.
+TEST(AtomicOutput, AFailedRunRemovesWhatItWrote) {
+  const TempDir dir;
+  common::writeTextAtomically(dir.path() / "out" / "a.json", "{}");
+  common::writeTextAtomically(dir.path() / "out" / "b.csv", "x\n");
+  EXPECT_EQ(filesUnder(dir.path() / "out").size(), 2u);
+  common::removeWrittenOutputs();
+  EXPECT_TRUE(filesUnder(dir.path() / "out").empty());
+}
+
 // ---- the commands, interrupted midway ------------------------------------------------------------
 
 /// Starts the command, signals it after `after`, and checks what is left in `out`: no temporary,

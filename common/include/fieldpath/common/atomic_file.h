@@ -5,6 +5,7 @@
 /// (removeTemporariesNow(), installed by the CLI's main()).
 #include <signal.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -14,7 +15,9 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <mutex>
 #include <string>
+#include <vector>
 
 #include "fieldpath/common/errors.h"
 
@@ -57,6 +60,20 @@ struct TemporaryListing {
 
 /// "what FILE: strerror(errno)" for a failed system call on a user's output path.
 inline std::string systemReason(int error) { return error != 0 ? std::strerror(error) : "unknown error"; }
+
+/// Why a write into `dir` failed: errno's text, or a full device when errno was lost on the way
+/// (std::ofstream does not keep it).
+inline std::string writeReason(int error, const std::filesystem::path& dir) {
+  if (error != 0) return std::strerror(error);
+  struct statvfs fs {};
+  if (::statvfs(dir.empty() ? "." : dir.c_str(), &fs) == 0 && fs.f_bavail == 0)
+    return std::strerror(ENOSPC);
+  return "write failed";
+}
+
+/// The outputs this process has put in place, for removeWrittenOutputs().
+inline std::mutex written_mutex;
+inline std::vector<std::filesystem::path> written_outputs;
 
 }  // namespace detail
 
@@ -161,24 +178,41 @@ inline void writeFileAtomically(const std::filesystem::path& path,
       if (!out)
         throw InputError(path.string() + ": cannot open for writing: " +
                          detail::systemReason(errno));
-      write(out);
       errno = 0;
+      write(out);
       out.flush();
-      if (!out) throw InputError(path.string() + ": cannot write: " + detail::systemReason(errno));
+      if (!out)
+        throw InputError(path.string() + ": cannot write: " +
+                         detail::writeReason(errno, path.parent_path()));
       out.close();
       if (out.fail())
-        throw InputError(path.string() + ": cannot write: " + detail::systemReason(errno));
+        throw InputError(path.string() + ": cannot write: " +
+                         detail::writeReason(errno, path.parent_path()));
     }
     std::error_code ec;
     if (fs::is_directory(path, ec))
       throw InputError(path.string() + ": is a directory, cannot write a file there");
     fs::rename(tmp, path, ec);
     if (ec) throw InputError(path.string() + ": cannot rename into place: " + ec.message());
+    const std::lock_guard<std::mutex> lock(detail::written_mutex);
+    detail::written_outputs.push_back(path);
   } catch (...) {
     std::error_code ec;
     fs::remove(tmp, ec);
     throw;
   }
+}
+
+/// Removes the outputs this process has written (writeFileAtomically) so far: a run that fails
+/// on its way (a full disk at the third file) leaves no partial set of outputs either. The CLI's
+/// main() calls it before exiting 1 or 2.
+inline void removeWrittenOutputs() {
+  const std::lock_guard<std::mutex> lock(detail::written_mutex);
+  for (const auto& file : detail::written_outputs) {
+    std::error_code ignored;
+    std::filesystem::remove(file, ignored);
+  }
+  detail::written_outputs.clear();
 }
 
 /// Writes `text` atomically (see writeFileAtomically).
