@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
   addGenerateCommand(app, global);
   addCheckCommand(app, global);
   addStudyCommand(app, global);
+  addViewCommand(app, global);
 
   try {
     app.parse(argc, argv);
