@@ -1,21 +1,32 @@
-/// fieldpath simulate: Z-buffer machining simulation of a `.cl` path (DESIGN.md command line).
+/// fieldpath simulate: Z-buffer machining simulation of a path (DESIGN.md command line).
+/// Fast as a process, not only as a kernel (issue 13): the path is read on all cores while the
+/// tool is prepared (and the CUDA context created) on another thread; with --region the engine
+/// cuts each chunk as soon as it is parsed; the outputs are written concurrently, each
+/// atomically; simulate.json says where the time went.
+#include <sys/resource.h>
+
 #include <algorithm>
-#include <cfloat>
-#include <charconv>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <limits>
+#include <set>
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
+#include "cli_parse.h"
 #include "commands.h"
 #include "errors.h"
+#include "fieldpath/common/atomic_file.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/mesh_io.h"
-#include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/zbuffer/outputs.h"
 #include "fieldpath/zbuffer/simulator.h"
+#include "posture_stream.h"
 #include "progress.h"
 #include "to_zbuffer.h"
 
@@ -23,76 +34,42 @@ namespace fieldpath::app {
 namespace {
 
 namespace zb = zbuffer;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
 
-bool isAnalyticToolText(const std::string& text) {
-  return text.rfind("ball:", 0) == 0 || text.rfind("torus:", 0) == 0 || text.rfind("flat:", 0) == 0;
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-/// TOOL: ball:R[:L] | torus:R:r[:L] | flat:R[:L], or a mesh file (tool frame).
-zb::Tool parseTool(const std::string& text) {
-  if (isAnalyticToolText(text)) {
-    const geometry::ToolSpec spec = geometry::parseToolSpec(text);
-    switch (spec.shape) {
-      case geometry::ToolShape::Ball:
-        return zb::Tool::ball(spec.radius_mm, spec.length_mm);
-      case geometry::ToolShape::Torus:
-        return zb::Tool::torus(spec.radius_mm, spec.corner_radius_mm, spec.length_mm);
-      case geometry::ToolShape::Flat:
-        return zb::Tool::flat(spec.radius_mm, spec.length_mm);
-    }
-  }
-  const geometry::TriangleMesh mesh = geometry::loadMesh(text);
-  try {
-    return zb::Tool::fromMesh(toZbuffer(mesh));
-  } catch (const InputError& e) {
-    throw InputError("--tool " + text + ": " + e.what());
-  }
-}
+const char* const kOutputNames[] = {"npy", "json", "stl", "png"};
 
-/// "NXxNY" → (nx, ny); refuses zero and counts beyond int.
-std::pair<int, int> parseGrid(const std::string& text) {
-  const auto x = text.find('x');
-  long long v[2] = {0, 0};
-  const std::string parts[2] = {text.substr(0, x),
-                                x == std::string::npos ? "" : text.substr(x + 1)};
-  for (int k = 0; k < 2; ++k) {
-    const auto& s = parts[k];
-    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v[k]);
-    if (s.empty() || ec != std::errc() || end != s.data() + s.size())
-      throw InputError("--grid '" + text + "': expected NXxNY, e.g. 1024x1024");
-  }
-  if (v[0] <= 0 || v[1] <= 0)
-    throw InputError("--grid '" + text + "': needs at least one line each way");
-  if (v[0] > std::numeric_limits<int>::max() / 2 || v[1] > std::numeric_limits<int>::max() / 2)
-    throw InputError("--grid '" + text + "' is too large: it needs about " +
-                     std::to_string(static_cast<long double>(v[0]) * v[1] * 12 / (1 << 20)) +
-                     " MiB of memory");
-  return {static_cast<int>(v[0]), static_cast<int>(v[1])};
-}
-
-std::vector<double> parseNumbers(const std::string& text, const char* option, std::size_t count) {
-  std::vector<double> out;
+/// "npy,json,stl,png" (any subset, any order) → the set; one line naming the bad item otherwise.
+std::set<std::string> parseOutputs(const std::string& text) {
+  std::set<std::string> out;
   std::size_t pos = 0;
   while (pos <= text.size()) {
     const auto comma = std::min(text.find(',', pos), text.size());
-    const std::string field = text.substr(pos, comma - pos);
-    std::size_t used = 0;
-    double value = 0;
-    try {
-      value = std::stod(field, &used);
-    } catch (...) {
-      used = 0;
-    }
-    if (field.empty() || used != field.size() || !std::isfinite(value))
-      throw InputError(std::string(option) + " '" + text + "': '" + field +
-                       "' is not a finite number");
-    out.push_back(value);
+    const std::string item = text.substr(pos, comma - pos);
+    if (std::find(std::begin(kOutputNames), std::end(kOutputNames), item) ==
+        std::end(kOutputNames))
+      throw InputError("--outputs '" + text + "': '" + item +
+                       "' is not one of npy, json, stl, png");
+    out.insert(item);
     pos = comma + 1;
   }
-  if (out.size() != count)
-    throw InputError(std::string(option) + " '" + text + "': expected " + std::to_string(count) +
-                     " numbers");
   return out;
+}
+
+/// Peak resident memory of this process so far (MiB).
+double peakRssMib() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return double(usage.ru_maxrss) / 1024.0;  // KiB on Linux
+}
+
+/// A number for JSON: finite, or null.
+nlohmann::json finiteOrNull(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
 }
 
 }  // namespace
@@ -100,54 +77,77 @@ std::vector<double> parseNumbers(const std::string& text, const char* option, st
 void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
   auto* cmd = app.add_subcommand("simulate",
                                  "Z-buffer machining simulation of a path: heights.npy (+ .json), "
-                                 "surface.stl, heights.png and a summary");
+                                 "surface.stl, heights.png, simulate.json and a summary");
   struct Options {
     std::string tool, path, grid = "1024x1024", region, part, backend = "auto", out;
+    std::string outputs = "npy,json,stl,png";
     double stock_mm = std::numeric_limits<double>::quiet_NaN();
+    std::size_t block_postures = 0;
   };
   auto o = std::make_shared<Options>();
   cmd->add_option("--tool", o->tool,
                   "Mesh file (tip at origin, axis +z) or ball:R[:L] | torus:R:r[:L] | flat:R[:L]")
       ->required();
-  cmd->add_option("--path", o->path, "Path file: .cl (x y z i j k per line), APT (.apt/.cls) or .npy (N×6/7 float32/64)")->required();
+  cmd->add_option("--path", o->path,
+                  "Path file: .cl (x y z i j k per line), APT (.apt/.cls) or .npy (N×6/7 "
+                  "float32/64)")
+      ->required();
   cmd->add_option("--grid", o->grid, "Lines NXxNY")->capture_default_str();
   cmd->add_option("--region", o->region,
-                  "x0,y0,x1,y1 mm (default: the tips' XY range plus the tool radius)");
+                  "x0,y0,x1,y1 mm (default: the tips' XY range plus the tool radius); given, the "
+                  "path is cut while it is read");
   auto* stock =
       cmd->add_option("--stock", o->stock_mm, "Stock top plane z, mm (default: the highest tip)");
   cmd->add_option("--part", o->part, "Part mesh whose top is the initial surface")->excludes(stock);
   cmd->add_option("--backend", o->backend, "auto | cpu | cuda")->capture_default_str();
+  cmd->add_option("--outputs", o->outputs,
+                  "Which of npy (heights.npy), json (heights.json), stl (surface.stl), png "
+                  "(heights.png) to write; simulate.json is always written")
+      ->capture_default_str();
+  cmd->add_option("--block", o->block_postures,
+                  "Postures per chunk read and cut together (default: 4 MB of text); the heights "
+                  "do not depend on it");
   cmd->add_option("--out", o->out, "Output directory")->required();
 
   cmd->callback([o, &global] {
+    const auto start = Clock::now();
+    // Everything the user typed is checked before any work.
     zb::SimulationRequest req;
     req.backend = zb::backendFromName(o->backend, "--backend");
     if (req.backend == zb::Backend::Cuda && !zb::cudaAvailable())
       throw InputError("--backend cuda: no CUDA device available (built without CUDA or no GPU)");
-
+    const std::set<std::string> outputs = parseOutputs(o->outputs);
+    const fs::path out = o->out;
+    if (std::error_code ec; fs::exists(out, ec) && !fs::is_directory(out, ec))
+      throw InputError("--out " + out.string() + ": exists and is not a directory");
     const auto [nx, ny] = parseGrid(o->grid);
+    std::vector<double> region;
+    if (!o->region.empty()) region = parseNumbers(o->region, "--region", 4);
     req.tool = parseTool(o->tool);
-    const std::vector<geometry::Posture> path = geometry::readPathFile(o->path).postures;
-    const std::vector<zb::Posture> postures = toZbuffer(path);
-    double xmin = DBL_MAX, ymin = DBL_MAX, xmax = -DBL_MAX, ymax = -DBL_MAX, ztop = -DBL_MAX;
-    for (const auto& p : path) {
-      xmin = std::min(xmin, p.tip_mm.x());
-      xmax = std::max(xmax, p.tip_mm.x());
-      ymin = std::min(ymin, p.tip_mm.y());
-      ymax = std::max(ymax, p.tip_mm.y());
-      ztop = std::max(ztop, p.tip_mm.z());
-    }
-    if (o->region.empty()) {
-      const double margin = zb::toolReach(req.tool);
-      req.grid =
-          zb::Grid::fromRegion(xmin - margin, ymin - margin, xmax + margin, ymax + margin, nx, ny);
-    } else {
-      const auto r = parseNumbers(o->region, "--region", 4);
+
+    // The path is read on all cores; beside it, the tool and the device get ready.
+    geometry::PathReadOptions read_options;
+    if (o->block_postures > 0) read_options.chunk_bytes = o->block_postures * 40;  // ~40 B a line
+    PostureStream stream(o->path, read_options);
+    const auto prepare_start = Clock::now();
+    std::future<double> prepared = std::async(std::launch::async, [&req, prepare_start] {
+      zb::prepare(req.tool, req.backend);
+      return secondsSince(prepare_start);
+    });
+
+    const bool streamed = !region.empty();
+    if (streamed) {
       try {
-        req.grid = zb::Grid::fromRegion(r[0], r[1], r[2], r[3], nx, ny);
+        req.grid = zb::Grid::fromRegion(region[0], region[1], region[2], region[3], nx, ny);
       } catch (const InputError& e) {
         throw InputError("--region '" + o->region + "': " + e.what());
       }
+    } else {
+      stream.waitAll();  // the default region needs every tip
+      const TipBounds b = stream.bounds();
+      const double margin = zb::toolReach(req.tool);
+      req.grid = zb::Grid::fromRegion(b.xmin - margin, b.ymin - margin, b.xmax + margin,
+                                      b.ymax + margin, nx, ny);
     }
     zb::checkGridFits(req.grid);  // before allocating anything grid-sized
 
@@ -155,21 +155,73 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
       const geometry::TriangleMesh part = geometry::loadMesh(o->part);
       const zb::ToolMesh m = toZbuffer(part);
       req.initial_heights_mm = zb::stockFromPart(req.grid, m.vertices, m.triangles);
+    } else if (!std::isnan(o->stock_mm)) {
+      req.stock_mm = static_cast<float>(o->stock_mm);
     } else {
-      req.stock_mm = static_cast<float>(std::isnan(o->stock_mm) ? ztop : o->stock_mm);
+      // the highest tip: known before the cut only when the whole path was read first
+      if (streamed) stream.waitAll();
+      req.stock_mm = static_cast<float>(stream.bounds().zmax);
     }
     req.progress = makeProgressLine(global.quiet);
+    const double prepare_s = prepared.get();
 
-    const zb::SimulationResult res = zb::simulate(req, postures);
+    const zb::SimulationResult res = zb::simulateBlocks(req, [&stream] { return stream.next(); });
+    stream.waitAll();  // an error after the last chunk (e.g. no postures at all)
+    if (res.postures == 0) throw InputError(o->path + ": no postures");
 
-    const std::filesystem::path out = o->out;
-    zb::writeHeightsNpy(out / "heights.npy", req.grid, res.heights_mm);
-    zb::writeHeightsJson(out / "heights.json", req.grid);
-    const std::size_t stl_triangles =
-        zb::writeSurfaceStl(out / "surface.stl", req.grid, res.heights_mm);
-    zb::writeReliefPng(out / "heights.png", req.grid, res.heights_mm);
+    // The outputs, concurrently; each lands atomically under its name.
+    const auto write_start = Clock::now();
+    fs::create_directories(out);
+    std::size_t stl_triangles = 0;
+    std::vector<std::future<void>> writing;
+    const auto write = [&writing](auto job) {
+      writing.push_back(std::async(std::launch::async, job));
+    };
+    if (outputs.count("npy"))
+      write([&] { zb::writeHeightsNpy(out / "heights.npy", req.grid, res.heights_mm); });
+    if (outputs.count("json")) write([&] { zb::writeHeightsJson(out / "heights.json", req.grid); });
+    if (outputs.count("stl"))
+      write([&] {
+        stl_triangles = zb::writeSurfaceStl(out / "surface.stl", req.grid, res.heights_mm);
+      });
+    if (outputs.count("png"))
+      write([&] { zb::writeReliefPng(out / "heights.png", req.grid, res.heights_mm); });
+    for (auto& w : writing) w.wait();
+    for (auto& w : writing) w.get();  // the first failure, after every writer stopped
+    const double write_s = secondsSince(write_start);
 
     const auto [lo, hi] = std::minmax_element(res.heights_mm.begin(), res.heights_mm.end());
+    const double read_s = stream.readSeconds(), total_s = secondsSince(start);
+    const double per_s = res.seconds > 0 ? double(res.postures) / res.seconds : 0.0;
+    std::error_code size_ec;
+    const double path_mb = double(fs::file_size(o->path, size_ec)) / 1e6;
+    nlohmann::json report = {
+        {"path", o->path},
+        {"path_megabytes", size_ec ? nlohmann::json(nullptr) : nlohmann::json(path_mb)},
+        {"postures", res.postures},
+        {"postures_culled", res.postures_culled},
+        {"grid",
+         {{"nx", req.grid.nx},
+          {"ny", req.grid.ny},
+          {"origin_mm", {req.grid.x0_mm, req.grid.y0_mm}},
+          {"spacing_mm", {req.grid.dx_mm, req.grid.dy_mm}}}},
+        {"lines_lowered", res.lines_lowered},
+        {"heights_mm", {{"min", finiteOrNull(*lo)}, {"max", finiteOrNull(*hi)}}},
+        {"backend", zb::backendName(res.backend)},
+        {"streamed", streamed},
+        {"seconds",
+         {{"read", read_s},
+          {"prepare", prepare_s},
+          {"cut", res.seconds},
+          {"write", write_s},
+          {"total", total_s}}},
+        {"note",
+         "read and prepare run side by side; with --region (streamed) the cut overlaps the read"},
+        {"postures_per_second", finiteOrNull(per_s)},
+        {"read_megabytes_per_second", finiteOrNull(size_ec || read_s <= 0 ? NAN : path_mb / read_s)},
+        {"peak_memory_mib", peakRssMib()}};
+    common::writeTextAtomically(out / "simulate.json", report.dump(2) + "\n");
+
     std::printf("postures        %zu (%zu culled: cannot lower any line)\n", res.postures,
                 res.postures_culled);
     std::printf(
@@ -180,12 +232,23 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     std::printf("lines touched   %zu of %zu (%.1f%%)\n", res.lines_lowered, req.grid.lineCount(),
                 100.0 * double(res.lines_lowered) / double(req.grid.lineCount()));
     std::printf("heights         %.6g .. %.6g mm\n", double(*lo) + 0.0, double(*hi) + 0.0);
-    std::printf("time            %.3f s\n", res.seconds);
+    std::printf("time            %.3f s simulation (%.3g postures/s); read %.3f s, prepare %.3f s, "
+                "write %.3f s, total %.3f s%s\n",
+                res.seconds, per_s, read_s, prepare_s, write_s, total_s,
+                streamed ? " (cut while reading)" : "");
+    std::printf("memory          %.0f MiB peak\n", peakRssMib());
     std::printf("backend         %s\n", zb::backendName(res.backend));
-    std::printf(
-        "outputs         %s/{heights.npy, heights.json, surface.stl (%zu triangles), "
-        "heights.png}\n",
-        out.string().c_str(), stl_triangles);
+    std::string names;
+    for (const char* name : kOutputNames) {
+      if (!outputs.count(name)) continue;
+      const std::string file = std::string(name) == "npy"    ? "heights.npy"
+                               : std::string(name) == "json" ? "heights.json"
+                               : std::string(name) == "stl"
+                                   ? "surface.stl (" + std::to_string(stl_triangles) + " triangles)"
+                                   : "heights.png";
+      names += file + ", ";
+    }
+    std::printf("outputs         %s/{%ssimulate.json}\n", out.string().c_str(), names.c_str());
   });
 }
 

@@ -11,11 +11,18 @@
 /// --block: postures per streamed block (default 2^22).
 /// --variants: instead of the main table, the fast engine's median ms with each EngineTuning knob
 /// turned off in turn (the same heights, bit for bit, are checked on the way).
+/// --write-cases DIR: instead, writes each chosen case's postures as DIR/case<ID>.cl (shortest
+/// float text, as a CAM system writes 32-bit values) and DIR/case<ID>.npy (float32, N×6), and
+/// DIR/cases.txt (id, tool, region, grid per line) for bench/zbuffer/process.sh, which times
+/// `fieldpath simulate` on them as a process.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <charconv>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <numbers>
@@ -317,6 +324,61 @@ std::string heightError(const std::vector<float>& h, const std::vector<float>& e
   return text;
 }
 
+/// --write-cases: the postures of the chosen cases as `.cl` and `.npy` files, and cases.txt.
+int writeCases(const std::string& dir, const std::vector<std::string>& wanted,
+               const std::string& which) {
+  std::filesystem::create_directories(dir);
+  std::ofstream list(dir + "/cases.txt");
+  list << "# id tool region(x0,y0,x1,y1 mm) grid postures\n";
+  for (const Case& c : allCases()) {
+    if (which != "all" && std::find(wanted.begin(), wanted.end(), c.id) == wanted.end()) continue;
+    if (c.zoom[2] > c.zoom[0]) continue;  // zooms: the same paths as their unzoomed cases
+    const std::vector<zb::Posture> postures = casePostures(c);
+    const std::string stem = dir + "/case" + c.id;
+    {
+      std::ofstream cl(stem + ".cl", std::ios::binary);
+      std::string text;
+      char buffer[32];
+      for (const zb::Posture& p : postures) {
+        const float v[6] = {p.tip_mm.x, p.tip_mm.y, p.tip_mm.z, p.axis.x, p.axis.y, p.axis.z};
+        for (int k = 0; k < 6; ++k) {
+          text.append(buffer, std::to_chars(buffer, buffer + sizeof buffer, v[k]).ptr);
+          text += k < 5 ? ' ' : '\n';
+        }
+        if (text.size() > (1u << 24)) {
+          cl << text;
+          text.clear();
+        }
+      }
+      cl << text;
+    }
+    {
+      std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" +
+                           std::to_string(postures.size()) + ", 6), }";
+      while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+      header += '\n';
+      std::ofstream npy(stem + ".npy", std::ios::binary);
+      npy.write("\x93NUMPY\x01\x00", 8);
+      const char size[2] = {char(header.size() & 0xff), char(header.size() >> 8)};
+      npy.write(size, 2);
+      npy << header;
+      static_assert(sizeof(zb::Posture) == 24, "6 floats, no padding");
+      npy.write(reinterpret_cast<const char*>(postures.data()),
+                std::streamsize(postures.size() * sizeof(zb::Posture)));
+    }
+    const std::string tool = c.torus ? "torus:" + std::to_string(c.radius_mm) + ":" +
+                                           std::to_string(c.corner_mm) + ":" +
+                                           std::to_string(c.length_mm)
+                                     : "ball:" + std::to_string(c.radius_mm) + ":" +
+                                           std::to_string(c.length_mm);
+    list << c.id << ' ' << tool << " 0,0," << c.width_mm << ',' << c.width_mm << ' ' << c.grid
+         << 'x' << c.grid << ' ' << c.postures << '\n';
+    std::fprintf(stderr, "wrote %s.cl and %s.npy (%zu postures)\n", stem.c_str(), stem.c_str(),
+                 postures.size());
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -325,6 +387,7 @@ int main(int argc, char** argv) {
   std::size_t peer_limit = 0;  // 0: the whole case
   bool exact = true;
   bool variants = false;  // time the fast engine with each tuning knob off instead of the table
+  std::string write_dir;  // --write-cases: write the cases' path files instead
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const auto value = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
@@ -344,10 +407,13 @@ int main(int argc, char** argv) {
       g_block = std::stoul(value());
     else if (a == "--variants")
       variants = true;
+    else if (a == "--write-cases")
+      write_dir = value();
     else {
       std::fprintf(stderr,
                    "usage: %s [--backend cpu|cuda] [--cases 1,2,R,...|all] [--reps N] "
-                   "[--peer-limit P] [--no-exact] [--variants] [--tile-shift S] [--block P]\n",
+                   "[--peer-limit P] [--no-exact] [--variants] [--tile-shift S] [--block P] "
+                   "[--write-cases DIR]\n",
                    argv[0]);
       return 1;
     }
@@ -359,6 +425,7 @@ int main(int argc, char** argv) {
     wanted.push_back(which.substr(p, q - p));
     p = q + 1;
   }
+  if (!write_dir.empty()) return writeCases(write_dir, wanted, which);
   if (variants) return variantTable(backend, wanted, which, reps);
   std::printf(
       "| case | P | T | grid | ours ms (median of %d) | coarse peer ms | best published ms | "

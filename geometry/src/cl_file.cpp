@@ -77,6 +77,38 @@ inline bool isBlank(char c) {
   return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f' || c == '\n';
 }
 
+/// The common line, the fast way: 6 or 7 numbers fastNumber reads, blanks between them, maybe a
+/// comment. Returns false, having done nothing, for any other line (blank, marker, unusual
+/// numbers, errors): the careful parse then gives the same posture or the message.
+template <class Out>
+bool fastLine(std::string_view content, const std::filesystem::path& file, std::size_t line,
+              Out& out) {
+  const char* p = content.data();
+  const char* const end = p + content.size();
+  double v[7];
+  std::size_t count = 0;
+  for (;;) {
+    while (p < end && (*p == ' ' || *p == '\t' || *p == '\r')) ++p;
+    if (p == end || *p == '#') break;
+    if (count == 7 || !fastNumber(p, end, v[count])) return false;
+    if (p < end && *p != ' ' && *p != '\t' && *p != '\r' && *p != '#') return false;
+    ++count;
+  }
+  if (count < 6) return false;
+  for (std::size_t c = 0; c < count; ++c)
+    if (!std::isfinite(v[c])) return false;
+  const auto where = [&] { return file.string() + ":" + std::to_string(line); };
+  Posture posture;
+  posture.tip_mm = Vec3(v[0], v[1], v[2]);
+  checkTip(posture.tip_mm, where);
+  posture.axis = checkedAxis(Vec3(v[3], v[4], v[5]), where);
+  posture.has_spindle = count == 7;
+  posture.spindle_rad = posture.has_spindle ? v[6] : 0.0;
+  out.add(posture, line);
+  if (p < end && isLimitNote(std::string_view(p + 1, std::size_t(end - p - 1)))) out.limit();
+  return true;
+}
+
 /// Parses the `.cl` lines of one chunk. `Out` takes the postures (`add`), the block markers
 /// (`mark`, with the kind of the next block) and the `# limit` notes (`limit`, after the posture).
 template <class Out>
@@ -88,6 +120,7 @@ void parseClChunk(std::string_view text, std::size_t first_line, const std::file
     if (nl == std::string_view::npos) nl = text.size();
     std::string_view content = text.substr(pos, nl - pos), comment;
     pos = nl + 1;
+    if (fastLine(content, file, line, out)) continue;
     bool has_comment = false;
     if (const auto hash = content.find('#'); hash != std::string_view::npos) {
       comment = content.substr(hash + 1);

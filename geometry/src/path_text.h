@@ -4,6 +4,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -63,6 +64,47 @@ inline double parseFinite(std::string_view token, const std::filesystem::path& f
     fail(file, line, quoted(token) + " is not a number");
   if (!std::isfinite(value)) fail(file, line, quoted(token) + " is not finite");
   return value;
+}
+
+/// Clinger's fast path: a decimal number whose digits fit in 2^53 and whose power of ten is
+/// within 1e+-22 is one multiplication or division of two exact doubles, correctly rounded: the
+/// same bits std::from_chars gives, several times faster. Reads [p, end) from p (an optional
+/// sign, digits, '.', digits, an exponent); returns false, p unchanged, for anything else (the
+/// caller then parses the careful way).
+inline bool fastNumber(const char*& p, const char* end, double& out) {
+  static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                      1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                      1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  const char* s = p;
+  bool negative = false;
+  if (s < end && (*s == '-' || *s == '+')) negative = *s++ == '-';
+  std::uint64_t mantissa = 0;
+  int digits = 0, fraction = 0;
+  for (; s < end && static_cast<unsigned>(*s - '0') < 10; ++s, ++digits)
+    mantissa = mantissa * 10 + static_cast<unsigned>(*s - '0');
+  if (s < end && *s == '.') {
+    for (++s; s < end && static_cast<unsigned>(*s - '0') < 10; ++s, ++digits, ++fraction)
+      mantissa = mantissa * 10 + static_cast<unsigned>(*s - '0');
+  }
+  if (digits == 0 || digits > 19) return false;  // (19 digits cannot overflow 64 bits)
+  int exponent = -fraction;
+  if (s < end && (*s == 'e' || *s == 'E')) {
+    ++s;
+    bool negative_exponent = false;
+    if (s < end && (*s == '-' || *s == '+')) negative_exponent = *s++ == '-';
+    int value = 0, exponent_digits = 0;
+    for (; s < end && static_cast<unsigned>(*s - '0') < 10; ++s)
+      if (++exponent_digits > 4) return false;
+      else value = value * 10 + (*s - '0');
+    if (exponent_digits == 0) return false;
+    exponent += negative_exponent ? -value : value;
+  }
+  if (mantissa > (std::uint64_t{1} << 53) || exponent < -22 || exponent > 22) return false;
+  const double magnitude = exponent < 0 ? double(mantissa) / kPow10[-exponent]
+                                        : double(mantissa) * kPow10[exponent];
+  out = negative ? -magnitude : magnitude;
+  p = s;
+  return true;
 }
 
 /// The axis as read: unit (or normalised when off by < 1e-3); otherwise an error at `where()`

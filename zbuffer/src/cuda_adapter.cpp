@@ -72,6 +72,10 @@ class CudaAdapter final : public BackendEngine {
 };
 }  // namespace
 
+void warmUpCuda(const ToolData& tool) {
+  if (cuda::available()) cuda::warmUp(arrays(tool, tool.view));
+}
+
 std::unique_ptr<BackendEngine> makeCudaEngine(const EngineSetup& setup) {
   if (!cuda::available()) throw std::runtime_error("no CUDA device");
   return std::make_unique<CudaAdapter>(setup);

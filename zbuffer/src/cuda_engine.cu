@@ -888,6 +888,11 @@ std::size_t Engine::culled() const {
   return static_cast<std::size_t>(n);
 }
 
+void warmUp(const ToolArrays& tool) {
+  FIELDPATH_CUDA_CHECK(cudaFree(nullptr));  // the context, created here rather than in a cut
+  deviceTool(tool);
+}
+
 bool available() {
   static const bool ok = [] {
     int n = 0;

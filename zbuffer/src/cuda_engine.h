@@ -30,6 +30,8 @@ struct ToolArrays {
 };
 
 bool available();
+/// Creates the device's context and uploads the tool (kept for the engines with its id).
+void warmUp(const ToolArrays& tool);
 
 class Engine {
  public:

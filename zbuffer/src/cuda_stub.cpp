@@ -12,5 +12,6 @@ namespace detail {
 std::unique_ptr<BackendEngine> makeCudaEngine(const EngineSetup&) {
   throw std::runtime_error("fieldpath was built without the CUDA backend");
 }
+void warmUpCuda(const ToolData&) {}
 }  // namespace detail
 }  // namespace fieldpath::zbuffer

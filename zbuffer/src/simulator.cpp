@@ -302,6 +302,15 @@ SimulationResult simulate(const SimulationRequest& request, const PostureSource&
   });
 }
 
+SimulationResult simulateBlocks(const SimulationRequest& request, const BlockSource& next) {
+  return run(request, request.expected_postures, [&] { return next(); });
+}
+
+void prepare(const Tool& tool, Backend backend) {
+  const std::shared_ptr<const detail::ToolData> data = preparedTool(tool);
+  if (backend != Backend::Cpu && cudaAvailable()) detail::warmUpCuda(*data);
+}
+
 SimulationResult simulate(const SimulationRequest& request, std::span<const Posture> postures) {
   const std::size_t block = std::max<std::size_t>(1, request.block_postures);
   std::size_t next = 0;

@@ -60,6 +60,9 @@ struct EngineSetup {
 std::unique_ptr<BackendEngine> makeCpuEngine(const EngineSetup& setup);
 /// Throws std::runtime_error if built without CUDA or no device is present.
 std::unique_ptr<BackendEngine> makeCudaEngine(const EngineSetup& setup);
+/// Creates the CUDA context and uploads `tool` (kept on the device for the engines after it with
+/// the same ToolData::id). Nothing without CUDA.
+void warmUpCuda(const ToolData& tool);
 
 }  // namespace detail
 }  // namespace fieldpath::zbuffer

@@ -138,6 +138,17 @@ struct SimulationResult {
 SimulationResult simulate(const SimulationRequest& request, const PostureSource& source);
 /// Convenience: all postures from memory.
 SimulationResult simulate(const SimulationRequest& request, std::span<const Posture> postures);
+/// Hands the next block out without a copy: the span stays valid until the next call; an empty
+/// span ends the stream.
+using BlockSource = std::function<std::span<const Posture>()>;
+/// Runs the simulation over the blocks of `next` (e.g. postures parsed in parallel chunks).
+SimulationResult simulateBlocks(const SimulationRequest& request, const BlockSource& next);
+
+/// Does ahead what the first simulation with `tool` on `backend` would pay for: the tool's BVH,
+/// bins and floors (cached for the same tool), and with CUDA the device's context and the tool's
+/// upload. A command calls it on a thread of its own while it reads its path; simulate() needs
+/// nothing of it (it does what is not done yet).
+void prepare(const Tool& tool, Backend backend);
 
 /// Bytes the simulation of `grid` needs on the host (heights, initial copy, tiles, outputs).
 std::size_t estimateHostBytes(const Grid& grid);

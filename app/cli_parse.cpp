@@ -1,0 +1,88 @@
+#include "cli_parse.h"
+
+#include <charconv>
+#include <cmath>
+#include <limits>
+
+#include "errors.h"
+#include "fieldpath/geometry/mesh_io.h"
+#include "fieldpath/geometry/tool_model.h"
+#include "to_zbuffer.h"
+
+namespace fieldpath::app {
+namespace {
+
+namespace zb = zbuffer;
+
+bool isAnalyticToolText(const std::string& text) {
+  return text.rfind("ball:", 0) == 0 || text.rfind("torus:", 0) == 0 || text.rfind("flat:", 0) == 0;
+}
+
+}  // namespace
+
+zb::Tool parseTool(const std::string& text) {
+  if (isAnalyticToolText(text)) {
+    const geometry::ToolSpec spec = geometry::parseToolSpec(text);
+    switch (spec.shape) {
+      case geometry::ToolShape::Ball:
+        return zb::Tool::ball(spec.radius_mm, spec.length_mm);
+      case geometry::ToolShape::Torus:
+        return zb::Tool::torus(spec.radius_mm, spec.corner_radius_mm, spec.length_mm);
+      case geometry::ToolShape::Flat:
+        return zb::Tool::flat(spec.radius_mm, spec.length_mm);
+    }
+  }
+  const geometry::TriangleMesh mesh = geometry::loadMesh(text);
+  try {
+    return zb::Tool::fromMesh(toZbuffer(mesh));
+  } catch (const InputError& e) {
+    throw InputError("--tool " + text + ": " + e.what());
+  }
+}
+
+std::pair<int, int> parseGrid(const std::string& text) {
+  const auto x = text.find('x');
+  long long v[2] = {0, 0};
+  const std::string parts[2] = {text.substr(0, x),
+                                x == std::string::npos ? "" : text.substr(x + 1)};
+  for (int k = 0; k < 2; ++k) {
+    const auto& s = parts[k];
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v[k]);
+    if (s.empty() || ec != std::errc() || end != s.data() + s.size())
+      throw InputError("--grid '" + text + "': expected NXxNY, e.g. 1024x1024");
+  }
+  if (v[0] <= 0 || v[1] <= 0)
+    throw InputError("--grid '" + text + "': needs at least one line each way");
+  if (v[0] > std::numeric_limits<int>::max() / 2 || v[1] > std::numeric_limits<int>::max() / 2)
+    throw InputError("--grid '" + text + "' is too large: it needs about " +
+                     std::to_string(static_cast<long double>(v[0]) * v[1] * 12 / (1 << 20)) +
+                     " MiB of memory");
+  return {static_cast<int>(v[0]), static_cast<int>(v[1])};
+}
+
+std::vector<double> parseNumbers(const std::string& text, const char* option, std::size_t count) {
+  std::vector<double> out;
+  std::size_t pos = 0;
+  while (pos <= text.size()) {
+    const auto comma = std::min(text.find(',', pos), text.size());
+    const std::string field = text.substr(pos, comma - pos);
+    std::size_t used = 0;
+    double value = 0;
+    try {
+      value = std::stod(field, &used);
+    } catch (...) {
+      used = 0;
+    }
+    if (field.empty() || used != field.size() || !std::isfinite(value))
+      throw InputError(std::string(option) + " '" + text + "': '" + field +
+                       "' is not a finite number");
+    out.push_back(value);
+    pos = comma + 1;
+  }
+  if (out.size() != count)
+    throw InputError(std::string(option) + " '" + text + "': expected " + std::to_string(count) +
+                     " numbers");
+  return out;
+}
+
+}  // namespace fieldpath::app
