@@ -3,10 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
+#include <numbers>
 #include <string>
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/geometry/mesh_io.h"
+#include "fieldpath/geometry/tool_model.h"
 #include "temp_files.h"
 
 namespace fieldpath::geometry {
@@ -75,6 +78,26 @@ TEST(FuzzRegressions, PlyElementCountBeyondTheFileIsRefused) {
   expectRefusedQuickly("huge.ply",
                        "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float "
                        "x\nproperty float y\nproperty float z\nend_header\n0 0 0\n");
+}
+
+// fuzz_tool timeout-93cb5020: a 613 mm holder on a 1 mm ball. Nodes 0.5 mm apart (the target
+// tied the spacing to the ball) are ~10 M: work the user never asks for (generate and study pick
+// the spacing from the area). At a spacing from the area, the count is what the area says, fast.
+TEST(FuzzRegressions, WideHolderOnASmallBallGivesNodesByArea) {
+  const ToolSpec tool = parseToolSpec("ball:1:40");
+  const HolderProfile holder = parseHolderProfile("45:613,95:13,98:122");
+  // The surface, by hand: hemisphere, shank running on to the holder at z = 45, the holder's
+  // bottom annulus, its two frusta and its top disc (mm²).
+  const double pi = std::numbers::pi;
+  const double area = 2 * pi + 2 * pi * 44 + pi * (613.0 * 613 - 1) +
+                      pi * (613 + 13) * std::hypot(50, 600) + pi * (13 + 122) * std::hypot(3, 109) +
+                      pi * 122 * 122;
+  const double spacing = std::sqrt(area / 2000);
+  const auto start = std::chrono::steady_clock::now();
+  const auto nodes = surfaceNodes(tool, holder, spacing);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
+  EXPECT_GT(nodes.size(), 1000u);
+  EXPECT_LT(nodes.size(), 4000u);
 }
 
 }  // namespace
