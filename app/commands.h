@@ -39,5 +39,6 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global);
 void addCheckCommand(CLI::App& app, const GlobalOptions& global);
 void addStudyCommand(CLI::App& app, const GlobalOptions& global);
 void addViewCommand(CLI::App& app, const GlobalOptions& global);
+void addConvertCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace fieldpath::app

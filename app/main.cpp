@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
   addCheckCommand(app, global);
   addStudyCommand(app, global);
   addViewCommand(app, global);
+  addConvertCommand(app, global);
 
   try {
     app.parse(argc, argv);

@@ -55,13 +55,18 @@ struct Outcome {
   std::string output() const { return out + err; }
 };
 
-/// Runs `fieldpath --quiet ARGS` (shell words) in `dir`.
-inline Outcome runFieldpath(const TempDir& dir, const std::string& args) {
+/// Runs `fieldpath ARGS` (shell words) in `dir`, exactly as typed (progress lines included).
+inline Outcome runFieldpathAsTyped(const TempDir& dir, const std::string& args) {
   const auto out = dir.path() / "stdout.txt", err = dir.path() / "stderr.txt";
-  const std::string command = "cd '" + dir.path().string() + "' && '" FIELDPATH_EXE "' --quiet " +
-                              args + " > '" + out.string() + "' 2> '" + err.string() + "'";
+  const std::string command = "cd '" + dir.path().string() + "' && '" FIELDPATH_EXE "' " + args +
+                              " > '" + out.string() + "' 2> '" + err.string() + "'";
   const int status = std::system(command.c_str());
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+}
+
+/// Runs `fieldpath --quiet ARGS` (shell words) in `dir`.
+inline Outcome runFieldpath(const TempDir& dir, const std::string& args) {
+  return runFieldpathAsTyped(dir, "--quiet " + args);
 }
 
 /// The same in a scratch folder of its own (for arguments that are absolute paths).

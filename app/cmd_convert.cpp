@@ -1,0 +1,93 @@
+/// fieldpath convert IN OUT: a path file from one format to another (`.cl`, APT CLDATA, `.npy`),
+/// each by its extension. The postures travel as doubles in every direction (`.cl` numbers in
+/// shortest round-trip form, `.npy` float64), so a path converted and read back gives the same
+/// postures bit for bit and `simulate` the same heights. `.npy` has no place for pass and link
+/// blocks or `# limit` marks: converting to it says what was dropped.
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "commands.h"
+#include "errors.h"
+#include "fieldpath/common/limits.h"
+#include "fieldpath/geometry/cl_file.h"
+#include "fieldpath/geometry/tool_model.h"
+
+namespace fieldpath::app {
+namespace {
+
+namespace fs = std::filesystem;
+using geometry::PathFormat;
+
+/// The output format by extension; unlike reading (anything else is `.cl`), a typo in the name
+/// of a file about to be written is refused.
+PathFormat outputFormat(const fs::path& file) {
+  const std::string ext = file.extension().string();
+  if (ext == ".cl") return PathFormat::Cl;
+  if (ext == ".apt" || ext == ".cls") return PathFormat::Apt;
+  if (ext == ".npy") return PathFormat::Npy;
+  throw InputError(file.string() + ": unknown output format '" + ext +
+                   "' (expected .cl, .apt, .cls or .npy)");
+}
+
+const char* formatName(PathFormat format) {
+  return format == PathFormat::Npy ? ".npy" : format == PathFormat::Apt ? "APT" : ".cl";
+}
+
+}  // namespace
+
+void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
+  auto* cmd = app.add_subcommand(
+      "convert", "A path file from one format to another (.cl, APT .apt/.cls, .npy) by extension");
+  struct Options {
+    std::string in, out, tool;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("IN", o->in, "Path file to read: .cl, APT (.apt/.cls) or .npy")->required();
+  cmd->add_option("OUT", o->out, "Path file to write: .cl, .apt/.cls or .npy (float64)")
+      ->required();
+  cmd->add_option("--tool", o->tool,
+                  "ball:R[:L] | torus:R:r[:L] | flat:R[:L]: the CUTTER record of an APT output "
+                  "(required for APT)");
+
+  cmd->callback([o] {
+    const fs::path in = o->in, out = o->out;
+    const PathFormat to = outputFormat(out);
+    geometry::AptHeader header;
+    if (to == PathFormat::Apt) {
+      if (o->tool.empty())
+        throw InputError(out.string() + ": APT output needs --tool (its CUTTER record)");
+      header.tool = geometry::parseToolSpec(o->tool);
+    }
+    if (std::error_code ec; fs::is_directory(out, ec))
+      throw InputError(out.string() + ": is a directory");
+    // A PathFile keeps ~80 bytes a posture (a Posture, its line, its block): the input's size
+    // bounds the posture count (a .cl line is at least 12 bytes, an .npy row 24).
+    std::error_code size_ec;
+    const double in_bytes = double(fs::file_size(in, size_ec));
+    if (!size_ec)
+      common::requireMemory(in.string(), in_bytes / 12.0 * 80.0,
+                            "the postures of the input, whole");
+
+    const geometry::PathFile path = geometry::readPathFile(in);
+    if (to == PathFormat::Cl)
+      geometry::writeClFile(out, path, "converted from " + in.filename().string());
+    else if (to == PathFormat::Apt)
+      geometry::writeAptFile(out, path, header);
+    else
+      geometry::writeNpyFile(out, path.postures);
+
+    const std::size_t passes = path.count(geometry::PathBlock::Kind::Pass);
+    const std::size_t links = path.count(geometry::PathBlock::Kind::Link);
+    // A loss of information is said even under --quiet (which silences progress, not warnings).
+    if (to == PathFormat::Npy && (path.blocks.size() > 1 || !path.limited.empty()))
+      std::fprintf(stderr,
+                   "note: .npy keeps postures only: %zu pass and %zu link blocks%s dropped\n",
+                   passes, links, path.limited.empty() ? "" : " and the # limit marks");
+    std::printf("converted %zu postures (%zu passes, %zu links) from %s %s to %s %s\n",
+                path.postures.size(), passes, links, formatName(geometry::pathFormatOf(in)),
+                in.string().c_str(), formatName(to), out.string().c_str());
+  });
+}
+
+}  // namespace fieldpath::app

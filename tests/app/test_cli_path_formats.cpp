@@ -1,0 +1,262 @@
+/// `fieldpath simulate` whatever the path's format and block size, and `fieldpath convert`, run as
+/// programs: the same postures as `.cl`, APT, `.npy` float64 and float32 give the same heights bit
+/// for bit, cut whole or streamed in blocks of any size; `--outputs` writes what it names;
+/// simulate.json says where the time went; bad `.npy` and `.cl` files are one line and exit 1
+/// with no output directory, also when the bad line comes after blocks already cut.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "fieldpath/geometry/cl_file.h"
+#include "files.h"
+
+namespace fieldpath::app::test {
+namespace {
+
+namespace fs = std::filesystem;
+using geometry::PathBlock;
+using geometry::PathFile;
+using geometry::Posture;
+
+/// A value as float32 carries it: the .npy float32 file then holds the same numbers as the others.
+double asFloat(double v) { return double(float(v)); }
+
+/// A 5-axis finishing path over a waved surface: rows 0.5 mm apart, axes tilted 15° sideways off
+/// +z and turning along the row; three passes. Every number already float-exact.
+PathFile wavedPath() {
+  PathFile path;
+  const double tilt = 15.0 * M_PI / 180.0;
+  for (int row = 0; row < 3; ++row) {
+    const std::size_t begin = path.postures.size();
+    for (int i = 0; i < 400; ++i) {
+      const double x = -10.0 + 0.05 * i, y = -4.0 + 0.5 * row;
+      const double phi = 0.02 * i + row;
+      Posture p;
+      p.tip_mm = {asFloat(x), asFloat(y), asFloat(0.5 * std::sin(x / 3.0) * std::cos(y / 2.0))};
+      p.axis = {asFloat(std::sin(tilt) * std::cos(phi)), asFloat(std::sin(tilt) * std::sin(phi)),
+                asFloat(std::cos(tilt))};
+      path.postures.push_back(p);
+    }
+    path.blocks.push_back({PathBlock::Kind::Pass, begin, path.postures.size()});
+  }
+  return path;
+}
+
+/// A version-1 .npy file: header dictionary `dict`, then `data` (bytes).
+std::string npyBytes(const std::string& dict, const std::string& data) {
+  std::string header = dict;
+  while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+  header += '\n';
+  std::string bytes = std::string("\x93NUMPY\x01\x00", 8);
+  bytes += char(header.size() & 0xff);
+  bytes += char(header.size() >> 8);
+  return bytes + header + data;
+}
+
+/// The postures as a float32 N×6 array's bytes.
+std::string float32Rows(const std::vector<Posture>& postures) {
+  std::string data;
+  for (const Posture& p : postures) {
+    const float row[6] = {float(p.tip_mm.x()), float(p.tip_mm.y()), float(p.tip_mm.z()),
+                          float(p.axis.x()),   float(p.axis.y()),   float(p.axis.z())};
+    data.append(reinterpret_cast<const char*>(row), sizeof row);
+  }
+  return data;
+}
+
+std::string rowsDict(const char* descr, std::size_t rows, int columns, bool fortran = false) {
+  return std::string("{'descr': '") + descr + "', 'fortran_order': " +
+         (fortran ? "True" : "False") + ", 'shape': (" + std::to_string(rows) + ", " +
+         std::to_string(columns) + "), }";
+}
+
+/// The scratch folder with the waved path in every format.
+struct Formats {
+  TempDir dir;
+  PathFile path = wavedPath();
+  Formats() {
+    geometry::writeClFile(dir.path() / "path.cl", path);
+    geometry::AptHeader header;
+    header.tool.radius_mm = 1.0;
+    geometry::writeAptFile(dir.path() / "path.apt", path, header);
+    geometry::writeNpyFile(dir.path() / "path64.npy", path.postures);
+    dir.write("path32.npy",
+              npyBytes(rowsDict("<f4", path.postures.size(), 6), float32Rows(path.postures)));
+  }
+  /// Runs simulate on `file` with `extra` options; returns heights.npy's bytes (empty on failure).
+  std::string heights(const std::string& file, const std::string& extra) const {
+    const std::string out = "out-" + std::to_string(++runs);
+    const Outcome run = runFieldpath(dir, "simulate --tool ball:1 --path " + file +
+                                              " --grid 160x90 --backend cpu --outputs npy " +
+                                              extra + " --out " + out);
+    EXPECT_EQ(run.exit_code, 0) << file << " " << extra << ": " << run.err;
+    return slurp(dir.path() / out / "heights.npy");
+  }
+  mutable int runs = 0;
+};
+
+TEST(SimulateFormats, HeightsBitIdenticalWhateverTheFormatAndBlock) {
+  const Formats f;
+  const std::string whole = f.heights("path.cl", "");
+  ASSERT_GT(whole.size(), 160u * 90u * 4u);
+  for (const char* file : {"path.apt", "path64.npy", "path32.npy"})
+    EXPECT_EQ(f.heights(file, ""), whole) << file << " read whole";
+
+  // Streamed (--region): the chunks are cut while the rest is read; any block size.
+  const std::string region = "--region -11.2,-5.2,10.2,-1.8 --stock 1";
+  const std::string streamed = f.heights("path.cl", region);
+  ASSERT_GT(streamed.size(), 160u * 90u * 4u);
+  EXPECT_NE(streamed, std::string(streamed.size(), '\0'));
+  for (const char* file : {"path.cl", "path.apt", "path64.npy", "path32.npy"})
+    for (const char* block : {"13", "100", "5000"})
+      EXPECT_EQ(f.heights(file, region + " --block " + block), streamed)
+          << file << " --block " << block;
+}
+
+TEST(SimulateFormats, OutputsAreTheOnesNamedAndSimulateJsonSaysWhereTheTimeWent) {
+  const Formats f;
+  const Outcome run = runFieldpath(f.dir, "simulate --tool ball:1 --path path.cl --grid 64x64 "
+                                          "--backend cpu --outputs png,npy --out out");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const fs::path out = f.dir.path() / "out";
+  EXPECT_TRUE(fs::exists(out / "heights.npy"));
+  EXPECT_TRUE(fs::exists(out / "heights.png"));
+  EXPECT_FALSE(fs::exists(out / "heights.json"));
+  EXPECT_FALSE(fs::exists(out / "surface.stl"));
+  const nlohmann::json report = nlohmann::json::parse(slurp(out / "simulate.json"));
+  EXPECT_EQ(report.at("postures").get<std::size_t>(), f.path.postures.size());
+  const auto& s = report.at("seconds");
+  for (const char* phase : {"read", "prepare", "cut", "write", "total"}) {
+    ASSERT_TRUE(s.at(phase).is_number()) << phase;
+    EXPECT_GE(s.at(phase).get<double>(), 0.0) << phase;
+    EXPECT_LE(s.at(phase).get<double>(), s.at("total").get<double>() + 1e-9) << phase;
+  }
+  EXPECT_GT(report.at("postures_per_second").get<double>(), 0.0);
+  EXPECT_GT(report.at("peak_memory_mib").get<double>(), 1.0);
+  EXPECT_NE(run.out.find("read"), std::string::npos) << run.out;
+
+  const Outcome bad = runFieldpath(f.dir, "simulate --tool ball:1 --path path.cl --outputs npy,vtk "
+                                          "--out out2");
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("'vtk'"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(f.dir.path() / "out2"));
+}
+
+TEST(SimulateFormats, QuietAfterTheSubCommand) {
+  const Formats f;
+  const Outcome run = runFieldpathAsTyped(
+      f.dir, "simulate --tool ball:1 --path path.cl --grid 32x32 --backend cpu --out out --quiet");
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err, "");
+}
+
+/// Every bad .npy: exit 1, one line naming the file (and the row where a row is bad), no outputs.
+TEST(SimulateFormats, BadNpyIsOneLineAndNoOutputs) {
+  const Formats f;
+  const std::vector<Posture>& p = f.path.postures;
+  std::string with_nan = float32Rows(p);
+  const float nan = std::nanf("");
+  std::memcpy(with_nan.data() + (3 * 6 + 2) * 4, &nan, 4);  // row 3, z
+  std::string axis_zero = float32Rows(p);
+  std::memset(axis_zero.data() + (5 * 6 + 3) * 4, 0, 12);  // row 5, axis 0
+  const std::string rows = float32Rows(p);
+  struct Case {
+    const char* name;
+    std::string bytes;
+    const char* says;
+  };
+  const std::vector<Case> cases = {
+      {"int.npy", npyBytes(rowsDict("<i4", p.size(), 6), rows), "dtype"},
+      {"big.npy", npyBytes(rowsDict(">f4", p.size(), 6), rows), "dtype"},
+      {"five.npy", npyBytes(rowsDict("<f4", p.size() * 6 / 5, 5), rows), "shape"},
+      {"fortran.npy", npyBytes(rowsDict("<f4", p.size(), 6, true), rows), "fortran"},
+      {"short.npy", npyBytes(rowsDict("<f4", p.size(), 6), rows.substr(0, rows.size() - 10)),
+       "truncated"},
+      {"nan.npy", npyBytes(rowsDict("<f4", p.size(), 6), with_nan), "row 3"},
+      {"axis.npy", npyBytes(rowsDict("<f4", p.size(), 6), axis_zero), "row 5"},
+      {"noheader.npy", "\x93NUMPY", "npy"},
+  };
+  for (const Case& c : cases) {
+    f.dir.write(c.name, c.bytes);
+    for (const std::string extra : {"", " --region -11,-5,10,-2 --stock 1 --block 10"}) {
+      const Outcome run = runFieldpath(
+          f.dir, std::string("simulate --tool ball:1 --path ") + c.name + " --out out" + extra);
+      EXPECT_EQ(run.exit_code, 1) << c.name << extra << ": " << run.err;
+      EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << c.name << ": " << run.err;
+      EXPECT_NE(run.err.find(c.name), std::string::npos) << run.err;
+      std::string lower = run.err;
+      std::transform(lower.begin(), lower.end(), lower.begin(), ::tolower);
+      EXPECT_NE(lower.find(c.says), std::string::npos) << c.name << ": " << run.err;
+      EXPECT_FALSE(fs::exists(f.dir.path() / "out")) << c.name << extra;
+    }
+  }
+}
+
+/// A bad line far into a big `.cl`: the blocks before it were cut already (streamed); still one
+/// line with the right line number and no outputs.
+TEST(SimulateFormats, BadClLineAfterManyBlocksIsOneLineAndNoOutputs) {
+  const TempDir dir;
+  std::string text;
+  for (int i = 1; i <= 6000; ++i)
+    text += i == 4321 ? "1 2 three 0 0 1\n"
+                      : std::to_string(0.001 * i) + " 0.5 0 0 0 1\n";
+  dir.write("big.cl", text);
+  for (const std::string extra : {"", " --region -1,-1,7,2 --stock 1 --block 50"}) {
+    const Outcome run =
+        runFieldpath(dir, "simulate --tool ball:1 --path big.cl --backend cpu --out out" + extra);
+    EXPECT_EQ(run.exit_code, 1) << extra << ": " << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+    EXPECT_NE(run.err.find("big.cl:4321"), std::string::npos) << run.err;
+    EXPECT_FALSE(fs::exists(dir.path() / "out")) << extra;
+  }
+}
+
+/// convert: .cl (passes, a link, a limit mark) → .npy → APT → .cl gives the same postures bit for
+/// bit; what .npy cannot keep is said; bad requests are one line and write nothing.
+TEST(Convert, RoundTripsKeepThePosturesBitForBit) {
+  const Formats f;
+  PathFile marked = f.path;
+  marked.blocks[1].kind = PathBlock::Kind::Link;
+  marked.limited = {17};
+  geometry::writeClFile(f.dir.path() / "marked.cl", marked);
+
+  const Outcome to_npy = runFieldpath(f.dir, "convert marked.cl a.npy");
+  ASSERT_EQ(to_npy.exit_code, 0) << to_npy.err;
+  EXPECT_NE(to_npy.err.find("dropped"), std::string::npos) << to_npy.err;
+  EXPECT_NE(to_npy.out.find("1200 postures"), std::string::npos) << to_npy.out;
+  ASSERT_EQ(runFieldpath(f.dir, "convert a.npy b.apt --tool ball:1").exit_code, 0);
+  ASSERT_EQ(runFieldpath(f.dir, "convert b.apt c.cl").exit_code, 0);
+  ASSERT_EQ(runFieldpath(f.dir, "convert marked.cl d.cls --tool torus:2:0.5").exit_code, 0);
+
+  // The reference is the .cl as read (the readers normalise the float-rounded axes).
+  marked = geometry::readPathFile(f.dir.path() / "marked.cl");
+  for (const char* file : {"a.npy", "b.apt", "c.cl", "d.cls"}) {
+    const PathFile back = geometry::readPathFile(f.dir.path() / file);
+    ASSERT_EQ(back.postures.size(), marked.postures.size()) << file;
+    for (std::size_t i = 0; i < back.postures.size(); ++i) {
+      ASSERT_EQ(back.postures[i].tip_mm, marked.postures[i].tip_mm) << file << " " << i;
+      ASSERT_EQ(back.postures[i].axis, marked.postures[i].axis) << file << " " << i;
+    }
+  }
+  // APT keeps the link (RAPID) and .cl the blocks.
+  EXPECT_EQ(geometry::readPathFile(f.dir.path() / "d.cls").blocks, marked.blocks);
+
+  for (const std::string args : {"convert marked.cl e.txt", "convert marked.cl e.apt",
+                                 "convert missing.cl e.cl", "convert marked.cl e.apt --tool cone"}) {
+    const Outcome run = runFieldpath(f.dir, args);
+    EXPECT_EQ(run.exit_code, 1) << args << ": " << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << args << ": " << run.err;
+    for (const char* name : {"e.txt", "e.apt", "e.cl"})
+      EXPECT_FALSE(fs::exists(f.dir.path() / name)) << args;
+  }
+}
+
+}  // namespace
+}  // namespace fieldpath::app::test
