@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fieldpath/common/atomic_file.h"
+#include "files.h"
 #include "run_fieldpath.h"
 
 namespace fieldpath {
@@ -265,20 +266,10 @@ TEST(Deterministic, FieldProbeOnOneAndOnAllCores) {
   }
 }
 
-/// A small impeller job (one channel, three passes): study and view in seconds.
-constexpr const char* kSmallScene = R"(obstacles:
-  - impeller: { u_range: [0.55, 0.8], passes_v: [0.3, 0.7], chord_tol: 0.5 }
-guide: { impeller: hub }
-tool: { shape: ball, radius: 3, length: 40 }
-holder: [[40, 6], [55, 6], [55, 12], [90, 12]]
-clearance: 0.5
-dynamics: { max_tilt_deg: 45, max_lead_deg: 45, rtol: 1.0e-4, atol: 1.0e-7 }
-path: { passes: 3, step: 2.0 }
-)";
 
 TEST(Deterministic, ViewPageOnOneAndOnAllCores) {
   const TempDir dir;
-  dir.write("scene.yaml", kSmallScene);
+  dir.write("scene.yaml", app::test::kSmallImpellerScene);
   ASSERT_EQ(run(dir, {"generate", "scene.yaml", "--out", "gen"}), 0);
   for (const char* out : {"one/view.html", "all/view.html"})
     ASSERT_EQ(run(dir, {"view", "scene.yaml", "--path", "gen/path.cl", "--out", out},
@@ -309,7 +300,7 @@ std::string withoutColumns(const std::string& csv, const std::vector<std::string
 
 TEST(Deterministic, StudyOnOneAndOnAllCores) {
   const TempDir dir;
-  dir.write("scene.yaml", kSmallScene);
+  dir.write("scene.yaml", app::test::kSmallImpellerScene);
   for (const char* out : {"one", "all"})
     ASSERT_EQ(run(dir, {"study", "scene.yaml", "--voxels", "2", "--no-brute-force", "--line-step",
                         "0.5", "--out", out},

@@ -217,15 +217,7 @@ TEST(StudyRefinement, RefinedVariantBeatsItsUniformGridAndIsCountedApart) {
 }
 
 /// The small job as a scene file.
-constexpr const char* kSmallScene = R"(obstacles:
-  - impeller: { u_range: [0.55, 0.8], passes_v: [0.3, 0.7], chord_tol: 0.5 }
-guide: { impeller: hub }
-tool: { shape: ball, radius: 3, length: 40 }
-holder: [[40, 6], [55, 6], [55, 12], [90, 12]]
-clearance: 0.5
-dynamics: { max_tilt_deg: 45, max_lead_deg: 45, rtol: 1.0e-4, atol: 1.0e-7 }
-path: { passes: 3, step: 2.0 }
-)";
+constexpr const char* kSmallScene = test::kSmallImpellerScene;
 
 TEST(StudyCommand, WritesTablesAndPicturesOrSaysWhyNot) {
   const test::TempDir dir;
