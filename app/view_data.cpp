@@ -252,6 +252,13 @@ zbuffer::Grid readGridJson(const fs::path& file) {
   if (shape[0] < 1 || shape[1] < 1 || shape[0] > 1e6 || shape[1] > 1e6 ||
       shape[0] != std::floor(shape[0]) || shape[1] != std::floor(shape[1]))
     throw InputError(file.string() + ": shape: expected [ny, nx], whole numbers from 1 to 1e6");
+  // A grid beyond any machine (an edited or corrupt .json) is refused like such a path tip.
+  const double far = common::kMaxCoordinateMm;
+  if (std::abs(origin[0]) > far || std::abs(origin[1]) > far ||
+      std::abs(origin[0] + spacing[0] * shape[1]) > far ||
+      std::abs(origin[1] + spacing[1] * shape[0]) > far)
+    throw InputError(file.string() +
+                     ": origin, spacing: the grid reaches beyond 1e6 mm (outside any machine)");
   zbuffer::Grid g;
   g.x0_mm = origin[0];
   g.y0_mm = origin[1];

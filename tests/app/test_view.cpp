@@ -215,6 +215,18 @@ TEST(View, BadInputIsExitOneWithOneLineOrAPageThatSaysWhatIsMissing) {
   EXPECT_EQ(r.exit_code, 1) << r.output();
   EXPECT_NE(r.err.find("truncated or padded"), std::string::npos) << r.err;
 
+  // A simulated surface whose .json was edited to lie beyond any machine (1e300 mm).
+  ASSERT_EQ(runFieldpath(dir, "simulate --tool ball:1 --path short.cl --grid 32x32 --out sim")
+                .exit_code,
+            0);
+  dir.write("sim/heights.json", R"({"origin":[1e300,0],"spacing":[0.1,0.1],"shape":[32,32]})");
+  r = runFieldpath(dir, "view scene.yaml --path path.cl --surface sim --out bad.html");
+  EXPECT_EQ(r.exit_code, 1) << r.output();
+  EXPECT_TRUE(oneLine(r.err)) << r.err;
+  EXPECT_NE(r.err.find("heights.json: origin, spacing: the grid reaches beyond"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir.path() / "bad.html"));
+
   // Without three.js there is no page: one line naming the package.
   ::setenv("FIELDPATH_THREE_DIR", (dir.path() / "no-three").c_str(), 1);
   r = runFieldpath(dir, "view scene.yaml --path path.cl --out bad.html");
