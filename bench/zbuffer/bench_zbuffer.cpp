@@ -324,57 +324,68 @@ std::string heightError(const std::vector<float>& h, const std::vector<float>& e
   return text;
 }
 
+/// One case's postures as `STEM.cl` (shortest float text, as a CAM system writes 32-bit values)
+/// and `STEM.npy` (float32, N×6).
+void writeCaseFiles(const std::string& stem, const std::vector<zb::Posture>& postures) {
+  {
+    std::ofstream cl(stem + ".cl", std::ios::binary);
+    std::string text;
+    char buffer[32];
+    for (const zb::Posture& p : postures) {
+      const float v[6] = {p.tip_mm.x, p.tip_mm.y, p.tip_mm.z, p.axis.x, p.axis.y, p.axis.z};
+      for (int k = 0; k < 6; ++k) {
+        text.append(buffer, std::to_chars(buffer, buffer + sizeof buffer, v[k]).ptr);
+        text += k < 5 ? ' ' : '\n';
+      }
+      if (text.size() > (1u << 24)) {
+        cl << text;
+        text.clear();
+      }
+    }
+    cl << text;
+  }
+  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" +
+                       std::to_string(postures.size()) + ", 6), }";
+  while ((10 + header.size() + 1) % 64 != 0) header += ' ';
+  header += '\n';
+  std::ofstream npy(stem + ".npy", std::ios::binary);
+  npy.write("\x93NUMPY\x01\x00", 8);
+  const char size[2] = {char(header.size() & 0xff), char(header.size() >> 8)};
+  npy.write(size, 2);
+  npy << header;
+  static_assert(sizeof(zb::Posture) == 24, "6 floats, no padding");
+  npy.write(reinterpret_cast<const char*>(postures.data()),
+            std::streamsize(postures.size() * sizeof(zb::Posture)));
+  std::fprintf(stderr, "wrote %s.cl and %s.npy (%zu postures)\n", stem.c_str(), stem.c_str(),
+               postures.size());
+}
+
 /// --write-cases: the postures of the chosen cases as `.cl` and `.npy` files, and cases.txt.
 int writeCases(const std::string& dir, const std::vector<std::string>& wanted,
                const std::string& which) {
   std::filesystem::create_directories(dir);
   std::ofstream list(dir + "/cases.txt");
-  list << "# id tool region(x0,y0,x1,y1 mm) grid postures\n";
+  list << "# id tool region(x0,y0,x1,y1 mm) grid postures stock(mm) file\n";
+  std::map<std::string, std::string> written;  // a path's key → the file stem that holds it
   for (const Case& c : allCases()) {
     if (which != "all" && std::find(wanted.begin(), wanted.end(), c.id) == wanted.end()) continue;
     if (c.zoom[2] > c.zoom[0]) continue;  // zooms: the same paths as their unzoomed cases
-    const std::vector<zb::Posture> postures = casePostures(c);
-    const std::string stem = dir + "/case" + c.id;
-    {
-      std::ofstream cl(stem + ".cl", std::ios::binary);
-      std::string text;
-      char buffer[32];
-      for (const zb::Posture& p : postures) {
-        const float v[6] = {p.tip_mm.x, p.tip_mm.y, p.tip_mm.z, p.axis.x, p.axis.y, p.axis.z};
-        for (int k = 0; k < 6; ++k) {
-          text.append(buffer, std::to_chars(buffer, buffer + sizeof buffer, v[k]).ptr);
-          text += k < 5 ? ' ' : '\n';
-        }
-        if (text.size() > (1u << 24)) {
-          cl << text;
-          text.clear();
-        }
-      }
-      cl << text;
-    }
-    {
-      std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (" +
-                           std::to_string(postures.size()) + ", 6), }";
-      while ((10 + header.size() + 1) % 64 != 0) header += ' ';
-      header += '\n';
-      std::ofstream npy(stem + ".npy", std::ios::binary);
-      npy.write("\x93NUMPY\x01\x00", 8);
-      const char size[2] = {char(header.size() & 0xff), char(header.size() >> 8)};
-      npy.write(size, 2);
-      npy << header;
-      static_assert(sizeof(zb::Posture) == 24, "6 floats, no padding");
-      npy.write(reinterpret_cast<const char*>(postures.data()),
-                std::streamsize(postures.size() * sizeof(zb::Posture)));
-    }
+    // cases that differ only in the grid (7 and 8) share one pair of files
+    const std::string key = c.name.substr(0, c.name.find(' ')) + std::to_string(c.postures) +
+                            "/" + std::to_string(c.width_mm);
+    const bool fresh = !written.count(key);
+    const std::string stem = fresh ? "case" + c.id : written[key];
+    written.emplace(key, stem);
     const std::string tool = c.torus ? "torus:" + std::to_string(c.radius_mm) + ":" +
                                            std::to_string(c.corner_mm) + ":" +
                                            std::to_string(c.length_mm)
                                      : "ball:" + std::to_string(c.radius_mm) + ":" +
                                            std::to_string(c.length_mm);
     list << c.id << ' ' << tool << " 0,0," << c.width_mm << ',' << c.width_mm << ' ' << c.grid
-         << 'x' << c.grid << ' ' << c.postures << '\n';
-    std::fprintf(stderr, "wrote %s.cl and %s.npy (%zu postures)\n", stem.c_str(), stem.c_str(),
-                 postures.size());
+         << 'x' << c.grid << ' ' << c.postures << ' '
+         << std::abs(c.surface.amp1) + std::abs(c.surface.amp2) + 3 << ' ' << stem << '\n';
+    if (!fresh) continue;
+    writeCaseFiles(dir + "/" + stem, casePostures(c));
   }
   return 0;
 }

@@ -20,9 +20,12 @@
 
 namespace fieldpath::geometry::detail {
 
-/// Axes whose length is off 1 by no more than this are taken as they are (a few ulps: rounding of
-/// an already normalised vector), so a written file reads back bit for bit.
-inline constexpr double kUnitAsIs = 8 * std::numeric_limits<double>::epsilon();
+/// Axes whose length is off 1 by no more than this are taken as they are: unit vectors rounded to
+/// float (a float32 .npy, or .cl text written from 32-bit values: length off by up to ~1e-7) or to
+/// double. Normalising them would move the .cl's decimal values and the .npy's floats apart by
+/// ~1e-9, enough to round a few axes to another float: the same path as .cl and as .npy would not
+/// cut the same heights bit for bit (bench/zbuffer/process.sh checks it).
+inline constexpr double kUnitAsIs = 1e-6;
 /// Axes off unit length by less than this are normalised; the others are rejected (DESIGN.md).
 inline constexpr double kUnitTolerance = 1e-3;
 

@@ -92,9 +92,13 @@ TEST(ClFile, RoundTripsExactly) {
 }
 
 TEST(ClFile, NormalisesNearlyUnitAxes) {
-  const auto p = readClFile(writeBytes("near.cl", "0 0 0 0 0 1.0009\n0 0 0 0.6 0.8 0.0001\n"));
+  const auto p = readClFile(
+      writeBytes("near.cl", "0 0 0 0 0 1.0009\n0 0 0 0.6 0.8 0.01\n0 0 0 0.6 0.8 0.0001\n"));
   EXPECT_EQ(p[0].axis, Vec3::UnitZ());
   EXPECT_NEAR(p[1].axis.norm(), 1.0, 1e-15);
+  // off by 5e-9 (float rounding, as from 32-bit values): kept as written, so that the same
+  // floats as text and as a float32 .npy give the same postures
+  EXPECT_EQ(p[2].axis, Vec3(0.6, 0.8, 0.0001));
 }
 
 TEST(ClFile, MalformedLinesNameTheLine) {
