@@ -9,10 +9,12 @@
 
 #include "commands.h"
 #include "errors.h"
+#include "estimates.h"
 #include "job.h"
 #include "progress.h"
 #include "scene.h"
 #include "study.h"
+#include "study_text.h"
 
 namespace fieldpath::app {
 namespace {
@@ -51,6 +53,9 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
   request.job = sceneJob(scene);
   request.impeller = scene.impeller_model->params();
   if (o.sample_step_mm > 0.0) request.job.field.sample_step_mm = o.sample_step_mm;
+  // What the options drive, estimated before any work (loadScene did the scene's own keys).
+  if (o.sample_step_mm > 0.0) checkSampleStep(scene, o.sample_step_mm, "--sample-step");
+  for (double h : request.voxel_sizes_mm) checkVoxelSize(scene, h, "--voxels " + study_detail::number(h));
   request.progress = makeProgressLine(global.quiet);
   const StudyResult result = runStudy(request);
   const std::filesystem::path dir = o.out;

@@ -119,6 +119,12 @@ void checkImpellerSize(const pathgen::Impeller& impeller, const std::string& whe
                             fmt(impeller.params().chord_tol_mm) + " mm");
 }
 
+void checkSampleStep(const Scene& scene, double step_mm, const std::string& key) {
+  const double samples = sampleCount(scene, step_mm);
+  common::requireMemory(scene.file.string() + ": " + key, samples * kBytesPerSample,
+                        fmt(samples) + " obstacle samples at " + fmt(step_mm) + " mm");
+}
+
 void checkSceneSize(const Scene& scene) {
   const std::string where = scene.file.string() + ": ";
   double triangles = 0.0;
@@ -127,11 +133,7 @@ void checkSceneSize(const Scene& scene) {
   common::requireMemory(where + "obstacles", triangles * kBytesPerMeshTriangle,
                         fmt(triangles) + " mesh triangles with their collision hierarchies");
 
-  // field.sample_step against the obstacles' area.
-  const double samples = sampleCount(scene, scene.field.sample_step_mm);
-  common::requireMemory(where + "field.sample_step", samples * kBytesPerSample,
-                        fmt(samples) + " obstacle samples at " +
-                            fmt(scene.field.sample_step_mm) + " mm");
+  checkSampleStep(scene, scene.field.sample_step_mm, "field.sample_step");
 
   // field.r0 against the obstacles' extent: beyond it every sample acts on every node, the field
   // is no longer local and its cost (nodes × samples within r0) grows with r0³ for nothing.

@@ -30,6 +30,10 @@ void checkImpellerSize(const pathgen::Impeller& impeller, const std::string& whe
 /// postures (`path.step`, `path.passes` against the passes' length).
 void checkSceneSize(const Scene& scene);
 
+/// The obstacle samples at `step_mm` (the scene's `field.sample_step` or an option overriding it,
+/// named by `key`).
+void checkSampleStep(const Scene& scene, double step_mm, const std::string& key);
+
 /// The uniform voxel grid of `field.voxel_size` (or `--voxel`) = `voxel_mm`: the shell within r0
 /// of the obstacles, at most their box padded by r0 (the field module estimates refinement).
 /// `key` names where h came from.

@@ -246,6 +246,14 @@ TEST(StudyCommand, BadInputIsExitOneWithNoOutputs) {
       test::runFieldpath(dir, "study scene.yaml --voxels 2,1 --refine 5 --out study").exit_code, 1);
   EXPECT_EQ(test::runFieldpath(dir, "study scene.yaml --sample-step 0 --out study").exit_code, 1);
   EXPECT_EQ(test::runFieldpath(dir, "study missing.yaml --out study").exit_code, 1);
+  // Sizes the options drive are estimated before any work (the brute-force variant, first, ran
+  // for minutes before the voxel size was looked at).
+  for (const char* args : {"--voxels 2,1e-6", "--voxels 2 --sample-step 1e-5"}) {
+    const test::Outcome run =
+        test::runFieldpath(dir, std::string("study scene.yaml ") + args + " --out study");
+    EXPECT_EQ(run.exit_code, 1) << args;
+    EXPECT_NE(run.err.find("of memory"), std::string::npos) << args << ": " << run.err;
+  }
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "study"));
 }
 
