@@ -53,7 +53,7 @@ h+=' '*((64-(10+len(h)+1)%64)%64)+'\n'
 open('int.npy','wb').write(b'\x93NUMPY\x01\x00'+struct.pack('<H',len(h))+h.encode()+b'\0'*24)"
 printf '0 0 0\n1 nan 2\n' > nan_points.txt
 echo "a file" > afile
-mkdir -p out2
+mkdir -p out2 emptydir
 printf 'obstacles:\n  - impeller:\nguide: { impeller: hub }\npath: { nominal: far30.cl, passes: 2 }\n' > nominal_far.yaml
 
 # ---- rows ---------------------------------------------------------------------------------------
@@ -152,6 +152,18 @@ row "check --path garbage" "garbage.stl" check base.yaml --path garbage.stl --ou
 row "check --out is a file" "afile" check base.yaml --path ok.cl --out afile
 row "study --voxels 0,-1" "--voxels" study base.yaml --voxels 0,-1 --out out
 row "study --voxels 1e-6" "1e-06" study base.yaml --voxels 1e-6 --out out
+row "study --sample-step 1e-4" "--sample-step" study base.yaml --sample-step 1e-4 --out out
+# view (the page is one file: --out names it)
+"$fp" --quiet simulate --tool ball:3 --path ok.cl --grid 64x64 --out farsurf > /dev/null 2>&1
+echo '{"origin":[1e300,0],"spacing":[0.1,0.1],"shape":[64,64]}' > farsurf/heights.json
+row "view --path missing file" "missing.cl" view base.yaml --path missing.cl --out out/v.html
+row "view --path nan coordinate" "nan.cl:2" view base.yaml --path nan.cl --out out/v.html
+row "view --check folder without check.json" "emptydir" view base.yaml --path ok.cl --check emptydir --out out/v.html
+row "view --surface folder without heights/deviation" "emptydir" view base.yaml --path ok.cl --surface emptydir --out out/v.html
+row "view --surface heights.json at x = 1e300" "farsurf/heights.json" view base.yaml --path ok.cl --surface farsurf --out out/v.html
+row "view --max-mb 0" "--max-mb" view base.yaml --path ok.cl --max-mb 0 --out out/v.html
+row "view obstacle mesh of garbage bytes" "garbage.stl" view mesh_garbage.yaml --out out/v.html
+row "view --out under a file" "afile" view base.yaml --path ok.cl --out afile/v.html
 echo
 echo "$n rows, $failed failing a requirement."
 exit "$failed"
