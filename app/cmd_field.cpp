@@ -64,6 +64,8 @@ struct FieldOptions {
   std::string out;
   std::string save_field;
   double max_memory_mib = 0.0;  ///< 0: the global --max-memory (common::memoryLimitBytes)
+  std::string backend;            ///< "" : the scene's field.backend
+  double refine_tolerance = -1.0; ///< < 0: the scene's field.refine_tolerance
 };
 
 /// The scene's obstacle samples and the exact field over them.
@@ -96,6 +98,8 @@ field::VoxelRequest voxelRequest(const FieldOptions& o, const Scene& scene, bool
   request.max_memory_bytes = o.max_memory_mib > 0.0
                                  ? static_cast<std::size_t>(o.max_memory_mib * 1024.0 * 1024.0)
                                  : common::memoryLimitBytes();
+  if (!o.backend.empty()) request.backend = *field::fieldBackendNamed(o.backend);
+  if (o.refine_tolerance >= 0.0) request.refine_tolerance = o.refine_tolerance;
   request.progress = makeProgressLine(quiet);
   return request;
 }
@@ -148,7 +152,12 @@ void build(const FieldOptions& o, const GlobalOptions& global) {
               s.dense_box_nodes ? 100.0 * s.active_nodes / s.dense_box_nodes : 0.0);
   std::printf("dense-box nodes: %zu\n", s.dense_box_nodes);
   std::printf("memory: %s\n", mib(s.memory_bytes).c_str());
-  std::printf("time: sampling %.3f s, build %.3f s\n", obstacles.sampling_s, s.build_seconds);
+  if (s.levels > 1)
+    std::printf("levels: %d (%zu refined cells, %zu refined nodes)\n", s.levels, s.refined_cells,
+                s.refined_nodes);
+  std::printf("time: sampling %.3f s, build %.3f s (%s nodes %.3f s, refinement %.3f s)\n",
+              obstacles.sampling_s, s.build_seconds, s.backend.c_str(), s.nodes_seconds,
+              s.refine_seconds);
   std::printf("wrote %s\n", o.out.c_str());
 }
 
@@ -198,6 +207,16 @@ void addFieldCommand(CLI::App& app, const GlobalOptions& global) {
                    "trilinear | quadratic (default: the scene's)")
       ->check(CLI::IsMember({"trilinear", "quadratic"}));
   build_cmd->add_option("--out", options->out, "Output .vdb file")->required();
+  for (auto* sub : {probe_cmd, build_cmd})
+    sub->add_option("--backend", options->backend,
+                    "Where the nodes are computed: auto | cpu | cuda | reference (the per-node "
+                    "build the others are checked against; default: the scene's field.backend)")
+        ->check(CLI::IsMember({"auto", "cpu", "cuda", "reference"}));
+  build_cmd
+      ->add_option("--refine-tolerance", options->refine_tolerance,
+                   "Split cells whose error estimate exceeds this fraction (default: the "
+                   "scene's field.refine_tolerance; 0: uniform)")
+      ->check(CLI::NonNegativeNumber);
   build_cmd
       ->add_option("--max-memory", options->max_memory_mib,
                    "Refuse voxel fields estimated above this, MiB")

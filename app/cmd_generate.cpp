@@ -137,6 +137,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     std::string scene, out;
     bool direct = false, nominal = false;
     double voxel_mm = 0.0;
+    std::string backend;  ///< "": the scene's field.backend
   };
   auto options = std::make_shared<Options>();
   cmd->add_option("scene", options->scene, "Scene file (YAML)")->required();
@@ -146,6 +147,11 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                                 "Voxel size H, mm (default: the scene's field.voxel_size)")
                     ->check(positiveFinite("mm"));
   direct->excludes(voxel);
+  cmd->add_option("--backend", options->backend,
+                  "Where the voxel nodes are computed: auto | cpu | cuda (default: the scene's "
+                  "field.backend)")
+      ->check(CLI::IsMember({"auto", "cpu", "cuda", "reference"}))
+      ->excludes(direct);
   cmd->add_flag("--nominal", options->nominal,
                 "The nominal path: axis on the hub normal (+ lead), no field, no dynamics");
   cmd->add_option("--out", options->out, "Output folder")->required();
@@ -159,6 +165,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (job.mode == pathgen::FieldMode::Voxel && !job.nominal)
       checkVoxelSize(scene, job.field.voxel.voxel_size_mm,
                      options->voxel_mm != 0.0 ? "--voxel" : "field.voxel_size");
+    if (!options->backend.empty())
+      job.field.voxel.backend = *field::fieldBackendNamed(options->backend);
     job.nominal = options->nominal;
     job.progress = makeProgressLine(global.quiet);
     const pathgen::GenerateResult result = pathgen::generatePath(job);

@@ -5,7 +5,12 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <exception>
+#include <mutex>
 #include <sstream>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/dynamics/steering.h"
@@ -181,14 +186,22 @@ GenerateResult generatePath(const GenerateRequest& request) {
   }
   result.times.field_s = seconds(field_start);
 
-  // ---- steering, pass by pass ----------------------------------------------------------------
+  // ---- steering: the passes are independent, steered on all cores (TBB), gathered in pass
+  // order: the output is the serial run's bit for bit (each pass's solver sees the same inputs;
+  // the field's evaluate is deterministic per point). Progress counts finished passes.
   const auto steer_start = Clock::now();
   const int pass_count = static_cast<int>(result.passes.size());
-  for (const Pass& pass : result.passes) {
-    const std::string label =
-        "pass " + std::to_string(pass.index + 1) + "/" + std::to_string(pass_count);
-    const double begin = 0.3 + 0.6 * pass.index / pass_count;
-    const double end = 0.3 + 0.6 * (pass.index + 1) / pass_count;
+  struct Steered {
+    std::vector<GeneratedPosture> postures;
+    dynamics::SolverStats stats;
+    std::exception_ptr error;
+  };
+  std::vector<Steered> steered_passes(result.passes.size());
+  std::mutex progress_mutex;
+  int passes_done = 0;
+  auto steerOne = [&](std::size_t p) {
+    const Pass& pass = result.passes[p];
+    Steered& out = steered_passes[p];
     if (request.nominal) {
       for (const PassSample& s : pass.samples) {
         GeneratedPosture g;
@@ -196,10 +209,9 @@ GenerateResult generatePath(const GenerateRequest& request) {
         g.s_mm = s.s_mm;
         g.lead_rad = lead_rad;
         g.posture = geometry::ballEndPosture(s.centre_mm, nominalAxis(s, lead_rad), r);
-        result.postures.push_back(g);
+        out.postures.push_back(g);
       }
-      common::report(request.progress, end, label);
-      continue;
+      return;
     }
     dynamics::Pass dyn_pass;
     dyn_pass.length_mm = pass.length_mm;
@@ -225,7 +237,11 @@ GenerateResult generatePath(const GenerateRequest& request) {
       if (i > 0) gap_mm = std::max(gap_mm, pass.samples[i].s_mm - pass.samples[i - 1].s_mm);
     }
     steer.step_mm = gap_mm > 0.0 ? gap_mm : pass.length_mm;
-    steer.progress = scaled(request.progress, begin, end, label);
+    if (request.progress)  // the interruption hook only: progress is reported per pass below
+      steer.progress = [&](double, std::string_view) {
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        return request.progress(0.3 + 0.6 * passes_done / pass_count, "passes");
+      };
     const dynamics::SteeringResult steered = dynamics::steerPass(dyn_pass, steer);
     if (steered.status != dynamics::Status::Ok) {
       std::ostringstream msg;
@@ -241,12 +257,42 @@ GenerateResult generatePath(const GenerateRequest& request) {
       g.moment = s.moment.norm();
       g.limited = s.limited;
       g.posture = s.posture;
+      out.postures.push_back(g);
+    }
+    out.stats = steered.stats;
+  };
+  auto runPass = [&](std::size_t p) {
+    try {
+      steerOne(p);
+    } catch (...) {
+      steered_passes[p].error = std::current_exception();
+    }
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    ++passes_done;
+    const std::string label =
+        "pass " + std::to_string(passes_done) + "/" + std::to_string(pass_count);
+    if (request.progress && !steered_passes[p].error &&
+        !request.progress(0.3 + 0.6 * passes_done / pass_count, label))
+      steered_passes[p].error = std::make_exception_ptr(common::Interrupted());
+  };
+  if (request.serial_passes)
+    for (std::size_t p = 0; p < result.passes.size(); ++p) runPass(p);
+  else
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, result.passes.size(), 1),
+                      [&](const auto& range) {
+                        for (std::size_t p = range.begin(); p != range.end(); ++p) runPass(p);
+                      });
+  // The first failure in pass order, as the serial loop would have thrown it.
+  for (const Steered& s : steered_passes)
+    if (s.error) std::rethrow_exception(s.error);
+  for (Steered& s : steered_passes) {
+    for (GeneratedPosture& g : s.postures) {
       if (g.limited && result.first_limited == ClearanceResult::npos)
         result.first_limited = result.postures.size();
       result.limited_postures += g.limited;
       result.postures.push_back(g);
     }
-    const dynamics::SolverStats& st = steered.stats;
+    const dynamics::SolverStats& st = s.stats;
     result.solver_steps += st.steps;
     result.rhs_evals += st.rhs_evals;
     result.jacobian_evals += st.jacobian_evals;

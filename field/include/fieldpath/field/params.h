@@ -1,5 +1,7 @@
 #pragma once
 /// Settings of the repulsive field (scene `field:` block). Defaults are documented here, once.
+#include <optional>
+#include <string_view>
 
 namespace fieldpath::field {
 
@@ -14,6 +16,18 @@ enum class Interpolation { Trilinear, Quadratic };  ///< voxel sampler
 ///   zone); the query returns P(s~)·G~. Exact for a plane at any h, on both sides of it and
 ///   through r0; the same at the nodes. One more float a node and a second lookup.
 enum class StoredQuantity { Force, PlaneRatio };
+/// Where the voxel nodes are computed (scene `field.backend`, `--backend`): Auto is the GPU when
+/// the program has CUDA and a device is present, else the CPU block build; Reference is the
+/// per-node build the block builds are checked against (tests, bench_field).
+enum class FieldBackend { Auto, Cpu, Cuda, Reference };
+/// "auto", "cpu", "cuda", "reference" (scene key and `--backend`); nothing for another word.
+inline std::optional<FieldBackend> fieldBackendNamed(std::string_view name) {
+  if (name == "auto") return FieldBackend::Auto;
+  if (name == "cpu") return FieldBackend::Cpu;
+  if (name == "cuda") return FieldBackend::Cuda;
+  if (name == "reference") return FieldBackend::Reference;
+  return std::nullopt;
+}
 
 /// How the field is sampled on voxels (scene `field.voxel_size`, `interpolation`, `stored`,
 /// `refine_tolerance`, `refine_levels`), written once: FieldParams holds the scene's, a
@@ -27,6 +41,7 @@ struct VoxelSettings {
   /// 0: a uniform grid (voxel_field.h VoxelRequest says how the error is estimated).
   double refine_tolerance = 0.0;
   int refine_levels = 2;
+  FieldBackend backend = FieldBackend::Auto;  ///< same node values on each, to float rounding
 };
 
 struct FieldParams {

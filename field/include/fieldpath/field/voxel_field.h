@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -66,6 +67,11 @@ struct VoxelStats {
   std::size_t refined_cells = 0;  ///< cells split, all levels
   std::size_t refined_nodes = 0;  ///< nodes of the finer levels (part of active_nodes)
   std::size_t tested_cells = 0;   ///< cells given an error estimate
+  std::string backend;            ///< where the nodes were computed: cpu, cuda or reference
+  double nodes_seconds = 0.0;     ///< of build_seconds: node values (all levels, transfers in)
+  /// of build_seconds: the refinement's host work but the nodes (error estimates, split
+  /// cells, hanging nodes, query blocks of the finer levels)
+  double refine_seconds = 0.0;
 };
 
 /// Nodes of a refined grid follow the field down to this many r_min over the surface.
@@ -83,6 +89,18 @@ std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams
 /// query block of the leaf, 16 bytes per node of 9³ (≈ 34 per active node). Measured with the
 /// plane ratio's closeness grid on top (× 16/12): 74-95 bytes per active node.
 inline constexpr double kVoxelBytesPerNode = 52.0;
+
+/// One active node as stored (VoxelField::storedNodes): for tests and tools.
+struct StoredNode {
+  Vec3 x_mm;          ///< world position
+  int level = 0;      ///< 0: h, 1: h/2, ...
+  Vec3 value;         ///< F (Force) or G (PlaneRatio), float-rounded
+  double closeness_mm = 0.0;  ///< PlaneRatio: r0 - s
+  bool over = false;  ///< PlaneRatio: over/under the surface (the closeness grid's active mask)
+};
+
+/// Whether `field.backend: cuda` can run here: the program has CUDA and a GPU is present.
+bool cudaFieldBackendAvailable();
 
 class VoxelField final : public ForceField {
  public:
@@ -106,6 +124,8 @@ class VoxelField final : public ForceField {
   StoredQuantity stored() const;
   /// World positions (mm) of the active nodes of every level, at most `max_count` of them.
   std::vector<Vec3> activeNodes(std::size_t max_count = std::size_t(-1)) const;
+  /// Every active node of every level with what it stores, level by level in grid order.
+  std::vector<StoredNode> storedNodes() const;
   /// Writes the grid (named "force"; finer levels "force_level1", ...) to a .vdb file
   /// atomically; Houdini and Blender open it.
   void save(const std::filesystem::path& file) const;

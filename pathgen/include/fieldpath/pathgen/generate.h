@@ -74,6 +74,9 @@ struct GenerateRequest {
   /// Hand the voxel field the path was steered by back in GenerateResult::voxels (the study
   /// measures its error without building it a second time).
   bool keep_voxels = false;
+  /// Steer the passes one after the other on this thread (default: in parallel on all cores;
+  /// the same output bit for bit).
+  bool serial_passes = false;
   common::Progress progress;  ///< "field", "pass k/n", "clearance", "motions"
 };
 

@@ -1,0 +1,15 @@
+#!/bin/bash
+# Bundles fieldpath and test_field (built with CUDA) with their libraries for the GPU machine,
+# which has no OpenVDB (BUILD-NOTES.md): bench/field/gpu_bundle.sh BUILD_DIR OUT_DIR -> OUT_DIR/fp.tar.xz
+set -eu
+build=$1
+out=$2
+rm -rf "$out/B" && mkdir -p "$out/B/lib"
+cp "$build/bin/fieldpath" "$build/bin/test_field" "$out/B/"
+for l in $(ldd "$build/bin/fieldpath" "$build/bin/test_field" | awk '{print $3}' | grep -E '^/' | sort -u |
+           grep -vE 'libc\.so|libm\.so|libdl|libpthread|librt|ld-linux|libgcc_s|libstdc\+\+'); do
+  cp -L "$l" "$out/B/lib/"
+done
+strip "$out/B/fieldpath" "$out/B/test_field" "$out/B/lib/"* 2>/dev/null || true
+tar -C "$out" -cJf "$out/fp.tar.xz" B
+ls -la "$out/fp.tar.xz"

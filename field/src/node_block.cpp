@@ -1,0 +1,398 @@
+/// The CPU block build of voxel nodes (node_block.h). No OpenVDB: this file is quick to compile
+/// and its loops are checked for vectorisation (`-fopt-info-vec`, CMakeLists.txt).
+#include "node_block.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
+namespace fieldpath::field {
+
+using kernel::Accum;
+using kernel::D3;
+using kernel::Law;
+using kernel::SampleSpan;
+
+SampleTable::SampleTable(const ObstacleSamples& samples, double r0_mm) {
+  const std::size_t n = samples.size();
+  double hi[3] = {0, 0, 0};
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = HUGE_VAL;
+    hi[a] = -HUGE_VAL;
+  }
+  for (const Vec3& p : samples.points_mm)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], p[a]);
+      hi[a] = std::max(hi[a], p[a]);
+    }
+  if (n == 0)
+    for (int a = 0; a < 3; ++a) lo[a] = hi[a] = 0.0;
+  double extent = 0.0;
+  for (int a = 0; a < 3; ++a) extent = std::max(extent, hi[a] - lo[a]);
+  cell_mm = std::max(0.5 * r0_mm, extent / (kMaxCellsPerAxis - 1));
+  for (int a = 0; a < 3; ++a)
+    dim[a] = std::max(1, std::min(kMaxCellsPerAxis, int(std::floor((hi[a] - lo[a]) / cell_mm)) + 1));
+  const std::size_t cells = std::size_t(dim[0]) * dim[1] * dim[2];
+  std::vector<std::int32_t> cell_of(n);
+  cell_start.assign(cells + 1, 0);
+  for (std::size_t j = 0; j < n; ++j) {
+    int c[3];
+    for (int a = 0; a < 3; ++a)
+      c[a] = std::clamp(int(std::floor((samples.points_mm[j][a] - lo[a]) / cell_mm)), 0, dim[a] - 1);
+    cell_of[j] = (c[0] * dim[1] + c[1]) * dim[2] + c[2];
+    ++cell_start[cell_of[j] + 1];
+  }
+  std::partial_sum(cell_start.begin(), cell_start.end(), cell_start.begin());
+  std::vector<std::int32_t> next(cell_start.begin(), cell_start.end() - 1);
+  for (auto* v : {&x, &y, &z, &nx, &ny, &nz, &w}) v->resize(n);
+  id.resize(n);
+  for (std::size_t j = 0; j < n; ++j) {  // stable: ids rise within a cell
+    const std::size_t at = std::size_t(next[cell_of[j]]++);
+    x[at] = samples.points_mm[j].x();
+    y[at] = samples.points_mm[j].y();
+    z[at] = samples.points_mm[j].z();
+    nx[at] = samples.normals[j].x();
+    ny[at] = samples.normals[j].y();
+    nz[at] = samples.normals[j].z();
+    w[at] = samples.weights[j];
+    id[at] = std::int32_t(j);
+  }
+}
+
+namespace {
+
+constexpr int kLanes = 8;
+
+/// The samples exactly at `at` among the first `count` of s (their term is along the normal).
+void addZeroTerms(const Law& L, const SampleSpan& s, int count, D3 at, Accum& a) {
+  for (int j = 0; j < count; ++j) {
+    const double dx = at.x - s.x[j], dy = at.y - s.y[j], dz = at.z - s.z[j];
+    if (dx * dx + dy * dy + dz * dz == 0.0)
+      kernel::addTerm(L, 0.0, 0.0, 0.0, 0.0, s.nx[j], s.ny[j], s.nz[j], s.w[j], a);
+  }
+}
+
+/// The per-lane nearest samples merged into a (ties: lowest id).
+void mergeNearest(const double* best, const std::int64_t* best_id, const std::int64_t* best_at,
+                  Accum& a) {
+  for (int l = 0; l < kLanes; ++l)
+    if (best_id[l] >= 0 && (best[l] < a.best_sq ||
+                            (best[l] == a.best_sq && (a.best_id < 0 || best_id[l] < a.best_id)))) {
+      a.best_sq = best[l];
+      a.best_id = int(best_id[l]);
+      a.best_at = int(best_at[l]);
+    }
+}
+
+SampleSpan tail(const SampleSpan& s, int from) {
+  SampleSpan rest = s;
+  rest.x += from;
+  rest.y += from;
+  rest.z += from;
+  rest.nx += from;
+  rest.ny += from;
+  rest.nz += from;
+  rest.w += from;
+  rest.id += from;
+  rest.count -= from;
+  rest.base += from;
+  return rest;
+}
+
+/// Eq. 1 over a span in lanes of kLanes: the same terms as kernel::addTerm, summed per lane then
+/// across the lanes; the nearest sample per lane (ties: lowest id), then across. The rest
+/// (count % kLanes) runs scalar. Written for the compiler to vectorise (branch-free lane loops).
+void accumulateGeneric(const Law& L, const SampleSpan& s, D3 at, bool track, Accum& a) {
+  const int full = s.count - s.count % kLanes;
+  if (full > 0) {
+    double fx[kLanes] = {}, fy[kLanes] = {}, fz[kLanes] = {};
+    double best[kLanes];
+    std::int64_t best_id[kLanes], best_at[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+      best[l] = a.best_sq;
+      best_id[l] = -1;
+      best_at[l] = -1;
+    }
+    int zero = 0;
+    const double r0_sq = L.r0_sq, r_min = L.r_min, inv_r0 = L.inv_r0;
+    for (int j = 0; j < full; j += kLanes) {
+      double dx[kLanes], dy[kLanes], dz[kLanes], r2[kLanes], c[kLanes];
+      for (int l = 0; l < kLanes; ++l) {
+        dx[l] = at.x - s.x[j + l];
+        dy[l] = at.y - s.y[j + l];
+        dz[l] = at.z - s.z[j + l];
+        r2[l] = dx[l] * dx[l] + dy[l] * dy[l] + dz[l] * dz[l];
+      }
+      for (int l = 0; l < kLanes; ++l) {
+        const double in = r2[l] < r0_sq && r2[l] > 0.0 ? 1.0 : 0.0;
+        const double r = std::sqrt(r2[l] > 0.0 ? r2[l] : 1.0);
+        const double rc = r < r_min ? r_min : r;
+        c[l] = in * (s.w[j + l] * ((1.0 / rc - inv_r0) / (rc * rc)) / r);
+        zero += r2[l] == 0.0 ? 1 : 0;
+      }
+      for (int l = 0; l < kLanes; ++l) {
+        fx[l] += c[l] * dx[l];
+        fy[l] += c[l] * dy[l];
+        fz[l] += c[l] * dz[l];
+      }
+      if (track)
+        for (int l = 0; l < kLanes; ++l) {
+          const std::int64_t id = s.id[j + l];
+          const bool closer = r2[l] < best[l] || (r2[l] == best[l] && id < best_id[l]);
+          best[l] = closer ? r2[l] : best[l];
+          best_id[l] = closer ? id : best_id[l];
+          best_at[l] = closer ? std::int64_t(s.base + j + l) : best_at[l];
+        }
+    }
+    for (int l = 0; l < kLanes; ++l) {
+      a.fx += fx[l];
+      a.fy += fy[l];
+      a.fz += fz[l];
+    }
+    if (track) mergeNearest(best, best_id, best_at, a);
+    if (zero) addZeroTerms(L, s, full, at, a);
+  }
+  if (full < s.count) kernel::accumulateScalar(L, tail(s, full), at, track, a);
+}
+
+#if defined(__x86_64__)
+/// accumulateGeneric with AVX-512 (8 doubles a register): 1/r from the 14-bit reciprocal square
+/// root and two Newton steps (relative error ~1e-16: no division, no square root), r² summed in
+/// the scalar's order (same nearest sample, same cut at r0).
+__attribute__((target("avx512f"))) void accumulate512(const Law& L, const SampleSpan& s, D3 at,
+                                                      bool track, Accum& a) {
+  const int full = s.count - s.count % kLanes;
+  if (full > 0) {
+    const __m512d ax = _mm512_set1_pd(at.x), ay = _mm512_set1_pd(at.y), az = _mm512_set1_pd(at.z);
+    const __m512d r0_sq = _mm512_set1_pd(L.r0_sq), inv_r_min = _mm512_set1_pd(1.0 / L.r_min);
+    const __m512d inv_r0 = _mm512_set1_pd(L.inv_r0), one = _mm512_set1_pd(1.0);
+    const __m512d half = _mm512_set1_pd(0.5), three_halves = _mm512_set1_pd(1.5);
+    __m512d fx = _mm512_setzero_pd(), fy = _mm512_setzero_pd(), fz = _mm512_setzero_pd();
+    __m512d best = _mm512_set1_pd(a.best_sq);
+    __m512i best_id = _mm512_set1_epi64(-1), best_at = _mm512_set1_epi64(-1);
+    const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
+    __mmask8 zero = 0;
+    for (int j = 0; j < full; j += kLanes) {
+      const __m512d dx = _mm512_sub_pd(ax, _mm512_loadu_pd(s.x + j));
+      const __m512d dy = _mm512_sub_pd(ay, _mm512_loadu_pd(s.y + j));
+      const __m512d dz = _mm512_sub_pd(az, _mm512_loadu_pd(s.z + j));
+      const __m512d r2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
+                                       _mm512_mul_pd(dz, dz));
+      const __mmask8 positive = _mm512_cmp_pd_mask(r2, _mm512_setzero_pd(), _CMP_GT_OQ);
+      const __mmask8 in = _mm512_mask_cmp_pd_mask(positive, r2, r0_sq, _CMP_LT_OQ);
+      zero |= _mm512_cmp_pd_mask(r2, _mm512_setzero_pd(), _CMP_EQ_OQ);
+      if (in) {
+        const __m512d r2s = _mm512_mask_blend_pd(positive, one, r2);
+        __m512d y = _mm512_rsqrt14_pd(r2s);  // 1/r
+        const __m512d hr2 = _mm512_mul_pd(half, r2s);
+        y = _mm512_mul_pd(y, _mm512_fnmadd_pd(hr2, _mm512_mul_pd(y, y), three_halves));
+        y = _mm512_mul_pd(y, _mm512_fnmadd_pd(hr2, _mm512_mul_pd(y, y), three_halves));
+        const __m512d inv_rc = _mm512_min_pd(y, inv_r_min);
+        const __m512d phi = _mm512_mul_pd(_mm512_sub_pd(inv_rc, inv_r0),
+                                          _mm512_mul_pd(inv_rc, inv_rc));
+        const __m512d c =
+            _mm512_maskz_mul_pd(in, _mm512_mul_pd(_mm512_loadu_pd(s.w + j), phi), y);
+        fx = _mm512_fmadd_pd(c, dx, fx);
+        fy = _mm512_fmadd_pd(c, dy, fy);
+        fz = _mm512_fmadd_pd(c, dz, fz);
+      }
+      if (track) {
+        const __m512i id =
+            _mm512_cvtepi32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(s.id + j)));
+        const __mmask8 closer =
+            _mm512_cmp_pd_mask(r2, best, _CMP_LT_OQ) |
+            (_mm512_cmp_pd_mask(r2, best, _CMP_EQ_OQ) & _mm512_cmplt_epi64_mask(id, best_id));
+        if (closer) {
+          best = _mm512_mask_blend_pd(closer, best, r2);
+          best_id = _mm512_mask_blend_epi64(closer, best_id, id);
+          best_at = _mm512_mask_blend_epi64(
+              closer, best_at, _mm512_add_epi64(lane, _mm512_set1_epi64(s.base + j)));
+        }
+      }
+    }
+    a.fx += _mm512_reduce_add_pd(fx);
+    a.fy += _mm512_reduce_add_pd(fy);
+    a.fz += _mm512_reduce_add_pd(fz);
+    if (track) {
+      alignas(64) double b[kLanes];
+      alignas(64) std::int64_t bid[kLanes], bat[kLanes];
+      _mm512_store_pd(b, best);
+      _mm512_store_epi64(bid, best_id);
+      _mm512_store_epi64(bat, best_at);
+      mergeNearest(b, bid, bat, a);
+    }
+    if (zero) addZeroTerms(L, s, full, at, a);
+  }
+  if (full < s.count) kernel::accumulateScalar(L, tail(s, full), at, track, a);
+}
+
+const bool kHaveAvx512 = __builtin_cpu_supports("avx512f");
+#endif
+
+void accumulateLanes(const Law& L, const SampleSpan& s, D3 at, bool track, Accum& a) {
+#if defined(__x86_64__)
+  if (kHaveAvx512) return accumulate512(L, s, at, track, a);
+#endif
+  accumulateGeneric(L, s, at, track, a);
+}
+
+/// A leaf's neighbourhood: the samples gathered in [box_lo, box_hi] (mm) for sums whose ball
+/// lies inside that box, the cell list for the others (points lifted far off the leaf).
+struct BlockHood {
+  const Law* law;
+  SampleSpan block;  ///< the leaf's samples: every one in [box_lo, box_hi]
+  double box_lo[3], box_hi[3];
+  SampleSpan row;    ///< the row's: every one within row_reach of the row's segment
+  double row_x = 0, row_y = 0, row_z0 = 0, row_z1 = 0, row_reach = -1;
+  const kernel::CellTable* cells;
+  const ObstacleSamples* samples;
+
+  struct Visit {
+    const Law* law;
+    D3 at;
+    bool track;
+    Accum* a;
+    void operator()(const SampleSpan& s) { accumulateLanes(*law, s, at, track, *a); }
+  };
+  void sum(D3 c, double radius, bool track, Accum& a) {
+    // Distance from c to the row's segment (x, y, [z0, z1]).
+    const double dz = c.z < row_z0 ? row_z0 - c.z : c.z > row_z1 ? c.z - row_z1 : 0.0;
+    const double dx = c.x - row_x, dy = c.y - row_y;
+    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+    if (d + radius <= row_reach) {
+      accumulateLanes(*law, row, c, track, a);
+      return;
+    }
+    const bool inside = c.x - radius >= box_lo[0] && c.y - radius >= box_lo[1] &&
+                        c.z - radius >= box_lo[2] && c.x + radius <= box_hi[0] &&
+                        c.y + radius <= box_hi[1] && c.z + radius <= box_hi[2];
+    if (inside) {
+      accumulateLanes(*law, block, c, track, a);
+      return;
+    }
+    Visit v{law, c, track, &a};
+    kernel::cellSpans(*cells, c, radius, v);
+  }
+  D3 point(const Accum& a) const {
+    const Vec3& p = samples->points_mm[std::size_t(a.best_id)];
+    return {p.x(), p.y(), p.z()};
+  }
+  D3 normal(const Accum& a) const {
+    const Vec3& n = samples->normals[std::size_t(a.best_id)];
+    return {n.x(), n.y(), n.z()};
+  }
+};
+
+}  // namespace
+
+kernel::CellTable cellTableOf(const SampleTable& t) {
+  kernel::CellTable c;
+  c.all = t.span(0, int(t.size()));
+  c.cell_start = t.cell_start.data();
+  for (int a = 0; a < 3; ++a) {
+    c.lo[a] = t.lo[a];
+    c.dim[a] = t.dim[a];
+  }
+  c.cell_mm = t.cell_mm;
+  c.inv_cell = 1.0 / t.cell_mm;
+  return c;
+}
+
+void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, const NodeJob& job,
+                    const LeafTask& leaf, BlockScratch& scratch, kernel::NodeValue* out) {
+  const double h = job.h_mm;
+  const double reach = std::max(job.rules.reach_mm, job.law.r0);
+  BlockHood hood;
+  hood.law = &job.law;
+  hood.samples = &samples;
+  for (int a = 0; a < 3; ++a) {
+    hood.box_lo[a] = leaf.origin[a] * h - reach;
+    hood.box_hi[a] = (leaf.origin[a] + 7) * h + reach;
+  }
+  const kernel::CellTable cells = cellTableOf(table);
+  hood.cells = &cells;
+  // Gather the samples of the box once, in SoA form.
+  for (auto* v : {&scratch.x, &scratch.y, &scratch.z, &scratch.nx, &scratch.ny, &scratch.nz,
+                  &scratch.w})
+    v->clear();
+  scratch.id.clear();
+  const D3 centre{0.5 * (hood.box_lo[0] + hood.box_hi[0]), 0.5 * (hood.box_lo[1] + hood.box_hi[1]),
+                  0.5 * (hood.box_lo[2] + hood.box_hi[2])};
+  struct Gather {
+    BlockScratch* s;
+    const double *lo, *hi;
+    void operator()(const SampleSpan& span) {
+      for (int j = 0; j < span.count; ++j) {
+        const double px = span.x[j], py = span.y[j], pz = span.z[j];
+        if (px < lo[0] || py < lo[1] || pz < lo[2] || px > hi[0] || py > hi[1] || pz > hi[2])
+          continue;
+        s->x.push_back(px);
+        s->y.push_back(py);
+        s->z.push_back(pz);
+        s->nx.push_back(span.nx[j]);
+        s->ny.push_back(span.ny[j]);
+        s->nz.push_back(span.nz[j]);
+        s->w.push_back(span.w[j]);
+        s->id.push_back(span.id[j]);
+      }
+    }
+  } gather{&scratch, hood.box_lo, hood.box_hi};
+  // The box's half diagonal covers it (a superset; the gather filters by the box).
+  const double half = std::sqrt(3.0) * 0.5 * (hood.box_hi[0] - hood.box_lo[0]);
+  kernel::cellSpans(cells, centre, half, gather);
+  hood.block = SampleSpan{scratch.x.data(),  scratch.y.data(),  scratch.z.data(),
+                          scratch.nx.data(), scratch.ny.data(), scratch.nz.data(),
+                          scratch.w.data(),  scratch.id.data(), int(scratch.x.size()), 0};
+  // Row by row (8 nodes along z): the leaf's samples within reach of the row's segment.
+  const double row_reach = reach * (1.0 + 1e-12);
+  hood.row_reach = reach;
+  for (int row = 0; row < 64; ++row) {
+    const std::uint64_t bits8 = (leaf.mask[row >> 3] >> ((row & 7) * 8)) & 0xffu;
+    if (!bits8) continue;
+    const int i = row >> 3, j = row & 7;
+    hood.row_x = (leaf.origin[0] + i) * h;
+    hood.row_y = (leaf.origin[1] + j) * h;
+    hood.row_z0 = leaf.origin[2] * h;
+    hood.row_z1 = (leaf.origin[2] + 7) * h;
+    const double reach_sq = row_reach * row_reach;
+    int n = 0;
+    auto& r = scratch.row;
+    r.resize(scratch.x.size());
+    for (std::size_t t = 0; t < scratch.x.size(); ++t) {
+      const double dx = scratch.x[t] - hood.row_x, dy = scratch.y[t] - hood.row_y;
+      const double z = scratch.z[t];
+      const double dz = z < hood.row_z0 ? hood.row_z0 - z : z > hood.row_z1 ? z - hood.row_z1 : 0.0;
+      r[n] = std::int32_t(t);
+      n += dx * dx + dy * dy + dz * dz <= reach_sq;
+    }
+    for (auto* v : {&scratch.rx, &scratch.ry, &scratch.rz, &scratch.rnx, &scratch.rny, &scratch.rnz,
+                    &scratch.rw})
+      v->resize(std::size_t(n));
+    scratch.rid.resize(std::size_t(n));
+    for (int t = 0; t < n; ++t) {
+      const std::size_t from = std::size_t(r[t]);
+      scratch.rx[t] = scratch.x[from];
+      scratch.ry[t] = scratch.y[from];
+      scratch.rz[t] = scratch.z[from];
+      scratch.rnx[t] = scratch.nx[from];
+      scratch.rny[t] = scratch.ny[from];
+      scratch.rnz[t] = scratch.nz[from];
+      scratch.rw[t] = scratch.w[from];
+      scratch.rid[t] = scratch.id[from];
+    }
+    hood.row = SampleSpan{scratch.rx.data(),  scratch.ry.data(),  scratch.rz.data(),
+                          scratch.rnx.data(), scratch.rny.data(), scratch.rnz.data(),
+                          scratch.rw.data(),  scratch.rid.data(), n, 0};
+    for (int k = 0; k < 8; ++k) {
+      if (!((bits8 >> k) & 1u)) continue;
+      const D3 x{hood.row_x, hood.row_y, (leaf.origin[2] + k) * h};
+      out[row * 8 + k] = kernel::nodeValue(hood, job.law, job.rules, x);
+    }
+  }
+}
+
+}  // namespace fieldpath::field

@@ -1,0 +1,15 @@
+/// The CUDA node build when the program is built without CUDA (node_cuda.h).
+#include <stdexcept>
+
+#include "node_cuda.h"
+
+namespace fieldpath::field::kernel {
+
+bool cudaNodeBuildAvailable() { return false; }
+
+std::vector<NodeValue> buildNodesCuda(const CellTable&, const NodeJob&,
+                                      const std::vector<LeafTask>&) {
+  throw std::runtime_error("field: this program was built without CUDA (FIELDPATH_WITH_CUDA)");
+}
+
+}  // namespace fieldpath::field::kernel

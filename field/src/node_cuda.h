@@ -1,0 +1,20 @@
+#pragma once
+/// Internal to field/: the CUDA node build (node_build_cuda.cu; node_build_stub.cpp without
+/// CUDA). Plain types only (node_kernel.h), so that nvcc sees no Eigen and no OpenVDB.
+#include <vector>
+
+#include "node_kernel.h"
+
+namespace fieldpath::field::kernel {
+
+/// Whether the CUDA build is compiled in and a device is present (any CUDA error: no).
+bool cudaNodeBuildAvailable();
+
+/// The values of the masked nodes of every leaf, computed on the GPU from the cell list
+/// (`table`'s pointers are host memory; copied over), compacted in leaf order then node offset
+/// order (a leaf's values start at the sum of the popcounts of the masks before it). Throws
+/// std::runtime_error (with file and line) on a CUDA error, or without CUDA.
+std::vector<NodeValue> buildNodesCuda(const CellTable& table, const NodeJob& job,
+                                      const std::vector<LeafTask>& leaves);
+
+}  // namespace fieldpath::field::kernel

@@ -1,0 +1,651 @@
+/// The voxel field's build: the nodes of each level from the samples (the CPU block build,
+/// the CUDA build, or the per-node reference), the refinement's error estimate and the split
+/// cells (voxel_grid.h; the queries: voxel_field.cpp).
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include <openvdb/tools/Morphology.h>
+#include <openvdb/tools/Prune.h>
+
+#include "fieldpath/common/errors.h"
+#include "node_block.h"
+#include "voxel_grid.h"
+
+namespace fieldpath::field {
+
+using namespace voxel;
+
+std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams& params,
+                               const VoxelRequest& request) {
+  const double h = request.voxel_size_mm;
+  checkVoxelSize(h);
+  const Eigen::AlignedBox3d box = reachBox(samples, params, request);
+  if (box.isEmpty()) return 0;
+  // Nodes of the lattice i·h in [lo, hi] along one axis.
+  auto count = [h](double lo, double hi) {
+    return std::max(0.0, std::floor(hi / h) - std::ceil(lo / h) + 1.0);
+  };
+  double dense = 1.0;
+  for (int a = 0; a < 3; ++a) dense *= count(box.min()[a], box.max()[a]);
+  // Every built node lies within reachMm of a sample, so in a cell (edge reach/2) at most two
+  // cells from one holding a sample: count the nodes of those cells (clipped to the box) on a
+  // coarse mask.
+  const double cell_mm = 0.5 * reachMm(params, request);
+  checkExtent(box, h, "voxel size");
+  Eigen::AlignedBox3d all;
+  for (const Vec3& q : samples.points_mm) all.extend(q);
+  checkExtent(all, cell_mm, "field.r0");
+  auto mask = openvdb::MaskGrid::create(false);
+  {
+    auto acc = mask->getAccessor();
+    for (const Vec3& q : samples.points_mm) {
+      const Vec3 c = (q / cell_mm).array().floor();
+      acc.setValueOn(openvdb::Coord(int(c.x()), int(c.y()), int(c.z())));
+    }
+  }
+  openvdb::tools::dilateActiveValues(mask->tree(), 2, openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                     openvdb::tools::IGNORE_TILES);
+  double cells = 0.0;
+  for (auto it = mask->cbeginValueOn(); it; ++it) {
+    const openvdb::Coord c = it.getCoord();
+    double nodes = 1.0;
+    for (int a = 0; a < 3; ++a) {
+      const double lo = std::max(c[a] * cell_mm, box.min()[a]);
+      const double hi = (c[a] + 1) * cell_mm;
+      // half-open cell [lo, hi), except where the box's own (closed) end cuts it
+      nodes *= hi > box.max()[a] ? count(lo, box.max()[a])
+                                 : std::max(0.0, std::ceil(hi / h) - std::ceil(lo / h));
+    }
+    cells += nodes;
+  }
+  const double estimate = std::min(dense, cells);
+  return estimate >= 1e18 ? std::size_t(1e18) : static_cast<std::size_t>(estimate);
+}
+
+namespace voxel {
+namespace {
+
+
+/// Whether x lies over (or under) the sampled surface: its nearest sample less than `over_mm`
+/// sideways. Beyond the edge of an open wall it does not, and "inside" means nothing there.
+bool overSurface(const detail::Probe& p, double over_mm) {
+  const double lateral_sq = p.nearest_mm * p.nearest_mm - p.height_mm * p.height_mm;
+  return lateral_sq <= over_mm * over_mm;
+}
+
+constexpr double kOverCos = 0.7;  ///< |cos| of the field's angle to n* over the surface
+
+/// One node of the plane ratio: s (mm), G, and whether it lies over/under the surface.
+struct RatioNode {
+  double s_mm;
+  Vec3 g;
+  bool over;
+};
+
+/// The plane-ratio pair (s, G) of one node from its probe (law.h): P(s)·G is the field there
+/// and s is the plane height η on both sides of a plane, G the plane's normal.
+/// - Elsewhere than below: s = P⁻¹(|F|), the height at which a plane gives |F|, and
+///   G = F / P(s), the unit field direction: the node gives back F.
+/// - Over the sampled surface closer than `near_mm` above it, or under it (inside the obstacle,
+///   down to the inside band): the samples' own field there is not yet a plane's (each sample's
+///   1/r³ shows, the r_min hold; inside, the surface rule's mirror), so the node holds the
+///   continuation of the field at the point x' lifted to near_mm above the surface: s = s' - δ
+///   (δ the lift) and G = G' of x'. Cells that reach down to or through the wall then
+///   interpolate the field above it, and a node inside gets P(|s|)·G, finite and outward.
+/// - Past r0 (the shell, no sample within r0): s = max(η, r0) and G the wall's direction, the
+///   plane's continuation, so that a cell straddling r0 interpolates s linearly through it.
+/// "Over the surface" (overSurface, and a field along n*) decides the side: beyond the edge of
+/// an open wall the field is even about the wall's plane and s stays positive there.
+/// `field_at(x')` is the direct field at a point.
+template <class FieldAt>
+RatioNode planeRatio(const detail::Probe& p, const Vec3& x, const Vec3& q, const Vec3& n,
+                     const PlaneLaw& law, double gain, double over_mm, double near_mm,
+                     FieldAt&& field_at) {
+  const double eta = p.height_mm;
+  // Over the surface, and the field along its normal (beyond an edge it turns sideways, away
+  // from the edge, and the sign of η says nothing).
+  const bool over = overSurface(p, over_mm) &&
+                    (!p.force || std::abs(p.force->dot(n)) >= kOverCos * p.force->norm());
+  const double sign = gain < 0.0 ? -1.0 : 1.0;
+  if (!p.force) {  // shell: no sample within r0
+    if (!over) return {std::max(p.nearest_mm, law.r0_mm), sign * (x - q) / p.nearest_mm, false};
+    if (eta >= 0.0) return {std::max(eta, law.r0_mm), sign * n, true};
+    return {-std::max(-eta, law.r0_mm), Vec3::Zero(), true};
+  }
+  auto ratioOf = [&](const Vec3& f, double lift_mm) {
+    const double e = law.height(f.norm());
+    const double plane = law.at(e);
+    return RatioNode{e - lift_mm, plane > 0.0 ? Vec3(f / plane) : Vec3::Zero(), over};
+  };
+  if (!over || eta >= near_mm) return ratioOf(*p.force, 0.0);
+  const double lift_mm = near_mm - eta;
+  return ratioOf(field_at(Vec3(x + lift_mm * n)), lift_mm);
+}
+
+
+
+/// What the node values of every level are made from.
+struct NodeBuilder {
+  const DirectField::Index& index;
+  const VoxelRequest& request;
+  bool ratio;
+  double band_in_mm, reach_mm, over_mm, near_mm;
+  PlaneLaw law;
+  FieldBackend backend;                      ///< Cpu, Cuda or Reference (resolved)
+  std::optional<SampleTable> table;          ///< the cell list (all but Reference)
+  mutable double nodes_seconds = 0.0;        ///< node evaluation, all levels
+
+  /// The constants of the block and CUDA builds at voxel size h.
+  NodeJob jobAt(double h) const {
+    const FieldParams& params = index.params;
+    NodeJob job;
+    job.h_mm = h;
+    job.law.r0 = params.r0_mm;
+    job.law.r0_sq = params.r0_mm * params.r0_mm;
+    job.law.inv_r0 = 1.0 / params.r0_mm;
+    job.law.r_min = params.r_min_mm;
+    job.law.r_min_sq = params.r_min_mm * params.r_min_mm;
+    job.law.gain = params.gain;
+    job.law.plane_scale = law.scale;
+    job.rules.ratio = ratio;
+    job.rules.band_in_mm = band_in_mm;
+    job.rules.reach_mm = reach_mm;
+    job.rules.over_mm = over_mm;
+    job.rules.near_mm = near_mm;
+    job.rules.has_region = bool(request.region_mm);
+    for (int a = 0; a < 3; ++a) {
+      job.rules.region_lo[a] = request.region_mm ? request.region_mm->min()[a] : 0.0;
+      job.rules.region_hi[a] = request.region_mm ? request.region_mm->max()[a] : 0.0;
+    }
+    return job;
+  }
+
+  /// Computes the nodes of `origins` (leaves of a level of size h): all of a leaf's nodes, or
+  /// those on in `only`. Returns the level's grids (inactive nodes pruned from the value grid).
+  /// Progress between batches, from this thread only.
+  std::pair<Grid::Ptr, FloatGrid::Ptr> build(double h, const std::vector<openvdb::Coord>& origins,
+                                             const openvdb::MaskGrid* only,
+                                             const std::function<void(double)>& progress) const {
+    auto grid = Grid::create(openvdb::Vec3s(0.0f));
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(h));
+    grid->setName(ratio ? "plane_ratio" : "force");
+    grid->setVectorType(openvdb::VEC_INVARIANT);
+    FloatGrid::Ptr closeness;
+    if (ratio) {
+      closeness = FloatGrid::create(0.0f);
+      closeness->setTransform(grid->transform().copy());
+      closeness->setName("plane_closeness");
+    }
+    std::vector<Leaf*> leaves;
+    std::vector<FloatLeaf*> float_leaves;
+    leaves.reserve(origins.size());
+    for (const auto& o : origins) {
+      leaves.push_back(grid->tree().touchLeaf(o));
+      if (ratio) float_leaves.push_back(closeness->tree().touchLeaf(o));
+    }
+    const auto start = std::chrono::steady_clock::now();
+    if (backend == FieldBackend::Reference)
+      buildReference(h, leaves, float_leaves, only, progress);
+    else
+      buildBlocks(h, leaves, float_leaves, only, progress);
+    nodes_seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    openvdb::tools::pruneInactive(grid->tree());
+    // (closeness keeps its leaves: its inactive nodes hold values, those beyond open edges.)
+    return {grid, closeness};
+  }
+
+  /// Writes a leaf's computed nodes (those of `mask`) into its value and closeness leaves.
+  static void store(const std::uint64_t (&mask)[8], const kernel::NodeValue* values, Leaf& leaf,
+                    FloatLeaf* float_leaf) {
+    for (int word = 0; word < 8; ++word) {
+      std::uint64_t bits = mask[word];
+      while (bits) {
+        const int offset = word * 64 + __builtin_ctzll(bits);
+        bits &= bits - 1;
+        const kernel::NodeValue& v = values[offset];
+        if (v.flags & kernel::kCloseSet) {
+          if (v.flags & kernel::kCloseOn)
+            float_leaf->setValueOn(openvdb::Index(offset), v.closeness);
+          else
+            float_leaf->setValueOff(openvdb::Index(offset), v.closeness);
+        }
+        if (v.flags & kernel::kNodeOn)
+          leaf.setValueOn(openvdb::Index(offset), openvdb::Vec3s(v.v[0], v.v[1], v.v[2]));
+      }
+    }
+  }
+
+  /// The leaves' tasks: every node, or those on in `only`.
+  static std::vector<LeafTask> tasksOf(const std::vector<Leaf*>& leaves,
+                                       const openvdb::MaskGrid* only) {
+    std::vector<LeafTask> tasks(leaves.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
+      std::optional<openvdb::MaskGrid::ConstAccessor> wanted;
+      if (only) wanted.emplace(only->getConstAccessor());
+      for (std::size_t l = range.begin(); l != range.end(); ++l) {
+        LeafTask& t = tasks[l];
+        const openvdb::Coord o = leaves[l]->origin();
+        for (int a = 0; a < 3; ++a) t.origin[a] = o[a];
+        const auto* mask_leaf = wanted ? wanted->probeConstLeaf(o) : nullptr;
+        for (int word = 0; word < 8; ++word)
+          t.mask[word] = !wanted ? ~std::uint64_t{0}
+                         : mask_leaf ? mask_leaf->getValueMask().getWord<std::uint64_t>(word)
+                                     : 0;
+      }
+    });
+    return tasks;
+  }
+
+  /// The block builds: on the GPU (all leaves at once) or on the CPU leaf by leaf.
+  void buildBlocks(double h, const std::vector<Leaf*>& leaves,
+                   const std::vector<FloatLeaf*>& float_leaves, const openvdb::MaskGrid* only,
+                   const std::function<void(double)>& progress) const {
+    const std::vector<LeafTask> tasks = tasksOf(leaves, only);
+    const NodeJob job = jobAt(h);
+    if (backend == FieldBackend::Cuda) {
+      const std::vector<kernel::NodeValue> values = buildNodesCuda(*table, job, tasks);
+      std::vector<std::size_t> first(tasks.size() + 1, 0);
+      for (std::size_t l = 0; l < tasks.size(); ++l) {
+        std::size_t n = 0;
+        for (std::uint64_t word : tasks[l].mask) n += std::size_t(__builtin_popcountll(word));
+        first[l + 1] = first[l] + n;
+      }
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tasks.size()), [&](const auto& range) {
+        kernel::NodeValue buffer[Leaf::SIZE];
+        for (std::size_t l = range.begin(); l != range.end(); ++l) {
+          std::size_t at = first[l];
+          for (int word = 0; word < 8; ++word)
+            for (std::uint64_t bits = tasks[l].mask[word]; bits; bits &= bits - 1)
+              buffer[word * 64 + __builtin_ctzll(bits)] = values[at++];
+          store(tasks[l].mask, buffer, *leaves[l], ratio ? float_leaves[l] : nullptr);
+        }
+      });
+      if (progress) progress(1.0);
+      return;
+    }
+    const std::size_t batches =
+        std::max<std::size_t>(1, std::min<std::size_t>(20, leaves.size() / 64));
+    const ObstacleSamples& samples = index.samples;
+    for (std::size_t batch = 0; batch < batches; ++batch) {
+      const std::size_t begin = leaves.size() * batch / batches;
+      const std::size_t end = leaves.size() * (batch + 1) / batches;
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 1), [&](const auto& range) {
+        BlockScratch scratch;
+        kernel::NodeValue buffer[Leaf::SIZE];
+        for (std::size_t l = range.begin(); l != range.end(); ++l) {
+          buildLeafNodes(*table, samples, job, tasks[l], scratch, buffer);
+          store(tasks[l].mask, buffer, *leaves[l], ratio ? float_leaves[l] : nullptr);
+        }
+      });
+      if (progress) progress(double(batch + 1) / double(batches));
+    }
+  }
+
+  /// The per-node reference build (FieldBackend::Reference): a probe through the point index
+  /// for each node against the samples gathered for its leaf.
+  void buildReference(double h, const std::vector<Leaf*>& leaves,
+                      const std::vector<FloatLeaf*>& float_leaves, const openvdb::MaskGrid* only,
+                      const std::function<void(double)>& progress) const {
+    const ObstacleSamples& samples = index.samples;
+    const FieldParams& params = index.params;
+    const std::size_t batches =
+        std::max<std::size_t>(1, std::min<std::size_t>(20, leaves.size() / 64));
+    for (std::size_t batch = 0; batch < batches; ++batch) {
+      const std::size_t begin = leaves.size() * batch / batches;
+      const std::size_t end = leaves.size() * (batch + 1) / batches;
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 1), [&](const auto& range) {
+        auto searcher = index.searcher();
+        std::optional<openvdb::MaskGrid::ConstAccessor> wanted;
+        if (only) wanted.emplace(only->getConstAccessor());
+        std::vector<std::size_t> near;
+        for (std::size_t l = range.begin(); l != range.end(); ++l) {
+          Leaf& leaf = *leaves[l];
+          const openvdb::Coord o = leaf.origin();
+          const Vec3 lo = Vec3(o.x(), o.y(), o.z()) * h;
+          const Vec3 hi = lo + Vec3::Constant((kLeafDim - 1) * h);
+          // Samples within reach of the leaf's nodes, gathered once; the surface rule's second
+          // sum, at a point lifted off the wall (rare: nodes within r_min or inside), searches
+          // the index.
+          near.clear();
+          index.forEachInBox(searcher, lo.array() - reach_mm, hi.array() + reach_mm,
+                             [&](std::size_t j) { near.push_back(j); });
+          for (auto it = leaf.beginValueAll(); it; ++it) {
+            const openvdb::Coord ijk = it.getCoord();
+            if (wanted && !wanted->isValueOn(ijk)) continue;
+            const Vec3 x(ijk.x() * h, ijk.y() * h, ijk.z() * h);
+            if (request.region_mm && !request.region_mm->contains(x)) continue;
+            auto for_each_near = [&](const Vec3& center, double radius, auto&& fn) {
+              if (center == x)
+                for (std::size_t j : near) fn(j);
+              else
+                index.forEachNear(searcher, center, radius, fn);
+            };
+            const detail::Probe p =
+                detail::probe(x, for_each_near, samples.points_mm, samples.normals, samples.weights,
+                              params, reach_mm);
+            if (p.nearest < 0 || (p.height_mm < -band_in_mm && overSurface(p, over_mm))) continue;
+            Vec3 value;
+            if (ratio) {
+              const RatioNode node =
+                  planeRatio(p, x, samples.points_mm[p.nearest], samples.normals[p.nearest], law,
+                             params.gain, over_mm, near_mm, [&](const Vec3& at) {
+                               return index.fieldAt(searcher, at).value_or(Vec3::Zero());
+                             });
+              // The closeness grid's active mask carries `over` (see ratioHolds).
+              const float closeness_mm = float(params.r0_mm - node.s_mm);
+              if (node.over)
+                float_leaves[l]->setValueOn(it.pos(), closeness_mm);
+              else
+                float_leaves[l]->setValueOff(it.pos(), closeness_mm);
+              value = node.g;
+            } else {
+              if (!p.force) continue;
+              value = *p.force;
+            }
+            it.setValue(openvdb::Vec3s(float(value.x()), float(value.y()), float(value.z())));
+            it.setValueOn();
+          }
+        }
+      });
+      if (progress) progress(double(batch + 1) / double(batches));
+    }
+  }
+};
+
+/// The trilinear error of a cell estimated from its nodes alone: at each corner, along each axis
+/// with both neighbours built, the second difference of what is interpolated (s and G for the
+/// plane ratio, F for the stored force) over 8 (linear interpolation's error is h²/8 |f''|),
+/// turned into a force error: |dP/ds|·|G|·|Δ²s| + P(s)·|Δ²G|, or |Δ²F|. The cell's value is
+/// the largest corner error over max(least corner force, floor).
+class CurvatureProbe {
+ public:
+  CurvatureProbe(const Level& level, const std::optional<PlaneLaw>& law, double floor)
+      : values_(level.grid->getConstAccessor()), law_(law), floor_(floor) {
+    if (law) closeness_.emplace(level.closeness->getConstAccessor());
+  }
+
+  double cellError(const openvdb::Coord& cell) {
+    double worst = 0.0, sum = 0.0;
+    int built = 0;
+    for (int c = 0; c < 8; ++c) {
+      const Node n = node(cell.offsetBy(c >> 2, (c >> 1) & 1, c & 1));
+      if (!n.built) continue;
+      worst = std::max(worst, n.error);
+      sum += n.force;
+      ++built;
+    }
+    if (!built) return 0.0;
+    return worst / std::max(sum / built, floor_);
+  }
+
+ private:
+  struct Node {
+    bool built = false;
+    double force = 0.0, error = 0.0;
+  };
+  struct Read {
+    bool built;
+    double s;
+    Vec3 v;
+  };
+  Read read(const openvdb::Coord& ijk) {
+    const openvdb::Vec3s v = values_.getValue(ijk);
+    return {values_.isValueOn(ijk), law_ ? law_->r0_mm - closeness_->getValue(ijk) : 0.0,
+            Vec3(v.x(), v.y(), v.z())};
+  }
+  Node node(const openvdb::Coord& ijk) {
+    const Read at = read(ijk);
+    Node out;
+    if (!at.built) return out;
+    out.built = true;
+    double slope = 0.0;
+    if (law_) {
+      constexpr double kStepMm = 1e-4;
+      out.force = law_->at(at.s) * at.v.norm();
+      slope = std::abs(law_->at(std::abs(at.s) + kStepMm) - law_->at(std::abs(at.s) - kStepMm)) /
+              (2 * kStepMm);
+    } else {
+      out.force = at.v.norm();
+    }
+    for (int a = 0; a < 3; ++a) {
+      openvdb::Coord lo = ijk, hi = ijk;
+      lo[a] -= 1;
+      hi[a] += 1;
+      const Read m = read(lo), p = read(hi);
+      if (!m.built || !p.built) continue;
+      const Vec3 dv = m.v - 2.0 * at.v + p.v;
+      const double e =
+          law_ ? slope * at.v.norm() * std::abs(m.s - 2.0 * at.s + p.s) + law_->at(at.s) * dv.norm()
+               : dv.norm();
+      out.error = std::max(out.error, e / 8.0);
+    }
+    return out;
+  }
+  Grid::ConstAccessor values_;
+  std::optional<FloatGrid::ConstAccessor> closeness_;
+  const std::optional<PlaneLaw>& law_;
+  double floor_;
+};
+
+/// Cells of level 0 to test: every cell of a block with a non-zero corner (index coordinates).
+std::vector<openvdb::Coord> cellsWithValues(const Level& level) {
+  std::vector<openvdb::Coord> cells;
+  auto acc = level.block_of->getConstAccessor();
+  for (auto it = level.block_of->cbeginValueOn(); it; ++it) {
+    const std::size_t b = std::size_t(*it);
+    const openvdb::Coord o = it.getCoord() << 3;
+    for (int i = 0; i < kLeafDim; ++i)
+      for (int j = 0; j < kLeafDim; ++j)
+        for (int k = 0; k < kLeafDim; ++k) {
+          const std::size_t n0 = b * kBlockNodes + std::size_t((i * kBlockDim + j) * kBlockDim + k);
+          bool any = false;
+          for (int c = 0; c < 8 && !any; ++c) {
+            const auto& v = level.nodes[n0 + kCornerOffset[c]];
+            any = v[0] != 0.0f || v[1] != 0.0f || v[2] != 0.0f;
+          }
+          if (any) cells.push_back(o.offsetBy(i, j, k));
+        }
+  }
+  return cells;
+}
+
+/// Auto: the GPU when one is there (and the program has CUDA), else the CPU.
+FieldBackend resolveBackend(FieldBackend wanted) {
+  if (wanted == FieldBackend::Auto)
+    return kernel::cudaNodeBuildAvailable() ? FieldBackend::Cuda : FieldBackend::Cpu;
+  if (wanted == FieldBackend::Cuda && !kernel::cudaNodeBuildAvailable())
+    throw common::InputError(
+        "field.backend: cuda, but this program was built without CUDA or no GPU is present");
+  return wanted;
+}
+
+}  // namespace
+
+BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) {
+  BuiltLevels built;
+  const DirectField::Index& index = direct.index();
+  const ObstacleSamples& samples = index.samples;
+  const FieldParams& params = index.params;
+  const double h = request.voxel_size_mm;
+  checkVoxelSize(h);
+  const StoredQuantity stored = request.stored;
+  const bool ratio = stored == StoredQuantity::PlaneRatio;
+  const double tolerance = request.refine_tolerance;
+  const int refine_levels = request.refine_levels;
+  if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
+    throw common::InputError("field.refine_tolerance: must be >= 0 (got " +
+                             std::to_string(tolerance) + ")");
+  if (refine_levels < 0 || refine_levels > 6)
+    throw common::InputError("field.refine_levels: must be in [0, 6] (got " +
+                             std::to_string(refine_levels) + ")");
+  if (tolerance > 0.0 && request.interpolation == Interpolation::Quadratic)
+    throw common::InputError(
+        "field.refine_tolerance: refinement is trilinear only (field.interpolation: quadratic)");
+  // Sideways reach of a sample (sub-triangle centroids: within 0.87 step of any surface point);
+  // closer to the surface than about one spacing the samples' field is not yet a plane's.
+  NodeBuilder builder{index,
+                            request,
+                            ratio,
+                            insideBandMm(params, request),
+                            reachMm(params, request),
+                            params.sample_step_mm,
+                            request.plane_near_mm.value_or(
+                                (tolerance > 0.0 ? kRefinedNearFactor : 2.0) * params.r_min_mm),
+                            PlaneLaw(params, weightPerMm2(samples, params)),
+                            resolveBackend(request.backend),
+                            std::nullopt};
+  if (builder.backend != FieldBackend::Reference) builder.table.emplace(samples, params.r0_mm);
+  const double reach_mm = builder.reach_mm;
+
+  auto refuse = [&](const std::string& what, double nodes, double bytes_per_node) {
+    const double bytes = nodes * bytes_per_node;
+    if (bytes <= static_cast<double>(request.max_memory_bytes)) return;
+    throw common::InputError("voxel field at h = " + std::to_string(h) + " mm: " + what + " " +
+                             std::to_string(static_cast<long long>(nodes)) + " nodes (" +
+                             mib(bytes) + "), over the limit of " +
+                             mib(static_cast<double>(request.max_memory_bytes)) +
+                             "; use a coarser voxel size or a smaller region");
+  };
+  built.stats.estimated_nodes = estimateVoxelNodes(samples, params, request);
+  // The plane ratio adds a float to the Vec3f of a node.
+  const double value_bytes = ratio ? 16.0 : 12.0;
+  refuse("estimated", static_cast<double>(built.stats.estimated_nodes),
+         kVoxelBytesPerNode * value_bytes / 12.0);
+
+  // Candidate leaves (8³ nodes): those within reach of a sample, inside the region.
+  const Eigen::AlignedBox3d reach = reachBox(samples, params, request);
+  std::vector<openvdb::Coord> origins;
+  if (!reach.isEmpty()) {
+    const Vec3 lo_region = reach.min() / h, hi_region = reach.max() / h;
+    const double leaf_mm = kLeafDim * h;
+    for (const Vec3& q : samples.points_mm) {
+      const Vec3 lo = ((q.array() - reach_mm) / h).max(lo_region.array()).ceil();
+      const Vec3 hi = ((q.array() + reach_mm) / h).min(hi_region.array()).floor();
+      if ((lo.array() > hi.array()).any()) continue;
+      const openvdb::Coord a(int(lo.x()), int(lo.y()), int(lo.z()));
+      const openvdb::Coord b(int(hi.x()), int(hi.y()), int(hi.z()));
+      const openvdb::Coord la = a & ~(kLeafDim - 1), lb = b & ~(kLeafDim - 1);
+      for (int i = la.x(); i <= lb.x(); i += kLeafDim)
+        for (int j = la.y(); j <= lb.y(); j += kLeafDim)
+          for (int k = la.z(); k <= lb.z(); k += kLeafDim) {
+            // Distance from q to the leaf's node box.
+            const Vec3 box_lo = Vec3(i, j, k) * h;
+            const Vec3 nearest = q.cwiseMax(box_lo).cwiseMin(box_lo + Vec3::Constant(leaf_mm - h));
+            if ((nearest - q).squaredNorm() < reach_mm * reach_mm) origins.emplace_back(i, j, k);
+          }
+    }
+  }
+  std::sort(origins.begin(), origins.end());
+  origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
+  // Full leaves: the values of a node, masks and header, and the query block (9³ × 16 bytes).
+  refuse("candidate leaves hold", static_cast<double>(origins.size()) * Leaf::SIZE,
+         static_cast<double>(sizeof(Leaf)) / Leaf::SIZE * value_bytes / 12.0 + 12.0 +
+             16.0 * kBlockNodes / Leaf::SIZE);
+
+  // Progress: level 0 takes the whole bar without refinement, half of it with.
+  const double level0_share = tolerance > 0.0 ? 0.5 : 1.0;
+  std::vector<Level>& levels = built.levels;
+  levels.emplace_back();
+  levels[0].h_mm = h;
+  std::tie(levels[0].grid, levels[0].closeness) = builder.build(h, origins, nullptr, [&](double f) {
+    common::report(request.progress, level0_share * f, "field");
+  });
+  makeBlocks(levels[0], ratio);
+  std::optional<PlaneLaw> law;
+  if (ratio) law = builder.law;
+
+  // Refinement: estimate each candidate cell's error from its nodes, split those that miss.
+  VoxelStats& stats = built.stats;
+  if (tolerance > 0.0 && refine_levels > 0) {
+    const double floor = kRefineFloorFraction * builder.law.at(2.0 * params.r_min_mm);
+    std::vector<openvdb::Coord> cells = cellsWithValues(levels[0]);
+    const auto refine_start = std::chrono::steady_clock::now();
+    const double nodes_before = builder.nodes_seconds;
+    for (int l = 0; l < refine_levels && !cells.empty(); ++l) {
+      const double hl = levels[l].h_mm;
+      std::vector<char> split(cells.size(), 0);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size()), [&](const auto& range) {
+        CurvatureProbe curvature(levels[std::size_t(l)], law, floor);
+        for (std::size_t c = range.begin(); c != range.end(); ++c) {
+          const openvdb::Coord& ijk = cells[c];
+          const Vec3 x = (Vec3(ijk.x(), ijk.y(), ijk.z()) + Vec3::Constant(0.5)) * hl;
+          if (request.region_mm && !request.region_mm->contains(x)) continue;
+          split[c] = curvature.cellError(ijk) > tolerance;
+        }
+      });
+      stats.tested_cells += cells.size();
+      // Mark the split cells and gather the nodes of their halves.
+      auto fine_nodes = openvdb::MaskGrid::create(false);
+      std::vector<openvdb::Coord> next_cells;
+      {
+        auto mask = fine_nodes->getAccessor();
+        auto acc = levels[l].block_of->getConstUnsafeAccessor();
+        for (std::size_t c = 0; c < cells.size(); ++c) {
+          if (!split[c]) continue;
+          const openvdb::Coord& ijk = cells[c];
+          CellRef ref;
+          const Vec3 x = (Vec3(ijk.x(), ijk.y(), ijk.z()) + Vec3::Constant(0.5)) * hl;
+          if (!locate(levels[l], acc, x, ref)) continue;
+          levels[l].refined[ref.block * kCellWords + (ref.cell >> 6)] |= std::uint64_t{1}
+                                                                         << (ref.cell & 63);
+          ++stats.refined_cells;
+          const openvdb::Coord fine = ijk << 1;
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j)
+              for (int k = 0; k < 3; ++k) {
+                mask.setValueOn(fine.offsetBy(i, j, k));
+                if (i < 2 && j < 2 && k < 2) next_cells.push_back(fine.offsetBy(i, j, k));
+              }
+        }
+      }
+      if (next_cells.empty()) break;
+      std::vector<openvdb::Coord> fine_origins;
+      for (auto leaf = fine_nodes->tree().cbeginLeaf(); leaf; ++leaf)
+        fine_origins.push_back(leaf->origin());
+      // All levels so far and the new one, at the estimate's bytes per node.
+      double built_nodes = double(fine_nodes->activeVoxelCount());
+      for (const Level& level : levels) built_nodes += double(level.grid->activeVoxelCount());
+      refuse("refined level " + std::to_string(l + 1) + " makes", built_nodes,
+             kVoxelBytesPerNode * value_bytes / 12.0);
+      Level fine;
+      fine.h_mm = 0.5 * hl;
+      const double share_begin = level0_share + (1.0 - level0_share) * l / refine_levels;
+      const double share_end = level0_share + (1.0 - level0_share) * (l + 1) / refine_levels;
+      std::tie(fine.grid, fine.closeness) =
+          builder.build(fine.h_mm, fine_origins, fine_nodes.get(), [&](double f) {
+            common::report(request.progress, share_begin + (share_end - share_begin) * f, "field");
+          });
+      fine.grid->setName(fine.grid->getName() + "_level" + std::to_string(l + 1));
+      if (fine.closeness) fine.closeness->setName("plane_closeness_level" + std::to_string(l + 1));
+      matchCoarserLevels(fine, levels, ratio);
+      makeBlocks(fine, ratio);
+      stats.refined_nodes += fine.grid->activeVoxelCount();
+      levels.push_back(std::move(fine));
+      cells = std::move(next_cells);
+    }
+    // The refinement's own work: error estimates, split cells, hanging nodes, blocks.
+    stats.refine_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - refine_start).count() -
+        (builder.nodes_seconds - nodes_before);
+  }
+
+  built.law = law;
+  built.stats.backend = builder.backend == FieldBackend::Cuda        ? "cuda"
+                        : builder.backend == FieldBackend::Reference ? "reference"
+                                                             : "cpu";
+  built.stats.nodes_seconds = builder.nodes_seconds;
+  return built;
+}
+
+}  // namespace voxel
+}  // namespace fieldpath::field

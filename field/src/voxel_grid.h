@@ -1,0 +1,238 @@
+#pragma once
+/// Internal to field/: the voxel field's grid levels and the pieces its two OpenVDB translation
+/// units share (voxel_build.cpp: the nodes and the refinement; voxel_field.cpp: the block form
+/// of a level and the queries). Includes OpenVDB: never include from a public header.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <openvdb/openvdb.h>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/field/voxel_field.h"
+#include "point_index.h"
+
+namespace fieldpath::field::voxel {
+
+using Grid = openvdb::Vec3SGrid;
+using Leaf = Grid::TreeType::LeafNodeType;
+constexpr int kLeafDim = static_cast<int>(Leaf::DIM);  // 8 nodes a side
+
+using FloatGrid = openvdb::FloatGrid;
+using FloatLeaf = FloatGrid::TreeType::LeafNodeType;
+
+/// How far from a sample nodes are built (mm): r0, plus for the plane ratio a shell one cell
+/// diagonal beyond it, whose nodes carry the plane height past r0 (so that a cell straddling
+/// r0 interpolates s linearly through it instead of towards the zero background).
+inline double reachMm(const FieldParams& params, const VoxelRequest& request) {
+  return request.stored == StoredQuantity::PlaneRatio
+             ? params.r0_mm + std::sqrt(3.0) * request.voxel_size_mm
+             : params.r0_mm;
+}
+
+/// Weight per mm² of sampled surface (κ of law.h PlaneLaw): 1 for area weights.
+inline double weightPerMm2(const ObstacleSamples& samples, const FieldParams& params) {
+  if (params.weights == Weights::Area || !(samples.area_mm2 > 0.0)) return 1.0;
+  double sum = 0.0;
+  for (double w : samples.weights) sum += w;
+  return sum / samples.area_mm2;
+}
+
+inline double insideBandMm(const FieldParams& params, const VoxelRequest& request) {
+  if (request.inside_band_mm >= 0.0) return request.inside_band_mm;
+  const double cells_mm = 2.0 * request.voxel_size_mm + params.r_min_mm;
+  return request.stored == StoredQuantity::PlaneRatio ? std::max(cells_mm, params.r0_mm) : cells_mm;
+}
+
+inline void checkVoxelSize(double h_mm) {
+  if (!(h_mm > 0.0) || !std::isfinite(h_mm))
+    throw common::InputError("voxel size must be > 0 mm (got " + std::to_string(h_mm) + ")");
+}
+
+/// World box of the samples padded by reachMm, clipped to the region; empty if no sample.
+inline Eigen::AlignedBox3d reachBox(const ObstacleSamples& samples, const FieldParams& params,
+                             const VoxelRequest& request) {
+  Eigen::AlignedBox3d box;
+  for (const Vec3& q : samples.points_mm) box.extend(q);
+  if (box.isEmpty()) return box;
+  box.min().array() -= reachMm(params, request);
+  box.max().array() += reachMm(params, request);
+  if (request.region_mm) box = box.intersection(*request.region_mm);
+  return box;
+}
+
+inline std::string mib(double bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.0f MiB", bytes / (1024.0 * 1024.0));
+  return text;
+}
+
+/// Index coordinates must fit OpenVDB's 32-bit Coord with room to spare.
+inline void checkExtent(const Eigen::AlignedBox3d& box, double cell_mm, const char* what) {
+  if (box.isEmpty()) return;
+  const double reach = std::max(box.min().cwiseAbs().maxCoeff(), box.max().cwiseAbs().maxCoeff());
+  if (reach / cell_mm > 1e9)
+    throw common::InputError(std::string(what) + " too small for the scene's extent (" +
+                             std::to_string(reach) + " mm from the origin)");
+}
+
+
+/// The 8 corner values of the cell at ijk (index bits: x 4, y 2, z 1), read straight from the
+/// leaf buffer when they share a leaf (7 cells in 8 along each axis), through the accessor
+/// otherwise. False where the cell lies in an absent leaf (background everywhere).
+/// `on`, if given, receives the corners' active states.
+template <class Accessor, class Value>
+bool cellCorners(Accessor& acc, const openvdb::Coord& ijk, Value (&c)[8], bool* on = nullptr) {
+  using LeafT = typename Accessor::TreeType::LeafNodeType;
+  const openvdb::Coord in_leaf = ijk & (kLeafDim - 1);
+  if (in_leaf.x() < kLeafDim - 1 && in_leaf.y() < kLeafDim - 1 && in_leaf.z() < kLeafDim - 1) {
+    const LeafT* leaf = acc.probeConstLeaf(ijk);
+    if (!leaf) return false;
+    const openvdb::Index base = LeafT::coordToOffset(ijk);
+    const Value* v = leaf->buffer().data() + base;
+    constexpr int dx = kLeafDim * kLeafDim, dy = kLeafDim;
+    for (int i = 0; i < 8; ++i) {
+      const int offset = (i & 4 ? dx : 0) + (i & 2 ? dy : 0) + (i & 1);
+      c[i] = v[offset];
+      if (on) on[i] = leaf->isValueOn(base + offset);
+    }
+  } else {
+    for (int i = 0; i < 8; ++i) {
+      const openvdb::Coord corner = ijk.offsetBy(i & 4 ? 1 : 0, i & 2 ? 1 : 0, i & 1);
+      c[i] = acc.getValue(corner);
+      if (on) on[i] = acc.isValueOn(corner);
+    }
+  }
+  return true;
+}
+
+inline Vec3 widen(const openvdb::Vec3s& v) { return Vec3(v.x(), v.y(), v.z()); }
+inline double widen(float v) { return v; }
+
+/// Trilinear blend (OpenVDB BoxSampler's weights) of the corners at fractions t in the cell.
+template <class Value>
+auto blend(const Value (&c)[8], const Vec3& t) {
+  using R = decltype(widen(c[0]));
+  auto lerp = [](const R& a, const R& b, double w) -> R { return a + w * (b - a); };
+  const R c00 = lerp(widen(c[0]), widen(c[1]), t.z()), c01 = lerp(widen(c[2]), widen(c[3]), t.z());
+  const R c10 = lerp(widen(c[4]), widen(c[5]), t.z()), c11 = lerp(widen(c[6]), widen(c[7]), t.z());
+  return lerp(lerp(c00, c01, t.y()), lerp(c10, c11, t.y()), t.x());
+}
+
+struct Accessors {
+  Grid::ConstAccessor grid;
+  std::optional<FloatGrid::ConstAccessor> closeness;
+};
+
+/// Whether the plane-ratio blend holds in a cell, from its corner heights s (mm) and whether
+/// each corner lies over/under the surface (the closeness grid's active mask): everywhere but
+/// where corners under the surface (s < 0) meet corners that are not (beyond the edge of an open
+/// wall, where s > 0 on both sides of the wall's plane; past the inner end of the inside band).
+/// s jumps there, and P(s~) would read the wall's r_min value in mid-air; the corner forces are
+/// blended instead.
+inline bool ratioHolds(const double (&s)[8], const bool (&over)[8]) {
+  const bool under = std::any_of(s, s + 8, [](double v) { return v < 0.0; });
+  return !under || std::all_of(over, over + 8, [](bool v) { return v; });
+}
+
+
+using IndexGrid = openvdb::Int32Grid;
+constexpr int kBlockDim = kLeafDim + 1;                         ///< a leaf's nodes and the +1 layer
+constexpr int kBlockNodes = kBlockDim * kBlockDim * kBlockDim;  // 729
+constexpr int kBlockWords = (kBlockNodes + 63) / 64;            ///< bits of one flag per block node
+constexpr int kCellWords = Leaf::SIZE / 64;                     ///< bits of one flag per leaf cell
+/// Offsets of a cell's 8 corners in a block (index bits: x 4, y 2, z 1, as cellCorners).
+constexpr int kCornerOffset[8] = {0,
+                                  1,
+                                  kBlockDim,
+                                  kBlockDim + 1,
+                                  kBlockDim* kBlockDim,
+                                  kBlockDim* kBlockDim + 1,
+                                  kBlockDim* kBlockDim + kBlockDim,
+                                  kBlockDim* kBlockDim + kBlockDim + 1};
+
+inline bool bit(const std::vector<std::uint64_t>& words, std::size_t i) {
+  return (words[i >> 6] >> (i & 63)) & 1u;
+}
+
+/// One level of the grid: the OpenVDB grids (build, save) and their query form, a block per
+/// leaf holding its 8³ nodes and the first layer of its +x, +y, +z neighbours (9³), so that every
+/// cell of the leaf reads its 8 corners from one place after one index lookup.
+struct Level {
+  double h_mm = 0.0;
+  Grid::Ptr grid;            ///< F (Force) or G = F / P(s) (PlaneRatio), world frame
+  FloatGrid::Ptr closeness;  ///< PlaneRatio: r0 - s (mm), same topology; background 0 (s = r0)
+  IndexGrid::Ptr block_of;   ///< leaf coordinate (node ijk >> 3) → block number; background -1
+  /// The same as a dense array over the leaves' bounding box (when it has at most
+  /// kDenseIndexMax entries; empty otherwise): a query outside the box is rejected by three
+  /// compares, one inside costs one load instead of a walk down the tree.
+  std::vector<std::int32_t> dense;
+  openvdb::Coord dense_lo, dense_dim;
+  std::vector<std::array<float, 4>> nodes;  ///< per block: value xyz, closeness
+  std::vector<std::uint64_t> over;          ///< per block node: over/under the surface (ratioHolds)
+  std::vector<std::uint64_t> refined;       ///< per leaf cell: read the next level instead
+
+  std::size_t blocks() const { return nodes.size() / kBlockNodes; }
+  std::size_t memUsage() const {
+    return grid->memUsage() + (closeness ? closeness->memUsage() : 0) + block_of->memUsage() +
+           dense.size() * sizeof(dense[0]) + nodes.size() * sizeof(nodes[0]) +
+           (over.size() + refined.size()) * 8;
+  }
+};
+
+/// Where a point falls at one level: its block, the cell's first node in it, the cell in the
+/// leaf and the fractions in the cell. False outside every block (zero field).
+struct CellRef {
+  std::size_t node0 = 0, cell = 0, block = 0;
+  Vec3 t;
+};
+
+/// Index lookups without registering with the tree (the trees are not changed once built): an
+/// evaluate call makes one per level, and a registered accessor costs a concurrent-map insert.
+using IndexAccessor = IndexGrid::ConstUnsafeAccessor;
+
+/// Entries of Level::dense at most (64 MiB).
+constexpr std::size_t kDenseIndexMax = std::size_t{16} << 20;
+
+bool locate(const Level& level, const IndexAccessor& acc, const Vec3& x_mm, CellRef& out);
+/// The block form of a level's grids (Level::nodes, over; refined cleared).
+void makeBlocks(Level& level, bool ratio);
+/// The trilinear value of one level's cell (no refinement): F, or for the plane ratio
+/// P(s~)·G~ where ratioHolds, else the blend of the corner forces.
+Vec3 cellValue(const Level& level, const CellRef& cell, const std::optional<PlaneLaw>& law);
+
+/// Per-thread query state: one index accessor per level.
+struct LevelAccessors {
+  std::vector<IndexAccessor> index;
+};
+LevelAccessors accessorsOf(const std::vector<Level>& levels);
+/// The cell that holds x at the finest level there (not refined), and that level; false
+/// outside every block.
+bool finestCell(const std::vector<Level>& levels, LevelAccessors& acc, const Vec3& x_mm,
+                CellRef& cell, std::size_t& level);
+/// The trilinear field at x: the finest level whose cell holds x and is not refined.
+Vec3 trilinearAt(const std::vector<Level>& levels, LevelAccessors& acc, const Vec3& x_mm,
+                 const std::optional<PlaneLaw>& law);
+/// Hanging nodes: the nodes of a new finer level that lie on a face, edge or corner of a cell
+/// of the level above that is not split (or not built) take the value the levels above give
+/// there (the trilinear blend of value and closeness, which on a face is the face's bilinear
+/// blend, itself exact on the finer nodes of that face). The field is then continuous across
+/// the levels' boundaries (the blend of corner forces of the few cells under open edges aside):
+/// no jump for the ODE solver to resolve. Nodes inside split cells keep their exact values.
+void matchCoarserLevels(Level& fine, const std::vector<Level>& coarser, bool ratio);
+
+/// The levels of a voxel field built from the samples (voxel_build.cpp): level 0 at h, then
+/// the refined levels; the stats but for memory and the dense box.
+struct BuiltLevels {
+  std::vector<Level> levels;
+  VoxelStats stats;
+  std::optional<PlaneLaw> law;  ///< PlaneRatio
+};
+BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request);
+
+}  // namespace fieldpath::field::voxel

@@ -1,0 +1,149 @@
+/// The voxel builds against each other: the CPU block build (field.backend: cpu) and the CUDA
+/// build give the per-node reference build's node values (FieldBackend::Reference) to 1e-6
+/// relative, on a plane (whose plane-ratio closed form the nodes also meet) and on the
+/// impeller's blades, uniform and refined.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <tuple>
+
+#include <gtest/gtest.h>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/field/law.h"
+#include "fieldpath/field/voxel_field.h"
+#include "fieldpath/pathgen/generate.h"
+#include "fieldpath/pathgen/impeller.h"
+#include "meshes.h"
+
+using namespace fieldpath::field;
+
+namespace {
+
+using Key = std::tuple<int, long, long, long>;  // level, node index
+
+std::map<Key, StoredNode> byNode(const VoxelField& field) {
+  std::map<Key, StoredNode> out;
+  const double h = field.voxelSizeMm();
+  for (const StoredNode& n : field.storedNodes()) {
+    const double hl = std::ldexp(h, -n.level);
+    out[{n.level, std::lround(n.x_mm.x() / hl), std::lround(n.x_mm.y() / hl),
+         std::lround(n.x_mm.z() / hl)}] = n;
+  }
+  return out;
+}
+
+/// The same active nodes, values to 1e-6 relative (of the larger, floored at 1e-6 of the
+/// largest value of the grid), closeness to 1e-5 mm, the same over/under flags; at most
+/// `ties` nodes may differ (a node equidistant from two samples may take either as its
+/// nearest: the reference takes the first the point index lists).
+void expectSameNodes(const VoxelField& expected, const VoxelField& actual, std::size_t ties = 0) {
+  const auto a = byNode(expected), b = byNode(actual);
+  ASSERT_EQ(a.size(), b.size());
+  double largest = 0.0;
+  for (const auto& [key, n] : a) largest = std::max(largest, n.value.norm());
+  std::size_t differ = 0, compared = 0;
+  double worst = 0.0;
+  for (const auto& [key, n] : a) {
+    const auto it = b.find(key);
+    ASSERT_NE(it, b.end()) << "node missing at " << n.x_mm.transpose();
+    const StoredNode& m = it->second;
+    const double scale = std::max({n.value.norm(), m.value.norm(), 1e-6 * largest});
+    const double error = (n.value - m.value).norm() / scale;
+    worst = std::max(worst, error);
+    ++compared;
+    if (error > 1e-6 || std::abs(n.closeness_mm - m.closeness_mm) > 1e-5 || n.over != m.over)
+      ++differ;
+  }
+  EXPECT_LE(differ, ties) << "of " << compared << " nodes; worst relative error " << worst;
+}
+
+VoxelRequest requestOn(double h, FieldBackend backend, StoredQuantity stored, double tolerance = 0) {
+  VoxelRequest r;
+  r.voxel_size_mm = h;
+  r.stored = stored;
+  r.backend = backend;
+  r.refine_tolerance = tolerance;
+  return r;
+}
+
+DirectField impellerField(double step_mm) {
+  const fieldpath::pathgen::Impeller impeller{fieldpath::pathgen::ImpellerParams{}};
+  const auto blades = fieldpath::pathgen::bladeMeshes(impeller);
+  FieldParams p;
+  p.sample_step_mm = step_mm;
+  return DirectField(sampleObstacles(blades, step_mm, Weights::Area), p);
+}
+
+}  // namespace
+
+TEST(VoxelBuild, BlockBuildEqualsTheReferenceOnAPlaneAndMeetsItsClosedForm) {
+  const auto plane = test::squarePlane(20.0);
+  FieldParams p;
+  const DirectField direct(sampleObstacles({&plane, 1}, 0.5, Weights::Area), p);
+  for (const StoredQuantity stored : {StoredQuantity::PlaneRatio, StoredQuantity::Force})
+    for (const double h : {1.0, 0.5}) {
+      SCOPED_TRACE(h);
+      const VoxelField reference(direct, requestOn(h, FieldBackend::Reference, stored));
+      const VoxelField block(direct, requestOn(h, FieldBackend::Cpu, stored));
+      EXPECT_EQ(block.stats().backend, "cpu");
+      EXPECT_EQ(reference.stats().backend, "reference");
+      // Regular samples: nodes over the middle of a sample grid's cell tie.
+      expectSameNodes(reference, block, reference.stats().active_nodes / 50);
+      if (stored != StoredQuantity::PlaneRatio) continue;
+      // The closed form: over the middle of the plane, 1-4 mm up, s is the height and G the
+      // normal (P(s)·G is the plane's field; the sampled plane departs from it by < 1e-3).
+      const PlaneLaw law(p);
+      for (const StoredNode& n : block.storedNodes()) {
+        const Vec3& x = n.x_mm;
+        if (std::abs(x.x()) > 5 || std::abs(x.y()) > 5 || x.z() < 1 || x.z() > 4) continue;
+        const double s = p.r0_mm - n.closeness_mm;
+        EXPECT_NEAR(s, x.z(), 2e-3 * x.z()) << x.transpose();
+        EXPECT_NEAR(n.value.z(), 1.0, 2e-3) << x.transpose();
+      }
+    }
+}
+
+TEST(VoxelBuild, BlockBuildEqualsTheReferenceOnTheImpellerUniformAndRefined) {
+  const DirectField direct = impellerField(1.0);
+  {
+    const VoxelField reference(direct, requestOn(1.0, FieldBackend::Reference,
+                                                 StoredQuantity::PlaneRatio));
+    const VoxelField block(direct, requestOn(1.0, FieldBackend::Cpu, StoredQuantity::PlaneRatio));
+    expectSameNodes(reference, block, reference.stats().active_nodes / 10000);
+  }
+  {
+    const VoxelField reference(
+        direct, requestOn(1.0, FieldBackend::Reference, StoredQuantity::PlaneRatio, 0.02));
+    const VoxelField block(direct,
+                           requestOn(1.0, FieldBackend::Cpu, StoredQuantity::PlaneRatio, 0.02));
+    EXPECT_GT(reference.stats().levels, 1);
+    EXPECT_EQ(reference.stats().refined_cells, block.stats().refined_cells);
+    expectSameNodes(reference, block, reference.stats().active_nodes / 10000);
+  }
+}
+
+TEST(VoxelBuild, CudaBuildEqualsTheCpuBuild) {
+  if (!cudaFieldBackendAvailable()) GTEST_SKIP() << "no CUDA build or no GPU here";
+  const DirectField direct = impellerField(1.0);
+  for (const double tolerance : {0.0, 0.02}) {
+    const VoxelField cpu(direct,
+                         requestOn(0.5, FieldBackend::Cpu, StoredQuantity::PlaneRatio, tolerance));
+    const VoxelField cuda(
+        direct, requestOn(0.5, FieldBackend::Cuda, StoredQuantity::PlaneRatio, tolerance));
+    EXPECT_EQ(cuda.stats().backend, "cuda");
+    expectSameNodes(cpu, cuda, cpu.stats().active_nodes / 10000);
+  }
+}
+
+TEST(VoxelBuild, CudaBackendIsRefusedWithoutAGpu) {
+  if (cudaFieldBackendAvailable()) GTEST_SKIP() << "a GPU is here";
+  const auto plane = test::squarePlane(5.0);
+  const DirectField direct(sampleObstacles({&plane, 1}, 1.0, Weights::Area), FieldParams{});
+  EXPECT_THROW(VoxelField(direct, requestOn(1.0, FieldBackend::Cuda, StoredQuantity::PlaneRatio)),
+               fieldpath::common::InputError);
+  EXPECT_EQ(VoxelField(direct, requestOn(1.0, FieldBackend::Auto, StoredQuantity::PlaneRatio))
+                .stats()
+                .backend,
+            "cpu");
+}
