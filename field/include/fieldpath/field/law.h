@@ -105,7 +105,10 @@ Probe probe(const Vec3& x_mm, ForEachNear&& for_each_near, const P& points, cons
     for_each_near(at, radius, [&](std::size_t j) {
       const Vec3 d = at - points[j];
       const double r2 = d.squaredNorm();
-      if (nearest && r2 < *nearest_sq) {
+      // Ties go to the lowest index, whatever order for_each_near visits them in (a cube's
+      // edge node lies as near to samples of both faces): the voxel builds agree with it.
+      if (nearest && (r2 < *nearest_sq ||
+                      (r2 == *nearest_sq && *nearest >= 0 && static_cast<long>(j) < *nearest))) {
         *nearest_sq = r2;
         *nearest = static_cast<long>(j);
       }
