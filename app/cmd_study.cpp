@@ -8,6 +8,7 @@
 #include <string>
 
 #include "commands.h"
+#include "fieldpath/field/voxel_field.h"
 #include "errors.h"
 #include "estimates.h"
 #include "job.h"
@@ -26,6 +27,7 @@ struct StudyOptions {
   std::string stored = "force,plane_ratio";
   std::string refine;  ///< percent per voxel size; empty: no refined variants
   int refine_levels = 2;
+  std::string backends;  ///< "": voxel nodes built once (auto), names unchanged
   double sample_step_mm = 0.0;  ///< > 0: overrides the scene's field.sample_step
   bool no_brute_force = false;
   double line_step_mm = 0.05;
@@ -42,6 +44,11 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
     request.refine_tolerances =
         parseRefineTolerances(o.refine, request.voxel_sizes_mm.size(), "--refine");
   request.refine_levels = o.refine_levels;
+  if (!o.backends.empty()) request.backends = parseBackends(o.backends, "--backend");
+  // Said before the direct variants run, not after them.
+  for (field::FieldBackend backend : request.backends)
+    if (backend == field::FieldBackend::Cuda && !field::cudaFieldBackendAvailable())
+      throw InputError("--backend: cuda, but this program was built without CUDA or no GPU is present");
   request.brute_force = !o.no_brute_force;
   request.line_step_mm = o.line_step_mm;
   request.repeats = o.repeats;
@@ -94,6 +101,10 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--refine-levels", options->refine_levels,
                   "Levels below the voxel size the refined variants may go")
       ->capture_default_str();
+  cmd->add_option("--backend", options->backends,
+                  "Voxel node builds, comma-separated (auto, cpu, cuda, reference): each voxel "
+                  "variant runs once per build, e.g. reference,cpu puts the old per-node build "
+                  "beside the block build (default: once, auto)");
   cmd->add_option("--sample-step", options->sample_step_mm,
                   "Obstacle sampling step, mm, instead of the scene's field.sample_step")
       ->check(CLI::PositiveNumber);
@@ -115,6 +126,7 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
                                  : " --refine " + options->refine + " --refine-levels " +
                                        std::to_string(options->refine_levels)) +
         (options->sample_step_mm > 0.0 ? " --sample-step " + sample_step.str() : std::string()) +
+        (options->backends.empty() ? std::string() : " --backend " + options->backends) +
         (options->no_brute_force ? " --no-brute-force" : "") + " --repeat " +
         std::to_string(options->repeats) + " --line-step " + line_step.str() + " --out " +
         options->out;

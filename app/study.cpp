@@ -10,6 +10,7 @@
 #include <iomanip>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -180,6 +181,12 @@ struct ErrorSets {
 }  // namespace
 
 std::string StudyVariant::name() const {
+  std::string base = nameWithoutBackend();
+  if (isVoxel() && named_backend) base += std::string(" [") + backendName(voxel.backend) + " build]";
+  return base;
+}
+
+std::string StudyVariant::nameWithoutBackend() const {
   const char* label = pathgen::fieldModeNames(mode).label;
   if (!isVoxel()) return label;
   std::ostringstream s;
@@ -256,6 +263,31 @@ std::vector<field::StoredQuantity> parseStored(const std::string& text, const st
                    std::pair{"plane_ratio", field::StoredQuantity::PlaneRatio});
 }
 
+const char* backendName(field::FieldBackend backend) {
+  switch (backend) {
+    case field::FieldBackend::Cpu: return "cpu";
+    case field::FieldBackend::Cuda: return "cuda";
+    case field::FieldBackend::Reference: return "reference";
+    default: return "auto";
+  }
+}
+
+std::vector<field::FieldBackend> parseBackends(const std::string& text, const std::string& key) {
+  std::vector<field::FieldBackend> result;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    const std::optional<field::FieldBackend> backend = field::fieldBackendNamed(item);
+    if (!backend) throw InputError(key + ": '" + item + "' is not auto, cpu, cuda or reference");
+    if (std::find(result.begin(), result.end(), *backend) != result.end())
+      throw InputError(key + ": '" + item + "' twice");
+    result.push_back(*backend);
+  }
+  if (result.empty() || text.back() == ',')
+    throw InputError(key + ": give builds among auto, cpu, cuda, reference (e.g. reference,cpu)");
+  return result;
+}
+
 std::vector<field::Interpolation> parseInterpolations(const std::string& text,
                                                       const std::string& key) {
   return parsePair(text, key, std::pair{"trilinear", field::Interpolation::Trilinear},
@@ -318,6 +350,7 @@ StudyResult runStudy(const StudyRequest& request) {
     throw InputError("--refine: give one tolerance per voxel size");
   if (request.refine_levels < 1 || request.refine_levels > 6)
     throw InputError("--refine-levels: must be in [1, 6]");
+  const std::size_t first_voxel = variants.size();
   for (std::size_t k = 0; k < request.voxel_sizes_mm.size(); ++k) {
     const double h = request.voxel_sizes_mm[k];
     for (field::StoredQuantity stored : request.stored)
@@ -329,6 +362,17 @@ StudyResult runStudy(const StudyRequest& request) {
         variants.push_back(
             {pathgen::FieldMode::Voxel,
              {h, field::Interpolation::Trilinear, stored, tolerance, request.refine_levels}});
+  }
+  if (!request.backends.empty()) {  // each voxel variant once per build, side by side
+    std::vector<StudyVariant> built(variants.begin(), variants.begin() + long(first_voxel));
+    for (std::size_t v = first_voxel; v < variants.size(); ++v)
+      for (field::FieldBackend backend : request.backends) {
+        StudyVariant variant = variants[v];
+        variant.voxel.backend = backend;
+        variant.named_backend = true;
+        built.push_back(variant);
+      }
+    variants = std::move(built);
   }
 
   // Shares of the progress bar: each variant's path run and its error evaluation.

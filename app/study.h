@@ -38,10 +38,15 @@ struct StudyVariant {
   /// uniform grid) and the levels below the size it may go.
   field::VoxelSettings voxel;
 
+  /// Whether the name says which build made the nodes (StudyRequest::backends given).
+  bool named_backend = false;
+
   bool isVoxel() const { return mode == pathgen::FieldMode::Voxel; }
   /// "brute force", "direct", "voxel 2 mm trilinear force", "voxel 2 mm trilinear plane_ratio
-  /// refined 7.5 % to 0.25 mm" (tables, plots).
+  /// refined 7.5 % to 0.25 mm", "voxel 0.5 mm trilinear plane_ratio [cpu build]" (tables, plots).
   std::string name() const;
+  /// name() without the build's part: the variants built by each backend share it.
+  std::string nameWithoutBackend() const;
 };
 
 struct StudyRequest {
@@ -59,6 +64,10 @@ struct StudyRequest {
   /// an extra variant of that size, trilinear, for each stored quantity; 0 adds none.
   std::vector<double> refine_tolerances;
   int refine_levels = 2;       ///< levels below the voxel size the refined variants may go
+  /// Where each voxel variant's nodes are built (issue 15): every voxel variant runs once per
+  /// entry, named with it ("... [reference build]"), e.g. {Reference, Cpu} puts the old
+  /// per-node build beside the block build. Empty: once, FieldBackend::Auto, names unchanged.
+  std::vector<field::FieldBackend> backends;
   bool brute_force = true;     ///< run the seed's every-point direct sum (slow on big scenes)
   double line_step_mm = 0.05;  ///< sampling of the study lines
   int repeats = 1;             ///< runs per variant; times are their medians
@@ -150,5 +159,10 @@ std::vector<field::Interpolation> parseInterpolations(const std::string& text,
                                                       const std::string& key);
 /// "force,plane_ratio" → what the voxel nodes store. Throws InputError naming `key`.
 std::vector<field::StoredQuantity> parseStored(const std::string& text, const std::string& key);
+/// "reference,cpu" → voxel node builds (auto, cpu, cuda, reference), each once. Throws
+/// InputError naming `key`.
+std::vector<field::FieldBackend> parseBackends(const std::string& text, const std::string& key);
+/// "auto", "cpu", "cuda", "reference".
+const char* backendName(field::FieldBackend backend);
 
 }  // namespace fieldpath::app

@@ -146,6 +146,40 @@ struct Target {
 };
 constexpr Target kTargets[] = {{2.0, 7.5, 0.35}, {1.0, 2.5, 0.25}, {0.5, 0.5, 0.1}};
 
+/// `study --backend A,B`: each voxel variant's builds in one group, times against the group's
+/// first build (issue 15: old and new build side by side, field + path totals). Empty without.
+std::string buildsSideBySide(const StudyResult& r) {
+  std::vector<std::string> groups;
+  for (const StudyRow& row : r.rows)
+    if (row.variant.isVoxel() && row.variant.named_backend &&
+        std::find(groups.begin(), groups.end(), row.variant.nameWithoutBackend()) == groups.end())
+      groups.push_back(row.variant.nameWithoutBackend());
+  if (groups.empty()) return {};
+  std::ostringstream s;
+  s << "\n## Node builds side by side (`--backend`)\n\n"
+    << "The same variant built by each backend (`reference`: the per-node build of before issue"
+    << " 15; `cpu`: the block build; `cuda`: the GPU's), in this run; × is the first build's time"
+    << " over this one's (> 1: faster). Same node values to float rounding: the errors agree.\n\n"
+    << "| variant | build | active nodes | field s | path s | total s | field × | total × |"
+       " max force error % | tilt diff max ° |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const std::string& group : groups) {
+    const StudyRow* first = nullptr;
+    for (const StudyRow& row : r.rows) {
+      if (!row.variant.isVoxel() || !row.variant.named_backend ||
+          row.variant.nameWithoutBackend() != group)
+        continue;
+      if (!first) first = &row;
+      s << "| " << group << " | " << backendName(row.variant.voxel.backend) << " | "
+        << row.active_nodes << " | " << fixed(row.times.field_s, 3) << " | "
+        << fixed(row.times.steering_s, 3) << " | " << fixed(row.total_s, 3) << " | "
+        << fixed(first->times.field_s / row.times.field_s, 2) << " | "
+        << fixed(first->total_s / row.total_s, 2) << " | " << fixed(100 * maxForceError(row), 3)
+        << " | " << fixed(row.tilt_max_deg, 4) << " |\n";
+    }
+  }
+  return s.str();
+}
+
 std::string markdownText(const StudyResult& r, const std::string& command_line,
                          const std::string& machine) {
   std::ostringstream s;
@@ -209,6 +243,7 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
     s << "| voxel " << p.h_mm << " mm | " << fixed(p.nodes / 1e3, 0) << "e3 | " << p.field_s
       << " | " << kPublishedPathS << " (2 mm) | " << p.total_s << " |\n";
 
+  s << buildsSideBySide(r);
   s << "\n## Table 2: what it breaks (errors in %, tilt in degrees)\n\n"
     << "| variant | line a max | line a rms | line b max | line b rms | nodes max | nodes rms |"
        " nodes scaled max | max force error | moment max | moment rms | tilt diff max ° |"

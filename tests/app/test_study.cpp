@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
@@ -90,6 +91,11 @@ TEST(StudyOptions, ParsesListsAndRejectsBadOnes) {
             (std::vector<double>{0.075, 0.025, 0.0}));
   for (const char* bad : {"", "7.5", "7.5,2.5,", "7.5,-1,0", "7.5,x,0", "7.5,nan,0"})
     EXPECT_THROW(parseRefineTolerances(bad, 3, "--refine"), common::InputError) << bad;
+  EXPECT_EQ(parseBackends("reference,cpu", "--backend"),
+            (std::vector<field::FieldBackend>{field::FieldBackend::Reference,
+                                              field::FieldBackend::Cpu}));
+  for (const char* bad : {"", "cpu,", "gpu", "cpu,cpu", "cpu,,auto"})
+    EXPECT_THROW(parseBackends(bad, "--backend"), common::InputError) << bad;
 }
 
 void bruteForceEqualsTheIndexedDirectField(const StudyResult& result) {
@@ -216,6 +222,40 @@ TEST(StudyRefinement, RefinedVariantBeatsItsUniformGridAndIsCountedApart) {
   EXPECT_EQ(refined.colliding, 0u);
 }
 
+TEST(StudyBackends, OldAndNewBuildsSideBySideGiveTheSameErrorsAndPaths) {
+  // --backend reference,cpu: each voxel variant built per node (before issue 15) and by leaf
+  // blocks; the node values agree to float rounding, so the errors and the tilts do too.
+  StudyRequest request;
+  request.job = smallJob();
+  request.impeller = smallImpeller();
+  request.voxel_sizes_mm = {1.0};
+  request.interpolations = {field::Interpolation::Trilinear};
+  request.stored = {field::StoredQuantity::PlaneRatio};
+  request.backends = {field::FieldBackend::Reference, field::FieldBackend::Cpu};
+  request.brute_force = false;
+  request.line_step_mm = 0.2;
+  const StudyResult result = runStudy(request);
+  ASSERT_EQ(result.rows.size(), 3u);  // direct, reference build, cpu build
+  const StudyRow& old_build = rowNamed(result, "voxel 1 mm trilinear plane_ratio [reference build]");
+  const StudyRow& new_build = rowNamed(result, "voxel 1 mm trilinear plane_ratio [cpu build]");
+  EXPECT_EQ(old_build.variant.nameWithoutBackend(), new_build.variant.nameWithoutBackend());
+  EXPECT_EQ(old_build.active_nodes, new_build.active_nodes);
+  EXPECT_GT(old_build.nodes.relative.max_relative, 0.0);
+  EXPECT_NEAR(new_build.nodes.relative.max_relative, old_build.nodes.relative.max_relative,
+              1e-4 * old_build.nodes.relative.max_relative);
+  EXPECT_NEAR(new_build.line_a.relative.max_relative, old_build.line_a.relative.max_relative,
+              1e-4 * old_build.line_a.relative.max_relative);
+  EXPECT_NEAR(new_build.tilt_max_deg, old_build.tilt_max_deg, 0.01);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("fieldpath_test_study_backends_" + std::to_string(::getpid()));
+  writeStudy(result, dir, "test_study", "test machine");
+  std::ifstream md(dir / "study.md");
+  const std::string text((std::istreambuf_iterator<char>(md)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("## Node builds side by side"), std::string::npos);
+  EXPECT_NE(text.find("| voxel 1 mm trilinear plane_ratio | cpu |"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
 /// The small job as a scene file.
 constexpr const char* kSmallScene = test::kSmallImpellerScene;
 
@@ -246,6 +286,7 @@ TEST(StudyCommand, BadInputIsExitOneWithNoOutputs) {
       test::runFieldpath(dir, "study scene.yaml --voxels 2,1 --refine 5 --out study").exit_code, 1);
   EXPECT_EQ(test::runFieldpath(dir, "study scene.yaml --sample-step 0 --out study").exit_code, 1);
   EXPECT_EQ(test::runFieldpath(dir, "study missing.yaml --out study").exit_code, 1);
+  EXPECT_EQ(test::runFieldpath(dir, "study scene.yaml --backend gpu --out study").exit_code, 1);
   // Sizes the options drive are estimated before any work (the brute-force variant, first, ran
   // for minutes before the voxel size was looked at).
   for (const char* args : {"--voxels 2,1e-6", "--voxels 2 --sample-step 1e-5"}) {
