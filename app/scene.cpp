@@ -297,6 +297,8 @@ void readLinks(const Reader& r, const YAML::Node& node, pathgen::LinkParams& lin
 
 Scene loadScene(const std::filesystem::path& file) {
   std::error_code ec;
+  if (std::filesystem::is_directory(file, ec))
+    throw InputError(file.string() + ": is a directory, expected a scene file (YAML)");
   if (!std::filesystem::is_regular_file(file, ec))
     throw InputError(file.string() + ": no such scene file");
   YAML::Node root;

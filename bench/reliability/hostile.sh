@@ -114,7 +114,7 @@ row "obstacle mesh of garbage bytes" "garbage.stl" generate mesh_garbage.yaml --
 row "obstacle PLY without end_header (hung assimp)" "hang.ply" generate mesh_hang.yaml --out out
 row "obstacle mesh missing" "missing.stl" generate mesh_missing.yaml --out out
 row "path.nominal with a tip at 1e30" "far30.cl" generate nominal_far.yaml --out out
-row "scene file is a directory" "out2" generate out2 --out out
+row "scene file is a directory" "out2: is a directory" generate out2 --out out
 row "--out under a file (afile/x)" "afile" generate base.yaml --out afile/x
 row "--out in /proc (cannot be created)" "/proc/fieldpath" generate base.yaml --out /proc/fieldpath/out
 row "--max-memory 1 (MiB) on the example" "--max-memory" generate base.yaml --max-memory 1 --out out

@@ -172,3 +172,13 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
 TEST(Scene, MissingSceneFile) {
   EXPECT_THROW(app::loadScene("/nonexistent/scene.yaml"), common::InputError);
 }
+
+TEST(Scene, ADirectoryIsNoSceneFile) {
+  try {
+    const app::test::TempDir dir;
+    (void)app::loadScene(dir.path());
+    ADD_FAILURE() << "a directory was read as a scene";
+  } catch (const common::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+  }
+}
