@@ -15,6 +15,7 @@
 
 #include <openvdb/tools/Morphology.h>
 #include <openvdb/tools/Prune.h>
+#include <tbb/parallel_reduce.h>
 
 #include "fieldpath/common/errors.h"
 #include "node_block.h"
@@ -362,101 +363,29 @@ struct NodeBuilder {
   }
 };
 
-/// The trilinear error of a cell estimated from its nodes alone: at each corner, along each axis
-/// with both neighbours built, the second difference of what is interpolated (s and G for the
-/// plane ratio, F for the stored force) over 8 (linear interpolation's error is h²/8 |f''|),
-/// turned into a force error: |dP/ds|·|G|·|Δ²s| + P(s)·|Δ²G|, or |Δ²F|. The cell's value is
-/// the largest corner error over max(least corner force, floor).
-class CurvatureProbe {
- public:
-  CurvatureProbe(const Level& level, const std::optional<PlaneLaw>& law, double floor)
-      : values_(level.grid->getConstAccessor()), law_(law), floor_(floor) {
-    if (law) closeness_.emplace(level.closeness->getConstAccessor());
-  }
 
-  double cellError(const openvdb::Coord& cell) {
-    double worst = 0.0, sum = 0.0;
-    int built = 0;
-    for (int c = 0; c < 8; ++c) {
-      const Node n = node(cell.offsetBy(c >> 2, (c >> 1) & 1, c & 1));
-      if (!n.built) continue;
-      worst = std::max(worst, n.error);
-      sum += n.force;
-      ++built;
+/// The nodes of the halves of `cells` (3³ a cell at the next level), marked on a mask per task
+/// and merged (the same set as one serial pass).
+openvdb::MaskGrid::Ptr nodesOfHalves(const std::vector<openvdb::Coord>& cells) {
+  struct Marker {
+    const std::vector<openvdb::Coord>* cells;
+    openvdb::MaskGrid::Ptr mask = openvdb::MaskGrid::create(false);
+    explicit Marker(const std::vector<openvdb::Coord>* c) : cells(c) {}
+    Marker(Marker& other, tbb::split) : cells(other.cells) {}
+    void operator()(const tbb::blocked_range<std::size_t>& range) {
+      auto acc = mask->getAccessor();
+      for (std::size_t c = range.begin(); c != range.end(); ++c) {
+        const openvdb::Coord fine = (*cells)[c] << 1;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            for (int k = 0; k < 3; ++k) acc.setValueOn(fine.offsetBy(i, j, k));
+      }
     }
-    if (!built) return 0.0;
-    return worst / std::max(sum / built, floor_);
-  }
-
- private:
-  struct Node {
-    bool built = false;
-    double force = 0.0, error = 0.0;
+    void join(Marker& other) { mask->tree().topologyUnion(other.mask->tree()); }
   };
-  struct Read {
-    bool built;
-    double s;
-    Vec3 v;
-  };
-  Read read(const openvdb::Coord& ijk) {
-    const openvdb::Vec3s v = values_.getValue(ijk);
-    return {values_.isValueOn(ijk), law_ ? law_->r0_mm - closeness_->getValue(ijk) : 0.0,
-            Vec3(v.x(), v.y(), v.z())};
-  }
-  Node node(const openvdb::Coord& ijk) {
-    const Read at = read(ijk);
-    Node out;
-    if (!at.built) return out;
-    out.built = true;
-    double slope = 0.0;
-    if (law_) {
-      constexpr double kStepMm = 1e-4;
-      out.force = law_->at(at.s) * at.v.norm();
-      slope = std::abs(law_->at(std::abs(at.s) + kStepMm) - law_->at(std::abs(at.s) - kStepMm)) /
-              (2 * kStepMm);
-    } else {
-      out.force = at.v.norm();
-    }
-    for (int a = 0; a < 3; ++a) {
-      openvdb::Coord lo = ijk, hi = ijk;
-      lo[a] -= 1;
-      hi[a] += 1;
-      const Read m = read(lo), p = read(hi);
-      if (!m.built || !p.built) continue;
-      const Vec3 dv = m.v - 2.0 * at.v + p.v;
-      const double e =
-          law_ ? slope * at.v.norm() * std::abs(m.s - 2.0 * at.s + p.s) + law_->at(at.s) * dv.norm()
-               : dv.norm();
-      out.error = std::max(out.error, e / 8.0);
-    }
-    return out;
-  }
-  Grid::ConstAccessor values_;
-  std::optional<FloatGrid::ConstAccessor> closeness_;
-  const std::optional<PlaneLaw>& law_;
-  double floor_;
-};
-
-/// Cells of level 0 to test: every cell of a block with a non-zero corner (index coordinates).
-std::vector<openvdb::Coord> cellsWithValues(const Level& level) {
-  std::vector<openvdb::Coord> cells;
-  auto acc = level.block_of->getConstAccessor();
-  for (auto it = level.block_of->cbeginValueOn(); it; ++it) {
-    const std::size_t b = std::size_t(*it);
-    const openvdb::Coord o = it.getCoord() << 3;
-    for (int i = 0; i < kLeafDim; ++i)
-      for (int j = 0; j < kLeafDim; ++j)
-        for (int k = 0; k < kLeafDim; ++k) {
-          const std::size_t n0 = b * kBlockNodes + std::size_t((i * kBlockDim + j) * kBlockDim + k);
-          bool any = false;
-          for (int c = 0; c < 8 && !any; ++c) {
-            const auto& v = level.nodes[n0 + kCornerOffset[c]];
-            any = v[0] != 0.0f || v[1] != 0.0f || v[2] != 0.0f;
-          }
-          if (any) cells.push_back(o.offsetBy(i, j, k));
-        }
-  }
-  return cells;
+  Marker marker(&cells);
+  tbb::parallel_reduce(tbb::blocked_range<std::size_t>(0, cells.size(), 4096), marker);
+  return marker.mask;
 }
 
 /// Auto: the GPU when one is there (and the program has CUDA), else the CPU.
@@ -574,21 +503,21 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
     for (int l = 0; l < refine_levels && !cells.empty(); ++l) {
       const double hl = levels[l].h_mm;
       std::vector<char> split(cells.size(), 0);
+      const CellErrors errors(levels[std::size_t(l)], law, floor);
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size()), [&](const auto& range) {
-        CurvatureProbe curvature(levels[std::size_t(l)], law, floor);
+        auto acc = levels[std::size_t(l)].block_of->getConstUnsafeAccessor();
         for (std::size_t c = range.begin(); c != range.end(); ++c) {
           const openvdb::Coord& ijk = cells[c];
           const Vec3 x = (Vec3(ijk.x(), ijk.y(), ijk.z()) + Vec3::Constant(0.5)) * hl;
           if (request.region_mm && !request.region_mm->contains(x)) continue;
-          split[c] = curvature.cellError(ijk) > tolerance;
+          split[c] = errors.cellError(ijk, acc) > tolerance;
         }
       });
       stats.tested_cells += cells.size();
-      // Mark the split cells and gather the nodes of their halves.
-      auto fine_nodes = openvdb::MaskGrid::create(false);
-      std::vector<openvdb::Coord> next_cells;
+      // Mark the split cells and list their halves (serial: a lookup a split cell), then
+      // the nodes of the halves (3³ a split cell) on masks in parallel, merged.
+      std::vector<openvdb::Coord> split_cells, next_cells;
       {
-        auto mask = fine_nodes->getAccessor();
         auto acc = levels[l].block_of->getConstUnsafeAccessor();
         for (std::size_t c = 0; c < cells.size(); ++c) {
           if (!split[c]) continue;
@@ -599,15 +528,14 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
           levels[l].refined[ref.block * kCellWords + (ref.cell >> 6)] |= std::uint64_t{1}
                                                                          << (ref.cell & 63);
           ++stats.refined_cells;
+          split_cells.push_back(ijk);
           const openvdb::Coord fine = ijk << 1;
-          for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-              for (int k = 0; k < 3; ++k) {
-                mask.setValueOn(fine.offsetBy(i, j, k));
-                if (i < 2 && j < 2 && k < 2) next_cells.push_back(fine.offsetBy(i, j, k));
-              }
+          for (int i = 0; i < 2; ++i)
+            for (int j = 0; j < 2; ++j)
+              for (int k = 0; k < 2; ++k) next_cells.push_back(fine.offsetBy(i, j, k));
         }
       }
+      const openvdb::MaskGrid::Ptr fine_nodes = nodesOfHalves(split_cells);
       if (next_cells.empty()) break;
       std::vector<openvdb::Coord> fine_origins;
       for (auto leaf = fine_nodes->tree().cbeginLeaf(); leaf; ++leaf)

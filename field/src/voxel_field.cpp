@@ -26,18 +26,7 @@ bool locate(const Level& level, const IndexAccessor& acc, const Vec3& x_mm, Cell
   const Vec3 base = p.array().floor();
   const int i = int(base.x()), j = int(base.y()), k = int(base.z());
   const openvdb::Coord leaf(i >> 3, j >> 3, k >> 3);  // floor division by 8
-  int b;
-  if (!level.dense.empty()) {
-    const openvdb::Coord d = leaf - level.dense_lo;
-    if (unsigned(d.x()) >= unsigned(level.dense_dim.x()) ||
-        unsigned(d.y()) >= unsigned(level.dense_dim.y()) ||
-        unsigned(d.z()) >= unsigned(level.dense_dim.z()))
-      return false;
-    b = level.dense[(std::size_t(d.x()) * level.dense_dim.y() + d.y()) * level.dense_dim.z() +
-                    d.z()];
-  } else {
-    b = acc.getValue(leaf);
-  }
+  const int b = blockAt(level, acc, leaf);
   if (b < 0) return false;
   const int li = i & (kLeafDim - 1), lj = j & (kLeafDim - 1), lk = k & (kLeafDim - 1);
   out.block = std::size_t(b);
@@ -178,18 +167,14 @@ Vec3 trilinearAt(const std::vector<Level>& levels, LevelAccessors& acc, const Ve
   return cellValue(levels[l], cell, law);
 }
 
-/// Hanging nodes: the nodes of a new finer level that lie on a face, edge or corner of a cell
-/// of the level above that is not split (or not built) take the value the levels above give
-/// there (the trilinear blend of value and closeness, which on a face is the face's bilinear
-/// blend, itself exact on the finer nodes of that face). The field is then continuous across
-/// the levels' boundaries (the blend of corner forces of the few cells under open edges aside):
+namespace {
 
-void matchCoarserLevels(Level& fine, const std::vector<Level>& coarser, bool ratio) {
+/// matchCoarserLevels for the nodes of one leaf of the new level (and its closeness leaf).
+void matchLeaf(Leaf& leaf, FloatLeaf* closeness, const std::vector<Level>& coarser,
+               LevelAccessors& acc) {
   const Level& parent = coarser.back();
-  LevelAccessors acc = accessorsOf(coarser);
-  std::optional<FloatGrid::Accessor> closeness;
-  if (ratio) closeness.emplace(fine.closeness->getAccessor());
-  for (auto it = fine.grid->beginValueOn(); it; ++it) {
+  const double fine_h_mm = 0.5 * parent.h_mm;
+  for (auto it = leaf.beginValueOn(); it; ++it) {
     const openvdb::Coord f = it.getCoord();
     if ((f.x() & 1) && (f.y() & 1) && (f.z() & 1)) continue;  // inside one parent cell
     // The parent cells that share this node: one or two along each axis.
@@ -213,7 +198,7 @@ void matchCoarserLevels(Level& fine, const std::vector<Level>& coarser, bool rat
                 !bit(parent.refined, ref.block * Leaf::SIZE + ref.cell);
     }
     if (!hanging) continue;
-    const Vec3 x = Vec3(f.x(), f.y(), f.z()) * fine.h_mm;
+    const Vec3 x = Vec3(f.x(), f.y(), f.z()) * fine_h_mm;
     CellRef cell;
     std::size_t l = 0;
     if (!finestCell(coarser, acc, x, cell, l)) continue;
@@ -226,9 +211,28 @@ void matchCoarserLevels(Level& fine, const std::vector<Level>& coarser, bool rat
       for (int k = 0; k < 4; ++k) v[k] += w * n[kCornerOffset[c]][k];
     }
     it.setValue(openvdb::Vec3s(float(v[0]), float(v[1]), float(v[2])));
-    if (closeness) closeness->setValueOnly(f, float(v[3]));
+    if (closeness) closeness->setValueOnly(it.pos(), float(v[3]));
   }
 }
+
+}  // namespace
+
+/// Hanging nodes (voxel_grid.h).
+void matchCoarserLevels(Level& fine, const std::vector<Level>& coarser, bool ratio) {
+  // By leaves in parallel: each writes its own value and closeness leaf.
+  std::vector<Leaf*> leaves;
+  std::vector<FloatLeaf*> closeness_leaves;
+  for (auto it = fine.grid->tree().beginLeaf(); it; ++it) {
+    leaves.push_back(&*it);
+    closeness_leaves.push_back(ratio ? fine.closeness->tree().touchLeaf(it->origin()) : nullptr);
+  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
+    LevelAccessors acc = accessorsOf(coarser);
+    for (std::size_t l = range.begin(); l != range.end(); ++l)
+      matchLeaf(*leaves[l], closeness_leaves[l], coarser, acc);
+  });
+}
+
 
 
 }  // namespace voxel

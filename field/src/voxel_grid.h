@@ -199,6 +199,18 @@ using IndexAccessor = IndexGrid::ConstUnsafeAccessor;
 /// Entries of Level::dense at most (64 MiB).
 constexpr std::size_t kDenseIndexMax = std::size_t{16} << 20;
 
+/// The block of the leaf at `leaf` (node ijk >> 3), -1 where there is none.
+inline int blockAt(const Level& level, const IndexAccessor& acc, const openvdb::Coord& leaf) {
+  if (level.dense.empty()) return acc.getValue(leaf);
+  const openvdb::Coord d = leaf - level.dense_lo;
+  if (unsigned(d.x()) >= unsigned(level.dense_dim.x()) ||
+      unsigned(d.y()) >= unsigned(level.dense_dim.y()) ||
+      unsigned(d.z()) >= unsigned(level.dense_dim.z()))
+    return -1;
+  return level.dense[(std::size_t(d.x()) * level.dense_dim.y() + d.y()) * level.dense_dim.z() +
+                     d.z()];
+}
+
 bool locate(const Level& level, const IndexAccessor& acc, const Vec3& x_mm, CellRef& out);
 /// The block form of a level's grids (Level::nodes, over; refined cleared).
 void makeBlocks(Level& level, bool ratio);
@@ -225,6 +237,27 @@ Vec3 trilinearAt(const std::vector<Level>& levels, LevelAccessors& acc, const Ve
 /// the levels' boundaries (the blend of corner forces of the few cells under open edges aside):
 /// no jump for the ODE solver to resolve. Nodes inside split cells keep their exact values.
 void matchCoarserLevels(Level& fine, const std::vector<Level>& coarser, bool ratio);
+
+/// The refinement's error estimate of a level's cells (voxel_refine.cpp), from its nodes alone:
+/// at each built node, along each axis with both neighbours built, the second difference of
+/// what is interpolated (s and G for the plane ratio, F for the stored force) over 8 (linear
+/// interpolation's error is h²/8 |f''|) as a force error, |dP/ds|·|G|·|Δ²s| + P(s)·|Δ²G| or
+/// |Δ²F|; a cell's is the largest of its corners' over max(their mean force, floor). The nodes'
+/// are computed once, by leaves in parallel (the level's blocks made: makeBlocks).
+class CellErrors {
+ public:
+  CellErrors(const Level& level, const std::optional<PlaneLaw>& law, double floor);
+  /// Of the cell whose lowest corner is `cell` (index space); 0 where no corner is built.
+  double cellError(const openvdb::Coord& cell, const IndexAccessor& acc) const;
+
+ private:
+  const Level& level_;
+  double floor_;
+  std::vector<double> force_, error_;  ///< per node of each block's leaf (Leaf::SIZE a block)
+  std::vector<std::uint64_t> built_;   ///< a bit per such node: value on
+};
+/// Cells of a level to test: every cell of a block with a non-zero corner (index coordinates).
+std::vector<openvdb::Coord> cellsWithValues(const Level& level);
 
 /// The levels of a voxel field built from the samples (voxel_build.cpp): level 0 at h, then
 /// the refined levels; the stats but for memory and the dense box.

@@ -1,0 +1,133 @@
+/// The refinement's error estimate (voxel_grid.h CellErrors, cellsWithValues): each node's
+/// error once, by leaves in parallel, then the cells' from their corners. Split out of
+/// voxel_build.cpp (issue 15: the estimate read 56 nodes through accessors a cell, serially
+/// per cell, each node again for each of its 8 cells).
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "voxel_grid.h"
+
+namespace fieldpath::field::voxel {
+namespace {
+
+/// A node's share of the estimate: along each axis with both neighbours built, the second
+/// difference of what is interpolated (s and G for the plane ratio, F for the stored force) over
+/// 8 (linear interpolation's error is h²/8 |f''|), turned into a force error:
+/// |dP/ds|·|G|·|Δ²s| + P(s)·|Δ²G|, or |Δ²F|; the largest over the axes; and its force.
+class NodeCurvature {
+ public:
+  NodeCurvature(const Level& level, const std::optional<PlaneLaw>& law)
+      : values_(level.grid->getConstAccessor()), law_(law) {
+    if (law) closeness_.emplace(level.closeness->getConstAccessor());
+  }
+
+  /// Of a built node (its value on).
+  void at(const openvdb::Coord& ijk, double& force, double& error) {
+    const Read here = read(ijk);
+    double slope = 0.0;
+    if (law_) {
+      constexpr double kStepMm = 1e-4;
+      force = law_->at(here.s) * here.v.norm();
+      slope = std::abs(law_->at(std::abs(here.s) + kStepMm) - law_->at(std::abs(here.s) - kStepMm)) /
+              (2 * kStepMm);
+    } else {
+      force = here.v.norm();
+    }
+    error = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      openvdb::Coord lo = ijk, hi = ijk;
+      lo[a] -= 1;
+      hi[a] += 1;
+      const Read m = read(lo), p = read(hi);
+      if (!m.built || !p.built) continue;
+      const Vec3 dv = m.v - 2.0 * here.v + p.v;
+      const double e = law_ ? slope * here.v.norm() * std::abs(m.s - 2.0 * here.s + p.s) +
+                                  law_->at(here.s) * dv.norm()
+                            : dv.norm();
+      error = std::max(error, e / 8.0);
+    }
+  }
+
+ private:
+  struct Read {
+    bool built;
+    double s;
+    Vec3 v;
+  };
+  Read read(const openvdb::Coord& ijk) {
+    const openvdb::Vec3s v = values_.getValue(ijk);
+    return {values_.isValueOn(ijk), law_ ? law_->r0_mm - closeness_->getValue(ijk) : 0.0,
+            Vec3(v.x(), v.y(), v.z())};
+  }
+  Grid::ConstAccessor values_;
+  std::optional<FloatGrid::ConstAccessor> closeness_;
+  const std::optional<PlaneLaw>& law_;
+};
+
+}  // namespace
+
+CellErrors::CellErrors(const Level& level, const std::optional<PlaneLaw>& law, double floor)
+    : level_(level), floor_(floor) {
+  // The leaves in makeBlocks' order: leaf b is block b.
+  std::vector<const Leaf*> leaves;
+  for (auto it = level.grid->tree().cbeginLeaf(); it; ++it) leaves.push_back(&*it);
+  if (leaves.size() != level.blocks())
+    throw std::logic_error("CellErrors: the level's blocks are not its leaves");
+  force_.assign(leaves.size() * Leaf::SIZE, 0.0);
+  error_.assign(leaves.size() * Leaf::SIZE, 0.0);
+  built_.assign(leaves.size() * kCellWords, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
+    NodeCurvature curvature(level, law);
+    for (std::size_t b = range.begin(); b != range.end(); ++b) {
+      for (auto it = leaves[b]->cbeginValueOn(); it; ++it) {
+        const std::size_t n = b * Leaf::SIZE + it.pos();
+        curvature.at(it.getCoord(), force_[n], error_[n]);
+        built_[n >> 6] |= std::uint64_t{1} << (n & 63);
+      }
+    }
+  });
+}
+
+double CellErrors::cellError(const openvdb::Coord& cell, const IndexAccessor& acc) const {
+  // The same terms in the same order as reading the corners one by one: the largest corner
+  // error over max(mean corner force, floor).
+  double worst = 0.0, sum = 0.0;
+  int built = 0;
+  for (int c = 0; c < 8; ++c) {
+    const openvdb::Coord ijk = cell.offsetBy(c >> 2, (c >> 1) & 1, c & 1);
+    const int b = blockAt(level_, acc, openvdb::Coord(ijk.x() >> 3, ijk.y() >> 3, ijk.z() >> 3));
+    if (b < 0) continue;
+    const std::size_t n = std::size_t(b) * Leaf::SIZE + Leaf::coordToOffset(ijk);
+    if (!bit(built_, n)) continue;
+    worst = std::max(worst, error_[n]);
+    sum += force_[n];
+    ++built;
+  }
+  if (!built) return 0.0;
+  return worst / std::max(sum / built, floor_);
+}
+
+std::vector<openvdb::Coord> cellsWithValues(const Level& level) {
+  std::vector<openvdb::Coord> cells;
+  for (auto it = level.block_of->cbeginValueOn(); it; ++it) {
+    const std::size_t b = std::size_t(*it);
+    const openvdb::Coord o = it.getCoord() << 3;
+    for (int i = 0; i < kLeafDim; ++i)
+      for (int j = 0; j < kLeafDim; ++j)
+        for (int k = 0; k < kLeafDim; ++k) {
+          const std::size_t n0 = b * kBlockNodes + std::size_t((i * kBlockDim + j) * kBlockDim + k);
+          bool any = false;
+          for (int c = 0; c < 8 && !any; ++c) {
+            const auto& v = level.nodes[n0 + kCornerOffset[c]];
+            any = v[0] != 0.0f || v[1] != 0.0f || v[2] != 0.0f;
+          }
+          if (any) cells.push_back(o.offsetBy(i, j, k));
+        }
+  }
+  return cells;
+}
+
+}  // namespace fieldpath::field::voxel
