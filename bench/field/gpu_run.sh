@@ -24,7 +24,7 @@ grep -q 'sample_step: 0.5 ' /tmp/study_scene.yaml || echo "WARNING: study scene 
 run() {  # case backend scene voxel tolerance rep
   echo -n "== $1 $2 rep $6: "
   timeout 120 "$fp" --quiet field build "$3" --backend "$2" --voxel "$4" --refine-tolerance "$5" \
-    --out /tmp/f_$2.vdb 2>&1 | grep -E "samples|active|levels|time" | tr '\n' ' '
+    --out /tmp/f_$2.vdb 2>&1 | grep -E "samples|active|levels|time|start-up" | tr '\n' ' '
   echo
 }
 for rep in 1 2 3 4 5; do

@@ -57,9 +57,11 @@ __global__ void nodeKernel(CellTable table, NodeJob job, const LeafTask* leaves,
 }  // namespace
 
 bool cudaNodeBuildAvailable() {
+  // The first call also makes the device's context (cudaFree(0)): CUDA's start-up, once per
+  // process, here rather than inside the first build that asks for the device.
   static const bool available = [] {
     int count = 0;
-    return cudaGetDeviceCount(&count) == cudaSuccess && count > 0;
+    return cudaGetDeviceCount(&count) == cudaSuccess && count > 0 && cudaFree(nullptr) == cudaSuccess;
   }();
   return available;
 }

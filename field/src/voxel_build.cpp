@@ -155,6 +155,7 @@ struct NodeBuilder {
     job.law.inv_r0 = 1.0 / params.r0_mm;
     job.law.r_min = params.r_min_mm;
     job.law.r_min_sq = params.r_min_mm * params.r_min_mm;
+    job.law.inv_r_min = 1.0 / params.r_min_mm;
     job.law.gain = params.gain;
     job.law.plane_scale = law.scale;
     job.rules.ratio = ratio;
