@@ -1,5 +1,7 @@
 /// fieldpath: collision-free 5-axis ball-end paths through a repulsive field, and their proof.
+#include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 
@@ -14,8 +16,30 @@
 #define FIELDPATH_VERSION "unknown"
 #endif
 
+namespace {
+
+/// FIELDPATH_T0=$(date +%s%N) fieldpath ...: when main() starts and ends, in ms after that
+/// instant, on stderr (bench/zbuffer/process.sh: what a process pays before and after its work).
+struct StartupTrace {
+  long long t0_ns = 0;
+  StartupTrace() {
+    if (const char* t0 = std::getenv("FIELDPATH_T0")) t0_ns = std::atoll(t0);
+    say("main() entered");
+  }
+  ~StartupTrace() { say("main() returns"); }
+  void say(const char* what) const {
+    if (t0_ns <= 0) return;
+    const auto now = std::chrono::system_clock::now().time_since_epoch();
+    const long long ns = std::chrono::duration_cast<std::chrono::nanoseconds>(now).count();
+    std::fprintf(stderr, "trace: %s %.1f ms after FIELDPATH_T0\n", what, double(ns - t0_ns) / 1e6);
+  }
+};
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace fieldpath::app;
+  const StartupTrace trace;
   fieldpath::common::installTemporaryCleanupOnSignals();  // no partial outputs on Ctrl-C
   CLI::App app{
       "fieldpath: collision-free 5-axis ball-end milling paths (repulsive field), "
@@ -67,6 +91,11 @@ int main(int argc, char** argv) {
     fieldpath::common::removeWrittenOutputs();
     std::fprintf(stderr, "fieldpath: internal error: %s\n", e.what());
     return 2;
+  }
+  if (fastExitRequested() && !std::getenv("FIELDPATH_NO_FAST_EXIT")) {
+    trace.say("main() returns (fast exit)");
+    std::fflush(nullptr);
+    std::_Exit(0);
   }
   return 0;
 }

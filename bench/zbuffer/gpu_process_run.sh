@@ -15,22 +15,23 @@ cat "$out/device.txt"
 timeout 120 "$B/test_zbuffer_cuda" >"$out/cpu_vs_cuda.txt" 2>&1
 tail -3 "$out/cpu_vs_cuda.txt"
 # whole program: CUDA vs CPU heights of a case, bit for bit, as processes
-mkdir -p /tmp/w
-timeout 400 bash bench/zbuffer/process.sh --bin "$B" --cases "$cases" --backend cuda --reps 3 \
-  --work /tmp/w >"$out/process_cuda.md" 2>"$out/process_cuda.err"
+W=${W:-/var/tmp/fp-w}  # kept between calls of a warm machine (not under a carried folder)
+mkdir -p "$W"
+timeout 400 bash bench/zbuffer/process.sh --bin "$B" --cases "$cases" --backend cuda --reps 3 --work "$W" \
+  >"$out/process_cuda.md" 2>"$out/process_cuda.err"
 for id in 4 5; do
-  read -r _ tool region grid _ stock stem < <(grep "^$id " /tmp/w/cases.txt)
-  "$B/fieldpath" --quiet simulate --tool "$tool" --path "/tmp/w/$stem.npy" --grid "$grid" \
-    --region "$region" --stock "$stock" --backend cpu --outputs npy --out "/tmp/w/cpu-$id" >/dev/null
-  cmp -s "/tmp/w/cpu-$id/heights.npy" "/tmp/w/out-$id-npy/heights.npy" && same=yes || same=NO
+  read -r _ tool region grid _ stock stem < <(grep "^$id " $W/cases.txt)
+  "$B/fieldpath" --quiet simulate --tool "$tool" --path "$W/$stem.npy" --grid "$grid" \
+    --region "$region" --stock "$stock" --backend cpu --outputs npy --out "$W/cpu-$id" >/dev/null
+  cmp -s "$W/cpu-$id/heights.npy" "$W/out-$id-npy/heights.npy" && same=yes || same=NO
   echo "case $id: fieldpath --backend cpu heights = --backend cuda heights: $same" | tee -a "$out/cpu_vs_cuda.txt"
 done
 # the 2-core machine's question on 2 of these cores: reading .cl and .npy of case 6
-timeout 120 bash bench/zbuffer/process.sh --bin "$B" --cases 6 --backend cuda --reps 3 --work /tmp/w \
+timeout 120 bash bench/zbuffer/process.sh --bin "$B" --cases 6 --backend cuda --reps 3 --work "$W" \
   --taskset 0,1 --no-kernel >"$out/process_2cores.md" 2>&1
-taskset -c 0,1 "$B/bench_path_read" /tmp/w/case6.cl >"$out/path_read_2cores.txt" 2>&1
-"$B/bench_path_read" /tmp/w/case7.cl >"$out/path_read_16cores.txt" 2>&1
-cp /tmp/w/logs/kernel.md "$out/kernel.md" 2>/dev/null
+taskset -c 0,1 "$B/bench_path_read" --reps 3 $W/case6.cl $W/case6.npy >"$out/path_read_2cores.txt" 2>&1
+"$B/bench_path_read" --reps 3 $W/case7.cl $W/case7.npy >"$out/path_read_16cores.txt" 2>&1
+cp "$W/logs/kernel.md" "$W/logs/write.log" "$out/" 2>/dev/null
 echo "== all cores, CUDA"; cat "$out/process_cuda.md"
 echo "== 2 cores (taskset 0,1)"; cat "$out/process_2cores.md"
-tail -5 "$out/path_read_2cores.txt" "$out/path_read_16cores.txt"
+tail -6 "$out/path_read_2cores.txt" "$out/path_read_16cores.txt"

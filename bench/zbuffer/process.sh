@@ -46,7 +46,7 @@ for id in ${cases//,/ }; do
 done
 if [[ -n "$missing" ]]; then
   "$bench" --write-cases "$work/new" --cases "$missing" 2>>"$work/logs/write.log"
-  mv -f "$work"/new/case* "$work"/ 2>/dev/null || true
+  mv -f "$work"/new/case*.cl "$work"/new/case*.npy "$work"/
   grep -v '^#' "$work/new/cases.txt" >>"$work/cases.txt"
   rm -rf "$work/new"
 fi
