@@ -127,6 +127,44 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     geometry::PathReadOptions read_options;
     if (o->block_postures > 0) read_options.chunk_bytes = o->block_postures * 40;  // ~40 B a line
     PostureStream stream(o->path, read_options);
+    const bool streamed = !region.empty();
+    bool have_grid = false;
+    const auto makeGrid = [&] {
+      if (have_grid) return;
+      have_grid = true;
+      if (streamed) {
+        try {
+          req.grid = zb::Grid::fromRegion(region[0], region[1], region[2], region[3], nx, ny);
+        } catch (const InputError& e) {
+          throw InputError("--region '" + o->region + "': " + e.what());
+        }
+        return;
+      }
+      stream.waitAll();  // the default region needs every tip
+      const TipBounds b = stream.bounds();
+      const double margin = zb::toolReach(req.tool);
+      req.grid = zb::Grid::fromRegion(b.xmin - margin, b.ymin - margin, b.xmax + margin,
+                                      b.ymax + margin, nx, ny);
+    };
+
+    // auto: the CPU where it would be done before the GPU is ready (a small path), decided
+    // before any CUDA call. Without --region a small path is read first to know its grid.
+    std::string choice = zb::backendName(req.backend);
+    if (req.backend == zb::Backend::Auto) {
+      std::error_code ec;
+      const double bytes = double(fs::file_size(o->path, ec));
+      const bool npy = geometry::pathFormatOf(o->path) == geometry::PathFormat::Npy;
+      const double postures_estimate = ec ? 0.0 : bytes / (npy ? 24.0 : 30.0);
+      if (streamed || postures_estimate <= 5e6) {
+        makeGrid();
+        double cpu_s = 0;
+        if (zb::cpuFinishesFirst(req.tool, req.grid, postures_estimate, &cpu_s)) {
+          req.backend = zb::Backend::Cpu;
+          choice = "auto: cpu (estimated " + std::to_string(cpu_s).substr(0, 5) +
+                   " s, less than the GPU takes to start)";
+        }
+      }
+    }
     const auto prepare_start = Clock::now();
     // The first CUDA call (the driver's start, ~0.1 s) is made here too, not before the reading.
     std::future<double> prepared = std::async(std::launch::async, [&req, prepare_start] {
@@ -135,21 +173,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
       zb::prepare(req.tool, req.backend);
       return secondsSince(prepare_start);
     });
-
-    const bool streamed = !region.empty();
-    if (streamed) {
-      try {
-        req.grid = zb::Grid::fromRegion(region[0], region[1], region[2], region[3], nx, ny);
-      } catch (const InputError& e) {
-        throw InputError("--region '" + o->region + "': " + e.what());
-      }
-    } else {
-      stream.waitAll();  // the default region needs every tip
-      const TipBounds b = stream.bounds();
-      const double margin = zb::toolReach(req.tool);
-      req.grid = zb::Grid::fromRegion(b.xmin - margin, b.ymin - margin, b.xmax + margin,
-                                      b.ymax + margin, nx, ny);
-    }
+    makeGrid();
     zb::checkGridFits(req.grid);  // before allocating anything grid-sized
 
     if (!o->part.empty()) {
@@ -167,7 +191,6 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     const double prepare_s = prepared.get();
 
     const zb::SimulationResult res = zb::simulateBlocks(req, [&stream] { return stream.next(); });
-    if (res.backend == zb::Backend::Cuda) fastExitRequested() = true;
     stream.waitAll();  // an error after the last chunk (e.g. no postures at all)
     if (res.postures == 0) throw InputError(o->path + ": no postures");
 
@@ -210,6 +233,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
         {"lines_lowered", res.lines_lowered},
         {"heights_mm", {{"min", finiteOrNull(*lo)}, {"max", finiteOrNull(*hi)}}},
         {"backend", zb::backendName(res.backend)},
+        {"backend_asked", choice},
         {"streamed", streamed},
         {"seconds",
          {{"read", read_s},

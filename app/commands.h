@@ -2,7 +2,6 @@
 /// Each sub-command lives in its own cmd_*.cpp and registers itself here. A registration adds the
 /// sub-command and its options to `app` and sets its callback; the callback throws InputError for
 /// bad input (exit 1) and returns normally on success (exit 0).
-#include <atomic>
 #include <cmath>
 #include <string>
 
@@ -27,15 +26,6 @@ inline CLI::Validator positiveFinite(const std::string& unit) {
         return {};
       },
       unit + " > 0");
-}
-
-/// A command whose work used the GPU asks main() to end the process without the CUDA runtime's
-/// teardown at exit (0.1-0.17 s on the H100 machine, bench/results/zbuffer-process.md): every
-/// output is written and closed by then, and the driver frees the context when the process ends.
-/// FIELDPATH_NO_FAST_EXIT=1 turns it off (the benchmark's peer).
-inline std::atomic<bool>& fastExitRequested() {
-  static std::atomic<bool> requested{false};
-  return requested;
 }
 
 struct GlobalOptions {

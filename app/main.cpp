@@ -92,10 +92,5 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fieldpath: internal error: %s\n", e.what());
     return 2;
   }
-  if (fastExitRequested() && !std::getenv("FIELDPATH_NO_FAST_EXIT")) {
-    trace.say("main() returns (fast exit)");
-    std::fflush(nullptr);
-    std::_Exit(0);
-  }
   return 0;
 }

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <omp.h>
 #include <random>
 
 #ifdef FIELDPATH_TEST_ZLIB
@@ -829,6 +830,30 @@ TEST(BadInput, RegionGridAndToolAreChecked) {
   req.tool = Tool::ball(1, 4);
   req.engine = Engine::Coarse;
   EXPECT_THROW(simulate(req, std::span<const Posture>{}), common::InputError);
+}
+
+}  // namespace
+}  // namespace fieldpath::zbuffer
+
+namespace fieldpath::zbuffer {
+namespace {
+
+/// auto's choice: the CPU estimate is postures × footprint lines / (5e7 × cores), the footprint
+/// a disc of the tool's reach in lines (closed form), and the CPU is chosen under 0.25 s.
+TEST(AutoBackend, CpuEstimateIsTheFootprintClosedForm) {
+  const Tool ball = Tool::ball(3.0, 12.0);
+  const Grid grid = Grid::fromRegion(0, 0, 102.4, 102.4, 1024, 1024);  // 0.1 mm lines
+  const double lines = 3.14159 * 31.0 * 31.0;                         // (3 / 0.1 + 1)²
+  const double cores = std::max(1, omp_get_max_threads());
+  double seconds = 0;
+  const bool few = cpuFinishesFirst(ball, grid, 1000, &seconds);
+  EXPECT_NEAR(seconds, 1000 * lines / (5e7 * cores), 1e-9);
+  EXPECT_TRUE(few);
+  EXPECT_FALSE(cpuFinishesFirst(ball, grid, 27.4e6, &seconds));  // 27 M postures: the GPU
+  // a footprint larger than the grid counts the grid's lines only
+  const Grid tiny = Grid::fromRegion(0, 0, 1, 1, 4, 4);
+  cpuFinishesFirst(ball, tiny, 1000, &seconds);
+  EXPECT_NEAR(seconds, 1000 * 16 / (5e7 * cores), 1e-12);
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 #include "fieldpath/zbuffer/engine.h"
 
 #include <unistd.h>
+#include <omp.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -323,6 +325,19 @@ SimulationResult simulate(const SimulationRequest& request, std::span<const Post
     next += n;
     return out;
   });
+}
+
+bool cpuFinishesFirst(const Tool& tool, const Grid& grid, double postures, double* cpu_seconds) {
+  constexpr double kGpuStartSeconds = 0.25;           // driver + context, before the first cut
+  constexpr double kLineVisitsPerCoreSecond = 5e7;    // the CPU engine, ball R 3 at 1024²
+  const double reach_mm = toolReach(tool);
+  const double footprint_lines =
+      std::min(double(grid.lineCount()),
+               3.14159 * (reach_mm / grid.dx_mm + 1.0) * (reach_mm / grid.dy_mm + 1.0));
+  const double cores = std::max(1, omp_get_max_threads());  // the process's CPUs (affinity)
+  const double seconds = postures * footprint_lines / (kLineVisitsPerCoreSecond * cores);
+  if (cpu_seconds) *cpu_seconds = seconds;
+  return seconds < kGpuStartSeconds;
 }
 
 double toolReach(const Tool& tool) {

@@ -67,6 +67,14 @@ Backend backendFromName(const std::string& name, const std::string& key = "backe
 /// True if a CUDA device can be used (built with CUDA and cudaGetDeviceCount succeeds with >= 1).
 bool cudaAvailable();
 
+/// For Backend::Auto, without any CUDA call: whether the CPU engine would finish about `postures`
+/// postures of `tool` on `grid` before the GPU is even ready to cut. Starting the GPU (the driver
+/// and a context) costs ~0.25 s on the H100 machine before its first cut and ~0.1 s to end; the
+/// CPU engine visits ~5e7 grid lines a second per core (both bench/results/zbuffer-process.md).
+/// `cpu_seconds` receives the CPU estimate (a rough one: culling and tilt are not counted).
+bool cpuFinishesFirst(const Tool& tool, const Grid& grid, double postures,
+                      double* cpu_seconds = nullptr);
+
 /// Supplies postures block by block: fills `out` from the front and returns how many it wrote;
 /// 0 ends the stream. Lets 27 million postures pass through a fixed buffer.
 using PostureSource = std::function<std::size_t(std::span<Posture> out)>;
