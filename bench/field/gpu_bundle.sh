@@ -12,4 +12,5 @@ for l in $(ldd "$build/bin/fieldpath" "$build/bin/test_field" | awk '{print $3}'
 done
 strip "$out/B/fieldpath" "$out/B/test_field" "$out/B/lib/"* 2>/dev/null || true
 tar -C "$out" -cJf "$out/fp.tar.xz" B
+rm -rf "$out/B"  # only the tarball travels (carry counts every file of the folder)
 ls -la "$out/fp.tar.xz"

@@ -365,6 +365,65 @@ struct NodeBuilder {
 };
 
 
+/// Origins (index space) of the leaves within reach_mm of a sample and inside `reach` (the
+/// region's box), sorted. Marked on a byte per leaf of that box (a sample touches ~60 leaves:
+/// a list of them all, sorted and made unique, cost more than the uniform grid's nodes on the
+/// GPU), or listed and sorted where the box has too many leaves.
+std::vector<openvdb::Coord> candidateLeaves(const ObstacleSamples& samples,
+                                            const Eigen::AlignedBox3d& reach, double h,
+                                            double reach_mm) {
+  std::vector<openvdb::Coord> origins;
+  if (reach.isEmpty()) return origins;
+  const Vec3 lo_region = reach.min() / h, hi_region = reach.max() / h;
+  const double leaf_mm = kLeafDim * h;
+  // Calls hit(i, j, k) for each leaf origin within reach of q (inside the region).
+  auto leavesNear = [&](const Vec3& q, auto&& hit) {
+    const Vec3 lo = ((q.array() - reach_mm) / h).max(lo_region.array()).ceil();
+    const Vec3 hi = ((q.array() + reach_mm) / h).min(hi_region.array()).floor();
+    if ((lo.array() > hi.array()).any()) return;
+    const openvdb::Coord a(int(lo.x()), int(lo.y()), int(lo.z()));
+    const openvdb::Coord b(int(hi.x()), int(hi.y()), int(hi.z()));
+    const openvdb::Coord la = a & ~(kLeafDim - 1), lb = b & ~(kLeafDim - 1);
+    for (int i = la.x(); i <= lb.x(); i += kLeafDim)
+      for (int j = la.y(); j <= lb.y(); j += kLeafDim)
+        for (int k = la.z(); k <= lb.z(); k += kLeafDim) {
+          // Distance from q to the leaf's node box.
+          const Vec3 box_lo = Vec3(i, j, k) * h;
+          const Vec3 nearest = q.cwiseMax(box_lo).cwiseMin(box_lo + Vec3::Constant(leaf_mm - h));
+          if ((nearest - q).squaredNorm() < reach_mm * reach_mm) hit(i, j, k);
+        }
+  };
+  const Vec3 lo_all = lo_region.array().ceil(), hi_all = hi_region.array().floor();
+  if ((lo_all.array() > hi_all.array()).any()) return origins;
+  const openvdb::Coord box_lo =
+      openvdb::Coord(int(lo_all.x()), int(lo_all.y()), int(lo_all.z())) & ~(kLeafDim - 1);
+  const openvdb::Coord box_hi =
+      openvdb::Coord(int(hi_all.x()), int(hi_all.y()), int(hi_all.z())) & ~(kLeafDim - 1);
+  const openvdb::Coord dim((box_hi.x() - box_lo.x()) / kLeafDim + 1,
+                          (box_hi.y() - box_lo.y()) / kLeafDim + 1,
+                          (box_hi.z() - box_lo.z()) / kLeafDim + 1);
+  const double box_leaves = double(dim.x()) * dim.y() * dim.z();
+  if (box_leaves > double(kDenseIndexMax)) {
+    for (const Vec3& q : samples.points_mm)
+      leavesNear(q, [&](int i, int j, int k) { origins.emplace_back(i, j, k); });
+    std::sort(origins.begin(), origins.end());
+    origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
+    return origins;
+  }
+  std::vector<std::uint8_t> near(std::size_t(box_leaves), 0);
+  auto at = [&](int i, int j, int k) {
+    return (std::size_t((i - box_lo.x()) / kLeafDim) * dim.y() + (j - box_lo.y()) / kLeafDim) *
+               dim.z() + (k - box_lo.z()) / kLeafDim;
+  };
+  for (const Vec3& q : samples.points_mm)
+    leavesNear(q, [&](int i, int j, int k) { near[at(i, j, k)] = 1; });
+  for (int i = box_lo.x(); i <= box_hi.x(); i += kLeafDim)  // sorted: x, then y, then z
+    for (int j = box_lo.y(); j <= box_hi.y(); j += kLeafDim)
+      for (int k = box_lo.z(); k <= box_hi.z(); k += kLeafDim)
+        if (near[at(i, j, k)]) origins.emplace_back(i, j, k);
+  return origins;
+}
+
 /// The nodes of the halves of `cells` (3³ a cell at the next level), marked on a mask per task
 /// and merged (the same set as one serial pass).
 openvdb::MaskGrid::Ptr nodesOfHalves(const std::vector<openvdb::Coord>& cells) {
@@ -454,29 +513,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
 
   // Candidate leaves (8³ nodes): those within reach of a sample, inside the region.
   const Eigen::AlignedBox3d reach = reachBox(samples, params, request);
-  std::vector<openvdb::Coord> origins;
-  if (!reach.isEmpty()) {
-    const Vec3 lo_region = reach.min() / h, hi_region = reach.max() / h;
-    const double leaf_mm = kLeafDim * h;
-    for (const Vec3& q : samples.points_mm) {
-      const Vec3 lo = ((q.array() - reach_mm) / h).max(lo_region.array()).ceil();
-      const Vec3 hi = ((q.array() + reach_mm) / h).min(hi_region.array()).floor();
-      if ((lo.array() > hi.array()).any()) continue;
-      const openvdb::Coord a(int(lo.x()), int(lo.y()), int(lo.z()));
-      const openvdb::Coord b(int(hi.x()), int(hi.y()), int(hi.z()));
-      const openvdb::Coord la = a & ~(kLeafDim - 1), lb = b & ~(kLeafDim - 1);
-      for (int i = la.x(); i <= lb.x(); i += kLeafDim)
-        for (int j = la.y(); j <= lb.y(); j += kLeafDim)
-          for (int k = la.z(); k <= lb.z(); k += kLeafDim) {
-            // Distance from q to the leaf's node box.
-            const Vec3 box_lo = Vec3(i, j, k) * h;
-            const Vec3 nearest = q.cwiseMax(box_lo).cwiseMin(box_lo + Vec3::Constant(leaf_mm - h));
-            if ((nearest - q).squaredNorm() < reach_mm * reach_mm) origins.emplace_back(i, j, k);
-          }
-    }
-  }
-  std::sort(origins.begin(), origins.end());
-  origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
+  const std::vector<openvdb::Coord> origins = candidateLeaves(samples, reach, h, reach_mm);
   // Full leaves: the values of a node, masks and header, and the query block (9³ × 16 bytes).
   refuse("candidate leaves hold", static_cast<double>(origins.size()) * Leaf::SIZE,
          static_cast<double>(sizeof(Leaf)) / Leaf::SIZE * value_bytes / 12.0 + 12.0 +
