@@ -88,8 +88,9 @@ TEST(VoxelBuild, BlockBuildEqualsTheReferenceOnAPlaneAndMeetsItsClosedForm) {
       const VoxelField block(direct, requestOn(h, FieldBackend::Cpu, stored));
       EXPECT_EQ(block.stats().backend, "cpu");
       EXPECT_EQ(reference.stats().backend, "reference");
-      // Regular samples: nodes over the middle of a sample grid's cell tie.
-      expectSameNodes(reference, block, reference.stats().active_nodes / 50);
+      // Regular samples: nodes over the middle of a sample grid's cell tie; both take the
+      // lowest index, but r² rounds differently in the lanes and in Eigen (5 of 31 k nodes).
+      expectSameNodes(reference, block, reference.stats().active_nodes / 5000);
       if (stored != StoredQuantity::PlaneRatio) continue;
       // The closed form: over the middle of the plane, 1-4 mm up, s is the height and G the
       // normal (P(s)·G is the plane's field; the sampled plane departs from it by < 1e-3).
