@@ -23,6 +23,7 @@
 #include "commands.h"
 #include "errors.h"
 #include "fieldpath/common/atomic_file.h"
+#include "fieldpath/common/limits.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/mesh_io.h"
 #include "fieldpath/zbuffer/outputs.h"
@@ -144,6 +145,12 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     // The path is read on all cores; beside it, the tool and the device get ready.
     geometry::PathReadOptions read_options;
     if (o->block_postures > 0) read_options.chunk_bytes = o->block_postures * 40;  // ~40 B a line
+    // Until cut, the postures are held as 24-byte floats (all of them where the reading runs
+    // ahead of the cutting): refused before anything is read when that cannot fit.
+    const double postures_estimate = estimatePostures(o->path);
+    common::requireMemory("--path " + o->path, postures_estimate * 24.0,
+                          "about " + std::to_string(std::llround(postures_estimate)) +
+                              " postures of 24 bytes");
     PostureStream stream(o->path, read_options);
     const bool streamed = !region.empty();
     bool have_grid = false;
@@ -169,7 +176,6 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     // before any CUDA call. Without --region a small path is read first to know its grid.
     std::string choice = zb::backendName(req.backend);
     if (req.backend == zb::Backend::Auto) {
-      const double postures_estimate = estimatePostures(o->path);
       if (streamed || postures_estimate <= 5e6) {
         makeGrid();
         double cpu_s = 0;
