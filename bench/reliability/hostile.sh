@@ -153,6 +153,15 @@ row "check --out is a file" "afile" check base.yaml --path ok.cl --out afile
 row "study --voxels 0,-1" "--voxels" study base.yaml --voxels 0,-1 --out out
 row "study --voxels 1e-6" "1e-06" study base.yaml --voxels 1e-6 --out out
 row "study --sample-step 1e-4" "--sample-step" study base.yaml --sample-step 1e-4 --out out
+# convert (path files from one format to another)
+row "convert: input missing" "missing.cl" convert missing.cl out/o.cl
+row "convert: unknown output extension" "o.txt" convert ok.cl out/o.txt
+row "convert: APT output without --tool" "--tool" convert ok.cl out/o.apt
+row "convert: nan coordinate" "nan.cl:2" convert nan.cl out/o.npy
+row "convert: a tip at x = 1e30" "far30.cl:2" convert far30.cl out/o.npy
+row "convert: .npy of int32" "int.npy" convert int.npy out/o.cl
+row "convert: APT GOTO with 2 numbers" "short.apt:1" convert short.apt out/o.cl
+row "convert: output under a file" "afile" convert ok.cl afile/o.cl
 # view (the page is one file: --out names it)
 "$fp" --quiet simulate --tool ball:3 --path ok.cl --grid 64x64 --out farsurf > /dev/null 2>&1
 echo '{"origin":[1e300,0],"spacing":[0.1,0.1],"shape":[64,64]}' > farsurf/heights.json

@@ -1,7 +1,7 @@
 /// Reliability of the outputs (issue 14): an interrupted run (SIGINT, SIGTERM) leaves no partial
 /// file under a final name, nor a temporary; the same inputs give the same files, bit for bit,
 /// whatever the number of threads (generate, simulate, check, tool, field build and probe, view,
-/// study; the run's own timings aside).
+/// study, convert; the run's own timings aside).
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <sstream>
@@ -322,6 +324,35 @@ TEST(Deterministic, StudyOnOneAndOnAllCores) {
   const std::string one = withoutColumns(slurp(dir.path() / "one/study.csv"), timings);
   EXPECT_EQ(one, withoutColumns(slurp(dir.path() / "all/study.csv"), timings));
   EXPECT_NE(one.find("line_a_max_pct"), std::string::npos);  // the errors are compared
+}
+
+TEST(Deterministic, ConvertOnOneAndOnAllCores) {
+  const TempDir dir;
+  // ~11 MB of .cl: more than two of the readers' 4 MiB chunks, so all cores read it in parallel.
+  std::string cl;
+  char line[128];
+  for (int i = 0; i < 250000; ++i) {
+    if (i % 50000 == 0) cl += "# pass " + std::to_string(i / 50000 + 1) + "\n";
+    const double t = 1e-3 * i, ai = 0.3 * std::sin(7 * t), aj = 0.3 * std::cos(5 * t);
+    const double ak = std::sqrt(1 - ai * ai - aj * aj);  // a unit axis, tilted up to 25 deg
+    std::snprintf(line, sizeof line, "%.6f %.6f %.6f %.9f %.9f %.9f\n", 40 * std::cos(t),
+                  40 * std::sin(t), 0.01 * i, ai, aj, ak);
+    cl += line;
+  }
+  dir.write("in.cl", cl);
+  for (const std::string out : {"one", "all"}) {
+    const std::string cpus = out == "one" ? "0" : "";
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"in.cl", out + "/a.npy"},
+          {"in.cl", out + "/b.apt", "--tool", "ball:3"},
+          {out + "/a.npy", out + "/c.cl"},
+          {out + "/b.apt", out + "/d.cl"}}) {
+      std::vector<std::string> command{"convert"};
+      command.insert(command.end(), args.begin(), args.end());
+      ASSERT_EQ(run(dir, command, cpus), 0) << slurp(dir.path() / "stderr.txt");
+    }
+  }
+  expectSameFiles(dir.path() / "one", dir.path() / "all");
 }
 
 }  // namespace
