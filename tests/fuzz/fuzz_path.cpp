@@ -2,7 +2,10 @@
 /// (FIELDPATH_FUZZ_FORMAT 0, 1, 2). The first byte picks the reading options (threads, chunk
 /// size), so that the chunked parallel reading is fuzzed at its chunk boundaries too: the result
 /// must not depend on them (checked against a whole-file read).
+#include <cstdint>
 #include <cstdlib>
+
+#include <tbb/global_control.h>
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/geometry/cl_file.h"
@@ -15,6 +18,13 @@
 namespace {
 
 using namespace fieldpath;
+
+// TBB held to the calling thread: the readers' parallel loops then run their chunks in order here.
+// Spinning TBB workers took 95 % of the time on a busy 2-core machine (the readers' line count,
+// splitAtLines, runs on all cores whatever PathReadOptions::threads says, so every input with
+// more than one chunk started them). The chunk cutting and joining checked here are the same on
+// one thread; their concurrency is TSan's (scripts/sanitize.sh tsan).
+const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
 
 geometry::PathFile readAs(const std::filesystem::path& file, const geometry::PathReadOptions& o) {
   switch (FIELDPATH_FUZZ_FORMAT) {
@@ -51,11 +61,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const char* ext[] = {"path.cl", "path.apt", "path.npy"};
   const auto file = fuzz::writeScratch(ext[FIELDPATH_FUZZ_FORMAT], fuzz::view(data + 1, size - 1));
   geometry::PathReadOptions small;
-  // Two threads for one input in 64, picked by a hash of the whole input: TBB's workers spin
-  // after each parallel call (95 % of fuzz_cl's time on a busy 2-core machine), and a choice by
-  // the first byte was learnt by the fuzzer (the threaded branch is new coverage: 59 % of the
-  // corpus took it). The chunks (1..32 bytes: many boundaries) are cut and joined the same way on
-  // one thread.
+  // The arena path (threads = 2, run on this thread) for one input in 64, picked by a hash of
+  // the whole input (a choice by the first byte was learnt by the fuzzer: new coverage); chunks
+  // of 1..32 bytes: many boundaries.
   std::uint32_t hash = 2166136261u;  // FNV-1a
   for (std::size_t i = 0; i < size; ++i) hash = (hash ^ data[i]) * 16777619u;
   small.threads = hash % 64 == 0 ? 2 : 1;
