@@ -14,11 +14,14 @@ inline common::Progress makeProgressLine(bool quiet) {
   if (quiet) return [](double, std::string_view) { return true; };
   const auto start = std::chrono::steady_clock::now();
   auto last = start;
-  return [start, last](double fraction, std::string_view what) mutable {
+  std::string finished;  // the work whose 100 % line was printed (a second report of it is not)
+  return [start, last, finished](double fraction, std::string_view what) mutable {
     const auto now = std::chrono::steady_clock::now();
     const double elapsed_s = std::chrono::duration<double>(now - start).count();
     if (elapsed_s < 1.0 || (now - last < std::chrono::milliseconds(100) && fraction < 1.0))
       return true;
+    if (fraction >= 1.0 && finished == what) return true;
+    finished = fraction >= 1.0 ? std::string(what) : std::string();
     last = now;
     std::fprintf(stderr, "\r%-24.*s %5.1f%%  %6.1f s%s", static_cast<int>(what.size()), what.data(),
                  100.0 * fraction, elapsed_s, fraction >= 1.0 ? "\n" : "");
