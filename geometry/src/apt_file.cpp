@@ -117,7 +117,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   const MappedFile mapped(file);
   const std::string_view text = mapped.text();
   const std::vector<TextChunk> pieces =
-      splitAtLines(text, options.chunk_bytes, [](std::string_view line) {
+      splitAtLines(text, options.chunk_bytes, options.threads, [](std::string_view line) {
         const std::string_view content = aptContent(line);
         return !content.empty() && content.back() == '$';
       });

@@ -73,6 +73,7 @@ void forEachChunk(std::size_t n, unsigned threads, const std::function<void(std:
 }
 
 std::vector<TextChunk> splitAtLines(std::string_view text, std::size_t chunk_bytes,
+                                    unsigned threads,
                                     const std::function<bool(std::string_view)>& continues) {
   chunk_bytes = std::max<std::size_t>(chunk_bytes, 1);
   std::vector<TextChunk> chunks;
@@ -98,7 +99,7 @@ std::vector<TextChunk> splitAtLines(std::string_view text, std::size_t chunk_byt
   }
   // Line numbers: the '\n's before each chunk, counted in parallel.
   std::vector<std::size_t> newlines(chunks.size());
-  forEachChunk(chunks.size(), 0, [&](std::size_t i) {
+  forEachChunk(chunks.size(), threads, [&](std::size_t i) {
     const char* p = text.data() + chunks[i].begin;
     newlines[i] = static_cast<std::size_t>(std::count(p, text.data() + chunks[i].end, '\n'));
   });

@@ -37,10 +37,11 @@ struct TextChunk {
   std::size_t first_line = 1;  ///< 1-based number of its first line
 };
 
-/// Cuts `text` into pieces of about `chunk_bytes` at line ends, numbered in parallel.
-/// `continues(line)` (optional) says that a line goes on into the next one (APT's `$`), so that
-/// no cut falls inside a record.
+/// Cuts `text` into pieces of about `chunk_bytes` at line ends, numbered in parallel on
+/// `threads` workers (0: all cores, as forEachChunk). `continues(line)` (optional) says that a
+/// line goes on into the next one (APT's `$`), so that no cut falls inside a record.
 std::vector<TextChunk> splitAtLines(std::string_view text, std::size_t chunk_bytes,
+                                    unsigned threads,
                                     const std::function<bool(std::string_view)>& continues = {});
 
 /// Calls `work(i)` for i in [0, n) on all cores (TBB; `threads` 0: all of them). When calls

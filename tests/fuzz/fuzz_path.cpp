@@ -20,9 +20,9 @@ namespace {
 using namespace fieldpath;
 
 // TBB held to the calling thread: the readers' parallel loops then run their chunks in order here.
-// Spinning TBB workers took 95 % of the time on a busy 2-core machine (the readers' line count,
-// splitAtLines, runs on all cores whatever PathReadOptions::threads says, so every input with
-// more than one chunk started them). The chunk cutting and joining checked here are the same on
+// Spinning TBB workers took 95 % of the time on a busy 2-core machine (inputs of several chunks
+// start them; the readers' line count, splitAtLines, did whatever PathReadOptions::threads said
+// until it took the same thread count). The chunk cutting and joining checked here are the same on
 // one thread; their concurrency is TSan's (scripts/sanitize.sh tsan).
 const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
 
