@@ -160,33 +160,38 @@ void accumulateGeneric(const Law& L, const SampleSpan& s, D3 at, bool track, Acc
 }
 
 #if defined(__x86_64__)
-/// accumulateGeneric with AVX-512 (8 doubles a register): 1/r from the 14-bit reciprocal square
-/// root and two Newton steps (relative error ~1e-16: no division, no square root), r² summed in
-/// the scalar's order (same nearest sample, same cut at r0).
-__attribute__((target("avx512f"))) void accumulate512(const Law& L, const SampleSpan& s, D3 at,
-                                                      bool track, Accum& a) {
-  const int full = s.count - s.count % kLanes;
-  if (full > 0) {
-    const __m512d ax = _mm512_set1_pd(at.x), ay = _mm512_set1_pd(at.y), az = _mm512_set1_pd(at.z);
-    const __m512d r0_sq = _mm512_set1_pd(L.r0_sq), inv_r_min = _mm512_set1_pd(1.0 / L.r_min);
-    const __m512d inv_r0 = _mm512_set1_pd(L.inv_r0), one = _mm512_set1_pd(1.0);
-    const __m512d half = _mm512_set1_pd(0.5), three_halves = _mm512_set1_pd(1.5);
-    __m512d fx = _mm512_setzero_pd(), fy = _mm512_setzero_pd(), fz = _mm512_setzero_pd();
-    __m512d best = _mm512_set1_pd(a.best_sq);
-    __m512i best_id = _mm512_set1_epi64(-1), best_at = _mm512_set1_epi64(-1);
-    const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
+/// accumulateGeneric with AVX-512 (8 doubles a register) over `n` spans in the same lanes (one
+/// reduction for them all: the cell list's columns are short): 1/r from the 14-bit reciprocal
+/// square root and two Newton steps (relative error ~1e-16: no division, no square root), r²
+/// summed in the scalar's order (same nearest sample, same cut at r0); each span's last
+/// count % 8 samples under a load mask.
+__attribute__((target("avx512f"))) void accumulate512(const Law& L, const SampleSpan* spans, int n,
+                                                      D3 at, bool track, Accum& a) {
+  const __m512d ax = _mm512_set1_pd(at.x), ay = _mm512_set1_pd(at.y), az = _mm512_set1_pd(at.z);
+  const __m512d r0_sq = _mm512_set1_pd(L.r0_sq), inv_r_min = _mm512_set1_pd(1.0 / L.r_min);
+  const __m512d inv_r0 = _mm512_set1_pd(L.inv_r0), one = _mm512_set1_pd(1.0);
+  const __m512d half = _mm512_set1_pd(0.5), three_halves = _mm512_set1_pd(1.5);
+  const __m512d far = _mm512_set1_pd(HUGE_VAL);  // lanes past a span's end: never in, never nearest
+  __m512d fx = _mm512_setzero_pd(), fy = _mm512_setzero_pd(), fz = _mm512_setzero_pd();
+  __m512d best = _mm512_set1_pd(a.best_sq);
+  __m512i best_id = _mm512_set1_epi64(-1), best_at = _mm512_set1_epi64(-1);
+  const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
+  for (int k = 0; k < n; ++k) {
+    const SampleSpan& s = spans[k];
     __mmask8 zero = 0;
-    for (int j = 0; j < full; j += kLanes) {
-      const __m512d dx = _mm512_sub_pd(ax, _mm512_loadu_pd(s.x + j));
-      const __m512d dy = _mm512_sub_pd(ay, _mm512_loadu_pd(s.y + j));
-      const __m512d dz = _mm512_sub_pd(az, _mm512_loadu_pd(s.z + j));
+    for (int j = 0; j < s.count; j += kLanes) {
+      const int left = s.count - j;
+      const __mmask8 valid = left >= kLanes ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
+      const __m512d dx = _mm512_sub_pd(ax, _mm512_mask_loadu_pd(far, valid, s.x + j));
+      const __m512d dy = _mm512_sub_pd(ay, _mm512_maskz_loadu_pd(valid, s.y + j));
+      const __m512d dz = _mm512_sub_pd(az, _mm512_maskz_loadu_pd(valid, s.z + j));
       const __m512d r2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
                                        _mm512_mul_pd(dz, dz));
       const __mmask8 positive = _mm512_cmp_pd_mask(r2, _mm512_setzero_pd(), _CMP_GT_OQ);
       const __mmask8 in = _mm512_mask_cmp_pd_mask(positive, r2, r0_sq, _CMP_LT_OQ);
-      zero |= _mm512_cmp_pd_mask(r2, _mm512_setzero_pd(), _CMP_EQ_OQ);
+      zero |= _mm512_mask_cmp_pd_mask(valid, r2, _mm512_setzero_pd(), _CMP_EQ_OQ);
       if (in) {
-        const __m512d r2s = _mm512_mask_blend_pd(positive, one, r2);
+        const __m512d r2s = _mm512_mask_blend_pd(in, one, r2);
         __m512d y = _mm512_rsqrt14_pd(r2s);  // 1/r
         const __m512d hr2 = _mm512_mul_pd(half, r2s);
         y = _mm512_mul_pd(y, _mm512_fnmadd_pd(hr2, _mm512_mul_pd(y, y), three_halves));
@@ -194,18 +199,19 @@ __attribute__((target("avx512f"))) void accumulate512(const Law& L, const Sample
         const __m512d inv_rc = _mm512_min_pd(y, inv_r_min);
         const __m512d phi = _mm512_mul_pd(_mm512_sub_pd(inv_rc, inv_r0),
                                           _mm512_mul_pd(inv_rc, inv_rc));
-        const __m512d c =
-            _mm512_maskz_mul_pd(in, _mm512_mul_pd(_mm512_loadu_pd(s.w + j), phi), y);
-        fx = _mm512_fmadd_pd(c, dx, fx);
-        fy = _mm512_fmadd_pd(c, dy, fy);
-        fz = _mm512_fmadd_pd(c, dz, fz);
+        const __m512d c = _mm512_maskz_mul_pd(
+            in, _mm512_mul_pd(_mm512_maskz_loadu_pd(valid, s.w + j), phi), y);
+        fx = _mm512_mask3_fmadd_pd(c, dx, fx, in);  // masked: 0 · inf past the end
+        fy = _mm512_mask3_fmadd_pd(c, dy, fy, in);
+        fz = _mm512_mask3_fmadd_pd(c, dz, fz, in);
       }
       if (track) {
-        const __m512i id =
-            _mm512_cvtepi32_epi64(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(s.id + j)));
+        const __m512i id = _mm512_cvtepi32_epi64(
+            _mm512_castsi512_si256(_mm512_maskz_loadu_epi32(__mmask16(valid), s.id + j)));
         const __mmask8 closer =
-            _mm512_cmp_pd_mask(r2, best, _CMP_LT_OQ) |
-            (_mm512_cmp_pd_mask(r2, best, _CMP_EQ_OQ) & _mm512_cmplt_epi64_mask(id, best_id));
+            _mm512_mask_cmp_pd_mask(valid, r2, best, _CMP_LT_OQ) |
+            (_mm512_mask_cmp_pd_mask(valid, r2, best, _CMP_EQ_OQ) &
+             _mm512_cmplt_epi64_mask(id, best_id));
         if (closer) {
           best = _mm512_mask_blend_pd(closer, best, r2);
           best_id = _mm512_mask_blend_epi64(closer, best_id, id);
@@ -214,30 +220,32 @@ __attribute__((target("avx512f"))) void accumulate512(const Law& L, const Sample
         }
       }
     }
-    a.fx += _mm512_reduce_add_pd(fx);
-    a.fy += _mm512_reduce_add_pd(fy);
-    a.fz += _mm512_reduce_add_pd(fz);
-    if (track) {
-      alignas(64) double b[kLanes];
-      alignas(64) std::int64_t bid[kLanes], bat[kLanes];
-      _mm512_store_pd(b, best);
-      _mm512_store_epi64(bid, best_id);
-      _mm512_store_epi64(bat, best_at);
-      mergeNearest(b, bid, bat, a);
-    }
-    if (zero) addZeroTerms(L, s, full, at, a);
+    if (zero) addZeroTerms(L, s, s.count, at, a);
   }
-  if (full < s.count) kernel::accumulateScalar(L, tail(s, full), at, track, a);
+  a.fx += _mm512_reduce_add_pd(fx);
+  a.fy += _mm512_reduce_add_pd(fy);
+  a.fz += _mm512_reduce_add_pd(fz);
+  if (track) {
+    alignas(64) double b[kLanes];
+    alignas(64) std::int64_t bid[kLanes], bat[kLanes];
+    _mm512_store_pd(b, best);
+    _mm512_store_epi64(bid, best_id);
+    _mm512_store_epi64(bat, best_at);
+    mergeNearest(b, bid, bat, a);
+  }
 }
 
 const bool kHaveAvx512 = __builtin_cpu_supports("avx512f");
 #endif
 
-void accumulateLanes(const Law& L, const SampleSpan& s, D3 at, bool track, Accum& a) {
+void accumulateLanes(const Law& L, const SampleSpan* spans, int n, D3 at, bool track, Accum& a) {
 #if defined(__x86_64__)
-  if (kHaveAvx512) return accumulate512(L, s, at, track, a);
+  if (kHaveAvx512) return accumulate512(L, spans, n, at, track, a);
 #endif
-  accumulateGeneric(L, s, at, track, a);
+  for (int k = 0; k < n; ++k) accumulateGeneric(L, spans[k], at, track, a);
+}
+void accumulateLanes(const Law& L, const SampleSpan& s, D3 at, bool track, Accum& a) {
+  accumulateLanes(L, &s, 1, at, track, a);
 }
 
 /// A leaf's neighbourhood: the samples gathered in [box_lo, box_hi] (mm) for sums whose ball
@@ -251,12 +259,23 @@ struct BlockHood {
   const kernel::CellTable* cells;
   const ObstacleSamples* samples;
 
+  /// Gathers the columns' spans, summed together in the lanes (in batches of kSpans).
   struct Visit {
+    static constexpr int kSpans = 64;
     const Law* law;
     D3 at;
     bool track;
     Accum* a;
-    void operator()(const SampleSpan& s) { accumulateLanes(*law, s, at, track, *a); }
+    SampleSpan spans[kSpans];
+    int n = 0;
+    void operator()(const SampleSpan& s) {
+      spans[n++] = s;
+      if (n == kSpans) flush();
+    }
+    void flush() {
+      if (n) accumulateLanes(*law, spans, n, at, track, *a);
+      n = 0;
+    }
   };
   void sum(D3 c, double radius, bool track, Accum& a) {
     // Distance from c to the row's segment (x, y, [z0, z1]).
@@ -274,8 +293,9 @@ struct BlockHood {
       accumulateLanes(*law, block, c, track, a);
       return;
     }
-    Visit v{law, c, track, &a};
+    Visit v{law, c, track, &a, {}, 0};
     kernel::cellSpans(*cells, c, radius, v);
+    v.flush();
   }
   D3 point(const Accum& a) const {
     const Vec3& p = samples->points_mm[std::size_t(a.best_id)];
