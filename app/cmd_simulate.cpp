@@ -118,7 +118,10 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
   auto* stock =
       cmd->add_option("--stock", o->stock_mm, "Stock top plane z, mm (default: the highest tip)");
   cmd->add_option("--part", o->part, "Part mesh whose top is the initial surface")->excludes(stock);
-  cmd->add_option("--backend", o->backend, "auto | cpu | cuda")->capture_default_str();
+  cmd->add_option("--backend", o->backend,
+                  "auto (the CPU where it would finish before the GPU has started, else the "
+                  "GPU) | cpu | cuda")
+      ->capture_default_str();
   cmd->add_option("--outputs", o->outputs,
                   "Which of npy (heights.npy), json (heights.json), stl (surface.stl), png "
                   "(heights.png) to write; simulate.json is always written")
