@@ -21,12 +21,14 @@ namespace fieldpath::fuzz {
 
 /// The scratch directory of this process (created on first use).
 inline const std::filesystem::path& scratchDir() {
-  static const std::filesystem::path dir = [] {
+  // Never destroyed: the atexit handler below runs after the destructors of statics initialised
+  // later, and a static path would be one of them (the directories were left behind).
+  static const std::filesystem::path* const dir = [] {
     std::error_code ec;
     const std::filesystem::path base =
         std::filesystem::is_directory("/dev/shm", ec) ? "/dev/shm" : std::filesystem::temp_directory_path();
-    auto d = base / ("fieldpath-fuzz-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(d);
+    auto* d = new std::filesystem::path(base / ("fieldpath-fuzz-" + std::to_string(::getpid())));
+    std::filesystem::create_directories(*d);
     std::atexit([] {  // libFuzzer ends by exit(): leave no scratch directory behind
       std::error_code ignored;
       std::filesystem::remove_all(scratchDir(), ignored);
@@ -35,7 +37,7 @@ inline const std::filesystem::path& scratchDir() {
     common::setMemoryLimitBytes(std::size_t{256} << 20);
     return d;
   }();
-  return dir;
+  return *dir;
 }
 
 /// Writes `bytes` to `name` in the scratch directory; returns its path.
