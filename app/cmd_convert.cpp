@@ -9,6 +9,7 @@
 
 #include "commands.h"
 #include "errors.h"
+#include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/limits.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/tool_model.h"
@@ -59,8 +60,7 @@ void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
         throw InputError(out.string() + ": APT output needs --tool (its CUTTER record)");
       header.tool = geometry::parseToolSpec(o->tool);
     }
-    if (std::error_code ec; fs::is_directory(out, ec))
-      throw InputError(out.string() + ": is a directory");
+    common::checkOutputFile(out, "OUT");  // before the reading, not after
     // A PathFile keeps ~80 bytes a posture (a Posture, its line, its block): the input's size
     // bounds the posture count (a .cl line is at least 12 bytes, an .npy row 24).
     std::error_code size_ec;

@@ -138,8 +138,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     req.backend = zb::backendFromName(o->backend, "--backend");
     const std::set<std::string> outputs = parseOutputs(o->outputs);
     const fs::path out = o->out;
-    if (std::error_code ec; fs::exists(out, ec) && !fs::is_directory(out, ec))
-      throw InputError("--out " + out.string() + ": exists and is not a directory");
+    common::checkOutputDirectory(out, "--out");  // before the work, not after
     const auto [nx, ny] = parseGrid(o->grid);
     std::vector<double> region;
     if (!o->region.empty()) region = parseNumbers(o->region, "--region", 4);

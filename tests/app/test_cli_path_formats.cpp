@@ -160,6 +160,20 @@ TEST(SimulateFormats, OutputsAreTheOnesNamedAndSimulateJsonSaysWhereTheTimeWent)
   EXPECT_FALSE(fs::exists(f.dir.path() / "out2"));
 }
 
+/// An --out (or OUT) that cannot be a directory (a file on its way) is refused before any work.
+TEST(SimulateFormats, OutUnderAFileIsOneLineBeforeTheWork) {
+  const Formats f;
+  f.dir.write("afile", "x");
+  for (const std::string args :
+       {"simulate --tool ball:1 --path path.cl --out afile/sub", "convert path.cl afile/x.npy"}) {
+    const Outcome run = runFieldpath(f.dir, args);
+    EXPECT_EQ(run.exit_code, 1) << args << ": " << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << args << ": " << run.err;
+    EXPECT_NE(run.err.find("afile"), std::string::npos) << run.err;
+    EXPECT_EQ(run.err.find("filesystem error"), std::string::npos) << run.err;
+  }
+}
+
 TEST(SimulateFormats, QuietAfterTheSubCommand) {
   const Formats f;
   const Outcome run = runFieldpathAsTyped(
