@@ -24,9 +24,10 @@ class NodeCurvature {
     if (law) closeness_.emplace(level.closeness->getConstAccessor());
   }
 
-  /// Of a built node (its value on).
-  void at(const openvdb::Coord& ijk, double& force, double& error) {
+  /// Of a built node (its value on); `inside`: over the surface's normal and s <= -depth_mm.
+  void at(const openvdb::Coord& ijk, double depth_mm, double& force, double& error, bool& inside) {
     const Read here = read(ijk);
+    inside = law_ && here.s <= -depth_mm && closeness_->isValueOn(ijk);
     double slope = 0.0;
     if (law_) {
       constexpr double kStepMm = 1e-4;
@@ -79,13 +80,17 @@ CellErrors::CellErrors(const Level& level, const std::optional<PlaneLaw>& law, d
   force_.assign(leaves.size() * Leaf::SIZE, 0.0);
   error_.assign(leaves.size() * Leaf::SIZE, 0.0);
   built_.assign(leaves.size() * kCellWords, 0);
+  inside_.assign(leaves.size() * kCellWords, 0);
+  const double depth_mm = 0.5 * std::sqrt(3.0) * level.h_mm;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
     NodeCurvature curvature(level, law);
     for (std::size_t b = range.begin(); b != range.end(); ++b) {
       for (auto it = leaves[b]->cbeginValueOn(); it; ++it) {
         const std::size_t n = b * Leaf::SIZE + it.pos();
-        curvature.at(it.getCoord(), force_[n], error_[n]);
+        bool inside = false;
+        curvature.at(it.getCoord(), depth_mm, force_[n], error_[n], inside);
         built_[n >> 6] |= std::uint64_t{1} << (n & 63);
+        if (inside) inside_[n >> 6] |= std::uint64_t{1} << (n & 63);
       }
     }
   });
@@ -95,7 +100,7 @@ double CellErrors::cellError(const openvdb::Coord& cell, const IndexAccessor& ac
   // The same terms in the same order as reading the corners one by one: the largest corner
   // error over max(mean corner force, floor).
   double worst = 0.0, sum = 0.0;
-  int built = 0;
+  int built = 0, inside = 0;
   for (int c = 0; c < 8; ++c) {
     const openvdb::Coord ijk = cell.offsetBy(c >> 2, (c >> 1) & 1, c & 1);
     const int b = blockAt(level_, acc, openvdb::Coord(ijk.x() >> 3, ijk.y() >> 3, ijk.z() >> 3));
@@ -105,8 +110,10 @@ double CellErrors::cellError(const openvdb::Coord& cell, const IndexAccessor& ac
     worst = std::max(worst, error_[n]);
     sum += force_[n];
     ++built;
+    inside += bit(inside_, n);
   }
-  if (!built) return 0.0;
+  if (inside == built) return 0.0;  // none built, or every built one inside (the others lie
+                                    // deeper than the inside band)
   return worst / std::max(sum / built, floor_);
 }
 

@@ -388,6 +388,33 @@ TEST(VoxelRefinement, SplitsWhereTheGridMissesAndComesCloseToItsFinestSize) {
   EXPECT_LE(tighter.max_relative, two.max_relative);
 }
 
+TEST(VoxelRefinement, NeverSplitsACellWhollyInsideTheObstacle) {
+  // Inside the cube the plane height s kinks where the nearest face changes (its medial
+  // planes), which the estimate reads as curvature; a cell whose corners are all deeper than
+  // half its diagonal lies inside the solid and is not split. So every refined node lies within
+  // a split cell of the level above, one of whose built corners is above that depth: s >
+  // -(√3/2 + √3) h_parent (s is 1-Lipschitz across the cell's diagonal). Outside, the
+  // refinement is that of before (the same split around the edges and corners).
+  FieldParams p;
+  p.sample_step_mm = 0.5;
+  const DirectField direct = fineCubeField(p);
+  const VoxelField voxel(direct, refined(1.0, 0.005, 2));
+  ASSERT_EQ(voxel.stats().levels, 3);
+  std::size_t refined_outside = 0, refined_inside = 0;
+  for (const StoredNode& n : voxel.storedNodes()) {
+    if (n.level == 0) continue;
+    const double s = p.r0_mm - n.closeness_mm;
+    const double h_parent = std::ldexp(1.0, -(n.level - 1));
+    (s > 0 ? refined_outside : refined_inside)++;
+    if (n.over)
+      EXPECT_GT(s, -1.5 * std::sqrt(3.0) * h_parent - 1e-3)
+          << "refined node at " << n.x_mm.transpose() << ", level " << n.level;
+  }
+  EXPECT_GT(refined_outside, 1000u);
+  // Cells that straddle the faces are split, so some refined nodes lie just inside.
+  EXPECT_GT(refined_inside, 0u);
+}
+
 TEST(VoxelRefinement, TheFieldIsContinuousAcrossLevels) {
   // Lines over the top face of the cube and past its edge, 1 to 3 mm above the face, sampled
   // every 1 µm: refined (2 mm down to 0.5 mm at 5 %), the lines cross level boundaries. Hanging
