@@ -248,6 +248,73 @@ void accumulateLanes(const Law& L, const SampleSpan& s, D3 at, bool track, Accum
   accumulateLanes(L, &s, 1, at, track, a);
 }
 
+/// Copies the leaf's gathered samples within sqrt(reach_sq) of the row's segment (x, y, [z0,
+/// z1]) to the row arrays (sized for them all), in their order; returns how many.
+int gatherRowGeneric(BlockScratch& s, double x, double y, double z0, double z1,
+                     double reach_sq) {
+  int n = 0;
+  for (std::size_t t = 0; t < s.x.size(); ++t) {
+    const double dx = s.x[t] - x, dy = s.y[t] - y, z = s.z[t];
+    const double dz = z < z0 ? z0 - z : z > z1 ? z - z1 : 0.0;
+    if (dx * dx + dy * dy + dz * dz > reach_sq) continue;
+    s.rx[n] = s.x[t];
+    s.ry[n] = s.y[t];
+    s.rz[n] = s.z[t];
+    s.rnx[n] = s.nx[t];
+    s.rny[n] = s.ny[t];
+    s.rnz[n] = s.nz[t];
+    s.rw[n] = s.w[t];
+    s.rid[n] = s.id[t];
+    ++n;
+  }
+  return n;
+}
+
+#if defined(__x86_64__)
+/// gatherRowGeneric in AVX-512 lanes: the same test, the passing samples compress-stored.
+__attribute__((target("avx512f"))) int gatherRow512(BlockScratch& s, double x, double y,
+                                                     double z0, double z1, double reach_sq) {
+  const __m512d vx = _mm512_set1_pd(x), vy = _mm512_set1_pd(y);
+  const __m512d vz0 = _mm512_set1_pd(z0), vz1 = _mm512_set1_pd(z1);
+  const __m512d limit = _mm512_set1_pd(reach_sq), zero = _mm512_setzero_pd();
+  const int count = int(s.x.size());
+  int n = 0;
+  for (int t = 0; t < count; t += kLanes) {
+    const int left = count - t;
+    const __mmask8 valid = left >= kLanes ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
+    const __m512d px = _mm512_maskz_loadu_pd(valid, s.x.data() + t);
+    const __m512d py = _mm512_maskz_loadu_pd(valid, s.y.data() + t);
+    const __m512d pz = _mm512_maskz_loadu_pd(valid, s.z.data() + t);
+    const __m512d dx = _mm512_sub_pd(px, vx), dy = _mm512_sub_pd(py, vy);
+    // z0 - z or z - z1 where positive, else 0 (the segment's distance along z)
+    const __m512d dz = _mm512_max_pd(zero, _mm512_max_pd(_mm512_sub_pd(vz0, pz),
+                                                         _mm512_sub_pd(pz, vz1)));
+    const __m512d d2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
+                                     _mm512_mul_pd(dz, dz));
+    const __mmask8 in = _mm512_mask_cmp_pd_mask(valid, d2, limit, _CMP_LE_OQ);
+    if (!in) continue;
+    _mm512_mask_compressstoreu_pd(s.rx.data() + n, in, px);
+    _mm512_mask_compressstoreu_pd(s.ry.data() + n, in, py);
+    _mm512_mask_compressstoreu_pd(s.rz.data() + n, in, pz);
+    _mm512_mask_compressstoreu_pd(s.rnx.data() + n, in, _mm512_maskz_loadu_pd(valid, s.nx.data() + t));
+    _mm512_mask_compressstoreu_pd(s.rny.data() + n, in, _mm512_maskz_loadu_pd(valid, s.ny.data() + t));
+    _mm512_mask_compressstoreu_pd(s.rnz.data() + n, in, _mm512_maskz_loadu_pd(valid, s.nz.data() + t));
+    _mm512_mask_compressstoreu_pd(s.rw.data() + n, in, _mm512_maskz_loadu_pd(valid, s.w.data() + t));
+    _mm512_mask_compressstoreu_epi32(s.rid.data() + n, __mmask16(in),
+                                     _mm512_maskz_loadu_epi32(__mmask16(valid), s.id.data() + t));
+    n += __builtin_popcount(in);
+  }
+  return n;
+}
+#endif
+
+int gatherRow(BlockScratch& s, double x, double y, double z0, double z1, double reach_sq) {
+#if defined(__x86_64__)
+  if (kHaveAvx512) return gatherRow512(s, x, y, z0, z1, reach_sq);
+#endif
+  return gatherRowGeneric(s, x, y, z0, z1, reach_sq);
+}
+
 /// A leaf's neighbourhood: the samples gathered in [box_lo, box_hi] (mm) for sums whose ball
 /// lies inside that box, the cell list for the others (points lifted far off the leaf).
 struct BlockHood {
@@ -368,6 +435,10 @@ void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, co
                           scratch.nx.data(), scratch.ny.data(), scratch.nz.data(),
                           scratch.w.data(),  scratch.id.data(), int(scratch.x.size()), 0};
   // Row by row (8 nodes along z): the leaf's samples within reach of the row's segment.
+  for (auto* v : {&scratch.rx, &scratch.ry, &scratch.rz, &scratch.rnx, &scratch.rny, &scratch.rnz,
+                  &scratch.rw})
+    v->resize(scratch.x.size());
+  scratch.rid.resize(scratch.x.size());
   const double row_reach = reach * (1.0 + 1e-12);
   hood.row_reach = reach;
   for (int row = 0; row < 64; ++row) {
@@ -378,32 +449,8 @@ void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, co
     hood.row_y = (leaf.origin[1] + j) * h;
     hood.row_z0 = leaf.origin[2] * h;
     hood.row_z1 = (leaf.origin[2] + 7) * h;
-    const double reach_sq = row_reach * row_reach;
-    int n = 0;
-    auto& r = scratch.row;
-    r.resize(scratch.x.size());
-    for (std::size_t t = 0; t < scratch.x.size(); ++t) {
-      const double dx = scratch.x[t] - hood.row_x, dy = scratch.y[t] - hood.row_y;
-      const double z = scratch.z[t];
-      const double dz = z < hood.row_z0 ? hood.row_z0 - z : z > hood.row_z1 ? z - hood.row_z1 : 0.0;
-      r[n] = std::int32_t(t);
-      n += dx * dx + dy * dy + dz * dz <= reach_sq;
-    }
-    for (auto* v : {&scratch.rx, &scratch.ry, &scratch.rz, &scratch.rnx, &scratch.rny, &scratch.rnz,
-                    &scratch.rw})
-      v->resize(std::size_t(n));
-    scratch.rid.resize(std::size_t(n));
-    for (int t = 0; t < n; ++t) {
-      const std::size_t from = std::size_t(r[t]);
-      scratch.rx[t] = scratch.x[from];
-      scratch.ry[t] = scratch.y[from];
-      scratch.rz[t] = scratch.z[from];
-      scratch.rnx[t] = scratch.nx[from];
-      scratch.rny[t] = scratch.ny[from];
-      scratch.rnz[t] = scratch.nz[from];
-      scratch.rw[t] = scratch.w[from];
-      scratch.rid[t] = scratch.id[from];
-    }
+    const int n = gatherRow(scratch, hood.row_x, hood.row_y, hood.row_z0, hood.row_z1,
+                            row_reach * row_reach);
     hood.row = SampleSpan{scratch.rx.data(),  scratch.ry.data(),  scratch.rz.data(),
                           scratch.rnx.data(), scratch.rny.data(), scratch.rnz.data(),
                           scratch.rw.data(),  scratch.rid.data(), n, 0};

@@ -540,7 +540,11 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
     const double nodes_before = builder.nodes_seconds;
     for (int l = 0; l < refine_levels && !cells.empty(); ++l) {
       const double hl = levels[l].h_mm;
+      // Each cell's error and, for those that miss, where it is in the level's blocks (in
+      // parallel); then, serially in the cells' order, the split cells marked and their halves
+      // listed; then the nodes of the halves (3³ a split cell) on masks in parallel, merged.
       std::vector<char> split(cells.size(), 0);
+      std::vector<CellRef> where(cells.size());
       const CellErrors errors(levels[std::size_t(l)], law, floor);
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size()), [&](const auto& range) {
         auto acc = levels[std::size_t(l)].block_of->getConstUnsafeAccessor();
@@ -548,31 +552,27 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
           const openvdb::Coord& ijk = cells[c];
           const Vec3 x = (Vec3(ijk.x(), ijk.y(), ijk.z()) + Vec3::Constant(0.5)) * hl;
           if (request.region_mm && !request.region_mm->contains(x)) continue;
-          split[c] = errors.cellError(ijk, acc) > tolerance;
+          split[c] = errors.cellError(ijk, acc) > tolerance && locate(levels[l], acc, x, where[c]);
         }
       });
       stats.tested_cells += cells.size();
-      // Mark the split cells and list their halves (serial: a lookup a split cell), then
-      // the nodes of the halves (3³ a split cell) on masks in parallel, merged.
       std::vector<openvdb::Coord> split_cells, next_cells;
-      {
-        auto acc = levels[l].block_of->getConstUnsafeAccessor();
-        for (std::size_t c = 0; c < cells.size(); ++c) {
-          if (!split[c]) continue;
-          const openvdb::Coord& ijk = cells[c];
-          CellRef ref;
-          const Vec3 x = (Vec3(ijk.x(), ijk.y(), ijk.z()) + Vec3::Constant(0.5)) * hl;
-          if (!locate(levels[l], acc, x, ref)) continue;
-          levels[l].refined[ref.block * kCellWords + (ref.cell >> 6)] |= std::uint64_t{1}
-                                                                         << (ref.cell & 63);
-          ++stats.refined_cells;
-          split_cells.push_back(ijk);
-          const openvdb::Coord fine = ijk << 1;
-          for (int i = 0; i < 2; ++i)
-            for (int j = 0; j < 2; ++j)
-              for (int k = 0; k < 2; ++k) next_cells.push_back(fine.offsetBy(i, j, k));
-        }
+      const std::size_t splits = std::size_t(std::count(split.begin(), split.end(), 1));
+      split_cells.reserve(splits);
+      next_cells.reserve(8 * splits);
+      for (std::size_t c = 0; c < cells.size(); ++c) {
+        if (!split[c]) continue;
+        const CellRef& ref = where[c];
+        levels[l].refined[ref.block * kCellWords + (ref.cell >> 6)] |= std::uint64_t{1}
+                                                                       << (ref.cell & 63);
+        const openvdb::Coord& ijk = cells[c];
+        split_cells.push_back(ijk);
+        const openvdb::Coord fine = ijk << 1;
+        for (int i = 0; i < 2; ++i)
+          for (int j = 0; j < 2; ++j)
+            for (int k = 0; k < 2; ++k) next_cells.push_back(fine.offsetBy(i, j, k));
       }
+      stats.refined_cells += splits;
       const openvdb::MaskGrid::Ptr fine_nodes = nodesOfHalves(split_cells);
       if (next_cells.empty()) break;
       std::vector<openvdb::Coord> fine_origins;
