@@ -4,10 +4,13 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <tuple>
@@ -74,6 +77,25 @@ std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams
 
 namespace voxel {
 namespace {
+
+/// FIELDPATH_TRACE_BUILD=1: the build's phases on stderr (ms each), for finding where a build's
+/// host time goes (issue 15); silent otherwise.
+class PhaseTrace {
+ public:
+  PhaseTrace() : on_(std::getenv("FIELDPATH_TRACE_BUILD") != nullptr) {}
+  void lap(const std::string& what) {
+    if (!on_) return;
+    const auto now = std::chrono::steady_clock::now();
+    std::fprintf(stderr, "build trace: %-28s %8.1f ms\n", what.c_str(),
+                 std::chrono::duration<double, std::milli>(now - last_).count());
+    last_ = now;
+  }
+
+ private:
+  bool on_;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
 
 
 /// Whether x lies over (or under) the sampled surface: its nearest sample less than `over_mm`
@@ -187,13 +209,28 @@ struct NodeBuilder {
       closeness->setTransform(grid->transform().copy());
       closeness->setName("plane_closeness");
     }
+    PhaseTrace trace;
     std::vector<Leaf*> leaves;
     std::vector<FloatLeaf*> float_leaves;
+    // The leaves made (allocated and filled) in parallel, then added to the trees.
+    std::vector<std::unique_ptr<Leaf>> made(origins.size());
+    std::vector<std::unique_ptr<FloatLeaf>> made_float(ratio ? origins.size() : 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size()), [&](const auto& range) {
+      for (std::size_t l = range.begin(); l != range.end(); ++l) {
+        made[l] = std::make_unique<Leaf>(origins[l], openvdb::Vec3s(0.0f), false);
+        if (ratio) made_float[l] = std::make_unique<FloatLeaf>(origins[l], 0.0f, false);
+      }
+    });
     leaves.reserve(origins.size());
-    for (const auto& o : origins) {
-      leaves.push_back(grid->tree().touchLeaf(o));
-      if (ratio) float_leaves.push_back(closeness->tree().touchLeaf(o));
+    for (std::size_t l = 0; l < origins.size(); ++l) {
+      leaves.push_back(made[l].get());
+      grid->tree().addLeaf(made[l].release());  // the tree owns it
+      if (ratio) {
+        float_leaves.push_back(made_float[l].get());
+        closeness->tree().addLeaf(made_float[l].release());
+      }
     }
+    trace.lap("  leaves touched");
     const auto start = std::chrono::steady_clock::now();
     if (backend == FieldBackend::Reference)
       buildReference(h, leaves, float_leaves, only, progress);
@@ -201,7 +238,9 @@ struct NodeBuilder {
       buildBlocks(h, leaves, float_leaves, only, progress);
     nodes_seconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    trace.lap("  nodes and store");
     openvdb::tools::pruneInactive(grid->tree());
+    trace.lap("  prune");
     // (closeness keeps its leaves: its inactive nodes hold values, those beyond open edges.)
     return {grid, closeness};
   }
@@ -493,7 +532,9 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
                             PlaneLaw(params, weightPerMm2(samples, params)),
                             resolveBackend(request.backend),
                             std::nullopt};
+  PhaseTrace trace;
   if (builder.backend != FieldBackend::Reference) builder.table.emplace(samples, params.r0_mm);
+  trace.lap("cell list");
   const double reach_mm = builder.reach_mm;
 
   auto refuse = [&](const std::string& what, double nodes, double bytes_per_node) {
@@ -514,6 +555,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
   // Candidate leaves (8³ nodes): those within reach of a sample, inside the region.
   const Eigen::AlignedBox3d reach = reachBox(samples, params, request);
   const std::vector<openvdb::Coord> origins = candidateLeaves(samples, reach, h, reach_mm);
+  trace.lap("estimate, candidate leaves");
   // Full leaves: the values of a node, masks and header, and the query block (9³ × 16 bytes).
   refuse("candidate leaves hold", static_cast<double>(origins.size()) * Leaf::SIZE,
          static_cast<double>(sizeof(Leaf)) / Leaf::SIZE * value_bytes / 12.0 + 12.0 +
@@ -527,7 +569,9 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
   std::tie(levels[0].grid, levels[0].closeness) = builder.build(h, origins, nullptr, [&](double f) {
     common::report(request.progress, level0_share * f, "field");
   });
+  trace.lap("level 0 nodes");
   makeBlocks(levels[0], ratio);
+  trace.lap("level 0 blocks");
   std::optional<PlaneLaw> law;
   if (ratio) law = builder.law;
 
@@ -536,6 +580,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
   if (tolerance > 0.0 && refine_levels > 0) {
     const double floor = kRefineFloorFraction * builder.law.at(2.0 * params.r_min_mm);
     std::vector<openvdb::Coord> cells = cellsWithValues(levels[0]);
+    trace.lap("cells with values");
     const auto refine_start = std::chrono::steady_clock::now();
     const double nodes_before = builder.nodes_seconds;
     for (int l = 0; l < refine_levels && !cells.empty(); ++l) {
@@ -546,6 +591,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
       std::vector<char> split(cells.size(), 0);
       std::vector<CellRef> where(cells.size());
       const CellErrors errors(levels[std::size_t(l)], law, floor);
+      trace.lap("node errors");
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size()), [&](const auto& range) {
         auto acc = levels[std::size_t(l)].block_of->getConstUnsafeAccessor();
         for (std::size_t c = range.begin(); c != range.end(); ++c) {
@@ -573,7 +619,9 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
             for (int k = 0; k < 2; ++k) next_cells.push_back(fine.offsetBy(i, j, k));
       }
       stats.refined_cells += splits;
+      trace.lap("cell errors, split cells");
       const openvdb::MaskGrid::Ptr fine_nodes = nodesOfHalves(split_cells);
+      trace.lap("nodes of halves");
       if (next_cells.empty()) break;
       std::vector<openvdb::Coord> fine_origins;
       for (auto leaf = fine_nodes->tree().cbeginLeaf(); leaf; ++leaf)
@@ -591,10 +639,13 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
           builder.build(fine.h_mm, fine_origins, fine_nodes.get(), [&](double f) {
             common::report(request.progress, share_begin + (share_end - share_begin) * f, "field");
           });
+      trace.lap("level " + std::to_string(l + 1) + " nodes");
       fine.grid->setName(fine.grid->getName() + "_level" + std::to_string(l + 1));
       if (fine.closeness) fine.closeness->setName("plane_closeness_level" + std::to_string(l + 1));
       matchCoarserLevels(fine, levels, ratio);
+      trace.lap("hanging nodes");
       makeBlocks(fine, ratio);
+      trace.lap("blocks");
       stats.refined_nodes += fine.grid->activeVoxelCount();
       levels.push_back(std::move(fine));
       cells = std::move(next_cells);

@@ -68,18 +68,33 @@ void makeBlocks(Level& level, bool ratio) {
     std::optional<FloatGrid::ConstAccessor> closeness;
     if (ratio) closeness.emplace(level.closeness->getConstAccessor());
     for (std::size_t b = range.begin(); b != range.end(); ++b) {
-      const openvdb::Coord o = leaves[b]->origin();
+      const Leaf& leaf = *leaves[b];
+      const openvdb::Coord o = leaf.origin();
+      // The leaf's own 8³ from its buffers, the +1 layer (another leaf's) through accessors.
+      const FloatLeaf* float_leaf = ratio ? closeness->probeConstLeaf(o) : nullptr;
       std::uint64_t* over = &level.over[b * kBlockWords];
       for (int i = 0, n = 0; i < kBlockDim; ++i)
         for (int j = 0; j < kBlockDim; ++j)
           for (int k = 0; k < kBlockDim; ++k, ++n) {
-            const openvdb::Coord ijk = o.offsetBy(i, j, k);
-            const openvdb::Vec3s v = values.getValue(ijk);
+            openvdb::Vec3s v;
             float c = 0.0f;
-            if (ratio) {
-              c = closeness->getValue(ijk);
-              if (closeness->isValueOn(ijk)) over[n >> 6] |= std::uint64_t{1} << (n & 63);
+            bool on = false;
+            if (i < kLeafDim && j < kLeafDim && k < kLeafDim && (float_leaf || !ratio)) {
+              const openvdb::Index offset = openvdb::Index((i * kLeafDim + j) * kLeafDim + k);
+              v = leaf.getValue(offset);
+              if (ratio) {
+                c = float_leaf->getValue(offset);
+                on = float_leaf->isValueOn(offset);
+              }
+            } else {
+              const openvdb::Coord ijk = o.offsetBy(i, j, k);
+              v = values.getValue(ijk);
+              if (ratio) {
+                c = closeness->getValue(ijk);
+                on = closeness->isValueOn(ijk);
+              }
             }
+            if (on) over[n >> 6] |= std::uint64_t{1} << (n & 63);
             level.nodes[b * kBlockNodes + n] = {v.x(), v.y(), v.z(), c};
           }
     }
@@ -224,7 +239,7 @@ void matchCoarserLevels(Level& fine, const std::vector<Level>& coarser, bool rat
   std::vector<FloatLeaf*> closeness_leaves;
   for (auto it = fine.grid->tree().beginLeaf(); it; ++it) {
     leaves.push_back(&*it);
-    closeness_leaves.push_back(ratio ? fine.closeness->tree().touchLeaf(it->origin()) : nullptr);
+    closeness_leaves.push_back(ratio ? fine.closeness->tree().probeLeaf(it->origin()) : nullptr);
   }
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
     LevelAccessors acc = accessorsOf(coarser);

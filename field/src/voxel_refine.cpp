@@ -24,10 +24,15 @@ class NodeCurvature {
     if (law) closeness_.emplace(level.closeness->getConstAccessor());
   }
 
-  /// Of a built node (its value on); `inside`: over the surface's normal and s <= -depth_mm.
-  void at(const openvdb::Coord& ijk, double depth_mm, double& force, double& error, bool& inside) {
+  /// Of a built node (its value on) of `leaf` (closeness: its closeness leaf); `inside`: over
+  /// the surface's normal and s <= -depth_mm.
+  void at(const Leaf& leaf, const FloatLeaf* closeness, openvdb::Index offset, double depth_mm,
+          double& force, double& error, bool& inside) {
+    leaf_ = &leaf;
+    float_leaf_ = closeness;
+    const openvdb::Coord ijk = leaf.offsetToGlobalCoord(offset);
     const Read here = read(ijk);
-    inside = law_ && here.s <= -depth_mm && closeness_->isValueOn(ijk);
+    inside = law_ && here.s <= -depth_mm && here.over;
     double slope = 0.0;
     if (law_) {
       constexpr double kStepMm = 1e-4;
@@ -54,18 +59,29 @@ class NodeCurvature {
 
  private:
   struct Read {
-    bool built;
+    bool built, over;
     double s;
     Vec3 v;
   };
+  /// From the current leaf's buffers when ijk is in it (most reads), else through accessors.
   Read read(const openvdb::Coord& ijk) {
+    const openvdb::Coord o = leaf_->origin();
+    if (((ijk.x() - o.x()) | (ijk.y() - o.y()) | (ijk.z() - o.z())) >> 3 == 0 &&
+        (float_leaf_ || !law_)) {
+      const openvdb::Index n = Leaf::coordToOffset(ijk);
+      const openvdb::Vec3s v = leaf_->getValue(n);
+      return {leaf_->isValueOn(n), law_ && float_leaf_->isValueOn(n),
+              law_ ? law_->r0_mm - float_leaf_->getValue(n) : 0.0, Vec3(v.x(), v.y(), v.z())};
+    }
     const openvdb::Vec3s v = values_.getValue(ijk);
-    return {values_.isValueOn(ijk), law_ ? law_->r0_mm - closeness_->getValue(ijk) : 0.0,
-            Vec3(v.x(), v.y(), v.z())};
+    return {values_.isValueOn(ijk), law_ && closeness_->isValueOn(ijk),
+            law_ ? law_->r0_mm - closeness_->getValue(ijk) : 0.0, Vec3(v.x(), v.y(), v.z())};
   }
   Grid::ConstAccessor values_;
   std::optional<FloatGrid::ConstAccessor> closeness_;
   const std::optional<PlaneLaw>& law_;
+  const Leaf* leaf_ = nullptr;
+  const FloatLeaf* float_leaf_ = nullptr;
 };
 
 }  // namespace
@@ -84,11 +100,14 @@ CellErrors::CellErrors(const Level& level, const std::optional<PlaneLaw>& law, d
   const double depth_mm = 0.5 * std::sqrt(3.0) * level.h_mm;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
     NodeCurvature curvature(level, law);
+    std::optional<FloatGrid::ConstAccessor> closeness;
+    if (law) closeness.emplace(level.closeness->getConstAccessor());
     for (std::size_t b = range.begin(); b != range.end(); ++b) {
+      const FloatLeaf* float_leaf = law ? closeness->probeConstLeaf(leaves[b]->origin()) : nullptr;
       for (auto it = leaves[b]->cbeginValueOn(); it; ++it) {
         const std::size_t n = b * Leaf::SIZE + it.pos();
         bool inside = false;
-        curvature.at(it.getCoord(), depth_mm, force_[n], error_[n], inside);
+        curvature.at(*leaves[b], float_leaf, it.pos(), depth_mm, force_[n], error_[n], inside);
         built_[n >> 6] |= std::uint64_t{1} << (n & 63);
         if (inside) inside_[n >> 6] |= std::uint64_t{1} << (n & 63);
       }
