@@ -78,8 +78,8 @@ void addZeroTerms(const Law& L, const SampleSpan& s, int count, D3 at, Accum& a)
 
 /// The per-lane nearest samples merged into a (ties: lowest id).
 void mergeNearest(const double* best, const std::int64_t* best_id, const std::int64_t* best_at,
-                  Accum& a) {
-  for (int l = 0; l < kLanes; ++l)
+                  Accum& a, int lanes = kLanes) {
+  for (int l = 0; l < lanes; ++l)
     if (best_id[l] >= 0 && (best[l] < a.best_sq ||
                             (best[l] == a.best_sq && (a.best_id < 0 || best_id[l] < a.best_id)))) {
       a.best_sq = best[l];
@@ -248,15 +248,16 @@ void accumulateLanes(const Law& L, const SampleSpan& s, D3 at, bool track, Accum
   accumulateLanes(L, &s, 1, at, track, a);
 }
 
-/// Copies the leaf's gathered samples within sqrt(reach_sq) of the row's segment (x, y, [z0,
-/// z1]) to the row arrays (sized for them all), in their order; returns how many.
-int gatherRowGeneric(BlockScratch& s, double x, double y, double z0, double z1,
-                     double reach_sq) {
-  int n = 0;
+/// Copies the leaf's gathered samples whose squared distance d² to the row's segment (x, y,
+/// [z0, z1]) has lo_sq < d² <= hi_sq to the row arrays (sized for them all) from position n, in
+/// their order; returns the position after the last.
+int gatherRowGeneric(BlockScratch& s, double x, double y, double z0, double z1, double lo_sq,
+                     double hi_sq, int n) {
   for (std::size_t t = 0; t < s.x.size(); ++t) {
     const double dx = s.x[t] - x, dy = s.y[t] - y, z = s.z[t];
     const double dz = z < z0 ? z0 - z : z > z1 ? z - z1 : 0.0;
-    if (dx * dx + dy * dy + dz * dz > reach_sq) continue;
+    const double d2 = dx * dx + dy * dy + dz * dz;
+    if (!(d2 > lo_sq && d2 <= hi_sq)) continue;
     s.rx[n] = s.x[t];
     s.ry[n] = s.y[t];
     s.rz[n] = s.z[t];
@@ -273,12 +274,13 @@ int gatherRowGeneric(BlockScratch& s, double x, double y, double z0, double z1,
 #if defined(__x86_64__)
 /// gatherRowGeneric in AVX-512 lanes: the same test, the passing samples compress-stored.
 __attribute__((target("avx512f"))) int gatherRow512(BlockScratch& s, double x, double y,
-                                                     double z0, double z1, double reach_sq) {
+                                                     double z0, double z1, double lo_sq,
+                                                     double hi_sq, int n) {
   const __m512d vx = _mm512_set1_pd(x), vy = _mm512_set1_pd(y);
   const __m512d vz0 = _mm512_set1_pd(z0), vz1 = _mm512_set1_pd(z1);
-  const __m512d limit = _mm512_set1_pd(reach_sq), zero = _mm512_setzero_pd();
+  const __m512d lo = _mm512_set1_pd(lo_sq), hi = _mm512_set1_pd(hi_sq);
+  const __m512d zero = _mm512_setzero_pd();
   const int count = int(s.x.size());
-  int n = 0;
   for (int t = 0; t < count; t += kLanes) {
     const int left = count - t;
     const __mmask8 valid = left >= kLanes ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
@@ -291,7 +293,8 @@ __attribute__((target("avx512f"))) int gatherRow512(BlockScratch& s, double x, d
                                                          _mm512_sub_pd(pz, vz1)));
     const __m512d d2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
                                      _mm512_mul_pd(dz, dz));
-    const __mmask8 in = _mm512_mask_cmp_pd_mask(valid, d2, limit, _CMP_LE_OQ);
+    const __mmask8 in = _mm512_mask_cmp_pd_mask(_mm512_mask_cmp_pd_mask(valid, d2, hi, _CMP_LE_OQ),
+                                                d2, lo, _CMP_GT_OQ);
     if (!in) continue;
     _mm512_mask_compressstoreu_pd(s.rx.data() + n, in, px);
     _mm512_mask_compressstoreu_pd(s.ry.data() + n, in, py);
@@ -308,12 +311,110 @@ __attribute__((target("avx512f"))) int gatherRow512(BlockScratch& s, double x, d
 }
 #endif
 
-int gatherRow(BlockScratch& s, double x, double y, double z0, double z1, double reach_sq) {
+int gatherRow(BlockScratch& s, double x, double y, double z0, double z1, double lo_sq,
+              double hi_sq, int n) {
 #if defined(__x86_64__)
-  if (kHaveAvx512) return gatherRow512(s, x, y, z0, z1, reach_sq);
+  if (kHaveAvx512) return gatherRow512(s, x, y, z0, z1, lo_sq, hi_sq, n);
 #endif
-  return gatherRowGeneric(s, x, y, z0, z1, reach_sq);
+  return gatherRowGeneric(s, x, y, z0, z1, lo_sq, hi_sq, n);
 }
+
+#if defined(__x86_64__)
+/// The nearest sample per lane so far (rowFirstSums512).
+struct Nearest512 {
+  __m512d best;
+  __m512i id, at;
+};
+/// Sample (id, at) at squared distances r2 from the lanes' points: nearer (or as near with a
+/// lower id) replaces a lane's nearest.
+__attribute__((target("avx512f"), always_inline)) inline void trackNearest(Nearest512& n,
+                                                                          __m512d r2,
+                                                                          std::int64_t id,
+                                                                          std::int64_t at) {
+  const __m512i vid = _mm512_set1_epi64(id);
+  const __mmask8 closer = _mm512_cmp_pd_mask(r2, n.best, _CMP_LT_OQ) |
+                          (_mm512_cmp_pd_mask(r2, n.best, _CMP_EQ_OQ) &
+                           _mm512_cmplt_epi64_mask(vid, n.id));
+  if (closer) {
+    n.best = _mm512_mask_blend_pd(closer, n.best, r2);
+    n.id = _mm512_mask_blend_epi64(closer, n.id, vid);
+    n.at = _mm512_mask_blend_epi64(closer, n.at, _mm512_set1_epi64(at));
+  }
+}
+
+/// The first sums (kernel::probe's) of a row's 8 nodes at once, the nodes in the lanes: every
+/// sample of `core` (those within r0 of the row's segment) read once for the 8, eq. 1 summed for
+/// those within r0, the nearest within sqrt(init_sq) tracked (ties: lowest id); then, for nodes
+/// with no sample within r0 (the shell), the nearest among `ring` (the rest of the row's reach).
+/// Each node's terms as accumulate512's, summed in the samples' order.
+__attribute__((target("avx512f"))) void rowFirstSums512(const Law& L, const SampleSpan& core,
+                                                        const SampleSpan& ring, double x,
+                                                        double y, const double* node_z,
+                                                        double init_sq, Accum* out) {
+  const __m512d az = _mm512_loadu_pd(node_z);
+  const __m512d r0_sq = _mm512_set1_pd(L.r0_sq), inv_r_min = _mm512_set1_pd(1.0 / L.r_min);
+  const __m512d inv_r0 = _mm512_set1_pd(L.inv_r0);
+  const __m512d half = _mm512_set1_pd(0.5), three_halves = _mm512_set1_pd(1.5);
+  const __m512d one = _mm512_set1_pd(1.0), zero_v = _mm512_setzero_pd();
+  __m512d fx = zero_v, fy = zero_v, fz = zero_v;
+  Nearest512 near{_mm512_set1_pd(init_sq), _mm512_set1_epi64(-1), _mm512_set1_epi64(-1)};
+  __mmask8 zero = 0;
+  for (int j = 0; j < core.count; ++j) {
+    const __m512d dx = _mm512_set1_pd(x - core.x[j]), dy = _mm512_set1_pd(y - core.y[j]);
+    const __m512d dz = _mm512_sub_pd(az, _mm512_set1_pd(core.z[j]));
+    const __m512d r2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
+                                     _mm512_mul_pd(dz, dz));
+    const __mmask8 positive = _mm512_cmp_pd_mask(r2, zero_v, _CMP_GT_OQ);
+    const __mmask8 in = _mm512_mask_cmp_pd_mask(positive, r2, r0_sq, _CMP_LT_OQ);
+    zero |= _mm512_cmp_pd_mask(r2, zero_v, _CMP_EQ_OQ);
+    if (in) {
+      const __m512d r2s = _mm512_mask_blend_pd(in, one, r2);
+      __m512d yv = _mm512_rsqrt14_pd(r2s);  // 1/r, two Newton steps (as accumulate512)
+      const __m512d hr2 = _mm512_mul_pd(half, r2s);
+      yv = _mm512_mul_pd(yv, _mm512_fnmadd_pd(hr2, _mm512_mul_pd(yv, yv), three_halves));
+      yv = _mm512_mul_pd(yv, _mm512_fnmadd_pd(hr2, _mm512_mul_pd(yv, yv), three_halves));
+      const __m512d inv_rc = _mm512_min_pd(yv, inv_r_min);
+      const __m512d phi =
+          _mm512_mul_pd(_mm512_sub_pd(inv_rc, inv_r0), _mm512_mul_pd(inv_rc, inv_rc));
+      const __m512d c =
+          _mm512_maskz_mul_pd(in, _mm512_mul_pd(_mm512_set1_pd(core.w[j]), phi), yv);
+      fx = _mm512_mask3_fmadd_pd(c, dx, fx, in);
+      fy = _mm512_mask3_fmadd_pd(c, dy, fy, in);
+      fz = _mm512_mask3_fmadd_pd(c, dz, fz, in);
+    }
+    trackNearest(near, r2, core.id[j], core.base + j);
+  }
+  // The ring's samples lie farther than r0 from every node: only a shell node's nearest.
+  if (_mm512_cmp_pd_mask(near.best, r0_sq, _CMP_GE_OQ))
+    for (int j = 0; j < ring.count; ++j) {
+      const __m512d dx = _mm512_set1_pd(x - ring.x[j]), dy = _mm512_set1_pd(y - ring.y[j]);
+      const __m512d dz = _mm512_sub_pd(az, _mm512_set1_pd(ring.z[j]));
+      trackNearest(near,
+                   _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
+                                 _mm512_mul_pd(dz, dz)),
+                   ring.id[j], ring.base + j);
+    }
+  alignas(64) double f[3][kLanes], b[kLanes];
+  alignas(64) std::int64_t bid[kLanes], bat[kLanes];
+  _mm512_store_pd(f[0], fx);
+  _mm512_store_pd(f[1], fy);
+  _mm512_store_pd(f[2], fz);
+  _mm512_store_pd(b, near.best);
+  _mm512_store_epi64(bid, near.id);
+  _mm512_store_epi64(bat, near.at);
+  for (int l = 0; l < kLanes; ++l) {
+    Accum& a = out[l];
+    a = Accum{};
+    a.fx = f[0][l];
+    a.fy = f[1][l];
+    a.fz = f[2][l];
+    a.best_sq = b[l];
+    a.best_id = int(bid[l]);
+    a.best_at = int(bat[l]);
+    if ((zero >> l) & 1) addZeroTerms(L, core, core.count, D3{x, y, node_z[l]}, a);
+  }
+}
+#endif
 
 /// A leaf's neighbourhood: the samples gathered in [box_lo, box_hi] (mm) for sums whose ball
 /// lies inside that box, the cell list for the others (points lifted far off the leaf).
@@ -325,6 +426,11 @@ struct BlockHood {
   double row_x = 0, row_y = 0, row_z0 = 0, row_z1 = 0, row_reach = -1;
   const kernel::CellTable* cells;
   const ObstacleSamples* samples;
+  /// The row's nodes' first sums when made together (rowFirstSums512; null otherwise): a sum
+  /// with tracking at node k's point (first_z[k]) over first_radius is first[k].
+  const Accum* first = nullptr;
+  double first_z[kLanes] = {};
+  double first_radius = -1;
 
   /// Gathers the columns' spans, summed together in the lanes (in batches of kSpans).
   struct Visit {
@@ -345,6 +451,16 @@ struct BlockHood {
     }
   };
   void sum(D3 c, double radius, bool track, Accum& a) {
+    if (first && track && radius == first_radius && c.x == row_x && c.y == row_y)
+      for (int k = 0; k < kLanes; ++k)
+        if (c.z == first_z[k]) {
+          a.fx += first[k].fx;
+          a.fy += first[k].fy;
+          a.fz += first[k].fz;
+          const std::int64_t id = first[k].best_id, at = first[k].best_at;
+          mergeNearest(&first[k].best_sq, &id, &at, a, 1);
+          return;
+        }
     // Distance from c to the row's segment (x, y, [z0, z1]).
     const double dz = c.z < row_z0 ? row_z0 - c.z : c.z > row_z1 ? c.z - row_z1 : 0.0;
     const double dx = c.x - row_x, dy = c.y - row_y;
@@ -441,6 +557,13 @@ void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, co
   scratch.rid.resize(scratch.x.size());
   const double row_reach = reach * (1.0 + 1e-12);
   hood.row_reach = reach;
+  const double core_sq = job.law.r0_sq * (1.0 + 1e-12);
+  // probe()'s first sum: radius max(reach, r0), the nearest tracked from its square.
+  double first_sq = kernel::dmax(job.rules.reach_mm, job.law.r0);
+  first_sq *= first_sq;
+  hood.first_radius = std::sqrt(first_sq);
+  for (int k = 0; k < kLanes; ++k) hood.first_z[k] = (leaf.origin[2] + k) * h;
+  Accum first[kLanes];
   for (int row = 0; row < 64; ++row) {
     const std::uint64_t bits8 = (leaf.mask[row >> 3] >> ((row & 7) * 8)) & 0xffu;
     if (!bits8) continue;
@@ -449,11 +572,24 @@ void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, co
     hood.row_y = (leaf.origin[1] + j) * h;
     hood.row_z0 = leaf.origin[2] * h;
     hood.row_z1 = (leaf.origin[2] + 7) * h;
-    const int n = gatherRow(scratch, hood.row_x, hood.row_y, hood.row_z0, hood.row_z1,
-                            row_reach * row_reach);
+    // The samples within r0 of the segment first (the core: every term of the row's first
+    // sums), then the rest within reach (the ring: only a shell node's nearest).
+    const int core = gatherRow(scratch, hood.row_x, hood.row_y, hood.row_z0, hood.row_z1, -1.0,
+                               core_sq, 0);
+    const int n = gatherRow(scratch, hood.row_x, hood.row_y, hood.row_z0, hood.row_z1, core_sq,
+                            row_reach * row_reach, core);
     hood.row = SampleSpan{scratch.rx.data(),  scratch.ry.data(),  scratch.rz.data(),
                           scratch.rnx.data(), scratch.rny.data(), scratch.rnz.data(),
                           scratch.rw.data(),  scratch.rid.data(), n, 0};
+#if defined(__x86_64__)
+    if (kHaveAvx512) {
+      SampleSpan core_span = hood.row, ring_span = tail(hood.row, core);
+      core_span.count = core;
+      rowFirstSums512(job.law, core_span, ring_span, hood.row_x, hood.row_y, hood.first_z,
+                      first_sq, first);
+      hood.first = first;
+    }
+#endif
     for (int k = 0; k < 8; ++k) {
       if (!((bits8 >> k) & 1u)) continue;
       const D3 x{hood.row_x, hood.row_y, (leaf.origin[2] + k) * h};
