@@ -60,7 +60,8 @@ void makeBlocks(Level& level, bool ratio) {
     for (std::size_t b = 0; b < leaves.size(); ++b)
       acc.setValueOn(leaves[b]->origin() >> 3, static_cast<int>(b));
   }
-  level.nodes.assign(leaves.size() * kBlockNodes, {0.0f, 0.0f, 0.0f, 0.0f});
+  level.nodes.clear();
+  level.nodes.resize(leaves.size() * kBlockNodes);  // every entry written below
   level.over.assign(leaves.size() * kBlockWords, 0);
   level.refined.assign(leaves.size() * kCellWords, 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {

@@ -93,8 +93,8 @@ CellErrors::CellErrors(const Level& level, const std::optional<PlaneLaw>& law, d
   for (auto it = level.grid->tree().cbeginLeaf(); it; ++it) leaves.push_back(&*it);
   if (leaves.size() != level.blocks())
     throw std::logic_error("CellErrors: the level's blocks are not its leaves");
-  force_.assign(leaves.size() * Leaf::SIZE, 0.0);
-  error_.assign(leaves.size() * Leaf::SIZE, 0.0);
+  force_.resize(leaves.size() * Leaf::SIZE);  // written for the built nodes, read for them only
+  error_.resize(leaves.size() * Leaf::SIZE);
   built_.assign(leaves.size() * kCellWords, 0);
   inside_.assign(leaves.size() * kCellWords, 0);
   const double depth_mm = 0.5 * std::sqrt(3.0) * level.h_mm;
