@@ -97,7 +97,9 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   cmd->add_option("--refine", options->refine,
                   "Refinement tolerances, %, one per voxel size (0: none): adds a refined "
-                  "trilinear variant of that size per stored quantity");
+                  "trilinear variant of that size per stored quantity (a size listed twice, "
+                  "e.g. --voxels 0.5,0.5 --refine 0.5,1, is refined to both, its uniform "
+                  "variants made once)");
   cmd->add_option("--refine-levels", options->refine_levels,
                   "Levels below the voxel size the refined variants may go")
       ->capture_default_str();

@@ -351,17 +351,27 @@ StudyResult runStudy(const StudyRequest& request) {
   if (request.refine_levels < 1 || request.refine_levels > 6)
     throw InputError("--refine-levels: must be in [1, 6]");
   const std::size_t first_voxel = variants.size();
+  // A size listed twice (to be refined to two tolerances) gets its uniform variants once.
+  auto listed = [&](const StudyVariant& v) {
+    return std::any_of(variants.begin(), variants.end(), [&](const StudyVariant& w) {
+      return w.name() == v.name();
+    });
+  };
   for (std::size_t k = 0; k < request.voxel_sizes_mm.size(); ++k) {
     const double h = request.voxel_sizes_mm[k];
     for (field::StoredQuantity stored : request.stored)
-      for (field::Interpolation interp : request.interpolations)
-        variants.push_back({pathgen::FieldMode::Voxel, {h, interp, stored, 0.0, 0}});
+      for (field::Interpolation interp : request.interpolations) {
+        const StudyVariant uniform{pathgen::FieldMode::Voxel, {h, interp, stored, 0.0, 0}};
+        if (!listed(uniform)) variants.push_back(uniform);
+      }
     const double tolerance = request.refine_tolerances.empty() ? 0.0 : request.refine_tolerances[k];
     if (tolerance > 0.0)
-      for (field::StoredQuantity stored : request.stored)
-        variants.push_back(
-            {pathgen::FieldMode::Voxel,
-             {h, field::Interpolation::Trilinear, stored, tolerance, request.refine_levels}});
+      for (field::StoredQuantity stored : request.stored) {
+        const StudyVariant refined{
+            pathgen::FieldMode::Voxel,
+            {h, field::Interpolation::Trilinear, stored, tolerance, request.refine_levels}};
+        if (!listed(refined)) variants.push_back(refined);
+      }
   }
   if (!request.backends.empty()) {  // each voxel variant once per build, side by side
     std::vector<StudyVariant> built(variants.begin(), variants.begin() + long(first_voxel));
