@@ -15,14 +15,16 @@ sed -e "s/refine_tolerance: 0 /refine_tolerance: $tol /" "$scene" > "$tmp/scene.
 grep -q "refine_tolerance: $tol " "$tmp/scene.yaml" || { echo "no 'refine_tolerance: 0 ' in $scene"; exit 1; }
 scene=$tmp/scene.yaml
 build_s() { grep -oE "build [0-9.]+ s" | head -1 | awk '{print $2}'; }
+counts() { grep -oE "[0-9]+ samples|active nodes: [0-9]+" | tr '\n' ' '; }
 declare -a o n
 for ((r = 1; r <= reps; r++)); do
-  o+=("$("$old" field build "$scene" --voxel "$h" --out "$tmp/o.vdb" 2>&1 | build_s)")
-  n+=("$("$new" field build "$scene" --voxel "$h" --backend "$backend" --out "$tmp/n.vdb" 2>&1 | build_s)")
+  "$old" field build "$scene" --voxel "$h" --out "$tmp/o.vdb" > "$tmp/o.txt" 2>&1
+  "$new" field build "$scene" --voxel "$h" --backend "$backend" --out "$tmp/n.vdb" > "$tmp/n.txt" 2>&1
+  o+=("$(build_s < "$tmp/o.txt")")
+  n+=("$(build_s < "$tmp/n.txt")")
   echo "rep $r: old ${o[-1]} s, new ($backend) ${n[-1]} s"
 done
-nodes() { "$1" field build "$scene" --voxel "$h" $2 --out "$tmp/x.vdb" 2>&1 | grep -oE "[0-9]+ samples|active nodes: [0-9]+" | tr '\n' ' '; }
+echo "old: $(counts < "$tmp/o.txt"); new: $(counts < "$tmp/n.txt")"
 median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2}'; }
 mo=$(median "${o[@]}") mn=$(median "${n[@]}")
-echo "old: $(nodes "$old" "") ; new: $(nodes "$new" "--backend $backend")"
 echo "median of $reps: old $mo s, new $mn s, x $(awk -v a="$mo" -v b="$mn" 'BEGIN {printf "%.2f", a / b}')"

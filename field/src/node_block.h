@@ -55,8 +55,8 @@ void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, co
                     const LeafTask& leaf, BlockScratch& scratch, kernel::NodeValue* out);
 
 /// The values of the masked nodes of every leaf on the GPU (node_cuda.h).
-inline std::vector<kernel::NodeValue> buildNodesCuda(const SampleTable& table, const NodeJob& job,
-                                                     const std::vector<LeafTask>& leaves) {
+inline kernel::NodeValues buildNodesCuda(const SampleTable& table, const NodeJob& job,
+                                         const std::vector<LeafTask>& leaves) {
   return kernel::buildNodesCuda(cellTableOf(table), job, leaves);
 }
 

@@ -66,8 +66,8 @@ bool cudaNodeBuildAvailable() {
   return available;
 }
 
-std::vector<NodeValue> buildNodesCuda(const CellTable& table, const NodeJob& job,
-                                      const std::vector<LeafTask>& leaves) {
+NodeValues buildNodesCuda(const CellTable& table, const NodeJob& job,
+                          const std::vector<LeafTask>& leaves) {
   std::vector<unsigned long long> first(leaves.size() + 1, 0);
   for (std::size_t l = 0; l < leaves.size(); ++l) {
     unsigned long long n = 0;
@@ -75,7 +75,7 @@ std::vector<NodeValue> buildNodesCuda(const CellTable& table, const NodeJob& job
     first[l + 1] = first[l] + n;
   }
   const std::size_t nodes = first.back();
-  std::vector<NodeValue> values(nodes);
+  NodeValues values{std::unique_ptr<NodeValue[]>(new NodeValue[nodes]), nodes};  // not zeroed
   if (nodes == 0) return values;
   cudaStream_t stream;
   FP_CUDA_CHECK(cudaStreamCreate(&stream));
@@ -99,7 +99,7 @@ std::vector<NodeValue> buildNodesCuda(const CellTable& table, const NodeJob& job
   nodeKernel<<<unsigned(leaves.size()), 512, 0, stream>>>(device, job, tasks.ptr, firsts.ptr,
                                                           out.ptr);
   FP_CUDA_CHECK(cudaGetLastError());
-  FP_CUDA_CHECK(cudaMemcpyAsync(values.data(), out.ptr, nodes * sizeof(NodeValue),
+  FP_CUDA_CHECK(cudaMemcpyAsync(values.data.get(), out.ptr, nodes * sizeof(NodeValue),
                                 cudaMemcpyDeviceToHost, stream));
   FP_CUDA_CHECK(cudaStreamSynchronize(stream));
   return values;

@@ -7,8 +7,7 @@ namespace fieldpath::field::kernel {
 
 bool cudaNodeBuildAvailable() { return false; }
 
-std::vector<NodeValue> buildNodesCuda(const CellTable&, const NodeJob&,
-                                      const std::vector<LeafTask>&) {
+NodeValues buildNodesCuda(const CellTable&, const NodeJob&, const std::vector<LeafTask>&) {
   throw std::runtime_error("field: this program was built without CUDA (FIELDPATH_WITH_CUDA)");
 }
 

@@ -1,6 +1,8 @@
 #pragma once
 /// Internal to field/: the CUDA node build (node_build_cuda.cu; node_build_stub.cpp without
 /// CUDA). Plain types only (node_kernel.h), so that nvcc sees no Eigen and no OpenVDB.
+#include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "node_kernel.h"
@@ -10,11 +12,19 @@ namespace fieldpath::field::kernel {
 /// Whether the CUDA build is compiled in and a device is present (any CUDA error: no).
 bool cudaNodeBuildAvailable();
 
+/// A build's node values, left uninitialised until the device's are copied in (zeroing the
+/// 100 MB of a refined level first cost 30 ms on the GPU machine).
+struct NodeValues {
+  std::unique_ptr<NodeValue[]> data;
+  std::size_t size = 0;
+  const NodeValue& operator[](std::size_t i) const { return data[i]; }
+};
+
 /// The values of the masked nodes of every leaf, computed on the GPU from the cell list
 /// (`table`'s pointers are host memory; copied over), compacted in leaf order then node offset
 /// order (a leaf's values start at the sum of the popcounts of the masks before it). Throws
 /// std::runtime_error (with file and line) on a CUDA error, or without CUDA.
-std::vector<NodeValue> buildNodesCuda(const CellTable& table, const NodeJob& job,
-                                      const std::vector<LeafTask>& leaves);
+NodeValues buildNodesCuda(const CellTable& table, const NodeJob& job,
+                          const std::vector<LeafTask>& leaves);
 
 }  // namespace fieldpath::field::kernel

@@ -3,6 +3,7 @@
 /// cells (voxel_grid.h; the queries: voxel_field.cpp).
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -222,12 +223,18 @@ struct NodeBuilder {
       }
     });
     leaves.reserve(origins.size());
-    for (std::size_t l = 0; l < origins.size(); ++l) {
-      leaves.push_back(made[l].get());
-      grid->tree().addLeaf(made[l].release());  // the tree owns it
-      if (ratio) {
-        float_leaves.push_back(made_float[l].get());
-        closeness->tree().addLeaf(made_float[l].release());
+    {
+      // Through accessors: the origins are sorted, so most share the accessor's cached path.
+      auto values = grid->getAccessor();
+      std::optional<FloatGrid::Accessor> closenesses;
+      if (ratio) closenesses.emplace(closeness->getAccessor());
+      for (std::size_t l = 0; l < origins.size(); ++l) {
+        leaves.push_back(made[l].get());
+        values.addLeaf(made[l].release());  // the tree owns it
+        if (ratio) {
+          float_leaves.push_back(made_float[l].get());
+          closenesses->addLeaf(made_float[l].release());
+        }
       }
     }
     trace.lap("  leaves touched");
@@ -294,7 +301,7 @@ struct NodeBuilder {
     const std::vector<LeafTask> tasks = tasksOf(leaves, only);
     const NodeJob job = jobAt(h);
     if (backend == FieldBackend::Cuda) {
-      const std::vector<kernel::NodeValue> values = buildNodesCuda(*table, job, tasks);
+      const kernel::NodeValues values = buildNodesCuda(*table, job, tasks);
       std::vector<std::size_t> first(tasks.size() + 1, 0);
       for (std::size_t l = 0; l < tasks.size(); ++l) {
         std::size_t n = 0;
@@ -454,8 +461,13 @@ std::vector<openvdb::Coord> candidateLeaves(const ObstacleSamples& samples,
     return (std::size_t((i - box_lo.x()) / kLeafDim) * dim.y() + (j - box_lo.y()) / kLeafDim) *
                dim.z() + (k - box_lo.z()) / kLeafDim;
   };
-  for (const Vec3& q : samples.points_mm)
-    leavesNear(q, [&](int i, int j, int k) { near[at(i, j, k)] = 1; });
+  // The samples in parallel: a leaf's byte may be set by several threads (the same 1).
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, samples.size(), 256), [&](const auto& r) {
+    for (std::size_t s = r.begin(); s != r.end(); ++s)
+      leavesNear(samples.points_mm[s], [&](int i, int j, int k) {
+        std::atomic_ref<std::uint8_t>(near[at(i, j, k)]).store(1, std::memory_order_relaxed);
+      });
+  });
   for (int i = box_lo.x(); i <= box_hi.x(); i += kLeafDim)  // sorted: x, then y, then z
     for (int j = box_lo.y(); j <= box_hi.y(); j += kLeafDim)
       for (int k = box_lo.z(); k <= box_hi.z(); k += kLeafDim)
@@ -547,6 +559,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
                              "; use a coarser voxel size or a smaller region");
   };
   built.stats.estimated_nodes = estimateVoxelNodes(samples, params, request);
+  trace.lap("estimate");
   // The plane ratio adds a float to the Vec3f of a node.
   const double value_bytes = ratio ? 16.0 : 12.0;
   refuse("estimated", static_cast<double>(built.stats.estimated_nodes),
@@ -555,7 +568,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
   // Candidate leaves (8³ nodes): those within reach of a sample, inside the region.
   const Eigen::AlignedBox3d reach = reachBox(samples, params, request);
   const std::vector<openvdb::Coord> origins = candidateLeaves(samples, reach, h, reach_mm);
-  trace.lap("estimate, candidate leaves");
+  trace.lap("candidate leaves");
   // Full leaves: the values of a node, masks and header, and the query block (9³ × 16 bytes).
   refuse("candidate leaves hold", static_cast<double>(origins.size()) * Leaf::SIZE,
          static_cast<double>(sizeof(Leaf)) / Leaf::SIZE * value_bytes / 12.0 + 12.0 +
