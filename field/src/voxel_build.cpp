@@ -615,22 +615,27 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
         }
       });
       stats.tested_cells += cells.size();
-      std::vector<openvdb::Coord> split_cells, next_cells;
-      const std::size_t splits = std::size_t(std::count(split.begin(), split.end(), 1));
-      split_cells.reserve(splits);
-      next_cells.reserve(8 * splits);
+      // The split cells' bits (serial: cells share a block's words), then their list and
+      // their halves' at each one's rank among them (in parallel, the cells' order).
+      std::vector<std::size_t> rank(cells.size() + 1, 0);
       for (std::size_t c = 0; c < cells.size(); ++c) {
+        rank[c + 1] = rank[c] + std::size_t(split[c]);
         if (!split[c]) continue;
         const CellRef& ref = where[c];
         levels[l].refined[ref.block * kCellWords + (ref.cell >> 6)] |= std::uint64_t{1}
                                                                        << (ref.cell & 63);
-        const openvdb::Coord& ijk = cells[c];
-        split_cells.push_back(ijk);
-        const openvdb::Coord fine = ijk << 1;
-        for (int i = 0; i < 2; ++i)
-          for (int j = 0; j < 2; ++j)
-            for (int k = 0; k < 2; ++k) next_cells.push_back(fine.offsetBy(i, j, k));
       }
+      const std::size_t splits = rank.back();
+      std::vector<openvdb::Coord> split_cells(splits), next_cells(8 * splits);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size()), [&](const auto& range) {
+        for (std::size_t c = range.begin(); c != range.end(); ++c) {
+          if (!split[c]) continue;
+          split_cells[rank[c]] = cells[c];
+          const openvdb::Coord fine = cells[c] << 1;
+          for (int h8 = 0; h8 < 8; ++h8)
+            next_cells[8 * rank[c] + std::size_t(h8)] = fine.offsetBy(h8 >> 2, (h8 >> 1) & 1, h8 & 1);
+        }
+      });
       stats.refined_cells += splits;
       trace.lap("cell errors, split cells");
       const openvdb::MaskGrid::Ptr fine_nodes = nodesOfHalves(split_cells);
