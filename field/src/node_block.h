@@ -54,10 +54,4 @@ struct BlockScratch {
 void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, const NodeJob& job,
                     const LeafTask& leaf, BlockScratch& scratch, kernel::NodeValue* out);
 
-/// The values of the masked nodes of every leaf on the GPU (node_cuda.h).
-inline kernel::NodeValues buildNodesCuda(const SampleTable& table, const NodeJob& job,
-                                         const std::vector<LeafTask>& leaves) {
-  return kernel::buildNodesCuda(cellTableOf(table), job, leaves);
-}
-
 }  // namespace fieldpath::field

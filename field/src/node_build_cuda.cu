@@ -4,6 +4,7 @@
 #include <cuda_runtime.h>
 
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -66,43 +67,81 @@ bool cudaNodeBuildAvailable() {
   return available;
 }
 
-NodeValues buildNodesCuda(const CellTable& table, const NodeJob& job,
-                          const std::vector<LeafTask>& leaves) {
-  std::vector<unsigned long long> first(leaves.size() + 1, 0);
+struct CudaNodeBuild::State {
+  struct Stream {
+    cudaStream_t s = nullptr;
+    Stream() { FP_CUDA_CHECK(cudaStreamCreate(&s)); }
+    ~Stream() {
+      if (s) cudaStreamDestroy(s);
+    }
+  } stream;
+  std::vector<unsigned long long> first;
+  std::size_t nodes = 0;
+  // The device's copies (freed on scope exit; the stream is synchronised first, ~CudaNodeBuild).
+  std::unique_ptr<DeviceArray<double>> x, y, z, nx, ny, nz, w;
+  std::unique_ptr<DeviceArray<std::int32_t>> id, starts;
+  std::unique_ptr<DeviceArray<LeafTask>> tasks;
+  std::unique_ptr<DeviceArray<unsigned long long>> firsts;
+  std::unique_ptr<DeviceArray<NodeValue>> out;
+};
+
+CudaNodeBuild::CudaNodeBuild(const CellTable& table, const NodeJob& job,
+                             const std::vector<LeafTask>& leaves)
+    : state_(std::make_unique<State>()) {
+  State& st = *state_;
+  st.first.assign(leaves.size() + 1, 0);
   for (std::size_t l = 0; l < leaves.size(); ++l) {
     unsigned long long n = 0;
     for (std::uint64_t word : leaves[l].mask) n += std::uint64_t(__builtin_popcountll(word));
-    first[l + 1] = first[l] + n;
+    st.first[l + 1] = st.first[l] + n;
   }
-  const std::size_t nodes = first.back();
-  NodeValues values{std::unique_ptr<NodeValue[]>(new NodeValue[nodes]), nodes};  // not zeroed
-  if (nodes == 0) return values;
-  cudaStream_t stream;
-  FP_CUDA_CHECK(cudaStreamCreate(&stream));
-  struct StreamGuard {
-    cudaStream_t s;
-    ~StreamGuard() { cudaStreamDestroy(s); }
-  } guard{stream};
+  st.nodes = st.first.back();
+  if (st.nodes == 0) return;
+  cudaStream_t stream = st.stream.s;
   const std::size_t n = std::size_t(table.all.count);
   const std::size_t cells = std::size_t(table.dim[0]) * table.dim[1] * table.dim[2] + 1;
-  DeviceArray<double> x(table.all.x, n, stream), y(table.all.y, n, stream),
-      z(table.all.z, n, stream), nx(table.all.nx, n, stream), ny(table.all.ny, n, stream),
-      nz(table.all.nz, n, stream), w(table.all.w, n, stream);
-  DeviceArray<std::int32_t> id(table.all.id, n, stream), starts(table.cell_start, cells, stream);
-  DeviceArray<LeafTask> tasks(leaves.data(), leaves.size(), stream);
-  DeviceArray<unsigned long long> firsts(first.data(), first.size(), stream);
-  DeviceArray<NodeValue> out(nodes);
+  // Host-to-device copies from pageable memory return once staged: the sources may go.
+  auto up = [&](const double* host) { return std::make_unique<DeviceArray<double>>(host, n, stream); };
+  st.x = up(table.all.x);
+  st.y = up(table.all.y);
+  st.z = up(table.all.z);
+  st.nx = up(table.all.nx);
+  st.ny = up(table.all.ny);
+  st.nz = up(table.all.nz);
+  st.w = up(table.all.w);
+  st.id = std::make_unique<DeviceArray<std::int32_t>>(table.all.id, n, stream);
+  st.starts = std::make_unique<DeviceArray<std::int32_t>>(table.cell_start, cells, stream);
+  st.tasks = std::make_unique<DeviceArray<LeafTask>>(leaves.data(), leaves.size(), stream);
+  st.firsts = std::make_unique<DeviceArray<unsigned long long>>(st.first.data(), st.first.size(),
+                                                                stream);
+  st.out = std::make_unique<DeviceArray<NodeValue>>(st.nodes);
   CellTable device = table;
-  device.all = SampleSpan{x.ptr, y.ptr, z.ptr, nx.ptr, ny.ptr, nz.ptr, w.ptr, id.ptr,
-                          table.all.count, 0};
-  device.cell_start = starts.ptr;
-  nodeKernel<<<unsigned(leaves.size()), 512, 0, stream>>>(device, job, tasks.ptr, firsts.ptr,
-                                                          out.ptr);
+  device.all = SampleSpan{st.x->ptr, st.y->ptr, st.z->ptr, st.nx->ptr, st.ny->ptr, st.nz->ptr,
+                          st.w->ptr, st.id->ptr, table.all.count, 0};
+  device.cell_start = st.starts->ptr;
+  nodeKernel<<<unsigned(leaves.size()), 512, 0, stream>>>(device, job, st.tasks->ptr,
+                                                          st.firsts->ptr, st.out->ptr);
   FP_CUDA_CHECK(cudaGetLastError());
-  FP_CUDA_CHECK(cudaMemcpyAsync(values.data.get(), out.ptr, nodes * sizeof(NodeValue),
-                                cudaMemcpyDeviceToHost, stream));
-  FP_CUDA_CHECK(cudaStreamSynchronize(stream));
+}
+
+CudaNodeBuild::~CudaNodeBuild() {
+  if (state_ && state_->stream.s) cudaStreamSynchronize(state_->stream.s);  // before the frees
+}
+
+NodeValues CudaNodeBuild::finish() {
+  State& st = *state_;
+  NodeValues values{std::unique_ptr<NodeValue[]>(new NodeValue[st.nodes]), st.nodes};  // not zeroed
+  if (st.nodes == 0) return values;
+  FP_CUDA_CHECK(cudaMemcpyAsync(values.data.get(), st.out->ptr, st.nodes * sizeof(NodeValue),
+                                cudaMemcpyDeviceToHost, st.stream.s));
+  FP_CUDA_CHECK(cudaStreamSynchronize(st.stream.s));
   return values;
+}
+
+NodeValues buildNodesCuda(const CellTable& table, const NodeJob& job,
+                          const std::vector<LeafTask>& leaves) {
+  CudaNodeBuild build(table, job, leaves);
+  return build.finish();
 }
 
 }  // namespace fieldpath::field::kernel

@@ -27,4 +27,20 @@ struct NodeValues {
 NodeValues buildNodesCuda(const CellTable& table, const NodeJob& job,
                           const std::vector<LeafTask>& leaves);
 
+/// buildNodesCuda in two halves, so that the host works while the device computes: the
+/// constructor copies the samples and tasks over and starts the kernel (returning at once), and
+/// finish() waits for it and brings the values back. Throws as buildNodesCuda.
+class CudaNodeBuild {
+ public:
+  CudaNodeBuild(const CellTable& table, const NodeJob& job, const std::vector<LeafTask>& leaves);
+  ~CudaNodeBuild();
+  CudaNodeBuild(const CudaNodeBuild&) = delete;
+  CudaNodeBuild& operator=(const CudaNodeBuild&) = delete;
+  NodeValues finish();
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
 }  // namespace fieldpath::field::kernel

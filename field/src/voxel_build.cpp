@@ -211,6 +211,15 @@ struct NodeBuilder {
       closeness->setName("plane_closeness");
     }
     PhaseTrace trace;
+    auto start = std::chrono::steady_clock::now();
+    // The tasks from the origins; on the GPU the nodes are started now and computed while the
+    // host makes the leaves below (their values are stored when both are done).
+    std::vector<LeafTask> tasks;
+    if (backend != FieldBackend::Reference) tasks = tasksOf(origins, only);
+    std::optional<kernel::CudaNodeBuild> gpu;
+    if (backend == FieldBackend::Cuda) gpu.emplace(cellTableOf(*table), jobAt(h), tasks);
+    const double started_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::vector<Leaf*> leaves;
     std::vector<FloatLeaf*> float_leaves;
     // The leaves made (allocated and filled) in parallel, then added to the trees.
@@ -238,12 +247,12 @@ struct NodeBuilder {
       }
     }
     trace.lap("  leaves touched");
-    const auto start = std::chrono::steady_clock::now();
+    start = std::chrono::steady_clock::now();
     if (backend == FieldBackend::Reference)
       buildReference(h, leaves, float_leaves, only, progress);
     else
-      buildBlocks(h, leaves, float_leaves, only, progress);
-    nodes_seconds +=
+      buildBlocks(h, leaves, float_leaves, tasks, gpu ? &*gpu : nullptr, progress);
+    nodes_seconds += started_s +
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     trace.lap("  nodes and store");
     openvdb::tools::pruneInactive(grid->tree());
@@ -274,15 +283,15 @@ struct NodeBuilder {
   }
 
   /// The leaves' tasks: every node, or those on in `only`.
-  static std::vector<LeafTask> tasksOf(const std::vector<Leaf*>& leaves,
+  static std::vector<LeafTask> tasksOf(const std::vector<openvdb::Coord>& origins,
                                        const openvdb::MaskGrid* only) {
-    std::vector<LeafTask> tasks(leaves.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
+    std::vector<LeafTask> tasks(origins.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size()), [&](const auto& range) {
       std::optional<openvdb::MaskGrid::ConstAccessor> wanted;
       if (only) wanted.emplace(only->getConstAccessor());
       for (std::size_t l = range.begin(); l != range.end(); ++l) {
         LeafTask& t = tasks[l];
-        const openvdb::Coord o = leaves[l]->origin();
+        const openvdb::Coord& o = origins[l];
         for (int a = 0; a < 3; ++a) t.origin[a] = o[a];
         const auto* mask_leaf = wanted ? wanted->probeConstLeaf(o) : nullptr;
         for (int word = 0; word < 8; ++word)
@@ -294,14 +303,14 @@ struct NodeBuilder {
     return tasks;
   }
 
-  /// The block builds: on the GPU (all leaves at once) or on the CPU leaf by leaf.
+  /// The block builds: on the GPU (all leaves at once, started by the caller: `gpu`) or on the
+  /// CPU leaf by leaf.
   void buildBlocks(double h, const std::vector<Leaf*>& leaves,
-                   const std::vector<FloatLeaf*>& float_leaves, const openvdb::MaskGrid* only,
-                   const std::function<void(double)>& progress) const {
-    const std::vector<LeafTask> tasks = tasksOf(leaves, only);
+                   const std::vector<FloatLeaf*>& float_leaves, const std::vector<LeafTask>& tasks,
+                   kernel::CudaNodeBuild* gpu, const std::function<void(double)>& progress) const {
     const NodeJob job = jobAt(h);
-    if (backend == FieldBackend::Cuda) {
-      const kernel::NodeValues values = buildNodesCuda(*table, job, tasks);
+    if (gpu) {
+      const kernel::NodeValues values = gpu->finish();
       std::vector<std::size_t> first(tasks.size() + 1, 0);
       for (std::size_t l = 0; l < tasks.size(); ++l) {
         std::size_t n = 0;
