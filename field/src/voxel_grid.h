@@ -293,6 +293,14 @@ class CellErrors {
 /// Cells of a level to test: every cell of a block with a non-zero corner (index coordinates).
 std::vector<openvdb::Coord> cellsWithValues(const Level& level);
 
+/// Origins (index space) of the leaves of a level of size h within reach_mm of a sample and
+/// inside `reach` (the region's box), sorted (voxel_leaves.cpp).
+std::vector<openvdb::Coord> candidateLeaves(const ObstacleSamples& samples,
+                                            const Eigen::AlignedBox3d& reach, double h,
+                                            double reach_mm);
+/// The nodes of the halves of `cells` (3³ a cell at the next level) on a mask (voxel_leaves.cpp).
+openvdb::MaskGrid::Ptr nodesOfHalves(const std::vector<openvdb::Coord>& cells);
+
 /// The levels of a voxel field built from the samples (voxel_build.cpp): level 0 at h, then
 /// the refined levels; the stats but for memory and the dense box.
 struct BuiltLevels {

@@ -1,0 +1,159 @@
+/// Which leaves and nodes a level of the voxel field has (voxel_grid.h): the estimate of a
+/// build's nodes before it allocates, the candidate leaves within reach of a sample, and the
+/// nodes of the halves of a level's split cells. Split out of voxel_build.cpp.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include <openvdb/tools/Morphology.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include "voxel_grid.h"
+
+namespace fieldpath::field {
+
+using namespace voxel;
+
+std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams& params,
+                               const VoxelRequest& request) {
+  const double h = request.voxel_size_mm;
+  checkVoxelSize(h);
+  const Eigen::AlignedBox3d box = reachBox(samples, params, request);
+  if (box.isEmpty()) return 0;
+  // Nodes of the lattice i·h in [lo, hi] along one axis.
+  auto count = [h](double lo, double hi) {
+    return std::max(0.0, std::floor(hi / h) - std::ceil(lo / h) + 1.0);
+  };
+  double dense = 1.0;
+  for (int a = 0; a < 3; ++a) dense *= count(box.min()[a], box.max()[a]);
+  // Every built node lies within reachMm of a sample, so in a cell (edge reach/2) at most two
+  // cells from one holding a sample: count the nodes of those cells (clipped to the box) on a
+  // coarse mask.
+  const double cell_mm = 0.5 * reachMm(params, request);
+  checkExtent(box, h, "voxel size");
+  Eigen::AlignedBox3d all;
+  for (const Vec3& q : samples.points_mm) all.extend(q);
+  checkExtent(all, cell_mm, "field.r0");
+  auto mask = openvdb::MaskGrid::create(false);
+  {
+    auto acc = mask->getAccessor();
+    for (const Vec3& q : samples.points_mm) {
+      const Vec3 c = (q / cell_mm).array().floor();
+      acc.setValueOn(openvdb::Coord(int(c.x()), int(c.y()), int(c.z())));
+    }
+  }
+  openvdb::tools::dilateActiveValues(mask->tree(), 2, openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                     openvdb::tools::IGNORE_TILES);
+  double cells = 0.0;
+  for (auto it = mask->cbeginValueOn(); it; ++it) {
+    const openvdb::Coord c = it.getCoord();
+    double nodes = 1.0;
+    for (int a = 0; a < 3; ++a) {
+      const double lo = std::max(c[a] * cell_mm, box.min()[a]);
+      const double hi = (c[a] + 1) * cell_mm;
+      // half-open cell [lo, hi), except where the box's own (closed) end cuts it
+      nodes *= hi > box.max()[a] ? count(lo, box.max()[a])
+                                 : std::max(0.0, std::ceil(hi / h) - std::ceil(lo / h));
+    }
+    cells += nodes;
+  }
+  const double estimate = std::min(dense, cells);
+  return estimate >= 1e18 ? std::size_t(1e18) : static_cast<std::size_t>(estimate);
+}
+
+namespace voxel {
+
+/// Origins (index space) of the leaves within reach_mm of a sample and inside `reach` (the
+/// region's box), sorted. Marked on a byte per leaf of that box (a sample touches ~60 leaves:
+/// a list of them all, sorted and made unique, cost more than the uniform grid's nodes on the
+/// GPU), or listed and sorted where the box has too many leaves.
+std::vector<openvdb::Coord> candidateLeaves(const ObstacleSamples& samples,
+                                            const Eigen::AlignedBox3d& reach, double h,
+                                            double reach_mm) {
+  std::vector<openvdb::Coord> origins;
+  if (reach.isEmpty()) return origins;
+  const Vec3 lo_region = reach.min() / h, hi_region = reach.max() / h;
+  const double leaf_mm = kLeafDim * h;
+  // Calls hit(i, j, k) for each leaf origin within reach of q (inside the region).
+  auto leavesNear = [&](const Vec3& q, auto&& hit) {
+    const Vec3 lo = ((q.array() - reach_mm) / h).max(lo_region.array()).ceil();
+    const Vec3 hi = ((q.array() + reach_mm) / h).min(hi_region.array()).floor();
+    if ((lo.array() > hi.array()).any()) return;
+    const openvdb::Coord a(int(lo.x()), int(lo.y()), int(lo.z()));
+    const openvdb::Coord b(int(hi.x()), int(hi.y()), int(hi.z()));
+    const openvdb::Coord la = a & ~(kLeafDim - 1), lb = b & ~(kLeafDim - 1);
+    for (int i = la.x(); i <= lb.x(); i += kLeafDim)
+      for (int j = la.y(); j <= lb.y(); j += kLeafDim)
+        for (int k = la.z(); k <= lb.z(); k += kLeafDim) {
+          // Distance from q to the leaf's node box.
+          const Vec3 box_lo = Vec3(i, j, k) * h;
+          const Vec3 nearest = q.cwiseMax(box_lo).cwiseMin(box_lo + Vec3::Constant(leaf_mm - h));
+          if ((nearest - q).squaredNorm() < reach_mm * reach_mm) hit(i, j, k);
+        }
+  };
+  const Vec3 lo_all = lo_region.array().ceil(), hi_all = hi_region.array().floor();
+  if ((lo_all.array() > hi_all.array()).any()) return origins;
+  const openvdb::Coord box_lo =
+      openvdb::Coord(int(lo_all.x()), int(lo_all.y()), int(lo_all.z())) & ~(kLeafDim - 1);
+  const openvdb::Coord box_hi =
+      openvdb::Coord(int(hi_all.x()), int(hi_all.y()), int(hi_all.z())) & ~(kLeafDim - 1);
+  const openvdb::Coord dim((box_hi.x() - box_lo.x()) / kLeafDim + 1,
+                          (box_hi.y() - box_lo.y()) / kLeafDim + 1,
+                          (box_hi.z() - box_lo.z()) / kLeafDim + 1);
+  const double box_leaves = double(dim.x()) * dim.y() * dim.z();
+  if (box_leaves > double(kDenseIndexMax)) {
+    for (const Vec3& q : samples.points_mm)
+      leavesNear(q, [&](int i, int j, int k) { origins.emplace_back(i, j, k); });
+    std::sort(origins.begin(), origins.end());
+    origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
+    return origins;
+  }
+  std::vector<std::uint8_t> near(std::size_t(box_leaves), 0);
+  auto at = [&](int i, int j, int k) {
+    return (std::size_t((i - box_lo.x()) / kLeafDim) * dim.y() + (j - box_lo.y()) / kLeafDim) *
+               dim.z() + (k - box_lo.z()) / kLeafDim;
+  };
+  // The samples in parallel: a leaf's byte may be set by several threads (the same 1).
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, samples.size(), 256), [&](const auto& r) {
+    for (std::size_t s = r.begin(); s != r.end(); ++s)
+      leavesNear(samples.points_mm[s], [&](int i, int j, int k) {
+        std::atomic_ref<std::uint8_t>(near[at(i, j, k)]).store(1, std::memory_order_relaxed);
+      });
+  });
+  for (int i = box_lo.x(); i <= box_hi.x(); i += kLeafDim)  // sorted: x, then y, then z
+    for (int j = box_lo.y(); j <= box_hi.y(); j += kLeafDim)
+      for (int k = box_lo.z(); k <= box_hi.z(); k += kLeafDim)
+        if (near[at(i, j, k)]) origins.emplace_back(i, j, k);
+  return origins;
+}
+
+/// The nodes of the halves of `cells` (3³ a cell at the next level), marked on a mask per task
+/// and merged (the same set as one serial pass).
+openvdb::MaskGrid::Ptr nodesOfHalves(const std::vector<openvdb::Coord>& cells) {
+  struct Marker {
+    const std::vector<openvdb::Coord>* cells;
+    openvdb::MaskGrid::Ptr mask = openvdb::MaskGrid::create(false);
+    explicit Marker(const std::vector<openvdb::Coord>* c) : cells(c) {}
+    Marker(Marker& other, tbb::split) : cells(other.cells) {}
+    void operator()(const tbb::blocked_range<std::size_t>& range) {
+      auto acc = mask->getAccessor();
+      for (std::size_t c = range.begin(); c != range.end(); ++c) {
+        const openvdb::Coord fine = (*cells)[c] << 1;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            for (int k = 0; k < 3; ++k) acc.setValueOn(fine.offsetBy(i, j, k));
+      }
+    }
+    void join(Marker& other) { mask->tree().topologyUnion(other.mask->tree()); }
+  };
+  Marker marker(&cells);
+  tbb::parallel_reduce(tbb::blocked_range<std::size_t>(0, cells.size(), 4096), marker);
+  return marker.mask;
+}
+
+}  // namespace voxel
+}  // namespace fieldpath::field
