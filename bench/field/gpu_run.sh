@@ -4,7 +4,7 @@
 # same run, same scenes. The machine has no OpenVDB: the program travels as a bundle
 # (BUILD-NOTES.md "The whole program on the GPU machine"):
 #   here:  OLD=/path/to/old/fieldpath bench/field/gpu_bundle.sh BUILD_DIR DIR   (DIR/fp.tar.xz)
-#   there: bench/field/gpu_run.sh DIR/fp.tar.xz OUTDIR
+#   there: bench/field/gpu_run.sh DIR/fp.tar.xz OUTDIR [study | study-only]
 # Prints one line per run: "== case backend rep" then the build's own times ("build X s (B nodes
 # Y s, refinement Z s)"; the CUDA start-up, made before the build, printed apart); then
 # `generate` end to end (voxel refined to 1 % against the indexed direct sum).
@@ -19,6 +19,16 @@ old=/tmp/B/fieldpath_old
 here=$(dirname "$0")
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
 echo "cores: $(nproc)"
+# The study at 16 cores / GPU (study or study-only): reference, cpu and cuda builds side by side,
+# uniform and refined 0.5 % and 1 % (the 2-core run: bench/results/study/builds/).
+study() {
+  timeout 300 "$fp" --quiet study examples/impeller/scene.yaml --sample-step 0.5 --voxels 0.5,0.5 \
+    --interp trilinear --stored plane_ratio --refine 0.5,1 --refine-levels 2 \
+    --backend reference,cpu,cuda --no-brute-force --line-step 0.2 --out /tmp/study 2>&1 | tail -12
+  cp /tmp/study/study.md "$out/study_gpu.md" 2>/dev/null
+  cp /tmp/study/study.csv "$out/study_gpu.csv" 2>/dev/null
+}
+if [ "${3:-}" = study-only ]; then study; exit 0; fi
 # 1. the CUDA build equals the CPU build (the test skips without a GPU)
 timeout 90 /tmp/B/test_field --gtest_filter='VoxelBuild.*' 2>&1 | grep -E "OK|FAILED|PASSED|SKIPPED|Failure|Expected|actual"
 # 2. scenes: the example (blades every 1 mm, 5100 samples) and the study's (every 0.5 mm, 25000),
@@ -58,3 +68,4 @@ for sc in "$st_r1" "$st_r"; do
   echo -n "path.cl cuda vs cpu: "; python3 "$here/compare_cl.py" /tmp/gen_backendcpu/path.cl /tmp/gen_backendcuda/path.cl
 done
 rm -f examples/impeller/.gpu_*.yaml
+[ "${3:-}" = study ] && study
