@@ -1,14 +1,12 @@
-/// The CPU block build of voxel nodes (node_block.h). No OpenVDB: this file is quick to compile
-/// and its loops are checked for vectorisation (`-fopt-info-vec`, CMakeLists.txt).
+/// The CPU block build of voxel nodes (node_block.h): the cell list, a leaf's samples gathered,
+/// its rows' sums through the lane kernels (node_lanes.cpp). No OpenVDB.
 #include "node_block.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 
-#if defined(__x86_64__)
-#include <immintrin.h>
-#endif
+#include "node_lanes.h"
 
 namespace fieldpath::field {
 
@@ -65,356 +63,9 @@ SampleTable::SampleTable(const ObstacleSamples& samples, double r0_mm) {
 
 namespace {
 
-constexpr int kLanes = 8;
-
-/// The samples exactly at `at` among the first `count` of s (their term is along the normal).
-void addZeroTerms(const Law& L, const SampleSpan& s, int count, D3 at, Accum& a) {
-  for (int j = 0; j < count; ++j) {
-    const double dx = at.x - s.x[j], dy = at.y - s.y[j], dz = at.z - s.z[j];
-    if (dx * dx + dy * dy + dz * dz == 0.0)
-      kernel::addTerm(L, 0.0, 0.0, 0.0, 0.0, s.nx[j], s.ny[j], s.nz[j], s.w[j], a);
-  }
-}
-
-/// The per-lane nearest samples merged into a (ties: lowest id).
-void mergeNearest(const double* best, const std::int64_t* best_id, const std::int64_t* best_at,
-                  Accum& a, int lanes = kLanes) {
-  for (int l = 0; l < lanes; ++l)
-    if (best_id[l] >= 0 && (best[l] < a.best_sq ||
-                            (best[l] == a.best_sq && (a.best_id < 0 || best_id[l] < a.best_id)))) {
-      a.best_sq = best[l];
-      a.best_id = int(best_id[l]);
-      a.best_at = int(best_at[l]);
-    }
-}
-
-SampleSpan tail(const SampleSpan& s, int from) {
-  SampleSpan rest = s;
-  rest.x += from;
-  rest.y += from;
-  rest.z += from;
-  rest.nx += from;
-  rest.ny += from;
-  rest.nz += from;
-  rest.w += from;
-  rest.id += from;
-  rest.count -= from;
-  rest.base += from;
-  return rest;
-}
-
-/// Eq. 1 over a span in lanes of kLanes: the same terms as kernel::addTerm, summed per lane then
-/// across the lanes; the nearest sample per lane (ties: lowest id), then across. The rest
-/// (count % kLanes) runs scalar. Written for the compiler to vectorise (branch-free lane loops).
-void accumulateGeneric(const Law& L, const SampleSpan& s, D3 at, bool track, Accum& a) {
-  const int full = s.count - s.count % kLanes;
-  if (full > 0) {
-    double fx[kLanes] = {}, fy[kLanes] = {}, fz[kLanes] = {};
-    double best[kLanes];
-    std::int64_t best_id[kLanes], best_at[kLanes];
-    for (int l = 0; l < kLanes; ++l) {
-      best[l] = a.best_sq;
-      best_id[l] = -1;
-      best_at[l] = -1;
-    }
-    int zero = 0;
-    const double r0_sq = L.r0_sq, r_min = L.r_min, inv_r0 = L.inv_r0;
-    for (int j = 0; j < full; j += kLanes) {
-      double dx[kLanes], dy[kLanes], dz[kLanes], r2[kLanes], c[kLanes];
-      for (int l = 0; l < kLanes; ++l) {
-        dx[l] = at.x - s.x[j + l];
-        dy[l] = at.y - s.y[j + l];
-        dz[l] = at.z - s.z[j + l];
-        r2[l] = dx[l] * dx[l] + dy[l] * dy[l] + dz[l] * dz[l];
-      }
-      for (int l = 0; l < kLanes; ++l) {
-        const double in = r2[l] < r0_sq && r2[l] > 0.0 ? 1.0 : 0.0;
-        const double r = std::sqrt(r2[l] > 0.0 ? r2[l] : 1.0);
-        const double rc = r < r_min ? r_min : r;
-        c[l] = in * (s.w[j + l] * ((1.0 / rc - inv_r0) / (rc * rc)) / r);
-        zero += r2[l] == 0.0 ? 1 : 0;
-      }
-      for (int l = 0; l < kLanes; ++l) {
-        fx[l] += c[l] * dx[l];
-        fy[l] += c[l] * dy[l];
-        fz[l] += c[l] * dz[l];
-      }
-      if (track)
-        for (int l = 0; l < kLanes; ++l) {
-          const std::int64_t id = s.id[j + l];
-          const bool closer = r2[l] < best[l] || (r2[l] == best[l] && id < best_id[l]);
-          best[l] = closer ? r2[l] : best[l];
-          best_id[l] = closer ? id : best_id[l];
-          best_at[l] = closer ? std::int64_t(s.base + j + l) : best_at[l];
-        }
-    }
-    for (int l = 0; l < kLanes; ++l) {
-      a.fx += fx[l];
-      a.fy += fy[l];
-      a.fz += fz[l];
-    }
-    if (track) mergeNearest(best, best_id, best_at, a);
-    if (zero) addZeroTerms(L, s, full, at, a);
-  }
-  if (full < s.count) kernel::accumulateScalar(L, tail(s, full), at, track, a);
-}
-
-#if defined(__x86_64__)
-/// accumulateGeneric with AVX-512 (8 doubles a register) over `n` spans in the same lanes (one
-/// reduction for them all: the cell list's columns are short): 1/r from the 14-bit reciprocal
-/// square root and two Newton steps (relative error ~1e-16: no division, no square root), r²
-/// summed in the scalar's order (same nearest sample, same cut at r0); each span's last
-/// count % 8 samples under a load mask.
-__attribute__((target("avx512f"))) void accumulate512(const Law& L, const SampleSpan* spans, int n,
-                                                      D3 at, bool track, Accum& a) {
-  const __m512d ax = _mm512_set1_pd(at.x), ay = _mm512_set1_pd(at.y), az = _mm512_set1_pd(at.z);
-  const __m512d r0_sq = _mm512_set1_pd(L.r0_sq), inv_r_min = _mm512_set1_pd(1.0 / L.r_min);
-  const __m512d inv_r0 = _mm512_set1_pd(L.inv_r0), one = _mm512_set1_pd(1.0);
-  const __m512d half = _mm512_set1_pd(0.5), three_halves = _mm512_set1_pd(1.5);
-  const __m512d far = _mm512_set1_pd(HUGE_VAL);  // lanes past a span's end: never in, never nearest
-  __m512d fx = _mm512_setzero_pd(), fy = _mm512_setzero_pd(), fz = _mm512_setzero_pd();
-  __m512d best = _mm512_set1_pd(a.best_sq);
-  __m512i best_id = _mm512_set1_epi64(-1), best_at = _mm512_set1_epi64(-1);
-  const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
-  for (int k = 0; k < n; ++k) {
-    const SampleSpan& s = spans[k];
-    __mmask8 zero = 0;
-    for (int j = 0; j < s.count; j += kLanes) {
-      const int left = s.count - j;
-      const __mmask8 valid = left >= kLanes ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
-      const __m512d dx = _mm512_sub_pd(ax, _mm512_mask_loadu_pd(far, valid, s.x + j));
-      const __m512d dy = _mm512_sub_pd(ay, _mm512_maskz_loadu_pd(valid, s.y + j));
-      const __m512d dz = _mm512_sub_pd(az, _mm512_maskz_loadu_pd(valid, s.z + j));
-      const __m512d r2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
-                                       _mm512_mul_pd(dz, dz));
-      const __mmask8 positive = _mm512_cmp_pd_mask(r2, _mm512_setzero_pd(), _CMP_GT_OQ);
-      const __mmask8 in = _mm512_mask_cmp_pd_mask(positive, r2, r0_sq, _CMP_LT_OQ);
-      zero |= _mm512_mask_cmp_pd_mask(valid, r2, _mm512_setzero_pd(), _CMP_EQ_OQ);
-      if (in) {
-        const __m512d r2s = _mm512_mask_blend_pd(in, one, r2);
-        __m512d y = _mm512_rsqrt14_pd(r2s);  // 1/r
-        const __m512d hr2 = _mm512_mul_pd(half, r2s);
-        y = _mm512_mul_pd(y, _mm512_fnmadd_pd(hr2, _mm512_mul_pd(y, y), three_halves));
-        y = _mm512_mul_pd(y, _mm512_fnmadd_pd(hr2, _mm512_mul_pd(y, y), three_halves));
-        const __m512d inv_rc = _mm512_min_pd(y, inv_r_min);
-        const __m512d phi = _mm512_mul_pd(_mm512_sub_pd(inv_rc, inv_r0),
-                                          _mm512_mul_pd(inv_rc, inv_rc));
-        const __m512d c = _mm512_maskz_mul_pd(
-            in, _mm512_mul_pd(_mm512_maskz_loadu_pd(valid, s.w + j), phi), y);
-        fx = _mm512_mask3_fmadd_pd(c, dx, fx, in);  // masked: 0 · inf past the end
-        fy = _mm512_mask3_fmadd_pd(c, dy, fy, in);
-        fz = _mm512_mask3_fmadd_pd(c, dz, fz, in);
-      }
-      if (track) {
-        const __m512i id = _mm512_cvtepi32_epi64(
-            _mm512_castsi512_si256(_mm512_maskz_loadu_epi32(__mmask16(valid), s.id + j)));
-        const __mmask8 closer =
-            _mm512_mask_cmp_pd_mask(valid, r2, best, _CMP_LT_OQ) |
-            (_mm512_mask_cmp_pd_mask(valid, r2, best, _CMP_EQ_OQ) &
-             _mm512_cmplt_epi64_mask(id, best_id));
-        if (closer) {
-          best = _mm512_mask_blend_pd(closer, best, r2);
-          best_id = _mm512_mask_blend_epi64(closer, best_id, id);
-          best_at = _mm512_mask_blend_epi64(
-              closer, best_at, _mm512_add_epi64(lane, _mm512_set1_epi64(s.base + j)));
-        }
-      }
-    }
-    if (zero) addZeroTerms(L, s, s.count, at, a);
-  }
-  a.fx += _mm512_reduce_add_pd(fx);
-  a.fy += _mm512_reduce_add_pd(fy);
-  a.fz += _mm512_reduce_add_pd(fz);
-  if (track) {
-    alignas(64) double b[kLanes];
-    alignas(64) std::int64_t bid[kLanes], bat[kLanes];
-    _mm512_store_pd(b, best);
-    _mm512_store_epi64(bid, best_id);
-    _mm512_store_epi64(bat, best_at);
-    mergeNearest(b, bid, bat, a);
-  }
-}
-
-const bool kHaveAvx512 = __builtin_cpu_supports("avx512f");
-#endif
-
-void accumulateLanes(const Law& L, const SampleSpan* spans, int n, D3 at, bool track, Accum& a) {
-#if defined(__x86_64__)
-  if (kHaveAvx512) return accumulate512(L, spans, n, at, track, a);
-#endif
-  for (int k = 0; k < n; ++k) accumulateGeneric(L, spans[k], at, track, a);
-}
-void accumulateLanes(const Law& L, const SampleSpan& s, D3 at, bool track, Accum& a) {
-  accumulateLanes(L, &s, 1, at, track, a);
-}
-
-/// Copies the leaf's gathered samples whose squared distance d² to the row's segment (x, y,
-/// [z0, z1]) has lo_sq < d² <= hi_sq to the row arrays (sized for them all) from position n, in
-/// their order; returns the position after the last.
-int gatherRowGeneric(BlockScratch& s, double x, double y, double z0, double z1, double lo_sq,
-                     double hi_sq, int n) {
-  for (std::size_t t = 0; t < s.x.size(); ++t) {
-    const double dx = s.x[t] - x, dy = s.y[t] - y, z = s.z[t];
-    const double dz = z < z0 ? z0 - z : z > z1 ? z - z1 : 0.0;
-    const double d2 = dx * dx + dy * dy + dz * dz;
-    if (!(d2 > lo_sq && d2 <= hi_sq)) continue;
-    s.rx[n] = s.x[t];
-    s.ry[n] = s.y[t];
-    s.rz[n] = s.z[t];
-    s.rnx[n] = s.nx[t];
-    s.rny[n] = s.ny[t];
-    s.rnz[n] = s.nz[t];
-    s.rw[n] = s.w[t];
-    s.rid[n] = s.id[t];
-    ++n;
-  }
-  return n;
-}
-
-#if defined(__x86_64__)
-/// gatherRowGeneric in AVX-512 lanes: the same test, the passing samples compress-stored.
-__attribute__((target("avx512f"))) int gatherRow512(BlockScratch& s, double x, double y,
-                                                     double z0, double z1, double lo_sq,
-                                                     double hi_sq, int n) {
-  const __m512d vx = _mm512_set1_pd(x), vy = _mm512_set1_pd(y);
-  const __m512d vz0 = _mm512_set1_pd(z0), vz1 = _mm512_set1_pd(z1);
-  const __m512d lo = _mm512_set1_pd(lo_sq), hi = _mm512_set1_pd(hi_sq);
-  const __m512d zero = _mm512_setzero_pd();
-  const int count = int(s.x.size());
-  for (int t = 0; t < count; t += kLanes) {
-    const int left = count - t;
-    const __mmask8 valid = left >= kLanes ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
-    const __m512d px = _mm512_maskz_loadu_pd(valid, s.x.data() + t);
-    const __m512d py = _mm512_maskz_loadu_pd(valid, s.y.data() + t);
-    const __m512d pz = _mm512_maskz_loadu_pd(valid, s.z.data() + t);
-    const __m512d dx = _mm512_sub_pd(px, vx), dy = _mm512_sub_pd(py, vy);
-    // z0 - z or z - z1 where positive, else 0 (the segment's distance along z)
-    const __m512d dz = _mm512_max_pd(zero, _mm512_max_pd(_mm512_sub_pd(vz0, pz),
-                                                         _mm512_sub_pd(pz, vz1)));
-    const __m512d d2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
-                                     _mm512_mul_pd(dz, dz));
-    const __mmask8 in = _mm512_mask_cmp_pd_mask(_mm512_mask_cmp_pd_mask(valid, d2, hi, _CMP_LE_OQ),
-                                                d2, lo, _CMP_GT_OQ);
-    if (!in) continue;
-    _mm512_mask_compressstoreu_pd(s.rx.data() + n, in, px);
-    _mm512_mask_compressstoreu_pd(s.ry.data() + n, in, py);
-    _mm512_mask_compressstoreu_pd(s.rz.data() + n, in, pz);
-    _mm512_mask_compressstoreu_pd(s.rnx.data() + n, in, _mm512_maskz_loadu_pd(valid, s.nx.data() + t));
-    _mm512_mask_compressstoreu_pd(s.rny.data() + n, in, _mm512_maskz_loadu_pd(valid, s.ny.data() + t));
-    _mm512_mask_compressstoreu_pd(s.rnz.data() + n, in, _mm512_maskz_loadu_pd(valid, s.nz.data() + t));
-    _mm512_mask_compressstoreu_pd(s.rw.data() + n, in, _mm512_maskz_loadu_pd(valid, s.w.data() + t));
-    _mm512_mask_compressstoreu_epi32(s.rid.data() + n, __mmask16(in),
-                                     _mm512_maskz_loadu_epi32(__mmask16(valid), s.id.data() + t));
-    n += __builtin_popcount(in);
-  }
-  return n;
-}
-#endif
-
-int gatherRow(BlockScratch& s, double x, double y, double z0, double z1, double lo_sq,
-              double hi_sq, int n) {
-#if defined(__x86_64__)
-  if (kHaveAvx512) return gatherRow512(s, x, y, z0, z1, lo_sq, hi_sq, n);
-#endif
-  return gatherRowGeneric(s, x, y, z0, z1, lo_sq, hi_sq, n);
-}
-
-#if defined(__x86_64__)
-/// The nearest sample per lane so far (rowFirstSums512).
-struct Nearest512 {
-  __m512d best;
-  __m512i id, at;
-};
-/// Sample (id, at) at squared distances r2 from the lanes' points: nearer (or as near with a
-/// lower id) replaces a lane's nearest.
-__attribute__((target("avx512f"), always_inline)) inline void trackNearest(Nearest512& n,
-                                                                          __m512d r2,
-                                                                          std::int64_t id,
-                                                                          std::int64_t at) {
-  const __m512i vid = _mm512_set1_epi64(id);
-  const __mmask8 closer = _mm512_cmp_pd_mask(r2, n.best, _CMP_LT_OQ) |
-                          (_mm512_cmp_pd_mask(r2, n.best, _CMP_EQ_OQ) &
-                           _mm512_cmplt_epi64_mask(vid, n.id));
-  if (closer) {
-    n.best = _mm512_mask_blend_pd(closer, n.best, r2);
-    n.id = _mm512_mask_blend_epi64(closer, n.id, vid);
-    n.at = _mm512_mask_blend_epi64(closer, n.at, _mm512_set1_epi64(at));
-  }
-}
-
-/// The first sums (kernel::probe's) of a row's 8 nodes at once, the nodes in the lanes: every
-/// sample of `core` (those within r0 of the row's segment) read once for the 8, eq. 1 summed for
-/// those within r0, the nearest within sqrt(init_sq) tracked (ties: lowest id); then, for nodes
-/// with no sample within r0 (the shell), the nearest among `ring` (the rest of the row's reach).
-/// Each node's terms as accumulate512's, summed in the samples' order.
-__attribute__((target("avx512f"))) void rowFirstSums512(const Law& L, const SampleSpan& core,
-                                                        const SampleSpan& ring, double x,
-                                                        double y, const double* node_z,
-                                                        double init_sq, Accum* out) {
-  const __m512d az = _mm512_loadu_pd(node_z);
-  const __m512d r0_sq = _mm512_set1_pd(L.r0_sq), inv_r_min = _mm512_set1_pd(1.0 / L.r_min);
-  const __m512d inv_r0 = _mm512_set1_pd(L.inv_r0);
-  const __m512d half = _mm512_set1_pd(0.5), three_halves = _mm512_set1_pd(1.5);
-  const __m512d one = _mm512_set1_pd(1.0), zero_v = _mm512_setzero_pd();
-  __m512d fx = zero_v, fy = zero_v, fz = zero_v;
-  Nearest512 near{_mm512_set1_pd(init_sq), _mm512_set1_epi64(-1), _mm512_set1_epi64(-1)};
-  __mmask8 zero = 0;
-  for (int j = 0; j < core.count; ++j) {
-    const __m512d dx = _mm512_set1_pd(x - core.x[j]), dy = _mm512_set1_pd(y - core.y[j]);
-    const __m512d dz = _mm512_sub_pd(az, _mm512_set1_pd(core.z[j]));
-    const __m512d r2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
-                                     _mm512_mul_pd(dz, dz));
-    const __mmask8 positive = _mm512_cmp_pd_mask(r2, zero_v, _CMP_GT_OQ);
-    const __mmask8 in = _mm512_mask_cmp_pd_mask(positive, r2, r0_sq, _CMP_LT_OQ);
-    zero |= _mm512_cmp_pd_mask(r2, zero_v, _CMP_EQ_OQ);
-    if (in) {
-      const __m512d r2s = _mm512_mask_blend_pd(in, one, r2);
-      __m512d yv = _mm512_rsqrt14_pd(r2s);  // 1/r, two Newton steps (as accumulate512)
-      const __m512d hr2 = _mm512_mul_pd(half, r2s);
-      yv = _mm512_mul_pd(yv, _mm512_fnmadd_pd(hr2, _mm512_mul_pd(yv, yv), three_halves));
-      yv = _mm512_mul_pd(yv, _mm512_fnmadd_pd(hr2, _mm512_mul_pd(yv, yv), three_halves));
-      const __m512d inv_rc = _mm512_min_pd(yv, inv_r_min);
-      const __m512d phi =
-          _mm512_mul_pd(_mm512_sub_pd(inv_rc, inv_r0), _mm512_mul_pd(inv_rc, inv_rc));
-      const __m512d c =
-          _mm512_maskz_mul_pd(in, _mm512_mul_pd(_mm512_set1_pd(core.w[j]), phi), yv);
-      fx = _mm512_mask3_fmadd_pd(c, dx, fx, in);
-      fy = _mm512_mask3_fmadd_pd(c, dy, fy, in);
-      fz = _mm512_mask3_fmadd_pd(c, dz, fz, in);
-    }
-    trackNearest(near, r2, core.id[j], core.base + j);
-  }
-  // The ring's samples lie farther than r0 from every node: only a shell node's nearest.
-  if (_mm512_cmp_pd_mask(near.best, r0_sq, _CMP_GE_OQ))
-    for (int j = 0; j < ring.count; ++j) {
-      const __m512d dx = _mm512_set1_pd(x - ring.x[j]), dy = _mm512_set1_pd(y - ring.y[j]);
-      const __m512d dz = _mm512_sub_pd(az, _mm512_set1_pd(ring.z[j]));
-      trackNearest(near,
-                   _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
-                                 _mm512_mul_pd(dz, dz)),
-                   ring.id[j], ring.base + j);
-    }
-  alignas(64) double f[3][kLanes], b[kLanes];
-  alignas(64) std::int64_t bid[kLanes], bat[kLanes];
-  _mm512_store_pd(f[0], fx);
-  _mm512_store_pd(f[1], fy);
-  _mm512_store_pd(f[2], fz);
-  _mm512_store_pd(b, near.best);
-  _mm512_store_epi64(bid, near.id);
-  _mm512_store_epi64(bat, near.at);
-  for (int l = 0; l < kLanes; ++l) {
-    Accum& a = out[l];
-    a = Accum{};
-    a.fx = f[0][l];
-    a.fy = f[1][l];
-    a.fz = f[2][l];
-    a.best_sq = b[l];
-    a.best_id = int(bid[l]);
-    a.best_at = int(bat[l]);
-    if ((zero >> l) & 1) addZeroTerms(L, core, core.count, D3{x, y, node_z[l]}, a);
-  }
-}
-#endif
+using lanes::accumulateLanes;
+using lanes::kLanes;
+using lanes::mergeNearest;
 
 /// A leaf's neighbourhood: the samples gathered in [box_lo, box_hi] (mm) for sums whose ball
 /// lies inside that box, the cell list for the others (points lifted far off the leaf).
@@ -574,22 +225,18 @@ void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, co
     hood.row_z1 = (leaf.origin[2] + 7) * h;
     // The samples within r0 of the segment first (the core: every term of the row's first
     // sums), then the rest within reach (the ring: only a shell node's nearest).
-    const int core = gatherRow(scratch, hood.row_x, hood.row_y, hood.row_z0, hood.row_z1, -1.0,
+    const int core = lanes::gatherRow(scratch, hood.row_x, hood.row_y, hood.row_z0, hood.row_z1, -1.0,
                                core_sq, 0);
-    const int n = gatherRow(scratch, hood.row_x, hood.row_y, hood.row_z0, hood.row_z1, core_sq,
+    const int n = lanes::gatherRow(scratch, hood.row_x, hood.row_y, hood.row_z0, hood.row_z1, core_sq,
                             row_reach * row_reach, core);
     hood.row = SampleSpan{scratch.rx.data(),  scratch.ry.data(),  scratch.rz.data(),
                           scratch.rnx.data(), scratch.rny.data(), scratch.rnz.data(),
                           scratch.rw.data(),  scratch.rid.data(), n, 0};
-#if defined(__x86_64__)
-    if (kHaveAvx512) {
-      SampleSpan core_span = hood.row, ring_span = tail(hood.row, core);
-      core_span.count = core;
-      rowFirstSums512(job.law, core_span, ring_span, hood.row_x, hood.row_y, hood.first_z,
-                      first_sq, first);
+    SampleSpan core_span = hood.row;
+    core_span.count = core;
+    if (lanes::rowFirstSums(job.law, core_span, kernel::tail(hood.row, core), hood.row_x,
+                            hood.row_y, hood.first_z, first_sq, first))
       hood.first = first;
-    }
-#endif
     for (int k = 0; k < 8; ++k) {
       if (!((bits8 >> k) & 1u)) continue;
       const D3 x{hood.row_x, hood.row_y, (leaf.origin[2] + k) * h};

@@ -40,6 +40,22 @@ struct SampleSpan {
   int base;  ///< position of sample 0 of the span in its neighbourhood's table
 };
 
+/// The samples of s from position `from` on (pointers, count and base moved together).
+FP_HD SampleSpan tail(const SampleSpan& s, int from) {
+  SampleSpan rest = s;
+  rest.x += from;
+  rest.y += from;
+  rest.z += from;
+  rest.nx += from;
+  rest.ny += from;
+  rest.nz += from;
+  rest.w += from;
+  rest.id += from;
+  rest.count -= from;
+  rest.base += from;
+  return rest;
+}
+
 /// eq. 1 and the plane law (law.h phi, sampleTerm, PlaneLaw) with their constants.
 struct Law {
   double r0, r0_sq, inv_r0, r_min, r_min_sq, gain;
@@ -156,17 +172,8 @@ FP_HD void cellSpans(const CellTable& T, D3 c, double radius, Visit& visit) {
       const int first = T.cell_start[column + ilo[2]];
       const int last = T.cell_start[column + ihi[2] + 1];
       if (first >= last) continue;
-      SampleSpan s = T.all;
-      s.x += first;
-      s.y += first;
-      s.z += first;
-      s.nx += first;
-      s.ny += first;
-      s.nz += first;
-      s.w += first;
-      s.id += first;
+      SampleSpan s = tail(T.all, first);
       s.count = last - first;
-      s.base = first;
       visit(s);
     }
   }
