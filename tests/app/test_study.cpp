@@ -222,6 +222,31 @@ TEST(StudyRefinement, RefinedVariantBeatsItsUniformGridAndIsCountedApart) {
   EXPECT_EQ(refined.colliding, 0u);
 }
 
+TEST(StudyRefinement, ASizeListedTwiceIsRefinedToBothTolerancesItsUniformGridMadeOnce) {
+  // --voxels 2,2 --refine 5,10: the uniform 2 mm grid once, then one refined variant per
+  // tolerance (three identical rows broke the plots, which group rows by name).
+  StudyRequest request;
+  request.job = smallJob();
+  request.impeller = smallImpeller();
+  request.voxel_sizes_mm = {2.0, 2.0};
+  request.interpolations = {field::Interpolation::Trilinear};
+  request.stored = {field::StoredQuantity::PlaneRatio};
+  request.refine_tolerances = {0.05, 0.10};
+  request.refine_levels = 1;
+  request.brute_force = false;
+  request.line_step_mm = 0.2;
+  const StudyResult result = runStudy(request);
+  std::vector<std::string> names;
+  for (const StudyRow& row : result.rows) names.push_back(row.variant.name());
+  EXPECT_EQ(names, (std::vector<std::string>{
+                       "direct", "voxel 2 mm trilinear plane_ratio",
+                       "voxel 2 mm trilinear plane_ratio refined 5 % to 1 mm",
+                       "voxel 2 mm trilinear plane_ratio refined 10 % to 1 mm"}));
+  // The looser tolerance splits no more cells than the tighter one.
+  ASSERT_EQ(result.rows.size(), 4u);
+  EXPECT_LE(result.rows[3].refined_nodes, result.rows[2].refined_nodes);
+}
+
 TEST(StudyBackends, OldAndNewBuildsSideBySideGiveTheSameErrorsAndPaths) {
   // --backend reference,cpu: each voxel variant built per node (before issue 15) and by leaf
   // blocks; the node values agree to float rounding, so the errors and the tilts do too.
