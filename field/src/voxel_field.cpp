@@ -208,10 +208,10 @@ void matchLeaf(Leaf& leaf, FloatLeaf* closeness, const std::vector<Level>& coars
         }
       }
       if (!valid) continue;
-      const Vec3 centre = (Vec3(cell.x(), cell.y(), cell.z()) + Vec3::Constant(0.5)) * parent.h_mm;
-      CellRef ref;
-      hanging = !locate(parent, acc.index.back(), centre, ref) ||
-                !bit(parent.refined, ref.block * Leaf::SIZE + ref.cell);
+      // The parent cell's block and offset from its index (locate's, without the world point).
+      const int b = blockAt(parent, acc.index.back(),
+                            openvdb::Coord(cell.x() >> 3, cell.y() >> 3, cell.z() >> 3));
+      hanging = b < 0 || !bit(parent.refined, std::size_t(b) * Leaf::SIZE + Leaf::coordToOffset(cell));
     }
     if (!hanging) continue;
     const Vec3 x = Vec3(f.x(), f.y(), f.z()) * fine_h_mm;
