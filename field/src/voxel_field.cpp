@@ -68,34 +68,34 @@ void makeBlocks(Level& level, bool ratio) {
     auto values = level.grid->getConstAccessor();
     std::optional<FloatGrid::ConstAccessor> closeness;
     if (ratio) closeness.emplace(level.closeness->getConstAccessor());
+    const openvdb::Vec3s value_background = level.grid->background();
+    const float closeness_background = ratio ? level.closeness->background() : 0.0f;
     for (std::size_t b = range.begin(); b != range.end(); ++b) {
       const Leaf& leaf = *leaves[b];
       const openvdb::Coord o = leaf.origin();
-      // The leaf's own 8³ from its buffers, the +1 layer (another leaf's) through accessors.
-      const FloatLeaf* float_leaf = ratio ? closeness->probeConstLeaf(o) : nullptr;
+      // From the buffers of the leaf and of its +x, +y, +z neighbours (side = which of them:
+      // bit 2 for i = 8, 1 for j = 8, 0 for k = 8), looked up once each; an absent leaf holds
+      // the background (the trees have no active tiles).
+      const Leaf* value_leaf[8];
+      const FloatLeaf* float_leaf[8];
+      for (int side = 0; side < 8; ++side) {
+        const openvdb::Coord n =
+            o.offsetBy(side & 4 ? kLeafDim : 0, side & 2 ? kLeafDim : 0, side & 1 ? kLeafDim : 0);
+        value_leaf[side] = side == 0 ? &leaf : values.probeConstLeaf(n);
+        float_leaf[side] = ratio ? closeness->probeConstLeaf(n) : nullptr;
+      }
       std::uint64_t* over = &level.over[b * kBlockWords];
       for (int i = 0, n = 0; i < kBlockDim; ++i)
         for (int j = 0; j < kBlockDim; ++j)
           for (int k = 0; k < kBlockDim; ++k, ++n) {
-            openvdb::Vec3s v;
-            float c = 0.0f;
-            bool on = false;
-            if (i < kLeafDim && j < kLeafDim && k < kLeafDim && (float_leaf || !ratio)) {
-              const openvdb::Index offset = openvdb::Index((i * kLeafDim + j) * kLeafDim + k);
-              v = leaf.getValue(offset);
-              if (ratio) {
-                c = float_leaf->getValue(offset);
-                on = float_leaf->isValueOn(offset);
-              }
-            } else {
-              const openvdb::Coord ijk = o.offsetBy(i, j, k);
-              v = values.getValue(ijk);
-              if (ratio) {
-                c = closeness->getValue(ijk);
-                on = closeness->isValueOn(ijk);
-              }
-            }
-            if (on) over[n >> 6] |= std::uint64_t{1} << (n & 63);
+            const int side = (i >> 3) << 2 | (j >> 3) << 1 | (k >> 3);
+            const openvdb::Index offset =
+                openvdb::Index(((i & 7) * kLeafDim + (j & 7)) * kLeafDim + (k & 7));
+            const openvdb::Vec3s v =
+                value_leaf[side] ? value_leaf[side]->getValue(offset) : value_background;
+            const FloatLeaf* f = float_leaf[side];
+            const float c = f ? f->getValue(offset) : closeness_background;
+            if (f && f->isValueOn(offset)) over[n >> 6] |= std::uint64_t{1} << (n & 63);
             level.nodes[b * kBlockNodes + n] = {v.x(), v.y(), v.z(), c};
           }
     }
