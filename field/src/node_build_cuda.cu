@@ -138,10 +138,4 @@ NodeValues CudaNodeBuild::finish() {
   return values;
 }
 
-NodeValues buildNodesCuda(const CellTable& table, const NodeJob& job,
-                          const std::vector<LeafTask>& leaves) {
-  CudaNodeBuild build(table, job, leaves);
-  return build.finish();
-}
-
 }  // namespace fieldpath::field::kernel

@@ -7,14 +7,9 @@ namespace fieldpath::field::kernel {
 
 bool cudaNodeBuildAvailable() { return false; }
 
-NodeValues buildNodesCuda(const CellTable&, const NodeJob&, const std::vector<LeafTask>&) {
-  throw std::runtime_error("field: this program was built without CUDA (FIELDPATH_WITH_CUDA)");
-}
-
 struct CudaNodeBuild::State {};
-CudaNodeBuild::CudaNodeBuild(const CellTable& table, const NodeJob& job,
-                             const std::vector<LeafTask>& leaves) {
-  buildNodesCuda(table, job, leaves);  // throws: no CUDA
+CudaNodeBuild::CudaNodeBuild(const CellTable&, const NodeJob&, const std::vector<LeafTask>&) {
+  throw std::runtime_error("field: this program was built without CUDA (FIELDPATH_WITH_CUDA)");
 }
 CudaNodeBuild::~CudaNodeBuild() = default;
 NodeValues CudaNodeBuild::finish() { return {}; }

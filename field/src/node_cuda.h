@@ -22,14 +22,11 @@ struct NodeValues {
 
 /// The values of the masked nodes of every leaf, computed on the GPU from the cell list
 /// (`table`'s pointers are host memory; copied over), compacted in leaf order then node offset
-/// order (a leaf's values start at the sum of the popcounts of the masks before it). Throws
-/// std::runtime_error (with file and line) on a CUDA error, or without CUDA.
-NodeValues buildNodesCuda(const CellTable& table, const NodeJob& job,
-                          const std::vector<LeafTask>& leaves);
-
-/// buildNodesCuda in two halves, so that the host works while the device computes: the
-/// constructor copies the samples and tasks over and starts the kernel (returning at once), and
-/// finish() waits for it and brings the values back. Throws as buildNodesCuda.
+/// order (a leaf's values start at the sum of the popcounts of the masks before it). In two
+/// halves, so that the host works while the device computes: the constructor copies the samples
+/// and tasks over and starts the kernel (returning at once), finish() waits for it and brings
+/// the values back. Throws std::runtime_error (with file and line) on a CUDA error, or without
+/// CUDA (the constructor).
 class CudaNodeBuild {
  public:
   CudaNodeBuild(const CellTable& table, const NodeJob& job, const std::vector<LeafTask>& leaves);

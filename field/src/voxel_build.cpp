@@ -3,15 +3,12 @@
 /// leaves a level has: voxel_leaves.cpp; the error estimate: voxel_refine.cpp; the queries:
 /// voxel_field.cpp).
 #include <algorithm>
-#include <array>
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cmath>
 #include <cstdint>
 #include <functional>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -49,8 +46,6 @@ class PhaseTrace {
   bool on_;
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
-
-
 
 /// Whether x lies over (or under) the sampled surface: its nearest sample less than `over_mm`
 /// sideways. Beyond the edge of an open wall it does not, and "inside" means nothing there.
@@ -107,8 +102,6 @@ RatioNode planeRatio(const detail::Probe& p, const Vec3& x, const Vec3& q, const
   const double lift_mm = near_mm - eta;
   return ratioOf(field_at(Vec3(x + lift_mm * n)), lift_mm);
 }
-
-
 
 /// What the node values of every level are made from.
 struct NodeBuilder {
@@ -371,7 +364,6 @@ struct NodeBuilder {
     }
   }
 };
-
 
 /// Auto: the GPU when one is there (and the program has CUDA), else the CPU.
 FieldBackend resolveBackend(FieldBackend wanted) {

@@ -11,6 +11,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fieldpath/common/errors.h"
@@ -191,19 +192,25 @@ TEST(Study, SmallJobExactMethodsAgreeCsvIsFiniteErrorsShrink) {
   if (!std::getenv("FIELDPATH_KEEP_TEST_OUTPUT")) std::filesystem::remove_all(dir);
 }
 
-TEST(StudyRefinement, RefinedVariantBeatsItsUniformGridAndIsCountedApart) {
-  // The small job at 2 mm, uniform and refined at 5 % down to 1 mm (plane ratio, trilinear).
+/// The small job's study of trilinear plane-ratio grids of `voxels` (mm), each refined to its
+/// tolerance (a fraction; 0: none) one level down, no brute force.
+static StudyRequest planeRatioStudy(std::vector<double> voxels, std::vector<double> tolerances = {}) {
   StudyRequest request;
   request.job = smallJob();
   request.impeller = smallImpeller();
-  request.voxel_sizes_mm = {2.0};
+  request.voxel_sizes_mm = std::move(voxels);
   request.interpolations = {field::Interpolation::Trilinear};
   request.stored = {field::StoredQuantity::PlaneRatio};
-  request.refine_tolerances = {0.05};
+  request.refine_tolerances = std::move(tolerances);
   request.refine_levels = 1;
   request.brute_force = false;
   request.line_step_mm = 0.2;
-  const StudyResult result = runStudy(request);
+  return request;
+}
+
+TEST(StudyRefinement, RefinedVariantBeatsItsUniformGridAndIsCountedApart) {
+  // The small job at 2 mm, uniform and refined at 5 % down to 1 mm (plane ratio, trilinear).
+  const StudyResult result = runStudy(planeRatioStudy({2.0}, {0.05}));
   ASSERT_EQ(result.rows.size(), 3u);  // direct, uniform, refined
   const StudyRow& uniform = result.rows[1];
   const StudyRow& refined = result.rows[2];
@@ -225,17 +232,7 @@ TEST(StudyRefinement, RefinedVariantBeatsItsUniformGridAndIsCountedApart) {
 TEST(StudyRefinement, ASizeListedTwiceIsRefinedToBothTolerancesItsUniformGridMadeOnce) {
   // --voxels 2,2 --refine 5,10: the uniform 2 mm grid once, then one refined variant per
   // tolerance (three identical rows broke the plots, which group rows by name).
-  StudyRequest request;
-  request.job = smallJob();
-  request.impeller = smallImpeller();
-  request.voxel_sizes_mm = {2.0, 2.0};
-  request.interpolations = {field::Interpolation::Trilinear};
-  request.stored = {field::StoredQuantity::PlaneRatio};
-  request.refine_tolerances = {0.05, 0.10};
-  request.refine_levels = 1;
-  request.brute_force = false;
-  request.line_step_mm = 0.2;
-  const StudyResult result = runStudy(request);
+  const StudyResult result = runStudy(planeRatioStudy({2.0, 2.0}, {0.05, 0.10}));
   std::vector<std::string> names;
   for (const StudyRow& row : result.rows) names.push_back(row.variant.name());
   EXPECT_EQ(names, (std::vector<std::string>{
@@ -250,15 +247,8 @@ TEST(StudyRefinement, ASizeListedTwiceIsRefinedToBothTolerancesItsUniformGridMad
 TEST(StudyBackends, OldAndNewBuildsSideBySideGiveTheSameErrorsAndPaths) {
   // --backend reference,cpu: each voxel variant built per node (before issue 15) and by leaf
   // blocks; the node values agree to float rounding, so the errors and the tilts do too.
-  StudyRequest request;
-  request.job = smallJob();
-  request.impeller = smallImpeller();
-  request.voxel_sizes_mm = {1.0};
-  request.interpolations = {field::Interpolation::Trilinear};
-  request.stored = {field::StoredQuantity::PlaneRatio};
+  StudyRequest request = planeRatioStudy({1.0});
   request.backends = {field::FieldBackend::Reference, field::FieldBackend::Cpu};
-  request.brute_force = false;
-  request.line_step_mm = 0.2;
   const StudyResult result = runStudy(request);
   ASSERT_EQ(result.rows.size(), 3u);  // direct, reference build, cpu build
   const StudyRow& old_build = rowNamed(result, "voxel 1 mm trilinear plane_ratio [reference build]");
