@@ -170,43 +170,40 @@ void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, co
   const kernel::CellTable cells = cellTableOf(table);
   hood.cells = &cells;
   // Gather the samples of the box once, in SoA form.
-  for (auto* v : {&scratch.x, &scratch.y, &scratch.z, &scratch.nx, &scratch.ny, &scratch.nz,
-                  &scratch.w})
-    v->clear();
-  scratch.id.clear();
+  SampleSet& block = scratch.block;
+  block.count = 0;
   const D3 centre{0.5 * (hood.box_lo[0] + hood.box_hi[0]), 0.5 * (hood.box_lo[1] + hood.box_hi[1]),
                   0.5 * (hood.box_lo[2] + hood.box_hi[2])};
   struct Gather {
-    BlockScratch* s;
+    SampleSet* s;
     const double *lo, *hi;
     void operator()(const SampleSpan& span) {
+      s->reserveFor(std::size_t(s->count + span.count));
+      int& n = s->count;
       for (int j = 0; j < span.count; ++j) {
         const double px = span.x[j], py = span.y[j], pz = span.z[j];
         if (px < lo[0] || py < lo[1] || pz < lo[2] || px > hi[0] || py > hi[1] || pz > hi[2])
           continue;
-        s->x.push_back(px);
-        s->y.push_back(py);
-        s->z.push_back(pz);
-        s->nx.push_back(span.nx[j]);
-        s->ny.push_back(span.ny[j]);
-        s->nz.push_back(span.nz[j]);
-        s->w.push_back(span.w[j]);
-        s->id.push_back(span.id[j]);
+        s->x[n] = px;
+        s->y[n] = py;
+        s->z[n] = pz;
+        s->nx[n] = span.nx[j];
+        s->ny[n] = span.ny[j];
+        s->nz[n] = span.nz[j];
+        s->w[n] = span.w[j];
+        s->id[n] = span.id[j];
+        ++n;
       }
     }
-  } gather{&scratch, hood.box_lo, hood.box_hi};
+  } gather{&block, hood.box_lo, hood.box_hi};
   // The box's half diagonal covers it (a superset; the gather filters by the box).
   const double half = std::sqrt(3.0) * 0.5 * (hood.box_hi[0] - hood.box_lo[0]);
   kernel::cellSpans(cells, centre, half, gather);
-  hood.block = SampleSpan{scratch.x.data(),  scratch.y.data(),  scratch.z.data(),
-                          scratch.nx.data(), scratch.ny.data(), scratch.nz.data(),
-                          scratch.w.data(),  scratch.id.data(), int(scratch.x.size()), 0};
-  // Row by row (8 nodes along z): the leaf's samples within reach of the row's segment.
-  for (auto* v : {&scratch.rx, &scratch.ry, &scratch.rz, &scratch.rnx, &scratch.rny, &scratch.rnz,
-                  &scratch.rw})
-    v->resize(scratch.x.size());
-  scratch.rid.resize(scratch.x.size());
+  hood.block = block.span();
+  for (SampleSet* set : {&scratch.row, &scratch.ring})
+    set->reserveFor(std::size_t(block.count));
   const double row_reach = reach * (1.0 + 1e-12);
+  const double reach_sq = row_reach * row_reach;
   hood.row_reach = reach;
   const double core_sq = job.law.r0_sq * (1.0 + 1e-12);
   // probe()'s first sum: radius max(reach, r0), the nearest tracked from its square.
@@ -214,26 +211,27 @@ void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, co
   first_sq *= first_sq;
   hood.first_radius = std::sqrt(first_sq);
   for (int k = 0; k < kLanes; ++k) hood.first_z[k] = (leaf.origin[2] + k) * h;
+  const double z0 = leaf.origin[2] * h, z1 = (leaf.origin[2] + 7) * h;
   Accum first[kLanes];
+  // Row by row (8 nodes along z): the leaf's samples within reach of the row's segment.
   for (int row = 0; row < 64; ++row) {
-    const std::uint64_t bits8 = (leaf.mask[row >> 3] >> ((row & 7) * 8)) & 0xffu;
-    if (!bits8) continue;
     const int i = row >> 3, j = row & 7;
+    const std::uint64_t bits8 = (leaf.mask[i] >> (j * 8)) & 0xffu;
+    if (!bits8) continue;
     hood.row_x = (leaf.origin[0] + i) * h;
     hood.row_y = (leaf.origin[1] + j) * h;
-    hood.row_z0 = leaf.origin[2] * h;
-    hood.row_z1 = (leaf.origin[2] + 7) * h;
+    hood.row_z0 = z0;
+    hood.row_z1 = z1;
     // The samples within r0 of the segment first (the core: every term of the row's first
-    // sums), then the rest within reach (the ring: only a shell node's nearest).
-    const int core = lanes::gatherRow(scratch, hood.row_x, hood.row_y, hood.row_z0, hood.row_z1, -1.0,
-                               core_sq, 0);
-    const int n = lanes::gatherRow(scratch, hood.row_x, hood.row_y, hood.row_z0, hood.row_z1, core_sq,
-                            row_reach * row_reach, core);
-    hood.row = SampleSpan{scratch.rx.data(),  scratch.ry.data(),  scratch.rz.data(),
-                          scratch.rnx.data(), scratch.rny.data(), scratch.rnz.data(),
-                          scratch.rw.data(),  scratch.rid.data(), n, 0};
+    // sums), then the rest within reach (the ring: only a shell node's nearest), in one pass.
+    const lanes::Box segment{{hood.row_x, hood.row_y, z0}, {hood.row_x, hood.row_y, z1}};
+    lanes::gather(hood.block, segment, core_sq, reach_sq, scratch.row, &scratch.ring);
+    const int core = scratch.row.count;
+    scratch.row.append(scratch.ring);
+    hood.row = scratch.row.span();
     SampleSpan core_span = hood.row;
     core_span.count = core;
+    hood.first = nullptr;
     if (lanes::rowFirstSums(job.law, core_span, kernel::tail(hood.row, core), hood.row_x,
                             hood.row_y, hood.first_z, first_sq, first))
       hood.first = first;

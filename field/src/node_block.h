@@ -2,6 +2,7 @@
 /// Internal to field/ (no OpenVDB): the samples as a cell list in structure-of-arrays form, and
 /// the node values of one leaf of voxel nodes computed together (the CPU block build) or of many
 /// leaves on the GPU (node_build_cuda.cu). node_kernel.h holds the per-node math for both.
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -38,12 +39,39 @@ using kernel::NodeJob;
 /// The table as the kernels' plain pointers.
 kernel::CellTable cellTableOf(const SampleTable& table);
 
-/// Per-thread scratch of the CPU block build (the leaf's gathered samples).
-struct BlockScratch {
-  std::vector<double> x, y, z, nx, ny, nz, w;  ///< the leaf's
+/// Samples in structure-of-arrays form, sized for `count` of them (the CPU block build's
+/// gathered sets).
+struct SampleSet {
+  std::vector<double> x, y, z, nx, ny, nz, w;
   std::vector<std::int32_t> id;
-  std::vector<double> rx, ry, rz, rnx, rny, rnz, rw;  ///< a row's
-  std::vector<std::int32_t> rid, row;
+  int count = 0;
+  /// Room for n samples and 8 more (the lanes' whole-vector stores; count unchanged).
+  void reserveFor(std::size_t n) {
+    n += 8;
+    for (auto* v : {&x, &y, &z, &nx, &ny, &nz, &w})
+      if (v->size() < n) v->resize(n);
+    if (id.size() < n) id.resize(n);
+  }
+  /// Appends the samples of `more` (room for them made beforehand: reserveFor).
+  void append(const SampleSet& more) {
+    const std::vector<double>* from[7] = {&more.x, &more.y, &more.z, &more.nx,
+                                          &more.ny, &more.nz, &more.w};
+    std::vector<double>* to[7] = {&x, &y, &z, &nx, &ny, &nz, &w};
+    for (int k = 0; k < 7; ++k)
+      std::copy(from[k]->begin(), from[k]->begin() + more.count, to[k]->begin() + count);
+    std::copy(more.id.begin(), more.id.begin() + more.count, id.begin() + count);
+    count += more.count;
+  }
+  kernel::SampleSpan span() const {
+    return {x.data(), y.data(), z.data(), nx.data(), ny.data(), nz.data(), w.data(), id.data(),
+            count, 0};
+  }
+};
+
+/// Per-thread scratch of the CPU block build: the samples gathered for the leaf (within reach
+/// of its box) and for one row (its core, then its ring, gathered apart in the same pass).
+struct BlockScratch {
+  SampleSet block, row, ring;
 };
 
 /// The values of a leaf's masked nodes (out[offset], 512 of them; unmasked ones untouched):

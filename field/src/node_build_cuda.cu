@@ -130,9 +130,9 @@ CudaNodeBuild::~CudaNodeBuild() {
 
 NodeValues CudaNodeBuild::finish() {
   State& st = *state_;
-  NodeValues values{std::unique_ptr<NodeValue[]>(new NodeValue[st.nodes]), st.nodes};  // not zeroed
+  NodeValues values(st.nodes);  // not zeroed
   if (st.nodes == 0) return values;
-  FP_CUDA_CHECK(cudaMemcpyAsync(values.data.get(), st.out->ptr, st.nodes * sizeof(NodeValue),
+  FP_CUDA_CHECK(cudaMemcpyAsync(values.data(), st.out->ptr, st.nodes * sizeof(NodeValue),
                                 cudaMemcpyDeviceToHost, st.stream.s));
   FP_CUDA_CHECK(cudaStreamSynchronize(st.stream.s));
   return values;

@@ -5,6 +5,7 @@
 #include <memory>
 #include <vector>
 
+#include "huge_pages.h"
 #include "node_kernel.h"
 
 namespace fieldpath::field::kernel {
@@ -13,12 +14,8 @@ namespace fieldpath::field::kernel {
 bool cudaNodeBuildAvailable();
 
 /// A build's node values, left uninitialised until the device's are copied in (zeroing the
-/// 100 MB of a refined level first cost 30 ms on the GPU machine).
-struct NodeValues {
-  std::unique_ptr<NodeValue[]> data;
-  std::size_t size = 0;
-  const NodeValue& operator[](std::size_t i) const { return data[i]; }
-};
+/// 100 MB of a refined level first cost 30 ms on the GPU machine), in huge pages.
+using NodeValues = HugeArray<NodeValue>;
 
 /// The values of the masked nodes of every leaf, computed on the GPU from the cell list
 /// (`table`'s pointers are host memory; copied over), compacted in leaf order then node offset

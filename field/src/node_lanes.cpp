@@ -187,75 +187,121 @@ void accumulateLanes(const Law& L, const SampleSpan& s, D3 at, bool track, Accum
   accumulateLanes(L, &s, 1, at, track, a);
 }
 
-/// Copies the leaf's gathered samples whose squared distance d² to the row's segment (x, y,
-/// [z0, z1]) has lo_sq < d² <= hi_sq to the row arrays (sized for them all) from position n, in
-/// their order; returns the position after the last.
-static int gatherRowGeneric(BlockScratch& s, double x, double y, double z0, double z1, double lo_sq,
-                     double hi_sq, int n) {
-  for (std::size_t t = 0; t < s.x.size(); ++t) {
-    const double dx = s.x[t] - x, dy = s.y[t] - y, z = s.z[t];
-    const double dz = z < z0 ? z0 - z : z > z1 ? z - z1 : 0.0;
+/// The gap between p and [lo, hi] (0 inside): for a row's segment (lo = hi) |p - lo|, whose
+/// square is (p - lo)² to the bit, so that a row's set is the same through a box or not.
+static inline double gapTo(double p, double lo, double hi) {
+  const double below = lo - p, above = p - hi;
+  return below > 0.0 ? below : above > 0.0 ? above : 0.0;
+}
+
+namespace {
+/// A SampleSet's arrays as plain pointers (loaded once: through the vectors, every store made
+/// the compiler load them again).
+struct SetOut {
+  double* v[7];
+  std::int32_t* id;
+  explicit SetOut(SampleSet& s)
+      : v{s.x.data(), s.y.data(), s.z.data(), s.nx.data(), s.ny.data(), s.nz.data(), s.w.data()},
+        id(s.id.data()) {}
+};
+}  // namespace
+
+static void gatherGeneric(const SampleSpan& f, const Box& box, double near_sq, double far_sq,
+                          SampleSet& near, SampleSet* far) {
+  int counts[2] = {0, 0};
+  SampleSet* sets[2] = {&near, far};
+  for (int t = 0; t < f.count; ++t) {
+    const double dx = gapTo(f.x[t], box.lo[0], box.hi[0]);
+    const double dy = gapTo(f.y[t], box.lo[1], box.hi[1]);
+    const double dz = gapTo(f.z[t], box.lo[2], box.hi[2]);
     const double d2 = dx * dx + dy * dy + dz * dz;
-    if (!(d2 > lo_sq && d2 <= hi_sq)) continue;
-    s.rx[n] = s.x[t];
-    s.ry[n] = s.y[t];
-    s.rz[n] = s.z[t];
-    s.rnx[n] = s.nx[t];
-    s.rny[n] = s.ny[t];
-    s.rnz[n] = s.nz[t];
-    s.rw[n] = s.w[t];
-    s.rid[n] = s.id[t];
-    ++n;
+    const int which = d2 <= near_sq ? 0 : far && d2 <= far_sq ? 1 : -1;
+    if (which < 0) continue;
+    SampleSet& to = *sets[which];
+    const int n = counts[which]++;
+    to.x[n] = f.x[t];
+    to.y[n] = f.y[t];
+    to.z[n] = f.z[t];
+    to.nx[n] = f.nx[t];
+    to.ny[n] = f.ny[t];
+    to.nz[n] = f.nz[t];
+    to.w[n] = f.w[t];
+    to.id[n] = f.id[t];
   }
-  return n;
+  near.count = counts[0];
+  if (far) far->count = counts[1];
 }
 
 #if defined(__x86_64__)
-/// gatherRowGeneric in AVX-512 lanes: the same test, the passing samples compress-stored.
-static __attribute__((target("avx512f"))) int gatherRow512(BlockScratch& s, double x, double y,
-                                                     double z0, double z1, double lo_sq,
-                                                     double hi_sq, int n) {
-  const __m512d vx = _mm512_set1_pd(x), vy = _mm512_set1_pd(y);
-  const __m512d vz0 = _mm512_set1_pd(z0), vz1 = _mm512_set1_pd(z1);
-  const __m512d lo = _mm512_set1_pd(lo_sq), hi = _mm512_set1_pd(hi_sq);
+/// The lanes `in` of one batch of 8 samples (px, py, pz and the rest at f's position t)
+/// appended to `to` at n: compressed in registers and stored whole (the lanes past the passing
+/// ones are written over by the next store, or lie in the arrays' padding; the memory form of
+/// vcompresspd is microcoded).
+static __attribute__((target("avx512f"), always_inline)) inline void append512(
+    const SampleSpan& f, int t, __mmask8 valid, __mmask8 in, __m512d px, __m512d py, __m512d pz,
+    const SetOut& to, int n) {
+  _mm512_storeu_pd(to.v[0] + n, _mm512_maskz_compress_pd(in, px));
+  _mm512_storeu_pd(to.v[1] + n, _mm512_maskz_compress_pd(in, py));
+  _mm512_storeu_pd(to.v[2] + n, _mm512_maskz_compress_pd(in, pz));
+  const double* rest[4] = {f.nx, f.ny, f.nz, f.w};
+  for (int k = 0; k < 4; ++k)
+    _mm512_storeu_pd(to.v[3 + k] + n,
+                     _mm512_maskz_compress_pd(in, _mm512_maskz_loadu_pd(valid, rest[k] + t)));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(to.id + n),
+                      _mm512_castsi512_si256(_mm512_maskz_compress_epi32(
+                          __mmask16(in), _mm512_maskz_loadu_epi32(__mmask16(valid), f.id + t))));
+}
+
+/// gatherGeneric in AVX-512 lanes: the same test, one pass for both sets.
+static __attribute__((target("avx512f"))) void gather512(const SampleSpan& f, const Box& box,
+                                                         double near_sq, double far_sq,
+                                                         SampleSet& near, SampleSet* far) {
   const __m512d zero = _mm512_setzero_pd();
-  const int count = int(s.x.size());
-  for (int t = 0; t < count; t += kLanes) {
-    const int left = count - t;
-    const __mmask8 valid = left >= kLanes ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
-    const __m512d px = _mm512_maskz_loadu_pd(valid, s.x.data() + t);
-    const __m512d py = _mm512_maskz_loadu_pd(valid, s.y.data() + t);
-    const __m512d pz = _mm512_maskz_loadu_pd(valid, s.z.data() + t);
-    const __m512d dx = _mm512_sub_pd(px, vx), dy = _mm512_sub_pd(py, vy);
-    // z0 - z or z - z1 where positive, else 0 (the segment's distance along z)
-    const __m512d dz = _mm512_max_pd(zero, _mm512_max_pd(_mm512_sub_pd(vz0, pz),
-                                                         _mm512_sub_pd(pz, vz1)));
-    const __m512d d2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
-                                     _mm512_mul_pd(dz, dz));
-    const __mmask8 in = _mm512_mask_cmp_pd_mask(_mm512_mask_cmp_pd_mask(valid, d2, hi, _CMP_LE_OQ),
-                                                d2, lo, _CMP_GT_OQ);
-    if (!in) continue;
-    _mm512_mask_compressstoreu_pd(s.rx.data() + n, in, px);
-    _mm512_mask_compressstoreu_pd(s.ry.data() + n, in, py);
-    _mm512_mask_compressstoreu_pd(s.rz.data() + n, in, pz);
-    _mm512_mask_compressstoreu_pd(s.rnx.data() + n, in, _mm512_maskz_loadu_pd(valid, s.nx.data() + t));
-    _mm512_mask_compressstoreu_pd(s.rny.data() + n, in, _mm512_maskz_loadu_pd(valid, s.ny.data() + t));
-    _mm512_mask_compressstoreu_pd(s.rnz.data() + n, in, _mm512_maskz_loadu_pd(valid, s.nz.data() + t));
-    _mm512_mask_compressstoreu_pd(s.rw.data() + n, in, _mm512_maskz_loadu_pd(valid, s.w.data() + t));
-    _mm512_mask_compressstoreu_epi32(s.rid.data() + n, __mmask16(in),
-                                     _mm512_maskz_loadu_epi32(__mmask16(valid), s.id.data() + t));
-    n += __builtin_popcount(in);
+  __m512d blo[3], bhi[3];
+  for (int a = 0; a < 3; ++a) {
+    blo[a] = _mm512_set1_pd(box.lo[a]);
+    bhi[a] = _mm512_set1_pd(box.hi[a]);
   }
-  return n;
+  const __m512d vnear = _mm512_set1_pd(near_sq), vfar = _mm512_set1_pd(far ? far_sq : near_sq);
+  const SetOut near_out(near);
+  const SetOut far_out(far ? *far : near);
+  int n_near = 0, n_far = 0;
+  for (int t = 0; t < f.count; t += kLanes) {
+    const int left = f.count - t;
+    const __mmask8 valid = left >= kLanes ? __mmask8(0xff) : __mmask8((1u << left) - 1u);
+    const __m512d px = _mm512_maskz_loadu_pd(valid, f.x + t);
+    const __m512d py = _mm512_maskz_loadu_pd(valid, f.y + t);
+    const __m512d pz = _mm512_maskz_loadu_pd(valid, f.z + t);
+    // max(0, lo - p, p - hi): gapTo's value (one of the two differences is <= 0)
+    __m512d d[3];
+    const __m512d p[3] = {px, py, pz};
+    for (int a = 0; a < 3; ++a)
+      d[a] = _mm512_max_pd(zero, _mm512_max_pd(_mm512_sub_pd(blo[a], p[a]), _mm512_sub_pd(p[a], bhi[a])));
+    const __m512d d2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(d[0], d[0]), _mm512_mul_pd(d[1], d[1])),
+                                     _mm512_mul_pd(d[2], d[2]));
+    const __mmask8 in_near = _mm512_mask_cmp_pd_mask(valid, d2, vnear, _CMP_LE_OQ);
+    const __mmask8 in_far =
+        far ? __mmask8(_mm512_mask_cmp_pd_mask(valid, d2, vfar, _CMP_LE_OQ) & ~in_near) : 0;
+    if (in_near) {
+      append512(f, t, valid, in_near, px, py, pz, near_out, n_near);
+      n_near += __builtin_popcount(in_near);
+    }
+    if (in_far) {
+      append512(f, t, valid, in_far, px, py, pz, far_out, n_far);
+      n_far += __builtin_popcount(in_far);
+    }
+  }
+  near.count = n_near;
+  if (far) far->count = n_far;
 }
 #endif
 
-int gatherRow(BlockScratch& s, double x, double y, double z0, double z1, double lo_sq,
-              double hi_sq, int n) {
+void gather(const SampleSpan& from, const Box& box, double near_sq, double far_sq,
+            SampleSet& near, SampleSet* far) {
 #if defined(__x86_64__)
-  if (kHaveAvx512) return gatherRow512(s, x, y, z0, z1, lo_sq, hi_sq, n);
+  if (kHaveAvx512) return gather512(from, box, near_sq, far_sq, near, far);
 #endif
-  return gatherRowGeneric(s, x, y, z0, z1, lo_sq, hi_sq, n);
+  gatherGeneric(from, box, near_sq, far_sq, near, far);
 }
 
 #if defined(__x86_64__)

@@ -22,11 +22,16 @@ void accumulateLanes(const kernel::Law& L, const kernel::SampleSpan* spans, int 
 void accumulateLanes(const kernel::Law& L, const kernel::SampleSpan& s, kernel::D3 at,
                      bool track, kernel::Accum& a);
 
-/// Copies the leaf's gathered samples (s.x ...) whose squared distance d² to the row's segment
-/// (x, y, [z0, z1]) has lo_sq < d² <= hi_sq to the row arrays (s.rx ..., sized for them all)
-/// from position n, in their order; returns the position after the last.
-int gatherRow(BlockScratch& s, double x, double y, double z0, double z1, double lo_sq,
-              double hi_sq, int n);
+/// An axis-aligned box (mm; a row's segment when x0 = x1 and y0 = y1).
+struct Box {
+  double lo[3], hi[3];
+};
+
+/// The samples of `from` within sqrt(near_sq) of `box` (squared distance d² <= near_sq) copied
+/// to `near`, and if `far` those with near_sq < d² <= far_sq to `far`, in their order (counts
+/// set; both sized for all of `from`: SampleSet::reserveFor).
+void gather(const kernel::SampleSpan& from, const Box& box, double near_sq, double far_sq,
+            SampleSet& near, SampleSet* far);
 
 /// The first sums (kernel::probe's) of a row's 8 nodes at (x, y, node_z[k]) at once, the nodes
 /// in the lanes: every sample of `core` (those within r0 of the row's segment) read once for the

@@ -18,6 +18,7 @@
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/field/voxel_field.h"
+#include "huge_pages.h"  // UninitVector
 #include "point_index.h"
 
 namespace fieldpath::field::voxel {
@@ -163,29 +164,6 @@ inline bool bit(const std::vector<std::uint64_t>& words, std::size_t i) {
   return (words[i >> 6] >> (i & 63)) & 1u;
 }
 
-/// An allocator that leaves trivially constructible elements uninitialised on resize: the
-/// blocks and the node errors are written in parallel where they are read (zeroing them first
-/// was 0.1 s a refined level, serial, on the GPU machine's 16 cores).
-template <class T>
-struct UninitAllocator : std::allocator<T> {
-  template <class U>
-  struct rebind {
-    using other = UninitAllocator<U>;
-  };
-  UninitAllocator() = default;
-  template <class U>
-  UninitAllocator(const UninitAllocator<U>&) noexcept {}
-  template <class U>
-  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-};
-template <class T>
-using UninitVector = std::vector<T, UninitAllocator<T>>;
 
 /// One level of the grid: the OpenVDB grids (build, save) and their query form, a block per
 /// leaf holding its 8³ nodes and the first layer of its +x, +y, +z neighbours (9³), so that every
