@@ -76,27 +76,33 @@ void makeBlocks(Level& level, bool ratio) {
       // From the buffers of the leaf and of its +x, +y, +z neighbours (side = which of them:
       // bit 2 for i = 8, 1 for j = 8, 0 for k = 8), looked up once each; an absent leaf holds
       // the background (the trees have no active tiles).
-      const Leaf* value_leaf[8];
-      const FloatLeaf* float_leaf[8];
+      // Their buffers' data read directly (LeafBuffer's accessors check for out-of-core data
+      // at every value: most of this loop's time).
+      const openvdb::Vec3s* values_of[8];
+      const float* floats_of[8];
+      const openvdb::util::NodeMask<3>* over_of[8];
       for (int side = 0; side < 8; ++side) {
         const openvdb::Coord n =
             o.offsetBy(side & 4 ? kLeafDim : 0, side & 2 ? kLeafDim : 0, side & 1 ? kLeafDim : 0);
-        value_leaf[side] = side == 0 ? &leaf : values.probeConstLeaf(n);
-        float_leaf[side] = ratio ? closeness->probeConstLeaf(n) : nullptr;
+        const Leaf* v = side == 0 ? &leaf : values.probeConstLeaf(n);
+        const FloatLeaf* f = ratio ? closeness->probeConstLeaf(n) : nullptr;
+        values_of[side] = v ? v->buffer().data() : nullptr;
+        floats_of[side] = f ? f->buffer().data() : nullptr;
+        over_of[side] = f ? &f->getValueMask() : nullptr;
       }
       std::uint64_t* over = &level.over[b * kBlockWords];
+      std::array<float, 4>* block = &level.nodes[b * kBlockNodes];
       for (int i = 0, n = 0; i < kBlockDim; ++i)
         for (int j = 0; j < kBlockDim; ++j)
           for (int k = 0; k < kBlockDim; ++k, ++n) {
             const int side = (i >> 3) << 2 | (j >> 3) << 1 | (k >> 3);
             const openvdb::Index offset =
                 openvdb::Index(((i & 7) * kLeafDim + (j & 7)) * kLeafDim + (k & 7));
-            const openvdb::Vec3s v =
-                value_leaf[side] ? value_leaf[side]->getValue(offset) : value_background;
-            const FloatLeaf* f = float_leaf[side];
-            const float c = f ? f->getValue(offset) : closeness_background;
-            if (f && f->isValueOn(offset)) over[n >> 6] |= std::uint64_t{1} << (n & 63);
-            level.nodes[b * kBlockNodes + n] = {v.x(), v.y(), v.z(), c};
+            const openvdb::Vec3s v = values_of[side] ? values_of[side][offset] : value_background;
+            const float c = floats_of[side] ? floats_of[side][offset] : closeness_background;
+            if (over_of[side] && over_of[side]->isOn(offset))
+              over[n >> 6] |= std::uint64_t{1} << (n & 63);
+            block[n] = {v.x(), v.y(), v.z(), c};
           }
     }
   });

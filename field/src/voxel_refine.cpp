@@ -28,15 +28,21 @@ class NodeCurvature {
   /// the surface's normal and s <= -depth_mm.
   void at(const Leaf& leaf, const FloatLeaf* closeness, openvdb::Index offset, double depth_mm,
           double& force, double& error, bool& inside) {
-    leaf_ = &leaf;
-    float_leaf_ = closeness;
+    if (leaf_ != &leaf) {  // the leaf's buffers read directly (no out-of-core check a value)
+      leaf_ = &leaf;
+      float_leaf_ = closeness;
+      origin_ = leaf.origin();
+      values_data_ = leaf.buffer().data();
+      floats_data_ = closeness ? closeness->buffer().data() : nullptr;
+    }
     const openvdb::Coord ijk = leaf.offsetToGlobalCoord(offset);
     const Read here = read(ijk);
     inside = law_ && here.s <= -depth_mm && here.over;
-    double slope = 0.0;
+    double slope = 0.0, plane = 0.0;
     if (law_) {
       constexpr double kStepMm = 1e-4;
-      force = law_->at(here.s) * here.v.norm();
+      plane = law_->at(here.s);
+      force = plane * here.v.norm();
       slope = std::abs(law_->at(std::abs(here.s) + kStepMm) - law_->at(std::abs(here.s) - kStepMm)) /
               (2 * kStepMm);
     } else {
@@ -51,7 +57,7 @@ class NodeCurvature {
       if (!m.built || !p.built) continue;
       const Vec3 dv = m.v - 2.0 * here.v + p.v;
       const double e = law_ ? slope * here.v.norm() * std::abs(m.s - 2.0 * here.s + p.s) +
-                                  law_->at(here.s) * dv.norm()
+                                  plane * dv.norm()
                             : dv.norm();
       error = std::max(error, e / 8.0);
     }
@@ -65,13 +71,13 @@ class NodeCurvature {
   };
   /// From the current leaf's buffers when ijk is in it (most reads), else through accessors.
   Read read(const openvdb::Coord& ijk) {
-    const openvdb::Coord o = leaf_->origin();
+    const openvdb::Coord& o = origin_;
     if (((ijk.x() - o.x()) | (ijk.y() - o.y()) | (ijk.z() - o.z())) >> 3 == 0 &&
         (float_leaf_ || !law_)) {
       const openvdb::Index n = Leaf::coordToOffset(ijk);
-      const openvdb::Vec3s v = leaf_->getValue(n);
-      return {leaf_->isValueOn(n), law_ && float_leaf_->isValueOn(n),
-              law_ ? law_->r0_mm - float_leaf_->getValue(n) : 0.0, Vec3(v.x(), v.y(), v.z())};
+      const openvdb::Vec3s& v = values_data_[n];
+      return {leaf_->getValueMask().isOn(n), law_ && float_leaf_->getValueMask().isOn(n),
+              law_ ? law_->r0_mm - floats_data_[n] : 0.0, Vec3(v.x(), v.y(), v.z())};
     }
     const openvdb::Vec3s v = values_.getValue(ijk);
     return {values_.isValueOn(ijk), law_ && closeness_->isValueOn(ijk),
@@ -82,6 +88,9 @@ class NodeCurvature {
   const std::optional<PlaneLaw>& law_;
   const Leaf* leaf_ = nullptr;
   const FloatLeaf* float_leaf_ = nullptr;
+  openvdb::Coord origin_;
+  const openvdb::Vec3s* values_data_ = nullptr;
+  const float* floats_data_ = nullptr;
 };
 
 }  // namespace
