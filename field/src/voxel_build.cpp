@@ -3,6 +3,7 @@
 /// leaves a level has: voxel_leaves.cpp; the error estimate: voxel_refine.cpp; the queries:
 /// voxel_field.cpp).
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -17,6 +18,7 @@
 
 #include <openvdb/tools/Prune.h>
 #include <tbb/parallel_reduce.h>
+#include <tbb/parallel_scan.h>
 
 #include "fieldpath/common/errors.h"
 #include "node_block.h"
@@ -458,48 +460,54 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
   VoxelStats& stats = built.stats;
   if (tolerance > 0.0 && refine_levels > 0) {
     const double floor = kRefineFloorFraction * builder.law.at(2.0 * params.r_min_mm);
-    std::vector<openvdb::Coord> cells = cellsWithValues(levels[0]);
+    CellList cells = cellsWithValues(levels[0]);
     trace.lap("cells with values");
     const auto refine_start = std::chrono::steady_clock::now();
     const double nodes_before = builder.nodes_seconds;
     for (int l = 0; l < refine_levels && !cells.empty(); ++l) {
       const double hl = levels[l].h_mm;
-      // Each cell's error and, for those that miss, where it is in the level's blocks (in
-      // parallel); then, serially in the cells' order, the split cells marked and their halves
-      // listed; then the nodes of the halves (3³ a split cell) on masks in parallel, merged.
-      std::vector<char> split(cells.size(), 0);
-      std::vector<CellRef> where(cells.size());
-      const CellErrors errors(levels[std::size_t(l)], law, floor);
+      Level& level = levels[std::size_t(l)];
+      const CellErrors errors(level, law, floor);
       trace.lap("node errors");
+      // Each cell's error and, for those that miss, their bit in the level's `refined` (cells
+      // share a block's words: atomic ors); then the split cells' ranks (a parallel prefix
+      // sum) and, at those ranks, the split cells and their halves, in the cells' order. No
+      // list is zeroed first: each entry is written once, in parallel.
+      UninitVector<std::uint32_t> split(cells.size());  // 0 or 1, then the ranks' prefix
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size()), [&](const auto& range) {
-        auto acc = levels[std::size_t(l)].block_of->getConstUnsafeAccessor();
+        auto acc = level.block_of->getConstUnsafeAccessor();
         for (std::size_t c = range.begin(); c != range.end(); ++c) {
-          const openvdb::Coord& ijk = cells[c];
+          const openvdb::Coord ijk = cells[c].coord();
           const Vec3 x = (Vec3(ijk.x(), ijk.y(), ijk.z()) + Vec3::Constant(0.5)) * hl;
-          if (request.region_mm && !request.region_mm->contains(x)) continue;
-          split[c] = errors.cellError(ijk, acc) > tolerance && locate(levels[l], acc, x, where[c]);
+          CellRef where;
+          split[c] = (!request.region_mm || request.region_mm->contains(x)) &&
+                     errors.cellError(ijk, acc) > tolerance && locate(level, acc, x, where);
+          if (split[c])
+            std::atomic_ref<std::uint64_t>(level.refined[where.block * kCellWords + (where.cell >> 6)])
+                .fetch_or(std::uint64_t{1} << (where.cell & 63), std::memory_order_relaxed);
         }
       });
       stats.tested_cells += cells.size();
-      // The split cells' bits (serial: cells share a block's words), then their list and
-      // their halves' at each one's rank among them (in parallel, the cells' order).
-      std::vector<std::size_t> rank(cells.size() + 1, 0);
-      for (std::size_t c = 0; c < cells.size(); ++c) {
-        rank[c + 1] = rank[c] + std::size_t(split[c]);
-        if (!split[c]) continue;
-        const CellRef& ref = where[c];
-        levels[l].refined[ref.block * kCellWords + (ref.cell >> 6)] |= std::uint64_t{1}
-                                                                       << (ref.cell & 63);
-      }
-      const std::size_t splits = rank.back();
-      std::vector<openvdb::Coord> split_cells(splits), next_cells(8 * splits);
+      UninitVector<std::uint32_t> rank(cells.size());  // split cells before c
+      const std::size_t splits = tbb::parallel_scan(
+          tbb::blocked_range<std::size_t>(0, cells.size()), std::size_t{0},
+          [&](const tbb::blocked_range<std::size_t>& range, std::size_t sum, bool is_final) {
+            for (std::size_t c = range.begin(); c != range.end(); ++c) {
+              if (is_final) rank[c] = std::uint32_t(sum);
+              sum += split[c];
+            }
+            return sum;
+          },
+          std::plus<std::size_t>());
+      CellList split_cells(splits), next_cells(8 * splits);
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size()), [&](const auto& range) {
         for (std::size_t c = range.begin(); c != range.end(); ++c) {
           if (!split[c]) continue;
           split_cells[rank[c]] = cells[c];
-          const openvdb::Coord fine = cells[c] << 1;
+          const CellIjk fine{2 * cells[c].x, 2 * cells[c].y, 2 * cells[c].z};
           for (int h8 = 0; h8 < 8; ++h8)
-            next_cells[8 * rank[c] + std::size_t(h8)] = fine.offsetBy(h8 >> 2, (h8 >> 1) & 1, h8 & 1);
+            next_cells[8 * std::size_t(rank[c]) + std::size_t(h8)] = {
+                fine.x + (h8 >> 2), fine.y + ((h8 >> 1) & 1), fine.z + (h8 & 1)};
         }
       });
       stats.refined_cells += splits;

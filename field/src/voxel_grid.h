@@ -268,8 +268,17 @@ class CellErrors {
   std::vector<std::uint64_t> built_;   ///< a bit per such node: value on
   std::vector<std::uint64_t> inside_;  ///< ... and under the surface by >= √3 h / 2 (plane ratio)
 };
-/// Cells of a level to test: every cell of a block with a non-zero corner (index coordinates).
-std::vector<openvdb::Coord> cellsWithValues(const Level& level);
+/// A cell's lowest corner (index coordinates), trivially constructible: the refinement's lists
+/// of millions of cells are made without zeroing them first (serial, it was a third of the
+/// refinement's host work on the GPU machine), then written in parallel.
+struct CellIjk {
+  std::int32_t x, y, z;
+  openvdb::Coord coord() const { return {x, y, z}; }
+};
+using CellList = UninitVector<CellIjk>;
+
+/// Cells of a level to test: every cell of a block with a non-zero corner.
+CellList cellsWithValues(const Level& level);
 
 /// Origins (index space) of the leaves of a level of size h within reach_mm of a sample and
 /// inside `reach` (the region's box), sorted (voxel_leaves.cpp).
@@ -277,7 +286,7 @@ std::vector<openvdb::Coord> candidateLeaves(const ObstacleSamples& samples,
                                             const Eigen::AlignedBox3d& reach, double h,
                                             double reach_mm);
 /// The nodes of the halves of `cells` (3³ a cell at the next level) on a mask (voxel_leaves.cpp).
-openvdb::MaskGrid::Ptr nodesOfHalves(const std::vector<openvdb::Coord>& cells);
+openvdb::MaskGrid::Ptr nodesOfHalves(const CellList& cells);
 
 /// The levels of a voxel field built from the samples (voxel_build.cpp): level 0 at h, then
 /// the refined levels; the stats but for memory and the dense box.

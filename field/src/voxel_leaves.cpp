@@ -133,16 +133,16 @@ std::vector<openvdb::Coord> candidateLeaves(const ObstacleSamples& samples,
 
 /// The nodes of the halves of `cells` (3³ a cell at the next level), marked on a mask per task
 /// and merged (the same set as one serial pass).
-openvdb::MaskGrid::Ptr nodesOfHalves(const std::vector<openvdb::Coord>& cells) {
+openvdb::MaskGrid::Ptr nodesOfHalves(const CellList& cells) {
   struct Marker {
-    const std::vector<openvdb::Coord>* cells;
+    const CellList* cells;
     openvdb::MaskGrid::Ptr mask = openvdb::MaskGrid::create(false);
-    explicit Marker(const std::vector<openvdb::Coord>* c) : cells(c) {}
+    explicit Marker(const CellList* c) : cells(c) {}
     Marker(Marker& other, tbb::split) : cells(other.cells) {}
     void operator()(const tbb::blocked_range<std::size_t>& range) {
       auto acc = mask->getAccessor();
       for (std::size_t c = range.begin(); c != range.end(); ++c) {
-        const openvdb::Coord fine = (*cells)[c] << 1;
+        const openvdb::Coord fine = (*cells)[c].coord() << 1;
         for (int i = 0; i < 3; ++i)
           for (int j = 0; j < 3; ++j)
             for (int k = 0; k < 3; ++k) acc.setValueOn(fine.offsetBy(i, j, k));

@@ -145,16 +145,16 @@ double CellErrors::cellError(const openvdb::Coord& cell, const IndexAccessor& ac
   return worst / std::max(sum / built, floor_);
 }
 
-std::vector<openvdb::Coord> cellsWithValues(const Level& level) {
+CellList cellsWithValues(const Level& level) {
   // Block by block in parallel, then joined in the blocks' order (the index grid's).
   std::vector<std::pair<openvdb::Coord, std::size_t>> blocks;
   for (auto it = level.block_of->cbeginValueOn(); it; ++it)
     blocks.emplace_back(it.getCoord() << 3, std::size_t(*it));
-  std::vector<std::vector<openvdb::Coord>> per_block(blocks.size());
+  std::vector<std::vector<CellIjk>> per_block(blocks.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size()), [&](const auto& range) {
     for (std::size_t q = range.begin(); q != range.end(); ++q) {
       const auto& [o, b] = blocks[q];
-      std::vector<openvdb::Coord>& cells = per_block[q];
+      std::vector<CellIjk>& cells = per_block[q];
       for (int i = 0; i < kLeafDim; ++i)
         for (int j = 0; j < kLeafDim; ++j)
           for (int k = 0; k < kLeafDim; ++k) {
@@ -165,13 +165,13 @@ std::vector<openvdb::Coord> cellsWithValues(const Level& level) {
               const auto& v = level.nodes[n0 + kCornerOffset[c]];
               any = v[0] != 0.0f || v[1] != 0.0f || v[2] != 0.0f;
             }
-            if (any) cells.push_back(o.offsetBy(i, j, k));
+            if (any) cells.push_back({o.x() + i, o.y() + j, o.z() + k});
           }
     }
   });
   std::vector<std::size_t> start(blocks.size() + 1, 0);
   for (std::size_t q = 0; q < blocks.size(); ++q) start[q + 1] = start[q] + per_block[q].size();
-  std::vector<openvdb::Coord> cells(start.back());
+  CellList cells(start.back());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size()), [&](const auto& range) {
     for (std::size_t q = range.begin(); q != range.end(); ++q)
       std::copy(per_block[q].begin(), per_block[q].end(), cells.begin() + long(start[q]));
