@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <sstream>
 #include <string>
 
@@ -13,6 +14,7 @@
 #include "commands.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/csv.h"
+#include "fieldpath/field/voxel_field.h"
 #include "estimates.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/units.h"
@@ -169,6 +171,14 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
       job.field.voxel.backend = *field::fieldBackendNamed(options->backend);
     job.nominal = options->nominal;
     job.progress = makeProgressLine(global.quiet);
+    // CUDA's start-up (the device's context: 0.2-0.3 s on the GPU machine) on a thread while the
+    // obstacles are sampled and the build's host work begins; the build's first use of the device
+    // waits for it (once per process). Only where the voxel build may take the GPU.
+    const field::FieldBackend wanted = job.field.voxel.backend;
+    std::future<bool> cuda_start;
+    if (job.mode == pathgen::FieldMode::Voxel && !job.nominal &&
+        (wanted == field::FieldBackend::Auto || wanted == field::FieldBackend::Cuda))
+      cuda_start = std::async(std::launch::async, field::cudaFieldBackendAvailable);
     const pathgen::GenerateResult result = pathgen::generatePath(job);
 
     // Every output is computed; now write them (each atomically).

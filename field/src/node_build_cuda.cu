@@ -9,27 +9,21 @@
 #include <string>
 #include <vector>
 
+#include "fieldpath/common/cuda_check.h"
 #include "node_cuda.h"
 
 namespace fieldpath::field::kernel {
 namespace {
-
-void check(cudaError_t status, const char* what, const char* file, int line) {
-  if (status != cudaSuccess)
-    throw std::runtime_error(std::string(file) + ":" + std::to_string(line) + ": " + what + ": " +
-                             cudaGetErrorString(status));
-}
-#define FP_CUDA_CHECK(call) check((call), #call, __FILE__, __LINE__)
 
 /// Device memory freed on scope exit.
 template <class T>
 struct DeviceArray {
   T* ptr = nullptr;
   explicit DeviceArray(std::size_t n) {
-    if (n) FP_CUDA_CHECK(cudaMalloc(&ptr, n * sizeof(T)));
+    if (n) FIELDPATH_CUDA_CHECK(cudaMalloc(&ptr, n * sizeof(T)));
   }
   DeviceArray(const T* host, std::size_t n, cudaStream_t stream) : DeviceArray(n) {
-    if (n) FP_CUDA_CHECK(cudaMemcpyAsync(ptr, host, n * sizeof(T), cudaMemcpyHostToDevice, stream));
+    if (n) FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(ptr, host, n * sizeof(T), cudaMemcpyHostToDevice, stream));
   }
   ~DeviceArray() {
     if (ptr) cudaFree(ptr);
@@ -70,7 +64,7 @@ bool cudaNodeBuildAvailable() {
 struct CudaNodeBuild::State {
   struct Stream {
     cudaStream_t s = nullptr;
-    Stream() { FP_CUDA_CHECK(cudaStreamCreate(&s)); }
+    Stream() { FIELDPATH_CUDA_CHECK(cudaStreamCreate(&s)); }
     ~Stream() {
       if (s) cudaStreamDestroy(s);
     }
@@ -121,7 +115,7 @@ CudaNodeBuild::CudaNodeBuild(const CellTable& table, const NodeJob& job,
   device.cell_start = st.starts->ptr;
   nodeKernel<<<unsigned(leaves.size()), 512, 0, stream>>>(device, job, st.tasks->ptr,
                                                           st.firsts->ptr, st.out->ptr);
-  FP_CUDA_CHECK(cudaGetLastError());
+  FIELDPATH_CUDA_CHECK(cudaGetLastError());
 }
 
 CudaNodeBuild::~CudaNodeBuild() {
@@ -132,9 +126,9 @@ NodeValues CudaNodeBuild::finish() {
   State& st = *state_;
   NodeValues values(st.nodes);  // not zeroed
   if (st.nodes == 0) return values;
-  FP_CUDA_CHECK(cudaMemcpyAsync(values.data(), st.out->ptr, st.nodes * sizeof(NodeValue),
+  FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(values.data(), st.out->ptr, st.nodes * sizeof(NodeValue),
                                 cudaMemcpyDeviceToHost, st.stream.s));
-  FP_CUDA_CHECK(cudaStreamSynchronize(st.stream.s));
+  FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(st.stream.s));
   return values;
 }
 

@@ -23,16 +23,10 @@
 #include <vector>
 
 #include "cuda_engine.h"
+#include "fieldpath/common/cuda_check.h"
 
 namespace fieldpath::zbuffer::cuda {
 namespace {
-
-void checkCuda(cudaError_t err, const char* what, const char* file, int line) {
-  if (err != cudaSuccess)
-    throw std::runtime_error(std::string(file) + ":" + std::to_string(line) + ": " + what + ": " +
-                             cudaGetErrorString(err));
-}
-#define FIELDPATH_CUDA_CHECK(call) checkCuda((call), #call, __FILE__, __LINE__)
 
 constexpr int kWarpsPerBlock = 4;
 /// Trace counters (FIELDPATH_ZB_TRACE): lines visited, lowered; the group kernel's lines past its
