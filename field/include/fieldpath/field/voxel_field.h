@@ -85,6 +85,13 @@ inline constexpr double kRefineFloorFraction = 0.005;
 /// for h <= 0.
 std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams& params,
                                const VoxelRequest& request);
+namespace detail {
+/// estimateVoxelNodes marking the cells near samples on a dense bitmap when the samples' cells
+/// ± 2 are at most `dense_limit_cells`, on a sparse mask otherwise (the same count; tests
+/// compare the two).
+std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams& params,
+                               const VoxelRequest& request, double dense_limit_cells);
+}  // namespace detail
 /// Bytes per node of the estimate: a Vec3f per node of leaves that are ~2/3 full (18), and the
 /// query block of the leaf, 16 bytes per node of 9³ (≈ 34 per active node). Measured with the
 /// plane ratio's closeness grid on top (× 16/12): 74-95 bytes per active node.
