@@ -74,13 +74,16 @@ def speed_vs_error(study, out):
              if not any((q[2] <= p[2] and q[1] <= p[1]) and (q[2] < p[2] or q[1] < p[1]) for q in shown)]
     front.sort(key=lambda p: p[1])
     colour = colours([r["variant"] for r in study])
-    for name, e, t, raw in shown:
+    # Each point numbered, the names in a key under the plot: long names written beside the
+    # points overlapped each other and the axes where variants sit close (a build and its
+    # reference at the same error).
+    for k, (name, e, t, raw) in enumerate(shown, start=1):
         ratio = "plane_ratio" in name
         marker = "s" if raw <= 0 else {(False, False): "o", (True, False): "^", (False, True): "D",
                                        (True, True): "v"}[("quadratic" in name, ratio)]
-        ax.scatter(e, t, marker=marker, s=50, zorder=3, color=colour[name])
-        label = name + (" (exact)" if raw <= 0 else "")
-        ax.annotate(label, (e, t), textcoords="offset points", xytext=(6, 4), fontsize=8)
+        label = "%d  %s%s" % (k, name, " (exact)" if raw <= 0 else "")
+        ax.scatter(e, t, marker=marker, s=50, zorder=3, color=colour[name], label=label)
+        ax.annotate(str(k), (e, t), textcoords="offset points", xytext=(6, 3), fontsize=8)
     ax.plot([p[1] for p in front], [p[2] for p in front], "k--", lw=1, label="Pareto front", zorder=2)
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -88,7 +91,7 @@ def speed_vs_error(study, out):
     ax.set_ylabel("total time (field + path), s")
     ax.set_title("Speed against error (seed 004 Table 1-2)")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(loc="upper right")
+    ax.legend(loc="upper left", bbox_to_anchor=(0.0, -0.13), fontsize=8, frameon=False)
     save(fig, os.path.join(out, "speed_vs_error.png"))
 
 
