@@ -285,6 +285,10 @@ CellList cellsWithValues(const Level& level);
 std::vector<openvdb::Coord> candidateLeaves(const ObstacleSamples& samples,
                                             const Eigen::AlignedBox3d& reach, double h,
                                             double reach_mm);
+/// Adds a level's leaves (made apart, in parallel) to its tree, which takes them: grouped by
+/// their parent nodes, each parent filled by one task (voxel_leaves.cpp).
+void addLeaves(std::vector<std::unique_ptr<Leaf>>& made, Grid::TreeType& tree);
+void addLeaves(std::vector<std::unique_ptr<FloatLeaf>>& made, FloatGrid::TreeType& tree);
 /// The nodes of the halves of `cells` (3³ a cell at the next level) on a mask (voxel_leaves.cpp).
 openvdb::MaskGrid::Ptr nodesOfHalves(const CellList& cells);
 
