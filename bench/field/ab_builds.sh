@@ -7,6 +7,7 @@
 #   bench/field/ab_builds.sh OLD_FIELDPATH NEW_FIELDPATH SCENE H T REPEATS [NEW_BACKEND] [--study-scene]
 # (NEW_BACKEND, default cpu, is passed to the new one)
 set -eu
+. "$(dirname "$0")/common.sh"
 old=$1 new=$2 scene=$3 h=$4 tol=$5 reps=$6 backend=${7:-cpu}
 tmp=$(mktemp -d "$(dirname "$scene")/.ab_XXXX")  # beside the scene: its meshes are relative
 trap 'rm -rf "$tmp"' EXIT
@@ -25,6 +26,5 @@ for ((r = 1; r <= reps; r++)); do
   echo "rep $r: old ${o[-1]} s, new ($backend) ${n[-1]} s"
 done
 echo "old: $(counts < "$tmp/o.txt"); new: $(counts < "$tmp/n.txt")"
-median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2}'; }
 mo=$(median "${o[@]}") mn=$(median "${n[@]}")
 echo "median of $reps: old $mo s, new $mn s, x $(awk -v a="$mo" -v b="$mn" 'BEGIN {printf "%.2f", a / b}')"

@@ -6,18 +6,13 @@
 #   here:  OLD=/path/to/the/other/fieldpath bench/field/gpu_bundle.sh BUILD_DIR DIR
 #   there: bench/field/ab_gpu.sh DIR/fp.tar.xz OUTDIR [REPS] [BACKEND]
 set -u
+. "$(dirname "$0")/common.sh"
 bundle=$1 out=${2:-/tmp/gpu_out} reps=${3:-5} backend=${4:-cuda}
 mkdir -p "$out"
 tar -C /tmp -xJf "$bundle"
 export LD_LIBRARY_PATH=/tmp/B/lib
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
 echo "cores: $(nproc)"
-scene() {  # name sample_step tolerance
-  sed -e "s/sample_step: 1.0 /sample_step: $2 /" -e "s/refine_tolerance: 0 /refine_tolerance: $3 /" \
-    examples/impeller/scene.yaml > "examples/impeller/.ab_$1.yaml"
-  echo "examples/impeller/.ab_$1.yaml"
-}
-median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2}'; }
 for sc in "$(scene u 1.0 0)" "$(scene r 0.5 0.005)" "$(scene r1 0.5 0.01)"; do
   o=() n=()
   for ((rep = 1; rep <= reps; rep++)); do
@@ -30,4 +25,4 @@ for sc in "$(scene u 1.0 0)" "$(scene r 0.5 0.005)" "$(scene r1 0.5 0.01)"; do
   done
   echo "$(basename "$sc") $backend: old ${o[*]} | new ${n[*]} | medians old $(median "${o[@]}") new $(median "${n[@]}")"
 done | tee "$out/ab_gpu.log"
-rm -f examples/impeller/.ab_*.yaml
+remove_scenes

@@ -9,6 +9,7 @@
 # Y s, refinement Z s)"; the CUDA start-up, made before the build, printed apart); then
 # `generate` end to end (voxel refined to 1 % against the indexed direct sum).
 set -u
+. "$(dirname "$0")/common.sh"
 bundle=$1
 out=${2:-/tmp/gpu_out}
 mkdir -p "$out"
@@ -33,12 +34,6 @@ if [ "${3:-}" = study-only ]; then study; exit 0; fi
 timeout 90 /tmp/B/test_field --gtest_filter='VoxelBuild.*' 2>&1 | grep -E "OK|FAILED|PASSED|SKIPPED|Failure|Expected|actual"
 # 2. scenes: the example (blades every 1 mm, 5100 samples) and the study's (every 0.5 mm, 25000),
 # each uniform and with field.refine_tolerance T (the old program has no --refine-tolerance)
-scene() {  # name sample_step tolerance
-  sed -e "s/sample_step: 1.0 /sample_step: $2 /" -e "s/refine_tolerance: 0 /refine_tolerance: $3 /" \
-    examples/impeller/scene.yaml > "examples/impeller/.gpu_$1.yaml"
-  grep -q "refine_tolerance: $3 " "examples/impeller/.gpu_$1.yaml" || echo "WARNING: scene $1 not made"
-  echo "examples/impeller/.gpu_$1.yaml"
-}
 ex_u=$(scene ex_u 1.0 0) ex_r=$(scene ex_r 1.0 0.005) st_r=$(scene st_r 0.5 0.005) st_r1=$(scene st_r1 0.5 0.01)
 run() {  # case backend scene rep
   echo -n "== $1 $2 rep $4: "
@@ -67,5 +62,5 @@ for sc in "$st_r1" "$st_r"; do
   done
   echo -n "path.cl cuda vs cpu: "; python3 "$here/compare_cl.py" /tmp/gen_backendcpu/path.cl /tmp/gen_backendcuda/path.cl
 done
-rm -f examples/impeller/.gpu_*.yaml
+remove_scenes
 [ "${3:-}" = study ] && study

@@ -5,6 +5,7 @@
 # glibc.malloc.hugetlb=1: the host refinement is page-fault bound).
 #   bench/field/gpu_trace.sh DIR/fp.tar.xz OUTDIR [REPS]   (bundle: gpu_bundle.sh)
 set -u
+. "$(dirname "$0")/common.sh"
 bundle=$1 out=${2:-/tmp/gpu_out} reps=${3:-3}
 mkdir -p "$out"
 tar -C /tmp -xJf "$bundle"
@@ -12,11 +13,6 @@ export LD_LIBRARY_PATH=/tmp/B/lib
 fp=/tmp/B/fieldpath
 nvidia-smi --query-gpu=name,driver_version --format=csv,noheader
 echo "cores: $(nproc); THP: $(cat /sys/kernel/mm/transparent_hugepage/enabled); $(ldd --version | head -1)"
-scene() {  # name sample_step tolerance
-  sed -e "s/sample_step: 1.0 /sample_step: $2 /" -e "s/refine_tolerance: 0 /refine_tolerance: $3 /" \
-    examples/impeller/scene.yaml > "examples/impeller/.gpu_$1.yaml"
-  echo "examples/impeller/.gpu_$1.yaml"
-}
 ex_u=$(scene ex_u 1.0 0) st_r=$(scene st_r 0.5 0.005) st_r1=$(scene st_r1 0.5 0.01)
 for sc in "$ex_u" "$st_r" "$st_r1"; do
   for b in cuda cpu; do
@@ -34,4 +30,4 @@ for sc in "$ex_u" "$st_r" "$st_r1"; do
     echo "-- phases $(basename "$sc") $b thp:"; grep "build trace" "$out/trace_$(basename "$sc" .yaml)_${b}_thp_$reps.log"
   done
 done
-rm -f examples/impeller/.gpu_*.yaml
+remove_scenes
