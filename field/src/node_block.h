@@ -45,18 +45,22 @@ struct SampleSet {
   std::vector<double> x, y, z, nx, ny, nz, w;
   std::vector<std::int32_t> id;
   int count = 0;
+  /// The seven double arrays in SampleSpan's order (x, y, z, nx, ny, nz, w).
+  std::array<std::vector<double>*, 7> doubles() { return {&x, &y, &z, &nx, &ny, &nz, &w}; }
+  std::array<const std::vector<double>*, 7> doubles() const {
+    return {&x, &y, &z, &nx, &ny, &nz, &w};
+  }
   /// Room for n samples and 8 more (the lanes' whole-vector stores; count unchanged).
   void reserveFor(std::size_t n) {
     n += 8;
-    for (auto* v : {&x, &y, &z, &nx, &ny, &nz, &w})
+    for (std::vector<double>* v : doubles())
       if (v->size() < n) v->resize(n);
     if (id.size() < n) id.resize(n);
   }
   /// Appends the samples of `more` (room for them made beforehand: reserveFor).
   void append(const SampleSet& more) {
-    const std::vector<double>* from[7] = {&more.x, &more.y, &more.z, &more.nx,
-                                          &more.ny, &more.nz, &more.w};
-    std::vector<double>* to[7] = {&x, &y, &z, &nx, &ny, &nz, &w};
+    const auto from = more.doubles();
+    const auto to = doubles();
     for (int k = 0; k < 7; ++k)
       std::copy(from[k]->begin(), from[k]->begin() + more.count, to[k]->begin() + count);
     std::copy(more.id.begin(), more.id.begin() + more.count, id.begin() + count);

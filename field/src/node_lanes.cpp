@@ -200,9 +200,10 @@ namespace {
 struct SetOut {
   double* v[7];
   std::int32_t* id;
-  explicit SetOut(SampleSet& s)
-      : v{s.x.data(), s.y.data(), s.z.data(), s.nx.data(), s.ny.data(), s.nz.data(), s.w.data()},
-        id(s.id.data()) {}
+  explicit SetOut(SampleSet& s) : id(s.id.data()) {
+    const auto arrays = s.doubles();
+    for (int k = 0; k < 7; ++k) v[k] = arrays[k]->data();
+  }
 };
 }  // namespace
 

@@ -464,7 +464,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
       // share a block's words: atomic ors); then the split cells' ranks (a parallel prefix
       // sum) and, at those ranks, the split cells and their halves, in the cells' order. No
       // list is zeroed first: each entry is written once, in parallel.
-      UninitVector<std::uint32_t> split(cells.size());  // 0 or 1, then the ranks' prefix
+      UninitVector<std::uint8_t> split(cells.size());  // 1: split
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size()), [&](const auto& range) {
         auto acc = level.block_of->getConstUnsafeAccessor();
         for (std::size_t c = range.begin(); c != range.end(); ++c) {
@@ -479,12 +479,12 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
         }
       });
       stats.tested_cells += cells.size();
-      UninitVector<std::uint32_t> rank(cells.size());  // split cells before c
+      UninitVector<std::size_t> rank(cells.size());  // split cells before c
       const std::size_t splits = tbb::parallel_scan(
           tbb::blocked_range<std::size_t>(0, cells.size()), std::size_t{0},
           [&](const tbb::blocked_range<std::size_t>& range, std::size_t sum, bool is_final) {
             for (std::size_t c = range.begin(); c != range.end(); ++c) {
-              if (is_final) rank[c] = std::uint32_t(sum);
+              if (is_final) rank[c] = sum;
               sum += split[c];
             }
             return sum;
@@ -497,7 +497,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
           split_cells[rank[c]] = cells[c];
           const CellIjk fine{2 * cells[c].x, 2 * cells[c].y, 2 * cells[c].z};
           for (int h8 = 0; h8 < 8; ++h8)
-            next_cells[8 * std::size_t(rank[c]) + std::size_t(h8)] = {
+            next_cells[8 * rank[c] + std::size_t(h8)] = {
                 fine.x + (h8 >> 2), fine.y + ((h8 >> 1) & 1), fine.z + (h8 & 1)};
         }
       });
