@@ -73,7 +73,8 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
         {"tool_nodes", r.tool_nodes},
         {"tool_triangles", r.tool_triangles},
         {"voxel_nodes", r.voxel_nodes},
-        {"voxel_memory_bytes", r.voxel_memory_bytes}}},
+        {"voxel_memory_bytes", r.voxel_memory_bytes},
+        {"voxel_outside_points", r.voxel_outside_points}}},
       {"reach_box_mm",
        {{"min", {box.min().x(), box.min().y(), box.min().z()}},
         {"max", {box.max().x(), box.max().y(), box.max().z()}},
@@ -208,6 +209,10 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
         result.link_postures, result.max_tilt_deg, result.max_lead_deg, result.limited_postures,
         c.min_clearance_mm, job.clearance_mm, c.colliding, m.colliding, m.motions,
         m.min_clearance_mm, result.times.total_s, out.string().c_str());
+    if (result.voxel_outside_points > 0)
+      std::printf("note: %zu node positions fell outside the voxels' region (the reach box) and "
+                  "were given the exact field\n",
+                  result.voxel_outside_points);
   });
 }
 

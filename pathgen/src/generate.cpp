@@ -16,6 +16,7 @@
 #include "fieldpath/dynamics/steering.h"
 #include "fieldpath/field/direct_field.h"
 #include "fieldpath/field/sampling.h"
+#include "fieldpath/field/region_field.h"
 #include "fieldpath/field/voxel_field.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/geometry/units.h"
@@ -160,6 +161,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
   std::unique_ptr<field::DirectField> direct;
   std::shared_ptr<field::VoxelField> voxels;
   std::unique_ptr<field::BruteForceField> brute;
+  std::unique_ptr<field::RegionField> voxels_in_reach;
   const field::ForceField* force = nullptr;
   const double h = request.field.voxel.voxel_size_mm;
   result.reach_box_mm = reachBox(result.passes, nodes, r, request.dynamics, lead_rad,
@@ -181,7 +183,14 @@ GenerateResult generatePath(const GenerateRequest& request) {
       voxels = std::make_shared<field::VoxelField>(*direct, voxel_request);
       result.voxel_nodes = voxels->stats().active_nodes;
       result.voxel_memory_bytes = voxels->stats().memory_bytes;
-      force = voxels.get();
+      // The voxels hold values where every node of a point's stencil lies in the box (2 h in
+      // from its faces); beyond, the exact sum answers (a voxel field is zero where it has no
+      // nodes: a point the box missed would feel no wall).
+      Eigen::AlignedBox3d valid = result.reach_box_mm;
+      valid.min().array() += 2 * h;
+      valid.max().array() -= 2 * h;
+      voxels_in_reach = std::make_unique<field::RegionField>(*voxels, *direct, valid);
+      force = voxels_in_reach.get();
     }
   }
   result.times.field_s = seconds(field_start);
@@ -300,6 +309,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
     result.convergence_failures += st.convergence_failures;
   }
   result.times.steering_s = seconds(steer_start);
+  if (voxels_in_reach) result.voxel_outside_points = voxels_in_reach->outsidePoints();
 
   // ---- links, then the exact clearance of every posture and motion ----------------------------
   const auto clearance_start = Clock::now();

@@ -119,6 +119,9 @@ struct GenerateResult {
   std::size_t tool_triangles = 0;   ///< of the clearance mesh
   std::size_t voxel_nodes = 0;      ///< active nodes (voxel mode)
   std::size_t voxel_memory_bytes = 0;
+  /// Field evaluations (node positions) of the steering that fell outside the voxels' region
+  /// and were answered by the exact sum (voxel mode; 0 when the reach box held them all).
+  std::size_t voxel_outside_points = 0;
   /// The voxel field of the path (voxel mode with GenerateRequest::keep_voxels), else null.
   std::shared_ptr<const field::VoxelField> voxels;
   Eigen::AlignedBox3d reach_box_mm;  ///< region of the voxels: what tool + holder can reach

@@ -1,0 +1,41 @@
+#pragma once
+/// A field sampled only in a region, answered by another (exact) field outside it. The voxels of
+/// a job are built only in the box tool + holder can reach (pathgen's reach box, taken at a few
+/// stations of each pass and padded); a voxel field is zero where it has no nodes, so a point
+/// the box missed (a user's pass turning sharply between two of those stations) would feel no
+/// wall at all. Here it gets the exact sum instead, and is counted.
+#include <atomic>
+#include <cstddef>
+#include <span>
+
+#include <Eigen/Geometry>
+
+#include "fieldpath/field/force_field.h"
+
+namespace fieldpath::field {
+
+class RegionField final : public ForceField {
+ public:
+  /// `inside` answers the points of `region_mm` (world, mm), `outside` the others. Both are
+  /// borrowed: they must outlive this field. The region must be where `inside` is valid with
+  /// its interpolation's stencil: for voxels built in a box B of node spacing h, B shrunk by
+  /// 2 h (trilinear reads the cell's corners, quadratic one node more).
+  RegionField(const ForceField& inside, const ForceField& outside,
+              const Eigen::AlignedBox3d& region_mm);
+
+  /// Thread-safe. One call's points all inside go to `inside` in one call (the usual case:
+  /// nothing copied); otherwise the outside ones are gathered and sent to `outside`.
+  void evaluate(std::span<const Vec3> points_mm, std::span<Vec3> forces) const override;
+
+  /// Points answered by `outside` so far (all calls, all threads).
+  std::size_t outsidePoints() const { return outside_points_.load(std::memory_order_relaxed); }
+  const Eigen::AlignedBox3d& region() const { return region_; }
+
+ private:
+  const ForceField& inside_;
+  const ForceField& outside_;
+  Eigen::AlignedBox3d region_;
+  mutable std::atomic<std::size_t> outside_points_{0};
+};
+
+}  // namespace fieldpath::field
