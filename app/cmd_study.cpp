@@ -8,9 +8,9 @@
 #include <string>
 
 #include "commands.h"
-#include "fieldpath/field/voxel_field.h"
 #include "errors.h"
 #include "estimates.h"
+#include "fieldpath/field/voxel_field.h"
 #include "job.h"
 #include "progress.h"
 #include "scene.h"
@@ -27,7 +27,8 @@ struct StudyOptions {
   std::string stored = "force,plane_ratio";
   std::string refine;  ///< percent per voxel size; empty: no refined variants
   int refine_levels = 2;
-  std::string backends;  ///< "": voxel nodes built once (auto), names unchanged
+  std::string refine_regions = "path";
+  std::string backends;         ///< "": voxel nodes built once (auto), names unchanged
   double sample_step_mm = 0.0;  ///< > 0: overrides the scene's field.sample_step
   bool no_brute_force = false;
   double line_step_mm = 0.05;
@@ -44,25 +45,29 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
     request.refine_tolerances =
         parseRefineTolerances(o.refine, request.voxel_sizes_mm.size(), "--refine");
   request.refine_levels = o.refine_levels;
+  request.refine_regions = parseRefineRegions(o.refine_regions, "--refine-region");
   if (!o.backends.empty()) request.backends = parseBackends(o.backends, "--backend");
   // Said before the direct variants run, not after them.
   for (field::FieldBackend backend : request.backends)
     if (backend == field::FieldBackend::Cuda && !field::cudaFieldBackendAvailable())
-      throw InputError("--backend: cuda, but this program was built without CUDA or no GPU is present");
+      throw InputError(
+          "--backend: cuda, but this program was built without CUDA or no GPU is present");
   request.brute_force = !o.no_brute_force;
   request.line_step_mm = o.line_step_mm;
   request.repeats = o.repeats;
   const Scene scene = loadScene(o.scene);
   if (!scene.impeller_model || !scene.guide_impeller)
-    throw InputError(scene.file.string() +
-                     ": guide: study runs on the parametric impeller (`guide: { impeller: hub }` "
-                     "with `- impeller:` among the obstacles): its lines a and b cross its channel");
+    throw InputError(
+        scene.file.string() +
+        ": guide: study runs on the parametric impeller (`guide: { impeller: hub }` "
+        "with `- impeller:` among the obstacles): its lines a and b cross its channel");
   request.job = sceneJob(scene);
   request.impeller = scene.impeller_model->params();
   if (o.sample_step_mm > 0.0) request.job.field.sample_step_mm = o.sample_step_mm;
   // What the options drive, estimated before any work (loadScene did the scene's own keys).
   if (o.sample_step_mm > 0.0) checkSampleStep(scene, o.sample_step_mm, "--sample-step");
-  for (double h : request.voxel_sizes_mm) checkVoxelSize(scene, h, "--voxels " + study_detail::number(h));
+  for (double h : request.voxel_sizes_mm)
+    checkVoxelSize(scene, h, "--voxels " + study_detail::number(h));
   request.progress = makeProgressLine(global.quiet);
   const StudyResult result = runStudy(request);
   const std::filesystem::path dir = o.out;
@@ -103,6 +108,11 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--refine-levels", options->refine_levels,
                   "Levels below the voxel size the refined variants may go")
       ->capture_default_str();
+  cmd->add_option("--refine-region", options->refine_regions,
+                  "Where the refined variants split cells: path (near the path steered on the "
+                  "uniform grid first, as generate does), reach (everywhere tool + holder can "
+                  "reach) or both, comma-separated")
+      ->capture_default_str();
   cmd->add_option("--backend", options->backends,
                   "Voxel node builds, comma-separated (auto, cpu, cuda, reference): each voxel "
                   "variant runs once per build, e.g. reference,cpu puts the old per-node build "
@@ -126,7 +136,8 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
         options->interpolations + " --stored " + options->stored +
         (options->refine.empty() ? std::string()
                                  : " --refine " + options->refine + " --refine-levels " +
-                                       std::to_string(options->refine_levels)) +
+                                       std::to_string(options->refine_levels) +
+                                       " --refine-region " + options->refine_regions) +
         (options->sample_step_mm > 0.0 ? " --sample-step " + sample_step.str() : std::string()) +
         (options->backends.empty() ? std::string() : " --backend " + options->backends) +
         (options->no_brute_force ? " --no-brute-force" : "") + " --repeat " +

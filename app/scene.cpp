@@ -181,7 +181,7 @@ void readHolder(const Reader& r, const YAML::Node& node, geometry::HolderProfile
 void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
   r.expectMap(node, "field",
               {"r0", "r_min", "gain", "sample_step", "weights", "voxel_size", "interpolation",
-               "stored", "refine_tolerance", "refine_levels", "backend"});
+               "stored", "refine_tolerance", "refine_levels", "refine_region", "backend"});
   if (node["r0"]) f.r0_mm = r.positive(node["r0"], "field.r0");
   if (node["r_min"]) f.r_min_mm = r.positive(node["r_min"], "field.r_min");
   if (!(f.r_min_mm < f.r0_mm)) {
@@ -219,6 +219,9 @@ void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
       r.fail(node["refine_levels"], "field.refine_levels", "must be an integer in [0, 6]");
     f.voxel.refine_levels = static_cast<int>(levels);
   }
+  if (node["refine_region"])
+    f.voxel.refine_region = *field::refineRegionNamed(
+        r.word(node["refine_region"], "field.refine_region", {"path", "reach"}));
   if (node["backend"])
     f.voxel.backend = *field::fieldBackendNamed(
         r.word(node["backend"], "field.backend", {"auto", "cpu", "cuda", "reference"}));

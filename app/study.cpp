@@ -19,6 +19,7 @@
 #include "fieldpath/common/stats.h"
 #include "fieldpath/field/direct_field.h"
 #include "fieldpath/field/law.h"
+#include "fieldpath/field/region_field.h"
 #include "fieldpath/field/sampling.h"
 #include "fieldpath/field/voxel_field.h"
 #include "fieldpath/geometry/tool_model.h"
@@ -51,8 +52,6 @@ common::Progress scaled(const common::Progress& progress, double begin, double e
     return progress(begin + (end - begin) * fraction, label);
   };
 }
-
-
 
 /// A study line's points: t along the polyline, wall distances from FCL.
 StudyLine makeLine(std::string name, std::string description, std::vector<Vec3> points,
@@ -176,13 +175,12 @@ struct ErrorSets {
   std::vector<char> nodes_counted, line_a_counted, line_b_counted;
 };
 
-
-
 }  // namespace
 
 std::string StudyVariant::name() const {
   std::string base = nameWithoutBackend();
-  if (isVoxel() && named_backend) base += std::string(" [") + backendName(voxel.backend) + " build]";
+  if (isVoxel() && named_backend)
+    base += std::string(" [") + backendName(voxel.backend) + " build]";
   return base;
 }
 
@@ -194,7 +192,8 @@ std::string StudyVariant::nameWithoutBackend() const {
     << ' ' << storedName(voxel.stored);
   if (voxel.refine_tolerance > 0.0)
     s << " refined " << 100 * voxel.refine_tolerance << " % to "
-      << voxel.voxel_size_mm / double(1 << voxel.refine_levels) << " mm";
+      << voxel.voxel_size_mm / double(1 << voxel.refine_levels) << " mm"
+      << (voxel.refine_region == field::RefineRegion::Path ? " near its path" : " everywhere");
   return s.str();
 }
 
@@ -265,10 +264,14 @@ std::vector<field::StoredQuantity> parseStored(const std::string& text, const st
 
 const char* backendName(field::FieldBackend backend) {
   switch (backend) {
-    case field::FieldBackend::Cpu: return "cpu";
-    case field::FieldBackend::Cuda: return "cuda";
-    case field::FieldBackend::Reference: return "reference";
-    default: return "auto";
+    case field::FieldBackend::Cpu:
+      return "cpu";
+    case field::FieldBackend::Cuda:
+      return "cuda";
+    case field::FieldBackend::Reference:
+      return "reference";
+    default:
+      return "auto";
   }
 }
 
@@ -286,6 +289,12 @@ std::vector<field::FieldBackend> parseBackends(const std::string& text, const st
   if (result.empty() || text.back() == ',')
     throw InputError(key + ": give builds among auto, cpu, cuda, reference (e.g. reference,cpu)");
   return result;
+}
+
+std::vector<field::RefineRegion> parseRefineRegions(const std::string& text,
+                                                    const std::string& key) {
+  return parsePair(text, key, std::pair{"path", field::RefineRegion::Path},
+                   std::pair{"reach", field::RefineRegion::Reach});
 }
 
 std::vector<field::Interpolation> parseInterpolations(const std::string& text,
@@ -353,9 +362,8 @@ StudyResult runStudy(const StudyRequest& request) {
   const std::size_t first_voxel = variants.size();
   // A size listed twice (to be refined to two tolerances) gets its uniform variants once.
   auto listed = [&](const StudyVariant& v) {
-    return std::any_of(variants.begin(), variants.end(), [&](const StudyVariant& w) {
-      return w.name() == v.name();
-    });
+    return std::any_of(variants.begin(), variants.end(),
+                       [&](const StudyVariant& w) { return w.name() == v.name(); });
   };
   for (std::size_t k = 0; k < request.voxel_sizes_mm.size(); ++k) {
     const double h = request.voxel_sizes_mm[k];
@@ -366,12 +374,14 @@ StudyResult runStudy(const StudyRequest& request) {
       }
     const double tolerance = request.refine_tolerances.empty() ? 0.0 : request.refine_tolerances[k];
     if (tolerance > 0.0)
-      for (field::StoredQuantity stored : request.stored) {
-        const StudyVariant refined{
-            pathgen::FieldMode::Voxel,
-            {h, field::Interpolation::Trilinear, stored, tolerance, request.refine_levels}};
-        if (!listed(refined)) variants.push_back(refined);
-      }
+      for (field::StoredQuantity stored : request.stored)
+        for (field::RefineRegion where : request.refine_regions) {
+          StudyVariant refined{
+              pathgen::FieldMode::Voxel,
+              {h, field::Interpolation::Trilinear, stored, tolerance, request.refine_levels}};
+          refined.voxel.refine_region = where;
+          if (!listed(refined)) variants.push_back(refined);
+        }
   }
   if (!request.backends.empty()) {  // each voxel variant once per build, side by side
     std::vector<StudyVariant> built(variants.begin(), variants.begin() + long(first_voxel));
@@ -470,7 +480,18 @@ StudyResult runStudy(const StudyRequest& request) {
     } else if (row.variant.mode == pathgen::FieldMode::BruteForce) {
       brute = std::make_unique<field::BruteForceField>(direct->samples(), job.field);
     }
-    const field::ForceField* approx = voxels ? voxels.get() : brute.get();
+    // Refined near its path: the field the job read, the voxels in the mask's core and the
+    // exact sum beyond (generate's RegionField).
+    std::unique_ptr<field::RegionField> near_path;
+    if (voxels && run.refine_mask) {
+      Eigen::AlignedBox3d valid = run.reach_box_mm;
+      valid.min().array() += 2 * row.variant.voxel.voxel_size_mm;
+      valid.max().array() -= 2 * row.variant.voxel.voxel_size_mm;
+      near_path = std::make_unique<field::RegionField>(*voxels, *direct, valid, run.refine_mask);
+    }
+    const field::ForceField* approx = near_path ? near_path.get()
+                                      : voxels  ? voxels.get()
+                                                : brute.get();
     const field::ForceField& f = approx ? *approx : *direct;
     for (StudyLine* line : {&result.line_a, &result.line_b}) {
       const bool is_a = line == &result.line_a;

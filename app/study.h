@@ -63,11 +63,14 @@ struct StudyRequest {
   /// Per voxel size (same order, same count, or empty): a refinement tolerance (fraction) for
   /// an extra variant of that size, trilinear, for each stored quantity; 0 adds none.
   std::vector<double> refine_tolerances;
-  int refine_levels = 2;       ///< levels below the voxel size the refined variants may go
+  int refine_levels = 2;  ///< levels below the voxel size the refined variants may go
   /// Where each voxel variant's nodes are built (issue 15): every voxel variant runs once per
   /// entry, named with it ("... [reference build]"), e.g. {Reference, Cpu} puts the old
   /// per-node build beside the block build. Empty: once, FieldBackend::Auto, names unchanged.
   std::vector<field::FieldBackend> backends;
+  /// Where the refined variants split cells: each refined variant once per entry (near its
+  /// path, as `generate` does by default, and/or everywhere in reach).
+  std::vector<field::RefineRegion> refine_regions = {field::RefineRegion::Path};
   bool brute_force = true;     ///< run the seed's every-point direct sum (slow on big scenes)
   double line_step_mm = 0.05;  ///< sampling of the study lines
   int repeats = 1;             ///< runs per variant; times are their medians
@@ -162,6 +165,9 @@ std::vector<field::StoredQuantity> parseStored(const std::string& text, const st
 /// "reference,cpu" → voxel node builds (auto, cpu, cuda, reference), each once. Throws
 /// InputError naming `key`.
 std::vector<field::FieldBackend> parseBackends(const std::string& text, const std::string& key);
+/// "path", "reach" or both, comma-separated (study --refine-region); InputError naming `key`.
+std::vector<field::RefineRegion> parseRefineRegions(const std::string& text,
+                                                    const std::string& key);
 /// "auto", "cpu", "cuda", "reference".
 const char* backendName(field::FieldBackend backend);
 

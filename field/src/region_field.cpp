@@ -9,12 +9,16 @@ RegionField::RegionField(const ForceField& inside, const ForceField& outside,
                          const Eigen::AlignedBox3d& region_mm)
     : inside_(inside), outside_(outside), region_(region_mm) {}
 
+RegionField::RegionField(const ForceField& inside, const ForceField& outside,
+                         const Eigen::AlignedBox3d& region_mm, std::shared_ptr<const CellMask> core)
+    : inside_(inside), outside_(outside), region_(region_mm), core_(std::move(core)) {}
+
 void RegionField::evaluate(std::span<const Vec3> points_mm, std::span<Vec3> forces) const {
   if (points_mm.size() != forces.size())
     throw std::invalid_argument("RegionField::evaluate: points and forces differ in size");
   std::vector<std::size_t> out;
   for (std::size_t i = 0; i < points_mm.size(); ++i)
-    if (!region_.contains(points_mm[i])) out.push_back(i);
+    if (!contains(points_mm[i])) out.push_back(i);
   if (out.empty()) {
     inside_.evaluate(points_mm, forces);
     return;

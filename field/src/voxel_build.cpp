@@ -472,6 +472,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
           const Vec3 x = (Vec3(ijk.x(), ijk.y(), ijk.z()) + Vec3::Constant(0.5)) * hl;
           CellRef where;
           split[c] = (!request.region_mm || request.region_mm->contains(x)) &&
+                     (!request.refine_mask || request.refine_mask->contains(x)) &&
                      errors.cellError(ijk, acc) > tolerance && locate(level, acc, x, where);
           if (split[c])
             std::atomic_ref<std::uint64_t>(level.refined[where.block * kCellWords + (where.cell >> 6)])

@@ -215,7 +215,7 @@ TEST(StudyRefinement, RefinedVariantBeatsItsUniformGridAndIsCountedApart) {
   const StudyRow& uniform = result.rows[1];
   const StudyRow& refined = result.rows[2];
   EXPECT_EQ(uniform.variant.name(), "voxel 2 mm trilinear plane_ratio");
-  EXPECT_EQ(refined.variant.name(), "voxel 2 mm trilinear plane_ratio refined 5 % to 1 mm");
+  EXPECT_EQ(refined.variant.name(), "voxel 2 mm trilinear plane_ratio refined 5 % to 1 mm near its path");
   EXPECT_EQ(refined.failure, "");
   EXPECT_EQ(uniform.levels, 1);
   EXPECT_EQ(refined.levels, 2);
@@ -237,8 +237,8 @@ TEST(StudyRefinement, ASizeListedTwiceIsRefinedToBothTolerancesItsUniformGridMad
   for (const StudyRow& row : result.rows) names.push_back(row.variant.name());
   EXPECT_EQ(names, (std::vector<std::string>{
                        "direct", "voxel 2 mm trilinear plane_ratio",
-                       "voxel 2 mm trilinear plane_ratio refined 5 % to 1 mm",
-                       "voxel 2 mm trilinear plane_ratio refined 10 % to 1 mm"}));
+                       "voxel 2 mm trilinear plane_ratio refined 5 % to 1 mm near its path",
+                       "voxel 2 mm trilinear plane_ratio refined 10 % to 1 mm near its path"}));
   // The looser tolerance splits no more cells than the tighter one.
   ASSERT_EQ(result.rows.size(), 4u);
   EXPECT_LE(result.rows[3].refined_nodes, result.rows[2].refined_nodes);

@@ -29,8 +29,17 @@ inline std::optional<FieldBackend> fieldBackendNamed(std::string_view name) {
   return std::nullopt;
 }
 
+/// Where a job's refinement splits cells (scene `field.refine_region`): VoxelSettings says.
+enum class RefineRegion { Path, Reach };
+/// "path", "reach"; nothing for another word.
+inline std::optional<RefineRegion> refineRegionNamed(std::string_view name) {
+  if (name == "path") return RefineRegion::Path;
+  if (name == "reach") return RefineRegion::Reach;
+  return std::nullopt;
+}
+
 /// How the field is sampled on voxels (scene `field.voxel_size`, `interpolation`, `stored`,
-/// `refine_tolerance`, `refine_levels`), written once: FieldParams holds the scene's, a
+/// `refine_tolerance`, `refine_levels`, `refine_region`), written once: FieldParams holds the scene's, a
 /// VoxelRequest (voxel_field.h) starts from them and adds how to build.
 struct VoxelSettings {
   double voxel_size_mm = 0.5;  ///< h of the sparse grid
@@ -42,6 +51,10 @@ struct VoxelSettings {
   double refine_tolerance = 0.0;
   int refine_levels = 2;
   FieldBackend backend = FieldBackend::Auto;  ///< same node values on each, to float rounding
+  /// Where a job's refinement splits cells: Path, only near where the tool + holder nodes go
+  /// (the path steered on the uniform grid first, pathgen/generate.cpp); Reach, everywhere the
+  /// tool could reach. `fieldpath field build` has no path: everywhere.
+  RefineRegion refine_region = RefineRegion::Path;
 };
 
 struct FieldParams {

@@ -6,10 +6,12 @@
 /// wall at all. Here it gets the exact sum instead, and is counted.
 #include <atomic>
 #include <cstddef>
+#include <memory>
 #include <span>
 
 #include <Eigen/Geometry>
 
+#include "fieldpath/field/cell_mask.h"
 #include "fieldpath/field/force_field.h"
 
 namespace fieldpath::field {
@@ -22,6 +24,10 @@ class RegionField final : public ForceField {
   /// 2 h (trilinear reads the cell's corners, quadratic one node more).
   RegionField(const ForceField& inside, const ForceField& outside,
               const Eigen::AlignedBox3d& region_mm);
+  /// The region is the box and the core of `core` (voxels refined near a path only: the
+  /// refinement's decisions are those of a build refined everywhere in the core).
+  RegionField(const ForceField& inside, const ForceField& outside,
+              const Eigen::AlignedBox3d& region_mm, std::shared_ptr<const CellMask> core);
 
   /// Thread-safe. One call's points all inside go to `inside` in one call (the usual case:
   /// nothing copied); otherwise the outside ones are gathered and sent to `outside`.
@@ -29,12 +35,16 @@ class RegionField final : public ForceField {
 
   /// Points answered by `outside` so far (all calls, all threads).
   std::size_t outsidePoints() const { return outside_points_.load(std::memory_order_relaxed); }
-  const Eigen::AlignedBox3d& region() const { return region_; }
+  /// In the box and, with a mask, in its core.
+  bool contains(const Vec3& p_mm) const {
+    return region_.contains(p_mm) && (!core_ || core_->inCore(p_mm));
+  }
 
  private:
   const ForceField& inside_;
   const ForceField& outside_;
   Eigen::AlignedBox3d region_;
+  std::shared_ptr<const CellMask> core_;
   mutable std::atomic<std::size_t> outside_points_{0};
 };
 

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "fieldpath/common/progress.h"
+#include "fieldpath/field/cell_mask.h"
 #include "fieldpath/field/direct_field.h"
 
 namespace fieldpath::field {
@@ -50,6 +51,9 @@ struct VoxelRequest : VoxelSettings {
   /// Only nodes in this world box (mm): the region the tool can reach. Default: everywhere the
   /// field can be non-zero.
   std::optional<Eigen::AlignedBox3d> region_mm;
+  /// Refinement only where this mask holds a cell's centre (a job's path, pathgen); null:
+  /// wherever the error asks, in the region.
+  std::shared_ptr<const CellMask> refine_mask;
   /// A build whose estimated memory (estimateVoxelNodes) exceeds this is refused (InputError).
   std::size_t max_memory_bytes = std::size_t{4} << 30;
   common::Progress progress;  ///< "field" fraction of leaves built

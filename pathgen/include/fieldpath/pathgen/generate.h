@@ -13,10 +13,10 @@
 #include "fieldpath/common/progress.h"
 #include "fieldpath/dynamics/params.h"
 #include "fieldpath/field/params.h"
+#include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/geometry/tool.h"
 #include "fieldpath/pathgen/clearance.h"
-#include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/pathgen/impeller.h"
 #include "fieldpath/pathgen/links.h"
 #include "fieldpath/pathgen/params.h"
@@ -24,7 +24,8 @@
 
 namespace fieldpath::field {
 class VoxelField;
-}
+class CellMask;
+}  // namespace fieldpath::field
 
 namespace fieldpath::pathgen {
 
@@ -110,8 +111,8 @@ struct GenerateResult {
   MotionResult motions;       ///< of every motion of `path`
   double safe_z_mm = 0.0;     ///< the links' travel plane
   std::size_t link_postures = 0;
-  std::size_t limited_postures = 0;            ///< where dynamics.on_limit held an angle
-  std::size_t limited_colliding = 0;           ///< of those, colliding ones
+  std::size_t limited_postures = 0;                   ///< where dynamics.on_limit held an angle
+  std::size_t limited_colliding = 0;                  ///< of those, colliding ones
   std::size_t first_limited = ClearanceResult::npos;  ///< index into `postures`
   StageTimes times;
   std::size_t obstacle_points = 0;  ///< field samples
@@ -124,6 +125,9 @@ struct GenerateResult {
   std::size_t voxel_outside_points = 0;
   /// The voxel field of the path (voxel mode with GenerateRequest::keep_voxels), else null.
   std::shared_ptr<const field::VoxelField> voxels;
+  /// With `voxels`, refined near the path: the cells the voxels answer in (CellMask::inCore),
+  /// the exact field beyond (as the steering read them: field::RegionField); else null.
+  std::shared_ptr<const field::CellMask> refine_mask;
   Eigen::AlignedBox3d reach_box_mm;  ///< region of the voxels: what tool + holder can reach
   double path_length_mm = 0;         ///< sum of the pass lengths (ball centre)
   double max_tilt_deg = 0, max_lead_deg = 0;  ///< largest |angle| on the path

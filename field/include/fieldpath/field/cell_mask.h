@@ -1,0 +1,49 @@
+#pragma once
+/// Where a job's tool + holder nodes went, on a uniform grid of cells: the voxel refinement of a
+/// job splits cells only near its path (VoxelRequest::refine_mask), and the refined field answers
+/// only in the mask's core (RegionField), the exact field beyond. No OpenVDB here.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "fieldpath/geometry/posture.h"
+
+namespace fieldpath::field {
+
+using geometry::Vec3;
+
+class CellMask {
+ public:
+  /// The cells (edge cell_mm) holding `points_mm`, grown by `core_mm` (the core) and by
+  /// `outer_mm` >= core_mm (the whole mask), each as a cube of cells around a marked one
+  /// (Chebyshev distance, rounded up to whole cells). The cells are stored densely over the
+  /// points' box; where that would pass kMaxCells the cell edge grows (the distances in mm are
+  /// kept). Throws std::invalid_argument for cell_mm <= 0 or outer_mm < core_mm.
+  CellMask(std::span<const Vec3> points_mm, double cell_mm, double core_mm, double outer_mm);
+
+  /// In the whole mask / in its core (false outside the stored box, and for an empty mask).
+  bool contains(const Vec3& p_mm) const { return bits(p_mm) & kOuter; }
+  bool inCore(const Vec3& p_mm) const { return bits(p_mm) & kCore; }
+
+  double cellMm() const { return cell_mm_; }
+  std::size_t cells() const { return outer_cells_; }     ///< of the whole mask
+  std::size_t coreCells() const { return core_cells_; }  ///< of the core
+  double volumeMm3() const { return double(outer_cells_) * cell_mm_ * cell_mm_ * cell_mm_; }
+
+  static constexpr std::size_t kMaxCells = std::size_t{1} << 27;
+
+ private:
+  static constexpr std::uint8_t kCore = 1, kOuter = 2;
+  std::uint8_t bits(const Vec3& p_mm) const;
+
+  Vec3 lo_mm_ = Vec3::Zero();
+  double cell_mm_ = 1.0;
+  long dim_[3] = {0, 0, 0};
+  std::vector<std::uint8_t> bits_;  ///< x-major, z fastest
+  std::size_t outer_cells_ = 0, core_cells_ = 0;
+};
+
+}  // namespace fieldpath::field
