@@ -65,6 +65,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"times_s",
        {{"setup", r.times.setup_s},
         {"field", r.times.field_s},
+        {"field_near_path", r.times.near_path_s},
         {"steering", r.times.steering_s},
         {"clearance", r.times.clearance_s},
         {"total", r.times.total_s}}},

@@ -145,6 +145,7 @@ pathgen::StageTimes medianTimes(const std::vector<pathgen::StageTimes>& runs) {
   t.field_s = of(&pathgen::StageTimes::field_s);
   t.steering_s = of(&pathgen::StageTimes::steering_s);
   t.clearance_s = of(&pathgen::StageTimes::clearance_s);
+  t.near_path_s = of(&pathgen::StageTimes::near_path_s);
   t.total_s = of(&pathgen::StageTimes::total_s);
   return t;
 }

@@ -4,42 +4,48 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 namespace fieldpath::field {
 namespace {
 
-/// Grows the cells with `bit` set by `reach` cells along one axis (a run of `count` cells
-/// `stride` apart, `runs` of them starting `run_starts`): a cell gets the bit if one within
-/// `reach` along the axis has it. Two sweeps with a running distance to the last set cell.
+/// Grows the cells with `bit` set by `reach` cells along one axis (runs of `count` cells
+/// `stride` apart, starting at `run_starts`): a cell gets the bit if one within `reach` along the
+/// axis has it. Two sweeps a run with a running distance to the last set cell; runs in parallel
+/// (each writes its own cells).
 void growAlong(std::vector<std::uint8_t>& cells, std::uint8_t bit, long reach, long count,
                long stride, const std::vector<long>& run_starts) {
-  for (const long start : run_starts) {
-    long last = -(reach + 1);  // index of the last cell holding the bit before this sweep's cell
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, run_starts.size(), 64), [&](const auto& r) {
     std::vector<char> set(std::size_t(count), 0);
-    for (long i = 0; i < count; ++i) {
-      if (cells[std::size_t(start + i * stride)] & bit) last = i;
-      set[std::size_t(i)] = i - last <= reach;
+    for (std::size_t run = r.begin(); run != r.end(); ++run) {
+      const long start = run_starts[run];
+      long last = -(reach + 1);  // the last cell holding the bit before this one
+      for (long i = 0; i < count; ++i) {
+        if (cells[std::size_t(start + i * stride)] & bit) last = i;
+        set[std::size_t(i)] = i - last <= reach;
+      }
+      last = count + reach + 1;
+      for (long i = count - 1; i >= 0; --i) {
+        if (cells[std::size_t(start + i * stride)] & bit) last = i;
+        if (set[std::size_t(i)] || last - i <= reach) cells[std::size_t(start + i * stride)] |= bit;
+      }
     }
-    last = count + reach + 1;
-    for (long i = count - 1; i >= 0; --i) {
-      if (cells[std::size_t(start + i * stride)] & bit) last = i;
-      if (set[std::size_t(i)] || last - i <= reach) set[std::size_t(i)] = 1;
-    }
-    for (long i = 0; i < count; ++i)
-      if (set[std::size_t(i)]) cells[std::size_t(start + i * stride)] |= bit;
-  }
+  });
 }
 
 }  // namespace
 
-CellMask::CellMask(std::span<const Vec3> points_mm, double cell_mm, double core_mm,
-                   double outer_mm) {
+CellMask::CellMask(std::span<const Vec3> points_mm, double cell_mm, double core_mm, double outer_mm,
+                   const Eigen::AlignedBox3d& relevant_mm)
+    : relevant_mm_(relevant_mm) {
   if (!(cell_mm > 0.0) || !std::isfinite(cell_mm))
     throw std::invalid_argument("CellMask: the cell edge must be > 0 mm");
   if (!(outer_mm >= core_mm) || !(core_mm >= 0.0))
     throw std::invalid_argument("CellMask: need 0 <= core_mm <= outer_mm");
   Eigen::AlignedBox3d box;
   for (const Vec3& p : points_mm)
-    if (p.allFinite()) box.extend(p);
+    if (p.allFinite() && relevant_mm.contains(p)) box.extend(p);
   if (box.isEmpty()) return;
   // The cell edge: as asked, or larger where the box (grown by the dilation and a cell) would
   // hold too many cells.
@@ -56,7 +62,7 @@ CellMask::CellMask(std::span<const Vec3> points_mm, double cell_mm, double core_
   for (int a = 0; a < 3; ++a) dim_[a] = long(std::floor(box.sizes()[a] / cell_mm_)) + 1 + 2 * pad;
   bits_.assign(std::size_t(dim_[0] * dim_[1] * dim_[2]), 0);
   for (const Vec3& p : points_mm) {
-    if (!p.allFinite()) continue;
+    if (!p.allFinite() || !relevant_mm.contains(p)) continue;
     long c[3];
     for (int a = 0; a < 3; ++a)
       c[a] = std::clamp(long(std::floor((p[a] - lo_mm_[a]) / cell_mm_)), 0L, dim_[a] - 1);
@@ -85,6 +91,7 @@ CellMask::CellMask(std::span<const Vec3> points_mm, double cell_mm, double core_
 }
 
 std::uint8_t CellMask::bits(const Vec3& p_mm) const {
+  if (!relevant_mm_.contains(p_mm)) return kCore | kOuter;
   if (bits_.empty()) return 0;
   long c[3];
   for (int a = 0; a < 3; ++a) {

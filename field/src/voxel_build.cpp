@@ -5,10 +5,10 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -112,9 +112,9 @@ struct NodeBuilder {
   bool ratio;
   double band_in_mm, reach_mm, over_mm, near_mm;
   PlaneLaw law;
-  FieldBackend backend;                      ///< Cpu, Cuda or Reference (resolved)
-  std::optional<SampleTable> table;          ///< the cell list (all but Reference)
-  mutable double nodes_seconds = 0.0;        ///< node evaluation, all levels
+  FieldBackend backend;                ///< Cpu, Cuda or Reference (resolved)
+  std::optional<SampleTable> table;    ///< the cell list (all but Reference)
+  mutable double nodes_seconds = 0.0;  ///< node evaluation, all levels
 
   /// The constants of the block and CUDA builds at voxel size h.
   NodeJob jobAt(double h) const {
@@ -191,8 +191,8 @@ struct NodeBuilder {
       buildReference(h, leaves, float_leaves, only, progress);
     else
       buildBlocks(h, leaves, float_leaves, tasks, gpu ? &*gpu : nullptr, progress);
-    nodes_seconds += started_s +
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    nodes_seconds +=
+        started_s + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     trace.lap("  nodes and store");
     openvdb::tools::pruneInactive(grid->tree());
     trace.lap("  prune");
@@ -234,7 +234,7 @@ struct NodeBuilder {
         for (int a = 0; a < 3; ++a) t.origin[a] = o[a];
         const auto* mask_leaf = wanted ? wanted->probeConstLeaf(o) : nullptr;
         for (int word = 0; word < 8; ++word)
-          t.mask[word] = !wanted ? ~std::uint64_t{0}
+          t.mask[word] = !wanted     ? ~std::uint64_t{0}
                          : mask_leaf ? mask_leaf->getValueMask().getWord<std::uint64_t>(word)
                                      : 0;
       }
@@ -370,7 +370,8 @@ FieldBackend resolveBackend(FieldBackend wanted) {
 
 }  // namespace
 
-BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) {
+BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
+                        std::optional<Level> level0) {
   BuiltLevels built;
   const DirectField::Index& index = direct.index();
   const ObstacleSamples& samples = index.samples;
@@ -393,16 +394,16 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
   // Sideways reach of a sample (sub-triangle centroids: within 0.87 step of any surface point);
   // closer to the surface than about one spacing the samples' field is not yet a plane's.
   NodeBuilder builder{index,
-                            request,
-                            ratio,
-                            insideBandMm(params, request),
-                            reachMm(params, request),
-                            params.sample_step_mm,
-                            request.plane_near_mm.value_or(
-                                (tolerance > 0.0 ? kRefinedNearFactor : 2.0) * params.r_min_mm),
-                            PlaneLaw(params, weightPerMm2(samples, params)),
-                            resolveBackend(request.backend),
-                            std::nullopt};
+                      request,
+                      ratio,
+                      insideBandMm(params, request),
+                      reachMm(params, request),
+                      params.sample_step_mm,
+                      request.plane_near_mm.value_or((tolerance > 0.0 ? kRefinedNearFactor : 2.0) *
+                                                     params.r_min_mm),
+                      PlaneLaw(params, weightPerMm2(samples, params)),
+                      resolveBackend(request.backend),
+                      std::nullopt};
   PhaseTrace trace;
   if (builder.backend != FieldBackend::Reference) builder.table.emplace(samples, params.r0_mm);
   trace.lap("cell list");
@@ -417,33 +418,38 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
                              mib(static_cast<double>(request.max_memory_bytes)) +
                              "; use a coarser voxel size or a smaller region");
   };
-  built.stats.estimated_nodes = estimateVoxelNodes(samples, params, request);
-  trace.lap("estimate");
   // The plane ratio adds a float to the Vec3f of a node.
   const double value_bytes = ratio ? 16.0 : 12.0;
-  refuse("estimated", static_cast<double>(built.stats.estimated_nodes),
-         kVoxelBytesPerNode * value_bytes / 12.0);
-
-  // Candidate leaves (8³ nodes): those within reach of a sample, inside the region.
-  const Eigen::AlignedBox3d reach = reachBox(samples, params, request);
-  const std::vector<openvdb::Coord> origins = candidateLeaves(samples, reach, h, reach_mm);
-  trace.lap("candidate leaves");
-  // Full leaves: the values of a node, masks and header, and the query block (9³ × 16 bytes).
-  refuse("candidate leaves hold", static_cast<double>(origins.size()) * Leaf::SIZE,
-         static_cast<double>(sizeof(Leaf)) / Leaf::SIZE * value_bytes / 12.0 + 12.0 +
-             16.0 * kBlockNodes / Leaf::SIZE);
-
   // Progress: level 0 takes the whole bar without refinement, half of it with.
   const double level0_share = tolerance > 0.0 ? 0.5 : 1.0;
   std::vector<Level>& levels = built.levels;
-  levels.emplace_back();
-  levels[0].h_mm = h;
-  std::tie(levels[0].grid, levels[0].closeness) = builder.build(h, origins, nullptr, [&](double f) {
-    common::report(request.progress, level0_share * f, "field");
-  });
-  trace.lap("level 0 nodes");
-  makeBlocks(levels[0], ratio);
-  trace.lap("level 0 blocks");
+  if (level0) {  // built already (a job's uniform grid, refined near its path)
+    built.stats.estimated_nodes = level0->grid->activeVoxelCount();
+    levels.push_back(std::move(*level0));
+  } else {
+    built.stats.estimated_nodes = estimateVoxelNodes(samples, params, request);
+    trace.lap("estimate");
+    refuse("estimated", static_cast<double>(built.stats.estimated_nodes),
+           kVoxelBytesPerNode * value_bytes / 12.0);
+
+    // Candidate leaves (8³ nodes): those within reach of a sample, inside the region.
+    const Eigen::AlignedBox3d reach = reachBox(samples, params, request);
+    const std::vector<openvdb::Coord> origins = candidateLeaves(samples, reach, h, reach_mm);
+    trace.lap("candidate leaves");
+    // Full leaves: the values of a node, masks and header, and the query block (9³ × 16 bytes).
+    refuse("candidate leaves hold", static_cast<double>(origins.size()) * Leaf::SIZE,
+           static_cast<double>(sizeof(Leaf)) / Leaf::SIZE * value_bytes / 12.0 + 12.0 +
+               16.0 * kBlockNodes / Leaf::SIZE);
+
+    levels.emplace_back();
+    levels[0].h_mm = h;
+    std::tie(levels[0].grid, levels[0].closeness) = builder.build(
+        h, origins, nullptr,
+        [&](double f) { common::report(request.progress, level0_share * f, "field"); });
+    trace.lap("level 0 nodes");
+    makeBlocks(levels[0], ratio);
+    trace.lap("level 0 blocks");
+  }
   std::optional<PlaneLaw> law;
   if (ratio) law = builder.law;
 
@@ -475,7 +481,8 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
                      (!request.refine_mask || request.refine_mask->contains(x)) &&
                      errors.cellError(ijk, acc) > tolerance && locate(level, acc, x, where);
           if (split[c])
-            std::atomic_ref<std::uint64_t>(level.refined[where.block * kCellWords + (where.cell >> 6)])
+            std::atomic_ref<std::uint64_t>(
+                level.refined[where.block * kCellWords + (where.cell >> 6)])
                 .fetch_or(std::uint64_t{1} << (where.cell & 63), std::memory_order_relaxed);
         }
       });
@@ -543,7 +550,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request) 
   built.law = law;
   built.stats.backend = builder.backend == FieldBackend::Cuda        ? "cuda"
                         : builder.backend == FieldBackend::Reference ? "reference"
-                                                             : "cpu";
+                                                                     : "cpu";
   built.stats.nodes_seconds = builder.nodes_seconds;
   return built;
 }

@@ -217,7 +217,8 @@ void matchLeaf(Leaf& leaf, FloatLeaf* closeness, const std::vector<Level>& coars
       // The parent cell's block and offset from its index (locate's, without the world point).
       const int b = blockAt(parent, acc.index.back(),
                             openvdb::Coord(cell.x() >> 3, cell.y() >> 3, cell.z() >> 3));
-      hanging = b < 0 || !bit(parent.refined, std::size_t(b) * Leaf::SIZE + Leaf::coordToOffset(cell));
+      hanging =
+          b < 0 || !bit(parent.refined, std::size_t(b) * Leaf::SIZE + Leaf::coordToOffset(cell));
     }
     if (!hanging) continue;
     const Vec3 x = Vec3(f.x(), f.y(), f.z()) * fine_h_mm;
@@ -255,8 +256,6 @@ void matchCoarserLevels(Level& fine, const std::vector<Level>& coarser, bool rat
   });
 }
 
-
-
 }  // namespace voxel
 
 using namespace voxel;
@@ -270,10 +269,33 @@ struct VoxelField::Impl {
   std::optional<PlaneLaw> law;  ///< PlaneRatio
 };
 
+VoxelRequest levelZeroRequest(const VoxelRequest& refined, double r_min_mm) {
+  VoxelRequest uniform = refined;
+  uniform.refine_tolerance = 0.0;
+  uniform.refine_mask = nullptr;
+  if (refined.refine_tolerance > 0.0)
+    uniform.plane_near_mm = refined.plane_near_mm.value_or(kRefinedNearFactor * r_min_mm);
+  return uniform;
+}
+
 VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request)
+    : VoxelField(direct, request, static_cast<Level*>(nullptr)) {}
+
+VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request, VoxelField&& uniform)
+    : VoxelField(direct, request, [&] {
+        Impl& u = *uniform.impl_;
+        if (u.levels.size() != 1 || u.voxel_size_mm != request.voxel_size_mm ||
+            u.stored != request.stored || u.interpolation != request.interpolation)
+          throw std::invalid_argument(
+              "VoxelField: the uniform grid to refine is not this request's level 0");
+        return &u.levels[0];
+      }()) {}
+
+VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request, Level* level0)
     : impl_(std::make_unique<Impl>()) {
   const auto start = std::chrono::steady_clock::now();
-  BuiltLevels built = buildLevels(direct, request);
+  BuiltLevels built = buildLevels(direct, request,
+                                  level0 ? std::optional<Level>(std::move(*level0)) : std::nullopt);
   impl_->levels = std::move(built.levels);
   impl_->stats = built.stats;
   impl_->law = built.law;

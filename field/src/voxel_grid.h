@@ -299,6 +299,9 @@ struct BuiltLevels {
   VoxelStats stats;
   std::optional<PlaneLaw> law;  ///< PlaneRatio
 };
-BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request);
+/// `level0`: the level 0 of a uniform build (levelZeroRequest(request)), refined here instead
+/// of building it again.
+BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
+                        std::optional<Level> level0 = std::nullopt);
 
 }  // namespace fieldpath::field::voxel

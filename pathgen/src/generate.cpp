@@ -264,14 +264,16 @@ GenerateResult generatePath(const GenerateRequest& request) {
   // the uniform 0.5 mm grid's tilt is 0.008 deg from the exact field's), so the refined build's
   // cells, not the whole reach box's, are those the path reads. Null where the first steering
   // fails (the refinement then splits everywhere, as with `reach`).
+  // Returns the mask, and in `level0` the uniform grid (the refined build's level 0, refined
+  // next rather than built again).
   auto nodesNearPath =
       [&](const field::DirectField& exact, const field::VoxelRequest& refined,
-          const Eigen::AlignedBox3d& valid) -> std::shared_ptr<const field::CellMask> {
-    field::VoxelRequest uniform = refined;
-    uniform.refine_tolerance = 0.0;
+          const Eigen::AlignedBox3d& valid,
+          std::optional<field::VoxelField>& level0) -> std::shared_ptr<const field::CellMask> {
+    field::VoxelRequest uniform = field::levelZeroRequest(refined, request.field.r_min_mm);
     uniform.progress = scaled(request.progress, 0.0, 0.05, "field");
-    const field::VoxelField coarse(exact, uniform);
-    const field::RegionField coarse_in_reach(coarse, exact, valid);
+    level0.emplace(exact, uniform);
+    const field::RegionField coarse_in_reach(*level0, exact, valid);
     std::vector<Vec3> points;
     for (const Steered& s : steerPasses(&coarse_in_reach, false)) {
       if (s.error) return nullptr;
@@ -281,7 +283,13 @@ GenerateResult generatePath(const GenerateRequest& request) {
       }
     }
     const double hc = refined.voxel_size_mm;
-    return std::make_shared<const field::CellMask>(points, 0.5 * hc, 0.5 * hc, 1.5 * hc);
+    // Only near the obstacles: beyond r0 of every sample nothing is refined and the voxels are
+    // zero as the field is (the holder's nodes high above the part).
+    Eigen::AlignedBox3d relevant;
+    for (const Vec3& q : exact.samples().points_mm) relevant.extend(q);
+    relevant.min().array() -= request.field.r0_mm + 2.0 * hc;
+    relevant.max().array() += request.field.r0_mm + 2.0 * hc;
+    return std::make_shared<const field::CellMask>(points, 0.5 * hc, 0.5 * hc, 1.5 * hc, relevant);
   };
 
   // ---- field -----------------------------------------------------------------------------------
@@ -315,14 +323,20 @@ GenerateResult generatePath(const GenerateRequest& request) {
       valid.min().array() += 2 * h;
       valid.max().array() -= 2 * h;
       double built_share = 0.0;
+      std::optional<field::VoxelField> level0;
       if (voxel_request.refine_tolerance > 0.0 && voxel_request.refine_levels > 0 &&
           voxel_request.refine_region == field::RefineRegion::Path) {
-        refine_mask = nodesNearPath(*direct, voxel_request, valid);
+        const auto near_start = Clock::now();
+        refine_mask = nodesNearPath(*direct, voxel_request, valid, level0);
+        result.times.near_path_s = seconds(near_start);
         voxel_request.refine_mask = refine_mask;
         built_share = 0.05;
       }
       voxel_request.progress = scaled(request.progress, built_share, 0.3, "field");
-      voxels = std::make_shared<field::VoxelField>(*direct, voxel_request);
+      voxels = refine_mask
+                   ? std::make_shared<field::VoxelField>(*direct, voxel_request, std::move(*level0))
+                   : std::make_shared<field::VoxelField>(*direct, voxel_request);
+      level0.reset();
       result.voxel_nodes = voxels->stats().active_nodes;
       result.voxel_memory_bytes = voxels->stats().memory_bytes;
       voxels_in_reach =

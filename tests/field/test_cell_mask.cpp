@@ -50,6 +50,14 @@ TEST(CellMask, CubesAroundThePointsCellsAsABruteForceSays) {
   EXPECT_GT(core_hits, 50u);
   EXPECT_GT(outer_hits, 2 * core_hits);
   EXPECT_GT(mask.cells(), mask.coreCells());
+  // Only the relevant box is masked: a point beyond it marks nothing, and beyond it every point
+  // counts as inside (nothing is refined there, the voxels are exact).
+  const Eigen::AlignedBox3d relevant(Vec3(-1, -1, -1), Vec3(5, 11, 6));
+  const CellMask clipped(points, cell, core_mm, outer_mm, relevant);
+  EXPECT_TRUE(clipped.inCore(Vec3(8, 5, 2)));  // beyond the box
+  EXPECT_LT(clipped.cells(), mask.cells());
+  for (const Vec3& p : points)
+    EXPECT_EQ(clipped.inCore(p), true) << p.transpose();  // marked inside, or beyond the box
   // No point, no cell; bad sizes refused.
   EXPECT_FALSE(CellMask({}, 1.0, 1.0, 2.0).contains(Vec3::Zero()));
   EXPECT_THROW(CellMask(points, 0.0, 1.0, 2.0), std::invalid_argument);

@@ -482,3 +482,37 @@ TEST(VoxelRefinement, RefusesQuadraticAndBadSettings) {
   // A tolerance of 0 is a uniform grid.
   EXPECT_EQ(VoxelField(direct, refined(1.0, 0.0, 2)).stats().levels, 1);
 }
+
+TEST(VoxelRefinement, RefiningAUniformLevelZeroIsTheRefinedBuild) {
+  // A job steers on the uniform grid first, then refines that grid (pathgen): its nodes, every
+  // level, are those of the refined build made at once; a grid of another size is refused.
+  FieldParams p;
+  p.sample_step_mm = 0.5;
+  const DirectField direct = fineCubeField(p);
+  const VoxelRequest r = refined(2.0, 0.02, 2);
+  const VoxelField at_once(direct, r);
+  VoxelField uniform(direct, levelZeroRequest(r, p.r_min_mm));
+  EXPECT_EQ(uniform.stats().levels, 1);
+  const VoxelField from_uniform(direct, r, std::move(uniform));
+  const std::vector<StoredNode> a = at_once.storedNodes(), b = from_uniform.storedNodes();
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_EQ(from_uniform.stats().levels, 3);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a[i].x_mm, b[i].x_mm) << i;
+    ASSERT_EQ(a[i].level, b[i].level) << i;
+    ASSERT_EQ(a[i].value, b[i].value) << i;
+    ASSERT_EQ(a[i].closeness_mm, b[i].closeness_mm) << i;
+  }
+  // Without the refined build's near band the uniform grid's level 0 differs: the helper is
+  // what makes them equal (and a grid of another voxel size is refused outright).
+  VoxelRequest plain = r;
+  plain.refine_tolerance = 0.0;
+  const VoxelField from_plain(direct, r, VoxelField(direct, plain));
+  const std::vector<StoredNode> c = from_plain.storedNodes();
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < std::min(a.size(), c.size()); ++i)
+    differ += a[i].level == 0 && !(a[i].value == c[i].value);
+  EXPECT_GT(differ, 0u);
+  VoxelField other(direct, request(1.0));
+  EXPECT_THROW(VoxelField(direct, r, std::move(other)), std::invalid_argument);
+}

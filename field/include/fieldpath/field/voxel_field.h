@@ -103,15 +103,23 @@ inline constexpr double kVoxelBytesPerNode = 52.0;
 
 /// One active node as stored (VoxelField::storedNodes): for tests and tools.
 struct StoredNode {
-  Vec3 x_mm;          ///< world position
-  int level = 0;      ///< 0: h, 1: h/2, ...
-  Vec3 value;         ///< F (Force) or G (PlaneRatio), float-rounded
+  Vec3 x_mm;                  ///< world position
+  int level = 0;              ///< 0: h, 1: h/2, ...
+  Vec3 value;                 ///< F (Force) or G (PlaneRatio), float-rounded
   double closeness_mm = 0.0;  ///< PlaneRatio: r0 - s
   bool over = false;  ///< PlaneRatio: over/under the surface (the closeness grid's active mask)
 };
 
+/// The uniform grid whose nodes are those of `refined`'s level 0: no refinement, and the plane
+/// ratio's near band a refined build takes (kRefinedNearFactor · r_min unless set).
+VoxelRequest levelZeroRequest(const VoxelRequest& refined, double r_min_mm);
+
 /// Whether `field.backend: cuda` can run here: the program has CUDA and a GPU is present.
 bool cudaFieldBackendAvailable();
+
+namespace voxel {
+struct Level;
+}
 
 class VoxelField final : public ForceField {
  public:
@@ -120,6 +128,11 @@ class VoxelField final : public ForceField {
   /// request.max_memory_bytes (the message gives the estimate); common::Interrupted if the
   /// progress hook asks to stop.
   VoxelField(const DirectField& direct, const VoxelRequest& request);
+  /// The refined build of `request` from `uniform`'s level 0 instead of building it again:
+  /// `uniform` built from `direct` with levelZeroRequest(request) (its nodes are then those of
+  /// this build's level 0; a job steers on it first, pathgen). Throws std::invalid_argument
+  /// when `uniform` is refined or of another voxel size or stored quantity.
+  VoxelField(const DirectField& direct, const VoxelRequest& request, VoxelField&& uniform);
   ~VoxelField() override;
   VoxelField(VoxelField&&) noexcept;
   VoxelField& operator=(VoxelField&&) noexcept;
@@ -142,6 +155,8 @@ class VoxelField final : public ForceField {
   void save(const std::filesystem::path& file) const;
 
  private:
+  /// Builds all levels, or takes `level0` (moved from; null: built here) and refines it.
+  VoxelField(const DirectField& direct, const VoxelRequest& request, voxel::Level* level0);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

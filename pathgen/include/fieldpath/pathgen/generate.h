@@ -100,6 +100,9 @@ struct GeneratedPosture {
 /// Seconds per stage (steady clock).
 struct StageTimes {
   double setup_s = 0, field_s = 0, steering_s = 0, clearance_s = 0, total_s = 0;
+  /// Of field_s: refinement near the path's first steps (the uniform grid, the passes steered
+  /// on it, the cells their nodes went through).
+  double near_path_s = 0;
 };
 
 struct GenerateResult {
