@@ -1,3 +1,6 @@
+# Phases of the voxel build (FIELDPATH_TRACE_BUILD) and report.json times, refined near the path
+# against everywhere, CUDA, on the GPU machine: bash bench/field/trace_near_path.sh (bundle in
+# .gpu/fp.tar.xz, made by gpu_bundle.sh). Log of record: results/field_builds/gpu_near_path_trace_*.
 set -u
 . bench/field/common.sh
 tar -C /tmp -xJf .gpu/fp.tar.xz; export LD_LIBRARY_PATH=/tmp/B/lib; fp=/tmp/B/fieldpath

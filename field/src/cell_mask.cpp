@@ -59,13 +59,14 @@ CellMask::CellMask(std::span<const Vec3> points_mm, double cell_mm, double core_
     cell_mm_ *= 1.25;
   }
   lo_mm_ = box.min().array() - double(pad) * cell_mm_;
+  inv_cell_ = 1.0 / cell_mm_;
   for (int a = 0; a < 3; ++a) dim_[a] = long(std::floor(box.sizes()[a] / cell_mm_)) + 1 + 2 * pad;
   bits_.assign(std::size_t(dim_[0] * dim_[1] * dim_[2]), 0);
   for (const Vec3& p : points_mm) {
     if (!p.allFinite() || !relevant_mm.contains(p)) continue;
     long c[3];
     for (int a = 0; a < 3; ++a)
-      c[a] = std::clamp(long(std::floor((p[a] - lo_mm_[a]) / cell_mm_)), 0L, dim_[a] - 1);
+      c[a] = std::clamp(long(std::floor((p[a] - lo_mm_[a]) * inv_cell_)), 0L, dim_[a] - 1);
     bits_[std::size_t((c[0] * dim_[1] + c[1]) * dim_[2] + c[2])] = kCore | kOuter;
   }
   // A cube of cells around each marked one: grown along x, then y, then z (separable).
@@ -95,7 +96,7 @@ std::uint8_t CellMask::bits(const Vec3& p_mm) const {
   if (bits_.empty()) return 0;
   long c[3];
   for (int a = 0; a < 3; ++a) {
-    const double f = std::floor((p_mm[a] - lo_mm_[a]) / cell_mm_);
+    const double f = std::floor((p_mm[a] - lo_mm_[a]) * inv_cell_);
     if (!(f >= 0.0) || f >= double(dim_[a])) return 0;
     c[a] = long(f);
   }

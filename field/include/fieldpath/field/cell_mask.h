@@ -50,7 +50,7 @@ class CellMask {
 
   Eigen::AlignedBox3d relevant_mm_;
   Vec3 lo_mm_ = Vec3::Zero();
-  double cell_mm_ = 1.0;
+  double cell_mm_ = 1.0, inv_cell_ = 1.0;
   long dim_[3] = {0, 0, 0};
   std::vector<std::uint8_t> bits_;  ///< x-major, z fastest
   std::size_t outer_cells_ = 0, core_cells_ = 0;
