@@ -164,8 +164,10 @@ struct NodeBuilder {
     // host makes the leaves below (their values are stored when both are done).
     std::vector<LeafTask> tasks;
     if (backend != FieldBackend::Reference) tasks = tasksOf(origins, only);
+    trace.lap("  tasks");
     std::optional<kernel::CudaNodeBuild> gpu;
     if (backend == FieldBackend::Cuda) gpu.emplace(cellTableOf(*table), jobAt(h), tasks);
+    if (gpu) trace.lap("  device started");
     const double started_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     // The leaves made (allocated and filled) in parallel, then added to the trees.
@@ -183,9 +185,10 @@ struct NodeBuilder {
         }
       }
     });
+    trace.lap("  leaves made");
     addLeaves(made, grid->tree());
     if (ratio) addLeaves(made_float, closeness->tree());
-    trace.lap("  leaves touched");
+    trace.lap("  leaves added");
     start = std::chrono::steady_clock::now();
     if (backend == FieldBackend::Reference)
       buildReference(h, leaves, float_leaves, only, progress);
