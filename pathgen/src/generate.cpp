@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <memory>
 #include <mutex>
@@ -273,21 +275,35 @@ GenerateResult generatePath(const GenerateRequest& request) {
           std::optional<field::VoxelField>& level0) -> std::shared_ptr<const field::CellMask> {
     field::VoxelRequest uniform = field::levelZeroRequest(refined, request.field.r_min_mm);
     uniform.progress = scaled(request.progress, 0.0, 0.05, "field");
+    const bool trace = std::getenv("FIELDPATH_TRACE_BUILD") != nullptr;  // as the field's build
+    auto lap = [&, last = Clock::now()](const char* what) mutable {
+      if (trace) std::fprintf(stderr, "near path: %-24s %8.1f ms\n", what, 1e3 * seconds(last));
+      last = Clock::now();
+    };
     level0.emplace(exact, uniform);
+    lap("uniform grid");
     const field::RegionField coarse_in_reach(*level0, exact, valid);
-    std::vector<Vec3> points;
     // Where the nodes go, to well within the core (h/2): a looser solver suffices (rtol 1e-4
     // moves a node 90 mm up the holder by ~0.01 mm; impeller: 10 % off the job, same mask).
     dynamics::DynamicsParams rough = request.dynamics;
     rough.rtol = std::max(rough.rtol, 1e-4);
     rough.atol = std::max(rough.atol, 1e-7);
-    for (const Steered& s : steerPasses(&coarse_in_reach, false, rough)) {
+    const std::vector<Steered> first = steerPasses(&coarse_in_reach, false, rough);
+    std::vector<const GeneratedPosture*> postures;
+    for (const Steered& s : first) {
       if (s.error) return nullptr;
-      for (const GeneratedPosture& g : s.postures) {
-        const Eigen::Isometry3d placed = geometry::toolToWorld(g.posture);
-        for (const Vec3& n : nodes) points.push_back(placed * n);
-      }
+      for (const GeneratedPosture& g : s.postures) postures.push_back(&g);
     }
+    // Every node at every posture, placed in parallel.
+    std::vector<Vec3> points(postures.size() * nodes.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, postures.size(), 64), [&](const auto& r) {
+      for (std::size_t k = r.begin(); k != r.end(); ++k) {
+        const Eigen::Isometry3d placed = geometry::toolToWorld(postures[k]->posture);
+        for (std::size_t n = 0; n < nodes.size(); ++n)
+          points[k * nodes.size() + n] = placed * nodes[n];
+      }
+    });
+    lap("steering on it");
     const double hc = refined.voxel_size_mm;
     // Only near the obstacles: beyond r0 of every sample nothing is refined and the voxels are
     // zero as the field is (the holder's nodes high above the part).
@@ -295,7 +311,10 @@ GenerateResult generatePath(const GenerateRequest& request) {
     for (const Vec3& q : exact.samples().points_mm) relevant.extend(q);
     relevant.min().array() -= request.field.r0_mm + 2.0 * hc;
     relevant.max().array() += request.field.r0_mm + 2.0 * hc;
-    return std::make_shared<const field::CellMask>(points, 0.5 * hc, 0.5 * hc, 1.5 * hc, relevant);
+    auto mask =
+        std::make_shared<const field::CellMask>(points, 0.5 * hc, 0.5 * hc, 1.5 * hc, relevant);
+    lap("mask");
+    return mask;
   };
 
   // ---- field -----------------------------------------------------------------------------------

@@ -34,8 +34,8 @@ class CellMask {
   }
 
   /// In the whole mask / in its core (false outside the stored box, and for an empty mask).
-  bool contains(const Vec3& p_mm) const { return bits(p_mm) & kOuter; }
-  bool inCore(const Vec3& p_mm) const { return bits(p_mm) & kCore; }
+  bool contains(const Vec3& p_mm) const { return lookUp(outer_, p_mm); }
+  bool inCore(const Vec3& p_mm) const { return lookUp(core_, p_mm); }
 
   double cellMm() const { return cell_mm_; }
   std::size_t cells() const { return outer_cells_; }     ///< of the whole mask
@@ -45,14 +45,13 @@ class CellMask {
   static constexpr std::size_t kMaxCells = std::size_t{1} << 27;
 
  private:
-  static constexpr std::uint8_t kCore = 1, kOuter = 2;
-  std::uint8_t bits(const Vec3& p_mm) const;
+  bool lookUp(const std::vector<std::uint64_t>& bits, const Vec3& p_mm) const;
 
   Eigen::AlignedBox3d relevant_mm_;
   Vec3 lo_mm_ = Vec3::Zero();
   double cell_mm_ = 1.0, inv_cell_ = 1.0;
   long dim_[3] = {0, 0, 0};
-  std::vector<std::uint8_t> bits_;  ///< x-major, z fastest
+  std::vector<std::uint64_t> core_, outer_;  ///< a bit a cell, x-major, z fastest
   std::size_t outer_cells_ = 0, core_cells_ = 0;
 };
 
