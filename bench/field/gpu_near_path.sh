@@ -43,12 +43,23 @@ for rep in $(seq 1 "$reps"); do
 done
 echo -n "path.cl near path vs everywhere (cuda): "; python3 "$here/compare_cl.py" /tmp/gen_reach_cuda/path.cl /tmp/gen_path_cuda/path.cl | tail -1
 echo -n "path.cl cuda vs cpu (near path): "; python3 "$here/compare_cl.py" /tmp/gen_path_cpu/path.cl /tmp/gen_path_cuda/path.cl | tail -1
-# 3. the study at 16 cores / GPU, near the path and everywhere, cpu and cuda builds
-timeout 240 "$fp" --quiet study examples/impeller/scene.yaml --sample-step 0.5 --voxels 1 \
-  --interp trilinear --stored plane_ratio --refine 1 --refine-levels 3 --refine-region path,reach \
-  --backend cpu,cuda --no-brute-force --repeat 3 --line-step 0.2 --out /tmp/study_np 2>&1 | tail -8
-cp /tmp/study_np/study.md "$out/study_near_path_gpu.md" 2>/dev/null
-cp /tmp/study_np/study.csv "$out/study_near_path_gpu.csv" 2>/dev/null
+# 3. the study at 16 cores / GPU, near the path and everywhere, cpu and cuda builds: 1 mm refined
+# 1 % to 0.125 mm, and 0.5 mm refined 1 % to 0.125 mm
+for v in "1 3" "0.5 2"; do
+  set -- $v
+  timeout 240 "$fp" --quiet study examples/impeller/scene.yaml --sample-step 0.5 --voxels "$1" \
+    --interp trilinear --stored plane_ratio --refine 1 --refine-levels "$2" --refine-region path,reach \
+    --backend cpu,cuda --no-brute-force --repeat 5 --line-step 0.2 --out "/tmp/study_np_$1" 2>&1 | tail -6
+  cp "/tmp/study_np_$1/study.md" "$out/study_near_path_gpu_$1.md" 2>/dev/null
+  cp "/tmp/study_np_$1/study.csv" "$out/study_near_path_gpu_$1.csv" 2>/dev/null
+  grep "^| voxel\|^| direct" "/tmp/study_np_$1/study.md" | head -5 | cut -d'|' -f2,7-9
+done
+# 4. the near-path phases of one study build (cuda), FIELDPATH_TRACE_BUILD
+FIELDPATH_TRACE_BUILD=1 timeout 120 "$fp" --quiet study examples/impeller/scene.yaml --sample-step 0.5 \
+  --voxels 1 --interp trilinear --stored plane_ratio --refine 1 --refine-levels 3 \
+  --refine-region path --backend cuda --no-brute-force --repeat 3 --line-step 0.2 \
+  --out /tmp/study_trace 2> "$out/near_path_trace.txt" > /dev/null
+awk '/near path: uniform/{n++} n==3' "$out/near_path_trace.txt" | head -50
 rm -f examples/impeller/.bench_st1_reach.yaml
 remove_scenes
 echo
