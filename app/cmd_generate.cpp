@@ -12,10 +12,10 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "estimates.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/csv.h"
 #include "fieldpath/field/voxel_field.h"
-#include "estimates.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/units.h"
 #include "job.h"
@@ -90,18 +90,16 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
         {"safe_z", job.links.safe_z_mm ? "given" : "auto: highest mesh point + clearance + 2 mm"},
         {"max_turn_deg", pathgen::kMaxLinkTurnDeg}}},
       {"limits",
-       {{"on_limit",
-         job.dynamics.on_limit == dynamics::LimitPolicy::Clamp ? "clamp" : "fail"},
+       {{"on_limit", job.dynamics.on_limit == dynamics::LimitPolicy::Clamp ? "clamp" : "fail"},
         {"max_tilt_deg", job.dynamics.max_tilt_deg},
         {"max_lead_deg", job.dynamics.max_lead_deg},
         {"limited_postures", r.limited_postures},
         {"limited_colliding", r.limited_colliding},
-        {"first_limited",
-         r.first_limited == pathgen::ClearanceResult::npos
-             ? json(nullptr)
-             : json({{"posture", r.postures[r.first_limited].output},
-                     {"pass", r.postures[r.first_limited].pass + 1},
-                     {"s_mm", r.postures[r.first_limited].s_mm}})}}},
+        {"first_limited", r.first_limited == pathgen::ClearanceResult::npos
+                              ? json(nullptr)
+                              : json({{"posture", r.postures[r.first_limited].output},
+                                      {"pass", r.postures[r.first_limited].pass + 1},
+                                      {"s_mm", r.postures[r.first_limited].s_mm}})}}},
       {"max_tilt_deg", r.max_tilt_deg},
       {"max_lead_deg", r.max_lead_deg},
       {"solver",
@@ -123,8 +121,8 @@ std::string anglesCsv(const pathgen::GenerateResult& r) {
     csv << common::csvNumber(g.s_mm) << ',' << g.pass + 1 << ','
         << common::csvNumber(g.lead_rad * kRadToDeg) << ','
         << common::csvNumber(g.tilt_rad * kRadToDeg) << ',' << common::csvNumber(g.moment) << ','
-        << common::csvNumber(g.clearance_mm) << ',' << g.output
-        << ',' << (g.limited ? 1 : 0) << '\n';
+        << common::csvNumber(g.clearance_mm) << ',' << g.output << ',' << (g.limited ? 1 : 0)
+        << '\n';
   return csv.str();
 }
 
@@ -193,7 +191,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                               "moves between them; `# limit`: an angle limit held there");
     geometry::AptHeader header;
     header.part_name = scene.file.stem().string();
-    for (char& c : header.part_name) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    for (char& c : header.part_name)
+      c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
     header.tool = job.tool;
     header.feed_mm_per_min = job.dynamics.feed_mm_per_min;
     geometry::writeAptFile(out / "path.apt", result.path, header);
@@ -211,9 +210,11 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
         c.min_clearance_mm, job.clearance_mm, c.colliding, m.colliding, m.motions,
         m.min_clearance_mm, result.times.total_s, out.string().c_str());
     if (result.voxel_outside_points > 0)
-      std::printf("note: %zu node positions fell outside the voxels' region (the reach box) and "
-                  "were given the exact field\n",
-                  result.voxel_outside_points);
+      std::printf(
+          "note: %zu node positions fell outside where the voxels answer (the reach box; "
+          "with field.refine_region: path, near the first path) and were given the exact "
+          "field\n",
+          result.voxel_outside_points);
   });
 }
 

@@ -123,8 +123,9 @@ struct GenerateResult {
   std::size_t tool_triangles = 0;   ///< of the clearance mesh
   std::size_t voxel_nodes = 0;      ///< active nodes (voxel mode)
   std::size_t voxel_memory_bytes = 0;
-  /// Field evaluations (node positions) of the steering that fell outside the voxels' region
-  /// and were answered by the exact sum (voxel mode; 0 when the reach box held them all).
+  /// Field evaluations (node positions) of the steering that fell outside where the voxels
+  /// answer (the reach box; refined near the path: near the first path's nodes) and were
+  /// answered by the exact sum (voxel mode).
   std::size_t voxel_outside_points = 0;
   /// The voxel field of the path (voxel mode with GenerateRequest::keep_voxels), else null.
   std::shared_ptr<const field::VoxelField> voxels;
