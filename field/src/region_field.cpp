@@ -1,6 +1,7 @@
 #include "fieldpath/field/region_field.h"
 
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 namespace fieldpath::field {
