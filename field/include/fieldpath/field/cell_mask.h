@@ -33,14 +33,14 @@ class CellMask {
     return Eigen::AlignedBox3d(Vec3::Constant(-HUGE_VAL), Vec3::Constant(HUGE_VAL));
   }
 
-  /// In the whole mask / in its core (false outside the stored box, and for an empty mask).
+  /// In the whole mask / in its core: true beyond `relevant_mm`; within it, false outside the
+  /// stored cells (and everywhere for a mask no point marked).
   bool contains(const Vec3& p_mm) const { return lookUp(outer_, p_mm); }
   bool inCore(const Vec3& p_mm) const { return lookUp(core_, p_mm); }
 
   double cellMm() const { return cell_mm_; }
   std::size_t cells() const { return outer_cells_; }     ///< of the whole mask
   std::size_t coreCells() const { return core_cells_; }  ///< of the core
-  double volumeMm3() const { return double(outer_cells_) * cell_mm_ * cell_mm_ * cell_mm_; }
 
   static constexpr std::size_t kMaxCells = std::size_t{1} << 27;
 
