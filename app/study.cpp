@@ -178,7 +178,6 @@ struct ErrorSets {
 
 }  // namespace
 
-
 StudyResult runStudy(const StudyRequest& request) {
   if (request.voxel_sizes_mm.empty()) throw InputError("--voxels: give at least one voxel size");
   for (double h : request.voxel_sizes_mm)
@@ -322,10 +321,10 @@ StudyResult runStudy(const StudyRequest& request) {
     // exact sum beyond (generate's RegionField).
     std::unique_ptr<field::RegionField> near_path;
     if (voxels && run.refine_mask) {
-      Eigen::AlignedBox3d valid = run.reach_box_mm;
-      valid.min().array() += 2 * row.variant.voxel.voxel_size_mm;
-      valid.max().array() -= 2 * row.variant.voxel.voxel_size_mm;
-      near_path = std::make_unique<field::RegionField>(*voxels, *direct, valid, run.refine_mask);
+      near_path = std::make_unique<field::RegionField>(
+          *voxels, *direct,
+          field::RegionField::stencilBox(run.reach_box_mm, row.variant.voxel.voxel_size_mm),
+          run.refine_mask);
     }
     const field::ForceField* approx = near_path ? near_path.get()
                                       : voxels  ? voxels.get()

@@ -12,5 +12,15 @@ scene() {
 }
 remove_scenes() { rm -f examples/impeller/.bench_*.yaml; }
 
+# near_path_scenes: the study's scene (blades every 0.5 mm) at 1 mm refined 1 % to 0.125 mm, as
+# examples/impeller/.bench_st1.yaml (field.refine_region: path, the default) and
+# .bench_st1_reach.yaml (reach); remove them with remove_scenes.
+near_path_scenes() {
+  local st
+  st=$(scene st1 0.5 0.01)
+  sed -i -e "s/voxel_size: 0.5 /voxel_size: 1.0 /" -e "s/refine_levels: 2 /refine_levels: 3 /" "$st"
+  sed -e "/refine_levels:/a\\  refine_region: reach" "$st" > examples/impeller/.bench_st1_reach.yaml
+}
+
 # median X...: the median of the numbers
 median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2]+a[NR/2+1])/2}'; }

@@ -22,9 +22,8 @@ timeout 120 /tmp/B/test_field --gtest_filter='VoxelBuild.*:CellMask.*:RegionFiel
   grep -E "OK \]|FAILED|PASSED|SKIPPED|Failure"
 # 2. generate on the study's scene (blades every 0.5 mm): 1 mm refined 1 % to 0.125 mm (0.81 %
 # max force error on 2 cores), near the path and everywhere, cuda and cpu, against direct
-st=$(scene st1 0.5 0.01)
-sed -i -e "s/voxel_size: 0.5 /voxel_size: 1.0 /" -e "s/refine_levels: 2 /refine_levels: 3 /" "$st"
-sed -e "/refine_levels:/a\\  refine_region: reach" "$st" > examples/impeller/.bench_st1_reach.yaml
+near_path_scenes
+st=examples/impeller/.bench_st1.yaml
 declare -A totals wall
 for rep in $(seq 1 "$reps"); do
   for c in "path cuda" "reach cuda" "path cpu" "direct -"; do
@@ -60,7 +59,6 @@ FIELDPATH_TRACE_BUILD=1 timeout 120 "$fp" --quiet study examples/impeller/scene.
   --refine-region path --backend cuda --no-brute-force --repeat 3 --line-step 0.2 \
   --out /tmp/study_trace 2> "$out/near_path_trace.txt" > /dev/null
 awk '/near path: uniform/{n++} n==3' "$out/near_path_trace.txt" | head -50
-rm -f examples/impeller/.bench_st1_reach.yaml
 remove_scenes
 echo
 echo "generate, medians of $reps (field + steering s, from report.json):"

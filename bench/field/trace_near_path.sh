@@ -4,13 +4,12 @@
 set -u
 . bench/field/common.sh
 tar -C /tmp -xJf .gpu/fp.tar.xz; export LD_LIBRARY_PATH=/tmp/B/lib; fp=/tmp/B/fieldpath
-st=$(scene st1 0.5 0.01)
-sed -i -e "s/voxel_size: 0.5 /voxel_size: 1.0 /" -e "s/refine_levels: 2 /refine_levels: 3 /" "$st"
-sed -e "/refine_levels:/a\\  refine_region: reach" "$st" > examples/impeller/.bench_st1_reach.yaml
+near_path_scenes
+st=examples/impeller/.bench_st1.yaml
 for rep in 1 2 3; do for c in path reach; do
   sc=$st; [ $c = reach ] && sc=examples/impeller/.bench_st1_reach.yaml
   FIELDPATH_TRACE_BUILD=1 $fp --quiet generate $sc --backend cuda --out /tmp/g_$c 2>/tmp/trace_$c.txt >/dev/null
   echo "$c rep $rep: $(python3 -c "import json; print(json.load(open('/tmp/g_$c/report.json'))['times_s'])")"
 done; done
 for c in path reach; do echo "--- trace $c (last rep)"; cat /tmp/trace_$c.txt; done
-rm -f examples/impeller/.bench_st1_reach.yaml; remove_scenes
+remove_scenes

@@ -21,6 +21,7 @@
 #include <tbb/parallel_scan.h>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/phase_trace.h"
 #include "node_block.h"
 #include "voxel_grid.h"
 
@@ -31,23 +32,7 @@ using namespace voxel;
 namespace voxel {
 namespace {
 
-/// FIELDPATH_TRACE_BUILD=1: the build's phases on stderr (ms each), for finding where a build's
-/// host time goes (issue 15); silent otherwise.
-class PhaseTrace {
- public:
-  PhaseTrace() : on_(std::getenv("FIELDPATH_TRACE_BUILD") != nullptr) {}
-  void lap(const std::string& what) {
-    if (!on_) return;
-    const auto now = std::chrono::steady_clock::now();
-    std::fprintf(stderr, "build trace: %-28s %8.1f ms\n", what.c_str(),
-                 std::chrono::duration<double, std::milli>(now - last_).count());
-    last_ = now;
-  }
-
- private:
-  bool on_;
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
+using common::PhaseTrace;
 
 /// Whether x lies over (or under) the sampled surface: its nearest sample less than `over_mm`
 /// sideways. Beyond the edge of an open wall it does not, and "inside" means nothing there.

@@ -20,14 +20,22 @@ class RegionField final : public ForceField {
  public:
   /// `inside` answers the points of `region_mm` (world, mm), `outside` the others. Both are
   /// borrowed: they must outlive this field. The region must be where `inside` is valid with
-  /// its interpolation's stencil: for voxels built in a box B of node spacing h, B shrunk by
-  /// 2 h (trilinear reads the cell's corners, quadratic one node more).
+  /// its interpolation's stencil: stencilBox (trilinear reads the cell's corners, quadratic one
+  /// node more).
   RegionField(const ForceField& inside, const ForceField& outside,
               const Eigen::AlignedBox3d& region_mm);
   /// The region is the box and the core of `core` (voxels refined near a path only: the
   /// refinement's decisions are those of a build refined everywhere in the core).
   RegionField(const ForceField& inside, const ForceField& outside,
               const Eigen::AlignedBox3d& region_mm, std::shared_ptr<const CellMask> core);
+
+  /// Where voxels built in `built_mm` with node spacing `h_mm` answer with their stencil: the
+  /// box shrunk by 2 h (the region to give them here).
+  static Eigen::AlignedBox3d stencilBox(Eigen::AlignedBox3d built_mm, double h_mm) {
+    built_mm.min().array() += 2.0 * h_mm;
+    built_mm.max().array() -= 2.0 * h_mm;
+    return built_mm;
+  }
 
   /// Thread-safe. One call's points all inside go to `inside` in one call (the usual case:
   /// nothing copied); otherwise the outside ones are gathered and sent to `outside`.
