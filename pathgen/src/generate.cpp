@@ -21,6 +21,7 @@
 #include "fieldpath/field/voxel_field.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/geometry/units.h"
+#include "fieldpath/pathgen/reach_box.h"
 
 namespace fieldpath::pathgen {
 namespace {
@@ -62,39 +63,6 @@ void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>
       throw InputError(msg.str());
     }
   }
-}
-
-/// The world box that tool + holder can reach: nodes at pass stations every few mm at the nominal
-/// axis and at the lead/tilt limits, padded by the distance between those stations and `pad_mm`.
-Eigen::AlignedBox3d reachBox(const std::vector<Pass>& passes, const std::vector<Vec3>& nodes,
-                             double ball_radius_mm, const dynamics::DynamicsParams& dyn,
-                             double lead_rad, double pad_mm) {
-  Eigen::AlignedBox3d box;
-  double station_gap_mm = 0.0;
-  const double max_tilt = dyn.max_tilt_deg * kDegToRad, max_lead = dyn.max_lead_deg * kDegToRad;
-  const std::pair<double, double> corners[] = {{lead_rad, 0.0},
-                                               {max_lead, 0.0},
-                                               {-max_lead, 0.0},
-                                               {lead_rad, max_tilt},
-                                               {lead_rad, -max_tilt}};
-  for (const Pass& pass : passes) {
-    const size_t stride = std::max<size_t>(1, pass.samples.size() / 16);
-    if (pass.samples.size() > stride)
-      station_gap_mm = std::max(station_gap_mm, pass.samples[stride].s_mm);
-    for (size_t i = 0; i < pass.samples.size(); i += stride) {
-      const PassSample& s = pass.samples[i];
-      const dynamics::LocalFrame frame{s.feed, s.normal, s.binormal, false};
-      for (const auto& [lead, tilt] : corners) {
-        const geometry::Posture p = geometry::ballEndPosture(
-            s.centre_mm, dynamics::axisFromAngles(frame, lead, tilt), ball_radius_mm);
-        const Eigen::Isometry3d placed = geometry::toolToWorld(p);
-        for (const Vec3& n : nodes) box.extend(placed * n);
-      }
-    }
-  }
-  box.min().array() -= pad_mm + station_gap_mm;
-  box.max().array() += pad_mm + station_gap_mm;
-  return box;
 }
 
 }  // namespace
