@@ -26,6 +26,7 @@
 #include "fieldpath/geometry/units.h"
 #include "fieldpath/pathgen/clearance.h"
 #include "fieldpath/pathgen/impeller.h"
+#include "fieldpath/pathgen/reach_box.h"
 
 #ifndef FIELDPATH_PLOT_STUDY_SCRIPT
 #define FIELDPATH_PLOT_STUDY_SCRIPT "scripts/plot_study.py"
@@ -302,9 +303,10 @@ StudyResult runStudy(const StudyRequest& request) {
     std::unique_ptr<field::ForceField> brute;
     if (row.variant.isVoxel() && !voxels) {
       field::VoxelRequest voxel_request(row.variant.voxel);
-      Eigen::AlignedBox3d region = direct_reach_mm;  // padded by two voxels as generate pads it
-      region.min().array() -= 2 * row.variant.voxel.voxel_size_mm;
-      region.max().array() += 2 * row.variant.voxel.voxel_size_mm;
+      Eigen::AlignedBox3d region = direct_reach_mm;  // padded as generate pads it
+      const double pad_mm = pathgen::voxelRegionPadMm(row.variant.voxel.voxel_size_mm);
+      region.min().array() -= pad_mm;
+      region.max().array() += pad_mm;
       voxel_request.region_mm = row.failure.empty() ? run.reach_box_mm : region;
       voxels = std::make_shared<field::VoxelField>(*direct, voxel_request);
     }

@@ -291,7 +291,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
   const field::ForceField* force = nullptr;
   const double h = request.field.voxel.voxel_size_mm;
   result.reach_box_mm = reachBox(result.passes, nodes, r, request.dynamics, lead_rad,
-                                 request.mode == FieldMode::Voxel ? 2 * h : 0.0);
+                                 request.mode == FieldMode::Voxel ? voxelRegionPadMm(h) : 0.0);
   if (!request.nominal) {
     field::ObstacleSamples samples =
         field::sampleObstacles(obstacles, request.field.sample_step_mm, request.field.weights);

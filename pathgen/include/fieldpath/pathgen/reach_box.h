@@ -20,4 +20,8 @@ Eigen::AlignedBox3d reachBox(const std::vector<Pass>& passes, const std::vector<
                              double ball_radius_mm, const dynamics::DynamicsParams& dyn,
                              double lead_rad, double pad_mm);
 
+/// The padding of the reach box a voxel job builds its field over (`pad_mm` above): two voxels,
+/// so that the trilinear stencil of a point within reach has its nodes however the box falls.
+inline double voxelRegionPadMm(double voxel_size_mm) { return 2.0 * voxel_size_mm; }
+
 }  // namespace fieldpath::pathgen
