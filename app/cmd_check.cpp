@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -22,6 +23,7 @@
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/pathgen/clearance.h"
 #include "fieldpath/pathgen/generate.h"
+#include "fieldpath/pathgen/link_check.h"
 #include "fieldpath/zbuffer/outputs.h"
 #include "job.h"
 #include "progress.h"
@@ -64,8 +66,14 @@ json surfaceJson(const SurfaceResult& s) {
           {"spacing_coarsened", s.coarsened},
           {"backend", zbuffer::backendName(s.backend)},
           {"simulation_s", s.simulation_s},
-          {"postures_only",
-           "the Z-buffer cuts at the postures, not along the motions between them"},
+          {"swept",
+           "the Z-buffer cuts at the postures and along every motion between them that can reach "
+           "the stock (tip and axis interpolated linearly, no point of the tool moving more than "
+           "sweep_step_mm between cuts; a ball's cut between two is at most sweep_error_um "
+           "shallower than the swept one)"},
+          {"sweep_step_mm", s.sweep_step_mm},
+          {"sweep_error_um", s.sweep_error_um},
+          {"simulated_postures", s.simulated_postures},
           {"part_lines", s.part_lines},
           {"band_lines", s.band_lines},
           {"gouged_lines", s.gouged_lines},
@@ -129,6 +137,14 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     motion_request.posture_clearance_mm = clearance.clearance_mm;
     const pathgen::MotionResult motions =
         checker.checkMotions(path.postures, motion_request, progress);
+    // Links (the path's `# link` blocks) against the part: rapid moves must not touch it.
+    std::optional<pathgen::LinkPartResult> link_part;
+    if (scene.part && path.count(geometry::PathBlock::Kind::Link) > 0) {
+      const pathgen::ClearanceChecker part(
+          geometry::toolMesh(scene.tool, scene.holder, pathgen::kClearanceMeshTolMm),
+          std::span(&*scene.part, 1), pathgen::kClearanceMeshTolMm);
+      link_part = pathgen::checkLinksAgainstPart(part, path);
+    }
     std::size_t limited_colliding = 0;
     for (std::size_t i : path.limited) limited_colliding += clearance.clearance_mm[i] <= 0.0;
 
@@ -154,6 +170,10 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"links", path.count(geometry::PathBlock::Kind::Link)},
         {"clearance", clearanceJson(clearance, scene.clearance_mm, pathgen::kClearanceMeshTolMm)},
         {"motions", motionsJson(motions, scene.clearance_mm, motion_request.resolution_mm)},
+        {"link_part", linkPartJson(link_part)},
+        {"link_part_skipped",
+         link_part ? json(nullptr) : json("no `part` in the scene, or no `# link` blocks in the path")},
+        {"unsafe", unsafeReasons(clearance, motions, link_part)},
         {"limits",
          {{"limited_postures", path.limited.size()},
           {"limited_colliding", limited_colliding},
@@ -161,6 +181,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"surface", surface ? surfaceJson(*surface) : json(nullptr)},
         {"surface_skipped", surface ? json(nullptr) : json("the scene has no `part`")},
         {"ok", clearance.colliding == 0 && motions.colliding == 0 &&
+                   !(link_part && link_part->collides()) &&
                    clearance.min_clearance_mm >= scene.clearance_mm &&
                    motions.under_required == 0 && (!surface || surface->gouged_lines == 0)},
     };
@@ -186,6 +207,12 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         clearance.colliding ? " (COLLISIONS)" : "", motions.motions, motions.min_clearance_mm,
         index(motions.min_index).c_str(), motions.colliding,
         motions.colliding ? " (COLLISIONS)" : "", motions.under_required, motions.samples);
+    if (link_part)
+      std::printf("links vs part: %zu postures, %zu motions, min >= %.3f mm, %zu colliding "
+                  "postures, %zu colliding motions%s\n",
+                  link_part->postures, link_part->motions, link_part->min_clearance_mm,
+                  link_part->colliding_postures, link_part->colliding_motions,
+                  link_part->collides() ? " (COLLISIONS)" : "");
     if (!path.limited.empty())
       std::printf("limits: %zu postures held at an angle limit, %zu of them colliding\n",
                   path.limited.size(), limited_colliding);

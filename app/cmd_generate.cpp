@@ -8,10 +8,12 @@
 #include <future>
 #include <sstream>
 #include <string>
+#include <string_view>
 
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "errors.h"
 #include "estimates.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/csv.h"
@@ -82,6 +84,10 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
         {"volume_cm3", box.volume() / 1000.0}}},
       {"clearance", clearanceJson(r.clearance, job.clearance_mm, pathgen::kClearanceMeshTolMm)},
       {"motions", motionsJson(r.motions, job.clearance_mm, pathgen::MotionRequest{}.resolution_mm)},
+      {"link_part", linkPartJson(r.link_part)},
+      {"link_part_skipped", r.link_part ? json(nullptr) : json("no `part` in the scene, or no links")},
+      {"safe", unsafeReasons(r.clearance, r.motions, r.link_part).empty()},
+      {"unsafe", unsafeReasons(r.clearance, r.motions, r.link_part)},
       {"links",
        {{"links", r.path.count(geometry::PathBlock::Kind::Link)},
         {"link_postures", r.link_postures},
@@ -179,17 +185,35 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (job.mode == pathgen::FieldMode::Voxel && !job.nominal &&
         (wanted == field::FieldBackend::Auto || wanted == field::FieldBackend::Cuda))
       cuda_start = std::async(std::launch::async, field::cudaFieldBackendAvailable);
-    const pathgen::GenerateResult result = pathgen::generatePath(job);
+    // The job's errors name a scene key or a pass; the scene file says where to look.
+    const pathgen::GenerateResult result = [&] {
+      try {
+        return pathgen::generatePath(job);
+      } catch (const InputError& e) {
+        const std::string file = scene.file.string();
+        if (std::string_view(e.what()).starts_with(file)) throw;
+        throw InputError(file + ": " + e.what());
+      }
+    }();
 
     // Every output is computed; now write them (each atomically).
     const std::filesystem::path out = options->out;
     const std::string what = job.nominal ? "nominal path" : "field path";
+    // A path that collides is still written (to look at, and `check`), marked in both files.
+    const std::vector<std::string> unsafe =
+        unsafeReasons(result.clearance, result.motions, result.link_part);
+    std::string unsafe_text;
+    for (const std::string& reason : unsafe)
+      unsafe_text += (unsafe_text.empty() ? "" : "; ") + reason;
+    if (!unsafe.empty()) unsafe_text = "UNSAFE TO RUN: " + unsafe_text + " (report.json)";
     geometry::writeClFile(out / "path.cl", result.path,
-                          "fieldpath generate " + scene.file.string() + " (" + what +
+                          (unsafe.empty() ? "" : unsafe_text + "\n") + "fieldpath generate " +
+                              scene.file.string() + " (" + what +
                               "): x y z i j k, tool tip and axis, mm\n"
                               "`# pass K` blocks are cut at the feed, `# link` blocks are rapid "
                               "moves between them; `# limit`: an angle limit held there");
     geometry::AptHeader header;
+    for (const std::string& reason : unsafe) header.remarks.push_back("UNSAFE TO RUN: " + reason);
     header.part_name = scene.file.stem().string();
     for (char& c : header.part_name)
       c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
@@ -209,6 +233,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
         result.link_postures, result.max_tilt_deg, result.max_lead_deg, result.limited_postures,
         c.min_clearance_mm, job.clearance_mm, c.colliding, m.colliding, m.motions,
         m.min_clearance_mm, result.times.total_s, out.string().c_str());
+    if (!unsafe.empty()) std::fprintf(stderr, "warning: %s\n", unsafe_text.c_str());
     if (result.voxel_outside_points > 0)
       std::printf(
           "note: %zu node positions fell outside where the voxels answer (the reach box; "

@@ -1,6 +1,10 @@
 #pragma once
 /// The job of a scene, shared by `generate`, `study` and the benchmark (defined in job.cpp), and
 /// the JSON blocks that `generate` and `check` both write.
+#include <optional>
+#include <string>
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "fieldpath/pathgen/generate.h"
@@ -61,6 +65,48 @@ inline nlohmann::json motionsJson(const pathgen::MotionResult& m, double require
           {"samples", m.samples},
           {"ok", m.colliding == 0 && m.under_required == 0 &&
                      !(m.min_clearance_mm < required_mm)}};
+}
+
+/// The `link_part` block of report.json and check.json: the links against the part (null with the
+/// reason when the job has no part or no links).
+inline nlohmann::json linkPartJson(const std::optional<pathgen::LinkPartResult>& l) {
+  if (!l) return nullptr;
+  return {{"link_postures", l->postures},
+          {"link_motions", l->motions},
+          {"colliding_postures", l->colliding_postures},
+          {"first_colliding_posture", jsonIndex(l->first_colliding_posture)},
+          {"colliding_motions", l->colliding_motions},
+          {"first_colliding_motion", jsonIndex(l->first_colliding_motion)},
+          {"min_mm", jsonNumber(l->min_clearance_mm)},
+          {"method",
+           "every link posture and every motion between two link postures against the part mesh "
+           "(as `motions`, required 0: rapid moves must not touch it); the moves into and out "
+           "of a pass, which start where the ball cuts, are left out"},
+          {"ok", !l->collides()}};
+}
+
+/// Why a path is not safe to run as it stands (empty: it is): postures or motions that touch an
+/// obstacle, links that touch the part. Postures 1-based, motion i from posture i to i + 1.
+inline std::vector<std::string> unsafeReasons(const pathgen::ClearanceResult& c,
+                                              const pathgen::MotionResult& m,
+                                              const std::optional<pathgen::LinkPartResult>& l) {
+  std::vector<std::string> out;
+  auto first = [](std::size_t i) { return std::to_string(i + 1); };
+  if (c.colliding)
+    out.push_back(std::to_string(c.colliding) + " postures touch an obstacle (first: posture " +
+                  first(c.first_colliding) + ")");
+  if (m.colliding)
+    out.push_back(std::to_string(m.colliding) + " motions touch an obstacle (first: posture " +
+                  first(m.first_colliding) + " to the next)");
+  if (l && l->colliding_postures)
+    out.push_back(std::to_string(l->colliding_postures) +
+                  " link postures touch the part (first: posture " +
+                  first(l->first_colliding_posture) + ")");
+  if (l && l->colliding_motions)
+    out.push_back(std::to_string(l->colliding_motions) +
+                  " link motions touch the part (first: posture " +
+                  first(l->first_colliding_motion) + " to the next)");
+  return out;
 }
 
 }  // namespace fieldpath::app

@@ -103,6 +103,36 @@ std::vector<char> machinedBand(const zbuffer::Grid& grid, const geometry::PathFi
   return mask;
 }
 
+/// The path's postures with the motions between them swept: where a motion can reach below
+/// `stock_top_mm` (its lower tip less the tool's reach), postures interpolated as `check`'s
+/// motions are (tip and axis linear, the axis renormalised) so that no point of the tool moves
+/// more than `step_mm` between two of them (|Δtip| + reach · Δθ, as the motion bound of
+/// pathgen/clearance.h).
+std::vector<geometry::Posture> sweptPostures(const std::vector<geometry::Posture>& postures,
+                                             double reach_mm, double step_mm, double stock_top_mm) {
+  std::vector<geometry::Posture> out;
+  out.reserve(postures.size());
+  for (std::size_t i = 0; i < postures.size(); ++i) {
+    out.push_back(postures[i]);
+    if (i + 1 == postures.size()) break;
+    const geometry::Posture& a = postures[i];
+    const geometry::Posture& b = postures[i + 1];
+    if (std::min(a.tip_mm.z(), b.tip_mm.z()) - reach_mm > stock_top_mm) continue;  // above it all
+    const double angle = std::acos(std::clamp(a.axis.dot(b.axis), -1.0, 1.0));
+    const double moved_mm = (b.tip_mm - a.tip_mm).norm() + reach_mm * angle;
+    const auto steps = static_cast<std::size_t>(std::ceil(moved_mm / step_mm));
+    for (std::size_t k = 1; k < steps; ++k) {
+      const double t = static_cast<double>(k) / static_cast<double>(steps);
+      geometry::Posture p = a;
+      p.tip_mm = (1 - t) * a.tip_mm + t * b.tip_mm;
+      const Vec3 axis = (1 - t) * a.axis + t * b.axis;
+      p.axis = axis.norm() > 1e-12 ? Vec3(axis.normalized()) : a.axis;
+      out.push_back(p);
+    }
+  }
+  return out;
+}
+
 /// 3 × 5 pixel glyphs for the legend of deviation.png: digits, '-', '.', 'u', 'm'.
 const char* glyph(char c) {
   switch (c) {
@@ -262,8 +292,17 @@ SurfaceResult checkSurface(const SurfaceRequest& request) {
   sim.initial_heights_mm = nominal;
   for (float& h : sim.initial_heights_mm) h = (std::isnan(h) ? top : h) + kStockAllowanceMm;
   sim.progress = request.progress;
-  sim.expected_postures = path.postures.size();
-  const zbuffer::SimulationResult simulated = zbuffer::simulate(sim, toZbuffer(path.postures));
+  // Sweep the motions: a straight move between two cutting postures over a concave part, or a
+  // link that dips into it, cuts between them. Stamps `step` apart leave a ball's cut at most
+  // step² / (8 R) shallower than the swept one: a quarter of the gouge tolerance.
+  const double tol_mm = 1e-3 * request.gouge_tolerance_um;
+  result.sweep_step_mm = std::max(0.5 * spacing, std::sqrt(2.0 * radius * tol_mm));
+  result.sweep_error_um = 1e3 * result.sweep_step_mm * result.sweep_step_mm / (8.0 * radius);
+  const std::vector<geometry::Posture> swept = sweptPostures(
+      path.postures, zbuffer::toolReach(sim.tool), result.sweep_step_mm, top + kStockAllowanceMm);
+  result.simulated_postures = swept.size();
+  sim.expected_postures = swept.size();
+  const zbuffer::SimulationResult simulated = zbuffer::simulate(sim, toZbuffer(swept));
   result.grid = sim.grid;
   result.gouge_tolerance_um = request.gouge_tolerance_um;
   result.backend = simulated.backend;

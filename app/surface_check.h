@@ -1,6 +1,6 @@
 #pragma once
 /// The machined surface of a path against its part (`check`, DESIGN.md): the Z-buffer simulates
-/// the path's postures over the part's region, starting a stock allowance above the part, and
+/// the path's postures and the motions between them over the part's region, starting a stock allowance above the part, and
 /// every line is compared with the part's own height: gouge (below) and scallop (above), µm.
 #include <cstddef>
 #include <filesystem>
@@ -47,6 +47,10 @@ struct SurfaceResult {
   zbuffer::Backend backend = zbuffer::Backend::Cpu;
   double simulation_s = 0;
   bool coarsened = false;  ///< the spacing was widened to stay within kMaxSurfaceLines
+  /// The motions are swept: postures interpolated no farther apart than this (mm) where the tool
+  /// can reach the stock; a ball's cut between two of them is at most sweep_error_um shallower.
+  double sweep_step_mm = 0, sweep_error_um = 0;
+  std::size_t simulated_postures = 0;  ///< the path's and the interpolated ones
 };
 
 /// Simulates and compares. Throws common::InputError for a path whose passes miss the part.

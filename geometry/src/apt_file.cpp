@@ -1,8 +1,11 @@
 /// APT CLDATA as CAM systems write it and post-processors read it: `GOTO / x, y, z, i, j, k`
 /// (spaces allowed, 3 values keep the last axis), `$` at a line's end continues the record, `$$`
-/// starts a comment, `RAPID` makes the next motion a rapid (a link), every other record is read
-/// past.
+/// starts a comment, `RAPID` makes the next motion a rapid (a link), `UNITS/INCHES` scales the
+/// coordinates that follow to mm, `FINI` ends the program (nothing after it is read), every other
+/// record is read past.
 #include <fstream>
+#include <utility>
+#include <vector>
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/geometry/cl_file.h"
@@ -45,7 +48,17 @@ struct AptChunk {
   bool first_without_rapid = false;  ///< its first GOTO had no RAPID before it in this chunk
   bool trailing_rapid = false;       ///< a RAPID after its last GOTO (or anywhere, if none)
   std::size_t inherit_axis = 0;      ///< leading 3-number GOTOs: they keep an earlier chunk's axis
+  /// UNITS records: (first posture after it, mm per file unit), in order.
+  std::vector<std::pair<std::size_t, double>> units;
+  bool fini = false;  ///< FINI seen: the program ends there; later records are not read
 };
+
+/// mm per unit of a UNITS record's value (MM, INCHES), 0 if unknown.
+double unitScale(std::string_view value) {
+  if (value == "MM" || value == "MILLIMETERS" || value == "MILLIMETRES") return 1.0;
+  if (value == "INCHES" || value == "INCH" || value == "IN") return 25.4;
+  return 0.0;
+}
 
 void parseAptChunk(std::string_view text, std::size_t first_line,
                    const std::filesystem::path& file, AptChunk& out) {
@@ -72,6 +85,19 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
         trimmed(std::string_view(statement).substr(0, std::min(slash, statement.size())));
     if (major == "RAPID") {
       rapid = true;
+      continue;
+    }
+    if (major == "FINI") {
+      out.fini = true;
+      break;
+    }
+    if (major == "UNITS") {
+      const std::string_view value =
+          slash == std::string::npos ? std::string_view() : trimmed(std::string_view(statement).substr(slash + 1));
+      const double scale = unitScale(value);
+      if (scale == 0.0)
+        fail(file, record_line, "UNITS/" + std::string(value) + ": unknown unit (MM or INCHES)");
+      out.units.emplace_back(chunk.postures.size(), scale);
       continue;
     }
     if (major != "GOTO" || slash == std::string::npos) continue;
@@ -108,6 +134,8 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
     chunk.postures.push_back(p);
     chunk.lines.push_back(record_line);
   }
+  if (!record.empty())
+    fail(file, record_line, "the record goes on with `$` past the end of the file (truncated?)");
   out.trailing_rapid = rapid;
 }
 
@@ -127,12 +155,28 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
     parseAptChunk(text.substr(c.begin, c.end - c.begin), c.first_line, file, chunks[i]);
   });
   // What crosses chunk boundaries: a RAPID pending, and the axis of 3-number GOTOs.
+  // And the unit: a UNITS record holds until the next; inches are read as mm x 25.4.
   std::vector<std::size_t> link_postures;
-  bool pending = false;
+  bool pending = false, ended = false;
+  double scale = 1.0;
   std::size_t offset = 0;
   const Posture* last = nullptr;
   for (AptChunk& c : chunks) {
     auto& postures = c.postures.postures;
+    if (ended) {  // after FINI
+      postures.clear();
+      c.postures.lines.clear();
+      c.postures.links.clear();
+      continue;
+    }
+    ended = c.fini;
+    std::size_t next_unit = 0;
+    for (std::size_t k = 0; k < postures.size(); ++k) {
+      while (next_unit < c.units.size() && c.units[next_unit].first <= k)
+        scale = c.units[next_unit++].second;
+      postures[k].tip_mm *= scale;
+    }
+    if (next_unit < c.units.size()) scale = c.units.back().second;
     if (postures.empty()) {
       pending = pending || c.trailing_rapid;
       continue;
@@ -169,7 +213,14 @@ void writeAptFile(const std::filesystem::path& file, const PathFile& path,
   // taper angles a, b (0 for these tools), height h.
   const ToolSpec& t = header.tool;
   const double corner_mm = cornerRadius(t);
-  std::string text = "PARTNO/" + header.part_name + "\nUNITS/MM\nMULTAX/ON\nCUTTER/";
+  std::string text = "PARTNO/" + header.part_name + "\n";
+  for (const std::string& remark : header.remarks) {
+    std::string line = upperCase(remark);
+    for (char& c : line)
+      if (c == '\n' || c == '\r' || c == '$') c = ' ';  // one record, no continuation
+    text += "PPRINT/" + line + "\n";
+  }
+  text += "UNITS/MM\nMULTAX/ON\nCUTTER/";
   const double cutter[] = {2 * t.radius_mm, corner_mm, t.radius_mm - corner_mm, corner_mm, 0.0, 0.0,
                            t.length_mm};
   for (double v : cutter) {

@@ -117,6 +117,13 @@ GenerateResult generatePath(const GenerateRequest& request) {
   result.tool_triangles = tool_mesh.triangles.size();
   const ClearanceChecker checker(tool_mesh, obstacles, kClearanceMeshTolMm);
   checkBallClearance(checker, result.passes, r, request.clearance_mm);
+  // The links' travel plane, checked before any work.
+  double safe_z_mm = 0.0;
+  if (!request.passes_only) {
+    std::vector<geometry::TriangleMesh> meshes = obstacles;
+    if (request.part) meshes.push_back(*request.part);
+    safe_z_mm = resolveSafeZ(request.links.safe_z_mm, meshes, request.clearance_mm);
+  }
   std::vector<Vec3> nodes;
   for (const auto& node :
        geometry::surfaceNodes(tool, request.holder, defaultNodeSpacingMm(tool, request.holder)))
@@ -368,13 +375,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
     links.params = request.links;
     links.tool = tool;
     links.holder = request.holder;
-    if (request.links.safe_z_mm) {
-      links.safe_z_mm = *request.links.safe_z_mm;
-    } else {
-      std::vector<geometry::TriangleMesh> meshes = obstacles;
-      if (request.part) meshes.push_back(*request.part);
-      links.safe_z_mm = autoSafeZ(meshes, request.clearance_mm);
-    }
+    links.safe_z_mm = safe_z_mm;
     result.safe_z_mm = links.safe_z_mm;
     result.path = linkPasses(pass_postures, links);
   }
@@ -399,6 +400,10 @@ GenerateResult generatePath(const GenerateRequest& request) {
     motions.posture_clearance_mm = result.clearance.clearance_mm;
     result.motions = checker.checkMotions(result.path.postures, motions,
                                           scaled(request.progress, 0.93, 1.0, "motions"));
+    if (request.part) {
+      const ClearanceChecker part(tool_mesh, std::span(&*request.part, 1), kClearanceMeshTolMm);
+      result.link_part = checkLinksAgainstPart(part, result.path);
+    }
   }
   for (GeneratedPosture& g : result.postures) {
     g.clearance_mm = result.clearance.clearance_mm[g.output];

@@ -63,12 +63,32 @@ double lowestPointBelowTip(const geometry::ToolSpec& tool, const geometry::Holde
   return lowest;
 }
 
-double autoSafeZ(std::span<const geometry::TriangleMesh> meshes, double clearance_mm) {
+double topOfMeshes(std::span<const geometry::TriangleMesh> meshes) {
   double top = -std::numeric_limits<double>::infinity();
   for (const auto& mesh : meshes)
     for (const auto& v : mesh.vertices) top = std::max(top, v.z());
+  return top;
+}
+
+double autoSafeZ(std::span<const geometry::TriangleMesh> meshes, double clearance_mm) {
+  const double top = topOfMeshes(meshes);
   if (!std::isfinite(top)) throw InputError("links.safe_z: auto needs at least one mesh vertex");
   return top + clearance_mm + kSafeZMarginMm;
+}
+
+double resolveSafeZ(std::optional<double> given_mm, std::span<const geometry::TriangleMesh> meshes,
+                    double clearance_mm) {
+  if (!given_mm) return autoSafeZ(meshes, clearance_mm);
+  const double least = topOfMeshes(meshes) + clearance_mm;
+  if (*given_mm < least) {
+    std::ostringstream msg;
+    msg.precision(6);
+    msg << "links.safe_z: " << *given_mm << " mm is below the highest mesh point plus `clearance` ("
+        << least << " mm): the links would travel through the obstacles or the part; give at least "
+        << least << " or `auto`";
+    throw InputError(msg.str());
+  }
+  return *given_mm;
 }
 
 geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,

@@ -171,4 +171,36 @@ TEST(AptFile, ReadsContinuationAndRejectsBadGoto) {
   EXPECT_THROW(readAptFile(writeBytes("b.apt", "GOTO/1,2,3,0,0\n")), InputError);
   EXPECT_THROW(readAptFile(writeBytes("b.apt", "GOTO/1,2,x,0,0,1\n")), InputError);
   EXPECT_THROW(readAptFile(writeBytes("b.apt", "PARTNO/X\nFINI\n")), InputError);
+  // A record still continued at the end of the file: truncated.
+  EXPECT_THROW(readAptFile(writeBytes("b.apt", "GOTO/1,2,3\nGOTO/1,2,$\n")), InputError);
+}
+
+// UNITS scales what follows to mm (inches: 25.4), an unknown unit is refused with its line, FINI
+// ends the program (a post-processor reads nothing after it), PPRINT remarks are read past.
+TEST(AptFile, UnitsFiniAndRemarks) {
+  const auto p = readAptFile(writeBytes(
+      "u.apt",
+      "PARTNO/X\nPPRINT/UNSAFE TO RUN: 1 POSTURE\nUNITS/MM\nGOTO/1,2,3,0,0,1\nUNITS/INCHES\n"
+      "GOTO/1,2,3\nUNITS/MM\nGOTO/4,5,6\nFINI\nGOTO/7,8,9,0,0,1\n"));
+  ASSERT_EQ(p.size(), 3u);
+  EXPECT_EQ(p[0].tip_mm, Vec3(1, 2, 3));
+  EXPECT_EQ(p[1].tip_mm, 25.4 * Vec3(1, 2, 3));
+  EXPECT_EQ(p[1].axis, Vec3::UnitZ());
+  EXPECT_EQ(p[2].tip_mm, Vec3(4, 5, 6));
+  try {
+    readAptFile(writeBytes("f.apt", "GOTO/1,2,3\nUNITS/FEET\nGOTO/1,2,3\n"));
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("f.apt:2: UNITS/FEET"), std::string::npos) << e.what();
+  }
+  // Written remarks come back as PPRINT records, one line each, and read past.
+  AptHeader header;
+  header.remarks = {"unsafe to run: a $ and\na newline"};
+  const fs::path w = tempPath("remarks.apt");
+  writeAptFile(w, p, header);
+  std::ifstream in(w);
+  std::string l1, l2;
+  std::getline(in, l1), std::getline(in, l2);
+  EXPECT_EQ(l2, "PPRINT/UNSAFE TO RUN: A   AND A NEWLINE");
+  EXPECT_EQ(readAptFile(w).size(), 3u);
 }

@@ -176,3 +176,50 @@ TEST(StiffScene, ClampGivesAPathAndACountFailStops) {
   EXPECT_NE(fail.output().find("pass "), std::string::npos) << fail.output();
   EXPECT_FALSE(fs::exists(dir.path() / "fail"));
 }
+
+namespace {
+/// A box [x0, x1] × [y0, y1] × [z0, z1] appended to `mesh` as a closed shell.
+void addBox(geometry::TriangleMesh& mesh, double x0, double x1, double y0, double y1, double z0,
+            double z1) {
+  const int base = static_cast<int>(mesh.vertices.size());
+  for (double x : {x0, x1})
+    for (double y : {y0, y1})
+      for (double z : {z0, z1}) mesh.vertices.emplace_back(x, y, z);
+  const int faces[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                            {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  // (the face lists of the FCL tests wind inward: reversed here, outward as STL wants)
+  for (const auto& f : faces) mesh.triangles.emplace_back(base + f[0], base + f[2], base + f[1]);
+}
+}  // namespace
+
+// `check` cuts along the motions, not only at the postures: two postures on a floor either side
+// of a ridge 1 mm high, each clear of it, and the straight move between them through the ridge.
+// The gouge is the ridge's height (1000 um, less the sweep's bound); the same postures with the
+// move lifted over the ridge (up, across 0.5 mm above it, down) gouge nothing.
+TEST(CheckSurface, TheMotionBetweenTwoPosturesIsCut) {
+  const TempDir dir;
+  geometry::TriangleMesh part, wall;
+  addBox(part, -10, 20, -10, 10, -5, 0);  // the floor, top at z = 0
+  addBox(part, 4, 6, -10, 10, 0, 1);      // the ridge
+  addBox(wall, 60, 70, -10, 10, 0, 5);    // an obstacle far away (a scene needs one)
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  dir.write("scene.yaml", "obstacles:\n  - mesh: wall.stl\npart: part.stl\n"
+                          "tool: { shape: ball, radius: 3, length: 40 }\nclearance: 0.5\n");
+  dir.write("through.cl", "# pass 1\n0 0 0 0 0 1\n10 0 0 0 0 1\n");
+  dir.write("over.cl", "# pass 1\n0 0 0 0 0 1\n0 0 1.5 0 0 1\n10 0 1.5 0 0 1\n10 0 0 0 0 1\n");
+  auto gouge = [&](const std::string& path) {
+    const auto r = test::runFieldpath(dir, "check scene.yaml --path " + path +
+                                               " --spacing 0.1 --out out_" + path);
+    EXPECT_EQ(r.exit_code, 0) << r.output();
+    const auto check = nlohmann::json::parse(test::slurp(dir.path() / ("out_" + path) / "check.json"));
+    return check["surface"];
+  };
+  const auto through = gouge("through.cl");
+  EXPECT_GT(through["max_gouge_um"].get<double>(), 1000.0 - 10.0);
+  EXPECT_LE(through["max_gouge_um"].get<double>(), 1000.0 + 1.0);
+  EXPECT_GT(through["gouged_lines"].get<int>(), 100);
+  EXPECT_GT(through["simulated_postures"].get<int>(), 50);  // 10 mm at <= 0.17 mm
+  const auto over = gouge("over.cl");
+  EXPECT_EQ(over["gouged_lines"].get<int>(), 0);
+}

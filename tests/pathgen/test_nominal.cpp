@@ -11,6 +11,7 @@
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/pathgen/clearance.h"
+#include "fieldpath/pathgen/link_check.h"
 #include "fieldpath/pathgen/links.h"
 #include "fieldpath/pathgen/passes.h"
 #include "run_fieldpath.h"
@@ -300,4 +301,68 @@ TEST(Motions, AThinWallBetweenTwoClearPosturesIsACollidingMotion) {
   EXPECT_EQ(clear.colliding, 0u);
   EXPECT_LE(clear.min_clearance_mm, 2.0 - 0.02 + 1e-9);
   EXPECT_GE(clear.min_clearance_mm, 2.0 - 0.02 - 0.011 - 0.005);
+}
+
+namespace {
+/// A box [x0, x1] × [y0, y1] × [z0, z1] as a closed mesh.
+geometry::TriangleMesh boxMesh(double x0, double x1, double y0, double y1, double z0, double z1) {
+  geometry::TriangleMesh box;
+  for (double x : {x0, x1})
+    for (double y : {y0, y1})
+      for (double z : {z0, z1}) box.vertices.emplace_back(x, y, z);
+  const int faces[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
+                            {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
+  for (const auto& f : faces) box.triangles.emplace_back(f[0], f[1], f[2]);
+  return box;
+}
+}  // namespace
+
+TEST(Links, AGivenSafeZBelowTheMeshesIsRefusedNamingTheKey) {
+  const std::vector<geometry::TriangleMesh> meshes = {boxMesh(0, 10, 0, 10, 0, 5),
+                                                      boxMesh(20, 30, 0, 10, 0, 8)};
+  EXPECT_DOUBLE_EQ(resolveSafeZ(std::nullopt, meshes, 0.5), 8 + 0.5 + kSafeZMarginMm);
+  EXPECT_DOUBLE_EQ(resolveSafeZ(9.0, meshes, 0.5), 9.0);
+  EXPECT_DOUBLE_EQ(resolveSafeZ(8.5, meshes, 0.5), 8.5);  // the top + clearance: allowed
+  try {
+    resolveSafeZ(6.0, meshes, 0.5);  // above the first box, through the second
+    FAIL();
+  } catch (const common::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("links.safe_z"), std::string::npos) << e.what();
+  }
+}
+
+// The links against the part: a link that travels through a block standing on the part is
+// reported (its postures and the motion between them), the ball's contact where a pass starts
+// and ends is not (retract 0: the link's first posture is the pass's last).
+TEST(Links, ALinkThroughThePartIsReportedAndThePassContactIsNot) {
+  const geometry::ToolSpec tool{geometry::ToolShape::Ball, 3.0, 0.0, 20.0};
+  // The part: a floor at z = 0 with a block 4 mm high on it between x = 20 and 24.
+  const std::vector<geometry::TriangleMesh> floor_and_block = {boxMesh(-10, 50, -10, 10, -5, 0),
+                                                               boxMesh(20, 24, -10, 10, 0, 4)};
+  geometry::TriangleMesh part = floor_and_block[0];
+  for (const auto& t : floor_and_block[1].triangles)
+    part.triangles.emplace_back(t.x() + 8, t.y() + 8, t.z() + 8);
+  for (const auto& v : floor_and_block[1].vertices) part.vertices.push_back(v);
+  const ClearanceChecker checker(geometry::toolMesh(tool, {}, 0.02), {&part, 1}, 0.02);
+  auto posture = [](double x, double z) {
+    return Posture{Eigen::Vector3d(x, 0, z), Eigen::Vector3d::UnitZ(), 0.0, false};
+  };
+  geometry::PathFile path;
+  // pass 1 on the floor (tip at z = 0), a link at z = 1 across the block, pass 2 on the floor.
+  path.postures = {posture(0, 0), posture(10, 0), posture(10, 0), posture(10, 1), posture(40, 1),
+                   posture(40, 0), posture(40, 0), posture(45, 0)};
+  path.blocks = {{PathBlock::Kind::Pass, 0, 2}, {PathBlock::Kind::Link, 2, 6},
+                 {PathBlock::Kind::Pass, 6, 8}};
+  LinkPartResult through = checkLinksAgainstPart(checker, path);
+  EXPECT_EQ(through.postures, 2u);  // the two at z = 1; those at the passes' contact left out
+  EXPECT_EQ(through.colliding_postures, 0u);  // 1 mm above the floor, either side of the block
+  EXPECT_EQ(through.colliding_motions, 1u);
+  EXPECT_EQ(through.first_colliding_motion, 3u);
+  EXPECT_TRUE(through.collides());
+  // Over the block (the tool's tip 2 mm above its top) the same link is clear.
+  path.postures[3] = posture(10, 6);
+  path.postures[4] = posture(40, 6);
+  const LinkPartResult over = checkLinksAgainstPart(checker, path);
+  EXPECT_FALSE(over.collides());
+  EXPECT_NEAR(over.min_clearance_mm, 2.0 - 0.02, 0.03);
 }

@@ -117,9 +117,11 @@ struct AptHeader {
   std::string part_name = "FIELDPATH";
   ToolSpec tool;
   double feed_mm_per_min = 1000;
+  /// Operator messages written as `PPRINT/...` records after PARTNO (upper case, one a line).
+  std::vector<std::string> remarks;
 };
 
-/// Writes APT CLDATA atomically: PARTNO, UNITS/MM, MULTAX/ON, CUTTER/d,r,e,f,a,b,h, then per
+/// Writes APT CLDATA atomically: PARTNO, PPRINT remarks, UNITS/MM, MULTAX/ON, CUTTER/d,r,e,f,a,b,h, then per
 /// block `FEDRAT/MMPM,f` before a pass's GOTOs and `RAPID` before each link GOTO, FINI.
 void writeAptFile(const std::filesystem::path& file, const PathFile& path,
                   const AptHeader& header);

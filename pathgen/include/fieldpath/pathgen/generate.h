@@ -18,6 +18,7 @@
 #include "fieldpath/geometry/tool.h"
 #include "fieldpath/pathgen/clearance.h"
 #include "fieldpath/pathgen/impeller.h"
+#include "fieldpath/pathgen/link_check.h"
 #include "fieldpath/pathgen/links.h"
 #include "fieldpath/pathgen/params.h"
 #include "fieldpath/pathgen/passes.h"
@@ -112,6 +113,8 @@ struct GenerateResult {
   geometry::PathFile path;
   ClearanceResult clearance;  ///< of every posture of `path` (links included)
   MotionResult motions;       ///< of every motion of `path`
+  /// The links against the part (when the job has one and links): rapid moves must not touch it.
+  std::optional<LinkPartResult> link_part;
   double safe_z_mm = 0.0;     ///< the links' travel plane
   std::size_t link_postures = 0;
   std::size_t limited_postures = 0;                   ///< where dynamics.on_limit held an angle

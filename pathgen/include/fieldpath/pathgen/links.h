@@ -2,6 +2,7 @@
 /// Links between passes (DESIGN.md "Links and motion"): the output must be safe to run. Each pass
 /// is entered and left along its tool axis; between passes the tool travels in a plane above every
 /// mesh with the axis turned smoothly.
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -24,8 +25,17 @@ inline constexpr double kSafeZMarginMm = 2.0;
 double lowestPointBelowTip(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
                            const Vec3& axis);
 
+/// The highest vertex z of `meshes` (mm); -inf when they have none.
+double topOfMeshes(std::span<const geometry::TriangleMesh> meshes);
+
 /// `safe_z: auto`: the highest vertex of `meshes` + `clearance_mm` + kSafeZMarginMm.
 double autoSafeZ(std::span<const geometry::TriangleMesh> meshes, double clearance_mm);
+
+/// The travel plane of a job's links: `given_mm` when set, which must lie at least `clearance_mm`
+/// above every vertex of `meshes` (below it the links would travel through them: InputError
+/// naming `links.safe_z`), else autoSafeZ.
+double resolveSafeZ(std::optional<double> given_mm, std::span<const geometry::TriangleMesh> meshes,
+                    double clearance_mm);
 
 struct LinkRequest {
   LinkParams params;

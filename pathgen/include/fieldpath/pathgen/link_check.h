@@ -1,0 +1,33 @@
+#pragma once
+/// The links of a path against the machined part (DESIGN.md "Links and motion"): links are rapid
+/// moves, so the tool + holder must not touch the part anywhere on them. The obstacles are checked
+/// for every posture and motion by ClearanceChecker; the part is not an obstacle (the ball cuts
+/// it during a pass), so the links are checked against it here.
+#include <cstddef>
+#include <limits>
+
+#include "fieldpath/geometry/cl_file.h"
+#include "fieldpath/pathgen/clearance.h"
+
+namespace fieldpath::pathgen {
+
+struct LinkPartResult {
+  static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
+  std::size_t postures = 0;  ///< link postures checked
+  std::size_t motions = 0;   ///< motions between two link postures checked
+  std::size_t colliding_postures = 0, colliding_motions = 0;
+  std::size_t first_colliding_posture = npos;  ///< index in the path
+  std::size_t first_colliding_motion = npos;   ///< motion i: posture i → i + 1
+  /// Lower bound of tool + holder ↔ part over the checked postures and motions, mm.
+  double min_clearance_mm = std::numeric_limits<double>::infinity();
+  bool collides() const { return colliding_postures + colliding_motions > 0; }
+};
+
+/// Every posture of the path's link blocks and every motion between two of them, against
+/// `part` (a ClearanceChecker whose only obstacle is the part mesh). The motions from a pass's
+/// last posture into its link and from a link into the next pass's first posture are left out:
+/// they start or end where the ball cuts the part (retracting along the tool axis), and so are
+/// link postures at a pass's first or last posture (links.retract: 0).
+LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const geometry::PathFile& path);
+
+}  // namespace fieldpath::pathgen

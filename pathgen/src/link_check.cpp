@@ -1,0 +1,42 @@
+/// pathgen/link_check.h: the links of a path against the part.
+#include "fieldpath/pathgen/link_check.h"
+
+#include <algorithm>
+#include <span>
+
+namespace fieldpath::pathgen {
+
+LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const geometry::PathFile& path) {
+  LinkPartResult out;
+  const auto& all = path.postures;
+  auto same = [&](std::size_t i, std::size_t j) {
+    return (all[i].tip_mm - all[j].tip_mm).norm() < 1e-9 && (all[i].axis - all[j].axis).norm() < 1e-12;
+  };
+  for (geometry::PathBlock block : path.blocks) {
+    if (block.kind != geometry::PathBlock::Kind::Link) continue;
+    // A link posture where the pass beside it starts or ends (links.retract: 0) is that pass's:
+    // the ball cuts there.
+    if (block.begin > 0 && block.begin < block.end && same(block.begin, block.begin - 1)) ++block.begin;
+    if (block.end < all.size() && block.begin < block.end && same(block.end - 1, block.end)) --block.end;
+    if (block.size() == 0) continue;
+    const std::span<const geometry::Posture> postures(all.data() + block.begin, block.size());
+    const ClearanceResult c = part.check(postures);
+    out.postures += c.postures;
+    out.min_clearance_mm = std::min(out.min_clearance_mm, c.min_clearance_mm);
+    out.colliding_postures += c.colliding;
+    if (c.colliding && out.first_colliding_posture == LinkPartResult::npos)
+      out.first_colliding_posture = block.begin + c.first_colliding;
+    if (block.size() < 2) continue;
+    MotionRequest request;  // touching is what counts here: required 0
+    request.posture_clearance_mm = c.clearance_mm;
+    const MotionResult m = part.checkMotions(postures, request);
+    out.motions += m.motions;
+    out.min_clearance_mm = std::min(out.min_clearance_mm, m.min_clearance_mm);
+    out.colliding_motions += m.colliding;
+    if (m.colliding && out.first_colliding_motion == LinkPartResult::npos)
+      out.first_colliding_motion = block.begin + m.first_colliding;
+  }
+  return out;
+}
+
+}  // namespace fieldpath::pathgen
