@@ -16,9 +16,11 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "json_text.h"
 #include "errors.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/csv.h"
+#include "fieldpath/common/file_digest.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/pathgen/clearance.h"
@@ -124,6 +126,9 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     const Scene scene = loadScene(options->scene);
     const geometry::PathFile path = geometry::readPathFile(options->path);
     const common::Progress progress = makeProgressLine(global.quiet);
+    if (!scene.tool_given)
+      throw InputError(scene.file.string() + ": tool: missing: check needs the cutter (`tool: { "
+                                             "shape: ball, radius: R, length: L }`)");
     if (scene.tool.shape != geometry::ToolShape::Ball)
       throw InputError(scene.file.string() + ": tool.shape: check is for ball-end mills");
 
@@ -165,6 +170,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     const json report = {
         {"scene", scene.file.string()},
         {"path", options->path},
+        {"path_digest", common::fileDigest(options->path)},
         {"postures", path.postures.size()},
         {"passes", path.count(geometry::PathBlock::Kind::Pass)},
         {"links", path.count(geometry::PathBlock::Kind::Link)},
@@ -193,7 +199,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         writeDeviationPng(out / "deviation.png", *surface);
       }
       common::writeTextAtomically(out / "clearance.csv", clearanceCsv(path, clearance, motions));
-      common::writeTextAtomically(out / "check.json", report.dump(2) + "\n");
+      common::writeTextAtomically(out / "check.json", jsonText(report));
     }
     auto index = [](std::size_t i) {
       return i == pathgen::ClearanceResult::npos ? std::string("-") : std::to_string(i + 1);

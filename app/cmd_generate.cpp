@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "json_text.h"
 #include "errors.h"
 #include "estimates.h"
 #include "fieldpath/common/atomic_file.h"
@@ -221,7 +222,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     header.feed_mm_per_min = job.dynamics.feed_mm_per_min;
     geometry::writeAptFile(out / "path.apt", result.path, header);
     common::writeTextAtomically(out / "angles.csv", anglesCsv(result));
-    common::writeTextAtomically(out / "report.json", reportJson(scene, job, result).dump(2) + "\n");
+    common::writeTextAtomically(out / "report.json", jsonText(reportJson(scene, job, result)));
 
     const auto& c = result.clearance;
     const auto& m = result.motions;

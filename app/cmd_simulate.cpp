@@ -21,6 +21,7 @@
 
 #include "cli_parse.h"
 #include "commands.h"
+#include "json_text.h"
 #include "errors.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/limits.h"
@@ -269,7 +270,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
         {"postures_per_second", finiteOrNull(per_s)},
         {"read_megabytes_per_second", finiteOrNull(size_ec || read_s <= 0 ? NAN : path_mb / read_s)},
         {"peak_memory_mib", peakRssMib()}};
-    common::writeTextAtomically(out / "simulate.json", report.dump(2) + "\n");
+    common::writeTextAtomically(out / "simulate.json", jsonText(report));
 
     std::printf("postures        %zu (%zu culled: cannot lower any line)\n", res.postures,
                 res.postures_culled);

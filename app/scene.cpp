@@ -6,6 +6,8 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/geometry/mesh_io.h"
@@ -34,8 +36,14 @@ class Reader {
   void expectMap(const YAML::Node& node, const std::string& key,
                  std::initializer_list<const char*> allowed) const {
     if (!node.IsMap()) fail(node, key, "expected a map of keys");
+    std::vector<std::pair<std::string, int>> seen;  // a key given twice: YAML keeps one silently
     for (const auto& kv : node) {
       const std::string name = kv.first.Scalar();
+      for (const auto& [other, line] : seen)
+        if (other == name)
+          fail(kv.first, join(key, name),
+               "given twice (also on line " + std::to_string(line + 1) + ")");
+      seen.emplace_back(name, kv.first.Mark().line);
       bool known = false;
       for (const char* a : allowed) known = known || name == a;
       if (!known) {
@@ -152,13 +160,13 @@ void readGuide(const Reader& r, const YAML::Node& node, Scene& scene) {
 
 void readTool(const Reader& r, const YAML::Node& node, geometry::ToolSpec& tool) {
   r.expectMap(node, "tool", {"shape", "radius", "corner_radius", "length"});
-  if (node["shape"]) {
-    const std::string shape = r.word(node["shape"], "tool.shape", {"ball", "torus", "flat"});
-    tool.shape = shape == "ball"    ? geometry::ToolShape::Ball
-                 : shape == "torus" ? geometry::ToolShape::Torus
-                                    : geometry::ToolShape::Flat;
-  }
-  if (node["radius"]) tool.radius_mm = r.positive(node["radius"], "tool.radius");
+  if (!node["shape"]) r.fail(node, "tool.shape", "missing (ball, torus or flat)");
+  const std::string shape = r.word(node["shape"], "tool.shape", {"ball", "torus", "flat"});
+  tool.shape = shape == "ball"    ? geometry::ToolShape::Ball
+               : shape == "torus" ? geometry::ToolShape::Torus
+                                  : geometry::ToolShape::Flat;
+  if (!node["radius"]) r.fail(node, "tool.radius", "missing");
+  tool.radius_mm = r.positive(node["radius"], "tool.radius");
   if (node["corner_radius"])
     tool.corner_radius_mm = r.positive(node["corner_radius"], "tool.corner_radius");
   if (node["length"]) tool.length_mm = r.positive(node["length"], "tool.length");
@@ -331,7 +339,10 @@ Scene loadScene(const std::filesystem::path& file) {
     loads.push_back({root["part"], "part", true});
   }
   if (root["guide"]) readGuide(r, root["guide"], scene);
-  if (root["tool"]) readTool(r, root["tool"], scene.tool);
+  if (root["tool"]) {
+    readTool(r, root["tool"], scene.tool);
+    scene.tool_given = true;
+  }
   if (root["holder"]) readHolder(r, root["holder"], scene.holder);
   if (root["clearance"])
     scene.clearance_mm = r.number(

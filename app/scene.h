@@ -40,6 +40,7 @@ struct Scene {
   std::optional<pathgen::Impeller> impeller_model;
 
   geometry::ToolSpec tool;            ///< `tool:`
+  bool tool_given = false;            ///< `tool:` is in the file (generate and check need it)
   geometry::HolderProfile holder;     ///< `holder:` [[z, radius], ...]
   double clearance_mm = 0.5;          ///< `clearance:` tool+holder ↔ obstacles, mm
   field::FieldParams field;           ///< `field:`

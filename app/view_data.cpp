@@ -21,6 +21,7 @@
 #include "fieldpath/pathgen/generate.h"
 #include "job.h"
 #include "scene.h"
+#include "fieldpath/common/file_digest.h"
 #include "surface_check.h"
 #include "to_zbuffer.h"
 
@@ -339,6 +340,12 @@ ViewData gatherView(const ViewRequest& request) {
           !fs::equivalent(check->path, p.file.file, ec))
         throw InputError("--check " + request.check_dir.string() + ": the check of " + check->path +
                          ", not of " + p.what);
+      // The same file, but edited since it was checked: the check says nothing of it now.
+      if (!check->path_digest.empty() && fs::exists(p.file.file) &&
+          common::fileDigest(p.file.file) != check->path_digest)
+        throw InputError("--check " + request.check_dir.string() + ": " + p.what +
+                         " has changed since it was checked (check.json's path_digest differs): "
+                         "run `fieldpath check` on it again");
       readClearanceCsv(request.check_dir / "clearance.csv", n, p.clearance_mm, p.motion_mm);
       p.clearance_source = "check.json of " + request.check_dir.string();
       p.clearance_known = true;

@@ -119,6 +119,8 @@ CheckJson readCheckJson(const fs::path& dir) {
   c.colliding_motions =
       count(motions.value("colliding_motions", json()), file, "motions.colliding_motions");
   if (j.contains("path") && j["path"].is_string()) c.path = j["path"].get<std::string>();
+  if (j.contains("path_digest") && j["path_digest"].is_string())
+    c.path_digest = j["path_digest"].get<std::string>();
   return c;
 }
 

@@ -154,6 +154,12 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
       {"obstacles:\n  - mesh: wall.stl\nlinks: { retract: -1 }\n", "links.retract", 3},
       {"obstacles:\n  - mesh: wall.stl\nlinks: { safe_z: high }\n", "links.safe_z", 3},
       {"obstacles:\n  - mesh: wall.stl\nfield: { r0: [5\n", "YAML syntax", 0},
+      // A key given twice (YAML keeps one of them without a word), at the top and inside.
+      {"obstacles:\n  - mesh: wall.stl\nclearance: 0.5\nclearance: 0.7\n", "clearance", 4},
+      {"obstacles:\n  - mesh: wall.stl\nfield:\n  r0: 5\n  r0: 6\n", "field.r0", 5},
+      // A tool without its shape or radius is not the default tool.
+      {"obstacles:\n  - mesh: wall.stl\ntool: {}\n", "tool.shape", 3},
+      {"obstacles:\n  - mesh: wall.stl\ntool: { shape: ball }\n", "tool.radius", 3},
   };
   for (const Case& c : cases) {
     std::string file;

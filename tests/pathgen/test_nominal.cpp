@@ -162,6 +162,12 @@ TEST(NominalPasses, DegeneratePosturesAreClearErrorsNamingTheLine) {
   EXPECT_EQ(dropped, 1u);
   ASSERT_EQ(passes[0].samples.size(), 3u);
   for (const auto& s : passes[0].samples) EXPECT_TRUE(s.feed.allFinite() && s.normal.allFinite());
+  // An axis flipped on line 3 (0 0 -1 among 0 0 1): named with the turn; 60 deg is a path.
+  const auto flipped = dir.write("flip.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n2 0 0 0 0 -1\n3 0 0 0 0 1\n");
+  const std::string m4 = errorOf([&] { nominalPasses(geometry::readPathFile(flipped), {}, kR); });
+  EXPECT_NE(m4.find("flip.cl:3: the tool axis turns 180 deg"), std::string::npos) << m4;
+  const auto turned = dir.write("turn.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n2 0 0 0 0.866 0.5\n");
+  EXPECT_EQ(nominalPasses(geometry::readPathFile(turned), {}, kR).size(), 1u);
 }
 
 TEST(PathFiles, MarkedClAndNpyReadBackBitForBit) {
