@@ -1,6 +1,7 @@
 #include "scene.h"
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <initializer_list>
 #include <set>
@@ -100,11 +101,18 @@ class Reader {
   /// Loads a mesh, naming the scene's key and line in the error.
   geometry::TriangleMesh mesh(const YAML::Node& node, const std::string& key) const {
     const auto p = path(node, key);
+    geometry::TriangleMesh mesh;
     try {
-      return geometry::loadMesh(p);
+      mesh = geometry::loadMesh(p);
     } catch (const InputError& e) {
       fail(node, key, e.what());
     }
+    // Inward-wound shells would make the field pull into the walls (the samples' normals) and
+    // the part's top its bottom: turned, and said.
+    if (const std::size_t turned = geometry::orientClosedShells(mesh))
+      std::fprintf(stderr, "note: %s: %zu closed shell%s wound inward (normals flipped), turned "
+                           "outward\n", p.string().c_str(), turned, turned == 1 ? "" : "s");
+    return mesh;
   }
 
   /// Runs a module's own validation, naming the key and line in its error.

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <numeric>
 #include <utility>
 
 #include <Eigen/Geometry>
@@ -85,6 +86,56 @@ double meshVolume(const TriangleMesh& mesh) {
   for (const auto& t : mesh.triangles)
     six_volume_mm3 += mesh.vertices[t[0]].dot(mesh.vertices[t[1]].cross(mesh.vertices[t[2]]));
   return six_volume_mm3 / 6.0;
+}
+
+std::size_t orientClosedShells(TriangleMesh& mesh) {
+  const int n = static_cast<int>(mesh.vertices.size());
+  for (const auto& t : mesh.triangles)
+    if (!((t.array() >= 0).all() && (t.array() < n).all())) return 0;  // validateMesh's job
+  // Shells: triangles joined through their vertices (union-find on the vertices).
+  std::vector<int> parent(static_cast<std::size_t>(n));
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto root = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const auto& t : mesh.triangles)
+    for (int e = 1; e < 3; ++e) parent[root(t[e])] = root(t[0]);
+  // Per shell: its triangles' volume, and whether every edge is used once each way.
+  std::map<std::pair<int, int>, int> directed;  // (u, v) → uses
+  for (const auto& t : mesh.triangles)
+    for (int e = 0; e < 3; ++e) ++directed[{t[e], t[(e + 1) % 3]}];
+  std::map<int, double> volume;
+  std::map<int, bool> closed;
+  for (const auto& t : mesh.triangles) {
+    const int shell = root(t[0]);
+    const auto& a = mesh.vertices[t[0]];
+    volume[shell] += a.dot(mesh.vertices[t[1]].cross(mesh.vertices[t[2]])) / 6.0;
+    closed.try_emplace(shell, true);
+    for (int e = 0; e < 3; ++e) {
+      const int u = t[e], v = t[(e + 1) % 3];
+      const auto back = directed.find({v, u});
+      if (u == v || directed[{u, v}] != 1 || back == directed.end() || back->second != 1)
+        closed[shell] = false;
+    }
+  }
+  // A shell inside another one's box may be a cavity, rightly wound inward: left alone.
+  std::map<int, Eigen::AlignedBox3d> box;
+  for (const auto& t : mesh.triangles)
+    for (int e = 0; e < 3; ++e) box[root(t[0])].extend(mesh.vertices[t[e]]);
+  const auto inAnother = [&](int shell) {
+    for (const auto& [other, other_box] : box)
+      if (other != shell && closed[other] && other_box.contains(box[shell])) return true;
+    return false;
+  };
+  std::size_t turned = 0;
+  for (const auto& [shell, is_closed] : closed) {
+    if (!is_closed || !(volume[shell] < 0.0) || inAnother(shell)) continue;
+    ++turned;
+    for (auto& t : mesh.triangles)
+      if (root(t[0]) == shell) std::swap(t[1], t[2]);
+  }
+  return turned;
 }
 
 }  // namespace fieldpath::geometry

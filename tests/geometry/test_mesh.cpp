@@ -84,3 +84,42 @@ TEST(Mesh, ReportsEachDefect) {
     EXPECT_NE(r.summary().find("empty"), std::string::npos);
   }
 }
+
+namespace {
+/// `shell` scaled by s and moved by d, appended to `mesh`.
+void appendShell(TriangleMesh& mesh, const TriangleMesh& shell, double s, const Eigen::Vector3d& d,
+                 bool inward) {
+  const int base = static_cast<int>(mesh.vertices.size());
+  for (const auto& v : shell.vertices) mesh.vertices.push_back(s * v + d);
+  for (auto t : shell.triangles) {
+    if (inward) std::swap(t[1], t[2]);
+    mesh.triangles.push_back(t + Eigen::Vector3i::Constant(base));
+  }
+}
+}  // namespace
+
+// Closed shells wound inward are turned (the enclosed volume comes out positive, shell by
+// shell); a cavity inside another shell keeps its inward winding; an open shell is left alone.
+TEST(Mesh, OrientClosedShellsTurnsInwardShellsOnly) {
+  TriangleMesh two;  // an outward cube and an inward one beside it
+  appendShell(two, unitCube(), 1.0, Eigen::Vector3d(0, 0, 0), false);
+  appendShell(two, unitCube(), 2.0, Eigen::Vector3d(5, 0, 0), true);
+  EXPECT_DOUBLE_EQ(meshVolume(two), 1.0 - 8.0);
+  EXPECT_EQ(orientClosedShells(two), 1u);
+  EXPECT_DOUBLE_EQ(meshVolume(two), 1.0 + 8.0);
+  EXPECT_TRUE(validateMesh(two).closed());
+  EXPECT_EQ(orientClosedShells(two), 0u);  // nothing left to turn
+
+  TriangleMesh hollow;  // a 4 mm cube with a 1 mm cavity: the cavity's inward winding is right
+  appendShell(hollow, unitCube(), 4.0, Eigen::Vector3d(0, 0, 0), false);
+  appendShell(hollow, unitCube(), 1.0, Eigen::Vector3d(1.5, 1.5, 1.5), true);
+  EXPECT_EQ(orientClosedShells(hollow), 0u);
+  EXPECT_DOUBLE_EQ(meshVolume(hollow), 64.0 - 1.0);
+
+  TriangleMesh open = unitCube();  // inward and one face missing: no inside to speak of
+  for (auto& t : open.triangles) std::swap(t[1], t[2]);
+  open.triangles.pop_back();
+  const TriangleMesh before = open;
+  EXPECT_EQ(orientClosedShells(open), 0u);
+  EXPECT_EQ(open.triangles, before.triangles);
+}

@@ -38,4 +38,11 @@ double meshArea(const TriangleMesh& mesh);
 /// mesh.
 double meshVolume(const TriangleMesh& mesh);
 
+/// Turns every closed, consistently wound shell (a connected set of triangles whose every edge is
+/// used twice, once each way) that is wound inward (negative enclosed volume: CAD exports with the
+/// normals flipped) outward, and returns how many it turned. Open or inconsistent shells are left
+/// as they are (their inside is not defined), and so is a shell whose box lies in another closed
+/// shell's box (a cavity is wound inward on purpose).
+std::size_t orientClosedShells(TriangleMesh& mesh);
+
 }  // namespace fieldpath::geometry
