@@ -76,6 +76,7 @@ json surfaceJson(const SurfaceResult& s) {
           {"sweep_step_mm", s.sweep_step_mm},
           {"sweep_error_um", s.sweep_error_um},
           {"simulated_postures", s.simulated_postures},
+          {"cut_lines", s.cut_lines},
           {"part_lines", s.part_lines},
           {"band_lines", s.band_lines},
           {"gouged_lines", s.gouged_lines},
@@ -231,6 +232,10 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
           surface->simulation_s);
     else
       std::printf("surface: not checked (the scene has no `part`)\n");
+    if (surface && surface->cut_lines == 0)
+      std::fprintf(stderr,
+                   "warning: the path never reaches the part (no line of the surface cut): the "
+                   "figures above are the stock's; is the part in the path's frame and units?\n");
   });
 }
 

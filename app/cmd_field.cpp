@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "fieldpath/common/input_file.h"
 #include "errors.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/limits.h"
@@ -25,6 +26,7 @@ using field::Vec3;
 
 /// `x y z` per line; `#` starts a comment; blank lines are skipped.
 std::vector<Vec3> readPoints(const std::string& file) {
+  common::requireRegularFile(file, "points file");
   std::ifstream in(file);
   if (!in) throw InputError(file + ": cannot open points file");
   std::vector<Vec3> points;

@@ -1,6 +1,7 @@
 /// `fieldpath generate SCENE [--direct | --voxel H] [--nominal] --out DIR`: the path of a scene,
 /// passes joined by links (path.cl, path.apt, angles.csv, report.json), written only once the
 /// whole job has succeeded.
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -235,6 +236,13 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
         c.min_clearance_mm, job.clearance_mm, c.colliding, m.colliding, m.motions,
         m.min_clearance_mm, result.times.total_s, out.string().c_str());
     if (!unsafe.empty()) std::fprintf(stderr, "warning: %s\n", unsafe_text.c_str());
+    else if (c.min_clearance_mm < job.clearance_mm || m.under_required > 0)
+      std::fprintf(stderr,
+                   "warning: the path comes closer to the obstacles than `clearance` (%.3f mm): "
+                   "postures min %.3f mm (posture %zu), motions min >= %.3f mm (%zu under it; "
+                   "report.json)\n",
+                   job.clearance_mm, c.min_clearance_mm, c.min_index + 1, m.min_clearance_mm,
+                   m.under_required);
     if (result.voxel_outside_points > 0)
       std::printf(
           "note: %zu node positions fell outside where the voxels answer (the reach box; "

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/input_file.h"
 #include "fieldpath/geometry/mesh_io.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "estimates.h"
@@ -315,11 +316,7 @@ void readLinks(const Reader& r, const YAML::Node& node, pathgen::LinkParams& lin
 }  // namespace
 
 Scene loadScene(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(file, ec))
-    throw InputError(file.string() + ": is a directory, expected a scene file (YAML)");
-  if (!std::filesystem::is_regular_file(file, ec))
-    throw InputError(file.string() + ": no such scene file");
+  common::requireRegularFile(file, "scene file (YAML)");
   YAML::Node root;
   try {
     root = YAML::LoadFile(file.string());

@@ -307,6 +307,7 @@ SurfaceResult checkSurface(const SurfaceRequest& request) {
   result.gouge_tolerance_um = request.gouge_tolerance_um;
   result.backend = simulated.backend;
   result.simulation_s = simulated.seconds;
+  result.cut_lines = simulated.lines_lowered;
   result.in_band = machinedBand(sim.grid, path, radius);
   result.deviation_um.assign(sim.grid.lineCount(), std::numeric_limits<float>::quiet_NaN());
   double sum = 0, sum2 = 0, min_dev = 0, max_dev = 0;

@@ -51,6 +51,7 @@ struct SurfaceResult {
   /// can reach the stock; a ball's cut between two of them is at most sweep_error_um shallower.
   double sweep_step_mm = 0, sweep_error_um = 0;
   std::size_t simulated_postures = 0;  ///< the path's and the interpolated ones
+  std::size_t cut_lines = 0;           ///< lines the tool lowered (0: it never reached the part)
 };
 
 /// Simulates and compares. Throws common::InputError for a path whose passes miss the part.

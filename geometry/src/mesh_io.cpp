@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cctype>
+#include <cstdint>
 #include <cmath>
 #include <exception>
 #include <fstream>
@@ -17,6 +18,7 @@
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/input_file.h"
 #include "fieldpath/common/limits.h"
 
 namespace fieldpath::geometry {
@@ -66,6 +68,32 @@ void fillScene(aiScene& scene, const TriangleMesh& mesh) {
     face.mIndices = new unsigned[3];
     for (int c = 0; c < 3; ++c) face.mIndices[c] = static_cast<unsigned>(mesh.triangles[f][c]);
   }
+}
+
+/// A binary STL's size is fixed by its header: 84 bytes and 50 a triangle. One whose count does
+/// not match (truncated, or a count that lies) is refused saying so, where assimp would only say
+/// it cannot tell ASCII from binary. A file that starts with `solid` and does not match is left
+/// to assimp as ASCII.
+void checkStlSize(const std::filesystem::path& file, std::uintmax_t size) {
+  if (lowerExtension(file) != ".stl") return;
+  std::ifstream in(file, std::ios::binary);
+  unsigned char header[84] = {};
+  in.read(reinterpret_cast<char*>(header), sizeof header);
+  const std::size_t got = static_cast<std::size_t>(in.gcount());
+  std::size_t first = 0;
+  while (first < got && std::isspace(header[first])) ++first;
+  if (got >= first + 5 && std::string(reinterpret_cast<const char*>(header) + first, 5) == "solid")
+    return;  // ASCII (or a binary one whose header starts so: assimp tells them apart)
+  if (got < 84)
+    throw InputError(file.string() + ": binary STL of " + std::to_string(size) +
+                     " bytes, shorter than its 84-byte header (truncated, or not STL)");
+  const std::uint32_t count = std::uint32_t(header[80]) | std::uint32_t(header[81]) << 8 |
+                              std::uint32_t(header[82]) << 16 | std::uint32_t(header[83]) << 24;
+  const std::uintmax_t needed = 84 + 50 * std::uintmax_t(count);
+  if (needed != size)
+    throw InputError(file.string() + ": binary STL: its header says " + std::to_string(count) +
+                     " triangles (" + std::to_string(needed) + " bytes), the file has " +
+                     std::to_string(size) + " bytes (truncated, or not STL)");
 }
 
 /// assimp's PLY loader trusts what a header says and loops forever on some malformed ones (no
@@ -124,8 +152,7 @@ void checkPlyHeader(const std::filesystem::path& file, std::uintmax_t size) {
 
 TriangleMesh loadMesh(const std::filesystem::path& file) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec))
-    throw InputError(file.string() + ": no such file");
+  common::requireRegularFile(file, "mesh file");
   const std::uintmax_t size = std::filesystem::file_size(file, ec);
   if (ec || size == 0) throw InputError(file.string() + ": empty file");
   // assimp's scene, our joined copy and the hash that joins them: about 16 bytes per file byte
@@ -133,6 +160,7 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
   common::requireMemory(file.string(), 16.0 * static_cast<double>(size), "mesh file of " +
                         std::to_string(size >> 20) + " MiB");
   checkPlyHeader(file, size);
+  checkStlSize(file, size);
 
   Assimp::Importer importer;
   const aiScene* scene = nullptr;

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/input_file.h"
 #include "fieldpath/geometry/cl_file.h"
 
 namespace fieldpath::geometry::detail {
@@ -155,9 +156,7 @@ inline void appendNumber(std::string& out, double value) {
 
 /// Throws "FILE: reason" unless `file` is a regular file.
 inline void requireRegularFile(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec))
-    throw common::InputError(file.string() + ": no such file");
+  common::requireRegularFile(file, "path file");
 }
 
 /// Opens a path file for reading: "FILE: no such file" / "FILE: cannot open for reading".

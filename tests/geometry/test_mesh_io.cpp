@@ -136,6 +136,24 @@ TEST(MeshIo, BrokenFilesAreInputErrors) {
   truncated.append(reinterpret_cast<const char*>(&count), 4);
   truncated.append(50 * 3, '\0');
   expectInputErrorNamingFile(writeBytes("truncated.stl", truncated));
+  // ... said as such, with the counts (not "cannot tell ASCII from binary").
+  try {
+    loadMesh(tempPath("truncated.stl"));
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("header says 1000 triangles (50084 bytes), the file has 234"),
+              std::string::npos) << e.what();
+  }
+  // A directory or a device is said to be one, not "no such file".
+  for (const auto& [path, what] : {std::pair<fs::path, std::string>{fs::temp_directory_path(), "is a directory"},
+                                   {"/dev/null", "not a regular file"}}) {
+    try {
+      loadMesh(path);
+      FAIL();
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  }
   // Truncated ASCII STL.
   expectInputErrorNamingFile(writeBytes("cut.stl", std::string(kAsciiTetra).substr(0, 60)));
 }
