@@ -124,7 +124,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
   cmd->callback([options, &global] {
     const zbuffer::Backend backend = zbuffer::backendFromName(options->backend, "--backend");
     if (!options->out.empty()) common::checkOutputDirectory(options->out, "--out");
-    const Scene scene = loadScene(options->scene);
+    const Scene scene = loadScene(options->scene, /*read_nominal=*/false);
     const geometry::PathFile path = geometry::readPathFile(options->path);
     const common::Progress progress = makeProgressLine(global.quiet);
     if (!scene.tool_given)

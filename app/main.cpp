@@ -2,8 +2,10 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <filesystem>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -34,6 +36,25 @@ struct StartupTrace {
     std::fprintf(stderr, "trace: %s %.1f ms after FIELDPATH_T0\n", what, double(ns - t0_ns) / 1e6);
   }
 };
+
+/// An error as one line: control characters (a newline or a NUL in a YAML parser's message, a
+/// file name with a tab) are written as \xNN, so that "one clear line" holds for any input.
+std::string oneLine(const char* what) {
+  std::string out;
+  const char* end = what + std::strlen(what);
+  while (end > what && static_cast<unsigned char>(end[-1]) <= 0x20) --end;  // trailing newlines
+  for (const char* c = what; c < end; ++c) {
+    const auto byte = static_cast<unsigned char>(*c);
+    if (byte < 0x20 || byte == 0x7f) {
+      char hex[5];
+      std::snprintf(hex, sizeof hex, "\\x%02x", byte);
+      out += hex;
+    } else {
+      out += *c;
+    }
+  }
+  return out;
+}
 
 }  // namespace
 
@@ -75,21 +96,21 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
     // A usage error is bad input: one line, exit 1 (CLI11's own report adds a second line).
-    std::fprintf(stderr, "fieldpath: error: %s (see --help)\n", e.what());
+    std::fprintf(stderr, "fieldpath: error: %s (see --help)\n", oneLine(e.what()).c_str());
     return 1;
   } catch (const InputError& e) {
     fieldpath::common::removeWrittenOutputs();  // a failed run leaves no partial set of outputs
-    std::fprintf(stderr, "fieldpath: error: %s\n", e.what());
+    std::fprintf(stderr, "fieldpath: error: %s\n", oneLine(e.what()).c_str());
     return 1;
   } catch (const std::filesystem::filesystem_error& e) {
     // Reading or writing a path the user gave (an --out that is a file, a directory without
     // permission, a full disk): their environment, not our bug.
     fieldpath::common::removeWrittenOutputs();
-    std::fprintf(stderr, "fieldpath: error: %s\n", e.what());
+    std::fprintf(stderr, "fieldpath: error: %s\n", oneLine(e.what()).c_str());
     return 1;
   } catch (const std::exception& e) {
     fieldpath::common::removeWrittenOutputs();
-    std::fprintf(stderr, "fieldpath: internal error: %s\n", e.what());
+    std::fprintf(stderr, "fieldpath: internal error: %s\n", oneLine(e.what()).c_str());
     return 2;
   }
   return 0;

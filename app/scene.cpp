@@ -315,7 +315,7 @@ void readLinks(const Reader& r, const YAML::Node& node, pathgen::LinkParams& lin
 
 }  // namespace
 
-Scene loadScene(const std::filesystem::path& file) {
+Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
   common::requireRegularFile(file, "scene file (YAML)");
   YAML::Node root;
   try {
@@ -364,7 +364,7 @@ Scene loadScene(const std::filesystem::path& file) {
     else
       scene.obstacles.push_back(r.mesh(load.node, load.key));
   }
-  if (root["path"] && root["path"]["nominal"]) {
+  if (read_nominal && root["path"] && root["path"]["nominal"]) {
     const YAML::Node node = root["path"]["nominal"];
     const auto file = r.path(node, "path.nominal");
     try {

@@ -56,7 +56,9 @@ struct Scene {
 /// (key as a dotted path, e.g. `field.r0`, `obstacles[2].mesh`) for a missing or unreadable
 /// file, bad YAML, an unknown key, a value of the wrong type or out of range, or a mesh that
 /// cannot be loaded.
-Scene loadScene(const std::filesystem::path& file);
+/// `read_nominal`: false for the commands given their own path (`check --path`, `view`): the
+/// scene's `path.nominal` is then not read (a stale or broken one does not stop them).
+Scene loadScene(const std::filesystem::path& file, bool read_nominal = true);
 
 /// Turns scene.impeller / scene.guide_impeller into meshes (obstacles, part) and
 /// scene.impeller_model. Lives in scene_impeller.cpp (the impeller's owner replaces it).

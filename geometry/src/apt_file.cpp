@@ -143,7 +143,7 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
 
 PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& options) {
   const MappedFile mapped(file);
-  const std::string_view text = mapped.text();
+  const std::string_view text = withoutBom(mapped.text());
   const std::vector<TextChunk> pieces =
       splitAtLines(text, options.chunk_bytes, options.threads, [](std::string_view line) {
         const std::string_view content = aptContent(line);

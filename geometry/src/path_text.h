@@ -154,6 +154,11 @@ inline void appendNumber(std::string& out, double value) {
   out.append(buffer, result.ptr);
 }
 
+/// The text without a UTF-8 byte-order mark at its start (editors on Windows write one).
+inline std::string_view withoutBom(std::string_view text) {
+  return text.substr(0, 3) == "\xEF\xBB\xBF" ? text.substr(3) : text;
+}
+
 /// Throws "FILE: reason" unless `file` is a regular file.
 inline void requireRegularFile(const std::filesystem::path& file) {
   common::requireRegularFile(file, "path file");

@@ -175,6 +175,14 @@ TEST(AptFile, ReadsContinuationAndRejectsBadGoto) {
   EXPECT_THROW(readAptFile(writeBytes("b.apt", "GOTO/1,2,3\nGOTO/1,2,$\n")), InputError);
 }
 
+// A UTF-8 byte-order mark at the start (Windows editors) is not a number of line 1.
+TEST(ClFile, ByteOrderMarkIsReadPast) {
+  const auto cl = readClFile(writeBytes("bom.cl", "\xEF\xBB\xBF" "0 0 1 0 0 1\n1 0 1 0 0 1\n"));
+  ASSERT_EQ(cl.size(), 2u);
+  EXPECT_EQ(cl[0].tip_mm, Vec3(0, 0, 1));
+  EXPECT_EQ(readAptFile(writeBytes("bom.apt", "\xEF\xBB\xBFGOTO/1,2,3\n")).size(), 1u);
+}
+
 // UNITS scales what follows to mm (inches: 25.4), an unknown unit is refused with its line, FINI
 // ends the program (a post-processor reads nothing after it), PPRINT remarks are read past.
 TEST(AptFile, UnitsFiniAndRemarks) {
