@@ -88,10 +88,10 @@ double meshVolume(const TriangleMesh& mesh) {
   return six_volume_mm3 / 6.0;
 }
 
-std::size_t orientClosedShells(TriangleMesh& mesh) {
+std::vector<std::vector<int>> closedShells(const TriangleMesh& mesh) {
   const int n = static_cast<int>(mesh.vertices.size());
   for (const auto& t : mesh.triangles)
-    if (!((t.array() >= 0).all() && (t.array() < n).all())) return 0;  // validateMesh's job
+    if (!((t.array() >= 0).all() && (t.array() < n).all())) return {};  // validateMesh's job
   // Shells: triangles joined through their vertices (union-find on the vertices).
   std::vector<int> parent(static_cast<std::size_t>(n));
   std::iota(parent.begin(), parent.end(), 0);
@@ -101,16 +101,16 @@ std::size_t orientClosedShells(TriangleMesh& mesh) {
   };
   for (const auto& t : mesh.triangles)
     for (int e = 1; e < 3; ++e) parent[root(t[e])] = root(t[0]);
-  // Per shell: its triangles' volume, and whether every edge is used once each way.
+  // Closed: every edge used once each way.
   std::map<std::pair<int, int>, int> directed;  // (u, v) → uses
   for (const auto& t : mesh.triangles)
     for (int e = 0; e < 3; ++e) ++directed[{t[e], t[(e + 1) % 3]}];
-  std::map<int, double> volume;
+  std::map<int, std::vector<int>> triangles_of;
   std::map<int, bool> closed;
-  for (const auto& t : mesh.triangles) {
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const auto& t = mesh.triangles[i];
     const int shell = root(t[0]);
-    const auto& a = mesh.vertices[t[0]];
-    volume[shell] += a.dot(mesh.vertices[t[1]].cross(mesh.vertices[t[2]])) / 6.0;
+    triangles_of[shell].push_back(static_cast<int>(i));
     closed.try_emplace(shell, true);
     for (int e = 0; e < 3; ++e) {
       const int u = t[e], v = t[(e + 1) % 3];
@@ -119,21 +119,34 @@ std::size_t orientClosedShells(TriangleMesh& mesh) {
         closed[shell] = false;
     }
   }
+  std::vector<std::vector<int>> out;
+  for (auto& [shell, triangles] : triangles_of)
+    if (closed[shell]) out.push_back(std::move(triangles));
+  return out;
+}
+
+std::size_t orientClosedShells(TriangleMesh& mesh) {
+  const std::vector<std::vector<int>> shells = closedShells(mesh);
+  std::vector<double> volume(shells.size(), 0.0);
+  std::vector<Eigen::AlignedBox3d> box(shells.size());
+  for (std::size_t s = 0; s < shells.size(); ++s)
+    for (int i : shells[s]) {
+      const auto& t = mesh.triangles[i];
+      const auto& a = mesh.vertices[t[0]];
+      volume[s] += a.dot(mesh.vertices[t[1]].cross(mesh.vertices[t[2]])) / 6.0;
+      for (int e = 0; e < 3; ++e) box[s].extend(mesh.vertices[t[e]]);
+    }
   // A shell inside another one's box may be a cavity, rightly wound inward: left alone.
-  std::map<int, Eigen::AlignedBox3d> box;
-  for (const auto& t : mesh.triangles)
-    for (int e = 0; e < 3; ++e) box[root(t[0])].extend(mesh.vertices[t[e]]);
-  const auto inAnother = [&](int shell) {
-    for (const auto& [other, other_box] : box)
-      if (other != shell && closed[other] && other_box.contains(box[shell])) return true;
+  const auto inAnother = [&](std::size_t s) {
+    for (std::size_t o = 0; o < shells.size(); ++o)
+      if (o != s && box[o].contains(box[s])) return true;
     return false;
   };
   std::size_t turned = 0;
-  for (const auto& [shell, is_closed] : closed) {
-    if (!is_closed || !(volume[shell] < 0.0) || inAnother(shell)) continue;
+  for (std::size_t s = 0; s < shells.size(); ++s) {
+    if (!(volume[s] < 0.0) || inAnother(s)) continue;
     ++turned;
-    for (auto& t : mesh.triangles)
-      if (root(t[0]) == shell) std::swap(t[1], t[2]);
+    for (int i : shells[s]) std::swap(mesh.triangles[i][1], mesh.triangles[i][2]);
   }
   return turned;
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include <fcl/geometry/bvh/BVH_model.h>
@@ -12,6 +13,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "closed_shells.h"
 #include "fieldpath/common/errors.h"
 
 namespace fieldpath::pathgen {
@@ -40,6 +42,22 @@ struct ClearanceChecker::Impl {
   std::vector<std::shared_ptr<Model>> obstacles;
   double chord_tol_mm = 0.0;
   double reach_mm = 0.0;
+  /// The closed shells of the tool (tool frame) and of each obstacle: a tool wholly inside an
+  /// obstacle, or an obstacle wholly inside the tool, touches no triangle (FCL: clear).
+  std::optional<ClosedShells> tool_solid;
+  std::vector<ClosedShells> obstacle_solids;
+
+  /// Whether the tool placed at `placed` lies inside obstacle i or holds it, given that their
+  /// surfaces do not meet: its tip inside the obstacle, or an obstacle shell's vertex inside it.
+  bool enclosed(const Eigen::Isometry3d& placed, std::size_t i) const {
+    const ClosedShells& solid = obstacle_solids[i];
+    if (!solid.empty() && solid.contains(placed.translation())) return true;
+    if (!tool_solid || tool_solid->empty()) return false;
+    const Eigen::Isometry3d to_tool = placed.inverse();
+    for (const Eigen::Vector3d& anchor : solid.anchors())
+      if (tool_solid->contains(to_tool * anchor)) return true;
+    return false;
+  }
 };
 
 ClearanceChecker::ClearanceChecker(const geometry::TriangleMesh& tool_mesh,
@@ -49,8 +67,11 @@ ClearanceChecker::ClearanceChecker(const geometry::TriangleMesh& tool_mesh,
     throw common::InputError("tool mesh chordal tolerance: must be finite and >= 0");
   auto impl = std::make_shared<Impl>();
   impl->tool = buildModel(tool_mesh, "tool mesh");
-  for (size_t i = 0; i < obstacles.size(); ++i)
+  impl->tool_solid.emplace(tool_mesh);
+  for (size_t i = 0; i < obstacles.size(); ++i) {
     impl->obstacles.push_back(buildModel(obstacles[i], "obstacle " + std::to_string(i + 1)));
+    impl->obstacle_solids.emplace_back(obstacles[i]);
+  }
   impl->chord_tol_mm = tool_chord_tol_mm;
   for (const auto& v : tool_mesh.vertices) impl->reach_mm = std::max(impl->reach_mm, v.norm());
   impl_ = std::move(impl);
@@ -97,6 +118,12 @@ double ClearanceChecker::clearance(const geometry::Posture& posture, int* obstac
   const Eigen::Isometry3d placed = geometry::toolToWorld(posture);
   const double d = nearestObstacle(*impl_->tool, fcl::Transform3d(placed.matrix()),
                                    impl_->obstacles, obstacle);
+  if (d > 0.0)  // no surfaces meet: inside one another is the one way left to collide
+    for (std::size_t i = 0; i < impl_->obstacles.size(); ++i)
+      if (impl_->enclosed(placed, i)) {
+        if (obstacle) *obstacle = static_cast<int>(i);
+        return 0.0;
+      }
   return std::max(0.0, d - impl_->chord_tol_mm);
 }
 
@@ -112,6 +139,11 @@ double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double 
     fcl::Transform3d pose = fcl::Transform3d::Identity();
     pose.translation() = centres_mm[i];
     distance[i] = nearestObstacle(*ball, pose, impl_->obstacles, &nearest[i]);
+    for (std::size_t k = 0; k < impl_->obstacles.size() && distance[i] > 0.0; ++k)
+      if (!impl_->obstacle_solids[k].empty() && impl_->obstacle_solids[k].contains(centres_mm[i])) {
+        distance[i] = 0.0;  // the centre inside an obstacle: the ball is in it
+        nearest[i] = static_cast<int>(k);
+      }
   });
   double best = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < distance.size(); ++i) {

@@ -57,9 +57,13 @@ void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>
     const double d = checker.ballClearance(centres, ball_radius_mm, &at, &obstacle);
     if (d < clearance_mm) {
       std::ostringstream msg;
-      msg << pass.label << ": at s = " << pass.samples[at].s_mm << " mm the ball is " << d
-          << " mm from obstacle " << obstacle + 1 << ", less than `clearance` = " << clearance_mm
-          << " mm: the channel is narrower than the ball there";
+      msg << pass.label << ": at s = " << pass.samples[at].s_mm << " mm the ball ";
+      if (d <= 0.0)
+        msg << "touches or lies inside obstacle " << obstacle + 1
+            << ": the pass runs through it (an obstacle in another frame or units?)";
+      else
+        msg << "is " << d << " mm from obstacle " << obstacle + 1 << ", less than `clearance` = "
+            << clearance_mm << " mm: the channel is narrower than the ball there";
       throw InputError(msg.str());
     }
   }

@@ -372,3 +372,26 @@ TEST(Links, ALinkThroughThePartIsReportedAndThePassContactIsNot) {
   EXPECT_FALSE(over.collides());
   EXPECT_NEAR(over.min_clearance_mm, 2.0 - 0.02, 0.03);
 }
+
+// FCL measures between surfaces: a tool wholly inside a closed obstacle, or an obstacle wholly
+// inside the tool, touches no triangle. Both collide; the same tool beside the box is clear.
+TEST(Clearance, InsideOneAnotherIsColliding) {
+  const geometry::ToolSpec tool{geometry::ToolShape::Ball, 3.0, 0.0, 20.0};
+  const geometry::TriangleMesh tool_mesh = geometry::toolMesh(tool, {{20, 8}, {40, 8}}, 0.02);
+  const std::vector<geometry::TriangleMesh> room = {boxMesh(-50, 50, -50, 50, -50, 100)};
+  const ClearanceChecker in_room(tool_mesh, room, 0.02);
+  const Posture up{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d::UnitZ(), 0.0, false};
+  int obstacle = -1;
+  EXPECT_EQ(in_room.clearance(up, &obstacle), 0.0);
+  EXPECT_EQ(obstacle, 0);
+  EXPECT_EQ(in_room.check(std::vector<Posture>{up}).colliding, 1u);
+  // A 2 mm cube inside the holder (radius 8 from z = 20 to 40 above the tip).
+  const std::vector<geometry::TriangleMesh> pebble = {boxMesh(-1, 1, -1, 1, 29, 31)};
+  const ClearanceChecker held(tool_mesh, pebble, 0.02);
+  EXPECT_EQ(held.clearance(up), 0.0);
+  // Beside the cube, 10 mm off the holder's side: clear by that.
+  const Posture beside{Eigen::Vector3d(19, 0, 0), Eigen::Vector3d::UnitZ(), 0.0, false};
+  EXPECT_NEAR(held.clearance(beside), 19 - 1 - 8 - 0.02, 0.05);
+  // The ball's centre inside the room's walls is inside an obstacle too.
+  EXPECT_EQ(in_room.ballClearance(std::vector<Eigen::Vector3d>{{0, 0, 3}}, 3.0), 0.0);
+}

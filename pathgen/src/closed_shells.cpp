@@ -1,0 +1,86 @@
+#include "closed_shells.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace fieldpath::pathgen {
+namespace {
+
+using Vec2 = Eigen::Vector2d;
+
+double orient(const Vec2& u, const Vec2& v, const Vec2& p) {
+  return (v.x() - u.x()) * (p.y() - u.y()) - (v.y() - u.y()) * (p.x() - u.x());
+}
+
+/// The top-left rule for a counter-clockwise triangle's edge u → v: a point on the edge belongs
+/// to the triangle if the edge is a top or a left one; of the two triangles sharing an edge
+/// (traversed u → v by one, v → u by the other) exactly one owns it.
+bool topLeft(const Vec2& u, const Vec2& v) {
+  return (u.y() == v.y() && v.x() < u.x()) || v.y() < u.y();
+}
+
+bool owns(double w, const Vec2& u, const Vec2& v) { return w > 0.0 || (w == 0.0 && topLeft(u, v)); }
+
+}  // namespace
+
+ClosedShells::ClosedShells(const geometry::TriangleMesh& mesh)
+    : vertices_(mesh.vertices), triangles_(mesh.triangles) {
+  for (const std::vector<int>& shell_triangles : geometry::closedShells(mesh)) {
+    Shell shell;
+    for (int t : shell_triangles)
+      for (int e = 0; e < 3; ++e) shell.box.extend(vertices_[triangles_[t][e]]);
+    // About 4 triangles a cell, at most 256 × 256 cells.
+    const int n = std::clamp(static_cast<int>(std::sqrt(shell_triangles.size() / 4.0)), 1, 256);
+    shell.nx = shell.ny = n;
+    shell.cell_x = std::max(shell.box.sizes().x() / n, 1e-9);
+    shell.cell_y = std::max(shell.box.sizes().y() / n, 1e-9);
+    shell.cells.resize(static_cast<std::size_t>(n) * n);
+    auto cellX = [&](double x) {
+      return std::clamp(static_cast<int>((x - shell.box.min().x()) / shell.cell_x), 0, n - 1);
+    };
+    auto cellY = [&](double y) {
+      return std::clamp(static_cast<int>((y - shell.box.min().y()) / shell.cell_y), 0, n - 1);
+    };
+    for (int t : shell_triangles) {
+      Eigen::AlignedBox3d tb;
+      for (int e = 0; e < 3; ++e) tb.extend(vertices_[triangles_[t][e]]);
+      for (int ix = cellX(tb.min().x()); ix <= cellX(tb.max().x()); ++ix)
+        for (int iy = cellY(tb.min().y()); iy <= cellY(tb.max().y()); ++iy)
+          shell.cells[static_cast<std::size_t>(ix) * n + iy].push_back(t);
+    }
+    anchors_.push_back(vertices_[triangles_[shell_triangles.front()][0]]);
+    shells_.push_back(std::move(shell));
+  }
+}
+
+bool ClosedShells::contains(const Eigen::Vector3d& p) const {
+  const Vec2 q(p.x(), p.y());
+  for (const Shell& shell : shells_) {
+    if (!shell.box.contains(p)) continue;
+    const int ix = std::clamp(static_cast<int>((p.x() - shell.box.min().x()) / shell.cell_x), 0,
+                              shell.nx - 1);
+    const int iy = std::clamp(static_cast<int>((p.y() - shell.box.min().y()) / shell.cell_y), 0,
+                              shell.ny - 1);
+    int crossings = 0;
+    for (int t : shell.cells[static_cast<std::size_t>(ix) * shell.ny + iy]) {
+      Eigen::Vector3d a = vertices_[triangles_[t][0]], b = vertices_[triangles_[t][1]],
+                      c = vertices_[triangles_[t][2]];
+      Vec2 a2(a.x(), a.y()), b2(b.x(), b.y()), c2(c.x(), c.y());
+      const double area = orient(a2, b2, c2);
+      if (area == 0.0) continue;  // seen edge-on: the ray grazes it
+      if (area < 0.0) {           // counter-clockwise in projection
+        std::swap(b, c);
+        std::swap(b2, c2);
+      }
+      const double wa = orient(b2, c2, q), wb = orient(c2, a2, q), wc = orient(a2, b2, q);
+      if (!owns(wa, b2, c2) || !owns(wb, c2, a2) || !owns(wc, a2, b2)) continue;
+      const double z = (wa * a.z() + wb * b.z() + wc * c.z()) / (wa + wb + wc);
+      crossings += z > p.z();
+    }
+    if (crossings % 2 == 1) return true;
+  }
+  return false;
+}
+
+}  // namespace fieldpath::pathgen
