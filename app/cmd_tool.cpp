@@ -33,7 +33,8 @@ void addToolCommand(CLI::App& app, const GlobalOptions& /*global*/) {
     const geometry::HolderProfile holder = geometry::parseHolderProfile(options->holder);
     if (!(options->tol_mm > 0) || !(options->tol_mm < tool.radius_mm))
       throw InputError("--tol " + std::to_string(options->tol_mm) +
-                       ": chordal tolerance must be in (0, R) mm");
+                       ": chordal tolerance must be in (0, R) mm, R = " +
+                       std::to_string(tool.radius_mm) + " mm (the tool's radius)");
     const geometry::TriangleMesh mesh = geometry::toolMesh(tool, holder, options->tol_mm);
     geometry::saveMesh(mesh, options->out);
     const geometry::MeshReport report = geometry::validateMesh(mesh);

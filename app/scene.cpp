@@ -151,7 +151,16 @@ void readObstacles(const Reader& r, const YAML::Node& node, Scene& scene,
     r.expectMap(item, key, {"mesh", "impeller"});
     if (item.size() != 1) r.fail(item, key, "expected exactly one of mesh, impeller");
     if (item["mesh"]) {
-      scene.obstacle_files.push_back(r.path(item["mesh"], key + ".mesh"));
+      const auto file = r.path(item["mesh"], key + ".mesh");
+      // The same surfaces twice would repel twice as hard (the field is a sum over samples).
+      std::error_code ec;
+      for (std::size_t j = 0; j < scene.obstacle_files.size(); ++j)
+        if (scene.obstacle_files[j] == file ||
+            std::filesystem::equivalent(scene.obstacle_files[j], file, ec))
+          r.fail(item["mesh"], key + ".mesh",
+                 "the same file as an obstacle before it (" + scene.obstacle_files[j].string() +
+                     "): its field would count twice");
+      scene.obstacle_files.push_back(file);
       loads.push_back({item["mesh"], key + ".mesh", false});
     } else {
       if (scene.impeller) r.fail(item, key + ".impeller", "the impeller is given twice");

@@ -109,19 +109,23 @@ NpyRows checkedRows(const std::filesystem::path& file, std::string_view bytes) {
     item = 4;
   else
     bad(file, "npy dtype '" + *descr + "': expected float32 or float64, little-endian (<f4, <f8)");
-  if (*fortran != "False") bad(file, "npy array in Fortran order: expected C order");
+  if (*fortran == "True") bad(file, "npy array in Fortran order: expected C order");
+  if (*fortran != "False")
+    bad(file, "npy fortran_order '" + *fortran + "': expected False (or True, refused)");
   const std::vector<std::uint64_t> shape = parseShape(file, *shape_text);
   if (shape.size() != 2 || (shape[1] != 6 && shape[1] != 7))
     bad(file, "npy shape (" + *shape_text + "): expected N×6 (x y z i j k) or N×7 (+ spindle)");
   const std::uint64_t rows = shape[0], columns = shape[1];
   if (rows == 0) bad(file, "no postures (shape (0, " + std::to_string(columns) + "))");
   const std::uint64_t data_size = file_size - offset - header_size;
-  if (rows > data_size / (columns * item) || rows * columns * item != data_size)
+  if (rows > data_size / (columns * item))  // also where rows × columns × item overflows
+    bad(file, "npy data is " + std::to_string(data_size) + " bytes, shape (" +
+                  std::to_string(rows) + ", " + std::to_string(columns) +
+                  ") needs more (truncated file, or a shape that lies)");
+  if (rows * columns * item != data_size)
     bad(file, "npy data is " + std::to_string(data_size) + " bytes, shape (" +
                   std::to_string(rows) + ", " + std::to_string(columns) + ") needs " +
-                  std::to_string(rows * columns * item) + (rows * columns * item > data_size
-                                                               ? " (truncated file)"
-                                                               : " (trailing bytes)"));
+                  std::to_string(rows * columns * item) + " (trailing bytes)");
   return {bytes.data() + offset + header_size, rows, columns, item};
 }
 

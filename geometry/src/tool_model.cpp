@@ -277,6 +277,9 @@ std::string shortNumber(double value) {
 void validateToolSpec(const ToolSpec& tool) {
   if (!std::isfinite(tool.radius_mm) || !(tool.radius_mm > 0))
     throw InputError("tool radius must be > 0");
+  if (tool.radius_mm < 1e-3)  // below this the meshes and tolerances are rounding noise
+    throw InputError("tool radius " + shortNumber(tool.radius_mm) +
+                     " mm is below 0.001 mm (no cutter is that small)");
   for (const double v : {tool.radius_mm, tool.length_mm, tool.corner_radius_mm})
     if (std::abs(v) > kMaxToolSizeMm)
       throw InputError("tool size " + shortNumber(v) + " mm is beyond " +
@@ -285,7 +288,9 @@ void validateToolSpec(const ToolSpec& tool) {
       !(tool.corner_radius_mm > 0 && tool.corner_radius_mm <= tool.radius_mm))
     throw InputError("corner radius must be in (0, R]");
   const double end_mm = cornerRadius(tool);
-  if (!std::isfinite(tool.length_mm) || !(tool.length_mm >= end_mm) || !(tool.length_mm > 0))
+  if (!std::isfinite(tool.length_mm) || !(tool.length_mm > 0))
+    throw InputError("tool length must be > 0 mm");
+  if (!(tool.length_mm >= end_mm))
     throw InputError("tool length must cover the cutting end (>= " + shortNumber(end_mm) + " mm)");
 }
 

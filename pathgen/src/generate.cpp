@@ -59,8 +59,9 @@ void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>
       std::ostringstream msg;
       msg << pass.label << ": at s = " << pass.samples[at].s_mm << " mm the ball ";
       if (d <= 0.0)
-        msg << "touches or lies inside obstacle " << obstacle + 1
-            << ": the pass runs through it (an obstacle in another frame or units?)";
+        msg << "touches or enters obstacle " << obstacle + 1
+            << ": the channel is narrower than the ball there, or the pass runs through the "
+               "obstacle (in another frame or units?)";
       else
         msg << "is " << d << " mm from obstacle " << obstacle + 1 << ", less than `clearance` = "
             << clearance_mm << " mm: the channel is narrower than the ball there";

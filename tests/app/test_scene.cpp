@@ -160,6 +160,8 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
       // A tool without its shape or radius is not the default tool.
       {"obstacles:\n  - mesh: wall.stl\ntool: {}\n", "tool.shape", 3},
       {"obstacles:\n  - mesh: wall.stl\ntool: { shape: ball }\n", "tool.radius", 3},
+      // The same mesh twice would repel twice.
+      {"obstacles:\n  - mesh: wall.stl\n  - mesh: ./wall.stl\n", "obstacles[2].mesh", 3},
   };
   for (const Case& c : cases) {
     std::string file;

@@ -186,6 +186,10 @@ TEST(View, BadInputIsExitOneWithOneLineOrAPageThatSaysWhatIsMissing) {
   dir.write("far.cl", pathCl(1e4));
   dir.write("short.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
   ASSERT_EQ(runFieldpath(dir, "check scene.yaml --path short.cl --out chk_short").exit_code, 0);
+  // The same file, edited after its check (same name, same posture count): the check is stale.
+  dir.write("edited.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
+  ASSERT_EQ(runFieldpath(dir, "check scene.yaml --path edited.cl --out chk_edited").exit_code, 0);
+  dir.write("edited.cl", "0 0 0 0 0 1\n1 0 -5 0 0 1\n");
   fs::create_directories(dir.path() / "empty");
   struct Case {
     std::string args, message;
@@ -197,6 +201,7 @@ TEST(View, BadInputIsExitOneWithOneLineOrAPageThatSaysWhatIsMissing) {
       {"--path path.cl --check nowhere", "--check nowhere: no such folder"},
       {"--path path.cl --check empty", "no check.json"},
       {"--path path.cl --check chk_short", "a check of 2 postures"},
+      {"--path edited.cl --check chk_edited", "has changed since it was checked"},
       {"--path missing.cl", "missing.cl"},
   };
   for (const Case& c : cases) {
