@@ -3,6 +3,7 @@
 /// starts a comment, `RAPID` makes the next motion a rapid (a link), `UNITS/INCHES` scales the
 /// coordinates that follow to mm, `FINI` ends the program (nothing after it is read), every other
 /// record is read past.
+#include <exception>
 #include <fstream>
 #include <utility>
 #include <vector>
@@ -150,9 +151,15 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
         return !content.empty() && content.back() == '$';
       });
   std::vector<AptChunk> chunks(pieces.size());
+  // A chunk's error counts only if no FINI comes before it: kept, and thrown in file order below.
+  std::vector<std::exception_ptr> errors(pieces.size());
   forEachChunk(pieces.size(), options.threads, [&](std::size_t i) {
     const TextChunk& c = pieces[i];
-    parseAptChunk(text.substr(c.begin, c.end - c.begin), c.first_line, file, chunks[i]);
+    try {
+      parseAptChunk(text.substr(c.begin, c.end - c.begin), c.first_line, file, chunks[i]);
+    } catch (const InputError&) {
+      errors[i] = std::current_exception();
+    }
   });
   // What crosses chunk boundaries: a RAPID pending, and the axis of 3-number GOTOs.
   // And the unit: a UNITS record holds until the next; inches are read as mm x 25.4.
@@ -161,8 +168,10 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   double scale = 1.0;
   std::size_t offset = 0;
   const Posture* last = nullptr;
-  for (AptChunk& c : chunks) {
+  for (std::size_t i = 0; i < chunks.size(); ++i) {
+    AptChunk& c = chunks[i];
     auto& postures = c.postures.postures;
+    if (!ended && errors[i]) std::rethrow_exception(errors[i]);
     if (ended) {  // after FINI
       postures.clear();
       c.postures.lines.clear();

@@ -213,3 +213,16 @@ TEST(PathRead, ScanGivesTheCompactPosturesOfReadPathFile) {
     EXPECT_EQ(std::string(e.what()), errorOf(bad, 8, 1));
   }
 }
+
+// fuzz_apt crash-4361ce6d: a record a later chunk cannot read, after FINI, failed the chunked
+// read and not the whole one. Nothing after FINI is read, whatever the chunks.
+TEST(PathRead, AptAfterFiniIsNotReadWhateverTheChunks) {
+  const fs::path file = fs::temp_directory_path() / "fieldpath_fini_chunks.apt";
+  std::ofstream(file) << "GOTO/1,2,3,0,0,1\nFINI\nGOTO/1,2,x\nUNITS/FEET\nGOTO/4,5,$\n";
+  for (const std::size_t chunk_bytes : {std::size_t{1} << 20, std::size_t{8}, std::size_t{1}})
+    for (const unsigned threads : {1u, 2u}) {
+      EXPECT_EQ(errorOf(file, chunk_bytes, threads), "no error") << chunk_bytes << " " << threads;
+      EXPECT_EQ(read(file, chunk_bytes, threads).postures.size(), 1u);
+    }
+  fs::remove(file);
+}
