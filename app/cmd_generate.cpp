@@ -55,6 +55,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
                       {"colliding_postures", colliding}});
   }
   const auto& box = r.reach_box_mm;
+  const std::vector<std::string> unsafe = unsafeReasons(r.clearance, r.motions, r.link_part);
   return {
       {"scene", scene.file.string()},
       {"field_mode", job.nominal ? "nominal" : pathgen::fieldModeNames(job.mode).id},
@@ -88,8 +89,8 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"motions", motionsJson(r.motions, job.clearance_mm, pathgen::MotionRequest{}.resolution_mm)},
       {"link_part", linkPartJson(r.link_part)},
       {"link_part_skipped", r.link_part ? json(nullptr) : json("no `part` in the scene, or no links")},
-      {"safe", unsafeReasons(r.clearance, r.motions, r.link_part).empty()},
-      {"unsafe", unsafeReasons(r.clearance, r.motions, r.link_part)},
+      {"safe", unsafe.empty()},
+      {"unsafe", unsafe},
       {"links",
        {{"links", r.path.count(geometry::PathBlock::Kind::Link)},
         {"link_postures", r.link_postures},

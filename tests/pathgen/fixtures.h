@@ -1,5 +1,6 @@
 #pragma once
 /// Shared test scenes for pathgen.
+#include "fieldpath/geometry/mesh.h"
 #include "fieldpath/pathgen/impeller.h"
 
 namespace fieldpath::pathgen::test {
@@ -14,6 +15,26 @@ inline ImpellerParams flatChannel() {
   p.lean_left_deg = {0, 0};
   p.lean_right_deg = {0, 0};
   return p;
+}
+
+/// The box [x0, x1] × [y0, y1] × [z0, z1] appended to `mesh` as a closed shell, wound outward.
+inline void addBox(geometry::TriangleMesh& mesh, double x0, double x1, double y0, double y1,
+                   double z0, double z1) {
+  const int base = static_cast<int>(mesh.vertices.size());
+  for (double x : {x0, x1})
+    for (double y : {y0, y1})
+      for (double z : {z0, z1}) mesh.vertices.emplace_back(x, y, z);
+  const int faces[12][3] = {{0, 3, 2}, {0, 1, 3}, {4, 7, 5}, {4, 6, 7}, {0, 5, 1}, {0, 4, 5},
+                            {2, 7, 6}, {2, 3, 7}, {0, 6, 4}, {0, 2, 6}, {1, 7, 3}, {1, 5, 7}};
+  for (const auto& f : faces) mesh.triangles.emplace_back(base + f[0], base + f[1], base + f[2]);
+}
+
+/// The box alone.
+inline geometry::TriangleMesh boxMesh(double x0, double x1, double y0, double y1, double z0,
+                                      double z1) {
+  geometry::TriangleMesh box;
+  addBox(box, x0, x1, y0, y1, z0, z1);
+  return box;
 }
 
 }  // namespace fieldpath::pathgen::test

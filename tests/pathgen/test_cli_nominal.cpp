@@ -14,6 +14,7 @@
 #include "fieldpath/geometry/mesh_io.h"
 #include "fieldpath/pathgen/generate.h"
 #include "fieldpath/pathgen/impeller.h"
+#include "fixtures.h"
 #include "run_fieldpath.h"
 
 namespace fs = std::filesystem;
@@ -177,20 +178,6 @@ TEST(StiffScene, ClampGivesAPathAndACountFailStops) {
   EXPECT_FALSE(fs::exists(dir.path() / "fail"));
 }
 
-namespace {
-/// A box [x0, x1] × [y0, y1] × [z0, z1] appended to `mesh` as a closed shell.
-void addBox(geometry::TriangleMesh& mesh, double x0, double x1, double y0, double y1, double z0,
-            double z1) {
-  const int base = static_cast<int>(mesh.vertices.size());
-  for (double x : {x0, x1})
-    for (double y : {y0, y1})
-      for (double z : {z0, z1}) mesh.vertices.emplace_back(x, y, z);
-  const int faces[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
-                            {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
-  // (the face lists of the FCL tests wind inward: reversed here, outward as STL wants)
-  for (const auto& f : faces) mesh.triangles.emplace_back(base + f[0], base + f[2], base + f[1]);
-}
-}  // namespace
 
 // `check` cuts along the motions, not only at the postures: two postures on a floor either side
 // of a ridge 1 mm high, each clear of it, and the straight move between them through the ridge.
@@ -199,9 +186,9 @@ void addBox(geometry::TriangleMesh& mesh, double x0, double x1, double y0, doubl
 TEST(CheckSurface, TheMotionBetweenTwoPosturesIsCut) {
   const TempDir dir;
   geometry::TriangleMesh part, wall;
-  addBox(part, -10, 20, -10, 10, -5, 0);  // the floor, top at z = 0
-  addBox(part, 4, 6, -10, 10, 0, 1);      // the ridge
-  addBox(wall, 60, 70, -10, 10, 0, 5);    // an obstacle far away (a scene needs one)
+  pathgen::test::addBox(part, -10, 20, -10, 10, -5, 0);  // the floor, top at z = 0
+  pathgen::test::addBox(part, 4, 6, -10, 10, 0, 1);      // the ridge
+  pathgen::test::addBox(wall, 60, 70, -10, 10, 0, 5);    // an obstacle far away (a scene needs one)
   geometry::saveMesh(part, dir.path() / "part.stl");
   geometry::saveMesh(wall, dir.path() / "wall.stl");
   dir.write("scene.yaml", "obstacles:\n  - mesh: wall.stl\npart: part.stl\n"

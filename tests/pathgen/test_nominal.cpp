@@ -14,6 +14,7 @@
 #include "fieldpath/pathgen/link_check.h"
 #include "fieldpath/pathgen/links.h"
 #include "fieldpath/pathgen/passes.h"
+#include "fixtures.h"
 #include "run_fieldpath.h"
 
 using namespace fieldpath;
@@ -21,7 +22,8 @@ using namespace fieldpath::pathgen;
 using geometry::PathBlock;
 using geometry::PathFile;
 using geometry::Posture;
-using test::TempDir;
+using pathgen::test::boxMesh;
+using fieldpath::test::TempDir;
 
 namespace {
 
@@ -202,14 +204,14 @@ TEST(PathFiles, MarkedClAndNpyReadBackBitForBit) {
   }
   // Written again, the .cl file is the same text.
   geometry::writeClFile(dir.path() / "m2.cl", back, "a test\nof markers");
-  EXPECT_EQ(test::slurp(dir.path() / "m.cl"), test::slurp(dir.path() / "m2.cl"));
+  EXPECT_EQ(fieldpath::test::slurp(dir.path() / "m.cl"), fieldpath::test::slurp(dir.path() / "m2.cl"));
 }
 
 TEST(PathFiles, BadNpyFilesAreOneLineErrors) {
   TempDir dir;
   std::vector<Posture> postures(3);
   geometry::writeNpyFile(dir.path() / "good.npy", postures);
-  const std::string good = test::slurp(dir.path() / "good.npy");
+  const std::string good = fieldpath::test::slurp(dir.path() / "good.npy");
   auto variant = [&](const std::string& name, std::string bytes) {
     const auto file = dir.path() / name;
     std::ofstream(file, std::ios::binary) << bytes;
@@ -309,19 +311,6 @@ TEST(Motions, AThinWallBetweenTwoClearPosturesIsACollidingMotion) {
   EXPECT_GE(clear.min_clearance_mm, 2.0 - 0.02 - 0.011 - 0.005);
 }
 
-namespace {
-/// A box [x0, x1] × [y0, y1] × [z0, z1] as a closed mesh.
-geometry::TriangleMesh boxMesh(double x0, double x1, double y0, double y1, double z0, double z1) {
-  geometry::TriangleMesh box;
-  for (double x : {x0, x1})
-    for (double y : {y0, y1})
-      for (double z : {z0, z1}) box.vertices.emplace_back(x, y, z);
-  const int faces[12][3] = {{0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}, {0, 1, 5}, {0, 5, 4},
-                            {2, 6, 7}, {2, 7, 3}, {0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}};
-  for (const auto& f : faces) box.triangles.emplace_back(f[0], f[1], f[2]);
-  return box;
-}
-}  // namespace
 
 TEST(Links, AGivenSafeZBelowTheMeshesIsRefusedNamingTheKey) {
   const std::vector<geometry::TriangleMesh> meshes = {boxMesh(0, 10, 0, 10, 0, 5),
@@ -343,12 +332,9 @@ TEST(Links, AGivenSafeZBelowTheMeshesIsRefusedNamingTheKey) {
 TEST(Links, ALinkThroughThePartIsReportedAndThePassContactIsNot) {
   const geometry::ToolSpec tool{geometry::ToolShape::Ball, 3.0, 0.0, 20.0};
   // The part: a floor at z = 0 with a block 4 mm high on it between x = 20 and 24.
-  const std::vector<geometry::TriangleMesh> floor_and_block = {boxMesh(-10, 50, -10, 10, -5, 0),
-                                                               boxMesh(20, 24, -10, 10, 0, 4)};
-  geometry::TriangleMesh part = floor_and_block[0];
-  for (const auto& t : floor_and_block[1].triangles)
-    part.triangles.emplace_back(t.x() + 8, t.y() + 8, t.z() + 8);
-  for (const auto& v : floor_and_block[1].vertices) part.vertices.push_back(v);
+  geometry::TriangleMesh part;
+  pathgen::test::addBox(part, -10, 50, -10, 10, -5, 0);
+  pathgen::test::addBox(part, 20, 24, -10, 10, 0, 4);
   const ClearanceChecker checker(geometry::toolMesh(tool, {}, 0.02), {&part, 1}, 0.02);
   auto posture = [](double x, double z) {
     return Posture{Eigen::Vector3d(x, 0, z), Eigen::Vector3d::UnitZ(), 0.0, false};
