@@ -134,9 +134,10 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       throw InputError(scene.file.string() + ": tool.shape: check is for ball-end mills");
 
     // (a) exact clearance of postures and motions
-    const pathgen::ClearanceChecker checker(
-        geometry::toolMesh(scene.tool, scene.holder, pathgen::kClearanceMeshTolMm),
-        scene.obstacles, pathgen::kClearanceMeshTolMm);
+    const geometry::TriangleMesh tool_mesh =
+        geometry::toolMesh(scene.tool, scene.holder, pathgen::kClearanceMeshTolMm);
+    const pathgen::ClearanceChecker checker(tool_mesh, scene.obstacles,
+                                            pathgen::kClearanceMeshTolMm);
     const pathgen::ClearanceResult clearance = checker.check(path.postures, {}, progress);
     pathgen::MotionRequest motion_request;
     motion_request.required_mm = scene.clearance_mm;
@@ -146,9 +147,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     // Links (the path's `# link` blocks) against the part: rapid moves must not touch it.
     std::optional<pathgen::LinkPartResult> link_part;
     if (scene.part && path.count(geometry::PathBlock::Kind::Link) > 0) {
-      const pathgen::ClearanceChecker part(
-          geometry::toolMesh(scene.tool, scene.holder, pathgen::kClearanceMeshTolMm),
-          std::span(&*scene.part, 1), pathgen::kClearanceMeshTolMm);
+      const pathgen::ClearanceChecker part(tool_mesh, std::span(&*scene.part, 1),
+                                           pathgen::kClearanceMeshTolMm);
       link_part = pathgen::checkLinksAgainstPart(part, path);
     }
     std::size_t limited_colliding = 0;

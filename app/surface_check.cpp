@@ -104,10 +104,9 @@ std::vector<char> machinedBand(const zbuffer::Grid& grid, const geometry::PathFi
 }
 
 /// The path's postures with the motions between them swept: where a motion can reach below
-/// `stock_top_mm` (its lower tip less the tool's reach), postures interpolated as `check`'s
-/// motions are (tip and axis linear, the axis renormalised) so that no point of the tool moves
-/// more than `step_mm` between two of them (|Δtip| + reach · Δθ, as the motion bound of
-/// pathgen/clearance.h).
+/// `stock_top_mm` (its lower tip less the tool's reach), postures along it as `check`'s motions
+/// are (geometry::alongMotion) so that no point of the tool moves more than `step_mm` between two
+/// of them (geometry::motionSweepMm).
 std::vector<geometry::Posture> sweptPostures(const std::vector<geometry::Posture>& postures,
                                              double reach_mm, double step_mm, double stock_top_mm) {
   std::vector<geometry::Posture> out;
@@ -118,15 +117,11 @@ std::vector<geometry::Posture> sweptPostures(const std::vector<geometry::Posture
     const geometry::Posture& a = postures[i];
     const geometry::Posture& b = postures[i + 1];
     if (std::min(a.tip_mm.z(), b.tip_mm.z()) - reach_mm > stock_top_mm) continue;  // above it all
-    const double angle = std::acos(std::clamp(a.axis.dot(b.axis), -1.0, 1.0));
-    const double moved_mm = (b.tip_mm - a.tip_mm).norm() + reach_mm * angle;
+    const double moved_mm = geometry::motionSweepMm(a, b, reach_mm);
     const auto steps = static_cast<std::size_t>(std::ceil(moved_mm / step_mm));
     for (std::size_t k = 1; k < steps; ++k) {
-      const double t = static_cast<double>(k) / static_cast<double>(steps);
-      geometry::Posture p = a;
-      p.tip_mm = (1 - t) * a.tip_mm + t * b.tip_mm;
-      const Vec3 axis = (1 - t) * a.axis + t * b.axis;
-      p.axis = axis.norm() > 1e-12 ? Vec3(axis.normalized()) : a.axis;
+      const geometry::Posture p =
+          geometry::alongMotion(a, b, static_cast<double>(k) / static_cast<double>(steps));
       out.push_back(p);
     }
   }

@@ -41,4 +41,13 @@ Posture postureFromTransform(const Eigen::Isometry3d& tool_to_world) {
   return p;
 }
 
+Posture alongMotion(const Posture& a, const Posture& b, double t) {
+  Posture p;
+  p.tip_mm = (1 - t) * a.tip_mm + t * b.tip_mm;
+  Vec3 axis = (1 - t) * a.axis + t * b.axis;
+  if (axis.norm() < 1e-9) axis = a.axis.unitOrthogonal();
+  p.axis = axis.normalized();
+  return p;
+}
+
 }  // namespace fieldpath::geometry

@@ -190,24 +190,6 @@ ClearanceResult ClearanceChecker::check(std::span<const geometry::Posture> postu
 }  // namespace fieldpath::pathgen
 
 namespace fieldpath::pathgen {
-namespace {
-
-/// The pose at fraction t of the motion a → b: tip linear, axis linear and renormalised (for
-/// opposite axes, turned through the plane of the first axis and any perpendicular).
-geometry::Posture interpolate(const geometry::Posture& a, const geometry::Posture& b, double t) {
-  geometry::Posture p;
-  p.tip_mm = (1 - t) * a.tip_mm + t * b.tip_mm;
-  Vec3 axis = (1 - t) * a.axis + t * b.axis;
-  if (axis.norm() < 1e-9) axis = a.axis.unitOrthogonal();
-  p.axis = axis.normalized();
-  return p;
-}
-
-double angleBetween(const Vec3& a, const Vec3& b) {
-  return std::atan2(a.cross(b).norm(), a.dot(b));
-}
-
-}  // namespace
 
 MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> postures,
                                             const MotionRequest& request,
@@ -233,8 +215,7 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
     while (!stack.empty()) {
       const Piece piece = stack.back();
       stack.pop_back();
-      const double reach_mm = (piece.p1.tip_mm - piece.p0.tip_mm).norm() +
-                              reach * angleBetween(piece.p0.axis, piece.p1.axis);
+      const double reach_mm = geometry::motionSweepMm(piece.p0, piece.p1, reach);
       const double certain =
           std::min({piece.d0, piece.d1, 0.5 * (piece.d0 + piece.d1 - reach_mm)});
       if (certain >= stop_mm || reach_mm <= 2 * resolution) {
@@ -242,7 +223,7 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
         continue;
       }
       const double tm = 0.5 * (piece.t0 + piece.t1);
-      const geometry::Posture pm = interpolate(a, b, tm);
+      const geometry::Posture pm = geometry::alongMotion(a, b, tm);
       const double raw = nearestObstacle(
           *impl_->tool, fcl::Transform3d(geometry::toolToWorld(pm).matrix()), impl_->obstacles,
           nullptr);

@@ -125,9 +125,9 @@ GenerateResult generatePath(const GenerateRequest& request) {
   // The links' travel plane, checked before any work.
   double safe_z_mm = 0.0;
   if (!request.passes_only) {
-    std::vector<geometry::TriangleMesh> meshes = obstacles;
-    if (request.part) meshes.push_back(*request.part);
-    safe_z_mm = resolveSafeZ(request.links.safe_z_mm, meshes, request.clearance_mm);
+    double top_mm = topOfMeshes(obstacles);
+    if (request.part) top_mm = std::max(top_mm, topOfMeshes(std::span(&*request.part, 1)));
+    safe_z_mm = resolveSafeZ(request.links.safe_z_mm, top_mm, request.clearance_mm);
   }
   std::vector<Vec3> nodes;
   for (const auto& node :

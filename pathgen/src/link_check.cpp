@@ -9,9 +9,7 @@ namespace fieldpath::pathgen {
 LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const geometry::PathFile& path) {
   LinkPartResult out;
   const auto& all = path.postures;
-  auto same = [&](std::size_t i, std::size_t j) {
-    return (all[i].tip_mm - all[j].tip_mm).norm() < 1e-9 && (all[i].axis - all[j].axis).norm() < 1e-12;
-  };
+  auto same = [&](std::size_t i, std::size_t j) { return geometry::samePose(all[i], all[j]); };
   for (geometry::PathBlock block : path.blocks) {
     if (block.kind != geometry::PathBlock::Kind::Link) continue;
     // A link posture where the pass beside it starts or ends (links.retract: 0) is that pass's:

@@ -70,16 +70,10 @@ double topOfMeshes(std::span<const geometry::TriangleMesh> meshes) {
   return top;
 }
 
-double autoSafeZ(std::span<const geometry::TriangleMesh> meshes, double clearance_mm) {
-  const double top = topOfMeshes(meshes);
-  if (!std::isfinite(top)) throw InputError("links.safe_z: auto needs at least one mesh vertex");
-  return top + clearance_mm + kSafeZMarginMm;
-}
-
-double resolveSafeZ(std::optional<double> given_mm, std::span<const geometry::TriangleMesh> meshes,
-                    double clearance_mm) {
-  if (!given_mm) return autoSafeZ(meshes, clearance_mm);
-  const double least = topOfMeshes(meshes) + clearance_mm;
+double resolveSafeZ(std::optional<double> given_mm, double top_mm, double clearance_mm) {
+  if (!std::isfinite(top_mm)) throw InputError("links.safe_z: needs at least one mesh vertex");
+  if (!given_mm) return top_mm + clearance_mm + kSafeZMarginMm;
+  const double least = top_mm + clearance_mm;
   if (*given_mm < least) {
     std::ostringstream msg;
     msg.precision(6);
@@ -100,8 +94,7 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
   geometry::PathFile out;
   auto add = [&](PathBlock::Kind kind, const Posture& p) {
     if (kind == PathBlock::Kind::Link && !out.postures.empty() &&
-        (out.postures.back().tip_mm - p.tip_mm).norm() < 1e-9 &&
-        (out.postures.back().axis - p.axis).norm() < 1e-12)
+        geometry::samePose(out.postures.back(), p))
       return;  // e.g. the travel plane reached by the retract itself
     if (out.blocks.empty() || out.blocks.back().kind != kind)
       out.blocks.push_back({kind, out.postures.size(), out.postures.size()});

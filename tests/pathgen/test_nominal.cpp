@@ -315,11 +315,13 @@ TEST(Motions, AThinWallBetweenTwoClearPosturesIsACollidingMotion) {
 TEST(Links, AGivenSafeZBelowTheMeshesIsRefusedNamingTheKey) {
   const std::vector<geometry::TriangleMesh> meshes = {boxMesh(0, 10, 0, 10, 0, 5),
                                                       boxMesh(20, 30, 0, 10, 0, 8)};
-  EXPECT_DOUBLE_EQ(resolveSafeZ(std::nullopt, meshes, 0.5), 8 + 0.5 + kSafeZMarginMm);
-  EXPECT_DOUBLE_EQ(resolveSafeZ(9.0, meshes, 0.5), 9.0);
-  EXPECT_DOUBLE_EQ(resolveSafeZ(8.5, meshes, 0.5), 8.5);  // the top + clearance: allowed
+  const double top = topOfMeshes(meshes);
+  EXPECT_DOUBLE_EQ(top, 8.0);
+  EXPECT_DOUBLE_EQ(resolveSafeZ(std::nullopt, top, 0.5), 8 + 0.5 + kSafeZMarginMm);
+  EXPECT_DOUBLE_EQ(resolveSafeZ(9.0, top, 0.5), 9.0);
+  EXPECT_DOUBLE_EQ(resolveSafeZ(8.5, top, 0.5), 8.5);  // the top + clearance: allowed
   try {
-    resolveSafeZ(6.0, meshes, 0.5);  // above the first box, through the second
+    resolveSafeZ(6.0, top, 0.5);  // above the first box, through the second
     FAIL();
   } catch (const common::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("links.safe_z"), std::string::npos) << e.what();

@@ -2,6 +2,8 @@
 /// Postures (DESIGN.md "Conventions of data"): tool tip p and unit axis a from the tip to the
 /// spindle, and the rigid transform that places a tool-frame object (tip at origin, axis +z) at a
 /// posture.
+#include <cmath>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -42,5 +44,24 @@ Eigen::Isometry3d toolToWorld(const Posture& posture);
 
 /// Inverse of toolToWorld for a rigid transform (spindle angle is not recovered).
 Posture postureFromTransform(const Eigen::Isometry3d& tool_to_world);
+
+/// The pose at fraction t of the motion a → b as every check reads it (DESIGN.md "Links and
+/// motion"): tip linear, axis linear and renormalised (for opposite axes, turned through the
+/// plane of the first axis and any perpendicular).
+Posture alongMotion(const Posture& a, const Posture& b, double t);
+
+/// The angle between two axes (rad), exact for small and near-opposite ones.
+inline double axisAngle(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
+
+/// How far (mm) any point within `reach_mm` of the tip moves at most along the motion a → b:
+/// |Δtip| + reach · Δθ.
+inline double motionSweepMm(const Posture& a, const Posture& b, double reach_mm) {
+  return (b.tip_mm - a.tip_mm).norm() + reach_mm * axisAngle(a.axis, b.axis);
+}
+
+/// The same pose: tips within 1e-9 mm, axes within 1e-12 (a posture written twice).
+inline bool samePose(const Posture& a, const Posture& b) {
+  return (a.tip_mm - b.tip_mm).norm() < 1e-9 && (a.axis - b.axis).norm() < 1e-12;
+}
 
 }  // namespace fieldpath::geometry

@@ -28,14 +28,11 @@ double lowestPointBelowTip(const geometry::ToolSpec& tool, const geometry::Holde
 /// The highest vertex z of `meshes` (mm); -inf when they have none.
 double topOfMeshes(std::span<const geometry::TriangleMesh> meshes);
 
-/// `safe_z: auto`: the highest vertex of `meshes` + `clearance_mm` + kSafeZMarginMm.
-double autoSafeZ(std::span<const geometry::TriangleMesh> meshes, double clearance_mm);
-
-/// The travel plane of a job's links: `given_mm` when set, which must lie at least `clearance_mm`
-/// above every vertex of `meshes` (below it the links would travel through them: InputError
-/// naming `links.safe_z`), else autoSafeZ.
-double resolveSafeZ(std::optional<double> given_mm, std::span<const geometry::TriangleMesh> meshes,
-                    double clearance_mm);
+/// The travel plane of a job's links, `top_mm` the highest vertex of its meshes (topOfMeshes):
+/// `given_mm` when set, which must lie at least `clearance_mm` above it (below, the links would
+/// travel through the meshes: InputError naming `links.safe_z`); else (`safe_z: auto`)
+/// top + clearance + kSafeZMarginMm.
+double resolveSafeZ(std::optional<double> given_mm, double top_mm, double clearance_mm);
 
 struct LinkRequest {
   LinkParams params;
