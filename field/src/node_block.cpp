@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
+#include <string>
 
 #include "node_lanes.h"
 
@@ -63,73 +65,29 @@ SampleTable::SampleTable(const ObstacleSamples& samples, double r0_mm) {
 
 namespace {
 
-using lanes::accumulateLanes;
 using lanes::kLanes;
-using lanes::mergeNearest;
 
-/// A leaf's neighbourhood: the samples gathered in [box_lo, box_hi] (mm) for sums whose ball
-/// lies inside that box, the cell list for the others (points lifted far off the leaf).
-struct BlockHood {
-  const Law* law;
-  SampleSpan block;  ///< the leaf's samples: every one in [box_lo, box_hi]
-  double box_lo[3], box_hi[3];
-  SampleSpan row;    ///< the row's: every one within row_reach of the row's segment
-  double row_x = 0, row_y = 0, row_z0 = 0, row_z1 = 0, row_reach = -1;
-  const kernel::CellTable* cells;
+/// A node's neighbourhood in the staged build (buildLeafNodes): its sums answered in the order
+/// kernel::nodeValue asks for them; the first one not answered yet is recorded and every later
+/// one left empty (that run's value is thrown away, the node run again once it is answered).
+/// nodeValue asks each sum with a fresh Accum (zero sum, best_sq its search radius²), as the
+/// answers were started.
+struct ReplayHood {
+  const Accum* answers;
+  int answered;
+  SumRequest* request;
   const ObstacleSamples* samples;
-  /// The row's nodes' first sums when made together (rowFirstSums512; null otherwise): a sum
-  /// with tracking at node k's point (first_z[k]) over first_radius is first[k].
-  const Accum* first = nullptr;
-  double first_z[kLanes] = {};
-  double first_radius = -1;
+  int asked = 0;
+  bool missing = false;
 
-  /// Gathers the columns' spans, summed together in the lanes (in batches of kSpans).
-  struct Visit {
-    static constexpr int kSpans = 64;
-    const Law* law;
-    D3 at;
-    bool track;
-    Accum* a;
-    SampleSpan spans[kSpans];
-    int n = 0;
-    void operator()(const SampleSpan& s) {
-      spans[n++] = s;
-      if (n == kSpans) flush();
-    }
-    void flush() {
-      if (n) accumulateLanes(*law, spans, n, at, track, *a);
-      n = 0;
-    }
-  };
   void sum(D3 c, double radius, bool track, Accum& a) {
-    if (first && track && radius == first_radius && c.x == row_x && c.y == row_y)
-      for (int k = 0; k < kLanes; ++k)
-        if (c.z == first_z[k]) {
-          a.fx += first[k].fx;
-          a.fy += first[k].fy;
-          a.fz += first[k].fz;
-          const std::int64_t id = first[k].best_id, at = first[k].best_at;
-          mergeNearest(&first[k].best_sq, &id, &at, a, 1);
-          return;
-        }
-    // Distance from c to the row's segment (x, y, [z0, z1]).
-    const double dz = c.z < row_z0 ? row_z0 - c.z : c.z > row_z1 ? c.z - row_z1 : 0.0;
-    const double dx = c.x - row_x, dy = c.y - row_y;
-    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
-    if (d + radius <= row_reach) {
-      accumulateLanes(*law, row, c, track, a);
+    if (missing) return;
+    if (asked < answered) {
+      a = answers[asked++];
       return;
     }
-    const bool inside = c.x - radius >= box_lo[0] && c.y - radius >= box_lo[1] &&
-                        c.z - radius >= box_lo[2] && c.x + radius <= box_hi[0] &&
-                        c.y + radius <= box_hi[1] && c.z + radius <= box_hi[2];
-    if (inside) {
-      accumulateLanes(*law, block, c, track, a);
-      return;
-    }
-    Visit v{law, c, track, &a, {}, 0};
-    kernel::cellSpans(*cells, c, radius, v);
-    v.flush();
+    *request = SumRequest{{c.x, c.y, c.z}, radius, a.best_sq, track, -1};
+    missing = true;
   }
   D3 point(const Accum& a) const {
     const Vec3& p = samples->points_mm[std::size_t(a.best_id)];
@@ -140,6 +98,84 @@ struct BlockHood {
     return {n.x(), n.y(), n.z()};
   }
 };
+
+/// Copies the samples of the spans it is given that lie in [lo, hi] (mm) to `set`.
+struct GatherBox {
+  SampleSet* set;
+  const double *lo, *hi;
+  void operator()(const SampleSpan& span) {
+    set->reserveFor(std::size_t(set->count + span.count));
+    int& n = set->count;
+    for (int j = 0; j < span.count; ++j) {
+      const double px = span.x[j], py = span.y[j], pz = span.z[j];
+      if (px < lo[0] || py < lo[1] || pz < lo[2] || px > hi[0] || py > hi[1] || pz > hi[2])
+        continue;
+      set->x[n] = px;
+      set->y[n] = py;
+      set->z[n] = pz;
+      set->nx[n] = span.nx[j];
+      set->ny[n] = span.ny[j];
+      set->nz[n] = span.nz[j];
+      set->w[n] = span.w[j];
+      set->id[n] = span.id[j];
+      ++n;
+    }
+  }
+};
+
+/// The samples of the cell list in [lo, hi] (mm) copied to `set` (its count reset).
+void gatherBox(const kernel::CellTable& cells, const double* lo, const double* hi, SampleSet& set) {
+  set.count = 0;
+  GatherBox gather{&set, lo, hi};
+  const D3 centre{0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
+  // The box's half diagonal covers it (a superset; the gather filters by the box).
+  const double half = 0.5 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) +
+                                      (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                      (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  kernel::cellSpans(cells, centre, half, gather);
+}
+
+/// The sums of up to 8 requests together (SumRequest order, the points in the lanes): the
+/// samples of `from` within r0 of the points' bounding box, and the ring out to the largest
+/// radius, gathered (`from` holds every sample within that reach of the points); each answer
+/// appended to its node's.
+void answerBatch(const Law& law, const SampleSpan& from, const SumRequest* r, int n,
+                 BlockScratch& scratch) {
+  alignas(64) double px[kLanes], py[kLanes], pz[kLanes], init_sq[kLanes];
+  lanes::Box box{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
+  double reach = 0.0;
+  for (int l = 0; l < kLanes; ++l) {
+    const SumRequest& q = r[std::min(l, n - 1)];  // the last one again in the lanes past n
+    px[l] = q.at[0];
+    py[l] = q.at[1];
+    pz[l] = q.at[2];
+    init_sq[l] = q.track ? q.best_sq : 0.0;
+    for (int a = 0; a < 3; ++a) {
+      box.lo[a] = std::min(box.lo[a], q.at[a]);
+      box.hi[a] = std::max(box.hi[a], q.at[a]);
+    }
+    reach = std::max(reach, q.reach());
+  }
+  const double core_sq = law.r0_sq * (1.0 + 1e-12);
+  const double reach_sq = reach * reach * (1.0 + 1e-12);
+  scratch.core.reserveFor(std::size_t(from.count));
+  scratch.ring.reserveFor(std::size_t(from.count));
+  scratch.ring.count = 0;
+  lanes::gather(from, box, core_sq, reach_sq, scratch.core,
+                reach_sq > core_sq ? &scratch.ring : nullptr);
+  Accum out[kLanes];
+  lanes::laneSums(law, from, scratch.core, scratch.ring, px, py, pz, init_sq, out);
+  for (int l = 0; l < n; ++l) {
+    Accum a = out[l];
+    if (!r[l].track) {  // as an untracked sum leaves it
+      a.best_sq = r[l].best_sq;
+      a.best_id = -1;
+      a.best_at = -1;
+    }
+    const int node = r[l].node;
+    scratch.answers[std::size_t(node) * kMaxNodeSums + scratch.answered[node]++] = a;
+  }
+}
 
 }  // namespace
 
@@ -157,89 +193,105 @@ kernel::CellTable cellTableOf(const SampleTable& t) {
 }
 
 void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, const NodeJob& job,
-                    const LeafTask& leaf, BlockScratch& scratch, kernel::NodeValue* out) {
+                    const LeafTask& task, BlockScratch& scratch, kernel::NodeValue* out) {
   const double h = job.h_mm;
   const double reach = std::max(job.rules.reach_mm, job.law.r0);
-  BlockHood hood;
-  hood.law = &job.law;
-  hood.samples = &samples;
-  for (int a = 0; a < 3; ++a) {
-    hood.box_lo[a] = leaf.origin[a] * h - reach;
-    hood.box_hi[a] = (leaf.origin[a] + 7) * h + reach;
-  }
   const kernel::CellTable cells = cellTableOf(table);
-  hood.cells = &cells;
-  // Gather the samples of the box once, in SoA form.
+  double box_lo[3], box_hi[3];  // the leaf's nodes' reach
+  for (int a = 0; a < 3; ++a) {
+    box_lo[a] = task.origin[a] * h - reach;
+    box_hi[a] = (task.origin[a] + 7) * h + reach;
+  }
   SampleSet& block = scratch.block;
-  block.count = 0;
-  const D3 centre{0.5 * (hood.box_lo[0] + hood.box_hi[0]), 0.5 * (hood.box_lo[1] + hood.box_hi[1]),
-                  0.5 * (hood.box_lo[2] + hood.box_hi[2])};
-  struct Gather {
-    SampleSet* s;
-    const double *lo, *hi;
-    void operator()(const SampleSpan& span) {
-      s->reserveFor(std::size_t(s->count + span.count));
-      int& n = s->count;
-      for (int j = 0; j < span.count; ++j) {
-        const double px = span.x[j], py = span.y[j], pz = span.z[j];
-        if (px < lo[0] || py < lo[1] || pz < lo[2] || px > hi[0] || py > hi[1] || pz > hi[2])
-          continue;
-        s->x[n] = px;
-        s->y[n] = py;
-        s->z[n] = pz;
-        s->nx[n] = span.nx[j];
-        s->ny[n] = span.ny[j];
-        s->nz[n] = span.nz[j];
-        s->w[n] = span.w[j];
-        s->id[n] = span.id[j];
-        ++n;
-      }
-    }
-  } gather{&block, hood.box_lo, hood.box_hi};
-  // The box's half diagonal covers it (a superset; the gather filters by the box).
-  const double half = std::sqrt(3.0) * 0.5 * (hood.box_hi[0] - hood.box_lo[0]);
-  kernel::cellSpans(cells, centre, half, gather);
-  hood.block = block.span();
-  for (SampleSet* set : {&scratch.row, &scratch.ring})
-    set->reserveFor(std::size_t(block.count));
+  gatherBox(cells, box_lo, box_hi, block);
+  const SampleSpan block_span = block.span();
+  scratch.core.reserveFor(std::size_t(block.count));
+  scratch.ring.reserveFor(std::size_t(block.count));
+  scratch.answers.resize(512 * kMaxNodeSums);
   const double row_reach = reach * (1.0 + 1e-12);
   const double reach_sq = row_reach * row_reach;
-  hood.row_reach = reach;
   const double core_sq = job.law.r0_sq * (1.0 + 1e-12);
   // probe()'s first sum: radius max(reach, r0), the nearest tracked from its square.
   double first_sq = kernel::dmax(job.rules.reach_mm, job.law.r0);
   first_sq *= first_sq;
-  hood.first_radius = std::sqrt(first_sq);
-  for (int k = 0; k < kLanes; ++k) hood.first_z[k] = (leaf.origin[2] + k) * h;
-  const double z0 = leaf.origin[2] * h, z1 = (leaf.origin[2] + 7) * h;
-  Accum first[kLanes];
-  // Row by row (8 nodes along z): the leaf's samples within reach of the row's segment.
+  alignas(64) double row_x[kLanes], row_y[kLanes], node_z[kLanes], init_sq[kLanes];
+  for (int k = 0; k < kLanes; ++k) {
+    node_z[k] = (task.origin[2] + k) * h;
+    init_sq[k] = first_sq;
+  }
+  const double z0 = node_z[0], z1 = node_z[kLanes - 1];
+  std::vector<int>& pending = scratch.pending;
+  pending.clear();
+  // Row by row (8 nodes along z): the first sums over the leaf's samples within reach of the
+  // row's segment, those within r0 (the core: every term) apart from the rest (the ring: only a
+  // shell node's nearest), gathered in one pass.
   for (int row = 0; row < 64; ++row) {
     const int i = row >> 3, j = row & 7;
-    const std::uint64_t bits8 = (leaf.mask[i] >> (j * 8)) & 0xffu;
+    const std::uint64_t bits8 = (task.mask[i] >> (j * 8)) & 0xffu;
     if (!bits8) continue;
-    hood.row_x = (leaf.origin[0] + i) * h;
-    hood.row_y = (leaf.origin[1] + j) * h;
-    hood.row_z0 = z0;
-    hood.row_z1 = z1;
-    // The samples within r0 of the segment first (the core: every term of the row's first
-    // sums), then the rest within reach (the ring: only a shell node's nearest), in one pass.
-    const lanes::Box segment{{hood.row_x, hood.row_y, z0}, {hood.row_x, hood.row_y, z1}};
-    lanes::gather(hood.block, segment, core_sq, reach_sq, scratch.row, &scratch.ring);
-    const int core = scratch.row.count;
-    scratch.row.append(scratch.ring);
-    hood.row = scratch.row.span();
-    SampleSpan core_span = hood.row;
-    core_span.count = core;
-    hood.first = nullptr;
-    if (lanes::rowFirstSums(job.law, core_span, kernel::tail(hood.row, core), hood.row_x,
-                            hood.row_y, hood.first_z, first_sq, first))
-      hood.first = first;
-    for (int k = 0; k < 8; ++k) {
+    const double x = (task.origin[0] + i) * h, y = (task.origin[1] + j) * h;
+    std::fill(row_x, row_x + kLanes, x);
+    std::fill(row_y, row_y + kLanes, y);
+    const lanes::Box segment{{x, y, z0}, {x, y, z1}};
+    lanes::gather(block_span, segment, core_sq, reach_sq, scratch.core, &scratch.ring);
+    Accum first[kLanes];
+    lanes::laneSums(job.law, block_span, scratch.core, scratch.ring, row_x, row_y, node_z,
+                    init_sq, first);
+    for (int k = 0; k < kLanes; ++k) {
       if (!((bits8 >> k) & 1u)) continue;
-      const D3 x{hood.row_x, hood.row_y, (leaf.origin[2] + k) * h};
-      out[row * 8 + k] = kernel::nodeValue(hood, job.law, job.rules, x);
+      const int node = row * 8 + k;
+      scratch.answers[std::size_t(node) * kMaxNodeSums] = first[k];
+      scratch.answered[node] = 1;
+      pending.push_back(node);
     }
+  }
+  // Rounds: every pending node's value from the sums it has; those that ask for one more wait
+  // for the round's requests, answered 8 at a time (in node order: neighbours' lifted points
+  // lie together).
+  std::vector<SumRequest>& requests = scratch.requests;
+  std::vector<int>& next = scratch.next;
+  while (!pending.empty()) {
+    requests.clear();
+    next.clear();
+    for (const int node : pending) {
+      const D3 x{(task.origin[0] + (node >> 6)) * h, (task.origin[1] + ((node >> 3) & 7)) * h,
+                 (task.origin[2] + (node & 7)) * h};
+      SumRequest request;
+      ReplayHood hood{&scratch.answers[std::size_t(node) * kMaxNodeSums], scratch.answered[node],
+                      &request, &samples};
+      const kernel::NodeValue value = kernel::nodeValue(hood, job.law, job.rules, x);
+      if (!hood.missing) {
+        out[node] = value;
+        continue;
+      }
+      if (scratch.answered[node] >= kMaxNodeSums)
+        throw std::logic_error("voxel block build: a node asked for more than " +
+                               std::to_string(kMaxNodeSums) + " sums");
+      request.node = node;
+      requests.push_back(request);
+      next.push_back(node);
+    }
+    if (requests.empty()) break;
+    // The samples the round's points reach: the leaf's where they lie within its box (points
+    // lifted less than √3·h off the leaf), gathered from the cell list otherwise.
+    double lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = HUGE_VAL;
+      hi[a] = -HUGE_VAL;
+    }
+    for (const SumRequest& q : requests)
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], q.at[a] - q.reach());
+        hi[a] = std::max(hi[a], q.at[a] + q.reach());
+      }
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) inside = inside && lo[a] >= box_lo[a] && hi[a] <= box_hi[a];
+    if (!inside) gatherBox(cells, lo, hi, scratch.lifted);
+    const SampleSpan from = inside ? block_span : scratch.lifted.span();
+    for (std::size_t b = 0; b < requests.size(); b += kLanes)
+      answerBatch(job.law, from, &requests[b],
+                  int(std::min<std::size_t>(kLanes, requests.size() - b)), scratch);
+    std::swap(pending, next);
   }
 }
 

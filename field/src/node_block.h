@@ -4,12 +4,14 @@
 /// leaves on the GPU (node_build_cuda.cu). node_kernel.h holds the per-node math for both.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "fieldpath/field/sampling.h"
 #include "node_cuda.h"
+#include "node_lanes.h"
 
 namespace fieldpath::field {
 
@@ -57,32 +59,45 @@ struct SampleSet {
       if (v->size() < n) v->resize(n);
     if (id.size() < n) id.resize(n);
   }
-  /// Appends the samples of `more` (room for them made beforehand: reserveFor).
-  void append(const SampleSet& more) {
-    const auto from = more.doubles();
-    const auto to = doubles();
-    for (int k = 0; k < 7; ++k)
-      std::copy(from[k]->begin(), from[k]->begin() + more.count, to[k]->begin() + count);
-    std::copy(more.id.begin(), more.id.begin() + more.count, id.begin() + count);
-    count += more.count;
-  }
   kernel::SampleSpan span() const {
     return {x.data(), y.data(), z.data(), nx.data(), ny.data(), nz.data(), w.data(), id.data(),
             count, 0};
   }
 };
 
+/// kernel::nodeValue asks a node's neighbourhood for at most this many sums: probe's first and
+/// lifted ones, and again for the plane ratio's probe of the point lifted near_mm over the surface.
+constexpr int kMaxNodeSums = 4;
+
+/// A sum a node asks for (kernel::Hood::sum's arguments), answered with other nodes' in lanes.
+struct SumRequest {
+  double at[3];     ///< mm
+  double radius;    ///< every sample within it is asked for (the terms stop at r0)
+  double best_sq;   ///< the nearest is sought within sqrt(best_sq) when `track`
+  bool track;
+  int node;         ///< offset in the leaf
+  /// Every sample within this of `at` may count (its terms or its nearest).
+  double reach() const { return std::max(radius, track ? std::sqrt(best_sq) : 0.0); }
+};
+
 /// Per-thread scratch of the CPU block build: the samples gathered for the leaf (within reach
-/// of its box) and for one row (its core, then its ring, gathered apart in the same pass).
+/// of its box), for a round's lifted points where they leave that box, and those picked from
+/// them for a row or a batch of points (its core and its ring, in the same pass); the sums answered per node (kMaxNodeSums a node), the requests pending.
 struct BlockScratch {
-  SampleSet block, row, ring;
+  SampleSet block, lifted;
+  lanes::Picks core, ring;
+  std::vector<kernel::Accum> answers;        ///< node · kMaxNodeSums + k
+  std::array<std::uint8_t, 512> answered{};  ///< sums answered per node
+  std::vector<SumRequest> requests;
+  std::vector<int> pending, next;
 };
 
 /// The values of a leaf's masked nodes (out[offset], 512 of them; unmasked ones untouched):
-/// the samples within reach of the leaf gathered once, then every node summed against them in
-/// vector loops (the points a node's surface rule lifts it to read the same samples when they
-/// fall inside the gathered box, the cell list otherwise). Same values as the per-node
-/// reference build up to the order of the sums.
+/// the samples within reach of the leaf gathered once; a row's 8 first sums together, the nodes
+/// in the vector lanes, over the samples near the row; then, in rounds, every node's value
+/// made from the sums it has, the sums still asked for (the points the surface rule and the
+/// plane ratio lift a node to) answered 8 points at a time over the samples near them. Same
+/// values as the per-node reference build up to the order of the sums.
 void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, const NodeJob& job,
                     const LeafTask& leaf, BlockScratch& scratch, kernel::NodeValue* out);
 

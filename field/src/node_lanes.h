@@ -1,45 +1,49 @@
 #pragma once
 /// Internal to field/ (no OpenVDB): the CPU block build's sums in vector lanes (node_lanes.cpp),
-/// used by node_block.cpp. Each runs AVX-512 where the CPU has it, a generic lane loop (or
-/// nothing, rowFirstSums) elsewhere; the terms are kernel::addTerm's (node_kernel.h).
+/// used by node_block.cpp: the samples near a box picked (their positions, not copies), and
+/// eq. 1 at 8 points at once over the picked samples, the points in the lanes. Each runs
+/// AVX-512 where the CPU has it (FIELDPATH_LANES=generic turns it off), a generic loop the
+/// compiler vectorises elsewhere; the terms are kernel::addTerm's (node_kernel.h).
+#include <cstddef>
 #include <cstdint>
+#include <vector>
 
-#include "node_block.h"
 #include "node_kernel.h"
 
 namespace fieldpath::field::lanes {
 
 constexpr int kLanes = 8;
 
-/// The first `lanes` per-lane nearest samples merged into a (ties: lowest id).
-void mergeNearest(const double* best, const std::int64_t* best_id, const std::int64_t* best_at,
-                  kernel::Accum& a, int lanes = kLanes);
-
-/// Eq. 1 at `at` over the samples of `n` spans (a superset of those within r0: the terms filter
-/// by distance), the nearest tracked if `track` (from a.best_sq; ties: lowest id).
-void accumulateLanes(const kernel::Law& L, const kernel::SampleSpan* spans, int n, kernel::D3 at,
-                     bool track, kernel::Accum& a);
-void accumulateLanes(const kernel::Law& L, const kernel::SampleSpan& s, kernel::D3 at,
-                     bool track, kernel::Accum& a);
-
 /// An axis-aligned box (mm; a row's segment when x0 = x1 and y0 = y1).
 struct Box {
   double lo[3], hi[3];
 };
 
-/// The samples of `from` within sqrt(near_sq) of `box` (squared distance d² <= near_sq) copied
-/// to `near`, and if `far` those with near_sq < d² <= far_sq to `far`, in their order (counts
-/// set; both sized for all of `from`: SampleSet::reserveFor).
-void gather(const kernel::SampleSpan& from, const Box& box, double near_sq, double far_sq,
-            SampleSet& near, SampleSet* far);
+/// Positions of picked samples in a span (gather's output, laneSums' input).
+struct Picks {
+  std::vector<std::int32_t> at;
+  int count = 0;
+  /// Room for n picks and 16 more (the lanes' whole-vector stores; count unchanged).
+  void reserveFor(std::size_t n) {
+    if (at.size() < n + 16) at.resize(n + 16);
+  }
+};
 
-/// The first sums (kernel::probe's) of a row's 8 nodes at (x, y, node_z[k]) at once, the nodes
-/// in the lanes: every sample of `core` (those within r0 of the row's segment) read once for the
-/// 8, eq. 1 summed for those within r0, the nearest within sqrt(init_sq) tracked (ties: lowest
-/// id); then, for nodes with no sample within r0, the nearest among `ring` (the rest of the
-/// row's reach). False (nothing made) without AVX-512.
-bool rowFirstSums(const kernel::Law& L, const kernel::SampleSpan& core,
-                  const kernel::SampleSpan& ring, double x, double y, const double* node_z,
-                  double init_sq, kernel::Accum* out);
+/// The positions in `from` of its samples within sqrt(near_sq) of `box` (squared distance
+/// d² <= near_sq) to `near`, and if `far` of those with near_sq < d² <= far_sq to `far`, in
+/// their order (counts set; both sized for all of `from`: Picks::reserveFor).
+void gather(const kernel::SampleSpan& from, const Box& box, double near_sq, double far_sq,
+            Picks& near, Picks* far);
+
+/// The sums (kernel::probe's) at 8 points at once, point l at (px[l], py[l], pz[l]), the
+/// points in the lanes: every sample of `from` that `core` picks (a superset of those within r0
+/// of the points) read once for the 8, eq. 1 summed for those within r0, the nearest within
+/// sqrt(init_sq[l]) tracked (ties: lowest id; init_sq 0: none tracked); then, for points with
+/// no sample within r0, the nearest among those `ring` picks (the rest of their reach).
+/// out[l] starts from Accum{} with best_sq = init_sq[l]; best_at stays -1 (the block build
+/// finds the nearest by its id).
+void laneSums(const kernel::Law& L, const kernel::SampleSpan& from, const Picks& core,
+              const Picks& ring, const double* px, const double* py, const double* pz,
+              const double* init_sq, kernel::Accum* out);
 
 }  // namespace fieldpath::field::lanes
