@@ -68,8 +68,8 @@ namespace {
 using lanes::kLanes;
 
 /// A node's neighbourhood in the staged build (buildLeafNodes): its sums answered in the order
-/// kernel::nodeValue asks for them; the first one not answered yet is recorded and every later
-/// one left empty (that run's value is thrown away, the node run again once it is answered).
+/// kernel::nodeValue asks for them; the first one not answered yet is recorded and the hood
+/// pending (nodeValue stops; the node runs again once it is answered).
 /// nodeValue asks each sum with a fresh Accum (zero sum, best_sq its search radius²), as the
 /// answers were started.
 struct ReplayHood {
@@ -81,7 +81,6 @@ struct ReplayHood {
   bool missing = false;
 
   void sum(D3 c, double radius, bool track, Accum& a) {
-    if (missing) return;
     if (asked < answered) {
       a = answers[asked++];
       return;
@@ -97,6 +96,7 @@ struct ReplayHood {
     const Vec3& n = samples->normals[std::size_t(a.best_id)];
     return {n.x(), n.y(), n.z()};
   }
+  bool pending() const { return missing; }
 };
 
 /// Copies the samples of the spans it is given that lie in [lo, hi] (mm) to `set`.
@@ -106,10 +106,8 @@ struct GatherBox {
   void operator()(const SampleSpan& span) {
     set->reserveFor(std::size_t(set->count + span.count));
     int& n = set->count;
-    for (int j = 0; j < span.count; ++j) {
+    for (int j = 0; j < span.count; ++j) {  // written whether in or not: no branch to mispredict
       const double px = span.x[j], py = span.y[j], pz = span.z[j];
-      if (px < lo[0] || py < lo[1] || pz < lo[2] || px > hi[0] || py > hi[1] || pz > hi[2])
-        continue;
       set->x[n] = px;
       set->y[n] = py;
       set->z[n] = pz;
@@ -118,7 +116,8 @@ struct GatherBox {
       set->nz[n] = span.nz[j];
       set->w[n] = span.w[j];
       set->id[n] = span.id[j];
-      ++n;
+      n += (px >= lo[0]) & (py >= lo[1]) & (pz >= lo[2]) & (px <= hi[0]) & (py <= hi[1]) &
+           (pz <= hi[2]);
     }
   }
 };

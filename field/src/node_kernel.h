@@ -8,7 +8,10 @@
 ///       radius of center (a superset is fine: the terms and the nearest search filter by
 ///       distance), tracking the nearest sample if `track`
 ///   D3 point(const Accum& a), normal(const Accum& a);  // of the nearest sample (a.best_at)
-/// The CPU block build passes the samples gathered once for a leaf, the GPU a cell list.
+///   bool pending() const;  // a sum it could not answer yet: the value being made is thrown
+///                          // away, so probe() and nodeValue() stop at once
+/// The GPU passes a cell list (never pending); the CPU block build a node's sums made in lanes
+/// with other nodes' (node_block.cpp ReplayHood: pending until they are).
 #include <cmath>
 #include <cstdint>
 
@@ -200,6 +203,7 @@ struct CellHood {
   FP_HD D3 normal(const Accum& a) const {
     return {table->all.nx[a.best_at], table->all.ny[a.best_at], table->all.nz[a.best_at]};
   }
+  FP_HD bool pending() const { return false; }
 };
 
 /// law.h Probe, with the nearest sample's point and normal.
@@ -220,7 +224,7 @@ FP_HD Probe probe(Hood& hood, const Law& L, D3 x, double search_mm) {
   a.best_sq = dmax(search_mm, L.r0);
   a.best_sq *= a.best_sq;
   hood.sum(x, sqrt(a.best_sq), true, a);
-  if (a.best_id < 0) return out;
+  if (hood.pending() || a.best_id < 0) return out;
   out.has_nearest = true;
   out.q = hood.point(a);
   out.n = hood.normal(a);
@@ -233,6 +237,7 @@ FP_HD Probe probe(Hood& hood, const Law& L, D3 x, double search_mm) {
     Accum b;
     b.best_sq = 0.0;
     hood.sum(x + (lifted_mm - out.height_mm) * out.n, L.r0, false, b);
+    if (hood.pending()) return out;
     f = D3{b.fx, b.fy, b.fz};
   }
   out.has_force = true;
@@ -259,7 +264,7 @@ FP_HD NodeValue nodeValue(Hood& hood, const Law& L, const Rules& R, D3 x) {
                        x.x > R.region_hi[0] || x.y > R.region_hi[1] || x.z > R.region_hi[2]))
     return out;
   const Probe p = probe(hood, L, x, R.reach_mm);
-  if (!p.has_nearest) return out;
+  if (hood.pending() || !p.has_nearest) return out;
   const double lateral_sq = p.nearest_mm * p.nearest_mm - p.height_mm * p.height_mm;
   const bool over_surface = lateral_sq <= R.over_mm * R.over_mm;
   if (p.height_mm < -R.band_in_mm && over_surface) return out;
@@ -295,6 +300,7 @@ FP_HD NodeValue nodeValue(Hood& hood, const Law& L, const Rules& R, D3 x) {
     if (over && eta < R.near_mm) {
       lift_mm = R.near_mm - eta;
       const Probe lifted = probe(hood, L, x + lift_mm * p.n, L.r0);
+      if (hood.pending()) return out;
       f = lifted.has_force ? lifted.force : D3{0, 0, 0};
     }
     const double e = L.planeHeight(norm(f));

@@ -155,19 +155,16 @@ static __attribute__((target("avx512f"))) void gather512(const SampleSpan& f, co
       d[a] = _mm512_max_pd(zero, _mm512_max_pd(_mm512_sub_pd(blo[a], p[a]), _mm512_sub_pd(p[a], bhi[a])));
     const __m512d d2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(d[0], d[0]), _mm512_mul_pd(d[1], d[1])),
                                      _mm512_mul_pd(d[2], d[2]));
+    // Stored whether any lane passes or not: which do is data, not a branch to mispredict.
     const __mmask8 in_near = _mm512_mask_cmp_pd_mask(valid, d2, vnear, _CMP_LE_OQ);
-    if (in_near) {
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(near_at + n_near),
-                          _mm512_castsi512_si256(_mm512_maskz_compress_epi32(in_near, position)));
-      n_near += __builtin_popcount(in_near);
-    }
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(near_at + n_near),
+                        _mm512_castsi512_si256(_mm512_maskz_compress_epi32(in_near, position)));
+    n_near += __builtin_popcount(in_near);
     if (far) {
       const __mmask8 in_far = _mm512_mask_cmp_pd_mask(valid, d2, vfar, _CMP_LE_OQ) & ~in_near;
-      if (in_far) {
-        _mm256_storeu_si256(reinterpret_cast<__m256i*>(far_at + n_far),
-                            _mm512_castsi512_si256(_mm512_maskz_compress_epi32(in_far, position)));
-        n_far += __builtin_popcount(in_far);
-      }
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(far_at + n_far),
+                          _mm512_castsi512_si256(_mm512_maskz_compress_epi32(in_far, position)));
+      n_far += __builtin_popcount(in_far);
     }
   }
   near.count = n_near;

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include <openvdb/tools/Prune.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_scan.h>
 
@@ -260,11 +261,14 @@ struct NodeBuilder {
     const std::size_t batches =
         std::max<std::size_t>(1, std::min<std::size_t>(20, leaves.size() / 64));
     const ObstacleSamples& samples = index.samples;
+    // A thread's scratch lives through the build (ranges are often one leaf: made per range,
+    // its sample sets and 2048 answers were allocated and zeroed per leaf).
+    tbb::enumerable_thread_specific<BlockScratch> scratches;
     for (std::size_t batch = 0; batch < batches; ++batch) {
       const std::size_t begin = leaves.size() * batch / batches;
       const std::size_t end = leaves.size() * (batch + 1) / batches;
       tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 1), [&](const auto& range) {
-        BlockScratch scratch;
+        BlockScratch& scratch = scratches.local();
         kernel::NodeValue buffer[Leaf::SIZE];
         for (std::size_t l = range.begin(); l != range.end(); ++l) {
           buildLeafNodes(*table, samples, job, tasks[l], scratch, buffer);
