@@ -328,7 +328,15 @@ Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
   common::requireRegularFile(file, "scene file (YAML)");
   YAML::Node root;
   try {
-    root = YAML::LoadFile(file.string());
+    // Every document read, so that one past the scene (after `---`, or text after `...`) is
+    // refused rather than silently ignored.
+    const std::vector<YAML::Node> documents = YAML::LoadAllFromFile(file.string());
+    if (!documents.empty()) root = documents.front();
+    for (std::size_t d = 1; d < documents.size(); ++d)
+      if (!documents[d].IsNull())
+        throw InputError(file.string() + ":" + std::to_string(documents[d].Mark().line + 1) +
+                         ": a second YAML document (after `---` or `...`): a scene file holds "
+                         "one scene; remove it or put it in its own file");
   } catch (const YAML::ParserException& e) {
     throw InputError(file.string() + ":" + std::to_string(e.mark.line + 1) +
                      ": YAML syntax: " + e.msg);

@@ -261,6 +261,14 @@ SurfaceResult checkSurface(const SurfaceRequest& request) {
                              "to check");
   SurfaceResult result;
   double spacing = request.spacing_mm;
+  if (!(spacing <= region.sizes().maxCoeff())) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "--spacing: %g mm is wider than the surface checked (%.3g x %.3g mm in plan): "
+                  "give less (default 0.05 mm)",
+                  spacing, region.sizes().x(), region.sizes().y());
+    throw common::InputError(text);
+  }
   const double area = region.sizes().x() * region.sizes().y();
   if (area / (spacing * spacing) > static_cast<double>(kMaxSurfaceLines)) {
     spacing = std::sqrt(area / static_cast<double>(kMaxSurfaceLines));

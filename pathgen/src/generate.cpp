@@ -152,6 +152,14 @@ GenerateResult generatePath(const GenerateRequest& request) {
                          const dynamics::DynamicsParams& params) {
     std::vector<Steered> steered_passes(result.passes.size());
     int passes_done = 0;
+    // Each pass's fraction done (its solver's intervals): the bar moves within a pass too (a
+    // wide r0 makes one pass take minutes).
+    std::vector<double> pass_done(result.passes.size(), 0.0);
+    auto fractionDone = [&] {
+      double sum = 0.0;
+      for (const double f : pass_done) sum += f;
+      return 0.3 + 0.6 * sum / std::max(1, pass_count);
+    };
     auto steerOne = [&](std::size_t p) {
       const Pass& pass = result.passes[p];
       Steered& out = steered_passes[p];
@@ -190,11 +198,11 @@ GenerateResult generatePath(const GenerateRequest& request) {
         if (i > 0) gap_mm = std::max(gap_mm, pass.samples[i].s_mm - pass.samples[i - 1].s_mm);
       }
       steer.step_mm = gap_mm > 0.0 ? gap_mm : pass.length_mm;
-      if (request.progress &&
-          report)  // the interruption hook only: progress is reported per pass below
-        steer.progress = [&](double, std::string_view) {
+      if (request.progress && report)
+        steer.progress = [&, p](double fraction, std::string_view) {
           std::lock_guard<std::mutex> lock(progress_mutex);
-          return request.progress(0.3 + 0.6 * passes_done / pass_count, "passes");
+          pass_done[p] = std::clamp(fraction, 0.0, 1.0);
+          return request.progress(fractionDone(), "passes");
         };
       const dynamics::SteeringResult steered = dynamics::steerPass(dyn_pass, steer);
       if (steered.status != dynamics::Status::Ok) {
@@ -223,10 +231,11 @@ GenerateResult generatePath(const GenerateRequest& request) {
       }
       std::lock_guard<std::mutex> lock(progress_mutex);
       ++passes_done;
+      pass_done[p] = 1.0;
       const std::string label =
           "pass " + std::to_string(passes_done) + "/" + std::to_string(pass_count);
       if (report && request.progress && !steered_passes[p].error &&
-          !request.progress(0.3 + 0.6 * passes_done / pass_count, label))
+          !request.progress(fractionDone(), label))
         steered_passes[p].error = std::make_exception_ptr(common::Interrupted());
     };
     if (request.serial_passes)

@@ -93,6 +93,42 @@ TEST_F(MeshJob, ClAptAndNpyNominalPathsGiveTheSamePathBitForBit) {
   EXPECT_GE(report["motions"]["min_mm"].get<double>(), 0.5);
   EXPECT_EQ(report["links"]["links"].get<int>(), 8);
   EXPECT_NE(from_cl.find("# link"), std::string::npos);
+  // Clear everywhere: nothing marks it unsafe.
+  EXPECT_TRUE(report["safe"].get<bool>());
+  EXPECT_EQ(from_cl.find("UNSAFE"), std::string::npos);
+}
+
+TEST_F(MeshJob, ACollidingPathIsMarkedUnsafeWhereTheMachineReadsIt) {
+  // The nominal path hits the blades with the shank (README): SetUpTestSuite's `generate
+  // --nominal` wrote it. Marked before the first motion in both files, and in report.json.
+  const fs::path run = dir_->path() / "nominal_run";
+  const auto report = nlohmann::json::parse(test::slurp(run / "report.json"));
+  const int colliding = report["clearance"]["colliding_postures"].get<int>();
+  ASSERT_GT(colliding, 0);
+  EXPECT_FALSE(report["safe"].get<bool>());
+  ASSERT_FALSE(report["unsafe"].empty());
+  const std::string reason = report["unsafe"][0].get<std::string>();
+  EXPECT_NE(reason.find(std::to_string(colliding)), std::string::npos) << reason;
+
+  std::istringstream cl(test::slurp(run / "path.cl"));
+  bool marked = false;
+  for (std::string line; std::getline(cl, line);) {
+    if (line.empty() || line[0] != '#') break;  // the first posture: the mark must come before
+    marked = marked || line.rfind("# UNSAFE TO RUN: " + reason, 0) == 0;
+  }
+  EXPECT_TRUE(marked) << "path.cl has no '# UNSAFE TO RUN: " << reason << "' before its postures";
+
+  std::istringstream apt(test::slurp(run / "path.apt"));
+  bool partno = false, pprint = false;
+  for (std::string line; std::getline(apt, line);) {
+    if (line.rfind("GOTO", 0) == 0 || line.rfind("RAPID", 0) == 0) break;
+    partno = partno || line.rfind("PARTNO", 0) == 0;
+    pprint = pprint || (partno && line.rfind("PPRINT/UNSAFE TO RUN: ", 0) == 0);
+  }
+  EXPECT_TRUE(pprint) << "path.apt has no PPRINT/UNSAFE TO RUN after PARTNO, before its motions";
+  // The APT reader reads the remark past: the same postures as the .cl.
+  EXPECT_EQ(geometry::readPathFile(run / "path.apt").postures.size(),
+            geometry::readPathFile(run / "path.cl").postures.size());
 }
 
 TEST_F(MeshJob, CheckComparesWithThePartMesh) {
@@ -107,6 +143,13 @@ TEST_F(MeshJob, CheckComparesWithThePartMesh) {
   EXPECT_GT(check["surface"]["max_scallop_um"].get<double>(), 100.0);
   EXPECT_TRUE(fs::exists(dir_->path() / "checked/deviation.png"));
   EXPECT_TRUE(fs::exists(dir_->path() / "checked/clearance.csv"));
+  // A spacing wider than the surface is the option's error (it was a grid "outside any
+  // machine"), before any output.
+  const auto wide = test::runFieldpath(
+      *dir_, "check scene_cl.yaml --path out_scene_cl.yaml/path.cl --spacing 1e6 --out wide");
+  EXPECT_EQ(wide.exit_code, 1) << wide.output();
+  EXPECT_NE(wide.output().find("--spacing"), std::string::npos) << wide.output();
+  EXPECT_FALSE(fs::exists(dir_->path() / "wide"));
 }
 
 TEST_F(MeshJob, BadNominalPathsAndMeshesAreOneLineErrorsWithNoOutputs) {
