@@ -3,6 +3,7 @@
 /// sub-command and its options to `app` and sets its callback; the callback throws InputError for
 /// bad input (exit 1) and returns normally on success (exit 0).
 #include <cmath>
+#include <cstdlib>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -14,14 +15,12 @@ namespace fieldpath::app {
 inline CLI::Validator positiveFinite(const std::string& unit) {
   return CLI::Validator(
       [unit](std::string& text) -> std::string {
-        double value = 0.0;
-        std::size_t used = 0;
-        try {
-          value = std::stod(text, &used);
-        } catch (...) {
-          return "'" + text + "' is not a number";
-        }
-        if (used != text.size() || !std::isfinite(value) || value <= 0.0)
+        // strtod, not stod: a number too small or too large for a double is one (stod throws
+        // out_of_range and it read "not a number").
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (text.empty() || end == text.c_str()) return "'" + text + "' is not a number";
+        if (end != text.c_str() + text.size() || !std::isfinite(value) || value <= 0.0)
           return "must be a finite number > 0 " + unit + ", got '" + text + "'";
         return {};
       },

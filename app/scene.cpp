@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <initializer_list>
 #include <set>
@@ -62,7 +63,13 @@ class Reader {
     try {
       value = node.as<double>();
     } catch (const YAML::Exception&) {
-      fail(node, key, "expected a number, got '" + node.Scalar() + "'");
+      // yaml-cpp's stream read fails on numbers past a double's range (1e-320, 1e400): read
+      // them as strtod does (a denormal or 0, an infinity refused below).
+      const std::string& text = node.Scalar();
+      char* end = nullptr;
+      value = std::strtod(text.c_str(), &end);
+      if (text.empty() || end != text.c_str() + text.size())
+        fail(node, key, "expected a number, got '" + text + "'");
     }
     if (!std::isfinite(value)) fail(node, key, "must be finite");
     return value;
@@ -375,11 +382,25 @@ Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
   if (root["links"]) readLinks(r, root["links"], scene.links);
 
   // Meshes last: every key is checked before the slow part.
+  std::vector<const MeshLoad*> obstacle_loads;
   for (const MeshLoad& load : loads) {
-    if (load.part)
+    if (load.part) {
       scene.part = r.mesh(load.node, load.key);
-    else
-      scene.obstacles.push_back(r.mesh(load.node, load.key));
+      continue;
+    }
+    scene.obstacles.push_back(r.mesh(load.node, load.key));
+    obstacle_loads.push_back(&load);
+    // The same surfaces from another file (a copy, or the same mesh written again) would repel
+    // twice as hard, as the same file twice would.
+    const geometry::TriangleMesh& added = scene.obstacles.back();
+    for (std::size_t j = 0; j + 1 < scene.obstacles.size(); ++j) {
+      const geometry::TriangleMesh& before = scene.obstacles[j];
+      if (before.vertices == added.vertices && before.triangles == added.triangles &&
+          !added.triangles.empty())
+        r.fail(load.node, load.key,
+               "the same surfaces as " + obstacle_loads[j]->key + " (" +
+                   scene.obstacle_files[j].string() + "): their field would count twice");
+    }
   }
   if (read_nominal && root["path"] && root["path"]["nominal"]) {
     const YAML::Node node = root["path"]["nominal"];

@@ -193,3 +193,23 @@ TEST(Scene, ADirectoryIsNoSceneFile) {
     EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
   }
 }
+
+TEST(Scene, TheSameSurfacesFromTwoFilesAreRefused) {
+  // A copy of an obstacle's file would add its field twice, as the same file twice does; a
+  // different surface beside it is another obstacle.
+  TempDir dir;
+  dir.write("wall.stl", app::test::squareStl(5));
+  dir.write("copy.stl", app::test::squareStl(5));
+  dir.write("other.stl", app::test::squareStl(6));
+  const auto twice = dir.write("twice.yaml", "obstacles:\n  - mesh: wall.stl\n  - mesh: copy.stl\n");
+  try {
+    (void)app::loadScene(twice);
+    ADD_FAILURE() << "a copy of an obstacle was read as a second obstacle";
+  } catch (const common::InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(":3: obstacles[2].mesh"), std::string::npos) << message;
+    EXPECT_NE(message.find("obstacles[1].mesh"), std::string::npos) << message;
+  }
+  const auto two = dir.write("two.yaml", "obstacles:\n  - mesh: wall.stl\n  - mesh: other.stl\n");
+  EXPECT_EQ(app::loadScene(two).obstacles.size(), 2u);
+}
