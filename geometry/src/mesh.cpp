@@ -3,9 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <map>
+#include <cstdint>
 #include <numeric>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -39,8 +40,10 @@ MeshReport validateMesh(const TriangleMesh& mesh) {
   for (const auto& v : mesh.vertices)
     if (!v.allFinite()) ++r.non_finite_vertices;
 
-  // Undirected edge (lo, hi) → uses in direction lo→hi and hi→lo.
-  std::map<std::pair<int, int>, std::array<int, 2>> edges;
+  // Every edge use as (lo << 32 | hi) << 1 | direction (0: lo→hi), sorted: an undirected edge's
+  // uses are one run (vertex indices < 2^31; a std::map took 1 s at a million triangles).
+  std::vector<std::uint64_t> edges;
+  edges.reserve(3 * mesh.triangles.size());
   const int n = static_cast<int>(mesh.vertices.size());
   for (const auto& t : mesh.triangles) {
     const bool in_range = (t.array() >= 0).all() && (t.array() < n).all();
@@ -56,11 +59,17 @@ MeshReport validateMesh(const TriangleMesh& mesh) {
     for (int e = 0; e < 3; ++e) {
       const int u = t[e], v = t[(e + 1) % 3];
       if (u == v) continue;
-      auto& uses = edges[{std::min(u, v), std::max(u, v)}];
-      ++uses[u < v ? 0 : 1];
+      const std::uint64_t lo = std::uint32_t(std::min(u, v)), hi = std::uint32_t(std::max(u, v));
+      edges.push_back((lo << 32 | hi) << 1 | (u < v ? 0u : 1u));
     }
   }
-  for (const auto& [edge, uses] : edges) {
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t first = 0; first < edges.size();) {
+    std::array<int, 2> uses{0, 0};
+    std::size_t last = first;
+    for (; last < edges.size() && (edges[last] >> 1) == (edges[first] >> 1); ++last)
+      ++uses[edges[last] & 1u];
+    first = last;
     const int total = uses[0] + uses[1];
     if (total == 1)
       ++r.open_edges;
@@ -101,27 +110,39 @@ std::vector<std::vector<int>> closedShells(const TriangleMesh& mesh) {
   };
   for (const auto& t : mesh.triangles)
     for (int e = 1; e < 3; ++e) parent[root(t[e])] = root(t[0]);
-  // Closed: every edge used once each way.
-  std::map<std::pair<int, int>, int> directed;  // (u, v) → uses
+  // Closed: every edge used once each way. The directed edges as sorted keys (u << 32 | v): a
+  // count is the length of a key's run (a std::map of pairs took 1 s at a million triangles).
+  const auto key = [](int u, int v) {
+    return (std::uint64_t(std::uint32_t(u)) << 32) | std::uint32_t(v);
+  };
+  std::vector<std::uint64_t> directed;
+  directed.reserve(3 * mesh.triangles.size());
   for (const auto& t : mesh.triangles)
-    for (int e = 0; e < 3; ++e) ++directed[{t[e], t[(e + 1) % 3]}];
-  std::map<int, std::vector<int>> triangles_of;
-  std::map<int, bool> closed;
+    for (int e = 0; e < 3; ++e) directed.push_back(key(t[e], t[(e + 1) % 3]));
+  std::sort(directed.begin(), directed.end());
+  const auto uses = [&](std::uint64_t k) {
+    const auto [first, last] = std::equal_range(directed.begin(), directed.end(), k);
+    return last - first;
+  };
+  // Per shell (its union-find root): its triangles, and whether it is closed.
+  std::vector<std::vector<int>> triangles_of(static_cast<std::size_t>(n));
+  std::vector<char> closed(static_cast<std::size_t>(n), 1);
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
     const auto& t = mesh.triangles[i];
     const int shell = root(t[0]);
-    triangles_of[shell].push_back(static_cast<int>(i));
-    closed.try_emplace(shell, true);
+    triangles_of[static_cast<std::size_t>(shell)].push_back(static_cast<int>(i));
+    if (!closed[static_cast<std::size_t>(shell)]) continue;
     for (int e = 0; e < 3; ++e) {
       const int u = t[e], v = t[(e + 1) % 3];
-      const auto back = directed.find({v, u});
-      if (u == v || directed[{u, v}] != 1 || back == directed.end() || back->second != 1)
-        closed[shell] = false;
+      if (u == v || uses(key(u, v)) != 1 || uses(key(v, u)) != 1) {
+        closed[static_cast<std::size_t>(shell)] = 0;
+        break;
+      }
     }
   }
   std::vector<std::vector<int>> out;
-  for (auto& [shell, triangles] : triangles_of)
-    if (closed[shell]) out.push_back(std::move(triangles));
+  for (std::size_t shell = 0; shell < triangles_of.size(); ++shell)
+    if (!triangles_of[shell].empty() && closed[shell]) out.push_back(std::move(triangles_of[shell]));
   return out;
 }
 
