@@ -1,5 +1,5 @@
 /// The CPU block build of voxel nodes (node_block.h): the cell list, a leaf's samples gathered,
-/// its rows' sums through the lane kernels (node_lanes.cpp). No OpenVDB.
+/// its bricks' sums through the lane kernels (node_lanes.cpp). No OpenVDB.
 #include "node_block.h"
 
 #include <algorithm>
@@ -207,45 +207,49 @@ void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, co
   scratch.core.reserveFor(std::size_t(block.count));
   scratch.ring.reserveFor(std::size_t(block.count));
   scratch.answers.resize(512 * kMaxNodeSums);
-  const double row_reach = reach * (1.0 + 1e-12);
-  const double reach_sq = row_reach * row_reach;
+  const double reach_sq = reach * reach * (1.0 + 1e-12);
   const double core_sq = job.law.r0_sq * (1.0 + 1e-12);
   // probe()'s first sum: radius max(reach, r0), the nearest tracked from its square.
   double first_sq = kernel::dmax(job.rules.reach_mm, job.law.r0);
   first_sq *= first_sq;
-  alignas(64) double row_x[kLanes], row_y[kLanes], node_z[kLanes], init_sq[kLanes];
-  for (int k = 0; k < kLanes; ++k) {
-    node_z[k] = (task.origin[2] + k) * h;
-    init_sq[k] = first_sq;
-  }
-  const double z0 = node_z[0], z1 = node_z[kLanes - 1];
+  alignas(64) double lane_x[kLanes], lane_y[kLanes], lane_z[kLanes], init_sq[kLanes];
+  std::fill(init_sq, init_sq + kLanes, first_sq);
   std::vector<int>& pending = scratch.pending;
   pending.clear();
-  // Row by row (8 nodes along z): the first sums over the leaf's samples within reach of the
-  // row's segment, those within r0 (the core: every term) apart from the rest (the ring: only a
-  // shell node's nearest), gathered in one pass.
-  for (int row = 0; row < 64; ++row) {
-    const int i = row >> 3, j = row & 7;
-    const std::uint64_t bits8 = (task.mask[i] >> (j * 8)) & 0xffu;
-    if (!bits8) continue;
-    const double x = (task.origin[0] + i) * h, y = (task.origin[1] + j) * h;
-    std::fill(row_x, row_x + kLanes, x);
-    std::fill(row_y, row_y + kLanes, y);
-    const lanes::Box segment{{x, y, z0}, {x, y, z1}};
-    lanes::gather(block_span, segment, core_sq, reach_sq, scratch.core, &scratch.ring);
+  // Brick by brick (2 x 2 x 2 nodes, one a lane): the first sums over the leaf's samples within
+  // reach of the brick, those within r0 (the core: every term) apart from the rest (the ring:
+  // only a shell node's nearest), gathered in one pass. Bricks, not rows of 8 along z: the
+  // region within r0 of a cube is tighter than of a segment 7 h long (uniform example: 3.31 M
+  // samples read against 4.07 M, and the lifted points of a brick's nodes lie closer together).
+  for (int brick = 0; brick < 64; ++brick) {
+    const int i0 = 2 * (brick >> 4), j0 = 2 * ((brick >> 2) & 3), k0 = 2 * (brick & 3);
+    int nodes[kLanes];
+    bool any = false;
+    for (int l = 0; l < kLanes; ++l) {
+      const int i = i0 + (l >> 2), j = j0 + ((l >> 1) & 1), k = k0 + (l & 1);
+      const bool on = (task.mask[i] >> (j * 8 + k)) & 1u;
+      nodes[l] = on ? (i * 8 + j) * 8 + k : -1;
+      any = any || on;
+      lane_x[l] = (task.origin[0] + i) * h;
+      lane_y[l] = (task.origin[1] + j) * h;
+      lane_z[l] = (task.origin[2] + k) * h;
+    }
+    if (!any) continue;
+    const lanes::Box brick_box{{lane_x[0], lane_y[0], lane_z[0]},
+                               {lane_x[kLanes - 1], lane_y[kLanes - 1], lane_z[kLanes - 1]}};
+    lanes::gather(block_span, brick_box, core_sq, reach_sq, scratch.core, &scratch.ring);
     Accum first[kLanes];
-    lanes::laneSums(job.law, block_span, scratch.core, scratch.ring, row_x, row_y, node_z,
+    lanes::laneSums(job.law, block_span, scratch.core, scratch.ring, lane_x, lane_y, lane_z,
                     init_sq, first);
-    for (int k = 0; k < kLanes; ++k) {
-      if (!((bits8 >> k) & 1u)) continue;
-      const int node = row * 8 + k;
-      scratch.answers[std::size_t(node) * kMaxNodeSums] = first[k];
-      scratch.answered[node] = 1;
-      pending.push_back(node);
+    for (int l = 0; l < kLanes; ++l) {
+      if (nodes[l] < 0) continue;
+      scratch.answers[std::size_t(nodes[l]) * kMaxNodeSums] = first[l];
+      scratch.answered[nodes[l]] = 1;
+      pending.push_back(nodes[l]);
     }
   }
   // Rounds: every pending node's value from the sums it has; those that ask for one more wait
-  // for the round's requests, answered 8 at a time (in node order: neighbours' lifted points
+  // for the round's requests, answered 8 at a time (in brick order: neighbours' lifted points
   // lie together).
   std::vector<SumRequest>& requests = scratch.requests;
   std::vector<int>& next = scratch.next;
