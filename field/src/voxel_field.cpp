@@ -92,18 +92,29 @@ void makeBlocks(Level& level, bool ratio) {
       }
       std::uint64_t* over = &level.over[b * kBlockWords];
       std::array<float, 4>* block = &level.nodes[b * kBlockNodes];
-      for (int i = 0, n = 0; i < kBlockDim; ++i)
-        for (int j = 0; j < kBlockDim; ++j)
-          for (int k = 0; k < kBlockDim; ++k, ++n) {
-            const int side = (i >> 3) << 2 | (j >> 3) << 1 | (k >> 3);
-            const openvdb::Index offset =
-                openvdb::Index(((i & 7) * kLeafDim + (j & 7)) * kLeafDim + (k & 7));
-            const openvdb::Vec3s v = values_of[side] ? values_of[side][offset] : value_background;
-            const float c = floats_of[side] ? floats_of[side][offset] : closeness_background;
-            if (over_of[side] && over_of[side]->isOn(offset))
-              over[n >> 6] |= std::uint64_t{1} << (n & 63);
-            block[n] = {v.x(), v.y(), v.z(), c};
+      // A run along k at a time: k = 0..7 from the leaf of (i, j)'s side, k = 8 from the one
+      // above it in z (the per-node side lookup and its branches were most of this loop).
+      for (int i = 0; i < kBlockDim; ++i)
+        for (int j = 0; j < kBlockDim; ++j) {
+          const int side_ij = (i >> 3) << 2 | (j >> 3) << 1;
+          const openvdb::Index first = openvdb::Index(((i & 7) * kLeafDim + (j & 7)) * kLeafDim);
+          const int n0 = (i * kBlockDim + j) * kBlockDim;
+          for (int part = 0; part < 2; ++part) {  // k = 0..7, then k = 8
+            const int side = side_ij | part;
+            const int count = part == 0 ? kLeafDim : 1;
+            const int n = n0 + (part == 0 ? 0 : kLeafDim);
+            const openvdb::Vec3s* values = values_of[side];
+            const float* floats = floats_of[side];
+            for (int k = 0; k < count; ++k) {
+              const openvdb::Vec3s v = values ? values[first + k] : value_background;
+              block[n + k] = {v.x(), v.y(), v.z(), floats ? floats[first + k] : closeness_background};
+            }
+            if (const auto* mask = over_of[side])
+              for (int k = 0; k < count; ++k)
+                if (mask->isOn(first + openvdb::Index(k)))
+                  over[(n + k) >> 6] |= std::uint64_t{1} << ((n + k) & 63);
           }
+        }
     }
   });
 }
