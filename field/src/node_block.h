@@ -82,7 +82,8 @@ struct SumRequest {
 
 /// Per-thread scratch of the CPU block build: the samples gathered for the leaf (within reach
 /// of its box), for a round's lifted points where they leave that box, and those picked from
-/// them for a row or a batch of points (its core and its ring, in the same pass); the sums answered per node (kMaxNodeSums a node), the requests pending.
+/// them for a brick of nodes or a batch of points (its core and its ring, in the same pass);
+/// the sums answered per node (kMaxNodeSums a node), the requests pending.
 struct BlockScratch {
   SampleSet block, lifted;
   lanes::Picks core, ring;
@@ -93,8 +94,8 @@ struct BlockScratch {
 };
 
 /// The values of a leaf's masked nodes (out[offset], 512 of them; unmasked ones untouched):
-/// the samples within reach of the leaf gathered once; a row's 8 first sums together, the nodes
-/// in the vector lanes, over the samples near the row; then, in rounds, every node's value
+/// the samples within reach of the leaf gathered once; a 2 x 2 x 2 brick's first sums together,
+/// the nodes in the vector lanes, over the samples near the brick; then, in rounds, every node's value
 /// made from the sums it has, the sums still asked for (the points the surface rule and the
 /// plane ratio lift a node to) answered 8 points at a time over the samples near them. Same
 /// values as the per-node reference build up to the order of the sums.

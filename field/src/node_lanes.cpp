@@ -32,8 +32,7 @@ static void addZeroTerms(const Law& L, const SampleSpan& s, const Picks& picks, 
   }
 }
 
-/// The gap between p and [lo, hi] (0 inside): for a row's segment (lo = hi) |p - lo|, whose
-/// square is (p - lo)² to the bit, so that a row's picks are the same through a box or not.
+/// The gap between p and [lo, hi] (0 inside), as gather512 computes it.
 static inline double gapTo(double p, double lo, double hi) {
   const double below = lo - p, above = p - hi;
   return below > 0.0 ? below : above > 0.0 ? above : 0.0;

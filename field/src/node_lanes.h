@@ -14,7 +14,7 @@ namespace fieldpath::field::lanes {
 
 constexpr int kLanes = 8;
 
-/// An axis-aligned box (mm; a row's segment when x0 = x1 and y0 = y1).
+/// An axis-aligned box (mm; a brick of nodes, or the bounding box of a batch of points).
 struct Box {
   double lo[3], hi[3];
 };
