@@ -126,6 +126,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     if (!options->out.empty()) common::checkOutputDirectory(options->out, "--out");
     const Scene scene = loadScene(options->scene, /*read_nominal=*/false);
     const geometry::PathFile path = geometry::readPathFile(options->path);
+    geometry::requireSteadyAxes(path);  // a flipped axis: no motion to sweep
     const common::Progress progress = makeProgressLine(global.quiet);
     if (!scene.tool_given)
       throw InputError(scene.file.string() + ": tool: missing: check needs the cutter (`tool: { "

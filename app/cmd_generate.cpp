@@ -209,14 +209,29 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     for (const std::string& reason : unsafe)
       unsafe_text += (unsafe_text.empty() ? "" : "; ") + reason;
     if (!unsafe.empty()) unsafe_text = "UNSAFE TO RUN: " + unsafe_text + " (report.json)";
+    // Clear of the obstacles but closer than the scene's `clearance`: said where the machine
+    // reads it too (report.json's "safe" stays true: nothing is touched).
+    std::string under_text;
+    if (unsafe.empty() && (result.clearance.min_clearance_mm < job.clearance_mm ||
+                           result.motions.under_required > 0)) {
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "UNDER THE REQUIRED CLEARANCE: postures min %.3f mm, motions min >= %.3f mm, "
+                    "required %.3f mm (report.json)",
+                    result.clearance.min_clearance_mm, result.motions.min_clearance_mm,
+                    job.clearance_mm);
+      under_text = text;
+    }
+    const std::string mark = !unsafe.empty() ? unsafe_text : under_text;
     geometry::writeClFile(out / "path.cl", result.path,
-                          (unsafe.empty() ? "" : unsafe_text + "\n") + "fieldpath generate " +
+                          (mark.empty() ? "" : mark + "\n") + "fieldpath generate " +
                               scene.file.string() + " (" + what +
                               "): x y z i j k, tool tip and axis, mm\n"
                               "`# pass K` blocks are cut at the feed, `# link` blocks are rapid "
                               "moves between them; `# limit`: an angle limit held there");
     geometry::AptHeader header;
     for (const std::string& reason : unsafe) header.remarks.push_back("UNSAFE TO RUN: " + reason);
+    if (!under_text.empty()) header.remarks.push_back(under_text);
     header.part_name = scene.file.stem().string();
     for (char& c : header.part_name)
       c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));

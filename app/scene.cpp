@@ -223,7 +223,12 @@ void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
            "must be < r0 (r_min " + std::to_string(f.r_min_mm) + ", r0 " + std::to_string(f.r0_mm) +
                ")");
   }
-  if (node["gain"]) f.gain = r.number(node["gain"], "field.gain");
+  // A negative gain attracts the tool to the obstacles (it was accepted: every posture pulled
+  // into the walls); 0 turns the field off (the nominal path).
+  if (node["gain"])
+    f.gain = r.number(
+        node["gain"], "field.gain", [](double v) { return v >= 0.0; },
+        ">= 0 (the field pushes the tool away from the obstacles)");
   if (node["sample_step"]) f.sample_step_mm = r.positive(node["sample_step"], "field.sample_step");
   if (node["weights"])
     f.weights = r.word(node["weights"], "field.weights", {"area", "unit"}) == "area"

@@ -377,6 +377,13 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
   if (!(tolerance >= 0.0) || !std::isfinite(tolerance))
     throw common::InputError("field.refine_tolerance: must be >= 0 (got " +
                              std::to_string(tolerance) + ")");
+  // A node spacing past r0 cannot hold a field that lives within r0 of the surfaces: at 10 and
+  // 20 mm (r0 5) the paths collided more than the nominal one, from 50 mm the field was zero.
+  if (h > params.r0_mm)
+    throw common::InputError("field.voxel_size (or --voxel): " + std::to_string(h) +
+                             " mm is coarser than field.r0 (" + std::to_string(params.r0_mm) +
+                             " mm): the grid cannot hold a field that ends within r0 of the "
+                             "surfaces; use at most r0 (r0 / 10 for an accurate one)");
   if (refine_levels < 0 || refine_levels > 6)
     throw common::InputError("field.refine_levels: must be in [0, 6] (got " +
                              std::to_string(refine_levels) + ")");
@@ -401,15 +408,17 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
   trace.lap("cell list");
   const double reach_mm = builder.reach_mm;
 
-  auto refuse = [&](const std::string& what, double nodes, double bytes_per_node) {
+  auto refuse = [&](const std::string& what, double nodes, double bytes_per_node,
+                    const std::string& advice = "use a coarser voxel size") {
     const double bytes = nodes * bytes_per_node;
     if (bytes <= static_cast<double>(request.max_memory_bytes)) return;
     throw common::InputError("voxel field at h = " + std::to_string(h) + " mm: " + what + " " +
                              std::to_string(static_cast<long long>(nodes)) + " nodes (" +
                              mib(bytes) + "), over the limit of " +
-                             mib(static_cast<double>(request.max_memory_bytes)) +
-                             "; use a coarser voxel size or a smaller region");
+                             mib(static_cast<double>(request.max_memory_bytes)) + "; " + advice);
   };
+  const std::string refine_advice =
+      "raise field.refine_tolerance or lower field.refine_levels (or a coarser voxel size)";
   // The plane ratio adds a float to the Vec3f of a node.
   const double value_bytes = ratio ? 16.0 : 12.0;
   // Progress: level 0 takes the whole bar without refinement, half of it with.
@@ -490,6 +499,14 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
             return sum;
           },
           std::plus<std::size_t>());
+      // Refused before the split lists (8 cells a split) and the new nodes are made: at least 8
+      // new nodes a split cell (the whole build reached 21 GB before the refusal below).
+      {
+        double lower_nodes = 8.0 * double(splits);
+        for (const Level& level : levels) lower_nodes += double(level.grid->activeVoxelCount());
+        refuse("refined level " + std::to_string(l + 1) + " makes at least", lower_nodes,
+               kVoxelBytesPerNode * value_bytes / 12.0, refine_advice);
+      }
       CellList split_cells(splits), next_cells(8 * splits);
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size()), [&](const auto& range) {
         for (std::size_t c = range.begin(); c != range.end(); ++c) {
@@ -513,7 +530,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
       double built_nodes = double(fine_nodes->activeVoxelCount());
       for (const Level& level : levels) built_nodes += double(level.grid->activeVoxelCount());
       refuse("refined level " + std::to_string(l + 1) + " makes", built_nodes,
-             kVoxelBytesPerNode * value_bytes / 12.0);
+             kVoxelBytesPerNode * value_bytes / 12.0, refine_advice);
       Level fine;
       fine.h_mm = 0.5 * hl;
       const double share_begin = level0_share + (1.0 - level0_share) * l / refine_levels;

@@ -1,5 +1,8 @@
 #include "fieldpath/geometry/cl_file.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <fstream>
 
 #include "fieldpath/common/atomic_file.h"
@@ -42,6 +45,26 @@ std::size_t PathFile::count(PathBlock::Kind kind) const {
   std::size_t n = 0;
   for (const PathBlock& b : blocks) n += b.kind == kind;
   return n;
+}
+
+void requireSteadyAxes(const PathFile& path, double max_turn_deg) {
+  for (const PathBlock& block : path.blocks) {
+    if (block.kind != PathBlock::Kind::Pass) continue;
+    for (std::size_t i = block.begin + 1; i < block.end; ++i) {
+      const Vec3& a = path.postures[i - 1].axis;
+      const Vec3& b = path.postures[i].axis;
+      const double turn_deg =
+          std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180.0 / M_PI;
+      if (!(turn_deg <= max_turn_deg)) {
+        char turn[64], limit[64];
+        std::snprintf(turn, sizeof turn, "%.4g", turn_deg);
+        std::snprintf(limit, sizeof limit, "%g", max_turn_deg);
+        throw InputError(path.where(i) + ": the tool axis turns " + turn +
+                         " deg from the posture before (" + path.where(i - 1) + "): more than " +
+                         limit + " deg between two postures of a pass (a flipped axis?)");
+      }
+    }
+  }
 }
 
 PathFile singlePass(std::vector<Posture> postures) {

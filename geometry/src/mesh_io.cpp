@@ -74,6 +74,47 @@ void fillScene(aiScene& scene, const TriangleMesh& mesh) {
 /// not match (truncated, or a count that lies) is refused saying so, where assimp would only say
 /// it cannot tell ASCII from binary. A file that starts with `solid` and does not match is left
 /// to assimp as ASCII.
+/// assimp reads an ASCII STL cut after a facet (no `endsolid`) and a facet loop of 4 vertices
+/// (some exporters' quads: half the face lost) without a word: every facet must have 3
+/// `vertex` lines and the file must end with `endsolid`.
+void checkAsciiStl(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string line, last;
+  std::size_t number = 0, facet_line = 0, vertices = 0;
+  bool in_facet = false;
+  // The first word of each line, lower case (a scan by hand: a million facets are 7 M lines).
+  const auto firstWord = [](const std::string& text) {
+    std::size_t b = 0;
+    while (b < text.size() && std::isspace(static_cast<unsigned char>(text[b]))) ++b;
+    std::size_t e = b;
+    std::string w;
+    while (e < text.size() && !std::isspace(static_cast<unsigned char>(text[e])) && e - b < 9)
+      w += static_cast<char>(std::tolower(static_cast<unsigned char>(text[e++])));
+    return w;
+  };
+  while (std::getline(in, line)) {
+    ++number;
+    const std::string word = firstWord(line);
+    if (word.empty()) continue;
+    last = word;
+    if (word == "facet") {
+      in_facet = true;
+      facet_line = number;
+      vertices = 0;
+    } else if (word == "vertex") {
+      ++vertices;
+    } else if (word == "endfacet") {
+      if (in_facet && vertices != 3)
+        throw InputError(file.string() + ":" + std::to_string(facet_line) +
+                         ": ASCII STL facet with " + std::to_string(vertices) +
+                         " vertices (an STL facet has 3)");
+      in_facet = false;
+    }
+  }
+  if (last != "endsolid")
+    throw InputError(file.string() + ": ASCII STL without `endsolid` at its end (truncated?)");
+}
+
 void checkStlSize(const std::filesystem::path& file, std::uintmax_t size) {
   if (lowerExtension(file) != ".stl") return;
   std::ifstream in(file, std::ios::binary);
@@ -82,8 +123,16 @@ void checkStlSize(const std::filesystem::path& file, std::uintmax_t size) {
   const std::size_t got = static_cast<std::size_t>(in.gcount());
   std::size_t first = 0;
   while (first < got && std::isspace(header[first])) ++first;
-  if (got >= first + 5 && std::string(reinterpret_cast<const char*>(header) + first, 5) == "solid")
-    return;  // ASCII (or a binary one whose header starts so: assimp tells them apart)
+  if (got >= first + 5 && std::string(reinterpret_cast<const char*>(header) + first, 5) == "solid") {
+    // ASCII, unless a binary one whose header starts so (its size matches its count).
+    if (got == 84) {
+      const std::uint32_t count = std::uint32_t(header[80]) | std::uint32_t(header[81]) << 8 |
+                                  std::uint32_t(header[82]) << 16 | std::uint32_t(header[83]) << 24;
+      if (84 + 50 * std::uintmax_t(count) == size) return;
+    }
+    checkAsciiStl(file);
+    return;
+  }
   if (got < 84)
     throw InputError(file.string() + ": binary STL of " + std::to_string(size) +
                      " bytes, shorter than its 84-byte header (truncated, or not STL)");
@@ -114,7 +163,8 @@ void checkPlyHeader(const std::filesystem::path& file, std::uintmax_t size) {
   };
   std::string line;
   std::size_t read = 0, number = 0;
-  bool format = false;
+  bool format = false, ascii = false;
+  double lines_declared = 0.0;  // an ASCII PLY holds one line per element instance
   while (std::getline(in, line)) {
     ++number;
     read += line.size() + 1;
@@ -132,14 +182,31 @@ void checkPlyHeader(const std::filesystem::path& file, std::uintmax_t size) {
           (kind != "ascii" && kind != "binary_little_endian" && kind != "binary_big_endian"))
         refuse(number, "expected one `format ascii|binary_little_endian|binary_big_endian 1.0`");
       format = true;
+      ascii = kind == "ascii";
     } else if (word == "element") {
       std::string name;
       double count = -1;
       words >> name >> count;
       if (!words || count < 0 || count != std::floor(count) || count > static_cast<double>(size))
         refuse(number, "element count does not fit in the file: " + line);
+      lines_declared += count;
     } else if (word == "end_header") {
       if (!format) refuse(number, "no `format` line");
+      if (!ascii) return;
+      // assimp reads a file with fewer (or more) lines than its elements silently: faces dropped
+      // or made up at the end.
+      double lines = 0.0;
+      while (std::getline(in, line))
+        for (const char c : line)
+          if (!std::isspace(static_cast<unsigned char>(c))) {
+            ++lines;
+            break;
+          }
+      if (lines != lines_declared)
+        throw InputError(file.string() + ": ASCII PLY: its header declares " +
+                         std::to_string(static_cast<long long>(lines_declared)) +
+                         " element lines, the file has " + std::to_string(static_cast<long long>(lines)) +
+                         " (truncated, or the header's counts are wrong)");
       return;
     } else if (word != "property" && word != "comment" && word != "obj_info") {
       refuse(number, "unexpected line '" + line.substr(0, 40) + "'");

@@ -218,8 +218,12 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
       const double reach_mm = geometry::motionSweepMm(piece.p0, piece.p1, reach);
       const double certain =
           std::min({piece.d0, piece.d1, 0.5 * (piece.d0 + piece.d1 - reach_mm)});
-      if (certain >= stop_mm || reach_mm <= 2 * resolution) {
-        lowest = std::min(lowest, std::max(0.0, certain));
+      // A piece of a billionth of its motion that still sweeps farther than the resolution
+      // (an axis reversed between two postures jumps at one t: no halving shrinks it) is not
+      // resolved further: its lower bound stands, 0 where it may touch (was an endless halving).
+      const bool unresolved = !(piece.t1 - piece.t0 > 1e-9) || !std::isfinite(reach_mm);
+      if (certain >= stop_mm || reach_mm <= 2 * resolution || unresolved) {
+        lowest = std::min(lowest, std::max(0.0, std::isfinite(certain) ? certain : 0.0));
         continue;
       }
       const double tm = 0.5 * (piece.t0 + piece.t1);

@@ -86,11 +86,30 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
     }
     const double gap = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(steps);
     std::size_t begin = block.begin;
+    // The last few feed directions of the pass (repeats skipped): a feed that turns back past
+    // 90 deg from one of them (a zig-zag's return leg after its step-over) starts a new pass.
+    // The steering's frame (f, n, n x f) turns over with the feed: the same tilt would lean the
+    // axis to the other side, into the wall it leaned away from.
+    constexpr std::size_t kRecent = 3;
+    std::vector<Vec3> recent;
     for (std::size_t i = block.begin + 1; i < block.end; ++i) {
-      if (gap > 0.0 && (path.postures[i].tip_mm - path.postures[i - 1].tip_mm).norm() > gap) {
+      const Vec3 step = path.postures[i].tip_mm - path.postures[i - 1].tip_mm;
+      if (gap > 0.0 && step.norm() > gap) {  // the gap is the link between the two
         ranges.emplace_back(begin, i);
         begin = i;
+        recent.clear();
+        continue;
       }
+      if (step.norm() <= kRepeatMm) continue;
+      bool back = false;
+      for (const Vec3& before : recent) back = back || step.dot(before) < 0.0;
+      if (back) {  // the new pass starts where this step does; the step-over before is the link
+        if (i - 1 > begin) ranges.emplace_back(begin, i - 1);
+        begin = i - 1;
+        recent.clear();
+      }
+      recent.push_back(step);
+      if (recent.size() > kRecent) recent.erase(recent.begin());
     }
     ranges.emplace_back(begin, block.end);
   }

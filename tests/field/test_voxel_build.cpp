@@ -168,6 +168,22 @@ TEST(VoxelBuild, BlockBuildEqualsTheReferenceOnRandomScenes) {
   }
 }
 
+TEST(VoxelBuild, AVoxelSizePastR0IsRefusedNamingTheKey) {
+  const auto plane = test::squarePlane(10.0);
+  FieldParams p;  // r0 5 mm
+  const DirectField direct(sampleObstacles({&plane, 1}, 1.0, Weights::Area), p);
+  EXPECT_GT(VoxelField(direct, requestOn(5.0, FieldBackend::Cpu, StoredQuantity::PlaneRatio))
+                .stats()
+                .active_nodes,
+            0u);
+  try {
+    (void)VoxelField(direct, requestOn(10.0, FieldBackend::Cpu, StoredQuantity::PlaneRatio));
+    ADD_FAILURE() << "a 10 mm grid was built for a field that ends 5 mm from the surface";
+  } catch (const fieldpath::common::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("field.voxel_size"), std::string::npos) << e.what();
+  }
+}
+
 TEST(VoxelBuild, CudaBuildEqualsTheCpuBuild) {
   if (!cudaFieldBackendAvailable()) GTEST_SKIP() << "no CUDA build or no GPU here";
   const DirectField direct = impellerField(1.0);

@@ -156,6 +156,31 @@ TEST(MeshIo, BrokenFilesAreInputErrors) {
   }
   // Truncated ASCII STL.
   expectInputErrorNamingFile(writeBytes("cut.stl", std::string(kAsciiTetra).substr(0, 60)));
+  // Files assimp reads without a word, losing faces: an ASCII STL cut after a whole facet (no
+  // `endsolid`), a facet of 4 vertices, an ASCII PLY with fewer or more lines than its header's
+  // elements.
+  const std::string tetra = kAsciiTetra;
+  const auto expectMessage = [](const fs::path& p, const std::string& what) {
+    try {
+      (void)loadMesh(p);
+      ADD_FAILURE() << "no error for " << p;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  expectMessage(writeBytes("cut_at_facet.stl", tetra.substr(0, tetra.find("endsolid"))),
+                "without `endsolid`");
+  std::string quad = tetra;
+  quad.insert(quad.find("  vertex 1 0 0\n endloop"), "  vertex 1 1 0\n");
+  expectMessage(writeBytes("quad_facet.stl", quad), "quad_facet.stl:2: ASCII STL facet with 4 vertices");
+  const std::string ply_header =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n";
+  expectMessage(writeBytes("short.ply", ply_header), "declares 6 element lines, the file has 5");
+  expectMessage(writeBytes("long.ply", ply_header + "3 0 2 3\n3 0 1 3\n"),
+                "declares 6 element lines, the file has 7");
+  EXPECT_EQ(loadMesh(writeBytes("whole.ply", ply_header + "3 0 2 3\n")).triangles.size(), 2u);
 }
 
 TEST(MeshIo, DefectiveMeshesLoadAndAreReported) {

@@ -84,3 +84,29 @@ TEST(Passes, EmptyPassAndBadPathValuesNameThePassOrKey) {
   path.step_mm = 0;
   EXPECT_THROW(impellerPasses(good, path, 3.0), common::InputError);
 }
+
+TEST(Passes, AZigZagInOnePassBlockIsOnePassALeg) {
+  // Forward along x, a 1 mm step-over in y, back along -x, another step-over, forward again:
+  // one `# pass` block. The steering frame turns over with the feed, so each leg is a pass of
+  // its own, starting with its first step; the step-overs fall between passes (links).
+  geometry::PathFile path;
+  const auto leg = [&](double y, double from, double to) {
+    for (int k = 0; k <= 10; ++k)
+      path.postures.push_back({Vec3(from + (to - from) * k / 10.0, y, 0), Vec3::UnitZ()});
+  };
+  leg(0, 0, 10);   // postures 0-10
+  leg(1, 10, 0);   // 11-21 (posture 11 is the step-over's end)
+  leg(2, 0, 10);   // 22-32
+  path.blocks = {{geometry::PathBlock::Kind::Pass, 0, path.postures.size()}};
+  const auto ranges = passRanges(path, 0.0);
+  ASSERT_EQ(ranges.size(), 3u);
+  EXPECT_EQ(ranges[0], std::make_pair(std::size_t{0}, std::size_t{11}));
+  EXPECT_EQ(ranges[1], std::make_pair(std::size_t{11}, std::size_t{22}));
+  EXPECT_EQ(ranges[2], std::make_pair(std::size_t{22}, std::size_t{33}));
+  // A corner of 90 deg (an L) is one pass still.
+  geometry::PathFile corner;
+  for (int k = 0; k <= 10; ++k) corner.postures.push_back({Vec3(k, 0, 0), Vec3::UnitZ()});
+  for (int k = 1; k <= 10; ++k) corner.postures.push_back({Vec3(10, k, 0), Vec3::UnitZ()});
+  corner.blocks = {{geometry::PathBlock::Kind::Pass, 0, corner.postures.size()}};
+  EXPECT_EQ(passRanges(corner, 0.0).size(), 1u);
+}

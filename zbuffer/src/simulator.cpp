@@ -157,11 +157,14 @@ std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
   for (const auto& t : triangles) {
     if (t[0] >= vertices.size() || t[1] >= vertices.size() || t[2] >= vertices.size())
       throw InputError("part: triangle index out of range");
-    rasterTriangle(g, vertices[t[0]], vertices[t[1]], vertices[t[2]], 1.f,
-                   [&](int ix, int iy, float z) {
-                     float& h = top[std::size_t(iy) * grid.nx + ix];
-                     h = std::max(h, z);
-                   });
+    // Either way round: an open sheet wound downward (as CAD exports of surfaces often are)
+    // is still the part's top; on a closed solid the highest crossing faces up anyway.
+    for (const float sign : {1.f, -1.f})
+      rasterTriangle(g, vertices[t[0]], vertices[t[1]], vertices[t[2]], sign,
+                     [&](int ix, int iy, float z) {
+                       float& h = top[std::size_t(iy) * grid.nx + ix];
+                       h = std::max(h, z);
+                     });
   }
   for (auto& h : top)
     if (h == -FLT_MAX) h = std::numeric_limits<float>::quiet_NaN();

@@ -135,4 +135,9 @@ void writeNpyFile(const std::filesystem::path& file, std::span<const Posture> po
 /// One pass block over `postures` (a path without markers).
 PathFile singlePass(std::vector<Posture> postures);
 
+/// InputError naming the line where the tool axis turns more than `max_turn_deg` between two
+/// consecutive postures of a pass block (a flipped axis: the motion between them is not one a
+/// machine makes, and a check sweeping it cannot bound it).
+void requireSteadyAxes(const PathFile& path, double max_turn_deg = 90.0);
+
 }  // namespace fieldpath::geometry

@@ -61,7 +61,8 @@ std::vector<Pass> nominalPasses(const geometry::PathFile& path, const PathParams
 
 /// Posture ranges [begin, end) of the passes of a path: its pass blocks (link blocks dropped),
 /// each split where two consecutive tips are farther apart than `pass_gap_mm` (0: 4 × the
-/// block's median step).
+/// block's median step), and where the feed turns back more than 90° from one of its last three
+/// directions (a zig-zag's legs: the new pass starts with the step that turns back).
 std::vector<std::pair<std::size_t, std::size_t>> passRanges(const geometry::PathFile& path,
                                                             double pass_gap_mm);
 

@@ -164,8 +164,9 @@ std::size_t estimateHostBytes(const Grid& grid);
 /// (default: half the physical memory).
 void checkGridFits(const Grid& grid, std::size_t available_bytes = 0);
 
-/// The highest up-facing point of a part mesh on each line (world frame, mm); NaN where the line
-/// misses the part.
+/// The highest point of a part mesh on each line (world frame, mm), whichever way its triangles
+/// face (an open sheet wound downward is the top all the same); NaN where the line misses the
+/// part.
 std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
                            std::span<const std::array<std::uint32_t, 3>> triangles);
 
