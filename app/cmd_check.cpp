@@ -233,6 +233,11 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
           surface->simulation_s);
     else
       std::printf("surface: not checked (the scene has no `part`)\n");
+    if (surface && surface->coarsened)
+      std::fprintf(stderr,
+                   "note: --spacing %g mm would make more Z-buffer lines than a check takes: "
+                   "lines every %.4g mm (check.json `spacing`)\n",
+                   options->spacing_mm, surface->grid.dx_mm);
     if (surface && surface->cut_lines == 0)
       std::fprintf(stderr,
                    "warning: the path never reaches the part (no line of the surface cut): the "

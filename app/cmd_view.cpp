@@ -64,6 +64,13 @@ void addViewCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(positiveFinite("MB"))
       ->capture_default_str();
   cmd->callback([o, &global] {
+    // The page must not replace what it is made from (`--out` naming the scene or the path
+    // wrote the HTML over it without a word).
+    std::error_code same;
+    for (const std::string& input : {o->scene, o->path})
+      if (!input.empty() && (o->out == input || std::filesystem::equivalent(o->out, input, same)))
+        throw InputError("--out: " + o->out + " is an input of this view (" + input +
+                         "): give another file for the page");
     // three.js first: without it there is no page to write.
     const ThreeJs three = loadThreeJs(threeJsDir());
     ViewRequest request;

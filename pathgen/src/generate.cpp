@@ -208,6 +208,10 @@ GenerateResult generatePath(const GenerateRequest& request) {
       if (steered.status != dynamics::Status::Ok) {
         std::ostringstream msg;
         msg << pass.label << ": " << dynamics::toString(steered.status) << ": " << steered.message;
+        if (steered.status == dynamics::Status::SolverFailed)  // what to change, not CVODE's words
+          msg << " (the spring-damper is too stiff for the integrator here: raise "
+                 "dynamics.inertia or dynamics.damping, lower field.gain or dynamics.stiffness, "
+                 "or relax dynamics.rtol)";
         throw InputError(msg.str());
       }
       for (const dynamics::PostureSample& s : steered.samples) {

@@ -211,6 +211,14 @@ TEST(View, BadInputIsExitOneWithOneLineOrAPageThatSaysWhatIsMissing) {
     EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << ": " << r.err;
     EXPECT_FALSE(fs::exists(dir.path() / "bad.html")) << c.args;
   }
+  // The page written over its own path or scene: refused, both left as they were.
+  const std::string path_before = slurp(dir.path() / "short.cl");
+  for (const std::string& out : {"short.cl", "scene.yaml"}) {
+    const Outcome o = runFieldpath(dir, "view scene.yaml --path short.cl --out " + out);
+    EXPECT_EQ(o.exit_code, 1) << o.output();
+    EXPECT_NE(o.err.find("--out"), std::string::npos) << o.err;
+  }
+  EXPECT_EQ(slurp(dir.path() / "short.cl"), path_before);
 
   // A truncated deviation.npy.
   ASSERT_EQ(runFieldpath(dir, "check scene.yaml --path path.cl --out chk").exit_code, 0);
