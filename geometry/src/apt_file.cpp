@@ -74,7 +74,12 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
     const std::string_view content = aptContent(text.substr(pos, nl - pos));
     pos = nl + 1;
     if (record.empty()) record_line = line;
-    if (!content.empty() && content.back() == '$') {
+    // PPRINT and PARTNO carry text: a `$` at its end is the text's (it swallowed the next GOTO).
+    const auto isText = [](std::string_view c) {
+      const std::string head = upperCase(std::string(trimmed(c).substr(0, 6)));
+      return head == "PPRINT" || head == "PARTNO";
+    };
+    if (!content.empty() && content.back() == '$' && !(record.empty() && isText(content))) {
       record += content.substr(0, content.size() - 1);
       continue;
     }
@@ -101,6 +106,13 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
       out.units.emplace_back(chunk.postures.size(), scale);
       continue;
     }
+    // A motion the reader does not take would be a posture lost without a word: GOTO not at
+    // the record's start (`RAPID,GOTO/`, `N40 GOTO/`, `GO TO/`), a relative GODLTA.
+    if (major != "GOTO" && (major.find("GOTO") != std::string_view::npos ||
+                            major.find("GO TO") != std::string_view::npos || major == "GODLTA"))
+      fail(file, record_line,
+           std::string(major) + "/: a motion record this reader does not take (a GOTO/ record "
+           "of its own, absolute x, y, z[, i, j, k])");
     if (major != "GOTO" || slash == std::string::npos) continue;
     double v[6];
     std::size_t count = 0;

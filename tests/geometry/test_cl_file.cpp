@@ -212,3 +212,20 @@ TEST(AptFile, UnitsFiniAndRemarks) {
   EXPECT_EQ(l2, "PPRINT/UNSAFE TO RUN: A   AND A NEWLINE");
   EXPECT_EQ(readAptFile(w).size(), 3u);
 }
+
+// A motion the reader does not take is refused with its line (each lost a posture silently),
+// and a `$` ending a PPRINT is its text's, not a continuation (it swallowed the next GOTO).
+TEST(AptFile, MotionsNotReadAreRefusedAndPprintKeepsItsDollar) {
+  for (const std::string& record : {"RAPID,GOTO/1,2,3", "N40 GOTO/1,2,3", "GO TO/1,2,3",
+                                    "GODLTA/0,0,5"}) {
+    try {
+      readAptFile(writeBytes("m.apt", "GOTO/0,0,0,0,0,1\n" + record + "\nGOTO/1,0,0\n"));
+      ADD_FAILURE() << record << " was read past";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("m.apt:2:"), std::string::npos) << e.what();
+    }
+  }
+  const auto p = readAptFile(
+      writeBytes("d.apt", "GOTO/0,0,0,0,0,1\nPPRINT/PRICE 5$\nGOTO/1,0,0\nGOTO/2,0,0\n"));
+  EXPECT_EQ(p.size(), 3u);
+}
