@@ -1,10 +1,12 @@
 #include "cli_parse.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <limits>
 
 #include "errors.h"
+#include "fieldpath/geometry/mesh.h"
 #include "fieldpath/geometry/mesh_io.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "to_zbuffer.h"
@@ -33,6 +35,22 @@ zb::Tool parseTool(const std::string& text) {
     }
   }
   const geometry::TriangleMesh mesh = geometry::loadMesh(text);
+  // The Z-buffer cuts with the tool's downward-facing surface from its tip up: an open mesh
+  // (a cylinder without its bottom cap) cut nothing, one below its tip cut 13 mm too deep.
+  const geometry::MeshReport report = geometry::validateMesh(mesh);
+  if (report.open_edges > 0 || report.non_manifold_edges > 0)
+    throw InputError("--tool " + text + ": the tool mesh is not closed (" +
+                     std::to_string(report.open_edges) + " open, " +
+                     std::to_string(report.non_manifold_edges) +
+                     " non-manifold edges): a tool is a closed solid, tip at the origin, along +z");
+  double lowest = 0.0, size = 0.0;
+  for (const auto& v : mesh.vertices) {
+    lowest = std::min(lowest, v.z());
+    size = std::max(size, v.cwiseAbs().maxCoeff());
+  }
+  if (lowest < -1e-6 * std::max(size, 1.0))
+    throw InputError("--tool " + text + ": the tool mesh reaches z = " + std::to_string(lowest) +
+                     " mm, below its tip: the tip is the origin and the tool lies along +z");
   try {
     return zb::Tool::fromMesh(toZbuffer(mesh));
   } catch (const InputError& e) {

@@ -341,6 +341,12 @@ ViewData gatherView(const ViewRequest& request) {
           !fs::equivalent(check->path, p.file.file, ec))
         throw InputError("--check " + request.check_dir.string() + ": the check of " + check->path +
                          ", not of " + p.what);
+      // A check against another scene (its obstacles): its clearances are not this scene's.
+      if (!check->scene.empty() && fs::exists(check->scene) && fs::exists(request.scene) &&
+          !fs::equivalent(check->scene, request.scene, ec))
+        throw InputError("--check " + request.check_dir.string() + ": a check against " +
+                         check->scene + ", not " + request.scene.string() +
+                         ": give the folder that `check " + request.scene.string() + "` wrote");
       // The same file, but edited since it was checked: the check says nothing of it now.
       if (!check->path_digest.empty() && fs::exists(p.file.file) &&
           common::fileDigest(p.file.file) != check->path_digest)

@@ -121,6 +121,7 @@ CheckJson readCheckJson(const fs::path& dir) {
   if (j.contains("path") && j["path"].is_string()) c.path = j["path"].get<std::string>();
   if (j.contains("path_digest") && j["path_digest"].is_string())
     c.path_digest = j["path_digest"].get<std::string>();
+  if (j.contains("scene") && j["scene"].is_string()) c.scene = j["scene"].get<std::string>();
   return c;
 }
 

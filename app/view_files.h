@@ -23,6 +23,7 @@ struct CheckJson {
   std::size_t postures = 0, colliding_postures = 0, colliding_motions = 0;
   std::string path;
   std::string path_digest;  ///< common::fileDigest of the path checked (empty in older check.json)
+  std::string scene;        ///< the scene file checked against, as `check` was given it
 };
 /// check.json of a `check --out` folder (`--check DIR`).
 CheckJson readCheckJson(const std::filesystem::path& dir);
