@@ -80,7 +80,8 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
         {"tool_triangles", r.tool_triangles},
         {"voxel_nodes", r.voxel_nodes},
         {"voxel_memory_bytes", r.voxel_memory_bytes},
-        {"voxel_outside_points", r.voxel_outside_points}}},
+        {"voxel_outside_points", r.voxel_outside_points},
+        {"turned_open_sheets", r.turned_sheets}}},
       {"reach_box_mm",
        {{"min", {box.min().x(), box.min().y(), box.min().z()}},
         {"max", {box.max().x(), box.max().y(), box.max().z()}},
@@ -259,6 +260,11 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                    "report.json)\n",
                    job.clearance_mm, c.min_clearance_mm, c.min_index + 1, m.min_clearance_mm,
                    m.under_required);
+    if (result.turned_sheets > 0)
+      std::printf(
+          "note: %zu open obstacle surface%s faced away from the passes: turned to face them "
+          "(the field pushes along the normals)\n",
+          result.turned_sheets, result.turned_sheets == 1 ? "" : "s");
     if (result.voxel_outside_points > 0)
       std::printf(
           "note: %zu node positions fell outside where the voxels answer (the reach box; "

@@ -97,7 +97,31 @@ double meshVolume(const TriangleMesh& mesh) {
   return six_volume_mm3 / 6.0;
 }
 
+namespace {
+/// The shells of a mesh (triangles joined through their vertices) and whether each is closed.
+struct Shell {
+  std::vector<int> triangles;
+  bool closed;
+};
+std::vector<Shell> shellsOf(const TriangleMesh& mesh);
+}  // namespace
+
 std::vector<std::vector<int>> closedShells(const TriangleMesh& mesh) {
+  std::vector<std::vector<int>> out;
+  for (Shell& shell : shellsOf(mesh))
+    if (shell.closed) out.push_back(std::move(shell.triangles));
+  return out;
+}
+
+std::vector<std::vector<int>> openShells(const TriangleMesh& mesh) {
+  std::vector<std::vector<int>> out;
+  for (Shell& shell : shellsOf(mesh))
+    if (!shell.closed) out.push_back(std::move(shell.triangles));
+  return out;
+}
+
+namespace {
+std::vector<Shell> shellsOf(const TriangleMesh& mesh) {
   const int n = static_cast<int>(mesh.vertices.size());
   for (const auto& t : mesh.triangles)
     if (!((t.array() >= 0).all() && (t.array() < n).all())) return {};  // validateMesh's job
@@ -140,11 +164,13 @@ std::vector<std::vector<int>> closedShells(const TriangleMesh& mesh) {
       }
     }
   }
-  std::vector<std::vector<int>> out;
+  std::vector<Shell> out;
   for (std::size_t shell = 0; shell < triangles_of.size(); ++shell)
-    if (!triangles_of[shell].empty() && closed[shell]) out.push_back(std::move(triangles_of[shell]));
+    if (!triangles_of[shell].empty())
+      out.push_back({std::move(triangles_of[shell]), closed[shell] != 0});
   return out;
 }
+}  // namespace
 
 std::size_t orientClosedShells(TriangleMesh& mesh) {
   const std::vector<std::vector<int>> shells = closedShells(mesh);

@@ -98,6 +98,24 @@ TEST_F(MeshJob, ClAptAndNpyNominalPathsGiveTheSamePathBitForBit) {
   EXPECT_EQ(from_cl.find("UNSAFE"), std::string::npos);
 }
 
+TEST_F(MeshJob, BladesWoundAwayFromThePassesAreTurnedToFaceThem) {
+  // The blades are open sheets: wound the other way their field would pull the tool into them.
+  // Turned before sampling, the job is the same, bit for bit.
+  const std::string expected = generated("nominal.cl");
+  geometry::TriangleMesh flipped = geometry::loadMesh(dir_->path() / "blades.stl");
+  for (auto& t : flipped.triangles) std::swap(t[1], t[2]);
+  geometry::saveMesh(flipped, dir_->path() / "blades_away.stl");
+  std::string scene = sceneText("nominal.cl");
+  scene.replace(scene.find("blades.stl"), 10, "blades_away.stl");
+  dir_->write("away.yaml", scene);
+  const auto r = test::runFieldpath(*dir_, "generate away.yaml --out out_away");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  EXPECT_NE(r.out.find("open obstacle surfaces faced away from the passes"), std::string::npos)
+      << r.out;
+  const std::string text = test::slurp(dir_->path() / "out_away/path.cl");
+  EXPECT_EQ(text.substr(text.find('\n') + 1), expected);
+}
+
 TEST_F(MeshJob, ACollidingPathIsMarkedUnsafeWhereTheMachineReadsIt) {
   // The nominal path hits the blades with the shank (README): SetUpTestSuite's `generate
   // --nominal` wrote it. Marked before the first motion in both files, and in report.json.

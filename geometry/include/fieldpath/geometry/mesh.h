@@ -41,6 +41,8 @@ double meshVolume(const TriangleMesh& mesh);
 /// The closed, consistently wound shells of `mesh` (connected sets of triangles, joined through
 /// their vertices, whose every edge is used twice, once each way), as triangle indices.
 std::vector<std::vector<int>> closedShells(const TriangleMesh& mesh);
+/// The other shells (triangles joined through their vertices): open sheets, or not closed.
+std::vector<std::vector<int>> openShells(const TriangleMesh& mesh);
 
 /// Turns every closed, consistently wound shell (a connected set of triangles whose every edge is
 /// used twice, once each way) that is wound inward (negative enclosed volume: CAD exports with the

@@ -130,6 +130,9 @@ struct GenerateResult {
   /// answer (the reach box; refined near the path: near the first path's nodes) and were
   /// answered by the exact sum (voxel mode).
   std::size_t voxel_outside_points = 0;
+  /// Open obstacle sheets whose normals faced away from the passes, turned to face them before
+  /// sampling (the field pushes along the normals).
+  std::size_t turned_sheets = 0;
   /// The voxel field of the path (voxel mode with GenerateRequest::keep_voxels), else null.
   std::shared_ptr<const field::VoxelField> voxels;
   /// With `voxels`, refined near the path: the cells the voxels answer in (CellMask::inCore),
