@@ -271,3 +271,34 @@ TEST(CheckSurface, TheMotionBetweenTwoPosturesIsCut) {
   const auto over = gouge("over.cl");
   EXPECT_EQ(over["gouged_lines"].get<int>(), 0);
 }
+
+TEST(CheckSurface, TheSameJobHighUpInZReadsTheSame) {
+  // A pass along a plate, and the whole job lifted 1e5 mm in z: the same surface figures
+  // (float heights held there read a clean pass as 7.8 um of gouge on 498 lines).
+  const TempDir dir;
+  for (const double lift : {0.0, 1e5}) {
+    geometry::TriangleMesh part, wall;
+    pathgen::test::addBox(part, 0, 50, 0, 50, lift - 10, lift);
+    pathgen::test::addBox(wall, 0, 50, 30, 35, lift - 5, lift + 20);
+    const std::string tag = lift == 0.0 ? "low" : "high";
+    geometry::saveMesh(part, dir.path() / ("part_" + tag + ".stl"));
+    geometry::saveMesh(wall, dir.path() / ("wall_" + tag + ".stl"));
+    dir.write(tag + ".yaml", "obstacles:\n  - mesh: wall_" + tag + ".stl\npart: part_" + tag +
+                                 ".stl\ntool: { shape: ball, radius: 3, length: 40 }\n");
+    std::ostringstream path;
+    path.precision(17);
+    path << "# pass 1\n";
+    for (int k = 0; k <= 80; ++k) path << 5.0 + 0.5 * k << " 20 " << lift << " 0 0 1\n";
+    dir.write(tag + ".cl", path.str());
+  }
+  auto surface = [&](const std::string& tag) {
+    const auto r = test::runFieldpath(dir, "check " + tag + ".yaml --path " + tag + ".cl --out out_" + tag);
+    EXPECT_EQ(r.exit_code, 0) << r.output();
+    return nlohmann::json::parse(test::slurp(dir.path() / ("out_" + tag) / "check.json"))["surface"];
+  };
+  const auto low = surface("low"), high = surface("high");
+  EXPECT_EQ(low["gouged_lines"].get<int>(), 0);
+  EXPECT_EQ(high["gouged_lines"].get<int>(), 0);
+  EXPECT_NEAR(high["max_gouge_um"].get<double>(), low["max_gouge_um"].get<double>(), 1.0);
+  EXPECT_NEAR(high["max_scallop_um"].get<double>(), low["max_scallop_um"].get<double>(), 1.0);
+}
