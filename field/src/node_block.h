@@ -49,9 +49,6 @@ struct SampleSet {
   int count = 0;
   /// The seven double arrays in SampleSpan's order (x, y, z, nx, ny, nz, w).
   std::array<std::vector<double>*, 7> doubles() { return {&x, &y, &z, &nx, &ny, &nz, &w}; }
-  std::array<const std::vector<double>*, 7> doubles() const {
-    return {&x, &y, &z, &nx, &ny, &nz, &w};
-  }
   /// Room for n samples and 8 more (the lanes' whole-vector stores; count unchanged).
   void reserveFor(std::size_t n) {
     n += 8;

@@ -501,12 +501,11 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
           std::plus<std::size_t>());
       // Refused before the split lists (8 cells a split) and the new nodes are made: at least 8
       // new nodes a split cell (the whole build reached 21 GB before the refusal below).
-      {
-        double lower_nodes = 8.0 * double(splits);
-        for (const Level& level : levels) lower_nodes += double(level.grid->activeVoxelCount());
-        refuse("refined level " + std::to_string(l + 1) + " makes at least", lower_nodes,
-               kVoxelBytesPerNode * value_bytes / 12.0, refine_advice);
-      }
+      double levels_nodes = 0.0;  // the levels built so far
+      for (const Level& level : levels) levels_nodes += double(level.grid->activeVoxelCount());
+      refuse("refined level " + std::to_string(l + 1) + " makes at least",
+             levels_nodes + 8.0 * double(splits), kVoxelBytesPerNode * value_bytes / 12.0,
+             refine_advice);
       CellList split_cells(splits), next_cells(8 * splits);
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size()), [&](const auto& range) {
         for (std::size_t c = range.begin(); c != range.end(); ++c) {
@@ -527,8 +526,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
       for (auto leaf = fine_nodes->tree().cbeginLeaf(); leaf; ++leaf)
         fine_origins.push_back(leaf->origin());
       // All levels so far and the new one, at the estimate's bytes per node.
-      double built_nodes = double(fine_nodes->activeVoxelCount());
-      for (const Level& level : levels) built_nodes += double(level.grid->activeVoxelCount());
+      const double built_nodes = levels_nodes + double(fine_nodes->activeVoxelCount());
       refuse("refined level " + std::to_string(l + 1) + " makes", built_nodes,
              kVoxelBytesPerNode * value_bytes / 12.0, refine_advice);
       Level fine;

@@ -61,6 +61,12 @@ double unitScale(std::string_view value) {
   return 0.0;
 }
 
+/// PPRINT and PARTNO carry text: a `$` at their end is the text's (it swallowed the next GOTO).
+bool isTextRecord(std::string_view content) {
+  const std::string head = upperCase(std::string(trimmed(content).substr(0, 6)));
+  return head == "PPRINT" || head == "PARTNO";
+}
+
 void parseAptChunk(std::string_view text, std::size_t first_line,
                    const std::filesystem::path& file, AptChunk& out) {
   bool rapid = false;  // RAPID seen: the next motion is a link
@@ -74,12 +80,7 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
     const std::string_view content = aptContent(text.substr(pos, nl - pos));
     pos = nl + 1;
     if (record.empty()) record_line = line;
-    // PPRINT and PARTNO carry text: a `$` at its end is the text's (it swallowed the next GOTO).
-    const auto isText = [](std::string_view c) {
-      const std::string head = upperCase(std::string(trimmed(c).substr(0, 6)));
-      return head == "PPRINT" || head == "PARTNO";
-    };
-    if (!content.empty() && content.back() == '$' && !(record.empty() && isText(content))) {
+    if (!content.empty() && content.back() == '$' && !(record.empty() && isTextRecord(content))) {
       record += content.substr(0, content.size() - 1);
       continue;
     }
@@ -160,7 +161,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   const std::vector<TextChunk> pieces =
       splitAtLines(text, options.chunk_bytes, options.threads, [](std::string_view line) {
         const std::string_view content = aptContent(line);
-        return !content.empty() && content.back() == '$';
+        return !content.empty() && content.back() == '$' && !isTextRecord(content);
       });
   std::vector<AptChunk> chunks(pieces.size());
   // A chunk's error counts only if no FINI comes before it: kept, and thrown in file order below.

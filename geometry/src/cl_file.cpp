@@ -1,6 +1,5 @@
 #include "fieldpath/geometry/cl_file.h"
 
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -47,24 +46,21 @@ std::size_t PathFile::count(PathBlock::Kind kind) const {
   return n;
 }
 
-void requireSteadyAxes(const PathFile& path, double max_turn_deg) {
-  for (const PathBlock& block : path.blocks) {
-    if (block.kind != PathBlock::Kind::Pass) continue;
-    for (std::size_t i = block.begin + 1; i < block.end; ++i) {
-      const Vec3& a = path.postures[i - 1].axis;
-      const Vec3& b = path.postures[i].axis;
-      const double turn_deg =
-          std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180.0 / M_PI;
-      if (!(turn_deg <= max_turn_deg)) {
-        char turn[64], limit[64];
-        std::snprintf(turn, sizeof turn, "%.4g", turn_deg);
-        std::snprintf(limit, sizeof limit, "%g", max_turn_deg);
-        throw InputError(path.where(i) + ": the tool axis turns " + turn +
-                         " deg from the posture before (" + path.where(i - 1) + "): more than " +
-                         limit + " deg between two postures of a pass (a flipped axis?)");
-      }
-    }
-  }
+void requireSteadyAxis(const PathFile& path, std::size_t before, std::size_t i) {
+  const double turn_deg = axisAngle(path.postures[before].axis, path.postures[i].axis) * 180.0 / M_PI;
+  if (turn_deg <= kMaxPassAxisTurnDeg) return;
+  char turn[64], limit[64];
+  std::snprintf(turn, sizeof turn, "%.4g", turn_deg);
+  std::snprintf(limit, sizeof limit, "%g", kMaxPassAxisTurnDeg);
+  throw InputError(path.where(i) + ": the tool axis turns " + turn + " deg from the posture before (" +
+                   path.where(before) + "): more than " + limit +
+                   " deg between two postures of a pass (a flipped axis?)");
+}
+
+void requireSteadyAxes(const PathFile& path) {
+  for (const PathBlock& block : path.blocks)
+    if (block.kind == PathBlock::Kind::Pass)
+      for (std::size_t i = block.begin + 1; i < block.end; ++i) requireSteadyAxis(path, i - 1, i);
 }
 
 PathFile singlePass(std::vector<Posture> postures) {

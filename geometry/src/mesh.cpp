@@ -103,24 +103,6 @@ struct Shell {
   std::vector<int> triangles;
   bool closed;
 };
-std::vector<Shell> shellsOf(const TriangleMesh& mesh);
-}  // namespace
-
-std::vector<std::vector<int>> closedShells(const TriangleMesh& mesh) {
-  std::vector<std::vector<int>> out;
-  for (Shell& shell : shellsOf(mesh))
-    if (shell.closed) out.push_back(std::move(shell.triangles));
-  return out;
-}
-
-std::vector<std::vector<int>> openShells(const TriangleMesh& mesh) {
-  std::vector<std::vector<int>> out;
-  for (Shell& shell : shellsOf(mesh))
-    if (!shell.closed) out.push_back(std::move(shell.triangles));
-  return out;
-}
-
-namespace {
 std::vector<Shell> shellsOf(const TriangleMesh& mesh) {
   const int n = static_cast<int>(mesh.vertices.size());
   for (const auto& t : mesh.triangles)
@@ -171,6 +153,20 @@ std::vector<Shell> shellsOf(const TriangleMesh& mesh) {
   return out;
 }
 }  // namespace
+
+std::vector<std::vector<int>> closedShells(const TriangleMesh& mesh) {
+  std::vector<std::vector<int>> out;
+  for (Shell& shell : shellsOf(mesh))
+    if (shell.closed) out.push_back(std::move(shell.triangles));
+  return out;
+}
+
+std::vector<std::vector<int>> openShells(const TriangleMesh& mesh) {
+  std::vector<std::vector<int>> out;
+  for (Shell& shell : shellsOf(mesh))
+    if (!shell.closed) out.push_back(std::move(shell.triangles));
+  return out;
+}
 
 std::size_t orientClosedShells(TriangleMesh& mesh) {
   const std::vector<std::vector<int>> shells = closedShells(mesh);

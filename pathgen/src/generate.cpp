@@ -320,21 +320,27 @@ GenerateResult generatePath(const GenerateRequest& request) {
                                  request.mode == FieldMode::Voxel ? voxelRegionPadMm(h) : 0.0);
   if (!request.nominal) {
     // Open sheets turned to face the passes before they are sampled (their normals are the
-    // field's direction): points along the nominal axis of every 4th station vote.
-    std::vector<geometry::TriangleMesh> faced(obstacles.begin(), obstacles.end());
+    // field's direction): points along the nominal axis of every 4th station vote. The meshes
+    // are copied only when a sheet is turned.
+    std::vector<Vec3> points;
     {
       double reach_mm = tool.length_mm;
       for (const auto& station : request.holder) reach_mm = std::max(reach_mm, station.z_mm);
-      std::vector<Vec3> points;
       for (const Pass& pass : result.passes)
         for (std::size_t i = 0; i < pass.samples.size(); i += 4)
           for (double t = 0.0; t <= reach_mm; t += std::max(r, 1.0))
             points.push_back(pass.samples[i].centre_mm + t * pass.samples[i].normal);
-      result.turned_sheets =
-          faceOpenSheetsToward(faced, points, request.field.r0_mm + r);
+    }
+    const std::vector<OpenSheet> away = sheetsFacingAway(obstacles, points, request.field.r0_mm + r);
+    result.turned_sheets = away.size();
+    std::vector<geometry::TriangleMesh> faced;
+    if (!away.empty()) {
+      faced = obstacles;
+      turnSheets(faced, away);
     }
     field::ObstacleSamples samples =
-        field::sampleObstacles(faced, request.field.sample_step_mm, request.field.weights);
+        field::sampleObstacles(away.empty() ? obstacles : faced, request.field.sample_step_mm,
+                               request.field.weights);
     result.obstacle_points = samples.size();
     direct = std::make_unique<field::DirectField>(std::move(samples), request.field);
     force = direct.get();

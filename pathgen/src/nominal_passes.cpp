@@ -23,8 +23,6 @@ constexpr double kRepeatMm = 1e-9;
 /// The nominal axis must be at least this far from the feed direction (sin of 0.5°): closer, the
 /// frame's normal is the rounding noise of a projection.
 constexpr double kMinAxisToFeedSin = 0.0087;
-/// Largest turn of the nominal axis between two consecutive postures of a pass (deg).
-constexpr double kMaxAxisTurnDeg = 90.0;
 
 /// The vertices of one pass: ball centres, arc lengths, tangents, normals.
 struct Polyline {
@@ -150,22 +148,8 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
              "RAPID moves and gaps over path.pass_gap)";
       throw InputError(msg.str());
     }
-    // A cutting move does not turn the axis over: a turn past 90 deg between two postures is a
-    // flipped axis (its sign, or the tip and ball centre confused), not a path to steer from.
-    for (std::size_t k = 1; k < kept.size(); ++k) {
-      const Vec3& a = path.postures[kept[k - 1]].axis;
-      const Vec3& b = path.postures[kept[k]].axis;
-      const double turn_deg = std::acos(std::clamp(a.dot(b), -1.0, 1.0)) * 180.0 / M_PI;
-      if (turn_deg > kMaxAxisTurnDeg) {
-        std::ostringstream msg;
-        msg.precision(4);
-        msg << path.where(kept[k]) << ": the tool axis turns " << turn_deg
-            << " deg from the posture before (" << path.where(kept[k - 1])
-            << "): more than " << kMaxAxisTurnDeg
-            << " deg between two postures of a pass (a flipped axis?)";
-        throw InputError(msg.str());
-      }
-    }
+    // A cutting move does not turn the axis over (repeats dropped: between the kept postures).
+    for (std::size_t k = 1; k < kept.size(); ++k) geometry::requireSteadyAxis(path, kept[k - 1], kept[k]);
     auto line = std::make_shared<Polyline>();
     const std::size_t n = kept.size();
     for (std::size_t k = 0; k < n; ++k) {

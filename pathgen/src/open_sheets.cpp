@@ -3,14 +3,16 @@
 
 #include <algorithm>
 #include <array>
-#include <limits>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace fieldpath::pathgen {
 
 using geometry::Vec3;
 
-std::size_t faceOpenSheetsToward(std::vector<geometry::TriangleMesh>& meshes,
-                                 std::span<const Vec3> points, double near_mm) {
+std::vector<OpenSheet> sheetsFacingAway(std::span<const geometry::TriangleMesh> meshes,
+                                        std::span<const Vec3> points, double near_mm) {
   // Every open shell's triangles, up to kMaxProbes of them in all (evenly strided): each point
   // votes for the side of the nearest one's centre. Bounded whatever the count of shells (a
   // triangle soup is a shell a triangle).
@@ -25,7 +27,7 @@ std::size_t faceOpenSheetsToward(std::vector<geometry::TriangleMesh>& meshes,
     shells[m] = geometry::openShells(meshes[m]);
     for (const auto& shell : shells[m]) open_triangles += shell.size();
   }
-  if (open_triangles == 0 || points.empty()) return 0;
+  if (open_triangles == 0 || points.empty()) return {};
   const std::size_t stride = std::max<std::size_t>(1, open_triangles / kMaxProbes);
   std::vector<Probe> probes;
   std::size_t counter = 0;
@@ -44,29 +46,40 @@ std::size_t faceOpenSheetsToward(std::vector<geometry::TriangleMesh>& meshes,
   // Votes per shell: points in front of it, behind it.
   std::vector<std::vector<std::array<std::size_t, 2>>> votes(meshes.size());
   for (std::size_t m = 0; m < meshes.size(); ++m) votes[m].assign(shells[m].size(), {0, 0});
+  // Each point's nearest probe (on all cores: points × probes reaches 1e8 on a mesh job), then
+  // the votes in point order.
   const double near_sq = near_mm * near_mm;
-  for (const Vec3& p : points) {
-    double best = std::numeric_limits<double>::infinity();
-    const Probe* nearest = nullptr;
-    for (const Probe& probe : probes) {
-      const double d = (p - probe.centre).squaredNorm();
-      if (d < best) {
-        best = d;
-        nearest = &probe;
+  std::vector<const Probe*> nearest(points.size(), nullptr);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 64), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      double best = near_sq;
+      for (const Probe& probe : probes) {
+        const double d = (points[i] - probe.centre).squaredNorm();
+        if (d <= best) {
+          best = d;
+          nearest[i] = &probe;
+        }
       }
     }
-    if (nearest == nullptr || best > near_sq) continue;
-    const double side = (p - nearest->centre).dot(nearest->normal);
-    if (side != 0.0) ++votes[nearest->mesh][nearest->shell][side > 0.0 ? 0 : 1];
+  });
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (nearest[i] == nullptr) continue;
+    const double side = (points[i] - nearest[i]->centre).dot(nearest[i]->normal);
+    if (side != 0.0) ++votes[nearest[i]->mesh][nearest[i]->shell][side > 0.0 ? 0 : 1];
   }
-  std::size_t turned = 0;
+  std::vector<OpenSheet> away;
   for (std::size_t m = 0; m < meshes.size(); ++m)
-    for (std::size_t s = 0; s < shells[m].size(); ++s) {
-      if (!(votes[m][s][1] > votes[m][s][0])) continue;
-      ++turned;
-      for (const int t : shells[m][s]) std::swap(meshes[m].triangles[t][1], meshes[m].triangles[t][2]);
+    for (std::size_t s = 0; s < shells[m].size(); ++s)
+      if (votes[m][s][1] > votes[m][s][0]) away.push_back({m, std::move(shells[m][s])});
+  return away;
+}
+
+void turnSheets(std::vector<geometry::TriangleMesh>& meshes, std::span<const OpenSheet> sheets) {
+  for (const OpenSheet& sheet : sheets)
+    for (const int t : sheet.triangles) {
+      auto& triangle = meshes[sheet.mesh].triangles[static_cast<std::size_t>(t)];
+      std::swap(triangle[1], triangle[2]);
     }
-  return turned;
 }
 
 }  // namespace fieldpath::pathgen

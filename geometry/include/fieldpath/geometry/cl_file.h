@@ -135,9 +135,16 @@ void writeNpyFile(const std::filesystem::path& file, std::span<const Posture> po
 /// One pass block over `postures` (a path without markers).
 PathFile singlePass(std::vector<Posture> postures);
 
-/// InputError naming the line where the tool axis turns more than `max_turn_deg` between two
-/// consecutive postures of a pass block (a flipped axis: the motion between them is not one a
-/// machine makes, and a check sweeping it cannot bound it).
-void requireSteadyAxes(const PathFile& path, double max_turn_deg = 90.0);
+/// Largest turn of the tool axis between two postures of a pass (deg): past it the axis is
+/// flipped (its sign, or tip and ball centre confused), not a cutting move.
+constexpr double kMaxPassAxisTurnDeg = 90.0;
+
+/// InputError naming both lines if the tool axis turns more than kMaxPassAxisTurnDeg from
+/// posture `before` to posture `i` of a pass.
+void requireSteadyAxis(const PathFile& path, std::size_t before, std::size_t i);
+
+/// requireSteadyAxis for every two consecutive postures of every pass block (a flipped axis:
+/// the motion between them is not one a machine makes, and a check sweeping it cannot bound it).
+void requireSteadyAxes(const PathFile& path);
 
 }  // namespace fieldpath::geometry
