@@ -67,6 +67,13 @@ bool isTextRecord(std::string_view content) {
   return head == "PPRINT" || head == "PARTNO";
 }
 
+/// Whether a line's content goes on in the next line (`$` at its end, not a text record's).
+/// Decided by the line alone, so that the chunk splitter and the parser agree: a PPRINT line
+/// inside a continued record ends it too (the fuzzer found them disagreeing there).
+bool continuesRecord(std::string_view content) {
+  return !content.empty() && content.back() == '$' && !isTextRecord(content);
+}
+
 void parseAptChunk(std::string_view text, std::size_t first_line,
                    const std::filesystem::path& file, AptChunk& out) {
   bool rapid = false;  // RAPID seen: the next motion is a link
@@ -80,7 +87,7 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
     const std::string_view content = aptContent(text.substr(pos, nl - pos));
     pos = nl + 1;
     if (record.empty()) record_line = line;
-    if (!content.empty() && content.back() == '$' && !(record.empty() && isTextRecord(content))) {
+    if (continuesRecord(content)) {
       record += content.substr(0, content.size() - 1);
       continue;
     }
@@ -159,10 +166,8 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   const MappedFile mapped(file);
   const std::string_view text = withoutBom(mapped.text());
   const std::vector<TextChunk> pieces =
-      splitAtLines(text, options.chunk_bytes, options.threads, [](std::string_view line) {
-        const std::string_view content = aptContent(line);
-        return !content.empty() && content.back() == '$' && !isTextRecord(content);
-      });
+      splitAtLines(text, options.chunk_bytes, options.threads,
+                   [](std::string_view line) { return continuesRecord(aptContent(line)); });
   std::vector<AptChunk> chunks(pieces.size());
   // A chunk's error counts only if no FINI comes before it: kept, and thrown in file order below.
   std::vector<std::exception_ptr> errors(pieces.size());

@@ -156,6 +156,17 @@ TEST(PathRead, AptStateCrossesChunks) {
   }
 }
 
+TEST(PathRead, AptPprintLineEndsARecordWhateverTheChunks) {
+  // A PPRINT line's `$` is its text's even inside a continued GOTO (the parser took it as a
+  // continuation there and the chunk splitter did not: the fuzzer read two different results).
+  const fs::path file =
+      writeBytes("pprint_inside.apt", "GOTO/1.5,2.5,$\n PPRINT/3.5,1 $\n 3,0,0,1\nGOTO/4,5,6\n");
+  const std::string whole = errorOf(file, std::size_t{1} << 30, 1);
+  EXPECT_NE(whole.find("pprint_inside.apt:1: 'PPRINT/3.5' is not a number"), std::string::npos) << whole;
+  for (std::size_t bytes : kChunkBytes)
+    for (unsigned threads : {1u, 0u}) EXPECT_EQ(errorOf(file, bytes, threads), whole) << bytes;
+}
+
 TEST(PathRead, FirstErrorInFileOrderWhateverTheChunks) {
   // Two bad lines: every chunking names the first (line 40), with the same message.
   std::string text;
