@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "cutter_note.h"
 #include "json_text.h"
 #include "errors.h"
 #include "fieldpath/common/atomic_file.h"
@@ -133,6 +134,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                                              "shape: ball, radius: R, length: L }`)");
     if (scene.tool.shape != geometry::ToolShape::Ball)
       throw InputError(scene.file.string() + ": tool.shape: check is for ball-end mills");
+    const std::vector<std::string> tool_notes = cutterNotes(scene.tool, path);
 
     // (a) exact clearance of postures and motions
     const geometry::TriangleMesh tool_mesh =
@@ -182,6 +184,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"link_part_skipped",
          link_part ? json(nullptr) : json("no `part` in the scene, or no `# link` blocks in the path")},
         {"unsafe", unsafeReasons(clearance, motions, link_part)},
+        {"tool_notes", tool_notes},
         {"limits",
          {{"limited_postures", path.limited.size()},
           {"limited_colliding", limited_colliding},
@@ -233,6 +236,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
           surface->simulation_s);
     else
       std::printf("surface: not checked (the scene has no `part`)\n");
+    for (const std::string& note : tool_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
     if (surface && surface->coarsened)
       std::fprintf(stderr,
                    "note: --spacing %g mm would make more Z-buffer lines than a check takes: "

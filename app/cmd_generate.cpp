@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "cutter_note.h"
 #include "json_text.h"
 #include "errors.h"
 #include "estimates.h"
@@ -91,6 +92,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"link_part", linkPartJson(r.link_part)},
       {"link_part_skipped", r.link_part ? json(nullptr) : json("no `part` in the scene, or no links")},
       {"safe", unsafe.empty()},
+      {"tool_notes", scene.nominal ? cutterNotes(scene.tool, *scene.nominal) : std::vector<std::string>{}},
       {"unsafe", unsafe},
       {"links",
        {{"links", r.path.count(geometry::PathBlock::Kind::Link)},
@@ -260,6 +262,9 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                    "report.json)\n",
                    job.clearance_mm, c.min_clearance_mm, c.min_index + 1, m.min_clearance_mm,
                    m.under_required);
+    if (scene.nominal)
+      for (const std::string& note : cutterNotes(scene.tool, *scene.nominal))
+        std::printf("note: %s\n", note.c_str());
     if (result.turned_sheets > 0)
       std::printf(
           "note: %zu open obstacle surface%s faced away from the passes: turned to face them "

@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cutter_note.h"
 #include "errors.h"
 #include "fieldpath/common/limits.h"
 #include "fieldpath/geometry/tool_model.h"
@@ -294,6 +295,8 @@ ViewData gatherView(const ViewRequest& request) {
   if (surface_dir.empty() && check && fs::exists(request.check_dir / "deviation.npy"))
     surface_dir = request.check_dir;
 
+  if (d.path)
+    for (const std::string& note : cutterNotes(scene.tool, d.path->file)) d.notes.push_back(note);
   if (d.path) {
     ViewPath& p = *d.path;
     const auto& postures = p.file.postures;

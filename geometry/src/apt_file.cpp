@@ -3,8 +3,11 @@
 /// starts a comment, `RAPID` makes the next motion a rapid (a link), `UNITS/INCHES` scales the
 /// coordinates that follow to mm, `FINI` ends the program (nothing after it is read), every other
 /// record is read past.
+#include <charconv>
+#include <cmath>
 #include <exception>
 #include <fstream>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -52,7 +55,29 @@ struct AptChunk {
   /// UNITS records: (first posture after it, mm per file unit), in order.
   std::vector<std::pair<std::size_t, double>> units;
   bool fini = false;  ///< FINI seen: the program ends there; later records are not read
+  /// CUTTER records in file units, each with the count of this chunk's UNITS records before it.
+  std::vector<std::pair<std::size_t, PathFile::Cutter>> cutters;
 };
+
+/// CUTTER/d[, r, ...]: diameter and corner radius in file units, or nothing when the first value
+/// is not a number (a CAM's `CUTTER/TOOL1`: read past, as DESIGN.md says of CUTTER).
+std::optional<PathFile::Cutter> cutterOf(std::string_view values, std::size_t line) {
+  double v[2] = {0.0, -1.0};
+  int count = 0;
+  for (std::size_t start = 0; start <= values.size() && count < 2;) {
+    const auto comma = std::min(values.find(',', start), values.size());
+    const std::string_view token = trimmed(values.substr(start, comma - start));
+    double value = 0.0;
+    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+    if (ec != std::errc() || end != token.data() + token.size() || !std::isfinite(value) ||
+        value < 0.0)
+      break;
+    v[count++] = value;
+    start = comma + 1;
+  }
+  if (count == 0 || !(v[0] > 0.0)) return std::nullopt;
+  return PathFile::Cutter{v[0], v[1], line};
+}
 
 /// mm per unit of a UNITS record's value (MM, INCHES), 0 if unknown.
 double unitScale(std::string_view value) {
@@ -104,6 +129,12 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
     if (major == "FINI") {
       out.fini = true;
       break;
+    }
+    if (major == "CUTTER") {
+      if (slash != std::string::npos)
+        if (auto cutter = cutterOf(std::string_view(statement).substr(slash + 1), record_line))
+          out.cutters.emplace_back(out.units.size(), *cutter);
+      continue;
     }
     if (major == "UNITS") {
       const std::string_view value =
@@ -182,6 +213,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   // What crosses chunk boundaries: a RAPID pending, and the axis of 3-number GOTOs.
   // And the unit: a UNITS record holds until the next; inches are read as mm x 25.4.
   std::vector<std::size_t> link_postures;
+  std::vector<PathFile::Cutter> cutters;
   bool pending = false, ended = false;
   double scale = 1.0;
   std::size_t offset = 0;
@@ -197,6 +229,12 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
       continue;
     }
     ended = c.fini;
+    for (auto& [units_before, cutter] : c.cutters) {  // in the unit of the record before it
+      const double unit = units_before ? c.units[units_before - 1].second : scale;
+      cutter.diameter_mm *= unit;
+      if (cutter.corner_mm > 0.0) cutter.corner_mm *= unit;
+      cutters.push_back(cutter);
+    }
     std::size_t next_unit = 0;
     for (std::size_t k = 0; k < postures.size(); ++k) {
       while (next_unit < c.units.size() && c.units[next_unit].first <= k)
@@ -218,6 +256,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   }
   PathFile path;
   path.file = file;
+  path.cutters = std::move(cutters);
   if (offset == 0) throw InputError(file.string() + ": no GOTO records");
   // Blocks: runs of link postures between pass runs.
   std::size_t next = 0;

@@ -48,6 +48,11 @@ std::string outcome(const std::filesystem::path& file, const geometry::PathReadO
     }
     for (const auto& b : path.blocks)
       bits += std::to_string(b.begin) + "-" + std::to_string(b.end) + ";";
+    for (const auto& c : path.cutters) {  // APT's CUTTER records, in mm
+      bits.append(reinterpret_cast<const char*>(&c.diameter_mm), sizeof(double));
+      bits.append(reinterpret_cast<const char*>(&c.corner_mm), sizeof(double));
+      bits += std::to_string(c.line) + ";";
+    }
     return bits;
   } catch (const common::InputError& e) {
     return std::string("error: ") + e.what();

@@ -237,3 +237,33 @@ TEST(PathRead, AptAfterFiniIsNotReadWhateverTheChunks) {
     }
   fs::remove(file);
 }
+
+TEST(PathRead, AptCutterRecordsInMmWhateverTheChunks) {
+  // CUTTER/d, r, ... in the unit of the UNITS record before it (inches x 25.4), a continued one
+  // joined, one with words read past; every chunking the same records.
+  const std::string text =
+      "PARTNO/X\nCUTTER/TOOL1\nCUTTER/6.0, 3.0, 0, 3, 0, 0, 40\nGOTO/1,2,3,0,0,1\n"
+      "UNITS/INCHES\nCUTTER / 0.25,$\n 0.125\nGOTO/0.1,0.2,0.3\nFINI\nCUTTER/99\n";
+  const fs::path file = writeBytes("cutters.apt", text);
+  for (std::size_t bytes : kChunkBytes)
+    for (unsigned threads : {1u, 0u}) {
+      const PathFile p = read(file, bytes, threads);
+      ASSERT_EQ(p.cutters.size(), 2u) << bytes;
+      EXPECT_EQ(p.cutters[0].diameter_mm, 6.0);
+      EXPECT_EQ(p.cutters[0].corner_mm, 3.0);
+      EXPECT_EQ(p.cutters[0].line, 3u);
+      EXPECT_DOUBLE_EQ(p.cutters[1].diameter_mm, 6.35) << bytes;
+      EXPECT_DOUBLE_EQ(p.cutters[1].corner_mm, 3.175) << bytes;
+      EXPECT_EQ(p.cutters[1].line, 6u) << bytes;
+    }
+  // What the APT writer writes reads back as the tool it was given.
+  PathFile written = makePath(1, 5);
+  AptHeader header;
+  header.tool.radius_mm = 2.5;
+  const fs::path apt = tempPath("written.apt");
+  writeAptFile(apt, written, header);
+  const PathFile back = read(apt, std::size_t{1} << 30, 1);
+  ASSERT_EQ(back.cutters.size(), 1u);
+  EXPECT_EQ(back.cutters[0].diameter_mm, 5.0);
+  EXPECT_EQ(back.cutters[0].corner_mm, 2.5);
+}

@@ -39,6 +39,15 @@ struct PathFile {
   /// Postures whose `.cl` line carries the comment `# limit ...` (generate marks the postures where
   /// an angle limit held), sorted.
   std::vector<std::size_t> limited;
+  /// APT: the `CUTTER/d[, r, ...]` records (diameter d, corner radius r), in mm, in file order;
+  /// those whose first values are not numbers are read past. Not compared here: the commands
+  /// that take a tool say when the file was written for another one (app/cutter_note.h).
+  struct Cutter {
+    double diameter_mm = 0.0;
+    double corner_mm = -1.0;  ///< -1: not given
+    std::size_t line = 0;     ///< 1-based
+  };
+  std::vector<Cutter> cutters;
 
   /// "FILE:LINE" or "FILE: row R" of posture i, for messages.
   std::string where(std::size_t i) const;

@@ -1,0 +1,57 @@
+#include "cutter_note.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace fieldpath::app {
+namespace {
+
+constexpr double kCutterTolMm = 1e-3;  ///< CAM systems write 4-6 decimals; inches convert exactly
+
+std::string mm(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value);
+  return text;
+}
+
+std::string toolWords(const geometry::ToolSpec& tool) {
+  const std::string d = mm(2 * tool.radius_mm) + " mm";
+  switch (tool.shape) {
+    case geometry::ToolShape::Ball:
+      return "a ball of radius " + mm(tool.radius_mm) + " mm (" + d + ")";
+    case geometry::ToolShape::Torus:
+      return "a torus " + d + " with a " + mm(tool.corner_radius_mm) + " mm corner";
+    case geometry::ToolShape::Flat:
+      break;
+  }
+  return "a flat end mill of " + d;
+}
+
+}  // namespace
+
+std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool,
+                                     const geometry::PathFile& path) {
+  constexpr std::size_t kMaxLines = 3;
+  const double corner_mm = geometry::cornerRadius(tool);
+  std::vector<std::string> notes;
+  for (const geometry::PathFile::Cutter& c : path.cutters) {
+    const bool same_diameter = std::abs(c.diameter_mm - 2 * tool.radius_mm) <= kCutterTolMm;
+    const bool same_corner = c.corner_mm < 0.0 || std::abs(c.corner_mm - corner_mm) <= kCutterTolMm;
+    if (same_diameter && same_corner) continue;
+    std::string file_tool = "a " + mm(c.diameter_mm) + " mm cutter";
+    if (c.corner_mm >= 0.0) file_tool += " with a " + mm(c.corner_mm) + " mm corner";
+    notes.push_back(path.file.string() + ":" + std::to_string(c.line) +
+                    ": CUTTER says the path was written for " + file_tool +
+                    "; the scene's tool is " + toolWords(tool) +
+                    ": what follows is for the scene's tool, not the file's");
+  }
+  if (notes.size() > kMaxLines) {
+    const std::size_t more = notes.size() - (kMaxLines - 1);
+    notes.resize(kMaxLines - 1);
+    notes.push_back(path.file.string() + ": " + std::to_string(more) +
+                    " more CUTTER records differ from the scene's tool");
+  }
+  return notes;
+}
+
+}  // namespace fieldpath::app

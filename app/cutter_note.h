@@ -1,0 +1,20 @@
+#pragma once
+/// What a path file says of its cutter against the scene's tool: an APT file's `CUTTER/` records
+/// name the tool its tips were computed for. `check`, `generate` and `view` prove and show the
+/// scene's tool; a file written for another one is said, not refused (DESIGN.md reads CUTTER
+/// past, and a machine runs the tool it is given).
+#include <string>
+#include <vector>
+
+#include "fieldpath/geometry/cl_file.h"
+#include "fieldpath/geometry/tool.h"
+
+namespace fieldpath::app {
+
+/// One line per CUTTER record that differs from `tool` (diameter, or corner radius where the
+/// record gives one, by more than 1 um), "FILE:LINE: ..."; empty when they agree or there are
+/// none. At most 3 lines, the last saying how many more.
+std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool,
+                                     const geometry::PathFile& path);
+
+}  // namespace fieldpath::app

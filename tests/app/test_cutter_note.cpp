@@ -1,0 +1,44 @@
+/// app/cutter_note.h: an APT file's CUTTER against the scene's tool.
+#include <gtest/gtest.h>
+
+#include "cutter_note.h"
+
+namespace fieldpath::app::test {
+namespace {
+
+geometry::PathFile withCutters(std::vector<geometry::PathFile::Cutter> cutters) {
+  geometry::PathFile path;
+  path.file = "job.apt";
+  path.cutters = std::move(cutters);
+  return path;
+}
+
+TEST(CutterNotes, SaidWhenTheFileWasWrittenForAnotherTool) {
+  geometry::ToolSpec ball;  // ball, R 3
+  ball.radius_mm = 3.0;
+  EXPECT_TRUE(cutterNotes(ball, withCutters({})).empty());
+  // the same tool: diameter 6, corner 3 or none given, within 1 um (inches converted)
+  EXPECT_TRUE(cutterNotes(ball, withCutters({{6.0, 3.0, 4}, {6.0, -1.0, 9}, {0.23622 * 25.4, -1.0, 12}}))
+                  .empty());
+  const auto other = cutterNotes(ball, withCutters({{10.0, 5.0, 4}}));
+  ASSERT_EQ(other.size(), 1u);
+  EXPECT_EQ(other[0],
+            "job.apt:4: CUTTER says the path was written for a 10 mm cutter with a 5 mm corner; "
+            "the scene's tool is a ball of radius 3 mm (6 mm): what follows is for the scene's "
+            "tool, not the file's");
+  // a flat end mill of the same diameter differs by its corner
+  EXPECT_EQ(cutterNotes(ball, withCutters({{6.0, 0.0, 7}})).size(), 1u);
+  geometry::ToolSpec torus;
+  torus.shape = geometry::ToolShape::Torus;
+  torus.radius_mm = 5.0;
+  torus.corner_radius_mm = 1.0;
+  EXPECT_TRUE(cutterNotes(torus, withCutters({{10.0, 1.0, 2}})).empty());
+  // many: two lines and a count
+  const auto many =
+      cutterNotes(ball, withCutters({{8, -1, 1}, {8, -1, 2}, {8, -1, 3}, {8, -1, 4}, {8, -1, 5}}));
+  ASSERT_EQ(many.size(), 3u);
+  EXPECT_EQ(many[2], "job.apt: 3 more CUTTER records differ from the scene's tool");
+}
+
+}  // namespace
+}  // namespace fieldpath::app::test
