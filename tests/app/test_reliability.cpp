@@ -4,6 +4,8 @@
 /// study, convert; the run's own timings aside).
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -114,6 +116,35 @@ TEST(AtomicOutput, AFailedRunRemovesWhatItWrote) {
   EXPECT_EQ(filesUnder(dir.path() / "out").size(), 2u);
   common::removeWrittenOutputs();
   EXPECT_TRUE(filesUnder(dir.path() / "out").empty());
+}
+
+// An output name that is a FIFO (or /dev/null, a device) is written into, not replaced by a
+// regular file (renaming over /dev/null made it one), and a failed run leaves it; a name that is a
+// symbolic link is written through it, the link kept.
+TEST(AtomicOutput, DevicesAndFifosAreWrittenIntoAndLinksFollowed) {
+  const TempDir dir;
+  const fs::path fifo = dir.path() / "fifo.json";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  // The reading end opened first without blocking: the write then fits in the pipe's buffer, and
+  // a writer that renamed over the FIFO instead leaves it empty (a failure, not a hang).
+  const int fd = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+  ASSERT_GE(fd, 0);
+  common::writeTextAtomically(fifo, "through the pipe");
+  char buffer[64] = {};
+  const ssize_t got = ::read(fd, buffer, sizeof buffer - 1);
+  ::close(fd);
+  EXPECT_EQ(std::string(buffer, got > 0 ? std::size_t(got) : 0), "through the pipe");
+  EXPECT_TRUE(fs::is_fifo(fifo));
+  common::removeWrittenOutputs();
+  EXPECT_TRUE(fs::is_fifo(fifo));  // not taken away as a written output
+
+  const fs::path real = dir.path() / "real.csv", link = dir.path() / "link.csv";
+  common::writeTextAtomically(real, "old");
+  fs::create_symlink(real, link);
+  common::writeTextAtomically(link, "new");
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(slurp(real), "new");
+  common::removeWrittenOutputs();
 }
 
 // ---- the commands, interrupted midway ------------------------------------------------------------

@@ -163,10 +163,29 @@ inline void checkOutputFile(const std::filesystem::path& file, const std::string
 /// `path`. Throws InputError (one line naming the path and the system's reason: no permission, disk
 /// full, not a directory) if the file cannot be written; the temporary is removed on any failure,
 /// including an exception thrown by `write`, and by removeTemporariesNow() on a signal.
-inline void writeFileAtomically(const std::filesystem::path& path,
+///
+/// A name that is a symbolic link is written through it (the link stays, its target is replaced
+/// atomically); a name that is a device, FIFO or socket (`/dev/null`, `/dev/stdout`) is written
+/// into directly and never removed: renaming over it replaced /dev/null with a regular file.
+inline void writeFileAtomically(const std::filesystem::path& given,
                                 const std::function<void(std::ofstream&)>& write,
                                 std::ios::openmode mode = std::ios::out) {
   namespace fs = std::filesystem;
+  std::error_code status_ec;
+  const fs::path path = fs::is_symlink(given, status_ec) ? fs::weakly_canonical(given, status_ec)
+                                                         : given;
+  if (path.empty()) throw InputError(given.string() + ": cannot resolve the link: " + status_ec.message());
+  const fs::file_status status = fs::status(path, status_ec);
+  if (fs::exists(status) && !fs::is_regular_file(status) && !fs::is_directory(status)) {
+    errno = 0;
+    std::ofstream out(path, mode);
+    if (!out)
+      throw InputError(given.string() + ": cannot open for writing: " + detail::systemReason(errno));
+    write(out);
+    out.flush();
+    if (!out) throw InputError(given.string() + ": cannot write: " + detail::systemReason(errno));
+    return;
+  }
   if (path.has_parent_path()) createOutputDirectory(path.parent_path());
   const fs::path tmp = path.parent_path() / ("." + path.filename().string() + ".tmp-" +
                                              std::to_string(static_cast<long>(::getpid())));
