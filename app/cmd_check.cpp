@@ -154,6 +154,11 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                                            pathgen::kClearanceMeshTolMm);
       link_part = pathgen::checkLinksAgainstPart(part, path);
     }
+    // The holder against the part everywhere: it never cuts.
+    const std::optional<pathgen::LinkPartResult> holder_part =
+        scene.part ? pathgen::checkHolderAgainstPart(scene.tool, scene.holder, *scene.part,
+                                                     path.postures)
+                   : std::nullopt;
     std::size_t limited_colliding = 0;
     for (std::size_t i : path.limited) limited_colliding += clearance.clearance_mm[i] <= 0.0;
 
@@ -183,7 +188,10 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"link_part", linkPartJson(link_part)},
         {"link_part_skipped",
          link_part ? json(nullptr) : json("no `part` in the scene, or no `# link` blocks in the path")},
-        {"unsafe", unsafeReasons(clearance, motions, link_part)},
+        {"holder_part", holderPartJson(holder_part)},
+        {"holder_part_skipped",
+         holder_part ? json(nullptr) : json("no `part` or no `holder` in the scene")},
+        {"unsafe", unsafeReasons(clearance, motions, link_part, holder_part)},
         {"tool_notes", tool_notes},
         {"limits",
          {{"limited_postures", path.limited.size()},
@@ -193,6 +201,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"surface_skipped", surface ? json(nullptr) : json("the scene has no `part`")},
         {"ok", clearance.colliding == 0 && motions.colliding == 0 &&
                    !(link_part && link_part->collides()) &&
+                   !(holder_part && holder_part->collides()) &&
                    clearance.min_clearance_mm >= scene.clearance_mm &&
                    motions.under_required == 0 && (!surface || surface->gouged_lines == 0)},
     };
@@ -224,6 +233,12 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                   link_part->postures, link_part->motions, link_part->min_clearance_mm,
                   link_part->colliding_postures, link_part->colliding_motions,
                   link_part->collides() ? " (COLLISIONS)" : "");
+    if (holder_part)
+      std::printf("holder vs part: %zu postures, %zu motions, min >= %.3f mm, %zu colliding "
+                  "postures, %zu colliding motions%s\n",
+                  holder_part->postures, holder_part->motions, holder_part->min_clearance_mm,
+                  holder_part->colliding_postures, holder_part->colliding_motions,
+                  holder_part->collides() ? " (COLLISIONS)" : "");
     if (!path.limited.empty())
       std::printf("limits: %zu postures held at an angle limit, %zu of them colliding\n",
                   path.limited.size(), limited_colliding);

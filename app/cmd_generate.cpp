@@ -56,7 +56,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
                       {"colliding_postures", colliding}});
   }
   const auto& box = r.reach_box_mm;
-  const std::vector<std::string> unsafe = unsafeReasons(r.clearance, r.motions, r.link_part);
+  const std::vector<std::string> unsafe = unsafeReasons(r.clearance, r.motions, r.link_part, r.holder_part);
   return {
       {"scene", scene.file.string()},
       {"field_mode", job.nominal ? "nominal" : pathgen::fieldModeNames(job.mode).id},
@@ -90,6 +90,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"clearance", clearanceJson(r.clearance, job.clearance_mm, pathgen::kClearanceMeshTolMm)},
       {"motions", motionsJson(r.motions, job.clearance_mm, pathgen::MotionRequest{}.resolution_mm)},
       {"link_part", linkPartJson(r.link_part)},
+      {"holder_part", holderPartJson(r.holder_part)},
       {"link_part_skipped", r.link_part ? json(nullptr) : json("no `part` in the scene, or no links")},
       {"safe", unsafe.empty()},
       {"tool_notes", scene.nominal ? cutterNotes(scene.tool, *scene.nominal) : std::vector<std::string>{}},
@@ -207,7 +208,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     const std::string what = job.nominal ? "nominal path" : "field path";
     // A path that collides is still written (to look at, and `check`), marked in both files.
     const std::vector<std::string> unsafe =
-        unsafeReasons(result.clearance, result.motions, result.link_part);
+        unsafeReasons(result.clearance, result.motions, result.link_part, result.holder_part);
     std::string unsafe_text;
     for (const std::string& reason : unsafe)
       unsafe_text += (unsafe_text.empty() ? "" : "; ") + reason;

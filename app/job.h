@@ -85,11 +85,30 @@ inline nlohmann::json linkPartJson(const std::optional<pathgen::LinkPartResult>&
           {"ok", !l->collides()}};
 }
 
+/// The `holder_part` block of report.json and check.json: the holder against the part at every
+/// posture and motion (null with the reason when the job has no part or no holder).
+inline nlohmann::json holderPartJson(const std::optional<pathgen::LinkPartResult>& h) {
+  if (!h) return nullptr;
+  return {{"postures", h->postures},
+          {"motions", h->motions},
+          {"colliding_postures", h->colliding_postures},
+          {"first_colliding_posture", jsonIndex(h->first_colliding_posture)},
+          {"colliding_motions", h->colliding_motions},
+          {"first_colliding_motion", jsonIndex(h->first_colliding_motion)},
+          {"min_mm", jsonNumber(h->min_clearance_mm)},
+          {"method",
+           "the holder (the stations above the tool: it never cuts) against the part mesh at every "
+           "posture and motion, passes and links (as `motions`, required 0)"},
+          {"ok", !h->collides()}};
+}
+
 /// Why a path is not safe to run as it stands (empty: it is): postures or motions that touch an
-/// obstacle, links that touch the part. Postures 1-based, motion i from posture i to i + 1.
+/// obstacle, links that touch the part, the holder touching the part. Postures 1-based, motion i
+/// from posture i to i + 1.
 inline std::vector<std::string> unsafeReasons(const pathgen::ClearanceResult& c,
                                               const pathgen::MotionResult& m,
-                                              const std::optional<pathgen::LinkPartResult>& l) {
+                                              const std::optional<pathgen::LinkPartResult>& l,
+                                              const std::optional<pathgen::LinkPartResult>& h) {
   std::vector<std::string> out;
   auto first = [](std::size_t i) { return std::to_string(i + 1); };
   if (c.colliding)
@@ -106,6 +125,14 @@ inline std::vector<std::string> unsafeReasons(const pathgen::ClearanceResult& c,
     out.push_back(std::to_string(l->colliding_motions) +
                   " link motions touch the part (first: posture " +
                   first(l->first_colliding_motion) + " to the next)");
+  if (h && h->colliding_postures)
+    out.push_back(std::to_string(h->colliding_postures) +
+                  " postures put the holder into the part (first: posture " +
+                  first(h->first_colliding_posture) + ")");
+  if (h && h->colliding_motions)
+    out.push_back(std::to_string(h->colliding_motions) +
+                  " motions put the holder into the part (first: posture " +
+                  first(h->first_colliding_motion) + " to the next)");
   return out;
 }
 

@@ -313,7 +313,11 @@ void validateHolderProfile(const HolderProfile& holder) {
     throw InputError("holder has no height");
 }
 
-TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double chord_tol_mm) {
+namespace {
+
+/// toolMesh, or (`only` given) the bands of the profile pieces of that part alone: an open mesh.
+TriangleMesh revolvedMesh(const ToolSpec& tool, const HolderProfile& holder, double chord_tol_mm,
+                          const NodePart* only) {
   validateToolSpec(tool);
   validateHolderProfile(holder);
   if (!std::isfinite(chord_tol_mm) || !(chord_tol_mm > 0))
@@ -343,12 +347,16 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
 
   // Profile points from the tip to the top; arcs subdivided, straight pieces left whole.
   std::vector<Vec2> points{profile.front().from};
+  std::vector<NodePart> band_part;  // of the band between points k and k + 1
   for (const auto& s : profile) {
     const int pieces =
         s.is_arc ? std::max(1, static_cast<int>(std::ceil((s.end_rad - s.start_rad) /
                                                           angularStep(s.radius_mm, sagitta_mm))))
                  : 1;
-    for (int i = 1; i <= pieces; ++i) points.push_back(s.at(static_cast<double>(i) / pieces));
+    for (int i = 1; i <= pieces; ++i) {
+      points.push_back(s.at(static_cast<double>(i) / pieces));
+      band_part.push_back(s.part);
+    }
   }
 
   // One ring of vertices per profile point, vertex j at angle 2πj/N. A ring's N keeps the chord
@@ -377,6 +385,7 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
   // Zip neighbouring rings together by angle: advance on the ring whose next vertex comes first.
   // Outward orientation: the profile runs upwards with the solid on its left.
   for (std::size_t k = 0; k + 1 < count; ++k) {
+    if (only && band_part[k] != *only) continue;
     const int n_lo = sectors[k], n_hi = sectors[k + 1];
     const auto lo = [&](int i) { return first[k] + i % n_lo; };
     const auto hi = [&](int j) { return first[k + 1] + j % n_hi; };
@@ -394,6 +403,17 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
     }
   }
   return mesh;
+}
+
+}  // namespace
+
+TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double chord_tol_mm) {
+  return revolvedMesh(tool, holder, chord_tol_mm, nullptr);
+}
+
+TriangleMesh holderMesh(const ToolSpec& tool, const HolderProfile& holder, double chord_tol_mm) {
+  const NodePart holder_part = NodePart::Holder;
+  return revolvedMesh(tool, holder, chord_tol_mm, &holder_part);
 }
 
 std::vector<SurfaceNode> surfaceNodes(const ToolSpec& tool, const HolderProfile& holder,

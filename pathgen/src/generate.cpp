@@ -442,6 +442,8 @@ GenerateResult generatePath(const GenerateRequest& request) {
     if (request.part) {
       const ClearanceChecker part(tool_mesh, std::span(&*request.part, 1), kClearanceMeshTolMm);
       result.link_part = checkLinksAgainstPart(part, result.path);
+      result.holder_part =
+          checkHolderAgainstPart(tool, request.holder, *request.part, result.path.postures);
     }
   }
   for (GeneratedPosture& g : result.postures) {

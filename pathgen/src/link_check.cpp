@@ -1,6 +1,8 @@
 /// pathgen/link_check.h: the links of a path against the part.
 #include "fieldpath/pathgen/link_check.h"
 
+#include "fieldpath/pathgen/generate.h"  // kClearanceMeshTolMm
+
 #include <algorithm>
 #include <span>
 
@@ -34,6 +36,29 @@ LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const geometr
     if (m.colliding && out.first_colliding_motion == LinkPartResult::npos)
       out.first_colliding_motion = block.begin + m.first_colliding;
   }
+  return out;
+}
+
+std::optional<LinkPartResult> checkHolderAgainstPart(const geometry::ToolSpec& tool,
+                                                     const geometry::HolderProfile& holder,
+                                                     const geometry::TriangleMesh& part,
+                                                     std::span<const geometry::Posture> postures) {
+  const geometry::TriangleMesh holder_mesh = geometry::holderMesh(tool, holder, kClearanceMeshTolMm);
+  if (holder_mesh.triangles.empty() || postures.empty()) return std::nullopt;
+  const ClearanceChecker holder_part(holder_mesh, std::span(&part, 1), kClearanceMeshTolMm);
+  LinkPartResult out;
+  const ClearanceResult c = holder_part.check(postures, {});
+  out.postures = c.postures;
+  out.min_clearance_mm = c.min_clearance_mm;
+  out.colliding_postures = c.colliding;
+  out.first_colliding_posture = c.first_colliding;
+  MotionRequest request;  // touching is what counts: required 0
+  request.posture_clearance_mm = c.clearance_mm;
+  const MotionResult m = holder_part.checkMotions(postures, request);
+  out.motions = m.motions;
+  out.min_clearance_mm = std::min(out.min_clearance_mm, m.min_clearance_mm);
+  out.colliding_motions = m.colliding;
+  out.first_colliding_motion = m.first_colliding;
   return out;
 }
 

@@ -361,6 +361,35 @@ TEST(Links, ALinkThroughThePartIsReportedAndThePassContactIsNot) {
   EXPECT_NEAR(over.min_clearance_mm, 2.0 - 0.02, 0.03);
 }
 
+// The holder against the part at every posture and motion: a pass on the floor beside a wall of
+// the part (the ball 8 mm from it, the holder's r 12 section reaching 4 mm into it) collides at
+// each posture and motion, whatever the ball does; 5 mm farther off it clears by the distance
+// left (1 mm, less the chordal tolerance); with no holder there is nothing to check.
+TEST(Links, TheHolderIntoThePartIsReportedAtEveryPostureAndMotion) {
+  const geometry::ToolSpec tool{geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
+  const geometry::HolderProfile holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
+  geometry::TriangleMesh part;
+  pathgen::test::addBox(part, -30, 7, -30, 30, -10, 0);  // the floor
+  pathgen::test::addBox(part, 8, 30, -30, 30, -10, 60);  // a wall 60 mm high beside the pass
+  auto pass = [](double x) {
+    std::vector<Posture> p;
+    for (int i = 0; i <= 20; ++i)
+      p.push_back(Posture{Eigen::Vector3d(x, -5 + 0.5 * i, 0), Eigen::Vector3d::UnitZ(), 0.0, false});
+    return p;
+  };
+  const auto into = checkHolderAgainstPart(tool, holder, part, pass(0.0));
+  ASSERT_TRUE(into.has_value());
+  EXPECT_EQ(into->postures, 21u);
+  EXPECT_EQ(into->colliding_postures, 21u);
+  EXPECT_EQ(into->colliding_motions, 20u);
+  EXPECT_EQ(into->first_colliding_posture, 0u);
+  const auto clear = checkHolderAgainstPart(tool, holder, part, pass(-5.0));
+  ASSERT_TRUE(clear.has_value());
+  EXPECT_FALSE(clear->collides());
+  EXPECT_NEAR(clear->min_clearance_mm, 1.0 - 0.02, 0.03);
+  EXPECT_FALSE(checkHolderAgainstPart(tool, {}, part, pass(0.0)).has_value());
+}
+
 // FCL measures between surfaces: a tool wholly inside a closed obstacle, or an obstacle wholly
 // inside the tool, touches no triangle. Both collide; the same tool beside the box is clear.
 TEST(Clearance, InsideOneAnotherIsColliding) {

@@ -36,6 +36,10 @@ TriangleMesh toolMesh(const ToolSpec& tool, const HolderProfile& holder, double 
 
 enum class NodePart { Tool, Holder };
 
+/// The holder's surface alone as toolMesh makes it (the pieces of the profile above the shank that
+/// are not tool surface: it never cuts), an open mesh; empty when there is no holder.
+TriangleMesh holderMesh(const ToolSpec& tool, const HolderProfile& holder, double chord_tol_mm);
+
 /// A point on the surface of tool or holder (tool frame, mm) with its outward unit normal.
 struct SurfaceNode {
   Vec3 position_mm;

@@ -115,6 +115,9 @@ struct GenerateResult {
   MotionResult motions;       ///< of every motion of `path`
   /// The links against the part (when the job has one and links): rapid moves must not touch it.
   std::optional<LinkPartResult> link_part;
+  /// The holder against the part at every posture and motion (when the job has a part and a
+  /// holder): it never cuts, so touching is a crash.
+  std::optional<LinkPartResult> holder_part;
   double safe_z_mm = 0.0;     ///< the links' travel plane
   std::size_t link_postures = 0;
   std::size_t limited_postures = 0;                   ///< where dynamics.on_limit held an angle

@@ -5,8 +5,12 @@
 /// it during a pass), so the links are checked against it here.
 #include <cstddef>
 #include <limits>
+#include <optional>
+#include <span>
 
 #include "fieldpath/geometry/cl_file.h"
+#include "fieldpath/geometry/tool.h"
+#include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/pathgen/clearance.h"
 
 namespace fieldpath::pathgen {
@@ -29,5 +33,15 @@ struct LinkPartResult {
 /// they start or end where the ball cuts the part (retracting along the tool axis), and so are
 /// link postures at a pass's first or last posture (links.retract: 0).
 LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const geometry::PathFile& path);
+
+/// The holder (geometry::holderMesh) against the part at every posture and every motion of the
+/// path, passes and links. The holder never cuts: touching the part anywhere is a crash, also
+/// where the ball cuts (a holder swinging into a wall of the part beside the pass, which the
+/// Z-buffer of the ball's region never sees). Counted in the same fields as the links'; nothing
+/// (nullopt) when there is no holder.
+std::optional<LinkPartResult> checkHolderAgainstPart(const geometry::ToolSpec& tool,
+                                                     const geometry::HolderProfile& holder,
+                                                     const geometry::TriangleMesh& part,
+                                                     std::span<const geometry::Posture> postures);
 
 }  // namespace fieldpath::pathgen
