@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdio>
 #include <cmath>
 #include <limits>
 
@@ -34,7 +35,7 @@ zb::Tool parseTool(const std::string& text) {
         return zb::Tool::flat(spec.radius_mm, spec.length_mm);
     }
   }
-  const geometry::TriangleMesh mesh = geometry::loadMesh(text);
+  geometry::TriangleMesh mesh = geometry::loadMesh(text);
   // The Z-buffer cuts with the tool's downward-facing surface from its tip up: an open mesh
   // (a cylinder without its bottom cap) cut nothing, one below its tip cut 13 mm too deep.
   const geometry::MeshReport report = geometry::validateMesh(mesh);
@@ -51,6 +52,11 @@ zb::Tool parseTool(const std::string& text) {
   if (lowest < -1e-6 * std::max(size, 1.0))
     throw InputError("--tool " + text + ": the tool mesh reaches z = " + std::to_string(lowest) +
                      " mm, below its tip: the tip is the origin and the tool lies along +z");
+  // Wound inward (every triangle the other way round), its "downward" faces were its top: it cut
+  // nothing, or 6 mm too high with a tilted axis. Turned outward, as the scene's solids are.
+  if (geometry::orientClosedShells(mesh) > 0)
+    std::fprintf(stderr, "note: --tool %s: the tool mesh was wound inward: turned outward\n",
+                 text.c_str());
   try {
     return zb::Tool::fromMesh(toZbuffer(mesh));
   } catch (const InputError& e) {

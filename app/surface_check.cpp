@@ -244,14 +244,26 @@ SurfaceResult checkSurface(const SurfaceRequest& request) {
   const geometry::TriangleMesh& part = *request.part;
   const geometry::PathFile& path = *request.path;
   const double radius = request.tool.radius_mm;
-  // The region: the passes' ball centres in plan, padded by the tool radius, within the part.
+  // The region: in plan, what the passes' tool bodies reach of the part (the ball centre and the
+  // shank's axis up to the part's highest point), padded by the tool radius, within the part. A
+  // tilted shank cuts beside the ball's footprint: a flank driven into a wall reads as a gouge.
   Eigen::AlignedBox2d passes_box, part_box;
+  double part_top_mm = -std::numeric_limits<double>::infinity();
+  for (const Vec3& v : part.vertices) {
+    part_box.extend(Vec2(v.x(), v.y()));
+    part_top_mm = std::max(part_top_mm, v.z());
+  }
+  const double shank_mm = std::max(0.0, request.tool.length_mm - radius);  // centre to the top
   for (const auto& [begin, end] : pathgen::passRanges(path, 0.0))
     for (std::size_t i = begin; i < end; ++i) {
       const Vec3 c = geometry::ballCentre(path.postures[i], radius);
+      const Vec3& a = path.postures[i].axis;
       passes_box.extend(Vec2(c.x(), c.y()));
+      double up_mm = shank_mm;  // along the axis while the shank is below the part's top
+      if (a.z() > 0.0) up_mm = std::min(up_mm, std::max(0.0, (part_top_mm - c.z()) / a.z()));
+      const Vec3 reach = c + up_mm * a;
+      passes_box.extend(Vec2(reach.x(), reach.y()));
     }
-  for (const Vec3& v : part.vertices) part_box.extend(Vec2(v.x(), v.y()));
   passes_box.min().array() -= radius;
   passes_box.max().array() += radius;
   const Eigen::AlignedBox2d region = passes_box.intersection(part_box);

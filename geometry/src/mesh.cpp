@@ -116,15 +116,33 @@ std::vector<Shell> shellsOf(const TriangleMesh& mesh) {
   };
   for (const auto& t : mesh.triangles)
     for (int e = 1; e < 3; ++e) parent[root(t[e])] = root(t[0]);
-  // Closed: every edge used once each way. The directed edges as sorted keys (u << 32 | v): a
-  // count is the length of a key's run (a std::map of pairs took 1 s at a million triangles).
+  // A triangle written again (the same three vertices the same way round, as some exports do) is
+  // the same surface once: its repeats are left out of the shells.
+  std::vector<std::pair<std::array<int, 3>, int>> cycles(mesh.triangles.size());
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const auto& t = mesh.triangles[i];
+    const int first = t[0] <= t[1] && t[0] <= t[2] ? 0 : t[1] <= t[2] ? 1 : 2;
+    cycles[i] = {{t[first], t[(first + 1) % 3], t[(first + 2) % 3]}, static_cast<int>(i)};
+  }
+  std::sort(cycles.begin(), cycles.end());
+  std::vector<char> repeat(mesh.triangles.size(), 0);
+  for (std::size_t i = 1; i < cycles.size(); ++i)
+    if (cycles[i].first == cycles[i - 1].first) repeat[static_cast<std::size_t>(cycles[i].second)] = 1;
+  // Closed: every edge used as many times each way (once each way on a manifold; bodies that
+  // share a face or an edge, as a multi-body export writes them, use it twice each way: the
+  // vertical-ray parity of ClosedShells still tells inside from outside). The directed edges as
+  // sorted keys (u << 32 | v): a count is the length of a key's run (a std::map of pairs took 1 s
+  // at a million triangles).
   const auto key = [](int u, int v) {
     return (std::uint64_t(std::uint32_t(u)) << 32) | std::uint32_t(v);
   };
   std::vector<std::uint64_t> directed;
   directed.reserve(3 * mesh.triangles.size());
-  for (const auto& t : mesh.triangles)
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    if (repeat[i]) continue;
+    const auto& t = mesh.triangles[i];
     for (int e = 0; e < 3; ++e) directed.push_back(key(t[e], t[(e + 1) % 3]));
+  }
   std::sort(directed.begin(), directed.end());
   const auto uses = [&](std::uint64_t k) {
     const auto [first, last] = std::equal_range(directed.begin(), directed.end(), k);
@@ -134,13 +152,14 @@ std::vector<Shell> shellsOf(const TriangleMesh& mesh) {
   std::vector<std::vector<int>> triangles_of(static_cast<std::size_t>(n));
   std::vector<char> closed(static_cast<std::size_t>(n), 1);
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    if (repeat[i]) continue;
     const auto& t = mesh.triangles[i];
     const int shell = root(t[0]);
     triangles_of[static_cast<std::size_t>(shell)].push_back(static_cast<int>(i));
     if (!closed[static_cast<std::size_t>(shell)]) continue;
     for (int e = 0; e < 3; ++e) {
       const int u = t[e], v = t[(e + 1) % 3];
-      if (u == v || uses(key(u, v)) != 1 || uses(key(v, u)) != 1) {
+      if (u == v || uses(key(u, v)) != uses(key(v, u))) {
         closed[static_cast<std::size_t>(shell)] = 0;
         break;
       }

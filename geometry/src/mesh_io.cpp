@@ -6,6 +6,7 @@
 #include <cmath>
 #include <exception>
 #include <fstream>
+#include <iterator>
 #include <functional>
 #include <sstream>
 #include <string>
@@ -115,23 +116,29 @@ void checkAsciiStl(const std::filesystem::path& file) {
     throw InputError(file.string() + ": ASCII STL without `endsolid` at its end (truncated?)");
 }
 
-void checkStlSize(const std::filesystem::path& file, std::uintmax_t size) {
-  if (lowerExtension(file) != ".stl") return;
+/// Returns whether the file is an ASCII STL written in capitals (`SOLID`, `FACET NORMAL`, as some
+/// CAD systems write it): assimp takes its keywords in lower case only (and the file for binary).
+bool checkStlSize(const std::filesystem::path& file, std::uintmax_t size) {
+  if (lowerExtension(file) != ".stl") return false;
   std::ifstream in(file, std::ios::binary);
   unsigned char header[84] = {};
   in.read(reinterpret_cast<char*>(header), sizeof header);
   const std::size_t got = static_cast<std::size_t>(in.gcount());
   std::size_t first = 0;
   while (first < got && std::isspace(header[first])) ++first;
-  if (got >= first + 5 && std::string(reinterpret_cast<const char*>(header) + first, 5) == "solid") {
+  std::string word = got >= first + 5 ? std::string(reinterpret_cast<const char*>(header) + first, 5)
+                                       : std::string();
+  const std::string as_written = word;
+  for (char& c : word) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (word == "solid") {
     // ASCII, unless a binary one whose header starts so (its size matches its count).
     if (got == 84) {
       const std::uint32_t count = std::uint32_t(header[80]) | std::uint32_t(header[81]) << 8 |
                                   std::uint32_t(header[82]) << 16 | std::uint32_t(header[83]) << 24;
-      if (84 + 50 * std::uintmax_t(count) == size) return;
+      if (84 + 50 * std::uintmax_t(count) == size) return false;
     }
     checkAsciiStl(file);
-    return;
+    return as_written != word;
   }
   if (got < 84)
     throw InputError(file.string() + ": binary STL of " + std::to_string(size) +
@@ -143,6 +150,7 @@ void checkStlSize(const std::filesystem::path& file, std::uintmax_t size) {
     throw InputError(file.string() + ": binary STL: its header says " + std::to_string(count) +
                      " triangles (" + std::to_string(needed) + " bytes), the file has " +
                      std::to_string(size) + " bytes (truncated, or not STL)");
+  return false;
 }
 
 /// assimp's PLY loader trusts what a header says and loops forever on some malformed ones (no
@@ -227,7 +235,7 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
   common::requireMemory(file.string(), 16.0 * static_cast<double>(size), "mesh file of " +
                         std::to_string(size >> 20) + " MiB");
   checkPlyHeader(file, size);
-  checkStlSize(file, size);
+  const bool capital_stl = checkStlSize(file, size);
 
   Assimp::Importer importer;
   const aiScene* scene = nullptr;
@@ -235,7 +243,15 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
     // No post-processing but validation: assimp's steps trust the loaders' output and abort
     // (ai_assert in Triangulate) or crash on malformed files (found by tests/fuzz fuzz_mesh), so
     // polygons are split and node transforms applied below, with every index checked.
-    scene = importer.ReadFile(file.string(), aiProcess_ValidateDataStructure);
+    if (capital_stl) {  // its text in lower case (keywords, the E of exponents, the name)
+      std::ifstream in(file, std::ios::binary);
+      std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      scene = importer.ReadFileFromMemory(text.data(), text.size(), aiProcess_ValidateDataStructure,
+                                          "stl");
+    } else {
+      scene = importer.ReadFile(file.string(), aiProcess_ValidateDataStructure);
+    }
   } catch (const std::exception& e) {
     throw InputError(file.string() + ": cannot read mesh: " + e.what());
   }

@@ -5,10 +5,12 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "fieldpath/geometry/mesh_io.h"
 #include "files.h"
 
 namespace fieldpath::app::test {
@@ -55,6 +57,32 @@ TEST(CliSimulate, BallDimpleIsTheExactSphere) {
   EXPECT_GT(inside, 1000);
   for (const char* file : {"heights.json", "surface.stl", "heights.png"})
     EXPECT_TRUE(std::filesystem::exists(dir.path() / "out" / file)) << file;
+}
+
+// A tool mesh wound inward (each triangle the other way round) cut nothing with a vertical axis
+// (its downward faces were its top); turned outward with a note, it cuts as the same mesh wound
+// outward, bit for bit.
+TEST(CliSimulate, AToolMeshWoundInwardCutsAsWoundOutward) {
+  const TempDir dir;
+  dir.write("path.cl", "0 0 0 0 0 1\n0.5 0 0 0.3 0 0.953939\n");
+  ASSERT_EQ(runFieldpath(dir, "tool --shape ball:2:8 --out outward.stl").exit_code, 0);
+  geometry::TriangleMesh mesh = geometry::loadMesh(dir.path() / "outward.stl");
+  for (auto& t : mesh.triangles) std::swap(t[1], t[2]);
+  geometry::saveMesh(mesh, dir.path() / "inward.stl");
+  std::string heights[2];
+  for (int k = 0; k < 2; ++k) {
+    const std::string tool = k == 0 ? "outward.stl" : "inward.stl";
+    const Outcome run = runFieldpath(dir, "simulate --tool " + tool + " --path path.cl --grid 41x41 "
+                                     "--region -2.05,-2.05,2.55,2.05 --stock 5 --backend cpu --out o" +
+                                     std::to_string(k));
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    EXPECT_EQ(run.err.find("wound inward") != std::string::npos, k == 1) << run.err;
+    heights[k] = slurp(dir.path() / ("o" + std::to_string(k)) / "heights.npy");
+  }
+  const std::vector<float> h = npyFloats(heights[0]);
+  ASSERT_EQ(h.size(), 41u * 41u);
+  EXPECT_LT(*std::min_element(h.begin(), h.end()), 0.01f);  // it cuts down to the tip
+  EXPECT_EQ(heights[0], heights[1]);
 }
 
 TEST(CliSimulate, BadInputIsExitOneWithOneLineAndNoOutputs) {

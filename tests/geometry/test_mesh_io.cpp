@@ -1,3 +1,4 @@
+#include <cctype>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -66,6 +67,20 @@ TEST(MeshIo, AsciiStlClosedForm) {
   EXPECT_EQ(m.triangles.size(), 4u);
   EXPECT_TRUE(validateMesh(m).closed()) << validateMesh(m).summary();
   EXPECT_NEAR(meshVolume(m), 1.0 / 6.0, 1e-12);
+}
+
+// Written in capitals (`SOLID`, `FACET NORMAL`, `VERTEX`, `1.0E+00`), as some CAD systems do: the
+// same tetrahedron (it was taken for binary and refused with a triangle count from its text).
+TEST(MeshIo, AsciiStlInCapitalsIsTheSame) {
+  std::string capitals = kAsciiTetra;
+  for (char& c : capitals) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  const std::string::size_type one = capitals.find("VERTEX 1 0 0");
+  ASSERT_NE(one, std::string::npos);
+  capitals.replace(one, 12, "VERTEX 1.0E+00 0 0");
+  const TriangleMesh m = loadMesh(writeBytes("TETRA.STL", capitals));
+  const TriangleMesh lower = loadMesh(writeBytes("tetra_lower.stl", kAsciiTetra));
+  EXPECT_EQ(m.vertices, lower.vertices);
+  EXPECT_EQ(m.triangles, lower.triangles);
 }
 
 TEST(MeshIo, AsciiPlyAndObjWithQuadsClosedForm) {

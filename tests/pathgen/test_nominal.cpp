@@ -1,8 +1,10 @@
 /// Passes from a nominal path file: pass breaks (markers, blank lines, gaps, APT RAPID), frames at
 /// degenerate postures, marked path files read back bit for bit, links, and motions checked
 /// between clear postures.
+#include <array>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -388,6 +390,47 @@ TEST(Links, TheHolderIntoThePartIsReportedAtEveryPostureAndMotion) {
   EXPECT_FALSE(clear->collides());
   EXPECT_NEAR(clear->min_clearance_mm, 1.0 - 0.02, 0.03);
   EXPECT_FALSE(checkHolderAgainstPart(tool, {}, part, pass(0.0)).has_value());
+}
+
+// A mesh whose identical positions are one vertex (as loadMesh joins them).
+geometry::TriangleMesh joined(const geometry::TriangleMesh& in) {
+  geometry::TriangleMesh out;
+  std::map<std::array<double, 3>, int> index_of;
+  std::vector<int> remap;
+  for (const auto& v : in.vertices) {
+    const auto [it, added] = index_of.emplace(std::array<double, 3>{v.x(), v.y(), v.z()},
+                                              static_cast<int>(out.vertices.size()));
+    if (added) out.vertices.push_back(v);
+    remap.push_back(it->second);
+  }
+  for (const auto& t : in.triangles) out.triangles.emplace_back(remap[t[0]], remap[t[1]], remap[t[2]]);
+  return out;
+}
+
+// A tool wholly inside a solid obstacle collides also when the obstacle's file writes a triangle
+// twice, or holds two bodies sharing a face or an edge (a multi-body export): the shells are
+// still closed (every edge as often one way as the other) and their inside is known. Each of
+// these read as clear (17.48 mm) before.
+TEST(Clearance, InsideASolidWithRepeatsOrTouchingBodiesIsColliding) {
+  const geometry::ToolSpec tool{geometry::ToolShape::Ball, 1.0, 0.0, 4.0};
+  const geometry::TriangleMesh tool_mesh = geometry::toolMesh(tool, {{4, 1.5}, {8, 1.5}}, 0.02);
+  const Posture inside{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d::UnitZ(), 0.0, false};
+  geometry::TriangleMesh repeated = boxMesh(-20, 20, -20, 20, -20, 80);
+  repeated.triangles.push_back(repeated.triangles.front());
+  geometry::TriangleMesh stacked = boxMesh(-20, 20, -20, 20, -20, 30);
+  pathgen::test::addBox(stacked, -20, 20, -20, 20, 30, 80);
+  geometry::TriangleMesh by_edge = boxMesh(-20, 20, -20, 20, -20, 80);
+  pathgen::test::addBox(by_edge, 20, 40, 20, 40, -20, 80);
+  for (const auto& [name, mesh] : {std::pair{"repeated", repeated}, std::pair{"stacked", stacked},
+                                   std::pair{"by_edge", by_edge}}) {
+    const std::vector<geometry::TriangleMesh> obstacle = {joined(mesh)};
+    EXPECT_EQ(geometry::closedShells(obstacle[0]).size(), 1u) << name;  // joined through vertices
+    const ClearanceChecker checker(tool_mesh, obstacle, 0.02);
+    EXPECT_EQ(checker.clearance(inside), 0.0) << name;
+    // outside every body, beside it: clear
+    const Posture beside{Eigen::Vector3d(-30, 0, 0), Eigen::Vector3d::UnitZ(), 0.0, false};
+    EXPECT_GT(checker.clearance(beside), 5.0) << name;
+  }
 }
 
 // FCL measures between surfaces: a tool wholly inside a closed obstacle, or an obstacle wholly

@@ -39,7 +39,9 @@ double meshArea(const TriangleMesh& mesh);
 double meshVolume(const TriangleMesh& mesh);
 
 /// The closed, consistently wound shells of `mesh` (connected sets of triangles, joined through
-/// their vertices, whose every edge is used twice, once each way), as triangle indices.
+/// their vertices, whose every edge is used as often one way as the other: once each way, or
+/// twice where two bodies of one file share a face or an edge), as triangle indices. A triangle
+/// written again the same way round is left out (the surface is there once).
 std::vector<std::vector<int>> closedShells(const TriangleMesh& mesh);
 /// The other shells (triangles joined through their vertices): open sheets, or not closed.
 std::vector<std::vector<int>> openShells(const TriangleMesh& mesh);
