@@ -17,6 +17,9 @@ pathgen::GenerateRequest sceneJob(const Scene& scene) {
                      "path.nominal: missing: generate needs the nominal path (`path: { nominal: "
                      "FILE }`, .cl, APT or .npy) or the parametric impeller (`guide: { impeller: "
                      "hub }` with `- impeller:` among the obstacles)");
+  if (scene.nominal && scene.path.passes_given)
+    throw InputError(where + "path.passes: the parametric impeller's pass count (with `guide: { "
+                             "impeller: hub }`); a nominal path's passes are its own");
   if (!scene.tool_given)
     throw InputError(where + "tool: missing: generate needs the cutter (`tool: { shape: ball, "
                              "radius: R, length: L }`)");

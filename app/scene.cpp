@@ -106,6 +106,9 @@ class Reader {
     return p.is_absolute() ? p : file_.parent_path() / p;
   }
 
+  /// Beyond this distance from the origin a float's step passes 1 um (2^13 mm: 0.98 um).
+  static constexpr double kFloatExactMm = 8192.0;
+
   /// Loads a mesh, naming the scene's key and line in the error.
   geometry::TriangleMesh mesh(const YAML::Node& node, const std::string& key) const {
     const auto p = path(node, key);
@@ -120,6 +123,17 @@ class Reader {
     if (const std::size_t turned = geometry::orientClosedShells(mesh))
       std::fprintf(stderr, "note: %s: %zu closed shell%s wound inward (normals flipped), turned "
                            "outward\n", p.string().c_str(), turned, turned == 1 ? "" : "s");
+    // Mesh files are read in single precision (binary STL stores floats; assimp reads every
+    // format so): far from the origin their points move by half a float's step, which check
+    // then reads as microns of gouge or clearance (5e5 mm: 32 um, 32 769 false gouged lines).
+    double far_mm = 0.0;
+    for (const auto& v : mesh.vertices) far_mm = std::max(far_mm, v.cwiseAbs().maxCoeff());
+    if (far_mm > kFloatExactMm)
+      std::fprintf(stderr,
+                   "note: %s: points up to %.4g mm from the origin, read in single precision "
+                   "(steps of %.2g mm there): place the job near the origin for micron figures\n",
+                   p.string().c_str(), far_mm,
+                   double(std::nextafter(float(far_mm), HUGE_VALF) - float(far_mm)));
     return mesh;
   }
 
@@ -197,6 +211,13 @@ void readTool(const Reader& r, const YAML::Node& node, geometry::ToolSpec& tool)
   if (node["length"]) tool.length_mm = r.positive(node["length"], "tool.length");
   if (tool.shape == geometry::ToolShape::Torus && !node["corner_radius"])
     r.fail(node, "tool.corner_radius", "required for a torus tool");
+  // Only a torus has a corner radius of its own (a ball's is its radius): one given otherwise was
+  // read past without a word.
+  if (tool.shape != geometry::ToolShape::Torus && node["corner_radius"] &&
+      !(tool.shape == geometry::ToolShape::Ball && tool.corner_radius_mm == tool.radius_mm))
+    r.fail(node["corner_radius"], "tool.corner_radius",
+           "only a torus tool has one (a ball's is its radius, a flat end's 0)");
+  if (tool.shape != geometry::ToolShape::Torus) tool.corner_radius_mm = 0.0;
   r.check(node, "tool", [&] { geometry::validateToolSpec(tool); });
 }
 
@@ -306,6 +327,7 @@ void readPath(const Reader& r, const YAML::Node& node, pathgen::PathParams& p) {
         node["passes"], "path.passes",
         [](double v) { return v >= 1.0 && v == std::floor(v) && v <= 1e6; }, "a whole number >= 1");
     p.passes = static_cast<int>(passes);
+    p.passes_given = true;
   }
   if (node["step"]) {
     p.step_mm = r.positive(node["step"], "path.step");

@@ -4,6 +4,7 @@
 
 #include "fieldpath/common/errors.h"
 #include "files.h"
+#include "job.h"
 #include "scene.h"
 
 using namespace fieldpath;
@@ -141,6 +142,11 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
       {"obstacles:\n  - mesh: wall.stl\ntool: { shape: torus, radius: 3 }\n", "tool.corner_radius",
        3},
       {"obstacles:\n  - mesh: wall.stl\ntool: { shape: cone }\n", "tool.shape", 3},
+      // Only a torus has a corner radius of its own: one given to another tool was read past.
+      {"obstacles:\n  - mesh: wall.stl\ntool: { shape: flat, radius: 3, corner_radius: 1 }\n",
+       "tool.corner_radius", 3},
+      {"obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, corner_radius: 1 }\n",
+       "tool.corner_radius", 3},
       {"obstacles:\n  - mesh: wall.stl\nholder: [[40, 6], [30, 6]]\n", "holder", 3},
       {"obstacles:\n  - mesh: wall.stl\nholder: [[40, 6], [50]]\n", "holder[2]", 3},
       {"obstacles:\n  - mesh: wall.stl\nclearance: -0.1\n", "clearance", 3},
@@ -213,4 +219,23 @@ TEST(Scene, TheSameSurfacesFromTwoFilesAreRefused) {
   }
   const auto two = dir.write("two.yaml", "obstacles:\n  - mesh: wall.stl\n  - mesh: other.stl\n");
   EXPECT_EQ(app::loadScene(two).obstacles.size(), 2u);
+}
+
+// `path.passes` is the parametric impeller's: with a nominal path it was read past (the same
+// path.cl). A ball's corner radius equal to its radius says nothing new and is taken.
+TEST(Scene, KeysThatDoNotApplyAreRefused) {
+  TempDir dir;
+  dir.write("wall.stl", app::test::squareStl(5));
+  dir.write("nominal.cl", "0 0 1 0 0 1\n1 0 1 0 0 1\n");
+  const auto file = dir.write("job.yaml",
+                              "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, "
+                              "corner_radius: 3, length: 40 }\npath: { nominal: nominal.cl, passes: 3 }\n");
+  const app::Scene scene = app::loadScene(file);
+  EXPECT_EQ(scene.tool.radius_mm, 3.0);
+  try {
+    app::sceneJob(scene);
+    ADD_FAILURE() << "path.passes with a nominal path was read past";
+  } catch (const common::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("path.passes"), std::string::npos) << e.what();
+  }
 }

@@ -272,6 +272,42 @@ TEST(CheckSurface, TheMotionBetweenTwoPosturesIsCut) {
   EXPECT_EQ(over["gouged_lines"].get<int>(), 0);
 }
 
+// A tilted tool's shank cuts beside the ball's footprint: a pass on a floor with the axis tilted
+// 20° towards a wall of the part 7 mm off drives the shank ~4 mm into the wall. The Z-buffer's
+// region reached only the balls (0 um of gouge); it now reaches the shank's plan up to the
+// part's top. The same pass tilted away gouges nothing.
+TEST(CheckSurface, AShankDrivenIntoAWallOfThePartIsAGouge) {
+  const TempDir dir;
+  geometry::TriangleMesh part, far;
+  pathgen::test::addBox(part, -30, 7, -30, 30, -10, 0);  // the floor
+  pathgen::test::addBox(part, 8, 30, -30, 30, -10, 60);  // a wall beside the pass
+  pathgen::test::addBox(far, -100, -90, -100, -90, -50, -40);
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(far, dir.path() / "far.stl");
+  dir.write("scene.yaml", "obstacles:\n  - mesh: far.stl\npart: part.stl\n"
+                          "tool: { shape: ball, radius: 3, length: 40 }\n");
+  const double s = std::sin(20.0 * M_PI / 180.0), c = std::cos(20.0 * M_PI / 180.0);
+  for (const double side : {1.0, -1.0}) {
+    std::ostringstream path;
+    path.precision(17);
+    path << "# pass 1\n";
+    // the ball resting on the floor: its centre at z = 3 over x = -1, the tip R below it
+    for (int k = 0; k <= 40; ++k)
+      path << -1 - 3 * side * s << ' ' << -5 + 0.25 * k << ' ' << 3 - 3 * c << ' ' << side * s
+           << " 0 " << c << '\n';
+    dir.write(side > 0 ? "towards.cl" : "away.cl", path.str());
+  }
+  auto surface = [&](const std::string& name) {
+    const auto r = test::runFieldpath(dir, "check scene.yaml --path " + name + ".cl --spacing 0.1 --out out_" + name);
+    EXPECT_EQ(r.exit_code, 0) << r.output();
+    return nlohmann::json::parse(test::slurp(dir.path() / ("out_" + name) / "check.json"))["surface"];
+  };
+  const auto towards = surface("towards"), away = surface("away");
+  EXPECT_GT(towards["max_gouge_um"].get<double>(), 3000.0);
+  EXPECT_GT(towards["gouged_lines"].get<int>(), 100);
+  EXPECT_EQ(away["gouged_lines"].get<int>(), 0);
+}
+
 TEST(CheckSurface, TheSameJobHighUpInZReadsTheSame) {
   // A pass along a plate, and the whole job lifted 1e5 mm in z: the same surface figures
   // (float heights held there read a clean pass as 7.8 um of gouge on 498 lines).

@@ -7,6 +7,7 @@ namespace fieldpath::pathgen {
 
 struct PathParams {
   int passes = 7;  ///< `passes`: isoparametric passes of the parametric impeller (≥ 1)
+  bool passes_given = false;  ///< the scene names `path.passes` (a nominal path refuses it)
   /// `step`: largest distance between output postures along a pass (ball-centre arc, mm). The
   /// impeller's passes are always stepped so; a nominal path only when `step_given`.
   double step_mm = 0.5;
