@@ -33,6 +33,8 @@ using Clock = std::chrono::steady_clock;
 using geometry::kDegToRad;
 /// Tool + holder nodes aimed at (seed 004: "le maillage outil comporte 500 nœuds").
 constexpr double kTargetNodes = 500.0;
+/// The share of the job's progress the balls' pre-check reports in (the field's from there on).
+constexpr double kBallShare = 0.02;
 
 double seconds(Clock::time_point since) {
   return std::chrono::duration<double>(Clock::now() - since).count();
@@ -48,9 +50,13 @@ common::Progress scaled(const common::Progress& progress, double begin, double e
 }
 
 /// Every pass station's ball must clear the obstacles by `clearance_mm` (whatever the axis).
+/// `progress` after each pass (10 000 passes took minutes without a word).
 void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>& passes,
-                        double ball_radius_mm, double clearance_mm) {
-  for (const Pass& pass : passes) {
+                        double ball_radius_mm, double clearance_mm,
+                        const common::Progress& progress) {
+  for (std::size_t k = 0; k < passes.size(); ++k) {
+    const Pass& pass = passes[k];
+    common::report(progress, static_cast<double>(k) / passes.size(), "balls");
     std::vector<Vec3> centres;
     for (const PassSample& s : pass.samples) centres.push_back(s.centre_mm);
     size_t at = 0;
@@ -122,7 +128,8 @@ GenerateResult generatePath(const GenerateRequest& request) {
       geometry::toolMesh(tool, request.holder, kClearanceMeshTolMm);
   result.tool_triangles = tool_mesh.triangles.size();
   const ClearanceChecker checker(tool_mesh, obstacles, kClearanceMeshTolMm);
-  checkBallClearance(checker, result.passes, r, request.clearance_mm);
+  checkBallClearance(checker, result.passes, r, request.clearance_mm,
+                     scaled(request.progress, 0.0, kBallShare, "balls"));
   // The links' travel plane, checked before any work.
   double safe_z_mm = 0.0;
   if (!request.passes_only) {
@@ -267,7 +274,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
           const Eigen::AlignedBox3d& valid,
           std::optional<field::VoxelField>& level0) -> std::shared_ptr<const field::CellMask> {
     field::VoxelRequest uniform = field::levelZeroRequest(refined, request.field.r_min_mm);
-    uniform.progress = scaled(request.progress, 0.0, 0.05, "field");
+    uniform.progress = scaled(request.progress, kBallShare, 0.05, "field");
     common::PhaseTrace trace("near path");
     level0.emplace(exact, uniform);
     trace.lap("uniform grid");
@@ -355,7 +362,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
       // from its faces); beyond, the exact sum answers (a voxel field is zero where it has no
       // nodes: a point the box missed would feel no wall).
       const Eigen::AlignedBox3d valid = field::RegionField::stencilBox(result.reach_box_mm, h);
-      double built_share = 0.0;
+      double built_share = kBallShare;
       std::optional<field::VoxelField> level0;
       if (voxel_request.refine_tolerance > 0.0 && voxel_request.refine_levels > 0 &&
           voxel_request.refine_region == field::RefineRegion::Path) {
