@@ -248,8 +248,9 @@ void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
   // into the walls); 0 turns the field off (the nominal path).
   if (node["gain"])
     f.gain = r.number(
-        node["gain"], "field.gain", [](double v) { return v >= 0.0; },
-        ">= 0 (the field pushes the tool away from the obstacles)");
+        node["gain"], "field.gain", [](double v) { return v >= 0.0 && v <= 1e30; },
+        "in [0, 1e30] (>= 0: the field pushes the tool away from the obstacles; past 1e30 the "
+        "voxels' single-precision forces overflow)");
   if (node["sample_step"]) f.sample_step_mm = r.positive(node["sample_step"], "field.sample_step");
   if (node["weights"])
     f.weights = r.word(node["weights"], "field.weights", {"area", "unit"}) == "area"

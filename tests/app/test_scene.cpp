@@ -169,6 +169,7 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
       // The same mesh twice would repel twice.
       {"obstacles:\n  - mesh: wall.stl\n  - mesh: ./wall.stl\n", "obstacles[2].mesh", 3},
       {"obstacles:\n  - mesh: wall.stl\nfield:\n  gain: -1\n", "field.gain", 4},
+      {"obstacles:\n  - mesh: wall.stl\nfield:\n  gain: 1e38\n", "field.gain", 4},
       // A second scene in the file would be ignored (YAML reads the first document).
       {"obstacles:\n  - mesh: wall.stl\n---\nclearance: 0.5\n", "second YAML document", 4},
       {"obstacles:\n  - mesh: wall.stl\n...\nclearance: 0.5\n", "second YAML document", 4},
