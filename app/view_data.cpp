@@ -20,6 +20,7 @@
 #include "fieldpath/geometry/units.h"
 #include "fieldpath/pathgen/clearance.h"
 #include "fieldpath/pathgen/generate.h"
+#include "fieldpath/pathgen/link_check.h"
 #include "job.h"
 #include "scene.h"
 #include "fieldpath/common/file_digest.h"
@@ -386,8 +387,25 @@ ViewData gatherView(const ViewRequest& request) {
       p.clearance_source =
           "computed here, as `fieldpath check` computes it (FCL, postures and motions)";
       check = CheckJson{n, c.colliding, m.colliding, p.what};
+      // The part's contacts (the links', the holder's), as `check` finds them: not coloured on
+      // the page (its colours are the obstacles'), said above it.
+      if (scene.part) {
+        std::optional<pathgen::LinkPartResult> links;
+        if (p.file.count(geometry::PathBlock::Kind::Link) > 0)
+          links = pathgen::checkLinksAgainstPart(
+              pathgen::ClearanceChecker(
+                  geometry::toolMesh(scene.tool, scene.holder, pathgen::kClearanceMeshTolMm),
+                  std::span(&*scene.part, 1), pathgen::kClearanceMeshTolMm),
+              p.file);
+        check->link_part = links;
+        check->holder_part =
+            pathgen::checkHolderAgainstPart(scene.tool, scene.holder, *scene.part, postures);
+      }
       p.clearance_known = true;
     }
+    if (check)
+      for (const std::string& reason : unsafeReasons({}, {}, check->link_part, check->holder_part))
+        d.warnings.push_back("UNSAFE TO RUN: " + reason);
     for (std::size_t i = 0; i < n; ++i) {
       p.colliding_postures += p.clearance_mm[i] <= 0.0;
       p.colliding_motions += p.motion_mm[i] <= 0.0;

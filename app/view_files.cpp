@@ -122,6 +122,24 @@ CheckJson readCheckJson(const fs::path& dir) {
   if (j.contains("path_digest") && j["path_digest"].is_string())
     c.path_digest = j["path_digest"].get<std::string>();
   if (j.contains("scene") && j["scene"].is_string()) c.scene = j["scene"].get<std::string>();
+  // The part's contacts: counts and first indices (null: none) of `link_part` / `holder_part`.
+  const auto contacts = [&](const char* key) -> std::optional<pathgen::LinkPartResult> {
+    const json block = j.value(key, json());
+    if (!block.is_object()) return std::nullopt;
+    const std::string name = key;
+    pathgen::LinkPartResult r;
+    r.colliding_postures = count(block.value("colliding_postures", json()), file,
+                                 (name + ".colliding_postures").c_str());
+    r.colliding_motions = count(block.value("colliding_motions", json()), file,
+                                (name + ".colliding_motions").c_str());
+    if (block.value("first_colliding_posture", json()).is_number_unsigned())
+      r.first_colliding_posture = block["first_colliding_posture"].get<std::size_t>();
+    if (block.value("first_colliding_motion", json()).is_number_unsigned())
+      r.first_colliding_motion = block["first_colliding_motion"].get<std::size_t>();
+    return r;
+  };
+  c.link_part = contacts("link_part");
+  c.holder_part = contacts("holder_part");
   return c;
 }
 

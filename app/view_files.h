@@ -4,6 +4,7 @@
 /// throws common::InputError naming the file (and the line or key).
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,8 @@
 #include "scene.h"
 #include "surface_check.h"
 #include "view_data.h"
+
+#include "fieldpath/pathgen/link_check.h"
 
 namespace fieldpath::app::view_files {
 
@@ -24,6 +27,9 @@ struct CheckJson {
   std::string path;
   std::string path_digest;  ///< common::fileDigest of the path checked (empty in older check.json)
   std::string scene;        ///< the scene file checked against, as `check` was given it
+  /// check.json `link_part` and `holder_part`: the part's contacts (the page's colours are the
+  /// obstacles'), where check found them.
+  std::optional<pathgen::LinkPartResult> link_part, holder_part;
 };
 /// check.json of a `check --out` folder (`--check DIR`).
 CheckJson readCheckJson(const std::filesystem::path& dir);
