@@ -80,8 +80,9 @@ inline nlohmann::json linkPartJson(const std::optional<pathgen::LinkPartResult>&
           {"min_mm", jsonNumber(l->min_clearance_mm)},
           {"method",
            "every link posture and every motion between two link postures against the part mesh "
-           "(as `motions`, required 0: rapid moves must not touch it); the moves into and out "
-           "of a pass, which start where the ball cuts, are left out"},
+           "(as `motions`, required 0: rapid moves must not touch it), and the moves out of and "
+           "into a pass but for their 0.1 mm of tip travel at the pass, where the ball leaves or "
+           "reaches the surface it cuts (counted, not in min_mm)"},
           {"ok", !l->collides()}};
 }
 

@@ -361,6 +361,26 @@ TEST(Links, ALinkThroughThePartIsReportedAndThePassContactIsNot) {
   const LinkPartResult over = checkLinksAgainstPart(checker, path);
   EXPECT_FALSE(over.collides());
   EXPECT_NEAR(over.min_clearance_mm, 2.0 - 0.02, 0.03);
+  // The move out of a pass: a retract along an axis leaning 45° towards the block (the ball on
+  // the floor, its centre 5 mm before the block at the pass's end) drives the ball into the
+  // block's top edge; leaning away, it leaves clear. The first 0.1 mm, where the ball leaves the
+  // floor it cuts, is not counted either way.
+  for (const double lean : {45.0, -45.0}) {
+    const double rad = lean * M_PI / 180.0;
+    const Eigen::Vector3d axis(std::sin(rad), 0.0, std::cos(rad));
+    auto ball = [&](double x) {  // the ball resting on the floor, centre at x
+      return Posture{Eigen::Vector3d(x, 0, 3) - 3.0 * axis, axis, 0.0, false};
+    };
+    geometry::PathFile leaning = path;
+    leaning.postures[0] = ball(5);
+    leaning.postures[1] = leaning.postures[2] = ball(15);
+    leaning.postures[3] = Posture{leaning.postures[1].tip_mm + 10.0 * axis, axis, 0.0, false};
+    leaning.postures[4] = Posture{Eigen::Vector3d(40, 0, 10), Eigen::Vector3d::UnitZ(), 0.0, false};
+    const LinkPartResult out = checkLinksAgainstPart(checker, leaning);
+    EXPECT_EQ(out.colliding_postures, 0u) << lean;
+    EXPECT_EQ(out.colliding_motions, lean > 0 ? 1u : 0u) << lean;
+    if (lean > 0) EXPECT_EQ(out.first_colliding_motion, 2u);  // posture 2 (the pass's end) to 3
+  }
 }
 
 // The holder against the part at every posture and motion: a pass on the floor beside a wall of

@@ -28,10 +28,10 @@ struct LinkPartResult {
 };
 
 /// Every posture of the path's link blocks and every motion between two of them, against
-/// `part` (a ClearanceChecker whose only obstacle is the part mesh). The motions from a pass's
-/// last posture into its link and from a link into the next pass's first posture are left out:
-/// they start or end where the ball cuts the part (retracting along the tool axis), and so are
-/// link postures at a pass's first or last posture (links.retract: 0).
+/// `part` (a ClearanceChecker whose only obstacle is the part mesh), and the motions from a
+/// pass's last posture into its link and from a link into the next pass's first posture but for
+/// their first (last) 0.1 mm of tip travel: they start or end where the ball cuts the part. Link
+/// postures at a pass's first or last posture (links.retract: 0) are that pass's.
 LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const geometry::PathFile& path);
 
 /// The holder (geometry::holderMesh) against the part at every posture and every motion of the
