@@ -1,12 +1,15 @@
 /// APT CLDATA as CAM systems write it and post-processors read it: `GOTO / x, y, z, i, j, k`
 /// (spaces allowed, 3 values keep the last axis), `$` at a line's end continues the record, `$$`
 /// starts a comment, `RAPID` makes the next motion a rapid (a link), `UNITS/INCHES` scales the
-/// coordinates that follow to mm, `FINI` ends the program (nothing after it is read), every other
-/// record is read past.
+/// coordinates that follow to mm, `TLAXIS/i,j,k` sets the axis of the 3-value GOTOs that follow,
+/// `FINI` ends the program (nothing after it is read); motions it does not take (arcs, cycles,
+/// relative and drive-surface moves) are refused; every other record is read past.
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <exception>
 #include <fstream>
+#include <iterator>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -52,6 +55,7 @@ struct AptChunk {
   bool first_without_rapid = false;  ///< its first GOTO had no RAPID before it in this chunk
   bool trailing_rapid = false;       ///< a RAPID after its last GOTO (or anywhere, if none)
   std::size_t inherit_axis = 0;      ///< leading 3-number GOTOs: they keep an earlier chunk's axis
+  std::optional<Vec3> end_axis;      ///< the axis in force at its end (a GOTO's or TLAXIS'), if set
   /// UNITS records: (first posture after it, mm per file unit), in order.
   std::vector<std::pair<std::size_t, double>> units;
   bool fini = false;  ///< FINI seen: the program ends there; later records are not read
@@ -102,7 +106,8 @@ bool continuesRecord(std::string_view content) {
 void parseAptChunk(std::string_view text, std::size_t first_line,
                    const std::filesystem::path& file, AptChunk& out) {
   bool rapid = false;  // RAPID seen: the next motion is a link
-  bool own_axis = false;  // a 6-number GOTO seen in this chunk
+  bool own_axis = false;  // a 6-number GOTO or a TLAXIS seen in this chunk
+  Vec3 axis_now = Vec3::UnitZ();  // the axis of a 3-number GOTO here (once own_axis)
   std::string record;  // a statement, with `$` continuation lines joined
   std::size_t record_line = 0, line = first_line;
   PathChunk& chunk = out.postures;
@@ -145,13 +150,42 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
       out.units.emplace_back(chunk.postures.size(), scale);
       continue;
     }
+    const std::string_view values =
+        slash == std::string::npos ? std::string_view() : std::string_view(statement).substr(slash + 1);
+    if (major == "TLAXIS") {  // the axis of the 3-number GOTOs that follow (APT's modal axis)
+      double v[3];
+      std::size_t count = 0;
+      for (std::size_t start = 0; start <= values.size() && !values.empty();) {
+        const auto comma = std::min(values.find(',', start), values.size());
+        const auto tokens = splitWhitespace(values.substr(start, comma - start));
+        if (tokens.size() != 1 || count == 3)
+          fail(file, record_line, "TLAXIS/: this reader takes TLAXIS/i, j, k (a fixed tool axis)");
+        v[count++] = parseFinite(tokens[0], file, record_line);
+        start = comma + 1;
+      }
+      if (count != 3)
+        fail(file, record_line, "TLAXIS/: this reader takes TLAXIS/i, j, k (a fixed tool axis)");
+      axis_now = checkedAxis(Vec3(v[0], v[1], v[2]),
+                             [&] { return file.string() + ":" + std::to_string(record_line); });
+      own_axis = true;
+      continue;
+    }
     // A motion the reader does not take would be a posture lost without a word: GOTO not at
-    // the record's start (`RAPID,GOTO/`, `N40 GOTO/`, `GO TO/`), a relative GODLTA.
+    // the record's start (`RAPID,GOTO/`, `N40 GOTO/`, `GO TO/`), a relative GODLTA, arcs
+    // (CIRCLE/ before a GOTO makes it an arc; MOVARC), drive-surface motions (GOFWD, GOLFT, ...),
+    // GOHOME, a canned cycle (its GOTOs become plunges), and a GOTO a `$` joined to another record.
+    static constexpr std::string_view kMotions[] = {"GODLTA", "CIRCLE", "MOVARC", "GOFWD", "GOLFT",
+                                                    "GORGT",  "GOBACK", "GOUP",   "GODOWN", "GOHOME"};
+    const bool motion_word =
+        std::find(std::begin(kMotions), std::end(kMotions), major) != std::end(kMotions);
+    const bool cycle = major == "CYCLE" && trimmed(values) != "OFF";
+    const bool text = major == "INSERT" || isTextRecord(major);
     if (major != "GOTO" && (major.find("GOTO") != std::string_view::npos ||
-                            major.find("GO TO") != std::string_view::npos || major == "GODLTA"))
+                            major.find("GO TO") != std::string_view::npos || motion_word || cycle ||
+                            (!text && values.find("GOTO") != std::string_view::npos)))
       fail(file, record_line,
            std::string(major) + "/: a motion record this reader does not take (a GOTO/ record "
-           "of its own, absolute x, y, z[, i, j, k])");
+           "of its own, absolute x, y, z[, i, j, k]; no arcs, cycles or relative moves)");
     if (major != "GOTO" || slash == std::string::npos) continue;
     double v[6];
     std::size_t count = 0;
@@ -175,9 +209,10 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
     // 6-number GOTO, that axis is an earlier chunk's (filled in when the chunks are joined).
     if (count == 6) {
       p.axis = checkedAxis(Vec3(v[3], v[4], v[5]), where);
+      axis_now = p.axis;
       own_axis = true;
     } else {
-      p.axis = chunk.postures.empty() ? Vec3::UnitZ() : chunk.postures.back().axis;
+      p.axis = axis_now;
       if (!own_axis) ++out.inherit_axis;
     }
     if (chunk.postures.empty()) out.first_without_rapid = !rapid;
@@ -189,6 +224,7 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
   if (!record.empty())
     fail(file, record_line, "the record goes on with `$` past the end of the file (truncated?)");
   out.trailing_rapid = rapid;
+  if (own_axis) out.end_axis = axis_now;
 }
 
 }  // namespace
@@ -217,7 +253,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   bool pending = false, ended = false;
   double scale = 1.0;
   std::size_t offset = 0;
-  const Posture* last = nullptr;
+  Vec3 carried_axis = Vec3::UnitZ();  // the axis in force at the end of the chunks so far
   for (std::size_t i = 0; i < chunks.size(); ++i) {
     AptChunk& c = chunks[i];
     auto& postures = c.postures.postures;
@@ -242,17 +278,16 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
       postures[k].tip_mm *= scale;
     }
     if (next_unit < c.units.size()) scale = c.units.back().second;
+    for (std::size_t k = 0; k < c.inherit_axis; ++k) postures[k].axis = carried_axis;
+    if (c.end_axis) carried_axis = *c.end_axis;
     if (postures.empty()) {
       pending = pending || c.trailing_rapid;
       continue;
     }
     if (c.first_without_rapid && pending) link_postures.push_back(offset);
     for (std::size_t k : c.postures.links) link_postures.push_back(offset + k);
-    for (std::size_t k = 0; k < c.inherit_axis; ++k)
-      postures[k].axis = last ? last->axis : Vec3::UnitZ();
     pending = c.trailing_rapid;
     offset += postures.size();
-    last = &postures.back();
   }
   PathFile path;
   path.file = file;

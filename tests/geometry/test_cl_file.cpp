@@ -216,8 +216,13 @@ TEST(AptFile, UnitsFiniAndRemarks) {
 // A motion the reader does not take is refused with its line (each lost a posture silently),
 // and a `$` ending a PPRINT is its text's, not a continuation (it swallowed the next GOTO).
 TEST(AptFile, MotionsNotReadAreRefusedAndPprintKeepsItsDollar) {
-  for (const std::string& record : {"RAPID,GOTO/1,2,3", "N40 GOTO/1,2,3", "GO TO/1,2,3",
-                                    "GODLTA/0,0,5"}) {
+  for (const std::string& record :
+       {"RAPID,GOTO/1,2,3", "N40 GOTO/1,2,3", "GO TO/1,2,3", "GODLTA/0,0,5",
+        // an arc (CIRCLE/ makes the next GOTO one), drive-surface moves, a cycle, home
+        "CIRCLE/0,0,0,0,0,1,18,0.01,0.5,6,0", "MOVARC/0,0,0,0,0,1,18,ANGLE,90", "GOFWD/(CIRCLE/0,0,0,5)",
+        "GOHOME", "CYCLE/DRILL,5,FEDTO,0,MMPM,100",
+        // a GOTO joined to another record by a `$` (it was lost)
+        "COOLNT/ON $\nGOTO/2,2,3,0,0,1"}) {
     try {
       readAptFile(writeBytes("m.apt", "GOTO/0,0,0,0,0,1\n" + record + "\nGOTO/1,0,0\n"));
       ADD_FAILURE() << record << " was read past";
@@ -228,4 +233,17 @@ TEST(AptFile, MotionsNotReadAreRefusedAndPprintKeepsItsDollar) {
   const auto p = readAptFile(
       writeBytes("d.apt", "GOTO/0,0,0,0,0,1\nPPRINT/PRICE 5$\nGOTO/1,0,0\nGOTO/2,0,0\n"));
   EXPECT_EQ(p.size(), 3u);
+  // CYCLE/OFF ends a cycle: read past
+  EXPECT_EQ(readAptFile(writeBytes("o.apt", "CYCLE/OFF\nGOTO/0,0,0,0,0,1\n")).size(), 1u);
+}
+
+// TLAXIS/i,j,k sets the axis of the 3-value GOTOs after it (APT's modal axis: they kept the old
+// one); other forms are refused.
+TEST(AptFile, TlaxisSetsTheAxisOfThreeValueGotos) {
+  const auto p = readAptFile(writeBytes(
+      "t.apt", "GOTO/0,0,0,0,0,1\nTLAXIS/0.6,0,0.8\nGOTO/1,0,0\nGOTO/2,0,0,0,0,1\nGOTO/3,0,0\n"));
+  ASSERT_EQ(p.size(), 4u);
+  EXPECT_EQ(p[1].axis, Vec3(0.6, 0, 0.8));
+  EXPECT_EQ(p[3].axis, Vec3::UnitZ());
+  EXPECT_THROW(readAptFile(writeBytes("n.apt", "TLAXIS/NORMPS\nGOTO/1,0,0\n")), InputError);
 }

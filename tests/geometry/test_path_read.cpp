@@ -167,6 +167,21 @@ TEST(PathRead, AptPprintLineEndsARecordWhateverTheChunks) {
     for (unsigned threads : {1u, 0u}) EXPECT_EQ(errorOf(file, bytes, threads), whole) << bytes;
 }
 
+TEST(PathRead, AptTlaxisCrossesChunks) {
+  // A TLAXIS in one chunk gives its axis to the 3-value GOTOs of the next, whatever the chunks.
+  const std::string text =
+      "GOTO/0,0,0,0,0,1\nTLAXIS/0,0.6,0.8\n$$ a comment\n$$ another\nGOTO/1,0,0\nGOTO/2,0,0\n"
+      "TLAXIS/0.6,0,0.8\nCOOLNT/ON\nGOTO/3,0,0\n";
+  const fs::path file = writeBytes("tlaxis.apt", text);
+  for (std::size_t bytes : kChunkBytes) {
+    const PathFile p = read(file, bytes, 0);
+    ASSERT_EQ(p.postures.size(), 4u) << bytes;
+    EXPECT_EQ(p.postures[1].axis, Vec3(0, 0.6, 0.8)) << bytes;
+    EXPECT_EQ(p.postures[2].axis, Vec3(0, 0.6, 0.8)) << bytes;
+    EXPECT_EQ(p.postures[3].axis, Vec3(0.6, 0, 0.8)) << bytes;
+  }
+}
+
 TEST(PathRead, FirstErrorInFileOrderWhateverTheChunks) {
   // Two bad lines: every chunking names the first (line 40), with the same message.
   std::string text;
