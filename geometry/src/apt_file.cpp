@@ -231,7 +231,7 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
 
 PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& options) {
   const MappedFile mapped(file);
-  const std::string_view text = withoutBom(mapped.text());
+  const std::string_view text = withoutBom(mapped.text(), file);
   const std::vector<TextChunk> pieces =
       splitAtLines(text, options.chunk_bytes, options.threads,
                    [](std::string_view line) { return continuesRecord(aptContent(line)); });

@@ -166,8 +166,13 @@ void parseClChunk(std::string_view text, std::size_t first_line, const std::file
         out.mark(PathBlock::Kind::Link);
       continue;
     }
-    if (count < 6)
+    if (count < 6) {
+      if (content.find(',') != std::string_view::npos)
+        fail(file, line, "numbers separated by commas: a .cl line is `x y z i j k` separated by "
+                         "blanks (an APT file? name it .apt or .cls)");
+      for (std::size_t c = 0; c < count; ++c) parseFinite(tokens[c], file, line);  // "not a number"
       fail(file, line, "short line: " + std::to_string(count) + " numbers, need x y z i j k");
+    }
     if (count > 7)
       fail(file, line,
            "too many columns: " + std::to_string(count) + ", expected x y z i j k [spindle]");
@@ -231,7 +236,7 @@ std::vector<PathBlock> clBlocks(const std::vector<PathChunk>& chunks, std::size_
 
 PathFile readClPath(const std::filesystem::path& file, const PathReadOptions& options) {
   const MappedFile mapped(file);
-  const std::string_view text = withoutBom(mapped.text());
+  const std::string_view text = withoutBom(mapped.text(), file);
   const std::vector<TextChunk> pieces = splitAtLines(text, options.chunk_bytes, options.threads);
   std::vector<PathChunk> chunks(pieces.size());
   forEachChunk(pieces.size(), options.threads, [&](std::size_t i) {
@@ -287,7 +292,7 @@ std::size_t scanPathFile(const std::filesystem::path& file, const PathReadOption
       break;
   }
   const MappedFile mapped(file);
-  const std::string_view text = withoutBom(mapped.text());
+  const std::string_view text = withoutBom(mapped.text(), file);
   const std::vector<TextChunk> pieces = splitAtLines(text, options.chunk_bytes, options.threads);
   if (sink.begin) sink.begin(pieces.size());
   std::vector<std::size_t> counts(pieces.size(), 0);

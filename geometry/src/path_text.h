@@ -155,7 +155,11 @@ inline void appendNumber(std::string& out, double value) {
 }
 
 /// The text without a UTF-8 byte-order mark at its start (editors on Windows write one).
-inline std::string_view withoutBom(std::string_view text) {
+/// The text without a UTF-8 byte-order mark; UTF-16 (its mark, as some Windows editors save)
+/// refused saying so (it read as "no GOTO records" or a line of garbage).
+inline std::string_view withoutBom(std::string_view text, const std::filesystem::path& file) {
+  if (text.substr(0, 2) == "\xFF\xFE" || text.substr(0, 2) == "\xFE\xFF")
+    throw common::InputError(file.string() + ": UTF-16 text: save it as UTF-8 or ASCII");
   return text.substr(0, 3) == "\xEF\xBB\xBF" ? text.substr(3) : text;
 }
 

@@ -112,7 +112,24 @@ TEST(ClFile, MalformedLinesNameTheLine) {
   expectClError("1 2 3 0 0 1\n1 2 3 0 0 1 0 9\n", 2, "too many columns");
   expectClError("1 2 3 0 0 1x\n", 1, "not a number");
   expectClError("1 2 3 0 0 1\n1 2 1e999 0 0 1\n", 2, "out of range");
-  expectClError("1,2,3,0,0,1\n", 1, "short line");
+  expectClError("1,2,3,0,0,1\n", 1, "separated by commas");
+  expectClError("GOTO/1,2,3\n", 1, "separated by commas");  // an APT file named .cl
+  expectClError("PARTNO X\n", 1, "'PARTNO' is not a number");
+}
+
+// UTF-16 (a Windows editor's "Unicode") is said so, in either format (it read as "no GOTO
+// records" or a line of garbage).
+TEST(ClFile, Utf16IsRefusedSayingSo) {
+  for (const char* name : {"w16.cl", "w16.apt"}) {
+    std::string text = "\xFF\xFE";
+    for (char c : std::string("GOTO/1,2,3,0,0,1\n")) text += std::string{c, '\0'};
+    try {
+      readPathFile(writeBytes(name, text));
+      ADD_FAILURE() << name;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("UTF-16"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(ClFile, EmptyAndMissingFiles) {
