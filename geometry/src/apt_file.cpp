@@ -1,7 +1,8 @@
 /// APT CLDATA as CAM systems write it and post-processors read it: `GOTO / x, y, z, i, j, k`
 /// (spaces allowed, 3 values keep the last axis), `$` at a line's end continues the record, `$$`
-/// starts a comment, `RAPID` makes the next motion a rapid (a link), `UNITS/INCHES` scales the
-/// coordinates that follow to mm, `TLAXIS/i,j,k` sets the axis of the 3-value GOTOs that follow,
+/// starts a comment, `RAPID` makes the next motion a rapid (a link) unless a `FEDRAT` comes
+/// between them, `UNITS/INCHES` scales the coordinates that follow to mm, `TLAXIS/i,j,k` sets the
+/// axis of the 3-value GOTOs that follow,
 /// `FINI` ends the program (nothing after it is read); motions it does not take (arcs, cycles,
 /// relative and drive-surface moves) are refused; every other record is read past.
 #include <algorithm>
@@ -54,6 +55,9 @@ struct AptChunk {
   PathChunk postures;
   bool first_without_rapid = false;  ///< its first GOTO had no RAPID before it in this chunk
   bool trailing_rapid = false;       ///< a RAPID after its last GOTO (or anywhere, if none)
+  /// A FEDRAT before its first GOTO (or anywhere, if none) with no RAPID after it: it cancels a
+  /// RAPID pending from an earlier chunk (the next motion is a feed move, as posts read it).
+  bool cancels_rapid = false;
   std::size_t inherit_axis = 0;      ///< leading 3-number GOTOs: they keep an earlier chunk's axis
   std::optional<Vec3> end_axis;      ///< the axis in force at its end (a GOTO's or TLAXIS'), if set
   /// UNITS records: (first posture after it, mm per file unit), in order.
@@ -129,6 +133,12 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
         trimmed(std::string_view(statement).substr(0, std::min(slash, statement.size())));
     if (major == "RAPID") {
       rapid = true;
+      if (chunk.postures.empty()) out.cancels_rapid = false;
+      continue;
+    }
+    if (major == "FEDRAT") {  // a feed rate set after RAPID: the next motion is a feed move
+      rapid = false;
+      if (chunk.postures.empty()) out.cancels_rapid = true;
       continue;
     }
     if (major == "FINI") {
@@ -281,10 +291,10 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
     for (std::size_t k = 0; k < c.inherit_axis; ++k) postures[k].axis = carried_axis;
     if (c.end_axis) carried_axis = *c.end_axis;
     if (postures.empty()) {
-      pending = pending || c.trailing_rapid;
+      pending = c.trailing_rapid || (pending && !c.cancels_rapid);
       continue;
     }
-    if (c.first_without_rapid && pending) link_postures.push_back(offset);
+    if (c.first_without_rapid && pending && !c.cancels_rapid) link_postures.push_back(offset);
     for (std::size_t k : c.postures.links) link_postures.push_back(offset + k);
     pending = c.trailing_rapid;
     offset += postures.size();

@@ -182,6 +182,20 @@ TEST(PathRead, AptTlaxisCrossesChunks) {
   }
 }
 
+TEST(PathRead, AptFedratBetweenRapidAndGotoMakesAFeedMoveWhateverTheChunks) {
+  // RAPID, then FEDRAT, then GOTO: the GOTO is a feed move (posts read FEDRAT so), with comments
+  // between them to put chunk boundaries anywhere; a RAPID right before a GOTO stays a link.
+  const std::string text =
+      "GOTO/0,0,0,0,0,1\nRAPID\n$$ one\n$$ two\nFEDRAT/MMPM,500\n$$ three\nGOTO/1,0,0\n"
+      "GOTO/2,0,0\nFEDRAT/MMPM,500\nRAPID\n$$ four\nGOTO/3,0,0\nGOTO/4,0,0\n";
+  const fs::path file = writeBytes("fedrat.apt", text);
+  const std::vector<PathBlock> blocks = {{PathBlock::Kind::Pass, 0, 3},
+                                         {PathBlock::Kind::Link, 3, 4},
+                                         {PathBlock::Kind::Pass, 4, 5}};
+  for (std::size_t bytes : kChunkBytes)
+    for (unsigned threads : {1u, 0u}) EXPECT_EQ(read(file, bytes, threads).blocks, blocks) << bytes;
+}
+
 TEST(PathRead, FirstErrorInFileOrderWhateverTheChunks) {
   // Two bad lines: every chunking names the first (line 40), with the same message.
   std::string text;
