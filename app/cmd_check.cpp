@@ -11,6 +11,7 @@
 #include <span>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -227,18 +228,15 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         clearance.colliding ? " (COLLISIONS)" : "", motions.motions, motions.min_clearance_mm,
         index(motions.min_index).c_str(), motions.colliding,
         motions.colliding ? " (COLLISIONS)" : "", motions.under_required, motions.samples);
-    if (link_part)
-      std::printf("links vs part: %zu postures, %zu motions, min >= %.3f mm, %zu colliding "
-                  "postures, %zu colliding motions%s\n",
-                  link_part->postures, link_part->motions, link_part->min_clearance_mm,
-                  link_part->colliding_postures, link_part->colliding_motions,
-                  link_part->collides() ? " (COLLISIONS)" : "");
-    if (holder_part)
-      std::printf("holder vs part: %zu postures, %zu motions, min >= %.3f mm, %zu colliding "
-                  "postures, %zu colliding motions%s\n",
-                  holder_part->postures, holder_part->motions, holder_part->min_clearance_mm,
-                  holder_part->colliding_postures, holder_part->colliding_motions,
-                  holder_part->collides() ? " (COLLISIONS)" : "");
+    using Contacts = std::pair<const char*, const std::optional<pathgen::LinkPartResult>*>;
+    for (const auto& [what, contacts] :
+         {Contacts{"links", &link_part}, Contacts{"holder", &holder_part}})
+      if (*contacts)
+        std::printf("%s vs part: %zu postures, %zu motions, min >= %.3f mm, %zu colliding "
+                    "postures, %zu colliding motions%s\n",
+                    what, (*contacts)->postures, (*contacts)->motions,
+                    (*contacts)->min_clearance_mm, (*contacts)->colliding_postures,
+                    (*contacts)->colliding_motions, (*contacts)->collides() ? " (COLLISIONS)" : "");
     if (!path.limited.empty())
       std::printf("limits: %zu postures held at an angle limit, %zu of them colliding\n",
                   path.limited.size(), limited_colliding);

@@ -67,40 +67,41 @@ inline nlohmann::json motionsJson(const pathgen::MotionResult& m, double require
                      !(m.min_clearance_mm < required_mm)}};
 }
 
+/// A block of the part's contacts (LinkPartResult) as report.json and check.json write it, its
+/// counts named `postures_key` / `motions_key` and its `method` said.
+inline nlohmann::json partContactsJson(const pathgen::LinkPartResult& r, const char* postures_key,
+                                       const char* motions_key, const char* method) {
+  return {{postures_key, r.postures},
+          {motions_key, r.motions},
+          {"colliding_postures", r.colliding_postures},
+          {"first_colliding_posture", jsonIndex(r.first_colliding_posture)},
+          {"colliding_motions", r.colliding_motions},
+          {"first_colliding_motion", jsonIndex(r.first_colliding_motion)},
+          {"min_mm", jsonNumber(r.min_clearance_mm)},
+          {"method", method},
+          {"ok", !r.collides()}};
+}
+
 /// The `link_part` block of report.json and check.json: the links against the part (null with the
 /// reason when the job has no part or no links).
 inline nlohmann::json linkPartJson(const std::optional<pathgen::LinkPartResult>& l) {
   if (!l) return nullptr;
-  return {{"link_postures", l->postures},
-          {"link_motions", l->motions},
-          {"colliding_postures", l->colliding_postures},
-          {"first_colliding_posture", jsonIndex(l->first_colliding_posture)},
-          {"colliding_motions", l->colliding_motions},
-          {"first_colliding_motion", jsonIndex(l->first_colliding_motion)},
-          {"min_mm", jsonNumber(l->min_clearance_mm)},
-          {"method",
-           "every link posture and every motion between two link postures against the part mesh "
-           "(as `motions`, required 0: rapid moves must not touch it), and the moves out of and "
-           "into a pass but for their 0.1 mm of tip travel at the pass, where the ball leaves or "
-           "reaches the surface it cuts (counted, not in min_mm)"},
-          {"ok", !l->collides()}};
+  return partContactsJson(
+      *l, "link_postures", "link_motions",
+      "every link posture and every motion between two link postures against the part mesh "
+      "(as `motions`, required 0: rapid moves must not touch it), and the moves out of and "
+      "into a pass but for their 0.1 mm of tip travel at the pass, where the ball leaves or "
+      "reaches the surface it cuts (counted, not in min_mm)");
 }
 
 /// The `holder_part` block of report.json and check.json: the holder against the part at every
 /// posture and motion (null with the reason when the job has no part or no holder).
 inline nlohmann::json holderPartJson(const std::optional<pathgen::LinkPartResult>& h) {
   if (!h) return nullptr;
-  return {{"postures", h->postures},
-          {"motions", h->motions},
-          {"colliding_postures", h->colliding_postures},
-          {"first_colliding_posture", jsonIndex(h->first_colliding_posture)},
-          {"colliding_motions", h->colliding_motions},
-          {"first_colliding_motion", jsonIndex(h->first_colliding_motion)},
-          {"min_mm", jsonNumber(h->min_clearance_mm)},
-          {"method",
-           "the holder (the stations above the tool: it never cuts) against the part mesh at every "
-           "posture and motion, passes and links (as `motions`, required 0)"},
-          {"ok", !h->collides()}};
+  return partContactsJson(
+      *h, "postures", "motions",
+      "the holder (the stations above the tool: it never cuts) against the part mesh at every "
+      "posture and motion, passes and links (as `motions`, required 0)");
 }
 
 /// Why a path is not safe to run as it stands (empty: it is): postures or motions that touch an
