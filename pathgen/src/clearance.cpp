@@ -47,11 +47,17 @@ struct ClearanceChecker::Impl {
   std::optional<ClosedShells> tool_solid;
   std::vector<ClosedShells> obstacle_solids;
 
+  /// A point of the tool mesh's surface (tool frame): a vertex of its first triangle (the tip for
+  /// a whole tool; a point of the holder for geometry::holderMesh, whose tip is not its own).
+  Eigen::Vector3d tool_anchor = Eigen::Vector3d::Zero();
+
   /// Whether the tool placed at `placed` lies inside obstacle i or holds it, given that their
-  /// surfaces do not meet: its tip inside the obstacle, or an obstacle shell's vertex inside it.
+  /// surfaces do not meet: a point of its surface inside the obstacle, or an obstacle shell's
+  /// vertex inside it. (The tip was taken for the point: for the holder alone, a tip resting on
+  /// the part's top read as the holder inside the part.)
   bool enclosed(const Eigen::Isometry3d& placed, std::size_t i) const {
     const ClosedShells& solid = obstacle_solids[i];
-    if (!solid.empty() && solid.contains(placed.translation())) return true;
+    if (!solid.empty() && solid.contains(placed * tool_anchor)) return true;
     if (!tool_solid || tool_solid->empty()) return false;
     const Eigen::Isometry3d to_tool = placed.inverse();
     for (const Eigen::Vector3d& anchor : solid.anchors())
@@ -68,6 +74,8 @@ ClearanceChecker::ClearanceChecker(const geometry::TriangleMesh& tool_mesh,
   auto impl = std::make_shared<Impl>();
   impl->tool = buildModel(tool_mesh, "tool mesh");
   impl->tool_solid.emplace(tool_mesh);
+  if (!tool_mesh.triangles.empty())
+    impl->tool_anchor = tool_mesh.vertices[static_cast<std::size_t>(tool_mesh.triangles[0][0])];
   for (size_t i = 0; i < obstacles.size(); ++i) {
     impl->obstacles.push_back(buildModel(obstacles[i], "obstacle " + std::to_string(i + 1)));
     impl->obstacle_solids.emplace_back(obstacles[i]);

@@ -410,6 +410,16 @@ TEST(Links, TheHolderIntoThePartIsReportedAtEveryPostureAndMotion) {
   EXPECT_FALSE(clear->collides());
   EXPECT_NEAR(clear->min_clearance_mm, 1.0 - 0.02, 0.03);
   EXPECT_FALSE(checkHolderAgainstPart(tool, {}, part, pass(0.0)).has_value());
+  // The tip resting on the top of a closed part: the holder 40 mm above it is clear (the tip was
+  // the point of the "inside the part" test: on the face, its parity read "inside" at this y).
+  const geometry::TriangleMesh block = boxMesh(20, 60, -40, 40, -10, 37);
+  const std::vector<Posture> on_top = {
+      Posture{Eigen::Vector3d(40, 19.6551724, 37), Eigen::Vector3d::UnitZ(), 0.0, false},
+      Posture{Eigen::Vector3d(40, -30, 37), Eigen::Vector3d::UnitZ(), 0.0, false}};
+  const auto above = checkHolderAgainstPart(tool, holder, block, on_top);
+  ASSERT_TRUE(above.has_value());
+  EXPECT_FALSE(above->collides());
+  EXPECT_NEAR(above->min_clearance_mm, 40.0 - 0.02, 0.05);
 }
 
 // A mesh whose identical positions are one vertex (as loadMesh joins them).
