@@ -177,6 +177,20 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       surface = checkSurface(request);
     }
 
+    // Why the check fails, one line each (empty: ok): the collisions of `unsafe`, a clearance
+    // under the required one, and the gouges (a flank driven into a wall of the part is one).
+    std::vector<std::string> not_ok = unsafeReasons(clearance, motions, link_part, holder_part);
+    if (clearance.colliding == 0 && clearance.min_clearance_mm < scene.clearance_mm)
+      not_ok.push_back("postures come within " + std::to_string(clearance.min_clearance_mm) +
+                       " mm of the obstacles, under the required clearance");
+    if (motions.colliding == 0 && motions.under_required > 0)
+      not_ok.push_back(std::to_string(motions.under_required) +
+                       " motions come under the required clearance");
+    if (surface && surface->gouged_lines > 0)
+      not_ok.push_back(std::to_string(surface->gouged_lines) + " Z-buffer lines cut below the part "
+                       "by more than the gouge tolerance (max " +
+                       std::to_string(static_cast<long long>(std::lround(surface->max_gouge_um))) +
+                       " um)");
     const json report = {
         {"scene", scene.file.string()},
         {"path", options->path},
@@ -200,11 +214,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
           {"first_limited", path.limited.empty() ? json(nullptr) : json(path.limited.front())}}},
         {"surface", surface ? surfaceJson(*surface) : json(nullptr)},
         {"surface_skipped", surface ? json(nullptr) : json("the scene has no `part`")},
-        {"ok", clearance.colliding == 0 && motions.colliding == 0 &&
-                   !(link_part && link_part->collides()) &&
-                   !(holder_part && holder_part->collides()) &&
-                   clearance.min_clearance_mm >= scene.clearance_mm &&
-                   motions.under_required == 0 && (!surface || surface->gouged_lines == 0)},
+        {"ok", not_ok.empty()},
+        {"not_ok_because", not_ok},
     };
     if (!options->out.empty()) {
       const std::filesystem::path out = options->out;
