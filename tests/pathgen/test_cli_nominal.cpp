@@ -297,15 +297,19 @@ TEST(CheckSurface, AShankDrivenIntoAWallOfThePartIsAGouge) {
            << " 0 " << c << '\n';
     dir.write(side > 0 ? "towards.cl" : "away.cl", path.str());
   }
-  auto surface = [&](const std::string& name) {
+  auto checked = [&](const std::string& name) {
     const auto r = test::runFieldpath(dir, "check scene.yaml --path " + name + ".cl --spacing 0.1 --out out_" + name);
     EXPECT_EQ(r.exit_code, 0) << r.output();
-    return nlohmann::json::parse(test::slurp(dir.path() / ("out_" + name) / "check.json"))["surface"];
+    return nlohmann::json::parse(test::slurp(dir.path() / ("out_" + name) / "check.json"));
   };
-  const auto towards = surface("towards"), away = surface("away");
-  EXPECT_GT(towards["max_gouge_um"].get<double>(), 3000.0);
-  EXPECT_GT(towards["gouged_lines"].get<int>(), 100);
-  EXPECT_EQ(away["gouged_lines"].get<int>(), 0);
+  const auto towards = checked("towards"), away = checked("away");
+  EXPECT_GT(towards["surface"]["max_gouge_um"].get<double>(), 3000.0);
+  EXPECT_GT(towards["surface"]["gouged_lines"].get<int>(), 100);
+  EXPECT_FALSE(towards["ok"].get<bool>());
+  ASSERT_EQ(towards["not_ok_because"].size(), 1u);  // the gouge said as the reason
+  EXPECT_NE(towards["not_ok_because"][0].get<std::string>().find("below the part"), std::string::npos);
+  EXPECT_EQ(away["surface"]["gouged_lines"].get<int>(), 0);
+  EXPECT_TRUE(away["ok"].get<bool>()) << away["not_ok_because"];
 }
 
 TEST(CheckSurface, TheSameJobHighUpInZReadsTheSame) {
