@@ -1,11 +1,11 @@
 /// pathgen/link_check.h: the links of a path against the part.
 #include "fieldpath/pathgen/link_check.h"
 
-#include "fieldpath/pathgen/generate.h"  // kClearanceMeshTolMm
-
 #include <algorithm>
 #include <span>
 #include <vector>
+
+#include "fieldpath/pathgen/generate.h"  // kClearanceMeshTolMm
 
 namespace fieldpath::pathgen {
 
@@ -45,7 +45,6 @@ LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const geometr
   auto same = [&](std::size_t i, std::size_t j) { return geometry::samePose(all[i], all[j]); };
   for (geometry::PathBlock block : path.blocks) {
     if (block.kind != geometry::PathBlock::Kind::Link) continue;
-
     // A link posture where the pass beside it starts or ends (links.retract: 0) is that pass's:
     // the ball cuts there.
     if (block.begin > 0 && block.begin < block.end && same(block.begin, block.begin - 1)) ++block.begin;
