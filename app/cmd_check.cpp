@@ -153,7 +153,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     if (scene.part && path.count(geometry::PathBlock::Kind::Link) > 0) {
       const pathgen::ClearanceChecker part(tool_mesh, std::span(&*scene.part, 1),
                                            pathgen::kClearanceMeshTolMm);
-      link_part = pathgen::checkLinksAgainstPart(part, path);
+      link_part = pathgen::checkLinksAgainstPart(
+          part, pathgen::grazingPartChecker(scene.tool, scene.holder, *scene.part), path);
     }
     // The holder against the part everywhere: it never cuts.
     const std::optional<pathgen::LinkPartResult> holder_part =

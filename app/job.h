@@ -90,8 +90,8 @@ inline nlohmann::json linkPartJson(const std::optional<pathgen::LinkPartResult>&
       *l, "link_postures", "link_motions",
       "every link posture and every motion between two link postures against the part mesh "
       "(as `motions`, required 0: rapid moves must not touch it), and the moves out of and "
-      "into a pass but for their 0.1 mm of tip travel at the pass, where the ball leaves or "
-      "reaches the surface it cuts (counted, not in min_mm)");
+      "into a pass with the tool and holder 0.1 mm smaller all round (they start or end where "
+      "the ball cuts and may slide along a wall it finishes; counted, not in min_mm)");
 }
 
 /// The `holder_part` block of report.json and check.json: the holder against the part at every

@@ -396,7 +396,7 @@ ViewData gatherView(const ViewRequest& request) {
               pathgen::ClearanceChecker(
                   geometry::toolMesh(scene.tool, scene.holder, pathgen::kClearanceMeshTolMm),
                   std::span(&*scene.part, 1), pathgen::kClearanceMeshTolMm),
-              p.file);
+              pathgen::grazingPartChecker(scene.tool, scene.holder, *scene.part), p.file);
         check->link_part = links;
         check->holder_part =
             pathgen::checkHolderAgainstPart(scene.tool, scene.holder, *scene.part, postures);

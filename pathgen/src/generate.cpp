@@ -448,7 +448,8 @@ GenerateResult generatePath(const GenerateRequest& request) {
                                           scaled(request.progress, 0.93, 1.0, "motions"));
     if (request.part) {
       const ClearanceChecker part(tool_mesh, std::span(&*request.part, 1), kClearanceMeshTolMm);
-      result.link_part = checkLinksAgainstPart(part, result.path);
+      result.link_part = checkLinksAgainstPart(
+          part, grazingPartChecker(tool, request.holder, *request.part), result.path);
       result.holder_part =
           checkHolderAgainstPart(tool, request.holder, *request.part, result.path.postures);
     }

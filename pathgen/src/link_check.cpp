@@ -11,25 +11,14 @@ namespace fieldpath::pathgen {
 
 namespace {
 
-/// The tip's travel (mm) at the pass's end of a move out of (into) it that is left out: there the
-/// ball leaves (reaches) the surface it cuts. Past it a ball leaving at up to 78° to the surface's
-/// normal is clear of it by more than the tool mesh's chordal tolerance (0.1 cos 78° > 0.02).
-constexpr double kPassContactMm = 0.1;
-
-/// The motion a → b against the part but for its first kPassContactMm of tip travel
-/// (`from_start`) or its last (a pure turn, with no tip travel, is left out whole): counted in
-/// `out` as motion `index`.
-void checkPartOfMove(const ClearanceChecker& part, const geometry::Posture& a,
-                     const geometry::Posture& b, bool from_start, std::size_t index,
-                     LinkPartResult& out) {
-  const double travel_mm = (b.tip_mm - a.tip_mm).norm();
-  if (!(travel_mm > kPassContactMm)) return;
-  const double skip = kPassContactMm / travel_mm;
-  const std::vector<geometry::Posture> piece =
-      from_start ? std::vector<geometry::Posture>{geometry::alongMotion(a, b, skip), b}
-                 : std::vector<geometry::Posture>{a, geometry::alongMotion(a, b, 1.0 - skip)};
-  const MotionResult m = part.checkMotions(piece, MotionRequest{});  // required 0: touching
-  // Counted, but not in the links' minimum: it starts 0.1 mm off the cut surface by design.
+/// The motion a → b against the shrunk tool, each pose's tip `shrink_mm` up its axis (the shrunk
+/// ball's centre is the ball's): counted in `out` as motion `index`.
+void checkGrazingMove(const GrazingChecker& grazing, const geometry::Posture& a,
+                      const geometry::Posture& b, std::size_t index, LinkPartResult& out) {
+  std::vector<geometry::Posture> move = {a, b};
+  for (geometry::Posture& p : move) p.tip_mm += grazing.shrink_mm * p.axis;
+  const MotionResult m = grazing.checker.checkMotions(move, MotionRequest{});  // required 0
+  // Counted, but not in the links' minimum (it is the shrunk tool's).
   out.motions += 1;
   if (m.colliding) {
     ++out.colliding_motions;
@@ -39,7 +28,27 @@ void checkPartOfMove(const ClearanceChecker& part, const geometry::Posture& a,
 
 }  // namespace
 
-LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const geometry::PathFile& path) {
+GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
+                                  const geometry::HolderProfile& holder,
+                                  const geometry::TriangleMesh& part) {
+  const double corner_mm = geometry::cornerRadius(tool);
+  const double by = std::min(kPassGrazeMm, 0.5 * (corner_mm > 0.0 ? corner_mm : tool.radius_mm));
+  // In the shrunk tool's frame (its tip `by` up the axis) every surface lies `by` inside.
+  geometry::ToolSpec shrunk = tool;
+  shrunk.radius_mm -= by;
+  if (shrunk.shape == geometry::ToolShape::Torus) shrunk.corner_radius_mm -= by;
+  shrunk.length_mm -= 2 * by;
+  geometry::HolderProfile thinner = holder;  // its bottom already `by` up with the tip
+  for (auto& station : thinner) station.radius_mm -= by;
+  if (!thinner.empty()) thinner.back().z_mm -= 2 * by;
+  return {ClearanceChecker(geometry::toolMesh(shrunk, thinner, kClearanceMeshTolMm),
+                           std::span(&part, 1), kClearanceMeshTolMm),
+          by};
+}
+
+LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part,
+                                     const GrazingChecker& grazing,
+                                     const geometry::PathFile& path) {
   LinkPartResult out;
   const auto& all = path.postures;
   auto same = [&](std::size_t i, std::size_t j) { return geometry::samePose(all[i], all[j]); };
@@ -51,11 +60,11 @@ LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const geometr
     if (block.end < all.size() && block.begin < block.end && same(block.end - 1, block.end)) --block.end;
     if (block.size() == 0) continue;
     // The moves out of the pass before and into the pass after (a retract along a tool axis
-    // leaning over a wall of the part drove the ball into it), but where the ball cuts.
+    // leaning over a fin of the part drove the ball into it): they may graze what the ball cuts.
     if (block.begin > 0)
-      checkPartOfMove(part, all[block.begin - 1], all[block.begin], true, block.begin - 1, out);
+      checkGrazingMove(grazing, all[block.begin - 1], all[block.begin], block.begin - 1, out);
     if (block.end < all.size())
-      checkPartOfMove(part, all[block.end - 1], all[block.end], false, block.end - 1, out);
+      checkGrazingMove(grazing, all[block.end - 1], all[block.end], block.end - 1, out);
     const std::span<const geometry::Posture> postures(all.data() + block.begin, block.size());
     const ClearanceResult c = part.check(postures);
     out.postures += c.postures;

@@ -340,6 +340,7 @@ TEST(Links, ALinkThroughThePartIsReportedAndThePassContactIsNot) {
   pathgen::test::addBox(part, -10, 50, -10, 10, -5, 0);
   pathgen::test::addBox(part, 20, 24, -10, 10, 0, 4);
   const ClearanceChecker checker(geometry::toolMesh(tool, {}, 0.02), {&part, 1}, 0.02);
+  const GrazingChecker grazing = grazingPartChecker(tool, {}, part);
   auto posture = [](double x, double z) {
     return Posture{Eigen::Vector3d(x, 0, z), Eigen::Vector3d::UnitZ(), 0.0, false};
   };
@@ -349,7 +350,7 @@ TEST(Links, ALinkThroughThePartIsReportedAndThePassContactIsNot) {
                    posture(40, 0), posture(40, 0), posture(45, 0)};
   path.blocks = {{PathBlock::Kind::Pass, 0, 2}, {PathBlock::Kind::Link, 2, 6},
                  {PathBlock::Kind::Pass, 6, 8}};
-  LinkPartResult through = checkLinksAgainstPart(checker, path);
+  LinkPartResult through = checkLinksAgainstPart(checker, grazing, path);
   EXPECT_EQ(through.postures, 2u);  // the two at z = 1; those at the passes' contact left out
   EXPECT_EQ(through.colliding_postures, 0u);  // 1 mm above the floor, either side of the block
   EXPECT_EQ(through.colliding_motions, 1u);
@@ -358,7 +359,7 @@ TEST(Links, ALinkThroughThePartIsReportedAndThePassContactIsNot) {
   // Over the block (the tool's tip 2 mm above its top) the same link is clear.
   path.postures[3] = posture(10, 6);
   path.postures[4] = posture(40, 6);
-  const LinkPartResult over = checkLinksAgainstPart(checker, path);
+  const LinkPartResult over = checkLinksAgainstPart(checker, grazing, path);
   EXPECT_FALSE(over.collides());
   EXPECT_NEAR(over.min_clearance_mm, 2.0 - 0.02, 0.03);
   // The move out of a pass: a retract along an axis leaning 45° towards the block (the ball on
@@ -376,11 +377,24 @@ TEST(Links, ALinkThroughThePartIsReportedAndThePassContactIsNot) {
     leaning.postures[1] = leaning.postures[2] = ball(15);
     leaning.postures[3] = Posture{leaning.postures[1].tip_mm + 10.0 * axis, axis, 0.0, false};
     leaning.postures[4] = Posture{Eigen::Vector3d(40, 0, 10), Eigen::Vector3d::UnitZ(), 0.0, false};
-    const LinkPartResult out = checkLinksAgainstPart(checker, leaning);
+    const LinkPartResult out = checkLinksAgainstPart(checker, grazing, leaning);
     EXPECT_EQ(out.colliding_postures, 0u) << lean;
     EXPECT_EQ(out.colliding_motions, lean > 0 ? 1u : 0u) << lean;
     if (lean > 0) EXPECT_EQ(out.first_colliding_motion, 2u);  // posture 2 (the pass's end) to 3
   }
+  // A pass finishing the floor along a wall of the part, the ball tangent to both: its retract
+  // and plunge along the axis slide up the wall, tangent to it all the way: not a collision.
+  geometry::TriangleMesh corner;
+  pathgen::test::addBox(corner, -10, 50, -10, 10, -5, 0);  // the floor
+  pathgen::test::addBox(corner, -10, 50, 3, 10, 0, 30);    // a wall along the pass, 3 mm off
+  const ClearanceChecker corner_checker(geometry::toolMesh(tool, {}, 0.02), {&corner, 1}, 0.02);
+  const GrazingChecker corner_grazing = grazingPartChecker(tool, {}, corner);
+  geometry::PathFile along = path;
+  along.postures = {posture(0, 0), posture(10, 0), posture(10, 0), posture(10, 40), posture(40, 40),
+                    posture(40, 0), posture(40, 0), posture(45, 0)};
+  const LinkPartResult tangent = checkLinksAgainstPart(corner_checker, corner_grazing, along);
+  EXPECT_EQ(tangent.motions, 3u);  // the travel at z = 40, the retract and the plunge
+  EXPECT_FALSE(tangent.collides());
 }
 
 // The holder against the part at every posture and motion: a pass on the floor beside a wall of

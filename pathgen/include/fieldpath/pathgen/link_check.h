@@ -27,12 +27,31 @@ struct LinkPartResult {
   bool collides() const { return colliding_postures + colliding_motions > 0; }
 };
 
+/// How deep (mm) the moves out of and into a pass may graze the part: they start or end where
+/// the ball cuts, and slide along a wall the ball finishes (tangent to it all the way up).
+inline constexpr double kPassGrazeMm = 0.1;
+
+/// The checker of the moves out of and into passes (checkLinksAgainstPart): tool and holder
+/// shrunk by `shrink_mm` all round (kPassGrazeMm, or half the corner radius of a smaller tool)
+/// against the part; its poses have the tip `shrink_mm` up the axis (the ball's centre kept).
+struct GrazingChecker {
+  ClearanceChecker checker;
+  double shrink_mm;
+};
+GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
+                                  const geometry::HolderProfile& holder,
+                                  const geometry::TriangleMesh& part);
+
 /// Every posture of the path's link blocks and every motion between two of them, against
-/// `part` (a ClearanceChecker whose only obstacle is the part mesh), and the motions from a
-/// pass's last posture into its link and from a link into the next pass's first posture but for
-/// their first (last) 0.1 mm of tip travel: they start or end where the ball cuts the part. Link
-/// postures at a pass's first or last posture (links.retract: 0) are that pass's.
-LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const geometry::PathFile& path);
+/// `part` (a ClearanceChecker of the tool + holder whose only obstacle is the part mesh), and
+/// the motions from a pass's last posture into its link and from a link into the next pass's
+/// first posture against `grazing` (grazingPartChecker): they start or end where the ball cuts
+/// the part, so they may touch it, not enter it by more than kPassGrazeMm (a retract along an
+/// axis leaning over a fin of the part did). Link postures at a pass's first or last posture
+/// (links.retract: 0) are that pass's.
+LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part,
+                                     const GrazingChecker& grazing,
+                                     const geometry::PathFile& path);
 
 /// The holder (geometry::holderMesh) against the part at every posture and every motion of the
 /// path, passes and links. The holder never cuts: touching the part anywhere is a crash, also
