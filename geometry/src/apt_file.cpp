@@ -121,6 +121,10 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
     const std::string_view content = aptContent(text.substr(pos, nl - pos));
     pos = nl + 1;
     if (record.empty()) record_line = line;
+    // A GOTO line that a `$` joined to the record above (`COOLNT/ON $`): its motion would be lost.
+    if (!record.empty() && upperCase(content.substr(0, 4)) == "GOTO")
+      fail(file, line, "a GOTO joined by the `$` ending the line above to its record (the "
+                       "motion would be lost): end that line without `$`");
     if (continuesRecord(content)) {
       record += content.substr(0, content.size() - 1);
       continue;
@@ -162,37 +166,39 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
     }
     const std::string_view values =
         slash == std::string::npos ? std::string_view() : std::string_view(statement).substr(slash + 1);
-    if (major == "TLAXIS") {  // the axis of the 3-number GOTOs that follow (APT's modal axis)
+    if (major == "TLAXIS") {
+      // TLAXIS/i, j, k[, ...]: the axis of the 3-number GOTOs that follow (APT's modal axis).
+      // Other forms (TLAXIS/NORMPS, ...) leave them the last axis, as before: read past.
       double v[3];
       std::size_t count = 0;
-      for (std::size_t start = 0; start <= values.size() && !values.empty();) {
+      for (std::size_t start = 0; start < values.size() && count < 3;) {
         const auto comma = std::min(values.find(',', start), values.size());
-        const auto tokens = splitWhitespace(values.substr(start, comma - start));
-        if (tokens.size() != 1 || count == 3)
-          fail(file, record_line, "TLAXIS/: this reader takes TLAXIS/i, j, k (a fixed tool axis)");
-        v[count++] = parseFinite(tokens[0], file, record_line);
+        const std::string_view token = trimmed(values.substr(start, comma - start));
+        const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), v[count]);
+        if (token.empty() || ec != std::errc() || end != token.data() + token.size() ||
+            !std::isfinite(v[count]))
+          break;
+        ++count;
         start = comma + 1;
       }
-      if (count != 3)
-        fail(file, record_line, "TLAXIS/: this reader takes TLAXIS/i, j, k (a fixed tool axis)");
-      axis_now = checkedAxis(Vec3(v[0], v[1], v[2]),
-                             [&] { return file.string() + ":" + std::to_string(record_line); });
-      own_axis = true;
+      if (count == 3) {
+        axis_now = checkedAxis(Vec3(v[0], v[1], v[2]),
+                               [&] { return file.string() + ":" + std::to_string(record_line); });
+        own_axis = true;
+      }
       continue;
     }
     // A motion the reader does not take would be a posture lost without a word: GOTO not at
     // the record's start (`RAPID,GOTO/`, `N40 GOTO/`, `GO TO/`), a relative GODLTA, arcs
     // (CIRCLE/ before a GOTO makes it an arc; MOVARC), drive-surface motions (GOFWD, GOLFT, ...),
-    // GOHOME, a canned cycle (its GOTOs become plunges), and a GOTO a `$` joined to another record.
+    // GOHOME, a canned cycle (its GOTOs become plunges).
     static constexpr std::string_view kMotions[] = {"GODLTA", "CIRCLE", "MOVARC", "GOFWD", "GOLFT",
                                                     "GORGT",  "GOBACK", "GOUP",   "GODOWN", "GOHOME"};
     const bool motion_word =
         std::find(std::begin(kMotions), std::end(kMotions), major) != std::end(kMotions);
     const bool cycle = major == "CYCLE" && trimmed(values) != "OFF";
-    const bool text = major == "INSERT" || isTextRecord(major);
     if (major != "GOTO" && (major.find("GOTO") != std::string_view::npos ||
-                            major.find("GO TO") != std::string_view::npos || motion_word || cycle ||
-                            (!text && values.find("GOTO") != std::string_view::npos)))
+                            major.find("GO TO") != std::string_view::npos || motion_word || cycle))
       fail(file, record_line,
            std::string(major) + "/: a motion record this reader does not take (a GOTO/ record "
            "of its own, absolute x, y, z[, i, j, k]; no arcs, cycles or relative moves)");

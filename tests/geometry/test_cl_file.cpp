@@ -237,9 +237,7 @@ TEST(AptFile, MotionsNotReadAreRefusedAndPprintKeepsItsDollar) {
        {"RAPID,GOTO/1,2,3", "N40 GOTO/1,2,3", "GO TO/1,2,3", "GODLTA/0,0,5",
         // an arc (CIRCLE/ makes the next GOTO one), drive-surface moves, a cycle, home
         "CIRCLE/0,0,0,0,0,1,18,0.01,0.5,6,0", "MOVARC/0,0,0,0,0,1,18,ANGLE,90", "GOFWD/(CIRCLE/0,0,0,5)",
-        "GOHOME", "CYCLE/DRILL,5,FEDTO,0,MMPM,100",
-        // a GOTO joined to another record by a `$` (it was lost)
-        "COOLNT/ON $\nGOTO/2,2,3,0,0,1"}) {
+        "GOHOME", "CYCLE/DRILL,5,FEDTO,0,MMPM,100"}) {
     try {
       readAptFile(writeBytes("m.apt", "GOTO/0,0,0,0,0,1\n" + record + "\nGOTO/1,0,0\n"));
       ADD_FAILURE() << record << " was read past";
@@ -252,15 +250,30 @@ TEST(AptFile, MotionsNotReadAreRefusedAndPprintKeepsItsDollar) {
   EXPECT_EQ(p.size(), 3u);
   // CYCLE/OFF ends a cycle: read past
   EXPECT_EQ(readAptFile(writeBytes("o.apt", "CYCLE/OFF\nGOTO/0,0,0,0,0,1\n")).size(), 1u);
+  // A GOTO line joined by a `$` to the record above (it was lost), named at its own line; an
+  // operation name holding "GOTO" (NX: TOOL PATH/GOTO_POINTS,...) is no motion.
+  try {
+    readAptFile(writeBytes("j.apt", "GOTO/0,0,0,0,0,1\nCOOLNT/ON $\nGOTO/2,2,3,0,0,1\n"));
+    ADD_FAILURE() << "a GOTO joined to COOLNT was read past";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("j.apt:3:"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(readAptFile(writeBytes("nx.apt", "TOOL PATH/GOTO_POINTS,TOOL,BALL_6\n"
+                                             "GOTO/0,0,0,0,0,1\n")).size(), 1u);
 }
 
 // TLAXIS/i,j,k sets the axis of the 3-value GOTOs after it (APT's modal axis: they kept the old
-// one); other forms are refused.
+// one).
 TEST(AptFile, TlaxisSetsTheAxisOfThreeValueGotos) {
   const auto p = readAptFile(writeBytes(
       "t.apt", "GOTO/0,0,0,0,0,1\nTLAXIS/0.6,0,0.8\nGOTO/1,0,0\nGOTO/2,0,0,0,0,1\nGOTO/3,0,0\n"));
   ASSERT_EQ(p.size(), 4u);
   EXPECT_EQ(p[1].axis, Vec3(0.6, 0, 0.8));
   EXPECT_EQ(p[3].axis, Vec3::UnitZ());
-  EXPECT_THROW(readAptFile(writeBytes("n.apt", "TLAXIS/NORMPS\nGOTO/1,0,0\n")), InputError);
+  // Other forms (TLAXIS/NORMPS) are read past, as are a fourth value's words.
+  const auto n = readAptFile(writeBytes(
+      "n.apt", "GOTO/0,0,0,0.6,0,0.8\nTLAXIS/NORMPS\nGOTO/1,0,0\nTLAXIS/0,0.6,0.8,0\nGOTO/2,0,0\n"));
+  ASSERT_EQ(n.size(), 3u);
+  EXPECT_EQ(n[1].axis, Vec3(0.6, 0, 0.8));
+  EXPECT_EQ(n[2].axis, Vec3(0, 0.6, 0.8));
 }
