@@ -144,6 +144,12 @@ TEST(AtomicOutput, DevicesAndFifosAreWrittenIntoAndLinksFollowed) {
   common::writeTextAtomically(link, "new");
   EXPECT_TRUE(fs::is_symlink(link));
   EXPECT_EQ(slurp(real), "new");
+  // a link to a file not there yet: the file is made, the link kept
+  const fs::path dangling = dir.path() / "dangling.csv";
+  fs::create_symlink("sub/later.csv", dangling);
+  common::writeTextAtomically(dangling, "made");
+  EXPECT_TRUE(fs::is_symlink(dangling));
+  EXPECT_EQ(slurp(dir.path() / "sub" / "later.csv"), "made");
   common::removeWrittenOutputs();
 }
 

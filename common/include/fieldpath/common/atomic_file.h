@@ -172,9 +172,13 @@ inline void writeFileAtomically(const std::filesystem::path& given,
                                 std::ios::openmode mode = std::ios::out) {
   namespace fs = std::filesystem;
   std::error_code status_ec;
-  const fs::path path = fs::is_symlink(given, status_ec) ? fs::weakly_canonical(given, status_ec)
-                                                         : given;
-  if (path.empty()) throw InputError(given.string() + ": cannot resolve the link: " + status_ec.message());
+  fs::path path = given;  // through its links, also to a target not there yet
+  for (int hops = 0; fs::is_symlink(path, status_ec); ++hops) {
+    if (hops == 40) throw InputError(given.string() + ": too many levels of symbolic links");
+    const fs::path target = fs::read_symlink(path, status_ec);
+    if (status_ec) throw InputError(given.string() + ": cannot read the link: " + status_ec.message());
+    path = target.is_absolute() ? target : path.parent_path() / target;
+  }
   const fs::file_status status = fs::status(path, status_ec);
   if (fs::exists(status) && !fs::is_regular_file(status) && !fs::is_directory(status)) {
     errno = 0;
