@@ -148,19 +148,12 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     motion_request.posture_clearance_mm = clearance.clearance_mm;
     const pathgen::MotionResult motions =
         checker.checkMotions(path.postures, motion_request, progress);
-    // Links (the path's `# link` blocks) against the part: rapid moves must not touch it.
-    std::optional<pathgen::LinkPartResult> link_part;
-    if (scene.part && path.count(geometry::PathBlock::Kind::Link) > 0) {
-      const pathgen::ClearanceChecker part(tool_mesh, std::span(&*scene.part, 1),
-                                           pathgen::kClearanceMeshTolMm);
-      link_part = pathgen::checkLinksAgainstPart(
-          part, pathgen::grazingPartChecker(scene.tool, scene.holder, *scene.part), path);
-    }
-    // The holder against the part everywhere: it never cuts.
-    const std::optional<pathgen::LinkPartResult> holder_part =
-        scene.part ? pathgen::checkHolderAgainstPart(scene.tool, scene.holder, *scene.part,
-                                                     path.postures)
-                   : std::nullopt;
+    // The links (rapid moves) and the holder (it never cuts) must not touch the part.
+    pathgen::PartContacts contacts;
+    if (scene.part)
+      contacts = pathgen::checkAgainstPart(scene.tool, scene.holder, *scene.part, path);
+    const std::optional<pathgen::LinkPartResult>& link_part = contacts.links;
+    const std::optional<pathgen::LinkPartResult>& holder_part = contacts.holder;
     std::size_t limited_colliding = 0;
     for (std::size_t i : path.limited) limited_colliding += clearance.clearance_mm[i] <= 0.0;
 

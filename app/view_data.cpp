@@ -390,16 +390,10 @@ ViewData gatherView(const ViewRequest& request) {
       // The part's contacts (the links', the holder's), as `check` finds them: not coloured on
       // the page (its colours are the obstacles'), said above it.
       if (scene.part) {
-        std::optional<pathgen::LinkPartResult> links;
-        if (p.file.count(geometry::PathBlock::Kind::Link) > 0)
-          links = pathgen::checkLinksAgainstPart(
-              pathgen::ClearanceChecker(
-                  geometry::toolMesh(scene.tool, scene.holder, pathgen::kClearanceMeshTolMm),
-                  std::span(&*scene.part, 1), pathgen::kClearanceMeshTolMm),
-              pathgen::grazingPartChecker(scene.tool, scene.holder, *scene.part), p.file);
-        check->link_part = links;
-        check->holder_part =
-            pathgen::checkHolderAgainstPart(scene.tool, scene.holder, *scene.part, postures);
+        pathgen::PartContacts contacts =
+            pathgen::checkAgainstPart(scene.tool, scene.holder, *scene.part, p.file);
+        check->link_part = std::move(contacts.links);
+        check->holder_part = std::move(contacts.holder);
       }
       p.clearance_known = true;
     }

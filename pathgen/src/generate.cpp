@@ -447,11 +447,9 @@ GenerateResult generatePath(const GenerateRequest& request) {
     result.motions = checker.checkMotions(result.path.postures, motions,
                                           scaled(request.progress, 0.93, 1.0, "motions"));
     if (request.part) {
-      const ClearanceChecker part(tool_mesh, std::span(&*request.part, 1), kClearanceMeshTolMm);
-      result.link_part = checkLinksAgainstPart(
-          part, grazingPartChecker(tool, request.holder, *request.part), result.path);
-      result.holder_part =
-          checkHolderAgainstPart(tool, request.holder, *request.part, result.path.postures);
+      PartContacts contacts = checkAgainstPart(tool, request.holder, *request.part, result.path);
+      result.link_part = std::move(contacts.links);
+      result.holder_part = std::move(contacts.holder);
     }
   }
   for (GeneratedPosture& g : result.postures) {

@@ -109,4 +109,16 @@ std::optional<LinkPartResult> checkHolderAgainstPart(const geometry::ToolSpec& t
   return out;
 }
 
+PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
+                              const geometry::TriangleMesh& part, const geometry::PathFile& path) {
+  PartContacts out;
+  if (path.count(geometry::PathBlock::Kind::Link) > 0) {
+    const ClearanceChecker whole(geometry::toolMesh(tool, holder, kClearanceMeshTolMm),
+                                 std::span(&part, 1), kClearanceMeshTolMm);
+    out.links = checkLinksAgainstPart(whole, grazingPartChecker(tool, holder, part), path);
+  }
+  out.holder = checkHolderAgainstPart(tool, holder, part, path.postures);
+  return out;
+}
+
 }  // namespace fieldpath::pathgen

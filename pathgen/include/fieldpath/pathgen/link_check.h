@@ -63,4 +63,13 @@ std::optional<LinkPartResult> checkHolderAgainstPart(const geometry::ToolSpec& t
                                                      const geometry::TriangleMesh& part,
                                                      std::span<const geometry::Posture> postures);
 
+/// What a path must not do to the part, as generate, check and view all check it: its links
+/// (checkLinksAgainstPart, when it has link blocks) and its holder (checkHolderAgainstPart, when
+/// there is one); each nullopt when not checked.
+struct PartContacts {
+  std::optional<LinkPartResult> links, holder;
+};
+PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
+                              const geometry::TriangleMesh& part, const geometry::PathFile& path);
+
 }  // namespace fieldpath::pathgen
