@@ -84,6 +84,29 @@ void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
       std::fprintf(stderr,
                    "note: .npy keeps postures only: %zu pass and %zu link blocks%s dropped\n",
                    passes, links, path.limited.empty() ? "" : " and the # limit marks");
+    if (to == PathFormat::Apt) {
+      // APT breaks a pass only with RAPID (a link's moves): passes that follow one another with
+      // no link between them read back as one.
+      std::size_t joined = 0, first = 0;
+      for (std::size_t b = 0; b + 1 < path.blocks.size(); ++b)
+        if (path.blocks[b].kind == geometry::PathBlock::Kind::Pass &&
+            path.blocks[b + 1].kind == geometry::PathBlock::Kind::Pass && joined++ == 0)
+          first = b;
+      if (joined) {
+        std::size_t pass_no = 0;  // 1-based number of the pass of block `first`
+        for (std::size_t b = 0; b <= first; ++b)
+          pass_no += path.blocks[b].kind == geometry::PathBlock::Kind::Pass;
+        std::fprintf(stderr,
+                     "note: %zu pass break%s with no link between the passes (first: passes %zu "
+                     "and %zu): APT breaks a pass only with RAPID, so the passes either side of "
+                     "such a break read back as one (as the machine runs them: straight on at "
+                     "the feed)\n",
+                     joined, joined > 1 ? "s" : "", pass_no, pass_no + 1);
+      }
+      if (!path.limited.empty())
+        std::fprintf(stderr, "note: APT has no `# limit` marks: %zu dropped\n",
+                     path.limited.size());
+    }
     std::printf("converted %zu postures (%zu passes, %zu links) from %s %s to %s %s\n",
                 path.postures.size(), passes, links, formatName(geometry::pathFormatOf(in)),
                 in.string().c_str(), formatName(to), out.string().c_str());

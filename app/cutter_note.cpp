@@ -36,10 +36,15 @@ std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool,
   std::vector<std::string> notes;
   for (const geometry::PathFile::Cutter& c : path.cutters) {
     const bool same_diameter = std::abs(c.diameter_mm - 2 * tool.radius_mm) <= kCutterTolMm;
-    const bool same_corner = c.corner_mm < 0.0 || std::abs(c.corner_mm - corner_mm) <= kCutterTolMm;
+    // CUTTER/d alone is, in APT, a flat end mill (corner radius 0): compared as one.
+    const double file_corner_mm = c.corner_mm < 0.0 ? 0.0 : c.corner_mm;
+    const bool same_corner = std::abs(file_corner_mm - corner_mm) <= kCutterTolMm;
     if (same_diameter && same_corner) continue;
     std::string file_tool = "a " + mm(c.diameter_mm) + " mm cutter";
-    if (c.corner_mm >= 0.0) file_tool += " with a " + mm(c.corner_mm) + " mm corner";
+    if (c.corner_mm >= 0.0)
+      file_tool += " with a " + mm(c.corner_mm) + " mm corner";
+    else
+      file_tool += " with no corner radius given (in APT, a flat end mill)";
     notes.push_back(path.file.string() + ":" + std::to_string(c.line) +
                     ": CUTTER says the path was written for " + file_tool +
                     "; the scene's tool is " + toolWords(tool) +

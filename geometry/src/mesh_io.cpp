@@ -78,19 +78,24 @@ void fillScene(aiScene& scene, const TriangleMesh& mesh) {
 /// assimp reads an ASCII STL cut after a facet (no `endsolid`) and a facet loop of 4 vertices
 /// (some exporters' quads: half the face lost) without a word: every facet must have 3
 /// `vertex` lines and the file must end with `endsolid`.
-void checkAsciiStl(const std::filesystem::path& file) {
+/// Returns whether a keyword is written in capitals anywhere (`FACET NORMAL`, `Vertex`, also
+/// after a lower-case `solid`): assimp takes them in lower case only.
+bool checkAsciiStl(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   std::string line, last;
   std::size_t number = 0, facet_line = 0, vertices = 0;
-  bool in_facet = false;
+  bool in_facet = false, capitals = false;
   // The first word of each line, lower case (a scan by hand: a million facets are 7 M lines).
-  const auto firstWord = [](const std::string& text) {
+  const auto firstWord = [&capitals](const std::string& text) {
     std::size_t b = 0;
     while (b < text.size() && std::isspace(static_cast<unsigned char>(text[b]))) ++b;
     std::size_t e = b;
     std::string w;
-    while (e < text.size() && !std::isspace(static_cast<unsigned char>(text[e])) && e - b < 9)
-      w += static_cast<char>(std::tolower(static_cast<unsigned char>(text[e++])));
+    while (e < text.size() && !std::isspace(static_cast<unsigned char>(text[e])) && e - b < 9) {
+      const char c = text[e++];
+      w += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      capitals = capitals || w.back() != c;
+    }
     return w;
   };
   while (std::getline(in, line)) {
@@ -114,10 +119,12 @@ void checkAsciiStl(const std::filesystem::path& file) {
   }
   if (last != "endsolid")
     throw InputError(file.string() + ": ASCII STL without `endsolid` at its end (truncated?)");
+  return capitals;
 }
 
-/// Returns whether the file is an ASCII STL written in capitals (`SOLID`, `FACET NORMAL`, as some
-/// CAD systems write it): assimp takes its keywords in lower case only (and the file for binary).
+/// Returns whether the file is an ASCII STL with keywords in capitals (`SOLID`, `FACET NORMAL`, as
+/// some CAD systems write it, or in mixed case): assimp takes its keywords in lower case only
+/// (and the file for binary).
 bool checkStlSize(const std::filesystem::path& file, std::uintmax_t size) {
   if (lowerExtension(file) != ".stl") return false;
   std::ifstream in(file, std::ios::binary);
@@ -128,7 +135,6 @@ bool checkStlSize(const std::filesystem::path& file, std::uintmax_t size) {
   while (first < got && std::isspace(header[first])) ++first;
   std::string word = got >= first + 5 ? std::string(reinterpret_cast<const char*>(header) + first, 5)
                                        : std::string();
-  const std::string as_written = word;
   for (char& c : word) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (word == "solid") {
     // ASCII, unless a binary one whose header starts so (its size matches its count).
@@ -137,8 +143,7 @@ bool checkStlSize(const std::filesystem::path& file, std::uintmax_t size) {
                                   std::uint32_t(header[82]) << 16 | std::uint32_t(header[83]) << 24;
       if (84 + 50 * std::uintmax_t(count) == size) return false;
     }
-    checkAsciiStl(file);
-    return as_written != word;
+    return checkAsciiStl(file);
   }
   if (got < 84)
     throw InputError(file.string() + ": binary STL of " + std::to_string(size) +

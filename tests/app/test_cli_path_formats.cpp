@@ -280,8 +280,13 @@ TEST(Convert, RoundTripsKeepThePosturesBitForBit) {
       ASSERT_EQ(back.postures[i].axis, marked.postures[i].axis) << file << " " << i;
     }
   }
-  // APT keeps the link (RAPID) and .cl the blocks.
+  // APT keeps the link (RAPID) and .cl the blocks; the limit mark APT cannot hold is said.
   EXPECT_EQ(geometry::readPathFile(f.dir.path() / "d.cls").blocks, marked.blocks);
+  const Outcome to_apt = runFieldpath(f.dir, "convert marked.cl g.apt --tool ball:1");
+  ASSERT_EQ(to_apt.exit_code, 0) << to_apt.err;
+  EXPECT_NE(to_apt.err.find("note: APT has no `# limit` marks: 1 dropped"), std::string::npos)
+      << to_apt.err;
+  EXPECT_EQ(to_apt.err.find("no link between"), std::string::npos) << to_apt.err;
 
   for (const std::string args : {"convert marked.cl e.txt", "convert marked.cl e.apt",
                                  "convert missing.cl e.cl", "convert marked.cl e.apt --tool cone"}) {
@@ -291,6 +296,25 @@ TEST(Convert, RoundTripsKeepThePosturesBitForBit) {
     for (const char* name : {"e.txt", "e.apt", "e.cl"})
       EXPECT_FALSE(fs::exists(f.dir.path() / name)) << args;
   }
+}
+
+// Passes with no link between them (a .cl of three `# pass` blocks) are one pass in APT, which
+// breaks a pass only with RAPID: said, not silent (a helper found it silent).
+TEST(Convert, PassesWithNoLinkBetweenThemAreSaidToJoinInApt) {
+  const Formats f;
+  const Outcome run = runFieldpath(f.dir, "convert path.cl joined.apt --tool ball:1");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("note: 2 pass breaks with no link between the passes (first: passes 1 "
+                         "and 2): APT breaks a pass only with RAPID"),
+            std::string::npos)
+      << run.err;
+  const PathFile back = geometry::readPathFile(f.dir.path() / "joined.apt");
+  EXPECT_EQ(back.count(PathBlock::Kind::Pass), 1u);  // what the note says
+  EXPECT_EQ(back.postures.size(), f.path.postures.size());
+  // To .cl the blocks stay: no note.
+  const Outcome to_cl = runFieldpath(f.dir, "convert path.cl same.cl");
+  ASSERT_EQ(to_cl.exit_code, 0) << to_cl.err;
+  EXPECT_EQ(to_cl.err.find("note:"), std::string::npos) << to_cl.err;
 }
 
 }  // namespace

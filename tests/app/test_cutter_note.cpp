@@ -17,9 +17,19 @@ TEST(CutterNotes, SaidWhenTheFileWasWrittenForAnotherTool) {
   geometry::ToolSpec ball;  // ball, R 3
   ball.radius_mm = 3.0;
   EXPECT_TRUE(cutterNotes(ball, withCutters({})).empty());
-  // the same tool: diameter 6, corner 3 or none given, within 1 um (inches converted)
-  EXPECT_TRUE(cutterNotes(ball, withCutters({{6.0, 3.0, 4}, {6.0, -1.0, 9}, {0.23622 * 25.4, -1.0, 12}}))
-                  .empty());
+  // the same tool: diameter 6, corner 3, within 1 um (inches converted)
+  EXPECT_TRUE(cutterNotes(ball, withCutters({{6.0, 3.0, 4}, {0.23622 * 25.4, 3.0, 12}})).empty());
+  // CUTTER/6 alone is, in APT, a flat end mill: said against a ball, not against a flat one
+  const auto bare = cutterNotes(ball, withCutters({{6.0, -1.0, 9}}));
+  ASSERT_EQ(bare.size(), 1u);
+  EXPECT_EQ(bare[0],
+            "job.apt:9: CUTTER says the path was written for a 6 mm cutter with no corner radius "
+            "given (in APT, a flat end mill); the scene's tool is a ball of radius 3 mm (6 mm): "
+            "what follows is for the scene's tool, not the file's");
+  geometry::ToolSpec flat;
+  flat.shape = geometry::ToolShape::Flat;
+  flat.radius_mm = 3.0;
+  EXPECT_TRUE(cutterNotes(flat, withCutters({{6.0, -1.0, 9}, {6.0, 0.0, 10}})).empty());
   const auto other = cutterNotes(ball, withCutters({{10.0, 5.0, 4}}));
   ASSERT_EQ(other.size(), 1u);
   EXPECT_EQ(other[0],

@@ -81,6 +81,13 @@ TEST(MeshIo, AsciiStlInCapitalsIsTheSame) {
   const TriangleMesh lower = loadMesh(writeBytes("tetra_lower.stl", kAsciiTetra));
   EXPECT_EQ(m.vertices, lower.vertices);
   EXPECT_EQ(m.triangles, lower.triangles);
+  // `solid` in lower case, the rest in capitals or mixed case (it was refused: assimp saw no facet)
+  std::string mixed = capitals;
+  mixed.replace(mixed.find("SOLID"), 5, "solid");
+  mixed.replace(mixed.find("VERTEX"), 6, "Vertex");
+  const TriangleMesh m_mixed = loadMesh(writeBytes("tetra_mixed.stl", mixed));
+  EXPECT_EQ(m_mixed.vertices, lower.vertices);
+  EXPECT_EQ(m_mixed.triangles, lower.triangles);
 }
 
 TEST(MeshIo, AsciiPlyAndObjWithQuadsClosedForm) {
