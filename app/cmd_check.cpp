@@ -221,8 +221,12 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       common::writeTextAtomically(out / "clearance.csv", clearanceCsv(path, clearance, motions));
       common::writeTextAtomically(out / "check.json", jsonText(report));
     }
-    auto index = [](std::size_t i) {
-      return i == pathgen::ClearanceResult::npos ? std::string("-") : std::to_string(i + 1);
+    // Postures numbered from 0 in the file's order, as clearance.csv, check.json and view's
+    // #posture= number them, with the file's line (motion i: from posture i to i + 1).
+    auto index = [&path](std::size_t i) {
+      return i == pathgen::ClearanceResult::npos
+                 ? std::string("-")
+                 : std::to_string(i) + (i < path.lines.size() ? " (" + path.where(i) + ")" : "");
     };
     std::printf(
         "clearance: %zu postures, min %.3f mm (required %.3f) at posture %s, %zu colliding%s\n"

@@ -261,7 +261,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                    "warning: the path comes closer to the obstacles than `clearance` (%.3f mm): "
                    "postures min %.3f mm (posture %zu), motions min >= %.3f mm (%zu under it; "
                    "report.json)\n",
-                   job.clearance_mm, c.min_clearance_mm, c.min_index + 1, m.min_clearance_mm,
+                   job.clearance_mm, c.min_clearance_mm, c.min_index, m.min_clearance_mm,
                    m.under_required);
     if (scene.nominal)
       for (const std::string& note : cutterNotes(scene.tool, *scene.nominal))

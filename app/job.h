@@ -105,14 +105,14 @@ inline nlohmann::json holderPartJson(const std::optional<pathgen::LinkPartResult
 }
 
 /// Why a path is not safe to run as it stands (empty: it is): postures or motions that touch an
-/// obstacle, links that touch the part, the holder touching the part. Postures 1-based, motion i
-/// from posture i to i + 1.
+/// obstacle, links that touch the part, the holder touching the part. Postures numbered from 0,
+/// as in the JSON and clearance.csv; motion i from posture i to i + 1.
 inline std::vector<std::string> unsafeReasons(const pathgen::ClearanceResult& c,
                                               const pathgen::MotionResult& m,
                                               const std::optional<pathgen::LinkPartResult>& l,
                                               const std::optional<pathgen::LinkPartResult>& h) {
   std::vector<std::string> out;
-  auto first = [](std::size_t i) { return std::to_string(i + 1); };
+  auto first = [](std::size_t i) { return std::to_string(i); };
   if (c.colliding)
     out.push_back(std::to_string(c.colliding) + " postures touch an obstacle (first: posture " +
                   first(c.first_colliding) + ")");
