@@ -170,6 +170,9 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       request.progress = progress;
       surface = checkSurface(request);
     }
+    const char* surface_skipped = !scene.part ? "the scene has no `part`"
+                                  : !surface  ? "the passes do not pass over the part (`part` mesh)"
+                                              : nullptr;
 
     // Why the check fails, one line each (empty: ok): the collisions of `unsafe`, a clearance
     // under the required one, and the gouges (a flank driven into a wall of the part is one).
@@ -207,7 +210,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
           {"limited_colliding", limited_colliding},
           {"first_limited", path.limited.empty() ? json(nullptr) : json(path.limited.front())}}},
         {"surface", surface ? surfaceJson(*surface) : json(nullptr)},
-        {"surface_skipped", surface ? json(nullptr) : json("the scene has no `part`")},
+        {"surface_skipped", surface_skipped ? json(surface_skipped) : json(nullptr)},
         {"ok", not_ok.empty()},
         {"not_ok_because", not_ok},
     };
@@ -257,7 +260,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
           surface->max_scallop_um, surface->rms_um, zbuffer::backendName(surface->backend),
           surface->simulation_s);
     else
-      std::printf("surface: not checked (the scene has no `part`)\n");
+      std::printf("surface: not checked (%s)\n", surface_skipped);
     for (const std::string& note : tool_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
     if (surface && surface->coarsened)
       std::fprintf(stderr,

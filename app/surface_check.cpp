@@ -240,7 +240,7 @@ void writeDeviationPng(const std::filesystem::path& file, const SurfaceResult& s
   common::writeTextAtomically(file, png);
 }
 
-SurfaceResult checkSurface(const SurfaceRequest& request) {
+std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   const geometry::TriangleMesh& part = *request.part;
   const geometry::PathFile& path = *request.path;
   const double radius = request.tool.radius_mm;
@@ -267,10 +267,7 @@ SurfaceResult checkSurface(const SurfaceRequest& request) {
   passes_box.min().array() -= radius;
   passes_box.max().array() += radius;
   const Eigen::AlignedBox2d region = passes_box.intersection(part_box);
-  if (region.isEmpty() || !(region.sizes().minCoeff() > 0.0))
-    throw common::InputError(path.file.string() +
-                             ": the passes do not pass over the part (`part` mesh): no surface "
-                             "to check");
+  if (region.isEmpty() || !(region.sizes().minCoeff() > 0.0)) return std::nullopt;
   SurfaceResult result;
   double spacing = request.spacing_mm;
   if (!(spacing <= region.sizes().maxCoeff())) {

@@ -4,6 +4,7 @@
 /// every line is compared with the part's own height: gouge (below) and scallop (above), µm.
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include "fieldpath/common/progress.h"
@@ -54,8 +55,9 @@ struct SurfaceResult {
   std::size_t cut_lines = 0;           ///< lines the tool lowered (0: it never reached the part)
 };
 
-/// Simulates and compares. Throws common::InputError for a path whose passes miss the part.
-SurfaceResult checkSurface(const SurfaceRequest& request);
+/// Simulates and compares; nothing when the passes do not pass over the part (no surface to
+/// check: the clearance checks still stand).
+std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request);
 
 /// deviation.png: the map (row 0 = largest y, grey off the part) with a colour bar and its scale
 /// in µm on the right.

@@ -312,6 +312,38 @@ TEST(CheckSurface, AShankDrivenIntoAWallOfThePartIsAGouge) {
   EXPECT_TRUE(away["ok"].get<bool>()) << away["not_ok_because"];
 }
 
+// Passes that do not cross the part leave no surface to check, but their clearance still
+// counts: `check` refused the whole job (exit 1) and never said that the shank, tilted 40°
+// into a wall, collides.
+TEST(CheckSurface, PassesBesideThePartAreStillCheckedForClearance) {
+  const TempDir dir;
+  geometry::TriangleMesh part, wall;
+  pathgen::test::addBox(part, -40, -20, -30, 30, -10, 0);  // a plate well away from the pass
+  pathgen::test::addBox(wall, 8, 20, -30, 30, -10, 60);    // an obstacle beside the pass
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  dir.write("scene.yaml", "obstacles:\n  - mesh: wall.stl\npart: part.stl\n"
+                          "tool: { shape: ball, radius: 3, length: 40 }\nclearance: 0.5\n");
+  const double s = std::sin(40.0 * M_PI / 180.0), c = std::cos(40.0 * M_PI / 180.0);
+  std::ostringstream path;
+  path.precision(17);
+  path << "# pass 1\n";
+  for (int k = 0; k <= 10; ++k) path << "0 " << -5 + k << " 0 " << s << " 0 " << c << '\n';
+  dir.write("lean.cl", path.str());
+  const auto r = test::runFieldpath(dir, "check scene.yaml --path lean.cl --out out");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  EXPECT_NE(r.output().find("surface: not checked (the passes do not pass over the part"),
+            std::string::npos)
+      << r.output();
+  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out" / "check.json"));
+  EXPECT_TRUE(report["surface"].is_null());
+  EXPECT_NE(report["surface_skipped"].get<std::string>().find("do not pass over the part"),
+            std::string::npos);
+  // The shank's axis reaches x = 8 (the wall) 8 / sin 40° = 12.4 mm up: every posture collides.
+  EXPECT_EQ(report["clearance"]["colliding_postures"].get<int>(), 11);
+  EXPECT_FALSE(report["ok"].get<bool>());
+}
+
 TEST(CheckSurface, TheSameJobHighUpInZReadsTheSame) {
   // A pass along a plate, and the whole job lifted 1e5 mm in z: the same surface figures
   // (float heights held there read a clean pass as 7.8 um of gouge on 498 lines).
