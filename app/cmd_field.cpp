@@ -24,7 +24,8 @@ namespace {
 
 using field::Vec3;
 
-/// `x y z` per line; `#` starts a comment; blank lines are skipped.
+/// `x y z` per line; `#` starts a comment; blank lines are skipped; a UTF-8 byte-order mark is
+/// read past, coordinates beyond ±kMaxCoordinateMm are refused (as in every input).
 std::vector<Vec3> readPoints(const std::string& file) {
   common::requireRegularFile(file, "points file");
   std::ifstream in(file);
@@ -32,6 +33,7 @@ std::vector<Vec3> readPoints(const std::string& file) {
   std::vector<Vec3> points;
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
+    if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     if (const auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
     std::istringstream fields(line);
     std::vector<std::string> words;
@@ -51,6 +53,9 @@ std::vector<Vec3> readPoints(const std::string& file) {
       if (used != words[a].size() || !std::isfinite(p[a]))
         throw InputError(file + ":" + std::to_string(number) + ": '" + words[a] +
                          "' is not a finite number");
+      if (std::abs(p[a]) > common::kMaxCoordinateMm)
+        throw InputError(file + ":" + std::to_string(number) + ": '" + words[a] +
+                         "' is beyond +-1e6 mm (no machine is that large)");
     }
     points.push_back(p);
   }
@@ -226,7 +231,7 @@ void addFieldCommand(CLI::App& app, const GlobalOptions& global) {
       ->add_option("--refine-tolerance", options->refine_tolerance,
                    "Split cells whose error estimate exceeds this fraction (default: the "
                    "scene's field.refine_tolerance; 0: uniform)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(finiteNumber("", true));
   build_cmd
       ->add_option("--max-memory", options->max_memory_mib,
                    "Refuse voxel fields estimated above this, MiB")

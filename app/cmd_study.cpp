@@ -119,7 +119,7 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
                   "beside the block build (default: once, auto)");
   cmd->add_option("--sample-step", options->sample_step_mm,
                   "Obstacle sampling step, mm, instead of the scene's field.sample_step")
-      ->check(CLI::PositiveNumber);
+      ->check(positiveFinite("mm"));
   cmd->add_flag("--no-brute-force", options->no_brute_force,
                 "Skip the every-point direct sum (slow on large scenes)");
   cmd->add_option("--line-step", options->line_step_mm, "Sampling of the study lines, mm")

@@ -10,22 +10,27 @@
 
 namespace fieldpath::app {
 
-/// CLI11 check for a size option: a finite number > 0 (in `unit`), with a short message otherwise
-/// (CLI::PositiveNumber lets NaN through and prints its range as a 300-digit number).
-inline CLI::Validator positiveFinite(const std::string& unit) {
+/// CLI11 check for a size option: a finite number > 0 (or >= 0 with `zero_ok`), in `unit`, with
+/// a short message otherwise (CLI::PositiveNumber lets NaN through and prints its range as a
+/// 300-digit number).
+inline CLI::Validator finiteNumber(const std::string& unit, bool zero_ok) {
+  const std::string bound = zero_ok ? ">= 0" : "> 0";
   return CLI::Validator(
-      [unit](std::string& text) -> std::string {
+      [unit, zero_ok, bound](std::string& text) -> std::string {
         // strtod, not stod: a number too small or too large for a double is one (stod throws
         // out_of_range and it read "not a number").
         char* end = nullptr;
         const double value = std::strtod(text.c_str(), &end);
         if (text.empty() || end == text.c_str()) return "'" + text + "' is not a number";
-        if (end != text.c_str() + text.size() || !std::isfinite(value) || value <= 0.0)
-          return "must be a finite number > 0 " + unit + ", got '" + text + "'";
+        if (end != text.c_str() + text.size() || !std::isfinite(value) || value < 0.0 ||
+            (value == 0.0 && !zero_ok))
+          return "must be a finite number " + bound + (unit.empty() ? "" : " " + unit) +
+                 ", got '" + text + "'";
         return {};
       },
-      unit + " > 0");
+      (unit.empty() ? "" : unit + " ") + bound);
 }
+inline CLI::Validator positiveFinite(const std::string& unit) { return finiteNumber(unit, false); }
 
 struct GlobalOptions {
   bool quiet = false;  ///< silence progress lines on stderr

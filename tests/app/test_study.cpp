@@ -299,7 +299,12 @@ TEST(StudyCommand, BadInputIsExitOneWithNoOutputs) {
   EXPECT_EQ(test::runFieldpath(dir, "study scene.yaml --interp cubic --out study").exit_code, 1);
   EXPECT_EQ(
       test::runFieldpath(dir, "study scene.yaml --voxels 2,1 --refine 5 --out study").exit_code, 1);
-  EXPECT_EQ(test::runFieldpath(dir, "study scene.yaml --sample-step 0 --out study").exit_code, 1);
+  // One short line (CLI11's own check printed its range as a 300-digit number).
+  const test::Outcome zero_step = test::runFieldpath(dir, "study scene.yaml --sample-step 0 --out study");
+  EXPECT_EQ(zero_step.exit_code, 1);
+  EXPECT_NE(zero_step.err.find("--sample-step: must be a finite number > 0 mm, got '0'"),
+            std::string::npos)
+      << zero_step.err;
   EXPECT_EQ(test::runFieldpath(dir, "study missing.yaml --out study").exit_code, 1);
   EXPECT_EQ(test::runFieldpath(dir, "study scene.yaml --backend gpu --out study").exit_code, 1);
   // Sizes the options drive are estimated before any work (the brute-force variant, first, ran
@@ -310,6 +315,11 @@ TEST(StudyCommand, BadInputIsExitOneWithNoOutputs) {
     EXPECT_EQ(run.exit_code, 1) << args;
     EXPECT_NE(run.err.find("of memory"), std::string::npos) << args << ": " << run.err;
   }
+  // A voxel size past r0 (5 mm here) too (it was refused after the direct variants, ~40 s).
+  const test::Outcome coarse = test::runFieldpath(dir, "study scene.yaml --voxels 2,6 --out study");
+  EXPECT_EQ(coarse.exit_code, 1);
+  EXPECT_NE(coarse.err.find("--voxels 6: 6 mm is coarser than field.r0 (5 mm)"), std::string::npos)
+      << coarse.err;
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "study"));
 }
 
