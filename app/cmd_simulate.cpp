@@ -79,6 +79,14 @@ nlohmann::json finiteOrNull(double value) {
 /// N×6; float64 counts double), text by the line length of its first 64 KiB (5-axis lines of
 /// 32-bit values run ~60 bytes, 3-axis ones ~35). 0 where the file cannot be read (the reader
 /// then says why).
+/// How far the tool reaches up its axis from the tip, mm (a mesh tool: its highest vertex).
+double toolLength(const zb::Tool& tool) {
+  if (tool.kind != zb::ToolKind::Mesh) return tool.length_mm;
+  double top = 0.0;
+  for (const auto& v : tool.mesh.vertices) top = std::max(top, double(v.z));
+  return top;
+}
+
 double estimatePostures(const fs::path& file) {
   std::error_code ec;
   const double bytes = double(fs::file_size(file, ec));
@@ -114,8 +122,9 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
       ->required();
   cmd->add_option("--grid", o->grid, "Lines NXxNY")->capture_default_str();
   cmd->add_option("--region", o->region,
-                  "x0,y0,x1,y1 mm (default: the tips' XY range plus the tool radius); given, the "
-                  "path is cut while it is read");
+                  "x0,y0,x1,y1 mm (default: where the tool can cut, the tips' XY range and a "
+                  "tilted axis up to the stock's top, plus the tool radius); given, the path is "
+                  "cut while it is read");
   auto* stock =
       cmd->add_option("--stock", o->stock_mm, "Stock top plane z, mm (default: the highest tip)")
           ->check(CLI::Validator(
@@ -170,6 +179,13 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
                           "about " + std::to_string(std::llround(postures_estimate)) +
                               " postures of 24 bytes");
     PostureStream stream(o->path, read_options);
+    // The part (--part) read beside the path: its top bounds the default region.
+    std::optional<geometry::TriangleMesh> part;
+    double part_top_z = -HUGE_VAL;
+    if (!o->part.empty()) {
+      part = geometry::loadMesh(o->part);
+      for (const auto& v : part->vertices) part_top_z = std::max(part_top_z, double(v.z()));
+    }
     const bool streamed = !region.empty();
     bool have_grid = false;
     const auto makeGrid = [&] {
@@ -184,8 +200,14 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
         return;
       }
       stream.waitAll();  // the default region needs every tip
-      const TipBounds b = stream.bounds();
+      // Where the tool can cut: its axis up to the stock's top (--stock, the part's top, else
+      // the highest tip) reaches beside the tips when tilted.
+      double top_z = !std::isnan(o->stock_mm) ? o->stock_mm : stream.bounds().zmax;
+      if (part) top_z = part_top_z;
+      // (Every point of the tool lies within `margin` of its axis: those below the top, of the
+      // axis below top + margin.)
       const double margin = zb::toolReach(req.tool);
+      const TipBounds b = stream.cutBounds(toolLength(req.tool), top_z + margin);
       req.grid = zb::Grid::fromRegion(b.xmin - margin, b.ymin - margin, b.xmax + margin,
                                       b.ymax + margin, nx, ny);
     };
@@ -215,9 +237,8 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     makeGrid();
     zb::checkGridFits(req.grid);  // before allocating anything grid-sized
 
-    if (!o->part.empty()) {
-      const geometry::TriangleMesh part = geometry::loadMesh(o->part);
-      const zb::ToolMesh m = toZbuffer(part);
+    if (part) {
+      const zb::ToolMesh m = toZbuffer(*part);
       req.initial_heights_mm = zb::stockFromPart(req.grid, m.vertices, m.triangles);
     } else if (!std::isnan(o->stock_mm)) {
       req.stock_mm = static_cast<float>(o->stock_mm);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <chrono>
+#include <future>
 
 namespace fieldpath::app {
 
@@ -63,6 +64,10 @@ void PostureStream::waitAll() {
 
 TipBounds PostureStream::bounds() const {
   std::lock_guard lock(mutex_);
+  return bounds_locked();
+}
+
+TipBounds PostureStream::bounds_locked() const {
   TipBounds all{DBL_MAX, DBL_MAX, -DBL_MAX, -DBL_MAX, -DBL_MAX};
   for (const Chunk& c : chunks_) {
     if (c.postures.empty()) continue;
@@ -71,6 +76,38 @@ TipBounds PostureStream::bounds() const {
     all.xmax = std::max(all.xmax, c.bounds.xmax);
     all.ymax = std::max(all.ymax, c.bounds.ymax);
     all.zmax = std::max(all.zmax, c.bounds.zmax);
+  }
+  return all;
+}
+
+TipBounds PostureStream::cutBounds(double length_mm, double top_z) const {
+  std::lock_guard lock(mutex_);
+  TipBounds all = bounds_locked();
+  const std::size_t workers =
+      std::max<std::size_t>(1, std::min<std::size_t>(std::thread::hardware_concurrency(), chunks_.size()));
+  std::vector<std::future<TipBounds>> parts;
+  for (std::size_t w = 0; w < workers; ++w)
+    parts.push_back(std::async(std::launch::async, [&, w] {
+      TipBounds b = all;
+      for (std::size_t c = w; c < chunks_.size(); c += workers)
+        for (const zbuffer::Posture& p : chunks_[c].postures) {
+          double t = length_mm;  // along the axis, from the tip
+          const zbuffer::Vec3f &tip = p.tip_mm, &a = p.axis;
+          if (a.z > 0.0f) t = std::min(t, std::max(0.0, (top_z - tip.z) / a.z));
+          const double x = tip.x + t * a.x, y = tip.y + t * a.y;
+          b.xmin = std::min(b.xmin, x);
+          b.xmax = std::max(b.xmax, x);
+          b.ymin = std::min(b.ymin, y);
+          b.ymax = std::max(b.ymax, y);
+        }
+      return b;
+    }));
+  for (auto& part : parts) {
+    const TipBounds b = part.get();
+    all.xmin = std::min(all.xmin, b.xmin);
+    all.xmax = std::max(all.xmax, b.xmax);
+    all.ymin = std::min(all.ymin, b.ymin);
+    all.ymax = std::max(all.ymax, b.ymax);
   }
   return all;
 }

@@ -35,6 +35,10 @@ class PostureStream {
   /// After waitAll: every tip's extent and the number of postures.
   TipBounds bounds() const;
   std::size_t postures() const;
+  /// After waitAll: the XY extent of what the tool can cut (bounds' zmax: the highest tip): the
+  /// tips, and each posture's axis from its tip up to where it leaves the stock's top `top_z`
+  /// (at most `length_mm` along it: a tilted shank cuts beside the tip), on all cores.
+  TipBounds cutBounds(double length_mm, double top_z) const;
   /// Seconds from the start to the last chunk parsed (after waitAll).
   double readSeconds() const { return read_seconds_; }
 
@@ -49,6 +53,7 @@ class PostureStream {
     TipBounds bounds;
   };
   void read(const std::filesystem::path& file, const geometry::PathReadOptions& options);
+  TipBounds bounds_locked() const;  ///< bounds(), mutex_ held
 
   mutable std::mutex mutex_;
   std::condition_variable changed_;

@@ -85,6 +85,42 @@ TEST(CliSimulate, AToolMeshWoundInwardCutsAsWoundOutward) {
   EXPECT_EQ(heights[0], heights[1]);
 }
 
+// The default region holds the whole cut of a tilted tool. A ball R 3 along x, its axis a tilted
+// 45° towards +y, stock 2 mm over the tips: the shank's points A(t) + R u, u = (0, c, -c), c =
+// cos 45°, lie below z = 2 while c t <= 2 + R c, so the cut reaches y = 2 + 2 R c = 2 + 3√2 =
+// 6.24 mm. The region was the tips' range + R (y up to 3): the cut beyond was not in the heights.
+TEST(CliSimulate, TheDefaultRegionHoldsATiltedShanksCut) {
+  const TempDir dir;
+  const double c = std::sqrt(0.5);
+  std::string path;
+  for (int k = 0; k <= 100; ++k)
+    path += std::to_string(0.1 * k) + " 0 0 0 " + std::to_string(c) + " " + std::to_string(c) + "\n";
+  dir.write("t45.cl", path);
+  const Outcome run = runFieldpath(
+      dir, "simulate --tool ball:3:20 --path t45.cl --grid 200x400 --stock 2 --backend cpu --out o");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::string json = slurp(dir.path() / "o" / "heights.json");
+  const std::vector<float> h = npyFloats(slurp(dir.path() / "o" / "heights.npy"));
+  ASSERT_EQ(h.size(), 200u * 400u);
+  // origin and spacing from heights.json: "origin": [x0, y0], "spacing": [dx, dy]
+  auto pair = [&](const char* key) {
+    const std::size_t at = json.find(key);
+    EXPECT_NE(at, std::string::npos) << json;
+    double a = 0, b = 0;
+    std::sscanf(json.c_str() + json.find('[', at), "[%lf,%lf", &a, &b);
+    return std::pair{a, b};
+  };
+  const auto [x0, y0] = pair("\"origin\"");
+  const auto [dx, dy] = pair("\"spacing\"");
+  double cut_y_max = -1e9, y_max = y0 + 399 * dy;
+  for (int iy = 0; iy < 400; ++iy)
+    for (int ix = 0; ix < 200; ++ix)
+      if (h[static_cast<std::size_t>(iy) * 200 + ix] < 2.0f - 1e-5f) cut_y_max = std::max(cut_y_max, y0 + iy * dy);
+  EXPECT_NEAR(cut_y_max, 2.0 + 3.0 * std::sqrt(2.0), 2 * dy);  // 6.24 mm, reached
+  EXPECT_GT(y_max, cut_y_max + 0.5);  // and stock left beyond it: the whole cut is in
+  EXPECT_NEAR(x0, -3.0, 1e-9);
+}
+
 TEST(CliSimulate, BadInputIsExitOneWithOneLineAndNoOutputs) {
   const TempDir dir;
   dir.write("path.cl", "0 0 0 0 0 1\n");
