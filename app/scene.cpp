@@ -13,6 +13,7 @@
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/input_file.h"
+#include "fieldpath/common/limits.h"
 #include "fieldpath/geometry/mesh_io.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "estimates.h"
@@ -106,9 +107,6 @@ class Reader {
     return p.is_absolute() ? p : file_.parent_path() / p;
   }
 
-  /// Beyond this distance from the origin a float's step passes 1 um (2^13 mm: 0.98 um).
-  static constexpr double kFloatExactMm = 8192.0;
-
   /// Loads a mesh, naming the scene's key and line in the error.
   geometry::TriangleMesh mesh(const YAML::Node& node, const std::string& key) const {
     const auto p = path(node, key);
@@ -128,12 +126,11 @@ class Reader {
     // then reads as microns of gouge or clearance (5e5 mm: 32 um, 32 769 false gouged lines).
     double far_mm = 0.0;
     for (const auto& v : mesh.vertices) far_mm = std::max(far_mm, v.cwiseAbs().maxCoeff());
-    if (far_mm > kFloatExactMm)
+    if (far_mm > common::kFloatExactMm)
       std::fprintf(stderr,
                    "note: %s: points up to %.4g mm from the origin, read in single precision "
                    "(steps of %.2g mm there): place the job near the origin for micron figures\n",
-                   p.string().c_str(), far_mm,
-                   double(std::nextafter(float(far_mm), HUGE_VALF) - float(far_mm)));
+                   p.string().c_str(), far_mm, common::floatStepMm(far_mm));
     return mesh;
   }
 

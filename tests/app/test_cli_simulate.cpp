@@ -121,6 +121,31 @@ TEST(CliSimulate, TheDefaultRegionHoldsATiltedShanksCut) {
   EXPECT_NEAR(x0, -3.0, 1e-9);
 }
 
+// surface.stl holds floats: 9e5 mm from the origin they step by 0.0625 mm, coarser than a 0.05 mm
+// grid (rows merged, zero-area triangles), which was written without a word; near the origin no
+// note.
+TEST(CliSimulate, ASurfaceStlFarFromTheOriginIsSaidToBeCoarse) {
+  const TempDir dir;
+  dir.write("far.cl", "900000 0 0 0 0 1\n");
+  dir.write("near.cl", "0 0 0 0 0 1\n");
+  const Outcome far = runFieldpath(
+      dir, "simulate --tool ball:2 --path far.cl --grid 20x20 --stock 1 --out far");
+  ASSERT_EQ(far.exit_code, 0) << far.err;
+  EXPECT_NE(far.err.find("note: surface.stl: coordinates up to 9e+05 mm from the origin, in "
+                         "single precision (STL) in steps of 0.062 mm"),
+            std::string::npos)
+      << far.err;
+  const Outcome near = runFieldpath(
+      dir, "simulate --tool ball:2 --path near.cl --grid 20x20 --stock 1 --out near");
+  ASSERT_EQ(near.exit_code, 0) << near.err;
+  EXPECT_EQ(near.err.find("note:"), std::string::npos) << near.err;
+  // Without surface.stl, nothing to say.
+  const Outcome npy_only = runFieldpath(
+      dir, "simulate --tool ball:2 --path far.cl --grid 20x20 --stock 1 --outputs npy --out npy");
+  ASSERT_EQ(npy_only.exit_code, 0) << npy_only.err;
+  EXPECT_EQ(npy_only.err.find("note:"), std::string::npos) << npy_only.err;
+}
+
 TEST(CliSimulate, BadInputIsExitOneWithOneLineAndNoOutputs) {
   const TempDir dir;
   dir.write("path.cl", "0 0 0 0 0 1\n");

@@ -18,6 +18,16 @@ namespace fieldpath::common {
 /// |x| above this (mm) is outside any machine tool: refused as a typo or a corrupt file.
 inline constexpr double kMaxCoordinateMm = 1e6;
 
+/// Beyond this distance from the origin (mm) a float's step passes 1 um (2^13 mm: 0.98 um): where
+/// single-precision files (meshes read, STL written) stop carrying micron figures.
+inline constexpr double kFloatExactMm = 8192.0;
+
+/// The step of a float at x (its distance to the next float up), mm.
+inline double floatStepMm(double x) {
+  const float f = static_cast<float>(std::abs(x));
+  return double(std::nextafter(f, HUGE_VALF) - f);
+}
+
 namespace detail {
 inline std::atomic<std::size_t> memory_limit_bytes{0};  ///< 0: the machine's available memory
 }  // namespace detail
