@@ -153,7 +153,8 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   cmd->add_option("--block", o->block_postures,
                   "Postures per chunk read and cut together (default: 4 MB of text); the heights "
-                  "do not depend on it");
+                  "do not depend on it")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 40));
   cmd->add_option("--out", o->out, "Output directory")->required();
 
   cmd->callback([o, &global] {

@@ -154,12 +154,19 @@ inline void appendNumber(std::string& out, double value) {
   out.append(buffer, result.ptr);
 }
 
-/// The text without a UTF-8 byte-order mark at its start (editors on Windows write one).
-/// The text without a UTF-8 byte-order mark; UTF-16 (its mark, as some Windows editors save)
-/// refused saying so (it read as "no GOTO records" or a line of garbage).
+/// The text without a UTF-8 byte-order mark at its start (editors on Windows write one). UTF-16
+/// (its mark, as some Windows editors save) refused saying so (it read as "no GOTO records" or a
+/// line of garbage); so are lines ended by a CR alone (classic Mac OS: the file read as one line
+/// of too many columns).
 inline std::string_view withoutBom(std::string_view text, const std::filesystem::path& file) {
   if (text.substr(0, 2) == "\xFF\xFE" || text.substr(0, 2) == "\xFE\xFF")
     throw common::InputError(file.string() + ": UTF-16 text: save it as UTF-8 or ASCII");
+  if (const std::size_t cr = text.find('\r');
+      cr != std::string_view::npos && cr + 1 < text.size() && text[cr + 1] != '\n' &&
+      text.substr(0, cr).find('\n') == std::string_view::npos)
+    throw common::InputError(file.string() +
+                             ":1: the line ends in a CR alone (classic Mac OS line ends): save "
+                             "the file with LF or CRLF line ends");
   return text.substr(0, 3) == "\xEF\xBB\xBF" ? text.substr(3) : text;
 }
 

@@ -132,6 +132,25 @@ TEST(ClFile, Utf16IsRefusedSayingSo) {
   }
 }
 
+// Lines ended by a CR alone (classic Mac OS) read as one line of 12 columns: said what they are.
+// CRLF, and a lone CR at the very end, still read.
+TEST(ClFile, CrOnlyLineEndsAreRefusedSayingSo) {
+  for (const char* name : {"mac.cl", "mac.apt"}) {
+    const std::string text = std::string(name).ends_with(".cl")
+                                 ? "1 2 3 0 0 1\r4 5 6 0 0 1\r"
+                                 : "GOTO/1,2,3,0,0,1\rGOTO/4,5,6,0,0,1\r";
+    try {
+      readPathFile(writeBytes(name, text));
+      ADD_FAILURE() << name;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(":1: the line ends in a CR alone"), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_EQ(readPathFile(writeBytes("crlf.cl", "1 2 3 0 0 1\r\n4 5 6 0 0 1\r\n")).postures.size(), 2u);
+  EXPECT_EQ(readPathFile(writeBytes("one.cl", "1 2 3 0 0 1\r")).postures.size(), 1u);
+}
+
 TEST(ClFile, EmptyAndMissingFiles) {
   for (const char* text : {"", "# only a comment\n\n   \n"}) {
     const fs::path p = writeBytes("empty.cl", text);
