@@ -199,7 +199,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"motions", motionsJson(motions, scene.clearance_mm, motion_request.resolution_mm)},
         {"link_part", linkPartJson(link_part)},
         {"link_part_skipped",
-         link_part ? json(nullptr) : json("no `part` in the scene, or no `# link` blocks in the path")},
+         link_part ? json(nullptr)
+                   : json("no `part` in the scene, or no `# link` blocks in the path")},
         {"holder_part", holderPartJson(holder_part)},
         {"holder_part_skipped",
          holder_part ? json(nullptr) : json("no `part` or no `holder` in the scene")},

@@ -75,10 +75,6 @@ nlohmann::json finiteOrNull(double value) {
   return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
 }
 
-/// About how many postures a path file holds, from its size: `.npy` rows of 24 bytes (float32
-/// N×6; float64 counts double), text by the line length of its first 64 KiB (5-axis lines of
-/// 32-bit values run ~60 bytes, 3-axis ones ~35). 0 where the file cannot be read (the reader
-/// then says why).
 /// How far the tool reaches up its axis from the tip, mm (a mesh tool: its highest vertex).
 double toolLength(const zb::Tool& tool) {
   if (tool.kind != zb::ToolKind::Mesh) return tool.length_mm;
@@ -87,6 +83,10 @@ double toolLength(const zb::Tool& tool) {
   return top;
 }
 
+/// About how many postures a path file holds, from its size: `.npy` rows of 24 bytes (float32
+/// N×6; float64 counts double), text by the line length of its first 64 KiB (5-axis lines of
+/// 32-bit values run ~60 bytes, 3-axis ones ~35). 0 where the file cannot be read (the reader
+/// then says why).
 double estimatePostures(const fs::path& file) {
   std::error_code ec;
   const double bytes = double(fs::file_size(file, ec));

@@ -24,8 +24,8 @@ inline CLI::Validator finiteNumber(const std::string& unit, bool zero_ok) {
         if (text.empty() || end == text.c_str()) return "'" + text + "' is not a number";
         if (end != text.c_str() + text.size() || !std::isfinite(value) || value < 0.0 ||
             (value == 0.0 && !zero_ok))
-          return "must be a finite number " + bound + (unit.empty() ? "" : " " + unit) +
-                 ", got '" + text + "'";
+          return "must be a finite number " + bound + (unit.empty() ? "" : " " + unit) + ", got '" +
+                 text + "'";
         return {};
       },
       (unit.empty() ? "" : unit + " ") + bound);

@@ -83,8 +83,8 @@ TipBounds PostureStream::bounds_locked() const {
 TipBounds PostureStream::cutBounds(double length_mm, double top_z) const {
   std::lock_guard lock(mutex_);
   TipBounds all = bounds_locked();
-  const std::size_t workers =
-      std::max<std::size_t>(1, std::min<std::size_t>(std::thread::hardware_concurrency(), chunks_.size()));
+  const std::size_t workers = std::max<std::size_t>(
+      1, std::min<std::size_t>(std::thread::hardware_concurrency(), chunks_.size()));
   std::vector<std::future<TipBounds>> parts;
   for (std::size_t w = 0; w < workers; ++w)
     parts.push_back(std::async(std::launch::async, [&, w] {

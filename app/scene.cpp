@@ -11,12 +11,12 @@
 #include <utility>
 #include <vector>
 
+#include "estimates.h"
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/input_file.h"
 #include "fieldpath/common/limits.h"
 #include "fieldpath/geometry/mesh_io.h"
 #include "fieldpath/geometry/tool_model.h"
-#include "estimates.h"
 
 namespace fieldpath::app {
 namespace {

@@ -211,7 +211,8 @@ static __attribute__((target("avx512f"), always_inline)) inline void laneTerm512
   // e = 1 - r² y0² (relative error 5/16 e³ < 1e-13; two Newton steps took two more operations)
   const __m512d y0 = _mm512_rsqrt14_pd(r2s);
   const __m512d e = _mm512_fnmadd_pd(_mm512_mul_pd(r2s, y0), y0, k.one);
-  const __m512d y = _mm512_fmadd_pd(y0, _mm512_mul_pd(e, _mm512_fmadd_pd(e, k.three_eighths, k.half)), y0);
+  const __m512d y =
+      _mm512_fmadd_pd(y0, _mm512_mul_pd(e, _mm512_fmadd_pd(e, k.three_eighths, k.half)), y0);
   const __m512d inv_rc = _mm512_min_pd(y, k.inv_r_min);
   const __m512d phi = _mm512_mul_pd(_mm512_sub_pd(inv_rc, k.inv_r0), _mm512_mul_pd(inv_rc, inv_rc));
   const __m512d c = _mm512_maskz_mul_pd(in, _mm512_mul_pd(_mm512_set1_pd(s.w[j]), phi), y);
@@ -230,9 +231,10 @@ static __attribute__((target("avx512f"))) void laneSums512(const Law& L, const S
                                                           const double* pz, const double* init_sq,
                                                           Accum* out) {
   const __m512d ax = _mm512_loadu_pd(px), ay = _mm512_loadu_pd(py), az = _mm512_loadu_pd(pz);
-  const LaneConsts512 k{_mm512_set1_pd(L.r0_sq), _mm512_set1_pd(L.inv_r_min),
-                        _mm512_set1_pd(L.inv_r0), _mm512_set1_pd(0.5), _mm512_set1_pd(0.375),
-                        _mm512_set1_pd(1.0), _mm512_set1_pd(1e-300)};
+  const LaneConsts512 k{_mm512_set1_pd(L.r0_sq),  _mm512_set1_pd(L.inv_r_min),
+                        _mm512_set1_pd(L.inv_r0), _mm512_set1_pd(0.5),
+                        _mm512_set1_pd(0.375),    _mm512_set1_pd(1.0),
+                        _mm512_set1_pd(1e-300)};
   const __m512d zero = _mm512_setzero_pd();
   __m512d fx = zero, fy = zero, fz = zero, gx = zero, gy = zero, gz = zero;
   __m512d lowest = _mm512_set1_pd(HUGE_VAL);

@@ -133,8 +133,9 @@ bool checkStlSize(const std::filesystem::path& file, std::uintmax_t size) {
   const std::size_t got = static_cast<std::size_t>(in.gcount());
   std::size_t first = 0;
   while (first < got && std::isspace(header[first])) ++first;
-  std::string word = got >= first + 5 ? std::string(reinterpret_cast<const char*>(header) + first, 5)
-                                       : std::string();
+  std::string word = got >= first + 5
+                         ? std::string(reinterpret_cast<const char*>(header) + first, 5)
+                         : std::string();
   for (char& c : word) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (word == "solid") {
     // ASCII, unless a binary one whose header starts so (its size matches its count).

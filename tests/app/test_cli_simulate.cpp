@@ -94,10 +94,12 @@ TEST(CliSimulate, TheDefaultRegionHoldsATiltedShanksCut) {
   const double c = std::sqrt(0.5);
   std::string path;
   for (int k = 0; k <= 100; ++k)
-    path += std::to_string(0.1 * k) + " 0 0 0 " + std::to_string(c) + " " + std::to_string(c) + "\n";
+    path +=
+        std::to_string(0.1 * k) + " 0 0 0 " + std::to_string(c) + " " + std::to_string(c) + "\n";
   dir.write("t45.cl", path);
   const Outcome run = runFieldpath(
-      dir, "simulate --tool ball:3:20 --path t45.cl --grid 200x400 --stock 2 --backend cpu --out o");
+      dir,
+      "simulate --tool ball:3:20 --path t45.cl --grid 200x400 --stock 2 --backend cpu --out o");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const std::string json = slurp(dir.path() / "o" / "heights.json");
   const std::vector<float> h = npyFloats(slurp(dir.path() / "o" / "heights.npy"));
@@ -115,7 +117,8 @@ TEST(CliSimulate, TheDefaultRegionHoldsATiltedShanksCut) {
   double cut_y_max = -1e9, y_max = y0 + 399 * dy;
   for (int iy = 0; iy < 400; ++iy)
     for (int ix = 0; ix < 200; ++ix)
-      if (h[static_cast<std::size_t>(iy) * 200 + ix] < 2.0f - 1e-5f) cut_y_max = std::max(cut_y_max, y0 + iy * dy);
+      if (h[static_cast<std::size_t>(iy) * 200 + ix] < 2.0f - 1e-5f)
+        cut_y_max = std::max(cut_y_max, y0 + iy * dy);
   EXPECT_NEAR(cut_y_max, 2.0 + 3.0 * std::sqrt(2.0), 2 * dy);  // 6.24 mm, reached
   EXPECT_GT(y_max, cut_y_max + 0.5);  // and stock left beyond it: the whole cut is in
   EXPECT_NEAR(x0, -3.0, 1e-9);
@@ -128,15 +131,15 @@ TEST(CliSimulate, ASurfaceStlFarFromTheOriginIsSaidToBeCoarse) {
   const TempDir dir;
   dir.write("far.cl", "900000 0 0 0 0 1\n");
   dir.write("near.cl", "0 0 0 0 0 1\n");
-  const Outcome far = runFieldpath(
-      dir, "simulate --tool ball:2 --path far.cl --grid 20x20 --stock 1 --out far");
+  const Outcome far =
+      runFieldpath(dir, "simulate --tool ball:2 --path far.cl --grid 20x20 --stock 1 --out far");
   ASSERT_EQ(far.exit_code, 0) << far.err;
   EXPECT_NE(far.err.find("note: surface.stl: coordinates up to 9e+05 mm from the origin, in "
                          "single precision (STL) in steps of 0.062 mm"),
             std::string::npos)
       << far.err;
-  const Outcome near = runFieldpath(
-      dir, "simulate --tool ball:2 --path near.cl --grid 20x20 --stock 1 --out near");
+  const Outcome near =
+      runFieldpath(dir, "simulate --tool ball:2 --path near.cl --grid 20x20 --stock 1 --out near");
   ASSERT_EQ(near.exit_code, 0) << near.err;
   EXPECT_EQ(near.err.find("note:"), std::string::npos) << near.err;
   // Without surface.stl, nothing to say.

@@ -300,7 +300,8 @@ TEST(StudyCommand, BadInputIsExitOneWithNoOutputs) {
   EXPECT_EQ(
       test::runFieldpath(dir, "study scene.yaml --voxels 2,1 --refine 5 --out study").exit_code, 1);
   // One short line (CLI11's own check printed its range as a 300-digit number).
-  const test::Outcome zero_step = test::runFieldpath(dir, "study scene.yaml --sample-step 0 --out study");
+  const test::Outcome zero_step =
+      test::runFieldpath(dir, "study scene.yaml --sample-step 0 --out study");
   EXPECT_EQ(zero_step.exit_code, 1);
   EXPECT_NE(zero_step.err.find("--sample-step: must be a finite number > 0 mm, got '0'"),
             std::string::npos)

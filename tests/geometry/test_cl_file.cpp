@@ -147,7 +147,8 @@ TEST(ClFile, CrOnlyLineEndsAreRefusedSayingSo) {
           << e.what();
     }
   }
-  EXPECT_EQ(readPathFile(writeBytes("crlf.cl", "1 2 3 0 0 1\r\n4 5 6 0 0 1\r\n")).postures.size(), 2u);
+  EXPECT_EQ(readPathFile(writeBytes("crlf.cl", "1 2 3 0 0 1\r\n4 5 6 0 0 1\r\n")).postures.size(),
+            2u);
   EXPECT_EQ(readPathFile(writeBytes("one.cl", "1 2 3 0 0 1\r")).postures.size(), 1u);
 }
 

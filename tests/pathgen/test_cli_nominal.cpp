@@ -322,8 +322,9 @@ TEST(CheckSurface, PassesBesideThePartAreStillCheckedForClearance) {
   pathgen::test::addBox(wall, 8, 20, -30, 30, -10, 60);    // an obstacle beside the pass
   geometry::saveMesh(part, dir.path() / "part.stl");
   geometry::saveMesh(wall, dir.path() / "wall.stl");
-  dir.write("scene.yaml", "obstacles:\n  - mesh: wall.stl\npart: part.stl\n"
-                          "tool: { shape: ball, radius: 3, length: 40 }\nclearance: 0.5\n");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 40 }\nclearance: 0.5\n");
   const double s = std::sin(40.0 * M_PI / 180.0), c = std::cos(40.0 * M_PI / 180.0);
   std::ostringstream path;
   path.precision(17);
