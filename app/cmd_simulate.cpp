@@ -57,7 +57,8 @@ std::set<std::string> parseOutputs(const std::string& text) {
         std::end(kOutputNames))
       throw InputError("--outputs '" + text + "': '" + item +
                        "' is not one of npy, json, stl, png");
-    out.insert(item);
+    if (!out.insert(item).second)
+      throw InputError("--outputs '" + text + "': '" + item + "' named twice");
     pos = comma + 1;
   }
   return out;

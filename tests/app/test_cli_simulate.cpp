@@ -156,7 +156,8 @@ TEST(CliSimulate, BadInputIsExitOneWithOneLineAndNoOutputs) {
   dir.write("open_tool.stl", squareStl(2, 1));
   for (const std::string args :
        {"--tool cone:2", "--tool ball:2 --grid 0x10", "--tool ball:2 --region 1,2,3",
-        "--tool ball:2 --backend gpu", "--tool missing.stl", "--tool open_tool.stl"}) {
+        "--tool ball:2 --backend gpu", "--tool missing.stl", "--tool open_tool.stl",
+        "--tool ball:2 --block 0", "--tool ball:2 --outputs npy,png,npy"}) {
     const Outcome run = runFieldpath(dir, "simulate " + args + " --path path.cl --out out");
     EXPECT_EQ(run.exit_code, 1) << args << ": " << run.err;
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << args << ": " << run.err;
