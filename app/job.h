@@ -53,10 +53,13 @@ inline nlohmann::json motionsJson(const pathgen::MotionResult& m, double require
            "tip and axis interpolated linearly; adaptive sampling with a certified lower bound "
            "(tool + holder move at most |dtip| + reach * dangle between samples; the distance "
            "is 1-Lipschitz in that): halved until the bound reaches max(required_mm, closest "
-           "posture - 0.01 mm), a sample touches, or the sub-motion moves <= 2 * resolution_mm"},
+           "posture - max(0.01 mm, 1 % of it)), a sample touches, or the sub-motion moves <= 2 "
+           "* resolution_mm"},
           {"resolution_mm", resolution_mm},
           {"min_mm", jsonNumber(m.min_clearance_mm)},
-          {"min_is", "a lower bound, within 0.01 mm of the true minimum when that is above required_mm"},
+          {"min_is",
+           "a lower bound, within max(0.01 mm, 1 % of the closest posture's clearance) of the "
+           "true minimum when that is above required_mm"},
           {"min_motion", jsonIndex(m.min_index)},
           {"colliding_motions", m.colliding},
           {"first_colliding_motion", jsonIndex(m.first_colliding)},

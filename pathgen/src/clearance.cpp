@@ -265,10 +265,12 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
     common::report(progress, 0.3 * end / postures.size(), "motions");
   }
   // Refine each motion until its bound reaches the required clearance or, where the path comes
-  // closer, within kTightenMm of the closest posture: the reported minimum is then tight too.
+  // closer, within the slack of the closest posture: the reported minimum is then tight too.
   double closest_mm = std::numeric_limits<double>::infinity();
   for (double d : ends) closest_mm = std::min(closest_mm, d);
-  stop_mm = std::max(request.required_mm, closest_mm - request.tighten_mm);
+  stop_mm = std::max(request.required_mm,
+                     closest_mm - std::max(request.tighten_mm,
+                                           request.tighten_fraction * std::max(closest_mm, 0.0)));
   for (size_t begin = 0; begin < result.motions; begin += batch) {
     const size_t end = std::min(result.motions, begin + batch);
     tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
