@@ -32,6 +32,10 @@ namespace {
 
 using geometry::kRadToDeg;
 
+/// A nominal path whose axes lean along the feed by more than this (deg) gets a note: the
+/// steering starts from path.lead_deg, not from the file's lead.
+constexpr double kNoteLeanDeg = 1.0;
+
 nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& job,
                           const pathgen::GenerateResult& r) {
   using nlohmann::json;
@@ -266,6 +270,17 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (scene.nominal)
       for (const std::string& note : cutterNotes(scene.tool, *scene.nominal))
         std::printf("note: %s\n", note.c_str());
+    if (scene.nominal && !job.nominal) {  // a lead in the file is not kept: n is ⊥ the feed
+      const pathgen::Pass* leanest = nullptr;
+      for (const pathgen::Pass& p : job.passes)
+        if (!leanest || p.nominal_lean_deg > leanest->nominal_lean_deg) leanest = &p;
+      if (leanest && leanest->nominal_lean_deg > kNoteLeanDeg)
+        std::printf("note: %s: the nominal axes lean along the feed by up to %.1f deg: the "
+                    "steering starts from the axis made square to the feed and path.lead_deg "
+                    "(%g deg), not from the file's lead\n",
+                    leanest->nominal_lean_at.c_str(), leanest->nominal_lean_deg,
+                    job.path.lead_deg);
+    }
     if (result.turned_sheets > 0)
       std::printf(
           "note: %zu open obstacle surface%s faced away from the passes: turned to face them "

@@ -231,7 +231,7 @@ const char* toString(Status status) {
     case Status::Ok:
       return "ok";
     case Status::TiltLimit:
-      return "tilt limit";
+      return "angle limit";  // tilt or lead: the message names which
     case Status::RateLimit:
       return "angle change limit";
     case Status::SolverFailed:

@@ -158,6 +158,8 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
                                   : line->s_mm.back() +
                                         (line->centre_mm[k] - line->centre_mm[k - 1]).norm());
     }
+    double lean_max_deg = 0.0;
+    std::size_t lean_at = kept.front();
     for (std::size_t k = 0; k < n; ++k) {
       const std::size_t a = k == 0 ? 0 : k - 1, b = k + 1 == n ? n - 1 : k + 1;
       Vec3 tangent = line->centre_mm[b] - line->centre_mm[a];
@@ -177,8 +179,16 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
       }
       line->tangent.push_back(tangent);
       line->normal.push_back(normal.normalized());
+      const double lean_deg =
+          std::asin(std::min(1.0, std::abs(axis.normalized().dot(tangent)))) * 180.0 / M_PI;
+      if (lean_deg > lean_max_deg) {
+        lean_max_deg = lean_deg;
+        lean_at = kept[k];
+      }
     }
     Pass pass;
+    pass.nominal_lean_deg = lean_max_deg;
+    pass.nominal_lean_at = path.where(lean_at);
     pass.index = number - 1;
     pass.label = "pass " + std::to_string(number) + " (" + path.where(begin) + ")";
     pass.ball_radius_mm = r;

@@ -54,6 +54,29 @@ bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 }  // namespace
 
+// A lead written in the nominal path is not kept (the frame's n is the axis made square to the
+// feed): each pass says how far its axes lean along the feed and where, for generate's note. A
+// straight pass along x whose axes lean 20° towards +x from its third posture on (line 4; the
+// feed there bends with the ball centre's step, so the full 20° is first met at line 5), and one
+// with vertical axes.
+TEST(NominalPasses, TheAxesLeanAlongTheFeedIsMeasured) {
+  const double lean = 20.0 * M_PI / 180.0;
+  std::string text = "# pass 1\n";
+  for (int k = 0; k <= 10; ++k)
+    text += std::to_string(k) + " 0 0 " + (k < 2 ? std::string("0 0 1")
+                                                   : std::to_string(std::sin(lean)) + " 0 " +
+                                                         std::to_string(std::cos(lean))) +
+            "\n";
+  text += "# pass 2\n" + straightLines(0, 10, 1, 10);
+  TempDir dir;
+  const auto passes = nominalPasses(geometry::readPathFile(dir.write("lean.cl", text)), PathParams{}, kR);
+  ASSERT_EQ(passes.size(), 2u);
+  EXPECT_NEAR(passes[0].nominal_lean_deg, 20.0, 1e-4);
+  EXPECT_NE(passes[0].nominal_lean_at.find("lean.cl:5"), std::string::npos)
+      << passes[0].nominal_lean_at;
+  EXPECT_NEAR(passes[1].nominal_lean_deg, 0.0, 1e-9);
+}
+
 TEST(PathBlocks, ClMarkersBlankLinesAndLinksMakeBlocks) {
   TempDir dir;
   const auto file = dir.write("p.cl", "# header\n# pass 1\n" + straightLines(0, 2, 1, 0) +

@@ -38,6 +38,11 @@ struct Pass {
   double ball_radius_mm = 0.0;
   double length_mm = 0.0;
   std::vector<PassSample> samples;  ///< output stations, s = 0 ... length_mm
+  /// A nominal path's largest lean of its axes along the feed (deg) and where ("FILE:LINE"):
+  /// the frame takes the axis made orthogonal to the feed and steers from path.lead_deg, so a
+  /// lead written in the file is not kept (generate says so).
+  double nominal_lean_deg = 0.0;
+  std::string nominal_lean_at;
   /// The station at any s in [0, length_mm] (clamped): cheap, deterministic, thread-safe, so the
   /// dynamics can call it at every solver stage.
   std::function<PassSample(double s_mm)> at;
