@@ -281,6 +281,11 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                     leanest->nominal_lean_at.c_str(), leanest->nominal_lean_deg,
                     job.path.lead_deg);
     }
+    if (result.safe_z_proven_mm > 0.0)
+      std::printf("note: links.safe_z %g mm leaves the links within the checks' margin of "
+                  "`clearance` (the tool mesh's chordal tolerance, the motions' resolution): they "
+                  "may read as under it though clear; %.3f mm or more is proven clear\n",
+                  result.safe_z_mm, result.safe_z_proven_mm);
     if (result.turned_sheets > 0)
       std::printf(
           "note: %zu open obstacle surface%s faced away from the passes: turned to face them "

@@ -136,6 +136,9 @@ GenerateResult generatePath(const GenerateRequest& request) {
     double top_mm = topOfMeshes(obstacles);
     if (request.part) top_mm = std::max(top_mm, topOfMeshes(std::span(&*request.part, 1)));
     safe_z_mm = resolveSafeZ(request.links.safe_z_mm, top_mm, request.clearance_mm);
+    const double proven_mm =
+        top_mm + request.clearance_mm + kClearanceMeshTolMm + 2.0 * MotionRequest{}.resolution_mm;
+    if (request.links.safe_z_mm && safe_z_mm < proven_mm) result.safe_z_proven_mm = proven_mm;
   }
   std::vector<Vec3> nodes;
   for (const auto& node :

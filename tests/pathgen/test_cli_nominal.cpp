@@ -98,6 +98,26 @@ TEST_F(MeshJob, ClAptAndNpyNominalPathsGiveTheSamePathBitForBit) {
   EXPECT_EQ(from_cl.find("UNSAFE"), std::string::npos);
 }
 
+// The least links.safe_z accepted (the highest mesh point + clearance) puts the links at exactly
+// the clearance, which the checks' own margin (chordal tolerance, motion resolution) may read as
+// under it: said, with the least height proven clear; 0.05 mm above that, nothing to say.
+TEST_F(MeshJob, ASafeZAtTheLeastAcceptedIsSaid) {
+  double top = -HUGE_VAL;
+  for (const char* mesh : {"blades.stl", "hub.stl"})
+    for (const auto& v : geometry::loadMesh(dir_->path() / mesh).vertices) top = std::max(top, v.z());
+  const double least = top + 0.5;  // the scene's clearance
+  for (const double above : {0.0, 0.05}) {
+    std::ostringstream extra;
+    extra.precision(17);
+    extra << "links: { safe_z: " << least + above << " }\n";
+    dir_->write("tight.yaml", sceneText("nominal.cl", extra.str()));
+    const auto r = test::runFieldpath(*dir_, "generate tight.yaml --out out_tight");
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    const std::size_t note = r.out.find("leaves the links within the checks' margin");
+    EXPECT_EQ(note != std::string::npos, above == 0.0) << above << ": " << r.out;
+  }
+}
+
 TEST_F(MeshJob, BladesWoundAwayFromThePassesAreTurnedToFaceThem) {
   // The blades are open sheets: wound the other way their field would pull the tool into them.
   // Turned before sampling, the job is the same, bit for bit.

@@ -119,6 +119,10 @@ struct GenerateResult {
   /// holder): it never cuts, so touching is a crash.
   std::optional<LinkPartResult> holder_part;
   double safe_z_mm = 0.0;     ///< the links' travel plane
+  /// A given links.safe_z below this (mm) lets the links pass within the checks' own margin of
+  /// `clearance` (the tool mesh's chordal tolerance, the motions' resolution): they may read as
+  /// under it though clear. 0 when safe_z is `auto` (always above it) or there are no links.
+  double safe_z_proven_mm = 0.0;
   std::size_t link_postures = 0;
   std::size_t limited_postures = 0;                   ///< where dynamics.on_limit held an angle
   std::size_t limited_colliding = 0;                  ///< of those, colliding ones
