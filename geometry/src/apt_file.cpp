@@ -67,24 +67,27 @@ struct AptChunk {
   std::vector<std::pair<std::size_t, PathFile::Cutter>> cutters;
 };
 
+/// The leading finite numbers of comma-separated `values` (at most `max`, into v): how many.
+std::size_t leadingNumbers(std::string_view values, double* v, std::size_t max) {
+  std::size_t count = 0;
+  for (std::size_t start = 0; start <= values.size() && count < max;) {
+    const auto comma = std::min(values.find(',', start), values.size());
+    const std::string_view token = trimmed(values.substr(start, comma - start));
+    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), v[count]);
+    if (ec != std::errc() || end != token.data() + token.size() || !std::isfinite(v[count])) break;
+    ++count;
+    start = comma + 1;
+  }
+  return count;
+}
+
 /// CUTTER/d[, r, ...]: diameter and corner radius in file units, or nothing when the first value
 /// is not a number (a CAM's `CUTTER/TOOL1`: read past, as DESIGN.md says of CUTTER).
 std::optional<PathFile::Cutter> cutterOf(std::string_view values, std::size_t line) {
   double v[2] = {0.0, -1.0};
-  int count = 0;
-  for (std::size_t start = 0; start <= values.size() && count < 2;) {
-    const auto comma = std::min(values.find(',', start), values.size());
-    const std::string_view token = trimmed(values.substr(start, comma - start));
-    double value = 0.0;
-    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-    if (ec != std::errc() || end != token.data() + token.size() || !std::isfinite(value) ||
-        value < 0.0)
-      break;
-    v[count++] = value;
-    start = comma + 1;
-  }
+  const std::size_t count = leadingNumbers(values, v, 2);
   if (count == 0 || !(v[0] > 0.0)) return std::nullopt;
-  return PathFile::Cutter{v[0], v[1], line};
+  return PathFile::Cutter{v[0], count == 2 && v[1] >= 0.0 ? v[1] : -1.0, line};
 }
 
 /// mm per unit of a UNITS record's value (MM, INCHES), 0 if unknown.
@@ -170,18 +173,7 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
       // TLAXIS/i, j, k[, ...]: the axis of the 3-number GOTOs that follow (APT's modal axis).
       // Other forms (TLAXIS/NORMPS, ...) leave them the last axis, as before: read past.
       double v[3];
-      std::size_t count = 0;
-      for (std::size_t start = 0; start < values.size() && count < 3;) {
-        const auto comma = std::min(values.find(',', start), values.size());
-        const std::string_view token = trimmed(values.substr(start, comma - start));
-        const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), v[count]);
-        if (token.empty() || ec != std::errc() || end != token.data() + token.size() ||
-            !std::isfinite(v[count]))
-          break;
-        ++count;
-        start = comma + 1;
-      }
-      if (count == 3) {
+      if (leadingNumbers(values, v, 3) == 3) {
         axis_now = checkedAxis(Vec3(v[0], v[1], v[2]),
                                [&] { return file.string() + ":" + std::to_string(record_line); });
         own_axis = true;
@@ -247,7 +239,7 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
 
 PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& options) {
   const MappedFile mapped(file);
-  const std::string_view text = withoutBom(mapped.text(), file);
+  const std::string_view text = readableText(mapped.text(), file);
   const std::vector<TextChunk> pieces =
       splitAtLines(text, options.chunk_bytes, options.threads,
                    [](std::string_view line) { return continuesRecord(aptContent(line)); });

@@ -236,7 +236,7 @@ std::vector<PathBlock> clBlocks(const std::vector<PathChunk>& chunks, std::size_
 
 PathFile readClPath(const std::filesystem::path& file, const PathReadOptions& options) {
   const MappedFile mapped(file);
-  const std::string_view text = withoutBom(mapped.text(), file);
+  const std::string_view text = readableText(mapped.text(), file);
   const std::vector<TextChunk> pieces = splitAtLines(text, options.chunk_bytes, options.threads);
   std::vector<PathChunk> chunks(pieces.size());
   forEachChunk(pieces.size(), options.threads, [&](std::size_t i) {
@@ -292,7 +292,7 @@ std::size_t scanPathFile(const std::filesystem::path& file, const PathReadOption
       break;
   }
   const MappedFile mapped(file);
-  const std::string_view text = withoutBom(mapped.text(), file);
+  const std::string_view text = readableText(mapped.text(), file);
   const std::vector<TextChunk> pieces = splitAtLines(text, options.chunk_bytes, options.threads);
   if (sink.begin) sink.begin(pieces.size());
   std::vector<std::size_t> counts(pieces.size(), 0);

@@ -154,14 +154,15 @@ inline void appendNumber(std::string& out, double value) {
   out.append(buffer, result.ptr);
 }
 
-/// The text without a UTF-8 byte-order mark at its start (editors on Windows write one). UTF-16
-/// (its mark, as some Windows editors save) refused saying so (it read as "no GOTO records" or a
+/// A path file's text as the readers take it: without a UTF-8 byte-order mark at its start
+/// (editors on Windows write one). UTF-16 (its mark, as some Windows editors save) is refused
+/// saying so (it read as "no GOTO records" or a
 /// line of garbage); so are lines ended by a CR alone (classic Mac OS: the file read as one line
 /// of too many columns).
-inline std::string_view withoutBom(std::string_view text, const std::filesystem::path& file) {
+inline std::string_view readableText(std::string_view text, const std::filesystem::path& file) {
   if (text.substr(0, 2) == "\xFF\xFE" || text.substr(0, 2) == "\xFE\xFF")
     throw common::InputError(file.string() + ": UTF-16 text: save it as UTF-8 or ASCII");
-  // Only the first line is looked at (a scan of the whole text cost a gigabyte path ~0.2 s).
+  // The first line tells (not a scan of the whole text: paths run to gigabytes).
   const std::string_view first = text.substr(0, text.find('\n'));
   if (const std::size_t cr = first.find('\r'); cr != std::string_view::npos && cr + 1 < first.size())
     throw common::InputError(file.string() +

@@ -173,13 +173,15 @@ TEST(PathRead, AptTlaxisCrossesChunks) {
       "GOTO/0,0,0,0,0,1\nTLAXIS/0,0.6,0.8\n$$ a comment\n$$ another\nGOTO/1,0,0\nGOTO/2,0,0\n"
       "TLAXIS/0.6,0,0.8\nCOOLNT/ON\nGOTO/3,0,0\n";
   const fs::path file = writeBytes("tlaxis.apt", text);
-  for (std::size_t bytes : kChunkBytes) {
-    const PathFile p = read(file, bytes, 0);
-    ASSERT_EQ(p.postures.size(), 4u) << bytes;
-    EXPECT_EQ(p.postures[1].axis, Vec3(0, 0.6, 0.8)) << bytes;
-    EXPECT_EQ(p.postures[2].axis, Vec3(0, 0.6, 0.8)) << bytes;
-    EXPECT_EQ(p.postures[3].axis, Vec3(0.6, 0, 0.8)) << bytes;
-  }
+  // Read whole, the axes the records give; read in chunks, the same path bit for bit.
+  const PathFile whole = read(file, std::size_t{1} << 30, 1);
+  ASSERT_EQ(whole.postures.size(), 4u);
+  EXPECT_EQ(whole.postures[0].axis, Vec3::UnitZ());
+  EXPECT_EQ(whole.postures[1].axis, Vec3(0, 0.6, 0.8));
+  EXPECT_EQ(whole.postures[2].axis, Vec3(0, 0.6, 0.8));
+  EXPECT_EQ(whole.postures[3].axis, Vec3(0.6, 0, 0.8));
+  for (std::size_t bytes : kChunkBytes)
+    expectSamePath(read(file, bytes, 0), whole, "chunk " + std::to_string(bytes));
 }
 
 TEST(PathRead, AptFedratBetweenRapidAndGotoMakesAFeedMoveWhateverTheChunks) {
