@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <openvdb/io/Stream.h>
@@ -28,6 +29,7 @@ bool locate(const Level& level, const IndexAccessor& acc, const Vec3& x_mm, Cell
   const openvdb::Coord leaf(i >> 3, j >> 3, k >> 3);  // floor division by 8
   const int b = blockAt(level, acc, leaf);
   if (b < 0) return false;
+  ensureBlock(level, std::size_t(b));
   const int li = i & (kLeafDim - 1), lj = j & (kLeafDim - 1), lk = k & (kLeafDim - 1);
   out.block = std::size_t(b);
   out.node0 = out.block * kBlockNodes + std::size_t((li * kBlockDim + lj) * kBlockDim + lk);
@@ -36,8 +38,68 @@ bool locate(const Level& level, const IndexAccessor& acc, const Vec3& x_mm, Cell
   return true;
 }
 
+namespace {
+
+/// Fills block b of the level from its leaf and the leaf's +x, +y, +z neighbours, found through
+/// `values` and `closeness` (accessors of the level's trees, or none: the trees' own probes).
+template <class ValueProbe, class FloatProbe>
+void fillBlock(const Level& level, std::size_t b, ValueProbe&& values, FloatProbe&& closeness) {
+  const bool ratio = level.ratio;
+  const openvdb::Vec3s value_background = level.grid->background();
+  const float closeness_background = ratio ? level.closeness->background() : 0.0f;
+  const Leaf& leaf = *level.block_leaves[b];
+  const openvdb::Coord o = leaf.origin();
+  // From the buffers of the leaf and of its +x, +y, +z neighbours (side = which of them:
+  // bit 2 for i = 8, 1 for j = 8, 0 for k = 8), looked up once each; an absent leaf holds
+  // the background (the trees have no active tiles).
+  // Their buffers' data read directly (LeafBuffer's accessors check for out-of-core data
+  // at every value: most of this loop's time).
+  const openvdb::Vec3s* values_of[8];
+  const float* floats_of[8];
+  const openvdb::util::NodeMask<3>* over_of[8];
+  for (int side = 0; side < 8; ++side) {
+    const openvdb::Coord n =
+        o.offsetBy(side & 4 ? kLeafDim : 0, side & 2 ? kLeafDim : 0, side & 1 ? kLeafDim : 0);
+    const Leaf* v = side == 0 ? &leaf : values(n);
+    const FloatLeaf* f = ratio ? closeness(n) : nullptr;
+    values_of[side] = v ? v->buffer().data() : nullptr;
+    floats_of[side] = f ? f->buffer().data() : nullptr;
+    over_of[side] = f ? &f->getValueMask() : nullptr;
+  }
+  std::uint64_t* over = &level.over[b * kBlockWords];
+  std::fill(over, over + kBlockWords, std::uint64_t{0});
+  std::array<float, 4>* block = &level.nodes[b * kBlockNodes];
+  // A run along k at a time: k = 0..7 from the leaf of (i, j)'s side, k = 8 from the one
+  // above it in z (the per-node side lookup and its branches were most of this loop).
+  for (int i = 0; i < kBlockDim; ++i)
+    for (int j = 0; j < kBlockDim; ++j) {
+      const int side_ij = (i >> 3) << 2 | (j >> 3) << 1;
+      const openvdb::Index first = openvdb::Index(((i & 7) * kLeafDim + (j & 7)) * kLeafDim);
+      const int n0 = (i * kBlockDim + j) * kBlockDim;
+      for (int part = 0; part < 2; ++part) {  // k = 0..7, then k = 8
+        const int side = side_ij | part;
+        const int count = part == 0 ? kLeafDim : 1;
+        const int n = n0 + (part == 0 ? 0 : kLeafDim);
+        const openvdb::Vec3s* values = values_of[side];
+        const float* floats = floats_of[side];
+        for (int k = 0; k < count; ++k) {
+          const openvdb::Vec3s v = values ? values[first + k] : value_background;
+          block[n + k] = {v.x(), v.y(), v.z(), floats ? floats[first + k] : closeness_background};
+        }
+        if (const auto* mask = over_of[side])
+          for (int k = 0; k < count; ++k)
+            if (mask->isOn(first + openvdb::Index(k)))
+              over[(n + k) >> 6] |= std::uint64_t{1} << ((n + k) & 63);
+      }
+    }
+}
+
+}  // namespace
+
 void makeBlocks(Level& level, bool ratio) {
-  std::vector<const Leaf*> leaves;
+  level.ratio = ratio;
+  std::vector<const Leaf*>& leaves = level.block_leaves;
+  leaves.clear();
   for (auto it = level.grid->tree().cbeginLeaf(); it; ++it) leaves.push_back(&*it);
   level.block_of = IndexGrid::create(-1);
   level.dense.clear();
@@ -61,62 +123,49 @@ void makeBlocks(Level& level, bool ratio) {
       acc.setValueOn(leaves[b]->origin() >> 3, static_cast<int>(b));
   }
   level.nodes.clear();
-  level.nodes.resize(leaves.size() * kBlockNodes);  // every entry written below
+  level.nodes.resize(leaves.size() * kBlockNodes);  // a block's entries written when it is filled
   level.over.assign(leaves.size() * kBlockWords, 0);
   level.refined.assign(leaves.size() * kCellWords, 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
-    auto values = level.grid->getConstAccessor();
-    std::optional<FloatGrid::ConstAccessor> closeness;
-    if (ratio) closeness.emplace(level.closeness->getConstAccessor());
-    const openvdb::Vec3s value_background = level.grid->background();
-    const float closeness_background = ratio ? level.closeness->background() : 0.0f;
-    for (std::size_t b = range.begin(); b != range.end(); ++b) {
-      const Leaf& leaf = *leaves[b];
-      const openvdb::Coord o = leaf.origin();
-      // From the buffers of the leaf and of its +x, +y, +z neighbours (side = which of them:
-      // bit 2 for i = 8, 1 for j = 8, 0 for k = 8), looked up once each; an absent leaf holds
-      // the background (the trees have no active tiles).
-      // Their buffers' data read directly (LeafBuffer's accessors check for out-of-core data
-      // at every value: most of this loop's time).
-      const openvdb::Vec3s* values_of[8];
-      const float* floats_of[8];
-      const openvdb::util::NodeMask<3>* over_of[8];
-      for (int side = 0; side < 8; ++side) {
-        const openvdb::Coord n =
-            o.offsetBy(side & 4 ? kLeafDim : 0, side & 2 ? kLeafDim : 0, side & 1 ? kLeafDim : 0);
-        const Leaf* v = side == 0 ? &leaf : values.probeConstLeaf(n);
-        const FloatLeaf* f = ratio ? closeness->probeConstLeaf(n) : nullptr;
-        values_of[side] = v ? v->buffer().data() : nullptr;
-        floats_of[side] = f ? f->buffer().data() : nullptr;
-        over_of[side] = f ? &f->getValueMask() : nullptr;
-      }
-      std::uint64_t* over = &level.over[b * kBlockWords];
-      std::array<float, 4>* block = &level.nodes[b * kBlockNodes];
-      // A run along k at a time: k = 0..7 from the leaf of (i, j)'s side, k = 8 from the one
-      // above it in z (the per-node side lookup and its branches were most of this loop).
-      for (int i = 0; i < kBlockDim; ++i)
-        for (int j = 0; j < kBlockDim; ++j) {
-          const int side_ij = (i >> 3) << 2 | (j >> 3) << 1;
-          const openvdb::Index first = openvdb::Index(((i & 7) * kLeafDim + (j & 7)) * kLeafDim);
-          const int n0 = (i * kBlockDim + j) * kBlockDim;
-          for (int part = 0; part < 2; ++part) {  // k = 0..7, then k = 8
-            const int side = side_ij | part;
-            const int count = part == 0 ? kLeafDim : 1;
-            const int n = n0 + (part == 0 ? 0 : kLeafDim);
-            const openvdb::Vec3s* values = values_of[side];
-            const float* floats = floats_of[side];
-            for (int k = 0; k < count; ++k) {
-              const openvdb::Vec3s v = values ? values[first + k] : value_background;
-              block[n + k] = {v.x(), v.y(), v.z(), floats ? floats[first + k] : closeness_background};
-            }
-            if (const auto* mask = over_of[side])
-              for (int k = 0; k < count; ++k)
-                if (mask->isOn(first + openvdb::Index(k)))
-                  over[(n + k) >> 6] |= std::uint64_t{1} << ((n + k) & 63);
-          }
-        }
-    }
-  });
+  level.block_state = std::make_unique<std::atomic<std::uint8_t>[]>(leaves.size());
+  for (std::size_t b = 0; b < leaves.size(); ++b)
+    level.block_state[b].store(kBlockEmpty, std::memory_order_relaxed);
+}
+
+void fillBlockOnce(const Level& level, std::size_t b) {
+  std::atomic<std::uint8_t>& state = level.block_state[b];
+  std::uint8_t expected = kBlockEmpty;
+  if (state.compare_exchange_strong(expected, kBlockFilling, std::memory_order_acquire)) {
+    // The trees are not changed once built: probes from their roots (8 a block, no accessor
+    // to register).
+    fillBlock(
+        level, b, [&](const openvdb::Coord& c) { return level.grid->tree().probeConstLeaf(c); },
+        [&](const openvdb::Coord& c) { return level.closeness->tree().probeConstLeaf(c); });
+    state.store(kBlockReady, std::memory_order_release);
+    return;
+  }
+  while (state.load(std::memory_order_acquire) != kBlockReady) std::this_thread::yield();
+}
+
+void fillBlocks(const Level& level) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, level.block_leaves.size()),
+                    [&](const auto& range) {
+                      auto values = level.grid->getConstUnsafeAccessor();
+                      std::optional<FloatGrid::ConstUnsafeAccessor> closeness;
+                      if (level.ratio) closeness.emplace(level.closeness->getConstUnsafeAccessor());
+                      for (std::size_t b = range.begin(); b != range.end(); ++b) {
+                        std::uint8_t expected = kBlockEmpty;
+                        if (!level.block_state[b].compare_exchange_strong(
+                                expected, kBlockFilling, std::memory_order_acquire)) {
+                          ensureBlock(level, b);  // filled, or being filled by a query
+                          continue;
+                        }
+                        fillBlock(
+                            level, b,
+                            [&](const openvdb::Coord& c) { return values.probeConstLeaf(c); },
+                            [&](const openvdb::Coord& c) { return closeness->probeConstLeaf(c); });
+                        level.block_state[b].store(kBlockReady, std::memory_order_release);
+                      }
+                    });
 }
 
 /// The trilinear value of one level's cell (no refinement): F, or for the plane ratio

@@ -4,6 +4,7 @@
 /// of a level and the queries). Includes OpenVDB: never include from a public header.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -178,9 +179,16 @@ struct Level {
   /// compares, one inside costs one load instead of a walk down the tree.
   std::vector<std::int32_t> dense;
   openvdb::Coord dense_lo, dense_dim;
-  UninitVector<std::array<float, 4>> nodes;  ///< per block: value xyz, closeness
-  std::vector<std::uint64_t> over;          ///< per block node: over/under the surface (ratioHolds)
+  /// Blocks are filled when first read (ensureBlock: a query's locate; fillBlocks: all of a
+  /// level, for the refinement's estimate), not when the level is made: `field build` reads
+  /// none (8 of the uniform example's ~65 ms were its blocks: 16 MB of fresh pages, copied),
+  /// a job those its tool reaches. Hence mutable: a const query fills its block once.
+  mutable UninitVector<std::array<float, 4>> nodes;  ///< per block: value xyz, closeness
+  mutable std::vector<std::uint64_t> over;  ///< per block node: over/under the surface (ratioHolds)
   std::vector<std::uint64_t> refined;       ///< per leaf cell: read the next level instead
+  std::vector<const Leaf*> block_leaves;    ///< the leaf of each block
+  std::unique_ptr<std::atomic<std::uint8_t>[]> block_state;  ///< kBlockEmpty, kBlockFilling, kBlockReady
+  bool ratio = false;                                         ///< closeness read into the blocks
 
   std::size_t blocks() const { return nodes.size() / kBlockNodes; }
   std::size_t memUsage() const {
@@ -217,8 +225,18 @@ inline int blockAt(const Level& level, const IndexAccessor& acc, const openvdb::
 }
 
 bool locate(const Level& level, const IndexAccessor& acc, const Vec3& x_mm, CellRef& out);
-/// The block form of a level's grids (Level::nodes, over; refined cleared).
+/// The block form of a level's grids: the index from leaves to blocks, refined cleared, the
+/// blocks (Level::nodes, over) allocated but not filled (ensureBlock, fillBlocks).
 void makeBlocks(Level& level, bool ratio);
+constexpr std::uint8_t kBlockEmpty = 0, kBlockFilling = 1, kBlockReady = 2;
+/// Fills block b unless another thread has or is (then waits for it).
+void fillBlockOnce(const Level& level, std::size_t b);
+/// Block b filled before it is read: one load once it is.
+inline void ensureBlock(const Level& level, std::size_t b) {
+  if (level.block_state[b].load(std::memory_order_acquire) != kBlockReady) fillBlockOnce(level, b);
+}
+/// Every block of the level filled (in parallel).
+void fillBlocks(const Level& level);
 /// The trilinear value of one level's cell (no refinement): F, or for the plane ratio
 /// P(s~)·G~ where ratioHolds, else the blend of the corner forces.
 Vec3 cellValue(const Level& level, const CellRef& cell, const std::optional<PlaneLaw>& law);

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -69,6 +70,40 @@ TEST(Voxel, EqualsDirectAtTheNodes) {
     }
     EXPECT_GT(nonzero, nodes.size() * (stored == StoredQuantity::Force ? 9 : 4) / 10);
   }
+}
+
+TEST(Voxel, BlocksFilledOnFirstReadGiveTheSameFieldFromManyThreads) {
+  // A level's query blocks are filled when a query first reads them (voxel_grid.h ensureBlock),
+  // by whichever thread gets there first while others wait. Four threads reading the same
+  // points in different orders from one fresh field get, bit for bit, what one thread reads
+  // from another fresh field, and what that thread reads again once every block is filled.
+  const FieldParams p;
+  const DirectField direct = cubeField(p);
+  const VoxelField serial(direct, request(0.5)), shared(direct, request(0.5));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-11.0, 11.0);
+  std::vector<Vec3> x(4000);
+  for (Vec3& q : x) q = Vec3(u(rng), u(rng), u(rng));
+  const std::vector<Vec3> first = evaluate(serial, x), again = evaluate(serial, x);
+  std::vector<Vec3> threaded(x.size(), Vec3::Constant(-1.0));
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t)
+    threads.emplace_back([&, t] {
+      for (std::size_t k = 0; k < x.size(); ++k) {
+        const std::size_t i = t % 2 ? x.size() - 1 - k : (k * 7 + std::size_t(t)) % x.size();
+        Vec3 f;
+        shared.evaluate({&x[i], 1}, {&f, 1});
+        if (std::size_t(t) == i % 4) threaded[i] = f;  // each point written by one thread
+      }
+    });
+  for (std::thread& t : threads) t.join();
+  std::size_t nonzero = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    ASSERT_EQ(first[i], again[i]) << i;
+    ASSERT_EQ(first[i], threaded[i]) << i;
+    nonzero += first[i].norm() > 0.0;
+  }
+  EXPECT_GT(nonzero, x.size() / 4);
 }
 
 TEST(Voxel, SparseBandAndEstimate) {
@@ -493,6 +528,9 @@ TEST(VoxelRefinement, RefiningAUniformLevelZeroIsTheRefinedBuild) {
   const VoxelField at_once(direct, r);
   VoxelField uniform(direct, levelZeroRequest(r, p.r_min_mm));
   EXPECT_EQ(uniform.stats().levels, 1);
+  // The job has read some of its blocks (filled then), not all: the refinement fills the rest.
+  const std::vector<Vec3> read = {Vec3(0, 0, 6), Vec3(6, 0, 0), Vec3(0, -7, 0)};
+  EXPECT_GT(evaluate(uniform, read)[0].norm(), 0.0);
   const VoxelField from_uniform(direct, r, std::move(uniform));
   const std::vector<StoredNode> a = at_once.storedNodes(), b = from_uniform.storedNodes();
   ASSERT_EQ(a.size(), b.size());
