@@ -251,10 +251,14 @@ void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, co
   // Rounds: every pending node's value from the sums it has; those that ask for one more wait
   // for the round's requests, answered 8 at a time (in brick order: neighbours' lifted points
   // lie together).
-  std::vector<SumRequest>& requests = scratch.requests;
+  // The tracked sums and the untracked ones (the surface rule's lifted point) apart: a batch
+  // with none tracked skips the nearest (laneSums).
+  std::vector<SumRequest>& tracked = scratch.requests[0];
+  std::vector<SumRequest>& untracked = scratch.requests[1];
   std::vector<int>& next = scratch.next;
   while (!pending.empty()) {
-    requests.clear();
+    tracked.clear();
+    untracked.clear();
     next.clear();
     for (const int node : pending) {
       const D3 x{(task.origin[0] + (node >> 6)) * h, (task.origin[1] + ((node >> 3) & 7)) * h,
@@ -271,10 +275,10 @@ void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, co
         throw std::logic_error("voxel block build: a node asked for more than " +
                                std::to_string(kMaxNodeSums) + " sums");
       request.node = node;
-      requests.push_back(request);
+      (request.track ? tracked : untracked).push_back(request);
       next.push_back(node);
     }
-    if (requests.empty()) break;
+    if (next.empty()) break;
     // The samples the round's points reach: the leaf's where they lie within its box (points
     // lifted less than √3·h off the leaf), gathered from the cell list otherwise.
     double lo[3], hi[3];
@@ -282,18 +286,20 @@ void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, co
       lo[a] = HUGE_VAL;
       hi[a] = -HUGE_VAL;
     }
-    for (const SumRequest& q : requests)
-      for (int a = 0; a < 3; ++a) {
-        lo[a] = std::min(lo[a], q.at[a] - q.reach());
-        hi[a] = std::max(hi[a], q.at[a] + q.reach());
-      }
+    for (const std::vector<SumRequest>& requests : scratch.requests)
+      for (const SumRequest& q : requests)
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = std::min(lo[a], q.at[a] - q.reach());
+          hi[a] = std::max(hi[a], q.at[a] + q.reach());
+        }
     bool inside = true;
     for (int a = 0; a < 3; ++a) inside = inside && lo[a] >= box_lo[a] && hi[a] <= box_hi[a];
     if (!inside) gatherBox(cells, lo, hi, scratch.lifted);
     const SampleSpan from = inside ? block_span : scratch.lifted.span();
-    for (std::size_t b = 0; b < requests.size(); b += kLanes)
-      answerBatch(job.law, from, &requests[b],
-                  int(std::min<std::size_t>(kLanes, requests.size() - b)), scratch);
+    for (const std::vector<SumRequest>& requests : scratch.requests)
+      for (std::size_t b = 0; b < requests.size(); b += kLanes)
+        answerBatch(job.law, from, &requests[b],
+                    int(std::min<std::size_t>(kLanes, requests.size() - b)), scratch);
     std::swap(pending, next);
   }
 }

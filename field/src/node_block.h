@@ -86,7 +86,7 @@ struct BlockScratch {
   lanes::Picks core, ring;
   std::vector<kernel::Accum> answers;        ///< node · kMaxNodeSums + k
   std::array<std::uint8_t, 512> answered{};  ///< sums answered per node
-  std::vector<SumRequest> requests;
+  std::array<std::vector<SumRequest>, 2> requests;  ///< a round's tracked, untracked sums
   std::vector<int> pending, next;
 };
 
