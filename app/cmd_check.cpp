@@ -40,11 +40,16 @@ namespace {
 using nlohmann::json;
 
 /// Per posture: block, clearance and the lower bound of the motion to the next one.
+/// clearance.csv: a row a posture; the last two columns say where the links or the holder touch
+/// the part (1 / 0; empty when the scene has no part), at the posture and on the motion to the
+/// next (`view --check` colours them).
 std::string clearanceCsv(const geometry::PathFile& path, const pathgen::ClearanceResult& c,
-                         const pathgen::MotionResult& m) {
+                         const pathgen::MotionResult& m,
+                         const std::optional<pathgen::PartContacts::Marks>& part) {
   std::ostringstream csv;
   csv.precision(9);
-  csv << "posture,block,pass,clearance_mm,motion_to_next_mm,limited\n";
+  csv << "posture,block,pass,clearance_mm,motion_to_next_mm,limited,part_contact,"
+         "part_contact_to_next\n";
   std::size_t pass = 0, next_limited = 0;
   for (const geometry::PathBlock& block : path.blocks) {
     const bool is_pass = block.kind == geometry::PathBlock::Kind::Pass;
@@ -56,7 +61,11 @@ std::string clearanceCsv(const geometry::PathFile& path, const pathgen::Clearanc
       if (is_pass) csv << pass;
       csv << ',' << common::csvNumber(c.clearance_mm[i]) << ',';
       if (i < m.clearance_mm.size()) csv << common::csvNumber(m.clearance_mm[i]);
-      csv << ',' << (limited ? 1 : 0) << '\n';
+      csv << ',' << (limited ? 1 : 0) << ',';
+      if (part) csv << int(part->posture[i]);
+      csv << ',';
+      if (part && i + 1 < path.postures.size()) csv << int(part->motion[i]);
+      csv << '\n';
     }
   }
   return csv.str();
@@ -222,7 +231,9 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         zbuffer::writeHeightsJson(out / "deviation.json", surface->grid);
         writeDeviationPng(out / "deviation.png", *surface);
       }
-      common::writeTextAtomically(out / "clearance.csv", clearanceCsv(path, clearance, motions));
+      common::writeTextAtomically(out / "clearance.csv", clearanceCsv(path, clearance, motions,
+                                                   scene.part ? std::optional(contacts.marks(path.postures.size()))
+                                                              : std::nullopt));
       common::writeTextAtomically(out / "check.json", jsonText(report));
     }
     // Postures numbered from 0 in the file's order, as clearance.csv, check.json and view's

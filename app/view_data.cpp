@@ -357,7 +357,8 @@ ViewData gatherView(const ViewRequest& request) {
         throw InputError("--check " + request.check_dir.string() + ": " + p.what +
                          " has changed since it was checked (check.json's path_digest differs): "
                          "run `fieldpath check` on it again");
-      readClearanceCsv(request.check_dir / "clearance.csv", n, p.clearance_mm, p.motion_mm);
+      readClearanceCsv(request.check_dir / "clearance.csv", n, p.clearance_mm, p.motion_mm,
+                       p.part_contact, p.part_contact_to_next);
       p.clearance_source = "check.json of " + request.check_dir.string();
       p.clearance_known = true;
     } else if (scene.obstacles.empty()) {
@@ -387,11 +388,14 @@ ViewData gatherView(const ViewRequest& request) {
       p.clearance_source =
           "computed here, as `fieldpath check` computes it (FCL, postures and motions)";
       check = CheckJson{n, c.colliding, m.colliding, p.what};
-      // The part's contacts (the links', the holder's), as `check` finds them: not coloured on
-      // the page (its colours are the obstacles'), said above it.
+      // The part's contacts (the links', the holder's), as `check` finds them: marked on the
+      // page apart from the obstacles' and said above it.
       if (scene.part) {
         pathgen::PartContacts contacts =
             pathgen::checkAgainstPart(scene.tool, scene.holder, *scene.part, p.file);
+        pathgen::PartContacts::Marks marks = contacts.marks(n);
+        p.part_contact = std::move(marks.posture);
+        p.part_contact_to_next = std::move(marks.motion);
         check->link_part = std::move(contacts.links);
         check->holder_part = std::move(contacts.holder);
       }

@@ -4,6 +4,7 @@
 /// `check` computes it), tilt and lead (in the frames of the scene's passes), and a simulated
 /// surface (a `check` or `simulate` folder). view_page.h turns this into the page.
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <limits>
 #include <optional>
@@ -34,6 +35,9 @@ struct ViewPath {
   std::string what;  ///< where it came from, for the page ("path.cl", "the scene's path.nominal")
   std::vector<double> clearance_mm;  ///< tool + holder ↔ obstacles, as `check` (0: colliding)
   std::vector<double> motion_mm;     ///< lower bound along the motion to the next posture
+  /// 1 where the links or the holder touch the part (check's link_part, holder_part) at the
+  /// posture / on the motion to the next; empty when not known (no part, an older check folder).
+  std::vector<std::uint8_t> part_contact, part_contact_to_next;
   std::vector<double> s_mm;          ///< ball-centre arc length from the start of its pass block
   std::vector<double> tilt_deg, lead_deg;  ///< in the frame of the nearest pass station
   std::vector<int> pass;                   ///< 1-based pass block, 0 for link postures
@@ -95,9 +99,13 @@ struct ViewRequest {
 ViewData gatherView(const ViewRequest& request);
 
 /// `check`'s clearance.csv of `postures` postures: clearance_mm and motion_to_next_mm per
-/// posture (NaN for the last motion). Throws common::InputError naming the file and line.
+/// posture (NaN for the last motion), and where its last two columns are filled (a scene with a
+/// part; older files have neither column) the part contacts (ViewPath::part_contact, left empty
+/// otherwise). Throws common::InputError naming the file and line.
 void readClearanceCsv(const std::filesystem::path& file, std::size_t postures,
-                      std::vector<double>& clearance_mm, std::vector<double>& motion_mm);
+                      std::vector<double>& clearance_mm, std::vector<double>& motion_mm,
+                      std::vector<std::uint8_t>& part_contact,
+                      std::vector<std::uint8_t>& part_contact_to_next);
 
 /// A NumPy file of float32 ('<f4'), C order, shape (ny, nx) as `check` and `simulate` write
 /// heights and deviations. The size is checked against the file before anything is allocated.

@@ -261,17 +261,35 @@ ViewSurface readSurface(const fs::path& dir, const Scene& scene, std::size_t max
 // ------------------------------------------------------------------------------ readers
 
 void readClearanceCsv(const fs::path& file, std::size_t postures, std::vector<double>& clearance_mm,
-                      std::vector<double>& motion_mm) {
+                      std::vector<double>& motion_mm, std::vector<std::uint8_t>& part_contact,
+                      std::vector<std::uint8_t>& part_contact_to_next) {
   if (!fs::exists(file))
     throw InputError(file.string() + ": missing (the check folder has check.json without it)");
   std::ifstream in(file);
   if (!in) throw InputError(file.string() + ": cannot be read");
   std::string line;
+  // The part's columns came later: a check folder written before them has 6 cells a row.
   const std::string header = "posture,block,pass,clearance_mm,motion_to_next_mm,limited";
-  if (!std::getline(in, line) || line != header)
-    throw InputError(file.string() + ":1: expected the header '" + header + "'");
+  const std::string part_columns = ",part_contact,part_contact_to_next";
+  if (!std::getline(in, line) || (line != header && line != header + part_columns))
+    throw InputError(file.string() + ":1: expected the header '" + header + part_columns + "'");
+  const std::size_t cell_count = line == header ? 6 : 8;
   clearance_mm.assign(postures, kNaN);
   motion_mm.assign(postures, kNaN);
+  part_contact.assign(postures, 0);
+  part_contact_to_next.assign(postures, 0);
+  bool part_known = cell_count == 8;
+  // A part-contact cell: 0 or 1, or empty for all rows (the scene has no part).
+  auto flag = [&](std::string_view cell, std::size_t number, std::uint8_t& out) {
+    if (cell.empty()) {
+      part_known = false;
+      return;
+    }
+    if (cell != "0" && cell != "1")
+      throw InputError(file.string() + ":" + std::to_string(number) + ": a part contact of '" +
+                       std::string(cell) + "' (0 or 1)");
+    out = cell == "1";
+  };
   std::size_t row = 0, number = 1;
   while (std::getline(in, line)) {
     ++number;
@@ -283,8 +301,9 @@ void readClearanceCsv(const fs::path& file, std::size_t postures, std::vector<do
       rest.remove_prefix(comma + 1);
     }
     cells.push_back(rest);
-    if (cells.size() != 6)
-      throw InputError(file.string() + ":" + std::to_string(number) + ": expected 6 cells");
+    if (cells.size() != cell_count)
+      throw InputError(file.string() + ":" + std::to_string(number) + ": expected " +
+                       std::to_string(cell_count) + " cells");
     if (row >= postures)
       throw InputError(file.string() + ":" + std::to_string(number) + ": more rows than the " +
                        std::to_string(postures) + " postures of the path");
@@ -293,7 +312,15 @@ void readClearanceCsv(const fs::path& file, std::size_t postures, std::vector<do
                        std::string(cells[0]) + " where " + std::to_string(row) + " was expected");
     clearance_mm[row] = parseCell(cells[3], file, number, false);
     motion_mm[row] = parseCell(cells[4], file, number, true);
+    if (cell_count == 8) {
+      flag(cells[6], number, part_contact[row]);
+      if (row + 1 < postures) flag(cells[7], number, part_contact_to_next[row]);
+    }
     ++row;
+  }
+  if (!part_known) {
+    part_contact.clear();
+    part_contact_to_next.clear();
   }
   if (row != postures)
     throw InputError(file.string() + ": " + std::to_string(row) + " rows for a path of " +

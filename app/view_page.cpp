@@ -26,7 +26,7 @@ using nlohmann::json;
 
 // Bits of the page's per-posture flags (view.js reads the same).
 constexpr std::uint8_t kLink = 1, kLimited = 2, kColliding = 4, kMotionColliding = 8,
-                       kBlockStart = 16;
+                       kBlockStart = 16, kPartContact = 32, kMotionPartContact = 64;
 
 /// The page's binary data: typed arrays, each 4-byte aligned, referenced from the JSON block as
 /// {type, offset, count}.
@@ -191,6 +191,14 @@ json pathJson(const ViewData& d, std::size_t max_postures, Blob& blob, std::size
   for (std::size_t i = 0; i < n; ++i) {
     if (p.clearance_mm[i] <= 0.0) flags[i] |= kColliding;
     if (p.motion_mm[i] <= 0.0) flags[i] |= kMotionColliding;
+    if (i < p.part_contact.size() && p.part_contact[i]) flags[i] |= kPartContact;
+    if (i < p.part_contact_to_next.size() && p.part_contact_to_next[i])
+      flags[i] |= kMotionPartContact;
+  }
+  std::size_t part_postures = 0, part_motions = 0;
+  for (std::uint8_t f : flags) {
+    part_postures += (f & kPartContact) != 0;
+    part_motions += (f & kMotionPartContact) != 0;
   }
   // The slider's postures: every k-th, and always the flagged ones, both ends of a colliding
   // motion and the first and last of each block.
@@ -199,7 +207,7 @@ json pathJson(const ViewData& d, std::size_t max_postures, Blob& blob, std::size
   std::vector<std::size_t> shown;
   for (std::size_t i = 0; i < n; ++i) {
     const bool keep = i % stride == 0 || i + 1 == n || (flags[i] & ~kLink) ||
-                      (i > 0 && (flags[i - 1] & kMotionColliding)) ||
+                      (i > 0 && (flags[i - 1] & (kMotionColliding | kMotionPartContact))) ||
                       (i + 1 < n && (flags[i + 1] & kBlockStart));
     if (keep) shown.push_back(i);
   }
@@ -241,6 +249,9 @@ json pathJson(const ViewData& d, std::size_t max_postures, Blob& blob, std::size
         {"motions_under_required", p.motions_under_required},
         {"limited", p.file.limited.size()},
         {"limited_colliding", p.limited_colliding},
+        // null: not known (no part, or a check folder written before clearance.csv had them)
+        {"part_contact_postures", p.part_contact.empty() ? json() : json(part_postures)},
+        {"part_contact_motions", p.part_contact.empty() ? json() : json(part_motions)},
         {"outside", p.outside}}},
       {"tip", blob.add(tip)},
       {"axis", blob.add(axis)},

@@ -213,7 +213,9 @@
       return c;
     };
   }
-  var F_LINK = 1, F_LIMITED = 2, F_COLLIDING = 4, F_MOTION_COLLIDING = 8, F_BLOCK_START = 16;
+  var F_LINK = 1, F_LIMITED = 2, F_COLLIDING = 4, F_MOTION_COLLIDING = 8, F_BLOCK_START = 16,
+      F_PART = 32, F_MOTION_PART = 64;  // a link or the holder touching the part (not an obstacle)
+  var PART_COLOUR = 0xe040fb;
   var colourModes = {};
   if (P) {
     var range = function (values) {
@@ -241,11 +243,12 @@
   var passLine = null, passDots = null, linkLine = null, markGroup = null;
   function sameBlock(j) { return !(P.flags[j + 1] & F_BLOCK_START); }
   function buildPath() {
-    var pass = [], link = [], hit = [];
+    var pass = [], link = [], hit = [], partHit = [];
     for (var j = 0; j + 1 < P.n; ++j) {
       var isPass = sameBlock(j) && !(P.flags[j] & F_LINK);
       (isPass ? pass : link).push(j);
       if ((P.flags[j] & F_MOTION_COLLIDING) && P.index[j + 1] === P.index[j] + 1) hit.push(j);
+      if ((P.flags[j] & F_MOTION_PART) && P.index[j + 1] === P.index[j] + 1) partHit.push(j);
     }
     function segments(list) {
       var pos = new Float32Array(6 * list.length);
@@ -299,12 +302,14 @@
     }
     points(F_LIMITED, 0xff9f1c, 7);
     points(F_COLLIDING, 0xff2a1a, 6);
-    if (hit.length) {
-      var motionLines = new THREE.LineSegments(segments(hit),
-          new THREE.LineBasicMaterial({ color: 0xff2a1a, depthTest: false }));
+    points(F_PART, PART_COLOUR, 6);
+    [[hit, 0xff2a1a], [partHit, PART_COLOUR]].forEach(function (h) {
+      if (!h[0].length) return;
+      var motionLines = new THREE.LineSegments(segments(h[0]),
+          new THREE.LineBasicMaterial({ color: h[1], depthTest: false }));
       motionLines.renderOrder = 9;
       markGroup.add(motionLines);
-    }
+    });
     scene.add(markGroup);
     layers.marks = { object: markGroup, label: 'collisions, limits', count: '' };
   }
@@ -535,6 +540,9 @@
       ['passes / links', c.passes + ' / ' + c.links],
       ['colliding postures', P.count(F_COLLIDING)], ['colliding motions', P.count(F_MOTION_COLLIDING)],
       ['angle limit held', P.count(F_LIMITED)]];
+    if (c.part_contact_postures !== null && c.part_contact_postures !== undefined)
+      rows.push(['touching the part (links, holder)', P.count(F_PART) + ' postures, ' +
+                 P.count(F_MOTION_PART) + ' motions']);
     rows.forEach(function (r) { el('div', {}, side, r[0] + ': ' + r[1]); });
     el('div', { class: 'sub' }, side, 'clearance: ' + path.clearance_source);
     el('div', { class: 'sub' }, side, 'tilt, lead: ' + path.angles_source);
@@ -576,8 +584,11 @@
       legend('path: ' + mode.title, mode.lo, mode.hi, mode.map, '', 'fp-legend-path');
     if (P && layers.marks.object.visible) {
       var marks = el('div', { class: 'fp-legend fp-marks', id: 'fp-legend-marks' }, legends);
-      [['#ff2a1a', 'colliding posture / motion'], ['#ff9f1c', 'angle limit held'],
-       ['#b8c0cc', 'link (dashed)']].forEach(function (m) {
+      var kinds = [['#ff2a1a', 'colliding posture / motion'], ['#ff9f1c', 'angle limit held'],
+                   ['#b8c0cc', 'link (dashed)']];
+      if (P.count(F_PART) + P.count(F_MOTION_PART) > 0)
+        kinds.splice(1, 0, ['#e040fb', 'link / holder touching the part']);
+      kinds.forEach(function (m) {
         var row = el('div', {}, marks);
         el('span', { style: 'background:' + m[0] }, row);
         row.appendChild(document.createTextNode(m[1]));
@@ -653,6 +664,7 @@
               line: P.line[j], s_mm: num(P.s[j]), tilt_deg: num(P.tilt[j]), lead_deg: num(P.lead[j]),
               clearance_mm: num(c), motion_to_next_mm: num(P.motion[j]),
               colliding: !!(f & F_COLLIDING), motion_colliding: !!(f & F_MOTION_COLLIDING),
+              part_contact: !!(f & F_PART), motion_part_contact: !!(f & F_MOTION_PART),
               limited: !!(f & F_LIMITED),
               tip_mm: [P.tip[3 * j], P.tip[3 * j + 1], P.tip[3 * j + 2]],
               axis: [P.axis[3 * j], P.axis[3 * j + 1], P.axis[3 * j + 2]] };
@@ -665,7 +677,7 @@
     slider.value = current;
     placeTool(current);
     var o = postureInfo(current);
-    tool.material.emissive.setHex(o.colliding ? 0xaa1100 : 0x000000);
+    tool.material.emissive.setHex(o.colliding || o.part_contact ? 0xaa1100 : 0x000000);
     posLabel.textContent = (o.index + 1) + ' / ' + path.counts.postures;
     var rows = [
       ['posture', o.index + ' (' + (path.rows ? 'row ' : 'line ') + o.line + ')'],
@@ -674,11 +686,13 @@
       ['lead', fmt(o.lead_deg, 2) + '\u00b0'],
       ['clearance', fmt(o.clearance_mm, 3) + ' mm', o.colliding ? 'bad' :
                     o.clearance_mm !== null && o.clearance_mm < path.required_mm ? 'warn' : ''],
-      ['to next', fmt(o.motion_to_next_mm, 3) + ' mm', o.motion_colliding ? 'bad' : ''],
+      ['to next', fmt(o.motion_to_next_mm, 3) + ' mm' + (o.motion_part_contact ? ' (part)' : ''),
+       o.motion_colliding || o.motion_part_contact ? 'bad' : ''],
       ['tip', o.tip_mm.map(function (v) { return fmt(v, 2); }).join(' ') + ' mm'],
       ['axis', o.axis.map(function (v) { return fmt(v, 3); }).join(' ')]];
     // One status row always: the panel keeps its size from posture to posture.
     rows.push(o.colliding ? ['', o.limited ? 'COLLIDING, limit held' : 'COLLIDING', 'bad']
+              : o.part_contact ? ['', 'PART CONTACT (' + (o.block === 'link' ? 'link' : 'holder') + ')', 'bad']
               : o.limited ? ['', 'angle limit held', 'warn'] : ['', '\u00a0']);
     info.textContent = '';
     var table = el('table', { id: 'fp-posture' }, info);
@@ -757,6 +771,8 @@
       state.shown_postures = P.n;
       state.colliding_postures = P.count(F_COLLIDING);
       state.colliding_motions = P.count(F_MOTION_COLLIDING);
+      state.part_contact_postures = P.count(F_PART);
+      state.part_contact_motions = P.count(F_MOTION_PART);
       state.limited_postures = P.count(F_LIMITED);
       state.tool_box = tool.visible ? screenBox(tool) : null;
       if ('probe' in hash) {  // the tool's screen box at the first posture and at another

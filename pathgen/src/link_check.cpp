@@ -23,6 +23,23 @@ void checkGrazingMove(const GrazingChecker& grazing, const geometry::Posture& a,
   if (m.colliding) {
     ++out.colliding_motions;
     out.first_colliding_motion = std::min(out.first_colliding_motion, index);
+    out.motion_contacts.push_back(index);
+  }
+}
+
+/// The colliding entries of `clearance_mm` (per posture or per motion, d <= 0 as the checker
+/// counts them), as path indices from `first`, appended to `to`.
+void addContacts(const std::vector<double>& clearance_mm, std::size_t first,
+                 std::vector<std::size_t>& to) {
+  for (std::size_t k = 0; k < clearance_mm.size(); ++k)
+    if (clearance_mm[k] <= 0.0) to.push_back(first + k);
+}
+
+/// The contact lists ascending, each index once (a grazing move can also be a link's motion).
+void sortContacts(LinkPartResult& out) {
+  for (std::vector<std::size_t>* list : {&out.posture_contacts, &out.motion_contacts}) {
+    std::sort(list->begin(), list->end());
+    list->erase(std::unique(list->begin(), list->end()), list->end());
   }
 }
 
@@ -72,6 +89,7 @@ LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part,
     out.colliding_postures += c.colliding;
     if (c.colliding && out.first_colliding_posture == LinkPartResult::npos)
       out.first_colliding_posture = block.begin + c.first_colliding;
+    addContacts(c.clearance_mm, block.begin, out.posture_contacts);
     if (block.size() < 2) continue;
     MotionRequest request;  // touching is what counts here: required 0
     request.posture_clearance_mm = c.clearance_mm;
@@ -82,7 +100,9 @@ LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part,
     if (m.colliding)
       out.first_colliding_motion =
           std::min(out.first_colliding_motion, block.begin + m.first_colliding);
+    addContacts(m.clearance_mm, block.begin, out.motion_contacts);
   }
+  sortContacts(out);
   return out;
 }
 
@@ -106,6 +126,8 @@ std::optional<LinkPartResult> checkHolderAgainstPart(const geometry::ToolSpec& t
   out.min_clearance_mm = std::min(out.min_clearance_mm, m.min_clearance_mm);
   out.colliding_motions = m.colliding;
   out.first_colliding_motion = m.first_colliding;
+  addContacts(c.clearance_mm, 0, out.posture_contacts);
+  addContacts(m.clearance_mm, 0, out.motion_contacts);
   return out;
 }
 
@@ -118,6 +140,18 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
     out.links = checkLinksAgainstPart(whole, grazingPartChecker(tool, holder, part), path);
   }
   out.holder = checkHolderAgainstPart(tool, holder, part, path.postures);
+  return out;
+}
+
+PartContacts::Marks PartContacts::marks(std::size_t n) const {
+  Marks out{std::vector<std::uint8_t>(n, 0), std::vector<std::uint8_t>(n, 0)};
+  for (const std::optional<LinkPartResult>* r : {&links, &holder}) {
+    if (!*r) continue;
+    for (std::size_t i : (*r)->posture_contacts)
+      if (i < n) out.posture[i] = 1;
+    for (std::size_t i : (*r)->motion_contacts)
+      if (i < n) out.motion[i] = 1;
+  }
   return out;
 }
 

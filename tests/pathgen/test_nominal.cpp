@@ -1,6 +1,7 @@
 /// Passes from a nominal path file: pass breaks (markers, blank lines, gaps, APT RAPID), frames at
 /// degenerate postures, marked path files read back bit for bit, links, and motions checked
 /// between clear postures.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -380,6 +381,9 @@ TEST(Links, ALinkThroughThePartIsReportedAndThePassContactIsNot) {
   EXPECT_EQ(through.colliding_motions, 1u);
   EXPECT_EQ(through.first_colliding_motion, 3u);
   EXPECT_TRUE(through.collides());
+  // The contacts one by one (what view colours, clearance.csv marks), as the counts say.
+  EXPECT_TRUE(through.posture_contacts.empty());
+  EXPECT_EQ(through.motion_contacts, std::vector<std::size_t>{3});
   // Over the block (the tool's tip 2 mm above its top) the same link is clear.
   path.postures[3] = posture(10, 6);
   path.postures[4] = posture(40, 6);
@@ -405,6 +409,7 @@ TEST(Links, ALinkThroughThePartIsReportedAndThePassContactIsNot) {
     EXPECT_EQ(out.colliding_postures, 0u) << lean;
     EXPECT_EQ(out.colliding_motions, lean > 0 ? 1u : 0u) << lean;
     if (lean > 0) EXPECT_EQ(out.first_colliding_motion, 2u);  // posture 2 (the pass's end) to 3
+    EXPECT_EQ(out.motion_contacts, lean > 0 ? std::vector<std::size_t>{2} : std::vector<std::size_t>{});
   }
   // A pass finishing the floor along a wall of the part, the ball tangent to both: its retract
   // and plunge along the axis slide up the wall, tangent to it all the way: not a collision.
@@ -443,9 +448,20 @@ TEST(Links, TheHolderIntoThePartIsReportedAtEveryPostureAndMotion) {
   EXPECT_EQ(into->colliding_postures, 21u);
   EXPECT_EQ(into->colliding_motions, 20u);
   EXPECT_EQ(into->first_colliding_posture, 0u);
+  ASSERT_EQ(into->posture_contacts.size(), 21u);
+  ASSERT_EQ(into->motion_contacts.size(), 20u);
+  for (std::size_t i = 0; i < 21; ++i) EXPECT_EQ(into->posture_contacts[i], i);
+  for (std::size_t i = 0; i < 20; ++i) EXPECT_EQ(into->motion_contacts[i], i);
+  // The marks of a path: both lists as one flag a posture (this pass is the whole path).
+  const PartContacts contacts{std::nullopt, into};
+  const PartContacts::Marks marks = contacts.marks(21);
+  EXPECT_EQ(std::count(marks.posture.begin(), marks.posture.end(), 1), 21);
+  EXPECT_EQ(std::count(marks.motion.begin(), marks.motion.end(), 1), 20);
+  EXPECT_EQ(marks.motion[20], 0);  // no motion after the last posture
   const auto clear = checkHolderAgainstPart(tool, holder, part, pass(-5.0));
   ASSERT_TRUE(clear.has_value());
   EXPECT_FALSE(clear->collides());
+  EXPECT_TRUE(clear->posture_contacts.empty() && clear->motion_contacts.empty());
   EXPECT_NEAR(clear->min_clearance_mm, 1.0 - 0.02, 0.03);
   EXPECT_FALSE(checkHolderAgainstPart(tool, {}, part, pass(0.0)).has_value());
   // The tip resting on the top of a closed part: the holder 40 mm above it is clear (the tip was

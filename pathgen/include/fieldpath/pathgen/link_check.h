@@ -4,9 +4,11 @@
 /// for every posture and motion by ClearanceChecker; the part is not an obstacle (the ball cuts
 /// it during a pass), so the links are checked against it here.
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <span>
+#include <vector>
 
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/tool.h"
@@ -24,6 +26,9 @@ struct LinkPartResult {
   std::size_t first_colliding_motion = npos;   ///< motion i: posture i → i + 1
   /// Lower bound of tool + holder ↔ part over the checked postures and motions, mm.
   double min_clearance_mm = std::numeric_limits<double>::infinity();
+  /// Every colliding posture and motion (path indices, ascending): what `view` colours and
+  /// `check`'s clearance.csv marks.
+  std::vector<std::size_t> posture_contacts, motion_contacts;
   bool collides() const { return colliding_postures + colliding_motions > 0; }
 };
 
@@ -68,6 +73,12 @@ std::optional<LinkPartResult> checkHolderAgainstPart(const geometry::ToolSpec& t
 /// there is one); each nullopt when not checked.
 struct PartContacts {
   std::optional<LinkPartResult> links, holder;
+  /// Per posture of a path of n: 1 where the links or the holder touch the part there (posture)
+  /// or on the motion to the next (motion), from both results' contact lists.
+  struct Marks {
+    std::vector<std::uint8_t> posture, motion;
+  };
+  Marks marks(std::size_t n) const;
 };
 PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
                               const geometry::TriangleMesh& part, const geometry::PathFile& path);
