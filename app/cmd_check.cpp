@@ -143,7 +143,11 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       throw InputError(scene.file.string() + ": tool: missing: check needs the cutter (`tool: { "
                                              "shape: ball, radius: R, length: L }`)");
     if (scene.tool.shape != geometry::ToolShape::Ball)
-      throw InputError(scene.file.string() + ": tool.shape: check is for ball-end mills");
+      throw InputError(
+          scene.file.string() +
+          (scene.tool_shape_line > 0 ? ":" + std::to_string(scene.tool_shape_line) : "") +
+          ": tool.shape: check is for ball-end mills (its surface check models the ball's "
+          "cut; `simulate --tool torus:R:r` or `flat:R` cuts with the others)");
     const std::vector<std::string> tool_notes = cutterNotes(scene.tool, path);
 
     // (a) exact clearance of postures and motions

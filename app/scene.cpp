@@ -396,6 +396,8 @@ Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
   if (root["tool"]) {
     readTool(r, root["tool"], scene.tool);
     scene.tool_given = true;
+    if (root["tool"]["shape"].Mark().line >= 0)
+      scene.tool_shape_line = root["tool"]["shape"].Mark().line + 1;
   }
   if (root["holder"]) readHolder(r, root["holder"], scene.holder);
   if (root["clearance"])

@@ -41,6 +41,7 @@ struct Scene {
 
   geometry::ToolSpec tool;            ///< `tool:`
   bool tool_given = false;            ///< `tool:` is in the file (generate and check need it)
+  int tool_shape_line = 0;            ///< 1-based line of `tool.shape` (0: not known)
   geometry::HolderProfile holder;     ///< `holder:` [[z, radius], ...]
   double clearance_mm = 0.5;          ///< `clearance:` tool+holder ↔ obstacles, mm
   field::FieldParams field;           ///< `field:`

@@ -207,6 +207,10 @@ TEST_F(MeshJob, BadNominalPathsAndMeshesAreOneLineErrorsWithNoOutputs) {
        "empty.stl"},
       {"obstacles:\n  - mesh: blades.stl\npart: nothere.stl\npath: { nominal: nominal.cl }\n",
        "nothere.stl"},
+      // A torus: the passes are a ball's (the line of `shape` named).
+      {"obstacles:\n  - mesh: blades.stl\ntool:\n  shape: torus\n  radius: 3\n"
+       "  corner_radius: 1\npath: { nominal: nominal.cl }\n",
+       "bad.yaml:4: tool.shape: the passes are for a ball-end mill"},
   };
   for (const Case& c : cases) {
     dir_->write("bad.yaml", c.scene);
@@ -218,6 +222,12 @@ TEST_F(MeshJob, BadNominalPathsAndMeshesAreOneLineErrorsWithNoOutputs) {
     EXPECT_NE(output.find(c.expected), std::string::npos) << output;
     EXPECT_FALSE(fs::exists(dir_->path() / "bad_out")) << c.expected;
   }
+  // check refuses it too, at the same line.
+  const auto r = test::runFieldpath(*dir_, "check bad.yaml --path nominal.cl --out bad_out");
+  EXPECT_EQ(r.exit_code, 1) << r.output();
+  EXPECT_NE(r.err.find("bad.yaml:4: tool.shape: check is for ball-end mills"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir_->path() / "bad_out"));
 }
 
 // A stiff scene whose tilt runs into max_lead_deg: with on_limit clamp (the default) a path and
