@@ -149,6 +149,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
           ": tool.shape: check is for ball-end mills (its surface check models the ball's "
           "cut; `simulate --tool torus:R:r` or `flat:R` cuts with the others)");
     const std::vector<std::string> tool_notes = cutterNotes(scene.tool, path);
+    const geometry::AxisTurn axis_turn = geometry::largestAxisTurn(path, scene.tool.radius_mm);
 
     // (a) exact clearance of postures and motions
     const geometry::TriangleMesh tool_mesh =
@@ -219,6 +220,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
          holder_part ? json(nullptr) : json("no `part` or no `holder` in the scene")},
         {"unsafe", unsafeReasons(clearance, motions, link_part, holder_part)},
         {"tool_notes", tool_notes},
+        {"axis_turn", axisTurnJson(axis_turn)},
         {"limits",
          {{"limited_postures", path.limited.size()},
           {"limited_colliding", limited_colliding},
@@ -278,6 +280,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     else
       std::printf("surface: not checked (%s)\n", surface_skipped);
     for (const std::string& note : tool_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
+    if (const std::string turn = axisTurnWarning(path, axis_turn); !turn.empty())
+      std::fprintf(stderr, "warning: %s (check.json axis_turn)\n", turn.c_str());
     if (surface && surface->coarsened)
       std::fprintf(stderr,
                    "note: --spacing %g mm would make more Z-buffer lines than a check takes: "

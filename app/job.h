@@ -1,6 +1,7 @@
 #pragma once
 /// The job of a scene, shared by `generate`, `study` and the benchmark (defined in job.cpp), and
 /// the JSON blocks that `generate` and `check` both write.
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <vector>
@@ -105,6 +106,33 @@ inline nlohmann::json holderPartJson(const std::optional<pathgen::LinkPartResult
       *h, "postures", "motions",
       "the holder (the stations above the tool: it never cuts) against the part mesh at every "
       "posture and motion, passes and links (as `motions`, required 0)");
+}
+
+/// The path's largest axis turn between two postures of a pass (geometry::largestAxisTurn), for
+/// report.json and check.json: deg, the first posture (null: no pass of two), ball-centre step.
+inline nlohmann::json axisTurnJson(const geometry::AxisTurn& t) {
+  return {{"max_deg", t.deg},
+          {"posture", jsonIndex(t.at)},
+          {"step_mm", t.step_mm},
+          {"note_above_deg", geometry::kNoteAxisTurnDeg}};
+}
+
+/// The warning for a turn over kNoteAxisTurnDeg (empty otherwise), postures numbered from 0 with
+/// the file's line where it has one.
+inline std::string axisTurnWarning(const geometry::PathFile& path, const geometry::AxisTurn& t) {
+  if (t.at == pathgen::ClearanceResult::npos || !(t.deg > geometry::kNoteAxisTurnDeg)) return {};
+  auto name = [&](std::size_t i) {
+    return std::to_string(i) + (i < path.lines.size() ? " (" + path.where(i) + ")" : "");
+  };
+  char text[160];
+  std::snprintf(text, sizeof text, "the tool axis turns %.1f deg between postures %s and ", t.deg,
+                name(t.at).c_str());
+  char tail[160];
+  std::snprintf(tail, sizeof tail,
+                ", %.2f mm apart: more than a machine's rotary axes follow at feed (over %g deg "
+                "between two postures of a pass)",
+                t.step_mm, geometry::kNoteAxisTurnDeg);
+  return text + name(t.at + 1) + tail;
 }
 
 /// Why a path is not safe to run as it stands (empty: it is): postures or motions that touch an

@@ -63,6 +63,22 @@ void requireSteadyAxes(const PathFile& path) {
       for (std::size_t i = block.begin + 1; i < block.end; ++i) requireSteadyAxis(path, i - 1, i);
 }
 
+AxisTurn largestAxisTurn(const PathFile& path, double ball_radius_mm) {
+  AxisTurn out;
+  for (const PathBlock& block : path.blocks) {
+    if (block.kind != PathBlock::Kind::Pass) continue;
+    for (std::size_t i = block.begin + 1; i < block.end; ++i) {
+      const Posture &a = path.postures[i - 1], &b = path.postures[i];
+      const double deg = axisAngle(a.axis, b.axis) * 180.0 / M_PI;
+      if (deg <= out.deg) continue;
+      out.deg = deg;
+      out.at = i - 1;
+      out.step_mm = (ballCentre(b, ball_radius_mm) - ballCentre(a, ball_radius_mm)).norm();
+    }
+  }
+  return out;
+}
+
 PathFile singlePass(std::vector<Posture> postures) {
   PathFile path;
   if (!postures.empty()) path.blocks.push_back({PathBlock::Kind::Pass, 0, postures.size()});

@@ -373,6 +373,26 @@ TEST(CheckSurface, PassesBesideThePartAreStillCheckedForClearance) {
   // The shank's axis reaches x = 8 (the wall) 8 / sin 40° = 12.4 mm up: every posture collides.
   EXPECT_EQ(report["clearance"]["colliding_postures"].get<int>(), 11);
   EXPECT_FALSE(report["ok"].get<bool>());
+  // The axis holds its 40° all along: no turn, no warning.
+  EXPECT_NEAR(report["axis_turn"]["max_deg"].get<double>(), 0.0, 1e-6);
+  EXPECT_EQ(r.err.find("the tool axis turns"), std::string::npos) << r.err;
+  // The same pass with the axis snapping upright half-way: the turn said, naming the lines.
+  std::ostringstream snap;
+  snap.precision(17);
+  snap << "# pass 1\n";
+  for (int k = 0; k <= 10; ++k)
+    snap << "0 " << -5 + k << (k < 6 ? " 0 " + std::to_string(s) + " 0 " + std::to_string(c)
+                                     : std::string(" 0 0 0 1")) << '\n';
+  dir.write("snap.cl", snap.str());
+  const auto t = test::runFieldpath(dir, "check scene.yaml --path snap.cl --out snapped");
+  ASSERT_EQ(t.exit_code, 0) << t.output();
+  EXPECT_NE(t.err.find("warning: the tool axis turns 40.0 deg between postures 5 (snap.cl:7) and "
+                       "6 (snap.cl:8)"),
+            std::string::npos)
+      << t.err;
+  const auto snapped = nlohmann::json::parse(test::slurp(dir.path() / "snapped" / "check.json"));
+  EXPECT_NEAR(snapped["axis_turn"]["max_deg"].get<double>(), 40.0, 1e-4);
+  EXPECT_EQ(snapped["axis_turn"]["posture"].get<int>(), 5);
 }
 
 TEST(CheckSurface, TheSameJobHighUpInZReadsTheSame) {
