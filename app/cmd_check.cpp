@@ -237,9 +237,11 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         zbuffer::writeHeightsJson(out / "deviation.json", surface->grid);
         writeDeviationPng(out / "deviation.png", *surface);
       }
-      common::writeTextAtomically(out / "clearance.csv", clearanceCsv(path, clearance, motions,
-                                                   scene.part ? std::optional(contacts.marks(path.postures.size()))
-                                                              : std::nullopt));
+      common::writeTextAtomically(
+          out / "clearance.csv",
+          clearanceCsv(
+              path, clearance, motions,
+              scene.part ? std::optional(contacts.marks(path.postures.size())) : std::nullopt));
       common::writeTextAtomically(out / "check.json", jsonText(report));
     }
     // Postures numbered from 0 in the file's order, as clearance.csv, check.json and view's

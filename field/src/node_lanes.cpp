@@ -231,10 +231,10 @@ static __attribute__((target("avx512f"), always_inline)) inline void laneTerm512
 /// skip the nearest's 5 operations of ~30 a step, the tracked ones the least r²'s one.
 template <bool Track, bool Lowest>
 static __attribute__((target("avx512f"))) void laneSums512(const Law& L, const SampleSpan& s,
-                                                          const Picks& core, const Picks& ring,
-                                                          const double* px, const double* py,
-                                                          const double* pz, const double* init_sq,
-                                                          Accum* out) {
+                                                           const Picks& core, const Picks& ring,
+                                                           const double* px, const double* py,
+                                                           const double* pz, const double* init_sq,
+                                                           Accum* out) {
   const __m512d ax = _mm512_loadu_pd(px), ay = _mm512_loadu_pd(py), az = _mm512_loadu_pd(pz);
   const LaneConsts512 k{_mm512_set1_pd(L.r0_sq),  _mm512_set1_pd(L.inv_r_min),
                         _mm512_set1_pd(L.inv_r0), _mm512_set1_pd(0.5),
@@ -319,8 +319,10 @@ void laneSums(const Law& L, const SampleSpan& from, const Picks& core, const Pic
   if (kUseAvx512) {
     int tracked = 0;
     for (int l = 0; l < kLanes; ++l) tracked += init_sq[l] > 0.0;
-    if (tracked == kLanes) return laneSums512<true, false>(L, from, core, ring, px, py, pz, init_sq, out);
-    if (tracked == 0) return laneSums512<false, true>(L, from, core, ring, px, py, pz, init_sq, out);
+    if (tracked == kLanes)
+      return laneSums512<true, false>(L, from, core, ring, px, py, pz, init_sq, out);
+    if (tracked == 0)
+      return laneSums512<false, true>(L, from, core, ring, px, py, pz, init_sq, out);
     return laneSums512<true, true>(L, from, core, ring, px, py, pz, init_sq, out);
   }
 #endif

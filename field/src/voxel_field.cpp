@@ -147,25 +147,24 @@ void fillBlockOnce(const Level& level, std::size_t b) {
 }
 
 void fillBlocks(const Level& level) {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, level.block_leaves.size()),
-                    [&](const auto& range) {
-                      auto values = level.grid->getConstUnsafeAccessor();
-                      std::optional<FloatGrid::ConstUnsafeAccessor> closeness;
-                      if (level.ratio) closeness.emplace(level.closeness->getConstUnsafeAccessor());
-                      for (std::size_t b = range.begin(); b != range.end(); ++b) {
-                        std::uint8_t expected = kBlockEmpty;
-                        if (!level.block_state[b].compare_exchange_strong(
-                                expected, kBlockFilling, std::memory_order_acquire)) {
-                          ensureBlock(level, b);  // filled, or being filled by a query
-                          continue;
-                        }
-                        fillBlock(
-                            level, b,
-                            [&](const openvdb::Coord& c) { return values.probeConstLeaf(c); },
-                            [&](const openvdb::Coord& c) { return closeness->probeConstLeaf(c); });
-                        level.block_state[b].store(kBlockReady, std::memory_order_release);
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, level.block_leaves.size()), [&](const auto& range) {
+        auto values = level.grid->getConstUnsafeAccessor();
+        std::optional<FloatGrid::ConstUnsafeAccessor> closeness;
+        if (level.ratio) closeness.emplace(level.closeness->getConstUnsafeAccessor());
+        for (std::size_t b = range.begin(); b != range.end(); ++b) {
+          std::uint8_t expected = kBlockEmpty;
+          if (!level.block_state[b].compare_exchange_strong(expected, kBlockFilling,
+                                                            std::memory_order_acquire)) {
+            ensureBlock(level, b);  // filled, or being filled by a query
+            continue;
+          }
+          fillBlock(
+              level, b, [&](const openvdb::Coord& c) { return values.probeConstLeaf(c); },
+              [&](const openvdb::Coord& c) { return closeness->probeConstLeaf(c); });
+          level.block_state[b].store(kBlockReady, std::memory_order_release);
+        }
+      });
 }
 
 /// The trilinear value of one level's cell (no refinement): F, or for the plane ratio

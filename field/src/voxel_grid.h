@@ -187,8 +187,9 @@ struct Level {
   mutable std::vector<std::uint64_t> over;  ///< per block node: over/under the surface (ratioHolds)
   std::vector<std::uint64_t> refined;       ///< per leaf cell: read the next level instead
   std::vector<const Leaf*> block_leaves;    ///< the leaf of each block
-  std::unique_ptr<std::atomic<std::uint8_t>[]> block_state;  ///< kBlockEmpty, kBlockFilling, kBlockReady
-  bool ratio = false;                                         ///< closeness read into the blocks
+  std::unique_ptr<std::atomic<std::uint8_t>[]>
+      block_state;     ///< kBlockEmpty, kBlockFilling, kBlockReady
+  bool ratio = false;  ///< closeness read into the blocks
 
   std::size_t blocks() const { return nodes.size() / kBlockNodes; }
   std::size_t memUsage() const {

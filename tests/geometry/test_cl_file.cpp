@@ -90,8 +90,8 @@ TEST(ClFile, LargestAxisTurnIsOfThePassesAndItsClosedForm) {
   };
   PathFile path;
   path.postures = {at(0, 0), at(1, 12), at(2, 42), at(2, 42), at(3, -38), at(4, 0), at(5, 20)};
-  path.blocks = {{PathBlock::Kind::Pass, 0, 3}, {PathBlock::Kind::Link, 3, 5},
-                 {PathBlock::Kind::Pass, 5, 7}};
+  path.blocks = {
+      {PathBlock::Kind::Pass, 0, 3}, {PathBlock::Kind::Link, 3, 5}, {PathBlock::Kind::Pass, 5, 7}};
   const AxisTurn t = largestAxisTurn(path, 3.0);
   EXPECT_NEAR(t.deg, 30.0, 1e-9);
   EXPECT_EQ(t.at, 1u);

@@ -100,7 +100,8 @@ TEST_F(ImpellerRun, MatchesTheGoldenSummary) {
   // Critically damped: the steered axis turns smoothly (0.46 deg a 0.5 mm posture at most),
   // far under the turn that generate warns of; the nominal path's axis is the hub normal's.
   EXPECT_LT(field["axis_turn"]["max_deg"].get<double>(), 1.0);
-  EXPECT_LT(field["axis_turn"]["max_deg"].get<double>(), field["axis_turn"]["note_above_deg"].get<double>());
+  EXPECT_LT(field["axis_turn"]["max_deg"].get<double>(),
+            field["axis_turn"]["note_above_deg"].get<double>());
   EXPECT_EQ(field_.output.find("the tool axis turns"), std::string::npos);
   EXPECT_EQ(field["counts"]["obstacle_points"].get<int>(), 5100);
   // Safe to run: every motion, links included, keeps the clearance; the nominal path's do not.

@@ -381,8 +381,10 @@ TEST(CheckSurface, PassesBesideThePartAreStillCheckedForClearance) {
   snap.precision(17);
   snap << "# pass 1\n";
   for (int k = 0; k <= 10; ++k)
-    snap << "0 " << -5 + k << (k < 6 ? " 0 " + std::to_string(s) + " 0 " + std::to_string(c)
-                                     : std::string(" 0 0 0 1")) << '\n';
+    snap << "0 " << -5 + k
+         << (k < 6 ? " 0 " + std::to_string(s) + " 0 " + std::to_string(c)
+                   : std::string(" 0 0 0 1"))
+         << '\n';
   dir.write("snap.cl", snap.str());
   const auto t = test::runFieldpath(dir, "check scene.yaml --path snap.cl --out snapped");
   ASSERT_EQ(t.exit_code, 0) << t.output();

@@ -409,7 +409,8 @@ TEST(Links, ALinkThroughThePartIsReportedAndThePassContactIsNot) {
     EXPECT_EQ(out.colliding_postures, 0u) << lean;
     EXPECT_EQ(out.colliding_motions, lean > 0 ? 1u : 0u) << lean;
     if (lean > 0) EXPECT_EQ(out.first_colliding_motion, 2u);  // posture 2 (the pass's end) to 3
-    EXPECT_EQ(out.motion_contacts, lean > 0 ? std::vector<std::size_t>{2} : std::vector<std::size_t>{});
+    EXPECT_EQ(out.motion_contacts,
+              lean > 0 ? std::vector<std::size_t>{2} : std::vector<std::size_t>{});
   }
   // A pass finishing the floor along a wall of the part, the ball tangent to both: its retract
   // and plunge along the axis slide up the wall, tangent to it all the way: not a collision.
