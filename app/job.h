@@ -124,15 +124,15 @@ inline std::string axisTurnWarning(const geometry::PathFile& path, const geometr
   auto name = [&](std::size_t i) {
     return std::to_string(i) + (i < path.lines.size() ? " (" + path.where(i) + ")" : "");
   };
-  char text[160];
-  std::snprintf(text, sizeof text, "the tool axis turns %.1f deg between postures %s and ", t.deg,
-                name(t.at).c_str());
-  char tail[160];
-  std::snprintf(tail, sizeof tail,
-                ", %.2f mm apart: more than a machine's rotary axes follow at feed (over %g deg "
-                "between two postures of a pass)",
-                t.step_mm, geometry::kNoteAxisTurnDeg);
-  return text + name(t.at + 1) + tail;
+  // The numbers alone through snprintf: the names hold file paths of any length.
+  char deg[32], step[32], limit[32];
+  std::snprintf(deg, sizeof deg, "%.1f", t.deg);
+  std::snprintf(step, sizeof step, "%.2f", t.step_mm);
+  std::snprintf(limit, sizeof limit, "%g", geometry::kNoteAxisTurnDeg);
+  return std::string("the tool axis turns ") + deg + " deg between postures " + name(t.at) +
+         " and " + name(t.at + 1) + ", " + step +
+         " mm apart: more than a machine's rotary axes follow at feed (over " + limit +
+         " deg between two postures of a pass)";
 }
 
 /// Why a path is not safe to run as it stands (empty: it is): postures or motions that touch an

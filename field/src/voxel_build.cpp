@@ -458,7 +458,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
   VoxelStats& stats = built.stats;
   if (tolerance > 0.0 && refine_levels > 0) {
     const double floor = kRefineFloorFraction * builder.law.at(2.0 * params.r_min_mm);
-    fillBlocks(levels[0]);  // the estimate reads every block
+    fillBlocks(levels[0]);  // cellsWithValues reads every block (the rest read through locate)
     CellList cells = cellsWithValues(levels[0]);
     trace.lap("cells with values");
     const auto refine_start = std::chrono::steady_clock::now();
@@ -466,7 +466,6 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
     for (int l = 0; l < refine_levels && !cells.empty(); ++l) {
       const double hl = levels[l].h_mm;
       Level& level = levels[std::size_t(l)];
-      fillBlocks(level);  // (a refined level's were not: makeBlocks)
       const CellErrors errors(level, law, floor);
       trace.lap("node errors");
       // Each cell's error and, for those that miss, their bit in the level's `refined` (cells

@@ -70,7 +70,7 @@ AxisTurn largestAxisTurn(const PathFile& path, double ball_radius_mm) {
     for (std::size_t i = block.begin + 1; i < block.end; ++i) {
       const Posture &a = path.postures[i - 1], &b = path.postures[i];
       const double deg = axisAngle(a.axis, b.axis) * 180.0 / M_PI;
-      if (deg <= out.deg) continue;
+      if (out.at != AxisTurn{}.at && !(deg > out.deg)) continue;  // (the first pair counts)
       out.deg = deg;
       out.at = i - 1;
       out.step_mm = (ballCentre(b, ball_radius_mm) - ballCentre(a, ball_radius_mm)).norm();

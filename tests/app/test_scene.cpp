@@ -1,5 +1,9 @@
 /// Scene files: every key of DESIGN.md read into the Scene, defaults, paths relative to the file,
 /// and bad files rejected with the file, line and key.
+#include <cmath>
+#include <cstdio>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include "fieldpath/common/errors.h"
@@ -239,4 +243,38 @@ TEST(Scene, KeysThatDoNotApplyAreRefused) {
   } catch (const common::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("path.passes"), std::string::npos) << e.what();
   }
+}
+
+TEST(AxisTurn, TheWarningNamesBothPosturesWhateverTheFileNamesLength) {
+  // A path file 300 characters long: both postures named with their lines, the numbers after
+  // them (a fixed buffer cut the text and glued the names together).
+  geometry::PathFile path;
+  path.file = std::string(290, 'd') + "/p.cl";
+  auto at = [](double x, double deg) {
+    const double r = deg * M_PI / 180.0;
+    return geometry::Posture{geometry::Vec3(x, 0, 0),
+                             geometry::Vec3(std::sin(r), 0, std::cos(r)), 0.0, false};
+  };
+  path.postures = {at(0, 0), at(0.5, 0), at(1, 12)};
+  path.lines = {3, 4, 123456};
+  path.blocks = {{geometry::PathBlock::Kind::Pass, 0, 3}};
+  const geometry::AxisTurn t = geometry::largestAxisTurn(path, 3.0);
+  EXPECT_EQ(t.at, 1u);
+  const std::string w = app::axisTurnWarning(path, t);
+  const std::string name = path.file.string();
+  EXPECT_EQ(w, "the tool axis turns 12.0 deg between postures 1 (" + name + ":4) and 2 (" + name +
+                   ":123456), " + [&] {
+                     char step[32];
+                     std::snprintf(step, sizeof step, "%.2f", t.step_mm);
+                     return std::string(step);
+                   }() + " mm apart: more than a machine's rotary axes follow at feed (over 5 "
+                         "deg between two postures of a pass)");
+  // Under 5 deg: nothing said; a pass whose axis never turns still names its first pair.
+  path.postures[2] = at(1, 4);
+  EXPECT_TRUE(app::axisTurnWarning(path, geometry::largestAxisTurn(path, 3.0)).empty());
+  path.postures[2] = at(1, 0);
+  const geometry::AxisTurn still = geometry::largestAxisTurn(path, 3.0);
+  EXPECT_EQ(still.at, 0u);
+  EXPECT_EQ(still.deg, 0.0);
+  EXPECT_DOUBLE_EQ(still.step_mm, 0.5);
 }

@@ -375,6 +375,7 @@ TEST(CheckSurface, PassesBesideThePartAreStillCheckedForClearance) {
   EXPECT_FALSE(report["ok"].get<bool>());
   // The axis holds its 40° all along: no turn, no warning.
   EXPECT_NEAR(report["axis_turn"]["max_deg"].get<double>(), 0.0, 1e-6);
+  EXPECT_EQ(report["axis_turn"]["posture"].get<int>(), 0);  // the first pair: none turns more
   EXPECT_EQ(r.err.find("the tool axis turns"), std::string::npos) << r.err;
   // The same pass with the axis snapping upright half-way: the turn said, naming the lines.
   std::ostringstream snap;

@@ -158,7 +158,7 @@ void requireSteadyAxes(const PathFile& path);
 
 /// The largest turn of the tool axis between two consecutive postures of a pass block: `deg`,
 /// from posture `at` to at + 1, over `step_mm` of ball-centre travel (`at` npos: no pass has two
-/// postures). A machine's rotary axes follow a few degrees a millimetre at cutting feed; the
+/// postures; ties: the first). A machine's rotary axes follow a few degrees a millimetre at cutting feed; the
 /// steered examples turn under 1 deg a posture, a field pushing a tool with no room to move
 /// turned 30 deg in 0.5 mm.
 struct AxisTurn {
