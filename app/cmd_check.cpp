@@ -149,7 +149,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
           ": tool.shape: check is for ball-end mills (its surface check models the ball's "
           "cut; `simulate --tool torus:R:r` or `flat:R` cuts with the others)");
     const std::vector<std::string> tool_notes = cutterNotes(scene.tool, path);
-    const geometry::AxisTurn axis_turn = geometry::largestAxisTurn(path, scene.tool.radius_mm);
+    const pathgen::AxisTurn axis_turn = pathgen::largestAxisTurn(path, scene.tool.radius_mm);
 
     // (a) exact clearance of postures and motions
     const geometry::TriangleMesh tool_mesh =
@@ -206,6 +206,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"scene", scene.file.string()},
         {"path", options->path},
         {"path_digest", common::fileDigest(options->path)},
+        {"scene_digest", sceneDigest(scene)},
         {"postures", path.postures.size()},
         {"passes", path.count(geometry::PathBlock::Kind::Pass)},
         {"links", path.count(geometry::PathBlock::Kind::Link)},
@@ -252,14 +253,19 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                  : std::to_string(i) + (i < path.lines.size() ? " (" + path.where(i) + ")" : "");
     };
     std::printf(
-        "clearance: %zu postures, min %.3f mm (required %.3f) at posture %s, %zu colliding%s\n"
-        "motions: %zu, min >= %.3f mm at motion %s, %zu colliding%s, %zu under the required "
-        "clearance (%zu samples)\n",
+        "clearance: %zu postures, min %.3f mm (required %.3f) at posture %s, %zu colliding%s\n",
         path.postures.size(), clearance.min_clearance_mm, scene.clearance_mm,
         index(clearance.min_index).c_str(), clearance.colliding,
-        clearance.colliding ? " (COLLISIONS)" : "", motions.motions, motions.min_clearance_mm,
-        index(motions.min_index).c_str(), motions.colliding,
-        motions.colliding ? " (COLLISIONS)" : "", motions.under_required, motions.samples);
+        clearance.colliding ? " (COLLISIONS)" : "");
+    if (motions.motions == 0)  // one posture: no motion, no minimum (check.json: null)
+      std::printf("motions: 0\n");
+    else
+      std::printf(
+          "motions: %zu, min >= %.3f mm at motion %s, %zu colliding%s, %zu under the required "
+          "clearance (%zu samples)\n",
+          motions.motions, motions.min_clearance_mm, index(motions.min_index).c_str(),
+          motions.colliding, motions.colliding ? " (COLLISIONS)" : "", motions.under_required,
+          motions.samples);
     using Contacts = std::pair<const char*, const std::optional<pathgen::LinkPartResult>*>;
     for (const auto& [what, contacts] :
          {Contacts{"links", &link_part}, Contacts{"holder", &holder_part}})

@@ -3,6 +3,7 @@
 /// shortest round-trip form, `.npy` float64), so a path converted and read back gives the same
 /// postures bit for bit and `simulate` the same heights. `.npy` has no place for pass and link
 /// blocks or `# limit` marks: converting to it says what was dropped.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -106,6 +107,15 @@ void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
       if (!path.limited.empty())
         std::fprintf(stderr, "note: APT has no `# limit` marks: %zu dropped\n",
                      path.limited.size());
+      // GOTO/x, y, z, i, j, k has no seventh value: the spindle column of a .cl or N×7 .npy.
+      const std::size_t spindles =
+          std::count_if(path.postures.begin(), path.postures.end(),
+                        [](const geometry::Posture& p) { return p.has_spindle; });
+      if (spindles > 0)
+        std::fprintf(stderr,
+                     "note: APT's GOTO has no spindle angle: the 7th column of %zu postures "
+                     "dropped\n",
+                     spindles);
     }
     std::printf("converted %zu postures (%zu passes, %zu links) from %s %s to %s %s\n",
                 path.postures.size(), passes, links, formatName(geometry::pathFormatOf(in)),

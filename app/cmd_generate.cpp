@@ -121,7 +121,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
                                       {"s_mm", r.postures[r.first_limited].s_mm}})}}},
       {"max_tilt_deg", r.max_tilt_deg},
       {"max_lead_deg", r.max_lead_deg},
-      {"axis_turn", axisTurnJson(geometry::largestAxisTurn(r.path, job.tool.radius_mm))},
+      {"axis_turn", axisTurnJson(pathgen::largestAxisTurn(r.path, job.tool.radius_mm))},
       {"solver",
        {{"steps", r.solver_steps},
         {"rhs_evals", r.rhs_evals},
@@ -273,7 +273,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     // (the jumps of a field pushing a tool that has no room: 30 deg in 0.5 mm in a pocket
     // narrower than the holder; unsafe there too, but the turn is its own warning)
     if (const std::string turn = axisTurnWarning(
-            result.path, geometry::largestAxisTurn(result.path, job.tool.radius_mm));
+            result.path, pathgen::largestAxisTurn(result.path, job.tool.radius_mm));
         !turn.empty())
       std::fprintf(stderr, "warning: %s (report.json axis_turn)\n", turn.c_str());
     if (scene.nominal)

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "fieldpath/common/file_digest.h"
 #include "fieldpath/pathgen/generate.h"
 #include "scene.h"
 
@@ -108,19 +109,29 @@ inline nlohmann::json holderPartJson(const std::optional<pathgen::LinkPartResult
       "posture and motion, passes and links (as `motions`, required 0)");
 }
 
-/// The path's largest axis turn between two postures of a pass (geometry::largestAxisTurn), for
+/// The digest of what a check reads of its scene: the scene file and every mesh it loads (the
+/// part and the obstacles, in order), joined; `view --check` refuses a check whose scene or
+/// meshes have changed since (a part added after the check left its contacts unshown).
+inline std::string sceneDigest(const Scene& scene) {
+  std::string out = common::fileDigest(scene.file);
+  if (scene.part_file) out += ",part:" + common::fileDigest(*scene.part_file);
+  for (const std::filesystem::path& f : scene.obstacle_files) out += "," + common::fileDigest(f);
+  return out;
+}
+
+/// The path's largest axis turn between two postures of a pass (pathgen::largestAxisTurn), for
 /// report.json and check.json: deg, the first posture (null: no pass of two), ball-centre step.
-inline nlohmann::json axisTurnJson(const geometry::AxisTurn& t) {
+inline nlohmann::json axisTurnJson(const pathgen::AxisTurn& t) {
   return {{"max_deg", t.deg},
           {"posture", jsonIndex(t.at)},
           {"step_mm", t.step_mm},
-          {"note_above_deg", geometry::kNoteAxisTurnDeg}};
+          {"note_above_deg", pathgen::kNoteAxisTurnDeg}};
 }
 
 /// The warning for a turn over kNoteAxisTurnDeg (empty otherwise), postures numbered from 0 with
 /// the file's line where it has one.
-inline std::string axisTurnWarning(const geometry::PathFile& path, const geometry::AxisTurn& t) {
-  if (t.at == pathgen::ClearanceResult::npos || !(t.deg > geometry::kNoteAxisTurnDeg)) return {};
+inline std::string axisTurnWarning(const geometry::PathFile& path, const pathgen::AxisTurn& t) {
+  if (t.at == pathgen::ClearanceResult::npos || !(t.deg > pathgen::kNoteAxisTurnDeg)) return {};
   auto name = [&](std::size_t i) {
     return std::to_string(i) + (i < path.lines.size() ? " (" + path.where(i) + ")" : "");
   };
@@ -128,7 +139,7 @@ inline std::string axisTurnWarning(const geometry::PathFile& path, const geometr
   char deg[32], step[32], limit[32];
   std::snprintf(deg, sizeof deg, "%.1f", t.deg);
   std::snprintf(step, sizeof step, "%.2f", t.step_mm);
-  std::snprintf(limit, sizeof limit, "%g", geometry::kNoteAxisTurnDeg);
+  std::snprintf(limit, sizeof limit, "%g", pathgen::kNoteAxisTurnDeg);
   return std::string("the tool axis turns ") + deg + " deg between postures " + name(t.at) +
          " and " + name(t.at + 1) + ", " + step +
          " mm apart: more than a machine's rotary axes follow at feed (over " + limit +

@@ -357,8 +357,20 @@ ViewData gatherView(const ViewRequest& request) {
         throw InputError("--check " + request.check_dir.string() + ": " + p.what +
                          " has changed since it was checked (check.json's path_digest differs): "
                          "run `fieldpath check` on it again");
+      // The scene or its meshes edited since (a part added after the check: its contacts
+      // were never looked for).
+      if (!check->scene_digest.empty() && check->scene_digest != sceneDigest(scene))
+        throw InputError("--check " + request.check_dir.string() + ": " + request.scene.string() +
+                         " or its meshes have changed since the check (check.json's scene_digest "
+                         "differs): run `fieldpath check` again");
       readClearanceCsv(request.check_dir / "clearance.csv", n, p.clearance_mm, p.motion_mm,
                        p.part_contact, p.part_contact_to_next);
+      if (scene.part && p.part_contact.empty())
+        d.warnings.push_back(
+            "The part's contacts (links, holder) are not shown: " +
+            (request.check_dir / "clearance.csv").string() +
+            " does not mark them (a check written before it did, or without the part): run "
+            "`fieldpath check` again, or view without --check");
       p.clearance_source = "check.json of " + request.check_dir.string();
       p.clearance_known = true;
     } else if (scene.obstacles.empty()) {

@@ -122,6 +122,8 @@ CheckJson readCheckJson(const fs::path& dir) {
   if (j.contains("path_digest") && j["path_digest"].is_string())
     c.path_digest = j["path_digest"].get<std::string>();
   if (j.contains("scene") && j["scene"].is_string()) c.scene = j["scene"].get<std::string>();
+  if (j.contains("scene_digest") && j["scene_digest"].is_string())
+    c.scene_digest = j["scene_digest"].get<std::string>();
   // The part's contacts: counts and first indices (null: none) of `link_part` / `holder_part`.
   const auto contacts = [&](const char* key) -> std::optional<pathgen::LinkPartResult> {
     const json block = j.value(key, json());
@@ -271,28 +273,37 @@ void readClearanceCsv(const fs::path& file, std::size_t postures, std::vector<do
   // The part's columns came later: a check folder written before them has 6 cells a row.
   const std::string header = "posture,block,pass,clearance_mm,motion_to_next_mm,limited";
   const std::string part_columns = ",part_contact,part_contact_to_next";
-  if (!std::getline(in, line) || (line != header && line != header + part_columns))
+  // (a file saved again with CR LF line ends: the CR is not part of the last cell)
+  auto withoutCr = [](std::string& text) {
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+  };
+  if (std::getline(in, line)) withoutCr(line);
+  if (!in || (line != header && line != header + part_columns))
     throw InputError(file.string() + ":1: expected the header '" + header + part_columns + "'");
   const std::size_t cell_count = line == header ? 6 : 8;
   clearance_mm.assign(postures, kNaN);
   motion_mm.assign(postures, kNaN);
   part_contact.assign(postures, 0);
   part_contact_to_next.assign(postures, 0);
-  bool part_known = cell_count == 8;
-  // A part-contact cell: 0 or 1, or empty for all rows (the scene has no part).
+  // A part-contact cell: 0 or 1 in every row, or empty in every row (the scene had no part); a
+  // file with both was edited (one blank cell would hide every contact).
+  std::size_t empty_line = 0, filled_line = 0;
   auto flag = [&](std::string_view cell, std::size_t number, std::uint8_t& out) {
-    if (cell.empty()) {
-      part_known = false;
-      return;
-    }
-    if (cell != "0" && cell != "1")
+    if (!cell.empty() && cell != "0" && cell != "1")
       throw InputError(file.string() + ":" + std::to_string(number) + ": a part contact of '" +
                        std::string(cell) + "' (0 or 1)");
-    out = cell == "1";
+    std::size_t& first = cell.empty() ? empty_line : filled_line;
+    if (first == 0) first = number;
+    if (empty_line && filled_line)
+      throw InputError(file.string() + ":" + std::to_string(std::max(empty_line, filled_line)) +
+                       ": part contact cells empty in some rows and not in others (0 or 1 in "
+                       "every row, or empty in all)");
+    if (!cell.empty()) out = cell == "1";
   };
   std::size_t row = 0, number = 1;
   while (std::getline(in, line)) {
     ++number;
+    withoutCr(line);
     if (line.empty()) continue;
     std::vector<std::string_view> cells;
     std::string_view rest = line;
@@ -318,7 +329,7 @@ void readClearanceCsv(const fs::path& file, std::size_t postures, std::vector<do
     }
     ++row;
   }
-  if (!part_known) {
+  if (cell_count == 6 || filled_line == 0) {
     part_contact.clear();
     part_contact_to_next.clear();
   }

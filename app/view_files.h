@@ -27,6 +27,7 @@ struct CheckJson {
   std::string path;
   std::string path_digest;  ///< common::fileDigest of the path checked (empty in older check.json)
   std::string scene;        ///< the scene file checked against, as `check` was given it
+  std::string scene_digest;  ///< sceneDigest of it and its meshes (empty in older check.json)
   /// check.json `link_part` and `holder_part`: the part's contacts (the page's colours are the
   /// obstacles'), where check found them.
   std::optional<pathgen::LinkPartResult> link_part, holder_part;

@@ -1,8 +1,10 @@
 #include "fieldpath/geometry/cl_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <vector>
 
 #include "fieldpath/common/atomic_file.h"
 
@@ -61,22 +63,6 @@ void requireSteadyAxes(const PathFile& path) {
   for (const PathBlock& block : path.blocks)
     if (block.kind == PathBlock::Kind::Pass)
       for (std::size_t i = block.begin + 1; i < block.end; ++i) requireSteadyAxis(path, i - 1, i);
-}
-
-AxisTurn largestAxisTurn(const PathFile& path, double ball_radius_mm) {
-  AxisTurn out;
-  for (const PathBlock& block : path.blocks) {
-    if (block.kind != PathBlock::Kind::Pass) continue;
-    for (std::size_t i = block.begin + 1; i < block.end; ++i) {
-      const Posture &a = path.postures[i - 1], &b = path.postures[i];
-      const double deg = axisAngle(a.axis, b.axis) * 180.0 / M_PI;
-      if (out.at != AxisTurn{}.at && !(deg > out.deg)) continue;  // (the first pair counts)
-      out.deg = deg;
-      out.at = i - 1;
-      out.step_mm = (ballCentre(b, ball_radius_mm) - ballCentre(a, ball_radius_mm)).norm();
-    }
-  }
-  return out;
 }
 
 PathFile singlePass(std::vector<Posture> postures) {

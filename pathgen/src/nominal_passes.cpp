@@ -17,6 +17,7 @@ namespace {
 using common::InputError;
 using geometry::PathBlock;
 using geometry::PathFile;
+using geometry::Posture;
 
 /// Ball centres closer than this are one posture repeated (mm).
 constexpr double kRepeatMm = 1e-9;
@@ -71,6 +72,21 @@ double median(std::vector<double> values) {
 }
 
 }  // namespace
+
+AxisTurn largestAxisTurn(const PathFile& path, double ball_radius_mm) {
+  AxisTurn out;
+  for (const auto& [begin, end] : passRanges(path, 0.0))
+    for (std::size_t i = begin + 1; i < end; ++i) {
+      const Posture &a = path.postures[i - 1], &b = path.postures[i];
+      const double deg = geometry::axisAngle(a.axis, b.axis) * 180.0 / M_PI;
+      if (out.at != AxisTurn{}.at && !(deg > out.deg)) continue;  // (the first pair counts)
+      out.deg = deg;
+      out.at = i - 1;
+      out.step_mm =
+          (geometry::ballCentre(b, ball_radius_mm) - geometry::ballCentre(a, ball_radius_mm)).norm();
+    }
+  return out;
+}
 
 std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path,
                                                             double pass_gap_mm) {

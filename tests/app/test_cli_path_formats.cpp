@@ -317,5 +317,21 @@ TEST(Convert, PassesWithNoLinkBetweenThemAreSaidToJoinInApt) {
   EXPECT_EQ(to_cl.err.find("note:"), std::string::npos) << to_cl.err;
 }
 
+TEST(Convert, ASpindleColumnDroppedInAptIsSaid) {
+  // GOTO has six values: the 7th column of a .cl goes, and the note counts it; none, no note.
+  const TempDir dir;
+  dir.write("s.cl", "0 0 0 0 0 1 0.5\n1 0 0 0 0 1 0.25\n2 0 0 0 0 1\n");
+  const Outcome run = runFieldpath(dir, "convert s.cl s.apt --tool ball:1");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("note: APT's GOTO has no spindle angle: the 7th column of 2 postures "
+                         "dropped"),
+            std::string::npos)
+      << run.err;
+  dir.write("n.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
+  const Outcome none = runFieldpath(dir, "convert n.cl n.apt --tool ball:1");
+  ASSERT_EQ(none.exit_code, 0) << none.err;
+  EXPECT_EQ(none.err.find("spindle"), std::string::npos) << none.err;
+}
+
 }  // namespace
 }  // namespace fieldpath::app::test

@@ -118,6 +118,19 @@ TEST(AtomicOutput, AFailedRunRemovesWhatItWrote) {
   EXPECT_TRUE(filesUnder(dir.path() / "out").empty());
 }
 
+// A legal name of 250 bytes (names run to 255): written, and its temporary stayed under the
+// limit too (`.NAME.tmp-PID` of it was 263 bytes: "File name too long"); two long names that
+// share their first 180 bytes get temporaries of their own.
+TEST(AtomicOutput, NamesUpToTheLimitAreWritten) {
+  const TempDir dir;
+  const std::string a = std::string(246, 'b') + ".csv", b = std::string(246, 'b') + ".npy";
+  common::writeTextAtomically(dir.path() / a, "x\n");
+  common::writeTextAtomically(dir.path() / b, "y\n");
+  EXPECT_EQ(slurp(dir.path() / a), "x\n");
+  EXPECT_EQ(slurp(dir.path() / b), "y\n");
+  EXPECT_EQ(filesUnder(dir.path()).size(), 2u);  // no temporary left
+}
+
 // An output name that is a FIFO (or /dev/null, a device) is written into, not replaced by a
 // regular file (renaming over /dev/null made it one), and a failed run leaves it; a name that is a
 // symbolic link is written through it, the link kept.

@@ -258,7 +258,7 @@ TEST(AxisTurn, TheWarningNamesBothPosturesWhateverTheFileNamesLength) {
   path.postures = {at(0, 0), at(0.5, 0), at(1, 12)};
   path.lines = {3, 4, 123456};
   path.blocks = {{geometry::PathBlock::Kind::Pass, 0, 3}};
-  const geometry::AxisTurn t = geometry::largestAxisTurn(path, 3.0);
+  const pathgen::AxisTurn t = pathgen::largestAxisTurn(path, 3.0);
   EXPECT_EQ(t.at, 1u);
   const std::string w = app::axisTurnWarning(path, t);
   const std::string name = path.file.string();
@@ -267,13 +267,13 @@ TEST(AxisTurn, TheWarningNamesBothPosturesWhateverTheFileNamesLength) {
                      char step[32];
                      std::snprintf(step, sizeof step, "%.2f", t.step_mm);
                      return std::string(step);
-                   }() + " mm apart: more than a machine's rotary axes follow at feed (over 5 "
+                   }() + " mm apart: more than a machine's rotary axes follow at feed (over 10 "
                          "deg between two postures of a pass)");
-  // Under 5 deg: nothing said; a pass whose axis never turns still names its first pair.
+  // Under 10 deg: nothing said; a pass whose axis never turns still names its first pair.
   path.postures[2] = at(1, 4);
-  EXPECT_TRUE(app::axisTurnWarning(path, geometry::largestAxisTurn(path, 3.0)).empty());
+  EXPECT_TRUE(app::axisTurnWarning(path, pathgen::largestAxisTurn(path, 3.0)).empty());
   path.postures[2] = at(1, 0);
-  const geometry::AxisTurn still = geometry::largestAxisTurn(path, 3.0);
+  const pathgen::AxisTurn still = pathgen::largestAxisTurn(path, 3.0);
   EXPECT_EQ(still.at, 0u);
   EXPECT_EQ(still.deg, 0.0);
   EXPECT_DOUBLE_EQ(still.step_mm, 0.5);

@@ -249,6 +249,26 @@ TEST(View, PartContactsAreMarkedAsCheckFindsThem) {
   const json meta = pageMeta(html);
   EXPECT_TRUE(meta["path"]["counts"]["part_contact_postures"].is_null());
   EXPECT_EQ(countBit(pageFlags(html, meta), 32), 0u);
+  // ... and the page says so: the scene has a part, the check marks nothing of it.
+  EXPECT_NE(meta["warnings"].dump().find("The part's contacts (links, holder) are not shown"),
+            std::string::npos)
+      << meta["warnings"];
+  // Saved again with CR LF line ends: the same page.
+  std::string crlf;
+  for (char ch : csv) crlf += ch == '\n' ? std::string("\r\n") : std::string(1, ch);
+  dir.write("chk/clearance.csv", crlf);
+  const Outcome windows = runFieldpath(dir, "view scene.yaml --check chk --out crlf.html");
+  ASSERT_EQ(windows.exit_code, 0) << windows.output();
+  EXPECT_EQ(pageMeta(slurp(dir.path() / "crlf.html"))["path"]["counts"]["part_contact_postures"], 1);
+  // One cell blanked (the others filled): refused, not every contact dropped.
+  std::string blank = csv;
+  blank.replace(blank.find(",1,1\n"), 5, ",,1\n");
+  dir.write("chk/clearance.csv", blank);
+  const Outcome blanked = runFieldpath(dir, "view scene.yaml --check chk --out bad.html");
+  EXPECT_EQ(blanked.exit_code, 1) << blanked.output();
+  EXPECT_NE(blanked.err.find("clearance.csv:23: part contact cells empty in some rows"),
+            std::string::npos)
+      << blanked.err;
   // A part-contact cell that is neither 0 nor 1: refused naming the line.
   std::string bad = csv;
   bad.replace(bad.find(",1,1\n"), 5, ",x,1\n");
@@ -256,6 +276,18 @@ TEST(View, PartContactsAreMarkedAsCheckFindsThem) {
   const Outcome b = runFieldpath(dir, "view scene.yaml --check chk --out bad.html");
   EXPECT_EQ(b.exit_code, 1) << b.output();
   EXPECT_NE(b.err.find("clearance.csv:23: a part contact of 'x'"), std::string::npos) << b.err;
+  // The scene edited after the check (here its part file named anew): the check's contacts are
+  // not this scene's.
+  dir.write("chk/clearance.csv", csv);
+  dir.write("floor2.stl", slurp(dir.path() / "floor.stl"));
+  std::string scene = slurp(dir.path() / "scene.yaml");
+  scene.replace(scene.find("floor.stl"), 9, "floor2.stl");
+  dir.write("scene.yaml", scene);
+  const Outcome stale = runFieldpath(dir, "view scene.yaml --check chk --out bad.html");
+  EXPECT_EQ(stale.exit_code, 1) << stale.output();
+  EXPECT_NE(stale.err.find("or its meshes have changed since the check"), std::string::npos)
+      << stale.err;
+  EXPECT_FALSE(fs::exists(dir.path() / "bad.html"));
 }
 
 TEST(View, BadInputIsExitOneWithOneLineOrAPageThatSaysWhatIsMissing) {

@@ -81,30 +81,6 @@ TEST(ClFile, ClosedFormRead) {
   EXPECT_EQ(p[1].spindle_rad, 0.5);
 }
 
-TEST(ClFile, LargestAxisTurnIsOfThePassesAndItsClosedForm) {
-  // Pass 1: the axis tilts 12 deg then 30 deg about y between postures 1 mm apart; a link whose
-  // axis swings 80 deg is not a pass (rapid moves turn as they like); pass 2 turns 20 deg.
-  auto at = [](double x, double deg) {
-    const double r = deg * M_PI / 180.0;
-    return Posture{Vec3(x, 0, 0), Vec3(std::sin(r), 0, std::cos(r)), 0.0, false};
-  };
-  PathFile path;
-  path.postures = {at(0, 0), at(1, 12), at(2, 42), at(2, 42), at(3, -38), at(4, 0), at(5, 20)};
-  path.blocks = {
-      {PathBlock::Kind::Pass, 0, 3}, {PathBlock::Kind::Link, 3, 5}, {PathBlock::Kind::Pass, 5, 7}};
-  const AxisTurn t = largestAxisTurn(path, 3.0);
-  EXPECT_NEAR(t.deg, 30.0, 1e-9);
-  EXPECT_EQ(t.at, 1u);
-  // The ball centres p + R a: (1 + 3 sin 12, 0, 3 cos 12) to (2 + 3 sin 42, 0, 3 cos 42).
-  const double s12 = std::sin(12 * M_PI / 180), c12 = std::cos(12 * M_PI / 180);
-  const double s42 = std::sin(42 * M_PI / 180), c42 = std::cos(42 * M_PI / 180);
-  EXPECT_NEAR(t.step_mm, std::hypot(1 + 3 * (s42 - s12), 3 * (c42 - c12)), 1e-12);
-  // No pass of two postures: no turn.
-  PathFile single = singlePass({at(0, 0)});
-  EXPECT_EQ(largestAxisTurn(single, 3.0).at, static_cast<std::size_t>(-1));
-  EXPECT_EQ(largestAxisTurn(single, 3.0).deg, 0.0);
-}
-
 TEST(ClFile, RoundTripsExactly) {
   for (bool spindle : {false, true}) {
     const auto postures = randomPostures(1000, spindle);

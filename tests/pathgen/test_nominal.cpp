@@ -355,6 +355,36 @@ TEST(Links, AGivenSafeZBelowTheMeshesIsRefusedNamingTheKey) {
   }
 }
 
+TEST(NominalPasses, LargestAxisTurnIsOfThePassesAndItsClosedForm) {
+  // Pass 1: the axis tilts 12 deg then 30 deg about y between postures 1 mm apart; a link whose
+  // axis swings 80 deg is not a pass (rapid moves turn as they like); pass 2 turns 20 deg.
+  auto at = [](double x, double deg) {
+    const double r = deg * M_PI / 180.0;
+    return Posture{Eigen::Vector3d(x, 0, 0), Eigen::Vector3d(std::sin(r), 0, std::cos(r)), 0.0, false};
+  };
+  PathFile path;
+  path.postures = {at(0, 0), at(1, 12), at(2, 42), at(2, 42), at(3, -38), at(4, 0), at(5, 20)};
+  path.blocks = {
+      {PathBlock::Kind::Pass, 0, 3}, {PathBlock::Kind::Link, 3, 5}, {PathBlock::Kind::Pass, 5, 7}};
+  const AxisTurn t = largestAxisTurn(path, 3.0);
+  EXPECT_NEAR(t.deg, 30.0, 1e-9);
+  EXPECT_EQ(t.at, 1u);
+  // The ball centres p + R a: (1 + 3 sin 12, 0, 3 cos 12) to (2 + 3 sin 42, 0, 3 cos 42).
+  const double s12 = std::sin(12 * M_PI / 180), c12 = std::cos(12 * M_PI / 180);
+  const double s42 = std::sin(42 * M_PI / 180), c42 = std::cos(42 * M_PI / 180);
+  EXPECT_NEAR(t.step_mm, std::hypot(1 + 3 * (s42 - s12), 3 * (c42 - c12)), 1e-12);
+  // A pass whose tips jump 10 mm (more than 4 x its median step) holds two passes: the
+  // jump's 60 deg turn is a link's, not the cut's.
+  PathFile jump = geometry::singlePass({at(0, 0), at(1, 0), at(2, 5), at(12, 65), at(13, 65)});
+  const AxisTurn j = largestAxisTurn(jump, 3.0);
+  EXPECT_NEAR(j.deg, 5.0, 1e-9);
+  EXPECT_EQ(j.at, 1u);
+  // No pass of two postures: no turn.
+  PathFile single = geometry::singlePass({at(0, 0)});
+  EXPECT_EQ(largestAxisTurn(single, 3.0).at, static_cast<std::size_t>(-1));
+  EXPECT_EQ(largestAxisTurn(single, 3.0).deg, 0.0);
+}
+
 // The links against the part: a link that travels through a block standing on the part is
 // reported (its postures and the motion between them), the ball's contact where a pass starts
 // and ends is not (retract 0: the link's first posture is the pass's last).

@@ -10,6 +10,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -191,8 +192,18 @@ inline void writeFileAtomically(const std::filesystem::path& given,
     return;
   }
   if (path.has_parent_path()) createOutputDirectory(path.parent_path());
-  const fs::path tmp = path.parent_path() / ("." + path.filename().string() + ".tmp-" +
-                                             std::to_string(static_cast<long>(::getpid())));
+  // `.NAME.tmp-PID`; a name too long to take the 13 or so characters more (names run to 255
+  // bytes) keeps its first 180 and a hash of the whole (a legal 250-byte name was refused).
+  std::string stem = path.filename().string();
+  if (stem.size() > 180) {
+    std::uint64_t h = 1469598103934665603ull;  // FNV-1a
+    for (unsigned char c : stem) h = (h ^ c) * 1099511628211ull;
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+    stem = stem.substr(0, 180) + "-" + hex;
+  }
+  const fs::path tmp = path.parent_path() /
+                       ("." + stem + ".tmp-" + std::to_string(static_cast<long>(::getpid())));
   const detail::TemporaryListing listing{detail::listTemporary(tmp.string())};
   try {
     {

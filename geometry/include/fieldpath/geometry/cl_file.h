@@ -156,18 +156,4 @@ void requireSteadyAxis(const PathFile& path, std::size_t before, std::size_t i);
 /// the motion between them is not one a machine makes, and a check sweeping it cannot bound it).
 void requireSteadyAxes(const PathFile& path);
 
-/// The largest turn of the tool axis between two consecutive postures of a pass block: `deg`,
-/// from posture `at` to at + 1, over `step_mm` of ball-centre travel (`at` npos: no pass has two
-/// postures; ties: the first). A machine's rotary axes follow a few degrees a millimetre at cutting feed; the
-/// steered examples turn under 1 deg a posture, a field pushing a tool with no room to move
-/// turned 30 deg in 0.5 mm.
-struct AxisTurn {
-  double deg = 0.0, step_mm = 0.0;
-  std::size_t at = static_cast<std::size_t>(-1);
-};
-AxisTurn largestAxisTurn(const PathFile& path, double ball_radius_mm);
-
-/// Turns larger than this between two postures of a pass are said (generate, check).
-constexpr double kNoteAxisTurnDeg = 5.0;
-
 }  // namespace fieldpath::geometry

@@ -71,6 +71,21 @@ std::vector<Pass> nominalPasses(const geometry::PathFile& path, const PathParams
 std::vector<std::pair<std::size_t, std::size_t>> passRanges(const geometry::PathFile& path,
                                                             double pass_gap_mm);
 
+/// The largest turn of the tool axis between two consecutive postures of a pass (passRanges
+/// with the default gap: a file of passes with no markers, or an .npy, holds its links in one
+/// block): `deg`, from posture `at` to at + 1, over `step_mm` of ball-centre travel (`at` npos:
+/// no pass has two postures; ties: the first). A machine's rotary axes follow a few degrees a
+/// millimetre at cutting feed; the steered impeller example turns under 0.5 deg a posture, a
+/// field pushing a tool with no room to move turned 30 deg in 0.5 mm.
+struct AxisTurn {
+  double deg = 0.0, step_mm = 0.0;
+  std::size_t at = static_cast<std::size_t>(-1);
+};
+AxisTurn largestAxisTurn(const geometry::PathFile& path, double ball_radius_mm);
+
+/// Turns larger than this between two postures of a pass are said (generate, check).
+constexpr double kNoteAxisTurnDeg = 10.0;
+
 /// Nominal axis of a sample: n turned by `lead_rad` about b (towards f), i.e.
 /// dynamics::axisFromAngles of the sample's frame with no tilt.
 Vec3 nominalAxis(const PassSample& sample, double lead_rad);
