@@ -294,10 +294,15 @@
       list.forEach(function (j, k) { for (var c = 0; c < 3; ++c) pos[3 * k + c] = P.centre[3 * j + c]; });
       var geometry = new THREE.BufferGeometry();
       geometry.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+      // Each mark on a dark dot 3 px wider: a red mark over the red end of the deviation scale
+      // (large scallops) was hard to see.
+      var rim = new THREE.Points(geometry, new THREE.PointsMaterial({
+        color: 0x101418, size: size + 3, sizeAttenuation: false, depthTest: false }));
+      rim.renderOrder = 10;
       var p = new THREE.Points(geometry, new THREE.PointsMaterial({
         color: colour, size: size, sizeAttenuation: false, depthTest: false }));
-      p.renderOrder = 10;
-      markGroup.add(p);
+      p.renderOrder = 11;
+      markGroup.add(rim, p);
       return list.length;
     }
     points(F_LIMITED, 0xff9f1c, 7);
