@@ -1,0 +1,127 @@
+#pragma once
+/// What the `view` tests share (test_view.cpp, test_view_part.cpp): scenes and paths written for
+/// them, and the page's parts read back (its JSON block, its per-posture flags).
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "files.h"
+
+namespace fieldpath::app::test::view {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+inline const fs::path kImpellerScene =
+    fs::path(FIELDPATH_SOURCE_DIR) / "examples/impeller/scene.yaml";
+
+/// ASCII STL of the closed box [x0, x1] × [y0, y1] × [z0, z1], outward normals.
+inline std::string boxStl(double x0, double y0, double z0, double x1, double y1, double z1) {
+  const double x[2] = {x0, x1}, y[2] = {y0, y1}, z[2] = {z0, z1};
+  auto v = [&](int i, int j, int k) {
+    std::ostringstream s;
+    s << "   vertex " << x[i] << ' ' << y[j] << ' ' << z[k] << '\n';
+    return s.str();
+  };
+  // Each face as four corners, counter-clockwise seen from outside.
+  const int faces[6][4][3] = {{{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}},   // z0
+                              {{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}},   // z1
+                              {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}},   // y0
+                              {{0, 1, 0}, {0, 1, 1}, {1, 1, 1}, {1, 1, 0}},   // y1
+                              {{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}},   // x0
+                              {{1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1}}};  // x1
+  std::string text = "solid box\n";
+  for (const auto& f : faces)
+    for (const auto& t : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
+      text += " facet normal 0 0 0\n  outer loop\n";
+      for (int c : t) text += v(f[c][0], f[c][1], f[c][2]);
+      text += "  endloop\n endfacet\n";
+    }
+  return text + "endsolid box\n";
+}
+
+/// Two passes along x (y = 0 through the block, y = 8 beside it) joined by a link; one `# limit`.
+inline std::string pathCl(double shift_mm = 0) {
+  std::ostringstream s;
+  auto line = [&](double x, double y, double z, const char* mark = "") {
+    s << x + shift_mm << ' ' << y << ' ' << z << " 0 0 1" << mark << '\n';
+  };
+  s << "# pass 1\n";
+  for (int k = 0; k < 40; ++k) line(-9.75 + 0.5 * k, 0, 0);
+  s << "# link\n";
+  line(9.75, 0, 15);
+  line(-9.75, 8, 15);
+  s << "# pass 2\n";
+  for (int k = 0; k < 40; ++k) line(-9.75 + 0.5 * k, 8, 0, k == 20 ? "  # limit" : "");
+  return s.str();
+}
+
+/// A scene with a block in the way of pass 1 on a floor (the part), the path as its nominal.
+inline void writeBlockScene(const TempDir& dir, bool nominal = true) {
+  dir.write("block.stl", boxStl(3, -3, -1, 5, 3, 4));
+  dir.write("floor.stl", squareStl(20, 0));
+  dir.write("path.cl", pathCl());
+  dir.write("scene.yaml", std::string("obstacles:\n  - mesh: block.stl\npart: floor.stl\n"
+                                      "tool: { shape: ball, radius: 1, length: 10 }\n"
+                                      "clearance: 0.5\n") +
+                              (nominal ? "path: { nominal: path.cl }\n" : ""));
+}
+
+inline std::string between(const std::string& text, const std::string& open,
+                           const std::string& close) {
+  const auto a = text.find(open);
+  if (a == std::string::npos) return {};
+  const auto b = text.find(close, a + open.size());
+  return b == std::string::npos ? std::string() : text.substr(a + open.size(), b - a - open.size());
+}
+
+inline json pageMeta(const std::string& html) {
+  return json::parse(
+      between(html, "<script type=\"application/json\" id=\"fp-meta\">", "</script>"));
+}
+
+inline std::string base64Decode(const std::string& text) {
+  std::string out;
+  int bits = 0, buffer = 0;
+  for (char c : text) {
+    int v = c >= 'A' && c <= 'Z'   ? c - 'A'
+            : c >= 'a' && c <= 'z' ? c - 'a' + 26
+            : c >= '0' && c <= '9' ? c - '0' + 52
+            : c == '+'             ? 62
+            : c == '/'             ? 63
+                                   : -1;
+    if (v < 0) continue;
+    buffer = (buffer << 6) | v;
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out += char((buffer >> bits) & 0xff);
+    }
+  }
+  return out;
+}
+
+/// The page's per-posture flags (1 link, 2 limit held, 4 colliding, 8 colliding motion).
+inline std::vector<std::uint8_t> pageFlags(const std::string& html, const json& meta) {
+  const std::string blob = base64Decode(
+      between(html, "<script type=\"application/octet-stream\" id=\"fp-blob\">", "</script>"));
+  const json ref = meta["path"]["flags"];
+  const std::size_t offset = ref["offset"], count = ref["count"];
+  return {blob.begin() + offset, blob.begin() + offset + count};
+}
+
+inline std::size_t countBit(const std::vector<std::uint8_t>& flags, int bit) {
+  return std::count_if(flags.begin(), flags.end(), [bit](std::uint8_t f) { return f & bit; });
+}
+
+inline bool oneLine(const std::string& text) {
+  return !text.empty() && text.find('\n') == text.size() - 1;
+}
+
+}  // namespace fieldpath::app::test::view
