@@ -142,12 +142,6 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     if (!scene.tool_given)
       throw InputError(scene.file.string() + ": tool: missing: check needs the cutter (`tool: { "
                                              "shape: ball, radius: R, length: L }`)");
-    if (scene.tool.shape != geometry::ToolShape::Ball)
-      throw InputError(
-          scene.file.string() +
-          (scene.tool_shape_line > 0 ? ":" + std::to_string(scene.tool_shape_line) : "") +
-          ": tool.shape: check is for ball-end mills (its surface check models the ball's "
-          "cut; `simulate --tool torus:R:r` or `flat:R` cuts with the others)");
     const std::vector<std::string> tool_notes = cutterNotes(scene.tool, path);
     const pathgen::AxisTurn axis_turn = pathgen::largestAxisTurn(path, scene.tool.radius_mm);
 

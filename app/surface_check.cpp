@@ -314,11 +314,15 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   for (float& h : sim.initial_heights_mm) h = (std::isnan(h) ? top : h) + kStockAllowanceMm;
   sim.progress = request.progress;
   // Sweep the motions: a straight move between two cutting postures over a concave part, or a
-  // link that dips into it, cuts between them. Stamps `step` apart leave a ball's cut at most
-  // step² / (8 R) shallower than the swept one: a quarter of the gouge tolerance.
+  // link that dips into it, cuts between them. Stamps `step` apart leave a cutting edge of
+  // radius of curvature ρ at most step² / (8 ρ) shallower than the swept one: a quarter of the
+  // gouge tolerance. ρ: the ball's R, a torus's corner r; a flat end's rim is sharp, and its
+  // stamps leave at most that of its footprint circle (R) uncut at the sides of the cut.
   const double tol_mm = 1e-3 * request.gouge_tolerance_um;
-  result.sweep_step_mm = std::max(0.5 * spacing, std::sqrt(2.0 * radius * tol_mm));
-  result.sweep_error_um = 1e3 * result.sweep_step_mm * result.sweep_step_mm / (8.0 * radius);
+  const double edge_mm =
+      request.tool.shape == geometry::ToolShape::Torus ? request.tool.corner_radius_mm : radius;
+  result.sweep_step_mm = std::max(0.5 * spacing, std::sqrt(2.0 * edge_mm * tol_mm));
+  result.sweep_error_um = 1e3 * result.sweep_step_mm * result.sweep_step_mm / (8.0 * edge_mm);
   const std::vector<geometry::Posture> swept = sweptPostures(
       postures_local, zbuffer::toolReach(sim.tool), result.sweep_step_mm, top + kStockAllowanceMm);
   result.simulated_postures = swept.size();

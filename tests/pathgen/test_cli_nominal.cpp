@@ -222,12 +222,6 @@ TEST_F(MeshJob, BadNominalPathsAndMeshesAreOneLineErrorsWithNoOutputs) {
     EXPECT_NE(output.find(c.expected), std::string::npos) << output;
     EXPECT_FALSE(fs::exists(dir_->path() / "bad_out")) << c.expected;
   }
-  // check refuses it too, at the same line.
-  const auto r = test::runFieldpath(*dir_, "check bad.yaml --path nominal.cl --out bad_out");
-  EXPECT_EQ(r.exit_code, 1) << r.output();
-  EXPECT_NE(r.err.find("bad.yaml:4: tool.shape: check is for ball-end mills"), std::string::npos)
-      << r.err;
-  EXPECT_FALSE(fs::exists(dir_->path() / "bad_out"));
 }
 
 // A stiff scene whose tilt runs into max_lead_deg: with on_limit clamp (the default) a path and
@@ -269,6 +263,54 @@ TEST(StiffScene, ClampGivesAPathAndACountFailStops) {
   EXPECT_FALSE(fs::exists(dir.path() / "fail"));
 }
 
+
+// `check` with torus and flat end mills (it took ball-end mills only): two straight passes along
+// x over a plate (top at z = 0), tips on it, 5 mm apart in y. Midway (2.5 mm from each axis) a
+// torus R 3 r 1 leaves its corner's height there, r - sqrt(r² - (2.5 - (R - r))²) = 134 um; a
+// flat end R 3 cuts it to the plate (no scallop); neither gouges. The same passes 0.3 mm lower
+// gouge 300 um.
+TEST(CheckSurface, TorusAndFlatEndMillsAreCheckedAgainstTheirClosedForms) {
+  const TempDir dir;
+  geometry::TriangleMesh part, wall;
+  pathgen::test::addBox(part, -10, 30, -15, 15, -5, 0);
+  pathgen::test::addBox(wall, 60, 70, -10, 10, 0, 5);  // an obstacle far away (a scene needs one)
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  auto passes = [](double z) {
+    std::ostringstream cl;
+    cl << "# pass 1\n";
+    for (int k = 0; k <= 40; ++k) cl << 0.5 * k << " -2.5 " << z << " 0 0 1\n";
+    cl << "# link\n20 -2.5 5 0 0 1\n0 2.5 5 0 0 1\n# pass 2\n";
+    for (int k = 0; k <= 40; ++k) cl << 0.5 * k << " 2.5 " << z << " 0 0 1\n";
+    return cl.str();
+  };
+  dir.write("on.cl", passes(0.0));
+  dir.write("low.cl", passes(-0.3));
+  auto surface = [&](const std::string& tool, const std::string& path) {
+    dir.write("scene.yaml", "obstacles:\n  - mesh: wall.stl\npart: part.stl\ntool: " + tool +
+                                "\nclearance: 0.5\n");
+    const std::string out = "out_" + std::to_string(std::hash<std::string>{}(tool + path));
+    const auto r = test::runFieldpath(dir, "check scene.yaml --path " + path +
+                                               " --spacing 0.02 --backend cpu --out " + out);
+    EXPECT_EQ(r.exit_code, 0) << r.output();
+    return nlohmann::json::parse(test::slurp(dir.path() / out / "check.json"))["surface"];
+  };
+  const std::string torus = "{ shape: torus, radius: 3, corner_radius: 1, length: 20 }";
+  const std::string flat = "{ shape: flat, radius: 3, length: 20 }";
+  const double scallop_um = 1000.0 * (1.0 - std::sqrt(1.0 - 0.5 * 0.5));
+  // Lines within half a spacing of the midline: the corner's slope there 0.5 / sqrt(0.75).
+  const double tolerance_um = 1000.0 * 0.01 * 0.5 / std::sqrt(0.75) + 1.0;
+  const auto t = surface(torus, "on.cl");
+  EXPECT_NEAR(t["max_scallop_um"].get<double>(), scallop_um, tolerance_um) << t;
+  EXPECT_LT(t["max_gouge_um"].get<double>(), 0.5) << t;
+  const auto f = surface(flat, "on.cl");
+  EXPECT_LT(f["max_scallop_um"].get<double>(), 1.0) << f;
+  EXPECT_LT(f["max_gouge_um"].get<double>(), 0.5) << f;
+  for (const std::string& tool : {torus, flat}) {
+    const auto low = surface(tool, "low.cl");
+    EXPECT_NEAR(low["max_gouge_um"].get<double>(), 300.0, 1.0) << tool << low;
+  }
+}
 
 // `check` cuts along the motions, not only at the postures: two postures on a floor either side
 // of a ridge 1 mm high, each clear of it, and the straight move between them through the ridge.
