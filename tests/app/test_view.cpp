@@ -24,15 +24,7 @@
 #include "view_data.h"
 #include "view_pages.h"
 
-namespace fs = std::filesystem;
-using fieldpath::app::test::Outcome;
-using fieldpath::app::test::runFieldpath;
-using fieldpath::app::test::slurp;
-using fieldpath::app::test::squareStl;
-using fieldpath::app::test::TempDir;
-using nlohmann::json;
-using namespace fieldpath::app::test::view;
-
+using namespace fieldpath::app::test::view;  // fs, json, the files.h helpers
 
 TEST(View, PageAgreesWithCheckJson) {
   const TempDir dir;

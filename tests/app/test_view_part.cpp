@@ -12,13 +12,7 @@
 #include "files.h"
 #include "view_pages.h"
 
-namespace fs = std::filesystem;
-using fieldpath::app::test::Outcome;
-using fieldpath::app::test::runFieldpath;
-using fieldpath::app::test::slurp;
-using fieldpath::app::test::TempDir;
-using nlohmann::json;
-using namespace fieldpath::app::test::view;
+using namespace fieldpath::app::test::view;  // fs, json, the files.h helpers
 
 TEST(View, PartContactsAreMarkedAsCheckFindsThem) {
   // A link that dips 2 mm through the floor (the part) beside the block: check finds the dip's

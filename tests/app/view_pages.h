@@ -17,6 +17,12 @@ namespace fieldpath::app::test::view {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+// What the tests call from files.h, brought in with this namespace.
+using fieldpath::app::test::Outcome;
+using fieldpath::app::test::runFieldpath;
+using fieldpath::app::test::slurp;
+using fieldpath::app::test::squareStl;
+using fieldpath::app::test::TempDir;
 
 inline const fs::path kImpellerScene =
     fs::path(FIELDPATH_SOURCE_DIR) / "examples/impeller/scene.yaml";
