@@ -316,8 +316,8 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   // Sweep the motions: a straight move between two cutting postures over a concave part, or a
   // link that dips into it, cuts between them. Stamps `step` apart leave a cutting edge of
   // radius of curvature ρ at most step² / (8 ρ) shallower than the swept one: a quarter of the
-  // gouge tolerance. ρ: the ball's R, a torus's corner r; a flat end's rim is sharp, and its
-  // stamps leave at most that of its footprint circle (R) uncut at the sides of the cut.
+  // gouge tolerance. ρ: the ball's R, a torus's corner r (check refuses a flat end: its sharp
+  // rim, tilted, leaves step · tan(tilt), which this spacing does not bound).
   const double tol_mm = 1e-3 * request.gouge_tolerance_um;
   const double edge_mm =
       request.tool.shape == geometry::ToolShape::Torus ? request.tool.corner_radius_mm : radius;

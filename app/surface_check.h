@@ -50,7 +50,7 @@ struct SurfaceResult {
   bool coarsened = false;  ///< the spacing was widened to stay within kMaxSurfaceLines
   /// The motions are swept: postures interpolated no farther apart than this (mm) where the tool
   /// can reach the stock; the cut between two of them is at most sweep_error_um shallower (the
-  /// cutting edge's curvature: a ball's R, a torus's corner r, a flat end's footprint R).
+  /// cutting edge's curvature: a ball's R, a torus's corner r).
   double sweep_step_mm = 0, sweep_error_um = 0;
   std::size_t simulated_postures = 0;  ///< the path's and the interpolated ones
   std::size_t cut_lines = 0;           ///< lines the tool lowered (0: it never reached the part)
