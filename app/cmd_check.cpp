@@ -146,11 +146,10 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     // by up to step · tan(tilt) (30 um at 10 deg; a helper's 10 um ridge passed), not the
     // curvature bound the stamps are spaced by. Ball and torus (the corner's curvature) only.
     if (scene.tool.shape == geometry::ToolShape::Flat)
-      throw InputError(
-          scene.file.string() +
-          (scene.tool_shape_line > 0 ? ":" + std::to_string(scene.tool_shape_line) : "") +
-          ": tool.shape: check proves ball and torus tools; a flat end's sharp rim, tilted, is "
-          "not bounded by its Z-buffer stamps yet (`simulate --tool flat:R` cuts with it)");
+      throw InputError(toolShapeWhere(scene) +
+                       ": check proves ball and torus tools; a flat end's sharp rim, tilted, is "
+                       "not bounded by its Z-buffer stamps yet (`simulate --tool flat:R` cuts "
+                       "with it)");
     const std::vector<std::string> tool_notes = cutterNotes(scene.tool, path);
     const pathgen::AxisTurn axis_turn = pathgen::largestAxisTurn(path, scene.tool.radius_mm);
 

@@ -37,7 +37,7 @@ using geometry::kRadToDeg;
 constexpr double kNoteLeanDeg = 1.0;
 
 nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& job,
-                          const pathgen::GenerateResult& r) {
+                          const pathgen::GenerateResult& r, const pathgen::AxisTurn& axis_turn) {
   using nlohmann::json;
   json passes = json::array();
   for (const pathgen::Pass& pass : r.passes) {
@@ -121,7 +121,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
                                       {"s_mm", r.postures[r.first_limited].s_mm}})}}},
       {"max_tilt_deg", r.max_tilt_deg},
       {"max_lead_deg", r.max_lead_deg},
-      {"axis_turn", axisTurnJson(pathgen::largestAxisTurn(r.path, job.tool.radius_mm))},
+      {"axis_turn", axisTurnJson(axis_turn)},
       {"solver",
        {{"steps", r.solver_steps},
         {"rhs_evals", r.rhs_evals},
@@ -250,7 +250,9 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     header.feed_mm_per_min = job.dynamics.feed_mm_per_min;
     geometry::writeAptFile(out / "path.apt", result.path, header);
     common::writeTextAtomically(out / "angles.csv", anglesCsv(result));
-    common::writeTextAtomically(out / "report.json", jsonText(reportJson(scene, job, result)));
+    const pathgen::AxisTurn axis_turn = pathgen::largestAxisTurn(result.path, job.tool.radius_mm);
+    common::writeTextAtomically(out / "report.json",
+                                jsonText(reportJson(scene, job, result, axis_turn)));
 
     const auto& c = result.clearance;
     const auto& m = result.motions;
@@ -272,9 +274,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                    m.under_required);
     // (the jumps of a field pushing a tool that has no room: 30 deg in 0.5 mm in a pocket
     // narrower than the holder; unsafe there too, but the turn is its own warning)
-    if (const std::string turn = axisTurnWarning(
-            result.path, pathgen::largestAxisTurn(result.path, job.tool.radius_mm));
-        !turn.empty())
+    if (const std::string turn = axisTurnWarning(result.path, axis_turn); !turn.empty())
       std::fprintf(stderr, "warning: %s (report.json axis_turn)\n", turn.c_str());
     if (scene.nominal)
       for (const std::string& note : cutterNotes(scene.tool, *scene.nominal))

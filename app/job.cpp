@@ -34,10 +34,7 @@ pathgen::GenerateRequest sceneJob(const Scene& scene) {
   job.obstacles = scene.obstacles;  // the impeller's blades included (resolveImpeller)
   job.part = scene.part;
   if (job.tool.shape != geometry::ToolShape::Ball)
-    throw InputError(
-        scene.file.string() +
-        (scene.tool_shape_line > 0 ? ":" + std::to_string(scene.tool_shape_line) : "") +
-        ": tool.shape: the passes are for a ball-end mill (shape: ball)");
+    throw InputError(toolShapeWhere(scene) + ": the passes are for a ball-end mill (shape: ball)");
   job.passes = impeller ? pathgen::impellerPasses(*scene.impeller_model, job.path,
                                                   job.tool.radius_mm)
                         : pathgen::nominalPasses(*scene.nominal, job.path, job.tool.radius_mm);

@@ -131,7 +131,7 @@ inline nlohmann::json axisTurnJson(const pathgen::AxisTurn& t) {
 /// The warning for a turn over kNoteAxisTurnDeg (empty otherwise), postures numbered from 0 with
 /// the file's line where it has one.
 inline std::string axisTurnWarning(const geometry::PathFile& path, const pathgen::AxisTurn& t) {
-  if (t.at == pathgen::ClearanceResult::npos || !(t.deg > pathgen::kNoteAxisTurnDeg)) return {};
+  if (t.at == pathgen::AxisTurn{}.at || !(t.deg > pathgen::kNoteAxisTurnDeg)) return {};
   auto name = [&](std::size_t i) {
     return std::to_string(i) + (i < path.lines.size() ? " (" + path.where(i) + ")" : "");
   };

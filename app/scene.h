@@ -61,6 +61,13 @@ struct Scene {
 /// scene's `path.nominal` is then not read (a stale or broken one does not stop them).
 Scene loadScene(const std::filesystem::path& file, bool read_nominal = true);
 
+/// "FILE:LINE: tool.shape" (LINE where known): the start of a refusal of the scene's tool.
+inline std::string toolShapeWhere(const Scene& scene) {
+  return scene.file.string() +
+         (scene.tool_shape_line > 0 ? ":" + std::to_string(scene.tool_shape_line) : "") +
+         ": tool.shape";
+}
+
 /// Turns scene.impeller / scene.guide_impeller into meshes (obstacles, part) and
 /// scene.impeller_model. Lives in scene_impeller.cpp (the impeller's owner replaces it).
 void resolveImpeller(Scene& scene);
