@@ -36,10 +36,24 @@ using geometry::kRadToDeg;
 /// steering starts from path.lead_deg, not from the file's lead.
 constexpr double kNoteLeanDeg = 1.0;
 
+const char* startPolicyName(dynamics::StartPolicy start) {
+  switch (start) {
+    case dynamics::StartPolicy::Auto:
+      return "auto";
+    case dynamics::StartPolicy::Nominal:
+      return "nominal";
+    case dynamics::StartPolicy::Settled:
+      return "settled";
+  }
+  return "?";
+}
+
 nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& job,
                           const pathgen::GenerateResult& r, const pathgen::AxisTurn& axis_turn) {
   using nlohmann::json;
   json passes = json::array();
+  json settled = json::array();  // 1-based, as per_pass
+  for (const int p : r.settled_starts) settled.push_back(p + 1);
   for (const pathgen::Pass& pass : r.passes) {
     double min_clearance = INFINITY, max_tilt = 0;
     int postures = 0, colliding = 0;
@@ -57,7 +71,9 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
                       {"postures", postures},
                       {"min_clearance_mm", jsonNumber(min_clearance)},
                       {"max_tilt_deg", max_tilt},
-                      {"colliding_postures", colliding}});
+                      {"colliding_postures", colliding},
+                      {"settled_start", std::find(r.settled_starts.begin(), r.settled_starts.end(),
+                                                  pass.index) != r.settled_starts.end()}});
   }
   const auto& box = r.reach_box_mm;
   const std::vector<std::string> unsafe = unsafeReasons(r.clearance, r.motions, r.link_part, r.holder_part);
@@ -122,6 +138,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"max_tilt_deg", r.max_tilt_deg},
       {"max_lead_deg", r.max_lead_deg},
       {"axis_turn", axisTurnJson(axis_turn)},
+      {"start", {{"policy", startPolicyName(job.dynamics.start)}, {"settled_passes", settled}}},
       {"solver",
        {{"steps", r.solver_steps},
         {"rhs_evals", r.rhs_evals},
@@ -290,6 +307,14 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                     leanest->nominal_lean_at.c_str(), leanest->nominal_lean_deg,
                     job.path.lead_deg);
     }
+    if (!result.settled_starts.empty() && job.dynamics.start == dynamics::StartPolicy::Auto)
+      std::printf(
+          "note: %zu pass%s (first: pass %d) started from the axis settled under the field "
+          "at %s start: %s nominal start posture was within `clearance` of an obstacle "
+          "(dynamics.start: auto; `nominal` starts there and collides)\n",
+          result.settled_starts.size(), result.settled_starts.size() == 1 ? "" : "es",
+          result.settled_starts.front() + 1, result.settled_starts.size() == 1 ? "its" : "their",
+          result.settled_starts.size() == 1 ? "its" : "each one's");
     if (result.safe_z_proven_mm > 0.0)
       std::printf("note: links.safe_z %g mm leaves the links within the checks' margin of "
                   "`clearance` (the tool mesh's chordal tolerance, the motions' resolution): they "

@@ -287,7 +287,7 @@ void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
 void readDynamics(const Reader& r, const YAML::Node& node, dynamics::DynamicsParams& d) {
   r.expectMap(node, "dynamics",
               {"inertia", "damping", "stiffness", "feed", "rtol", "atol", "max_tilt_deg",
-               "max_lead_deg", "on_limit", "integrator"});
+               "max_lead_deg", "on_limit", "integrator", "start"});
   if (node["inertia"]) d.inertia = r.positive(node["inertia"], "dynamics.inertia");
   if (node["damping"]) {
     if (node["damping"].IsScalar() && node["damping"].Scalar() == "critical")
@@ -312,6 +312,13 @@ void readDynamics(const Reader& r, const YAML::Node& node, dynamics::DynamicsPar
     d.on_limit = r.word(node["on_limit"], "dynamics.on_limit", {"clamp", "fail"}) == "clamp"
                      ? dynamics::LimitPolicy::Clamp
                      : dynamics::LimitPolicy::Fail;
+  if (node["start"]) {
+    const std::string start =
+        r.word(node["start"], "dynamics.start", {"auto", "nominal", "settled"});
+    d.start = start == "auto"      ? dynamics::StartPolicy::Auto
+              : start == "nominal" ? dynamics::StartPolicy::Nominal
+                                   : dynamics::StartPolicy::Settled;
+  }
   if (node["integrator"])
     d.integrator = r.word(node["integrator"], "dynamics.integrator", {"bdf", "erk"}) == "bdf"
                        ? dynamics::Integrator::Bdf

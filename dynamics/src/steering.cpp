@@ -363,4 +363,50 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
   return result;
 }
 
+SettledStart settleAtStart(const Pass& pass, const SteeringRequest& request) {
+  validate(pass, request);
+  SettledStart out;
+  const double c = request.params.effectiveDamping();
+  if (!(c > 0.0)) {
+    out.why = "no damping (dynamics.damping: 0): the axis never comes to rest";
+    return out;
+  }
+  // The first frame held, one decay time 2J/c at a time (as a pass of that length at the feed,
+  // stations as far apart as the pass's: the limits are applied as often), each from where the
+  // last one ended, until the axis moves less than kSettledRad in one or kSettleDecays are run.
+  const double v = request.params.feed_mm_per_min / 60.0;
+  const PassFrame first = pass.frameAt(0.0);
+  Pass held;
+  held.length_mm = 2.0 * request.params.inertia / c * v;
+  held.frameAt = [first](double) { return first; };
+  SteeringRequest run = request;
+  run.output_s_mm.clear();
+  run.step_mm = std::min(request.step_mm, held.length_mm);
+  run.initial_lead_rad = first.lead0_rad;
+  run.initial_tilt_rad = first.tilt0_rad;
+  run.initial_lead_rate_rad_per_s = run.initial_tilt_rate_rad_per_s = 0.0;
+  run.max_angle_change_deg_per_mm = 0.0;  // the settling is not machined
+  run.clearance = nullptr;
+  run.progress = nullptr;
+  for (int decay = 0; decay < int(kSettleDecays); ++decay) {
+    const SteeringResult chunk = steerPass(held, run);
+    if (chunk.status != Status::Ok || chunk.samples.empty()) {
+      out.why = chunk.message.empty() ? "no sample" : chunk.message;
+      return out;
+    }
+    const PostureSample& end = chunk.samples.back();
+    const double moved = std::max(std::abs(end.lead_rad - *run.initial_lead_rad),
+                                  std::abs(end.tilt_rad - *run.initial_tilt_rad));
+    run.initial_lead_rad = end.lead_rad;
+    run.initial_tilt_rad = end.tilt_rad;
+    run.initial_lead_rate_rad_per_s = end.lead_rate_rad_per_s;
+    run.initial_tilt_rate_rad_per_s = end.tilt_rate_rad_per_s;
+    if (moved < kSettledRad && decay > 0) break;
+  }
+  out.settled = true;
+  out.lead_rad = *run.initial_lead_rad;
+  out.tilt_rad = *run.initial_tilt_rad;
+  return out;
+}
+
 }  // namespace fieldpath::dynamics

@@ -152,6 +152,20 @@ GenerateResult generatePath(const GenerateRequest& request) {
   // order: the output is the serial run's bit for bit (each pass's solver sees the same inputs;
   // the field's evaluate is deterministic per point). Progress counts finished passes.
   const int pass_count = static_cast<int>(result.passes.size());
+  // Which passes start from the axis settled at their start (dynamics.start): decided once, on
+  // the nominal start posture's exact clearance, so that both steerings (near the path, final)
+  // start the same passes settled.
+  std::vector<char> settle(result.passes.size(), 0);
+  if (!request.nominal && request.dynamics.start != dynamics::StartPolicy::Nominal)
+    for (std::size_t p = 0; p < result.passes.size(); ++p) {
+      const Pass& pass = result.passes[p];
+      settle[p] = request.dynamics.start == dynamics::StartPolicy::Settled ||
+                  (!pass.samples.empty() &&
+                   checker.clearance(geometry::ballEndPosture(
+                       pass.samples.front().centre_mm, nominalAxis(pass.samples.front(), lead_rad),
+                       r)) < request.clearance_mm);
+    }
+  std::vector<char> started_settled(result.passes.size(), 0);
   struct Steered {
     std::vector<GeneratedPosture> postures;
     dynamics::SolverStats stats;
@@ -162,6 +176,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
   auto steerPasses = [&](const field::ForceField* field, bool report,
                          const dynamics::DynamicsParams& params) {
     std::vector<Steered> steered_passes(result.passes.size());
+    std::fill(started_settled.begin(), started_settled.end(), 0);  // this steering's own
     int passes_done = 0;
     // Each pass's fraction done (its solver's intervals): the bar moves within a pass too (a
     // wide r0 makes one pass take minutes).
@@ -215,6 +230,14 @@ GenerateResult generatePath(const GenerateRequest& request) {
           pass_done[p] = std::clamp(fraction, 0.0, 1.0);
           return request.progress(fractionDone(), "passes");
         };
+      if (settle[p]) {
+        const dynamics::SettledStart at_rest = dynamics::settleAtStart(dyn_pass, steer);
+        if (at_rest.settled) {  // else the nominal start: the pass reports what goes wrong
+          steer.initial_lead_rad = at_rest.lead_rad;
+          steer.initial_tilt_rad = at_rest.tilt_rad;
+          started_settled[p] = 1;
+        }
+      }
       const dynamics::SteeringResult steered = dynamics::steerPass(dyn_pass, steer);
       if (steered.status != dynamics::Status::Ok) {
         std::ostringstream msg;
@@ -394,6 +417,8 @@ GenerateResult generatePath(const GenerateRequest& request) {
   // The first failure in pass order, as the serial loop would have thrown it.
   for (const Steered& s : steered_passes)
     if (s.error) std::rethrow_exception(s.error);
+  for (std::size_t p = 0; p < result.passes.size(); ++p)
+    if (started_settled[p]) result.settled_starts.push_back(result.passes[p].index);
   for (Steered& s : steered_passes) {
     for (GeneratedPosture& g : s.postures) {
       if (g.limited && result.first_limited == ClearanceResult::npos)

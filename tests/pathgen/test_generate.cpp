@@ -48,6 +48,7 @@ TEST(Generate, NoForceGivesTheNominalPath) {
     EXPECT_GT(g.clearance_mm, 10.0);
   }
   EXPECT_EQ(field.clearance.colliding, 0u);
+  EXPECT_TRUE(field.settled_starts.empty());  // clear starts keep the nominal axis (start: auto)
   EXPECT_NEAR(field.path_length_mm, 144.0, 1e-9);
   EXPECT_GT(field.obstacle_points, 0u);
   EXPECT_GT(field.tool_nodes, 400u);
@@ -141,4 +142,46 @@ TEST(Generate, RefinementNearThePathGivesThePathOfRefinementEverywhere) {
   EXPECT_LT(near.voxel_outside_points,
             std::size_t(near.rhs_evals) * near.tool_nodes / 2);  // mostly voxels
   EXPECT_EQ(all.voxel_outside_points, 0u);
+}
+
+// A pass along a tall wall whose nominal (upright) axis puts the holder into it. Started at the
+// nominal axis (dynamics.start: nominal, seed 004's), the pass begins colliding and swings to its
+// limits at once; `auto` (the default) sees the nominal start posture within `clearance` and
+// starts from the axis settled under the field there: no collision, no swing. (A pass whose
+// start is clear keeps the nominal start: NoForceGivesTheNominalPath.)
+TEST(Generate, APassStartingInCollisionStartsFromTheSettledAxis) {
+  GenerateRequest job;
+  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
+  job.holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
+  job.mode = FieldMode::Direct;
+  job.field.r0_mm = 8.0;
+  job.field.sample_step_mm = 2.0;
+  job.obstacles = {test::boxMesh(20, 22, -25, 25, -5, 60)};  // the holder's r 12 reaches x = 27
+  job.part = test::boxMesh(-30, 20, -25, 25, -5, 0);         // the floor machined
+  std::vector<geometry::Posture> nominal;
+  for (int k = 0; k <= 60; ++k)  // the ball on the floor 2 mm from the wall, along it
+    nominal.push_back({Vec3(15, -15 + 0.5 * k, 0), Vec3::UnitZ(), 0.0, false});
+  job.passes = nominalPasses(geometry::singlePass(std::move(nominal)), PathParams{}, 3.0);
+  ASSERT_EQ(job.passes.size(), 1u);
+
+  GenerateRequest at_nominal = job;
+  at_nominal.dynamics.start = dynamics::StartPolicy::Nominal;
+  const GenerateResult swung = generatePath(at_nominal);
+  EXPECT_TRUE(swung.settled_starts.empty());
+  EXPECT_GT(swung.clearance.colliding, 0u);  // the first posture, holder in the wall
+  EXPECT_LE(swung.postures.front().clearance_mm, 0.0);
+
+  const GenerateResult settled = generatePath(job);
+  EXPECT_EQ(settled.settled_starts, std::vector<int>{0});
+  EXPECT_EQ(settled.clearance.colliding, 0u);
+  EXPECT_EQ(settled.motions.colliding, 0u);
+  EXPECT_GE(settled.clearance.min_clearance_mm, job.clearance_mm);
+  // Tilted away from the wall (+x) from the first posture on, and steady; the nominal start
+  // swings over 10° in its first step.
+  const double first_tilt = settled.postures.front().tilt_rad;
+  EXPECT_GT(std::abs(first_tilt), 20.0 * M_PI / 180.0);
+  EXPECT_LT(settled.postures.front().posture.axis.x(), 0.0);
+  for (const GeneratedPosture& g : settled.postures)
+    EXPECT_NEAR(g.tilt_rad, first_tilt, 0.1 * M_PI / 180.0) << g.s_mm;
+  EXPECT_GT(std::abs(swung.postures[1].tilt_rad - swung.postures[0].tilt_rad), 10.0 * M_PI / 180.0);
 }

@@ -12,6 +12,15 @@ enum class LimitPolicy {
   Fail,   ///< `fail`: stop; status TiltLimit / RateLimit and a message naming the arc length
 };  ///< CVODE BDF (default) or ARKODE ERK (explicit reference)
 
+/// `start`: the axis a pass starts from (DESIGN.md leaves it open; seed 004 starts at the
+/// nominal angles). A pass whose nominal start posture already crowds an obstacle would begin
+/// colliding and then swing at once; settled, it begins where the field and the spring balance.
+enum class StartPolicy {
+  Auto,     ///< `auto`: settled where the nominal start posture is within `clearance` (pathgen)
+  Nominal,  ///< `nominal`: the nominal angles at rest
+  Settled,  ///< `settled`: the axis at rest under the field at the pass's first frame
+};
+
 /// Torques are in the field's unit times mm (τ = Σ (x_i - C) × F(x_i)); time in seconds.
 struct DynamicsParams {
   double inertia = 1.0;  ///< J, torque·s²/rad
@@ -26,6 +35,7 @@ struct DynamicsParams {
   double max_lead_deg = 20.0;
   Integrator integrator = Integrator::Bdf;
   LimitPolicy on_limit = LimitPolicy::Clamp;
+  StartPolicy start = StartPolicy::Auto;
 
   /// c, with the critical default resolved.
   double effectiveDamping() const {

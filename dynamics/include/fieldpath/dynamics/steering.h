@@ -101,6 +101,21 @@ struct SteeringResult {
 /// common::Interrupted when the progress hook asks to stop; numerical outcomes are in `status`.
 SteeringResult steerPass(const Pass& pass, const SteeringRequest& request);
 
+/// The axis at rest at a pass's start (DynamicsParams::start): the pass's first frame held while
+/// the spring-damper runs from the nominal angles at rest, one decay time 2J/c after another
+/// (the field's stiffness changes the frequency, not the decay), until the axis moves less than
+/// kSettledRad in one, or for kSettleDecays of them (the amplitude down by e^-20); the angle
+/// limits applied as in the pass. `settled` false (and `why`) where it cannot: no damping, a
+/// limit with on_limit: fail, the solver failing.
+struct SettledStart {
+  bool settled = false;
+  double lead_rad = 0.0, tilt_rad = 0.0;
+  std::string why;
+};
+constexpr double kSettleDecays = 20.0;
+constexpr double kSettledRad = 1e-7;  ///< 6e-6 deg: far below DESIGN's 0.01 deg
+SettledStart settleAtStart(const Pass& pass, const SteeringRequest& request);
+
 /// The moment of the field on the nodes placed at axis angles (lead, tilt) at one pass frame, about
 /// the ball centre: τ = [M·b, M·f]. Used by steerPass and by callers that want the static moment.
 struct AxisMoment {

@@ -127,6 +127,9 @@ struct GenerateResult {
   std::size_t limited_postures = 0;                   ///< where dynamics.on_limit held an angle
   std::size_t limited_colliding = 0;                  ///< of those, colliding ones
   std::size_t first_limited = ClearanceResult::npos;  ///< index into `postures`
+  /// Passes started from the axis settled at their start (dynamics.start: settled, or auto where
+  /// the nominal start posture was within `clearance`), by Pass::index.
+  std::vector<int> settled_starts;
   StageTimes times;
   std::size_t obstacle_points = 0;  ///< field samples
   std::size_t tool_nodes = 0;       ///< tool + holder nodes of the moment

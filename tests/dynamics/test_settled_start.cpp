@@ -1,0 +1,84 @@
+/// A pass started from the axis settled under the field at its start (settleAtStart,
+/// dynamics.start): the static equilibrium k θ = τ(θ) found here by bisection, independently;
+/// the pass then starts at rest there (no swing), and where no rest exists the caller is told.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "analytic_fields.h"
+#include "fieldpath/dynamics/steering.h"
+#include "steering_support.h"
+
+namespace fieldpath::dynamics {
+namespace {
+
+using namespace steering_test;  // with analytic_fields.h's fields
+
+/// The largest change of either angle between consecutive samples (rad).
+double largestStep(const SteeringResult& r) {
+  double worst = 0.0;
+  for (std::size_t i = 1; i < r.samples.size(); ++i)
+    worst = std::max({worst, std::abs(r.samples[i].tilt_rad - r.samples[i - 1].tilt_rad),
+                      std::abs(r.samples[i].lead_rad - r.samples[i - 1].lead_rad)});
+  return worst;
+}
+
+TEST(SettledStart, IsTheStaticEquilibriumAndThePassStartsAtRestThere) {
+  const auto wall = wallAt(3.1);  // the shank starts 0.1 mm from the wall, inside r_min
+  SteeringRequest request = requestFor(wall.get());
+  const Pass pass = straightPass(300.0);  // 18 decay times at the default feed
+  const SettledStart settled = settleAtStart(pass, request);
+  ASSERT_TRUE(settled.settled) << settled.why;
+  const double expected = staticTilt(*wall, request.params.stiffness, 0.0, 0.6);
+  EXPECT_GT(expected, 2.0 * kDeg);
+  EXPECT_NEAR(settled.tilt_rad, expected, 1e-6);
+  EXPECT_NEAR(settled.lead_rad, 0.0, 1e-12);  // a wall along the feed gives no lead moment
+
+  const SteeringResult from_nominal = steerPass(pass, request);
+  request.initial_lead_rad = settled.lead_rad;
+  request.initial_tilt_rad = settled.tilt_rad;
+  const SteeringResult from_rest = runToleranceStable(pass, request);
+  ASSERT_EQ(from_rest.status, Status::Ok) << from_rest.message;
+  // The nominal start swings (1° in its first mm here); the settled one stays.
+  EXPECT_GT(largestStep(from_nominal), 0.1 * expected);
+  EXPECT_LT(largestStep(from_rest), 1e-6);
+  for (const PostureSample& s : from_rest.samples) EXPECT_NEAR(s.tilt_rad, expected, 2e-6);
+  // Both end at rest at the same place.
+  EXPECT_NEAR(from_nominal.samples.back().tilt_rad, from_rest.samples.back().tilt_rad, 1e-6);
+}
+
+TEST(SettledStart, NoFieldNoDeflection) {
+  SteeringRequest request = requestFor(nullptr);
+  const SettledStart settled = settleAtStart(straightPass(10.0), request);
+  ASSERT_TRUE(settled.settled) << settled.why;
+  EXPECT_EQ(settled.tilt_rad, 0.0);
+  EXPECT_EQ(settled.lead_rad, 0.0);
+}
+
+TEST(SettledStart, HeldAtAClampedLimitOrRefusedWhenTheLimitFails) {
+  const auto wall = wallAt(3.1);
+  SteeringRequest request = requestFor(wall.get());
+  request.params.max_tilt_deg = 2.0;  // the equilibrium lies beyond it
+  ASSERT_GT(staticTilt(*wall, 1.0, 0.0, 0.6), 2.0 * kDeg);
+  request.params.on_limit = LimitPolicy::Clamp;
+  const SettledStart clamped = settleAtStart(straightPass(10.0), request);
+  ASSERT_TRUE(clamped.settled) << clamped.why;
+  EXPECT_NEAR(clamped.tilt_rad, 2.0 * kDeg, 1e-12);
+
+  request.params.on_limit = LimitPolicy::Fail;
+  const SettledStart failed = settleAtStart(straightPass(10.0), request);
+  EXPECT_FALSE(failed.settled);
+  EXPECT_NE(failed.why.find("dynamics.max_tilt_deg"), std::string::npos) << failed.why;
+}
+
+TEST(SettledStart, WithoutDampingThereIsNoRest) {
+  const auto wall = wallAt(3.1);
+  SteeringRequest request = requestFor(wall.get());
+  request.params.damping = 0.0;
+  const SettledStart settled = settleAtStart(straightPass(10.0), request);
+  EXPECT_FALSE(settled.settled);
+  EXPECT_NE(settled.why.find("dynamics.damping"), std::string::npos) << settled.why;
+}
+
+}  // namespace
+}  // namespace fieldpath::dynamics
