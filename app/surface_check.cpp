@@ -58,16 +58,54 @@ std::vector<Vec2> resampled(const std::vector<Vec2>& line, std::size_t count) {
   return out;
 }
 
+/// The part's upward unit normal at plan point p, from its top heights on the grid (central
+/// differences of the lines either side of the nearest one; a facet's own slope on a mesh); +z
+/// where the part or a neighbour line is missing.
+Vec3 partNormal(const zbuffer::Grid& grid, const std::vector<float>& top, const Vec2& p) {
+  if (grid.nx < 3 || grid.ny < 3) return Vec3::UnitZ();
+  const double fx = (p.x() - grid.x0_mm) / grid.dx_mm - 0.5, fy = (p.y() - grid.y0_mm) / grid.dy_mm - 0.5;
+  if (!std::isfinite(fx) || !std::isfinite(fy)) return Vec3::UnitZ();
+  const int ix = static_cast<int>(std::clamp(std::round(fx), 1.0, grid.nx - 2.0));
+  const int iy = static_cast<int>(std::clamp(std::round(fy), 1.0, grid.ny - 2.0));
+  auto h = [&](int i, int j) { return double(top[static_cast<std::size_t>(j) * grid.nx + i]); };
+  const double gx = (h(ix + 1, iy) - h(ix - 1, iy)) / (2.0 * grid.dx_mm);
+  const double gy = (h(ix, iy + 1) - h(ix, iy - 1)) / (2.0 * grid.dy_mm);
+  if (!std::isfinite(gx) || !std::isfinite(gy)) return Vec3::UnitZ();
+  return Vec3(-gx, -gy, 1.0).normalized();
+}
+
+/// Where a posture's tool touches the part, in plan: the support point, in the direction -n of
+/// the part's normal n there, of its cutting end (a ring of radius R - r, r above the tip, swept
+/// by a ball of radius r; a ball: r = R, its centre less R n). A fixed point from under the tip:
+/// the contact moves with the normal where it lands (a few rounds; a plane's in one).
+Vec2 contactInPlan(const geometry::Posture& p, double radius_mm, double corner_mm,
+                   const zbuffer::Grid& grid, const std::vector<float>& top) {
+  const Vec3& a = p.axis;
+  const Vec3 ring_centre = p.tip_mm + corner_mm * a;
+  Vec2 q(p.tip_mm.x(), p.tip_mm.y());
+  for (int round = 0; round < 4; ++round) {
+    const Vec3 n = partNormal(grid, top, q);
+    const Vec3 u = n - n.dot(a) * a;  // -n's direction in the ring's plane is -u
+    Vec3 point = ring_centre - corner_mm * n;
+    if (u.norm() > 1e-9) point -= (radius_mm - corner_mm) / u.norm() * u;
+    q = Vec2(point.x(), point.y());
+  }
+  return q;
+}
+
 /// The machined band: strips between consecutive passes that are neighbours (their facing points
 /// at most `neighbour_mm` apart on average), and a strip of ±R/2 along a pass with no neighbour.
+/// The passes as their contact points with the part in plan (contactInPlan), not their ball
+/// centres: on a slope those lie R sin(slope) off the contact, and a band of centres took in the
+/// tool's flank beyond the first pass (a tilted plane's 76 um scallop read as 233 um).
 std::vector<char> machinedBand(const zbuffer::Grid& grid, const geometry::PathFile& path,
-                               double radius_mm) {
+                               double radius_mm, double corner_mm, const std::vector<float>& top) {
   std::vector<std::vector<Vec2>> passes;
   for (const auto& [begin, end] : pathgen::passRanges(path, 0.0)) {
     std::vector<Vec2> line;
     for (std::size_t i = begin; i < end; ++i) {
-      const Vec3 c = geometry::ballCentre(path.postures[i], radius_mm);
-      if (line.empty() || (Vec2(c.x(), c.y()) - line.back()).norm() > 1e-9) line.emplace_back(c.x(), c.y());
+      const Vec2 c = contactInPlan(path.postures[i], radius_mm, corner_mm, grid, top);
+      if (line.empty() || (c - line.back()).norm() > 1e-9) line.push_back(c);
     }
     if (line.size() >= 2) passes.push_back(std::move(line));
   }
@@ -333,7 +371,7 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   result.backend = simulated.backend;
   result.simulation_s = simulated.seconds;
   result.cut_lines = simulated.lines_lowered;
-  result.in_band = machinedBand(sim.grid, path, radius);
+  result.in_band = machinedBand(sim.grid, path, radius, edge_mm, nominal);
   result.deviation_um.assign(sim.grid.lineCount(), std::numeric_limits<float>::quiet_NaN());
   double sum = 0, sum2 = 0, min_dev = 0, max_dev = 0;
   for (std::size_t i = 0; i < nominal.size(); ++i) {

@@ -316,6 +316,50 @@ TEST(CheckSurface, TorusEndMillsAreCheckedAgainstTheirClosedFormAndFlatOnesRefus
   EXPECT_FALSE(fs::exists(dir.path() / "flat_out"));
 }
 
+// The scallop statistics are taken between the passes' contact lines, not their ball centres: on
+// the plane z = 0.1 x + 0.4 y a vertical ball R 3 on six passes along x, contact lines 1.2 mm
+// apart in y, leaves R - sqrt(R² - d²/4) across the centre lines' spacing d (70.3 um normal to
+// the plane, 76.1 um in z); the band of the centres, 1.1 mm downhill of the first contact line,
+// took in the ball's flank over unmachined stock (232.7 um, a helper's finding).
+TEST(CheckSurface, ScallopOnASlopeIsBetweenTheContactLines) {
+  const TempDir dir;
+  const double sx = 0.1, sy = 0.4, R = 3.0, p = 1.2;
+  auto z = [&](double x, double y) { return sx * x + sy * y; };
+  geometry::TriangleMesh plane, wall;
+  for (const auto& [x, y] : {std::pair{-5.0, -5.0}, {25.0, -5.0}, {25.0, 15.0}, {-5.0, 15.0}})
+    plane.vertices.emplace_back(x, y, z(x, y));
+  plane.triangles = {{0, 1, 2}, {0, 2, 3}};
+  pathgen::test::addBox(wall, 60, 70, 60, 70, 0, 10);  // far away (a scene needs an obstacle)
+  geometry::saveMesh(plane, dir.path() / "plane.stl");
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  const Eigen::Vector3d n = Eigen::Vector3d(-sx, -sy, 1.0).normalized();
+  std::ostringstream cl;
+  cl.precision(12);
+  for (int k = 0; k < 6; ++k) {
+    if (k > 0) cl << "# link\n20 " << (k - 1) * p << " 20 0 0 1\n0 " << k * p << " 20 0 0 1\n";
+    cl << "# pass " << k + 1 << "\n";
+    for (int i = 0; i <= 40; ++i) {  // the ball centre R along the normal from its contact
+      const Eigen::Vector3d c = Eigen::Vector3d(0.5 * i, k * p, z(0.5 * i, k * p)) + R * n;
+      cl << c.x() << " " << c.y() << " " << c.z() - R << " 0 0 1\n";
+    }
+  }
+  dir.write("slope.cl", cl.str());
+  dir.write("scene.yaml", "obstacles:\n  - mesh: wall.stl\npart: plane.stl\n"
+                          "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
+  const auto r = test::runFieldpath(
+      dir, "check scene.yaml --path slope.cl --spacing 0.02 --backend cpu --out out");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const auto surface = nlohmann::json::parse(test::slurp(dir.path() / "out" / "check.json"))["surface"];
+  // The centre lines' spacing: the step (0, p, sy p) less its part along the passes (1, 0, sx).
+  const Eigen::Vector3d along = Eigen::Vector3d(1, 0, sx).normalized(), step(0, p, sy * p);
+  const double d = (step - step.dot(along) * along).norm();
+  const double scallop_um = 1000.0 * (R - std::sqrt(R * R - 0.25 * d * d)) / n.z();
+  // Lines within half a spacing of a cusp's ridge: the ball's slope there (d/2) / sqrt(R² - d²/4).
+  const double tolerance_um = 1000.0 * 0.01 * 0.5 * d / std::sqrt(R * R - 0.25 * d * d) / n.z() + 1.0;
+  EXPECT_NEAR(surface["max_scallop_um"].get<double>(), scallop_um, tolerance_um) << surface;
+  EXPECT_LT(surface["max_gouge_um"].get<double>(), 0.5) << surface;
+}
+
 // `check` cuts along the motions, not only at the postures: two postures on a floor either side
 // of a ridge 1 mm high, each clear of it, and the straight move between them through the ridge.
 // The gouge is the ridge's height (1000 um, less the sweep's bound); the same postures with the
