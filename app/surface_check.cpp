@@ -63,7 +63,8 @@ std::vector<Vec2> resampled(const std::vector<Vec2>& line, std::size_t count) {
 /// where the part or a neighbour line is missing.
 Vec3 partNormal(const zbuffer::Grid& grid, const std::vector<float>& top, const Vec2& p) {
   if (grid.nx < 3 || grid.ny < 3) return Vec3::UnitZ();
-  const double fx = (p.x() - grid.x0_mm) / grid.dx_mm - 0.5, fy = (p.y() - grid.y0_mm) / grid.dy_mm - 0.5;
+  const double fx = (p.x() - grid.x0_mm) / grid.dx_mm - 0.5,
+               fy = (p.y() - grid.y0_mm) / grid.dy_mm - 0.5;
   if (!std::isfinite(fx) || !std::isfinite(fy)) return Vec3::UnitZ();
   const int ix = static_cast<int>(std::clamp(std::round(fx), 1.0, grid.nx - 2.0));
   const int iy = static_cast<int>(std::clamp(std::round(fy), 1.0, grid.ny - 2.0));

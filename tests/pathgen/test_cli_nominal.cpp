@@ -344,18 +344,21 @@ TEST(CheckSurface, ScallopOnASlopeIsBetweenTheContactLines) {
     }
   }
   dir.write("slope.cl", cl.str());
-  dir.write("scene.yaml", "obstacles:\n  - mesh: wall.stl\npart: plane.stl\n"
-                          "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\npart: plane.stl\n"
+            "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
   const auto r = test::runFieldpath(
       dir, "check scene.yaml --path slope.cl --spacing 0.02 --backend cpu --out out");
   ASSERT_EQ(r.exit_code, 0) << r.output();
-  const auto surface = nlohmann::json::parse(test::slurp(dir.path() / "out" / "check.json"))["surface"];
+  const auto surface =
+      nlohmann::json::parse(test::slurp(dir.path() / "out" / "check.json"))["surface"];
   // The centre lines' spacing: the step (0, p, sy p) less its part along the passes (1, 0, sx).
   const Eigen::Vector3d along = Eigen::Vector3d(1, 0, sx).normalized(), step(0, p, sy * p);
   const double d = (step - step.dot(along) * along).norm();
   const double scallop_um = 1000.0 * (R - std::sqrt(R * R - 0.25 * d * d)) / n.z();
   // Lines within half a spacing of a cusp's ridge: the ball's slope there (d/2) / sqrt(R² - d²/4).
-  const double tolerance_um = 1000.0 * 0.01 * 0.5 * d / std::sqrt(R * R - 0.25 * d * d) / n.z() + 1.0;
+  const double tolerance_um =
+      1000.0 * 0.01 * 0.5 * d / std::sqrt(R * R - 0.25 * d * d) / n.z() + 1.0;
   EXPECT_NEAR(surface["max_scallop_um"].get<double>(), scallop_um, tolerance_um) << surface;
   EXPECT_LT(surface["max_gouge_um"].get<double>(), 0.5) << surface;
 }
