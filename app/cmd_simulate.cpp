@@ -306,6 +306,10 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
           {"spacing_mm", {req.grid.dx_mm, req.grid.dy_mm}}}},
         {"lines_lowered", res.lines_lowered},
         {"heights_mm", {{"min", finiteOrNull(*lo)}, {"max", finiteOrNull(*hi)}}},
+        // What the lines no pass cut still hold (`view` greys them): the stock plane, exactly
+        // as the heights store it (float), or the part's top (--part).
+        {"stock", part ? nlohmann::json{{"part", o->part}}
+                       : nlohmann::json{{"plane_mm", double(req.stock_mm)}}},
         {"backend", zb::backendName(res.backend)},
         {"backend_asked", choice},
         {"streamed", streamed},

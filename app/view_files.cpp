@@ -185,11 +185,32 @@ ViewSurface readSurface(const fs::path& dir, const Scene& scene, std::size_t max
     const zbuffer::ToolMesh part = toZbuffer(*scene.part);
     top = zbuffer::partTop(s.grid, part.vertices, part.triangles);
   }
-  // simulate's stock is a plane (or the part's top): lines still at its highest were never cut.
+  // Lines no pass cut keep simulate's stock: its plane (simulate.json `stock.plane_mm`, stored
+  // as the heights are, in float: a line at it was never lowered), or the part's top (`--part`:
+  // the scene's part at the block). Without simulate.json (older folders, --outputs without
+  // json), lines at the highest height: wrong where every line was cut (the highest cusps then
+  // read as uncut), so simulate.json's `lines_lowered` equal to the line count overrides it.
   float stock = -INFINITY;
-  if (!deviation)
+  bool part_stock = false, all_cut = false;
+  if (!deviation) {
     for (float v : values)
       if (std::isfinite(v)) stock = std::max(stock, v);
+    if (fs::exists(dir / "simulate.json")) {
+      const json j = view_files::readJson(dir / "simulate.json");
+      all_cut = j.value("lines_lowered", std::size_t{0}) == source.lineCount();
+      if (j.contains("stock") && j["stock"].is_object()) {
+        const json& st = j["stock"];
+        if (st.contains("plane_mm") && st["plane_mm"].is_number())
+          stock = static_cast<float>(st["plane_mm"].get<double>());
+        part_stock = st.contains("part") && scene.part.has_value();
+      }
+    }
+  }
+  auto uncut = [&](float lowest, std::size_t b) {
+    if (all_cut) return false;
+    if (part_stock) return std::isfinite(top[b]) && lowest >= top[b] - 1e-4f;
+    return lowest >= stock - 1e-4f;
+  };
   constexpr float kUncut = 1e30f;  // value of a block never cut (grey on the page)
   // Block representative: deviation: its deepest gouge if it has one, else its largest scallop
   // (a gouge is never averaged away); heights: the lowest (deepest cut).
@@ -211,7 +232,7 @@ ViewSurface readSurface(const fs::path& dir, const Scene& scene, std::size_t max
         s.height_mm[b] = top[b] + dev * 1e-3f;  // NaN where the block centre misses the part
       } else {
         s.height_mm[b] = lo;
-        s.value[b] = lo >= stock - 1e-4f ? kUncut : scene.part ? (lo - top[b]) * 1e3f : lo;
+        s.value[b] = uncut(lo, b) ? kUncut : scene.part ? (lo - top[b]) * 1e3f : lo;
       }
     }
   s.deviation = deviation || scene.part.has_value();

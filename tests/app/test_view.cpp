@@ -196,6 +196,53 @@ TEST(View, TiltLeadAndArcLengthAgreeWithGenerate) {
   EXPECT_GT(max_tilt, 1.0);  // the wall did tilt the tool
 }
 
+// A simulated surface's lines that no pass cut are greyed (the page's uncut marker) from the
+// stock simulate.json records, not from the highest height: in a zoom that every pass reaches
+// (11 passes 1 mm apart under a ball R 3, every line lowered), the highest lines are the cusps
+// between passes and postures, cut (they read as uncut before: a helper's finding); a region
+// reaching past the passes keeps its uncut corners grey.
+TEST(View, ASimulatedZoomCutEverywhereHasNoUncutLines) {
+  const TempDir dir;
+  dir.write("floor.stl", squareStl(30, 0));
+  dir.write("block.stl", boxStl(60, 60, 0, 70, 70, 10));
+  std::ostringstream cl;
+  for (int k = 0; k <= 10; ++k) {
+    cl << "# pass " << k + 1 << "\n";
+    for (int i = 0; i <= 40; ++i) cl << 0.5 * i << ' ' << k << " 0 0 0 1\n";
+  }
+  dir.write("flat.cl", cl.str());
+  dir.write("scene.yaml", "obstacles:\n  - mesh: block.stl\npart: floor.stl\n"
+                          "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
+  auto values = [&](const std::string& region) {
+    const std::string sim = "sim" + std::to_string(region.size());
+    const Outcome s = runFieldpath(dir, "--quiet simulate --tool ball:3 --path flat.cl --stock 1 "
+                                        "--grid 200x100 --region " + region + " --out " + sim);
+    EXPECT_EQ(s.exit_code, 0) << s.output();
+    const Outcome v = runFieldpath(
+        dir, "--quiet view scene.yaml --path flat.cl --surface " + sim + " --out " + sim + ".html");
+    EXPECT_EQ(v.exit_code, 0) << v.output();
+    const std::string html = slurp(dir.path() / (sim + ".html"));
+    const json meta = pageMeta(html);
+    const std::string blob = base64Decode(
+        between(html, "<script type=\"application/octet-stream\" id=\"fp-blob\">", "</script>"));
+    const std::size_t offset = meta["surface"]["value"]["offset"], count = meta["surface"]["value"]["count"];
+    std::vector<float> out(count);
+    std::memcpy(out.data(), blob.data() + offset, 4 * count);
+    return std::make_pair(out, meta["surface"]["uncut_um"].get<double>());
+  };
+  const auto [zoom, marker] = values("0,0,20,10");
+  ASSERT_EQ(zoom.size(), 20000u);
+  EXPECT_EQ(std::count_if(zoom.begin(), zoom.end(), [&](float v) { return v >= marker; }), 0);
+  // The highest point left: midway between passes (0.5 mm off each) and postures (0.25 mm),
+  // R - sqrt(R² - 0.5² - 0.25²) = 46.4 um; the lines sit at or beside it.
+  const double cusp_um = 1000.0 * (3.0 - std::sqrt(9.0 - 0.25 - 0.0625));
+  EXPECT_GT(*std::max_element(zoom.begin(), zoom.end()), 40.0);
+  EXPECT_LE(*std::max_element(zoom.begin(), zoom.end()), cusp_um + 0.01);
+  const auto [wide, wide_marker] = values("-10,-10,30,20");
+  EXPECT_GT(std::count_if(wide.begin(), wide.end(), [&](float v) { return v >= wide_marker; }), 0);
+  EXPECT_GE(wide.front(), wide_marker);  // the corner (-10, -10): 7 mm from the nearest tip
+}
+
 TEST(View, MeshesAreDecimatedToTheBudget) {
   // A finely triangulated sphere-like mesh: a subdivided box.
   fieldpath::geometry::TriangleMesh mesh;
