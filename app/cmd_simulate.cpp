@@ -322,7 +322,8 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
         {"note",
          "read and prepare run side by side; with --region (streamed) the cut overlaps the read"},
         {"postures_per_second", finiteOrNull(per_s)},
-        {"read_megabytes_per_second", finiteOrNull(size_ec || read_s <= 0 ? NAN : path_mb / read_s)},
+        {"read_megabytes_per_second",
+         finiteOrNull(size_ec || read_s <= 0 ? NAN : path_mb / read_s)},
         {"peak_memory_mib", peakRssMib()}};
     common::writeTextAtomically(out / "simulate.json", jsonText(report));
 

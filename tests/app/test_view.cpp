@@ -211,12 +211,15 @@ TEST(View, ASimulatedZoomCutEverywhereHasNoUncutLines) {
     for (int i = 0; i <= 40; ++i) cl << 0.5 * i << ' ' << k << " 0 0 0 1\n";
   }
   dir.write("flat.cl", cl.str());
-  dir.write("scene.yaml", "obstacles:\n  - mesh: block.stl\npart: floor.stl\n"
-                          "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: block.stl\npart: floor.stl\n"
+            "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
   auto values = [&](const std::string& region) {
     const std::string sim = "sim" + std::to_string(region.size());
-    const Outcome s = runFieldpath(dir, "--quiet simulate --tool ball:3 --path flat.cl --stock 1 "
-                                        "--grid 200x100 --region " + region + " --out " + sim);
+    const Outcome s = runFieldpath(dir,
+                                   "--quiet simulate --tool ball:3 --path flat.cl --stock 1 "
+                                   "--grid 200x100 --region " +
+                                       region + " --out " + sim);
     EXPECT_EQ(s.exit_code, 0) << s.output();
     const Outcome v = runFieldpath(
         dir, "--quiet view scene.yaml --path flat.cl --surface " + sim + " --out " + sim + ".html");
@@ -225,7 +228,8 @@ TEST(View, ASimulatedZoomCutEverywhereHasNoUncutLines) {
     const json meta = pageMeta(html);
     const std::string blob = base64Decode(
         between(html, "<script type=\"application/octet-stream\" id=\"fp-blob\">", "</script>"));
-    const std::size_t offset = meta["surface"]["value"]["offset"], count = meta["surface"]["value"]["count"];
+    const std::size_t offset = meta["surface"]["value"]["offset"],
+                      count = meta["surface"]["value"]["count"];
     std::vector<float> out(count);
     std::memcpy(out.data(), blob.data() + offset, 4 * count);
     return std::make_pair(out, meta["surface"]["uncut_um"].get<double>());
