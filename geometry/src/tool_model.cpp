@@ -286,7 +286,8 @@ void validateToolSpec(const ToolSpec& tool) {
                        shortNumber(kMaxToolSizeMm) + " mm (no spindle takes it)");
   if (tool.shape == ToolShape::Torus &&
       !(tool.corner_radius_mm > 0 && tool.corner_radius_mm <= tool.radius_mm))
-    throw InputError("corner radius must be in (0, R]");
+    throw InputError("corner_radius " + shortNumber(tool.corner_radius_mm) +
+                     " mm must be in (0, radius " + shortNumber(tool.radius_mm) + " mm]");
   const double end_mm = cornerRadius(tool);
   if (!std::isfinite(tool.length_mm) || !(tool.length_mm > 0))
     throw InputError("tool length must be > 0 mm");
