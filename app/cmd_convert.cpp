@@ -71,12 +71,22 @@ void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
                             "the postures of the input, whole");
 
     const geometry::PathFile path = geometry::readPathFile(in);
+    // The safety marks go with the path (`# ...` at the top of a .cl, PPRINT/ in APT): a path
+    // that collides must not read as a clean program once converted. .npy has no room for them.
+    std::string marks;
+    for (const std::string& w : path.warnings) marks += w + "\n";
+    header.remarks = path.warnings;
     if (to == PathFormat::Cl)
-      geometry::writeClFile(out, path, "converted from " + in.filename().string());
+      geometry::writeClFile(out, path, marks + "converted from " + in.filename().string());
     else if (to == PathFormat::Apt)
       geometry::writeAptFile(out, path, header);
     else
       geometry::writeNpyFile(out, path.postures);
+    for (const std::string& w : path.warnings)
+      std::fprintf(stderr, "warning: %s is marked \"%s\": %s\n", in.string().c_str(), w.c_str(),
+                   to == PathFormat::Npy ? ".npy cannot carry the mark: DROPPED, the .npy reads "
+                                           "as a clean path"
+                                         : "the mark is kept at the top of the output");
 
     const std::size_t passes = path.count(geometry::PathBlock::Kind::Pass);
     const std::size_t links = path.count(geometry::PathBlock::Kind::Link);

@@ -134,10 +134,13 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
     }
     record += content;
     const std::string statement = upperCase(record);
-    record.clear();
     const auto slash = statement.find('/');
     const std::string_view major =
         trimmed(std::string_view(statement).substr(0, std::min(slash, statement.size())));
+    if (major == "PPRINT" && slash != std::string::npos)
+      if (std::string mark = safetyMark(std::string_view(record).substr(slash + 1)); !mark.empty())
+        chunk.warnings.push_back(std::move(mark));
+    record.clear();
     if (major == "RAPID") {
       rapid = true;
       if (chunk.postures.empty()) out.cancels_rapid = false;

@@ -161,6 +161,11 @@ void parseClChunk(std::string_view text, std::size_t first_line, const std::file
       }
     }
     if (count == 0) {
+      if (has_comment)
+        if (std::string mark = safetyMark(comment); !mark.empty()) {
+          out.warn(std::move(mark));
+          continue;
+        }
       const Marker marker = has_comment ? markerOf(comment) : Marker::None;
       if (!has_comment || marker == Marker::Pass)  // a blank line or `# pass ...`
         out.mark(PathBlock::Kind::Pass);
@@ -201,6 +206,7 @@ struct FullOut {
   }
   void mark(PathBlock::Kind kind) { chunk.marks.push_back({chunk.postures.size(), kind}); }
   void limit() { chunk.limited.push_back(chunk.postures.size() - 1); }
+  void warn(std::string mark) { chunk.warnings.push_back(std::move(mark)); }
 };
 
 /// Only the postures, rounded to float.
@@ -209,6 +215,7 @@ struct CompactOut {
   void add(const Posture& p, std::size_t) { postures.push_back(compact(p)); }
   void mark(PathBlock::Kind) {}
   void limit() {}
+  void warn(std::string) {}
 };
 
 /// The blocks of a `.cl` file from its marks: a block starts at posture 0 and at every posture a

@@ -137,8 +137,25 @@ void concatenate(std::vector<PathChunk>& chunks, unsigned threads, PathFile& pat
     std::vector<Posture>().swap(chunks[i].postures);  // free as we go
     std::vector<std::size_t>().swap(chunks[i].lines);
   });
-  for (std::size_t i = 0; i < chunks.size(); ++i)
+  for (std::size_t i = 0; i < chunks.size(); ++i) {
     for (std::size_t k : chunks[i].limited) path.limited.push_back(offset[i] + k);
+    for (std::string& w : chunks[i].warnings) path.warnings.push_back(std::move(w));
+  }
+}
+
+std::string safetyMark(std::string_view text) {
+  while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
+  while (!text.empty() && (text.back() == ' ' || text.back() == '\t' || text.back() == '\r'))
+    text.remove_suffix(1);
+  auto startsWith = [&](std::string_view word) {
+    if (text.size() < word.size()) return false;
+    for (std::size_t i = 0; i < word.size(); ++i)
+      if (std::toupper(static_cast<unsigned char>(text[i])) != word[i]) return false;
+    return true;
+  };
+  return startsWith("UNSAFE TO RUN") || startsWith("UNDER THE REQUIRED CLEARANCE")
+             ? std::string(text)
+             : std::string();
 }
 
 }  // namespace fieldpath::geometry::detail

@@ -71,10 +71,15 @@ struct PathChunk {
   std::vector<std::size_t> limited;  ///< chunk-local indices of `# limit` postures
   std::vector<BlockMark> marks;      ///< `.cl`: markers and blank lines, chunk-local indices
   std::vector<std::size_t> links;    ///< APT: chunk-local indices of the postures after RAPID
+  std::vector<std::string> warnings;  ///< safety marks (PathFile::warnings), in order
 };
 
-/// Concatenates the chunks (postures, lines, limited) into `path`, in parallel; blocks are left
-/// to the caller.
+/// Concatenates the chunks (postures, lines, limited, warnings) into `path`, in parallel; blocks
+/// are left to the caller.
 void concatenate(std::vector<PathChunk>& chunks, unsigned threads, PathFile& path);
+
+/// The safety mark a comment or PPRINT text is (PathFile::warnings: it starts, blanks aside, with
+/// "UNSAFE TO RUN" or "UNDER THE REQUIRED CLEARANCE", in any case), or empty.
+std::string safetyMark(std::string_view text);
 
 }  // namespace fieldpath::geometry::detail

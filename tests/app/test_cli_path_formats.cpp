@@ -333,5 +333,42 @@ TEST(Convert, ASpindleColumnDroppedInAptIsSaid) {
   EXPECT_EQ(none.err.find("spindle"), std::string::npos) << none.err;
 }
 
+// A path marked unsafe by generate (`# UNSAFE TO RUN: ...`, `PPRINT/UNSAFE TO RUN: ...`, and
+// `UNDER THE REQUIRED CLEARANCE`) keeps its marks through convert to .cl and APT and back, each
+// said on stderr; .npy cannot hold them: said as DROPPED (they were dropped without a word: a
+// colliding path read as a clean program, a helper's finding).
+TEST(Convert, SafetyMarksGoWithThePathOrTheirLossIsSaid) {
+  const TempDir dir;
+  dir.write("u.cl",
+            "# UNSAFE TO RUN: 2 postures touch an obstacle (first: posture 1) (report.json)\n"
+            "# under the required clearance: postures min 0.3 mm\n"
+            "# fieldpath generate scene.yaml\n# pass 1\n0 0 0 0 0 1\n1 0 0 0 0 1\n2 0 0 0 0 1\n");
+  const std::vector<std::string> marks = {
+      "UNSAFE TO RUN: 2 postures touch an obstacle (first: posture 1) (report.json)",
+      "under the required clearance: postures min 0.3 mm"};
+  EXPECT_EQ(geometry::readPathFile(dir.path() / "u.cl").warnings, marks);
+  const Outcome to_apt = runFieldpath(dir, "convert u.cl u.apt --tool ball:1");
+  ASSERT_EQ(to_apt.exit_code, 0) << to_apt.err;
+  EXPECT_NE(to_apt.err.find("warning: u.cl is marked \"UNSAFE TO RUN"), std::string::npos)
+      << to_apt.err;
+  const std::string apt = slurp(dir.path() / "u.apt");
+  EXPECT_NE(apt.find("PPRINT/UNSAFE TO RUN: 2 POSTURES TOUCH"), std::string::npos) << apt;
+  EXPECT_NE(apt.find("PPRINT/UNDER THE REQUIRED CLEARANCE"), std::string::npos) << apt;
+  EXPECT_EQ(geometry::readPathFile(dir.path() / "u.apt").warnings.size(), 2u);
+  ASSERT_EQ(runFieldpath(dir, "convert u.apt back.cl").exit_code, 0);
+  const PathFile back = geometry::readPathFile(dir.path() / "back.cl");
+  ASSERT_EQ(back.warnings.size(), 2u);
+  EXPECT_EQ(back.warnings[0].rfind("UNSAFE TO RUN: 2 POSTURES", 0), 0u) << back.warnings[0];
+  EXPECT_EQ(back.postures.size(), 3u);
+  const Outcome to_npy = runFieldpath(dir, "convert u.cl u.npy");
+  ASSERT_EQ(to_npy.exit_code, 0) << to_npy.err;
+  EXPECT_NE(to_npy.err.find("DROPPED"), std::string::npos) << to_npy.err;
+  // An unmarked path: no warning; a comment that only mentions the words is not a mark.
+  dir.write("c.cl", "# the tool is not UNSAFE TO RUN here\n0 0 0 0 0 1\n1 0 0 0 0 1\n");
+  EXPECT_TRUE(geometry::readPathFile(dir.path() / "c.cl").warnings.empty());
+  const Outcome clean = runFieldpath(dir, "convert c.cl c.apt --tool ball:1");
+  EXPECT_EQ(clean.err.find("warning"), std::string::npos) << clean.err;
+}
+
 }  // namespace
 }  // namespace fieldpath::app::test

@@ -48,6 +48,10 @@ struct PathFile {
     std::size_t line = 0;     ///< 1-based
   };
   std::vector<Cutter> cutters;
+  /// The safety marks `generate` and `check` write at the top of a path: `# UNSAFE TO RUN: ...`
+  /// and `# UNDER THE REQUIRED CLEARANCE: ...` comment lines (`.cl`), the same after `PPRINT/`
+  /// (APT), as their text (from UNSAFE / UNDER on), in file order. `convert` carries them over.
+  std::vector<std::string> warnings;
 
   /// "FILE:LINE" or "FILE: row R" of posture i, for messages.
   std::string where(std::size_t i) const;
