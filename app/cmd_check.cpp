@@ -151,6 +151,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                        "not bounded by its Z-buffer stamps yet (`simulate --tool flat:R` cuts "
                        "with it)");
     const std::vector<std::string> tool_notes = cutterNotes(scene.tool, path);
+    const std::vector<std::string> obstacle_notes = openObstacleNotes(scene);
     const pathgen::AxisTurn axis_turn = pathgen::largestAxisTurn(path, scene.tool.radius_mm);
 
     // (a) exact clearance of postures and motions
@@ -223,6 +224,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
          holder_part ? json(nullptr) : json("no `part` or no `holder` in the scene")},
         {"unsafe", unsafeReasons(clearance, motions, link_part, holder_part)},
         {"tool_notes", tool_notes},
+        {"obstacle_notes", obstacle_notes},
         {"axis_turn", axisTurnJson(axis_turn)},
         {"limits",
          {{"limited_postures", path.limited.size()},
@@ -290,6 +292,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     else
       std::printf("surface: not checked (%s)\n", surface_skipped);
     for (const std::string& note : tool_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
+    for (const std::string& note : obstacle_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
     if (const std::string turn = axisTurnWarning(path, axis_turn); !turn.empty())
       std::fprintf(stderr, "warning: %s (check.json axis_turn)\n", turn.c_str());
     if (surface && surface->coarsened)

@@ -116,6 +116,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"safe", unsafe.empty()},
       {"tool_notes",
        scene.nominal ? cutterNotes(scene.tool, *scene.nominal) : std::vector<std::string>{}},
+      {"obstacle_notes", openObstacleNotes(scene)},
       {"unsafe", unsafe},
       {"links",
        {{"links", r.path.count(geometry::PathBlock::Kind::Link)},
@@ -296,6 +297,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (scene.nominal)
       for (const std::string& note : cutterNotes(scene.tool, *scene.nominal))
         std::printf("note: %s\n", note.c_str());
+    for (const std::string& note : openObstacleNotes(scene))
+      std::printf("note: %s\n", note.c_str());
     if (scene.nominal && !job.nominal) {  // a lead in the file is not kept: n is ⊥ the feed
       const pathgen::Pass* leanest = nullptr;
       for (const pathgen::Pass& p : job.passes)

@@ -451,4 +451,20 @@ Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
   return scene;
 }
 
+std::vector<std::string> openObstacleNotes(const Scene& scene) {
+  std::vector<std::string> notes;
+  for (std::size_t i = 0; i < scene.obstacle_files.size() && i < scene.obstacles.size(); ++i) {
+    const std::size_t open = geometry::openShells(scene.obstacles[i]).size();
+    if (open == 0) continue;
+    const std::size_t edges = geometry::validateMesh(scene.obstacles[i]).open_edges;
+    notes.push_back(scene.obstacle_files[i].string() + ": " + std::to_string(open) +
+                    (open == 1 ? " shell is" : " shells are") + " open (" + std::to_string(edges) +
+                    " edge" + (edges == 1 ? "" : "s") +
+                    " with one triangle): its surface repels and is checked, but an open shell "
+                    "has no inside, so a tool or holder wholly inside the solid it bounds reads as "
+                    "clear (close the mesh to have its inside checked)");
+  }
+  return notes;
+}
+
 }  // namespace fieldpath::app

@@ -68,6 +68,13 @@ inline std::string toolShapeWhere(const Scene& scene) {
          ": tool.shape";
 }
 
+/// One note per obstacle mesh file with open shells (triangles joined through their vertices
+/// whose surface does not close): its surface repels and is checked, but an open shell has no
+/// inside, so a tool wholly inside the solid it was meant to bound (a fixture exported with a
+/// facet missing) reads as clear. Empty when every shell is closed; the impeller's blades, sheets
+/// by design, are not files and get none.
+std::vector<std::string> openObstacleNotes(const Scene& scene);
+
 /// Turns scene.impeller / scene.guide_impeller into meshes (obstacles, part) and
 /// scene.impeller_model. Lives in scene_impeller.cpp (the impeller's owner replaces it).
 void resolveImpeller(Scene& scene);

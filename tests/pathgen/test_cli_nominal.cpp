@@ -363,6 +363,36 @@ TEST(CheckSurface, ScallopOnASlopeIsBetweenTheContactLines) {
   EXPECT_LT(surface["max_gouge_um"].get<double>(), 0.5) << surface;
 }
 
+// A block missing one facet is an open shell: no inside, so a tool buried in it reads as clear
+// (FCL measures surfaces; only closed shells have an inside). Said, naming the file, by `check`
+// and `generate` and in check.json `obstacle_notes` (it was silent: a helper's finding); the
+// closed block makes the same postures colliding and gets no note.
+TEST(CheckClearance, AnOpenObstacleMeshIsSaidToHaveNoInside) {
+  const TempDir dir;
+  geometry::TriangleMesh closed;
+  pathgen::test::addBox(closed, -50, 50, -50, 50, -50, 50);
+  geometry::TriangleMesh holed = closed;
+  holed.triangles.pop_back();
+  geometry::saveMesh(closed, dir.path() / "closed.stl");
+  geometry::saveMesh(holed, dir.path() / "holed.stl");
+  dir.write("in.cl", "# pass 1\n0 0 -20 0 0 1\n1 0 -20 0 0 1\n");
+  for (const std::string mesh : {"closed.stl", "holed.stl"}) {
+    dir.write("scene.yaml", "obstacles:\n  - mesh: " + mesh +
+                                "\ntool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
+    const auto r = test::runFieldpath(dir, "check scene.yaml --path in.cl --out out_" + mesh);
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    const auto check =
+        nlohmann::json::parse(test::slurp(dir.path() / ("out_" + mesh) / "check.json"));
+    const bool open = mesh == "holed.stl";
+    EXPECT_EQ(check["obstacle_notes"].size(), open ? 1u : 0u) << check["obstacle_notes"];
+    EXPECT_EQ(
+        r.err.find("holed.stl: 1 shell is open (3 edges with one triangle)") != std::string::npos,
+        open)
+        << r.err;
+    EXPECT_EQ(check["clearance"]["colliding_postures"].get<int>(), open ? 0 : 2);
+  }
+}
+
 // `check` cuts along the motions, not only at the postures: two postures on a floor either side
 // of a ridge 1 mm high, each clear of it, and the straight move between them through the ridge.
 // The gouge is the ridge's height (1000 um, less the sweep's bound); the same postures with the
