@@ -385,7 +385,8 @@ SettledStart settleAtStart(const Pass& pass, const SteeringRequest& request) {
   run.initial_lead_rad = first.lead0_rad;
   run.initial_tilt_rad = first.tilt0_rad;
   run.initial_lead_rate_rad_per_s = run.initial_tilt_rate_rad_per_s = 0.0;
-  run.max_angle_change_deg_per_mm = 0.0;  // the settling is not machined
+  run.max_angle_change_deg_per_mm = 0.0;     // the settling is not machined: its swing on the
+  run.params.on_limit = LimitPolicy::Clamp;  // way to rest is held at the limits, never failed
   run.clearance = nullptr;
   run.progress = nullptr;
   for (int decay = 0; decay < int(kSettleDecays); ++decay) {

@@ -104,9 +104,11 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request);
 /// The axis at rest at a pass's start (DynamicsParams::start): the pass's first frame held while
 /// the spring-damper runs from the nominal angles at rest, one decay time 2J/c after another
 /// (the field's stiffness changes the frequency, not the decay), until the axis moves less than
-/// kSettledRad in one, or for kSettleDecays of them (the amplitude down by e^-20); the angle
-/// limits applied as in the pass. `settled` false (and `why`) where it cannot: no damping, a
-/// limit with on_limit: fail, the solver failing.
+/// kSettledRad in one, or for kSettleDecays of them (the amplitude down by e^-20); the angles
+/// held at their limits on the way (on_limit: clamp whatever the pass's: the settling is not
+/// machined, its swing beyond a limit is no failure; a rest beyond one is held at it, and a pass
+/// with on_limit: fail then stops where the field pushes it further). `settled` false (and
+/// `why`) where it cannot: no damping, the solver failing.
 struct SettledStart {
   bool settled = false;
   double lead_rad = 0.0, tilt_rad = 0.0;
