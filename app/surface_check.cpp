@@ -102,7 +102,7 @@ Vec2 contactInPlan(const geometry::Posture& p, double radius_mm, double corner_m
 std::vector<char> machinedBand(const zbuffer::Grid& grid, const geometry::PathFile& path,
                                double radius_mm, double corner_mm, const std::vector<float>& top) {
   std::vector<std::vector<Vec2>> passes;
-  for (const auto& [begin, end] : pathgen::passRanges(path, 0.0)) {
+  for (const auto& [begin, end] : pathgen::passRanges(path, 0.0, radius_mm)) {
     std::vector<Vec2> line;
     for (std::size_t i = begin; i < end; ++i) {
       const Vec2 c = contactInPlan(path.postures[i], radius_mm, corner_mm, grid, top);
@@ -293,7 +293,7 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
     part_top_mm = std::max(part_top_mm, v.z());
   }
   const double shank_mm = std::max(0.0, request.tool.length_mm - radius);  // centre to the top
-  for (const auto& [begin, end] : pathgen::passRanges(path, 0.0))
+  for (const auto& [begin, end] : pathgen::passRanges(path, 0.0, radius))
     for (std::size_t i = begin; i < end; ++i) {
       const Vec3 c = geometry::ballCentre(path.postures[i], radius);
       const Vec3& a = path.postures[i].axis;

@@ -75,7 +75,7 @@ double median(std::vector<double> values) {
 
 AxisTurn largestAxisTurn(const PathFile& path, double ball_radius_mm) {
   AxisTurn out;
-  for (const auto& [begin, end] : passRanges(path, 0.0))
+  for (const auto& [begin, end] : passRanges(path, 0.0, ball_radius_mm))
     for (std::size_t i = begin + 1; i < end; ++i) {
       const Posture &a = path.postures[i - 1], &b = path.postures[i];
       const double deg = geometry::axisAngle(a.axis, b.axis) * 180.0 / M_PI;
@@ -89,13 +89,17 @@ AxisTurn largestAxisTurn(const PathFile& path, double ball_radius_mm) {
 }
 
 std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path,
-                                                            double pass_gap_mm) {
+                                                            double pass_gap_mm,
+                                                            double ball_radius_mm) {
+  auto centre = [&](std::size_t i) {
+    return geometry::ballCentre(path.postures[i], ball_radius_mm);
+  };
   std::vector<std::pair<std::size_t, std::size_t>> ranges;
   for (const PathBlock& block : path.blocks) {
     if (block.kind != PathBlock::Kind::Pass) continue;
     std::vector<double> steps;
     for (std::size_t i = block.begin + 1; i < block.end; ++i) {
-      const double d = (path.postures[i].tip_mm - path.postures[i - 1].tip_mm).norm();
+      const double d = (centre(i) - centre(i - 1)).norm();
       if (d > kRepeatMm) steps.push_back(d);
     }
     const double gap = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(steps);
@@ -107,7 +111,7 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
     constexpr std::size_t kRecent = 3;
     std::vector<Vec3> recent;
     for (std::size_t i = block.begin + 1; i < block.end; ++i) {
-      const Vec3 step = path.postures[i].tip_mm - path.postures[i - 1].tip_mm;
+      const Vec3 step = centre(i) - centre(i - 1);
       if (gap > 0.0 && step.norm() > gap) {  // the gap is the link between the two
         ranges.emplace_back(begin, i);
         begin = i;
@@ -117,6 +121,9 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
       if (step.norm() <= kRepeatMm) continue;
       bool back = false;
       for (const Vec3& before : recent) back = back || step.dot(before) < 0.0;
+      // An axis turned over (more than 90 deg) throws its centre 2R the other way: that is the
+      // axis's fault, named at its line by nominalPasses, not a new leg.
+      back = back && path.postures[i].axis.dot(path.postures[i - 1].axis) > 0.0;
       if (back) {  // the new pass starts where this step does; the step-over before is the link
         if (i - 1 > begin) ranges.emplace_back(begin, i - 1);
         begin = i - 1;
@@ -143,7 +150,7 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
   const double r = ball_radius_mm;
   std::size_t dropped = 0;
   std::vector<Pass> passes;
-  for (const auto& [begin, end] : passRanges(path, params.pass_gap_mm)) {
+  for (const auto& [begin, end] : passRanges(path, params.pass_gap_mm, r)) {
     const int number = static_cast<int>(passes.size()) + 1;
     // Distinct postures of the pass (consecutive repeats of a ball centre dropped).
     std::vector<std::size_t> kept;

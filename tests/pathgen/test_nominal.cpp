@@ -379,6 +379,22 @@ TEST(NominalPasses, LargestAxisTurnIsOfThePassesAndItsClosedForm) {
   const AxisTurn j = largestAxisTurn(jump, 3.0);
   EXPECT_NEAR(j.deg, 5.0, 1e-9);
   EXPECT_EQ(j.at, 1u);
+  // The axis leaning forward 45 deg in 1 mm of the ball centre's travel: the tip moves back
+  // 1.12 mm, which read as the feed turning back (a new pass) and the turn went uncounted (a
+  // helper's finding); the passes follow the ball centres.
+  auto centred = [](double x, double deg) {
+    const double r = deg * M_PI / 180.0;
+    const Eigen::Vector3d axis(std::sin(r), 0, std::cos(r));
+    return Posture{Eigen::Vector3d(x, 0, 3) - 3.0 * axis, axis, 0.0, false};
+  };
+  const PathFile forward =
+      geometry::singlePass({centred(0, 0), centred(1, 45), centred(2, 45), centred(3, 45)});
+  ASSERT_LT(forward.postures[1].tip_mm.x(), forward.postures[0].tip_mm.x());
+  const AxisTurn f = largestAxisTurn(forward, 3.0);
+  EXPECT_NEAR(f.deg, 45.0, 1e-9);
+  EXPECT_EQ(f.at, 0u);
+  EXPECT_NEAR(f.step_mm, 1.0, 1e-12);
+  EXPECT_EQ(passRanges(forward, 0.0, 3.0).size(), 1u);
   // No pass of two postures: no turn.
   PathFile single = geometry::singlePass({at(0, 0)});
   EXPECT_EQ(largestAxisTurn(single, 3.0).at, static_cast<std::size_t>(-1));

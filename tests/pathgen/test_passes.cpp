@@ -98,7 +98,7 @@ TEST(Passes, AZigZagInOnePassBlockIsOnePassALeg) {
   leg(1, 10, 0);   // 11-21 (posture 11 is the step-over's end)
   leg(2, 0, 10);   // 22-32
   path.blocks = {{geometry::PathBlock::Kind::Pass, 0, path.postures.size()}};
-  const auto ranges = passRanges(path, 0.0);
+  const auto ranges = passRanges(path, 0.0, 1.0);
   ASSERT_EQ(ranges.size(), 3u);
   EXPECT_EQ(ranges[0], std::make_pair(std::size_t{0}, std::size_t{11}));
   EXPECT_EQ(ranges[1], std::make_pair(std::size_t{11}, std::size_t{22}));
@@ -108,5 +108,5 @@ TEST(Passes, AZigZagInOnePassBlockIsOnePassALeg) {
   for (int k = 0; k <= 10; ++k) corner.postures.push_back({Vec3(k, 0, 0), Vec3::UnitZ()});
   for (int k = 1; k <= 10; ++k) corner.postures.push_back({Vec3(10, k, 0), Vec3::UnitZ()});
   corner.blocks = {{geometry::PathBlock::Kind::Pass, 0, corner.postures.size()}};
-  EXPECT_EQ(passRanges(corner, 0.0).size(), 1u);
+  EXPECT_EQ(passRanges(corner, 0.0, 1.0).size(), 1u);
 }

@@ -65,11 +65,15 @@ std::vector<Pass> nominalPasses(const geometry::PathFile& path, const PathParams
                                 double ball_radius_mm, std::size_t* repeated = nullptr);
 
 /// Posture ranges [begin, end) of the passes of a path: its pass blocks (link blocks dropped),
-/// each split where two consecutive tips are farther apart than `pass_gap_mm` (0: 4 × the
-/// block's median step), and where the feed turns back more than 90° from one of its last three
-/// directions (a zig-zag's legs: the new pass starts with the step that turns back).
+/// each split where two consecutive ball centres (R = `ball_radius_mm` up the axis from the tip)
+/// are farther apart than `pass_gap_mm` (0: 4 × the block's median step), and where their feed
+/// turns back more than 90° from one of its last three directions (a zig-zag's legs: the new
+/// pass starts with the step that turns back). The centres, not the tips: the programmed path
+/// is the centre's, and a tip moves back when the axis leans forward faster than the centre
+/// moves on (a 45° swing in 1 mm read as a new pass, and its turn went uncounted).
 std::vector<std::pair<std::size_t, std::size_t>> passRanges(const geometry::PathFile& path,
-                                                            double pass_gap_mm);
+                                                            double pass_gap_mm,
+                                                            double ball_radius_mm);
 
 /// The largest turn of the tool axis between two consecutive postures of a pass (passRanges
 /// with the default gap: a file of passes with no markers, or an .npy, holds its links in one
