@@ -239,10 +239,14 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
       unsafe_text += (unsafe_text.empty() ? "" : "; ") + reason;
     if (!unsafe.empty()) unsafe_text = "UNSAFE TO RUN: " + unsafe_text + " (report.json)";
     // Clear of the obstacles but closer than the scene's `clearance`: said where the machine
-    // reads it too (report.json's "safe" stays true: nothing is touched).
+    // reads it too (report.json's "safe" stays true: nothing is touched), beside the UNSAFE mark
+    // when the path is unsafe for another reason (the holder into the part: fixing that alone
+    // left the clearance unsaid, a helper's finding); an obstacle touched says it already.
+    const bool under_required =
+        result.clearance.colliding == 0 && result.motions.colliding == 0 &&
+        (result.clearance.min_clearance_mm < job.clearance_mm || result.motions.under_required > 0);
     std::string under_text;
-    if (unsafe.empty() && (result.clearance.min_clearance_mm < job.clearance_mm ||
-                           result.motions.under_required > 0)) {
+    if (under_required) {
       char text[200];
       std::snprintf(text, sizeof text,
                     "UNDER THE REQUIRED CLEARANCE: postures min %.3f mm, motions min >= %.3f mm, "
@@ -251,7 +255,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                     job.clearance_mm);
       under_text = text;
     }
-    const std::string mark = !unsafe.empty() ? unsafe_text : under_text;
+    const std::string mark =
+        unsafe_text + (!unsafe_text.empty() && !under_text.empty() ? "\n" : "") + under_text;
     geometry::writeClFile(out / "path.cl", result.path,
                           (mark.empty() ? "" : mark + "\n") + "fieldpath generate " +
                               scene.file.string() + " (" + what +
@@ -283,7 +288,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
         c.min_clearance_mm, job.clearance_mm, c.colliding, m.colliding, m.motions,
         m.min_clearance_mm, result.times.total_s, out.string().c_str());
     if (!unsafe.empty()) std::fprintf(stderr, "warning: %s\n", unsafe_text.c_str());
-    else if (c.min_clearance_mm < job.clearance_mm || m.under_required > 0)
+    if (under_required)
       std::fprintf(stderr,
                    "warning: the path comes closer to the obstacles than `clearance` (%.3f mm): "
                    "postures min %.3f mm (posture %zu), motions min >= %.3f mm (%zu under it; "

@@ -393,6 +393,43 @@ TEST(CheckClearance, AnOpenObstacleMeshIsSaidToHaveNoInside) {
   }
 }
 
+// A path that is unsafe for one reason and under the required clearance for another carries
+// both marks: a pass started upright beside a wall 0.3 mm from its holder (start: nominal) swings
+// so far (tilt limit 89°) that the holder goes into the part: UNSAFE; the first posture keeps
+// 0.29 mm from the wall: UNDER THE REQUIRED CLEARANCE too (only the first was said: a helper's
+// finding).
+TEST(CheckClearance, UnsafeAndUnderTheClearanceAreBothMarked) {
+  const TempDir dir;
+  geometry::TriangleMesh wall, part;
+  pathgen::test::addBox(wall, -20, 120, 12.3, 14, -2, 60);  // 0.3 mm from the holder's r 12
+  pathgen::test::addBox(part, -30, 130, -40, 40, -5, 0);
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  std::string cl = "# pass 1\n";
+  for (int i = 0; i <= 100; ++i) cl += std::to_string(i) + " 0 0 0 0 1\n";
+  dir.write("nominal.cl", cl);
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 40 }\n"
+            "holder: [[40, 6], [55, 6], [55, 12], [90, 12]]\nclearance: 0.5\n"
+            "dynamics: { max_tilt_deg: 89, start: nominal }\npath: { nominal: nominal.cl }\n");
+  const auto r = test::runFieldpath(dir, "generate scene.yaml --out out");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out" / "report.json"));
+  ASSERT_FALSE(report["unsafe"].empty()) << report["unsafe"];  // the holder into the part
+  ASSERT_EQ(report["clearance"]["colliding_postures"].get<int>(), 0);
+  ASSERT_LT(report["clearance"]["min_mm"].get<double>(), 0.5);
+  const std::string cl_out = test::slurp(dir.path() / "out" / "path.cl");
+  const std::string apt = test::slurp(dir.path() / "out" / "path.apt");
+  for (const std::string& text : {cl_out, apt}) {
+    EXPECT_NE(text.find("UNSAFE TO RUN"), std::string::npos) << text.substr(0, 400);
+    EXPECT_NE(text.find("UNDER THE REQUIRED CLEARANCE"), std::string::npos) << text.substr(0, 400);
+  }
+  EXPECT_NE(r.err.find("warning: UNSAFE TO RUN"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("closer to the obstacles than `clearance`"), std::string::npos) << r.err;
+  EXPECT_EQ(geometry::readPathFile(dir.path() / "out" / "path.cl").warnings.size(), 2u);
+}
+
 // `check` cuts along the motions, not only at the postures: two postures on a floor either side
 // of a ridge 1 mm high, each clear of it, and the straight move between them through the ridge.
 // The gouge is the ridge's height (1000 um, less the sweep's bound); the same postures with the
