@@ -72,6 +72,7 @@ std::string clearanceCsv(const geometry::PathFile& path, const pathgen::Clearanc
 }
 
 json surfaceJson(const SurfaceResult& s) {
+  auto scallop = [&s](double um) { return s.band_lines > 0 ? json(um) : json(nullptr); };
   return {{"grid",
            {{"origin", {s.grid.x0_mm, s.grid.y0_mm}},
             {"spacing", {s.grid.dx_mm, s.grid.dy_mm}},
@@ -93,9 +94,18 @@ json surfaceJson(const SurfaceResult& s) {
           {"gouged_lines", s.gouged_lines},
           {"gouge_tolerance_um", s.gouge_tolerance_um},
           {"max_gouge_um", s.max_gouge_um},
-          {"max_scallop_um", s.max_scallop_um},
-          {"mean_deviation_um", s.mean_um},
-          {"rms_deviation_um", s.rms_um},
+          // No band (a lone pass, passes too far apart to be neighbours): no scallop to tell.
+          {"max_scallop_um", scallop(s.max_scallop_um)},
+          {"scallop_grid_error_um", scallop(s.scallop_grid_error_um)},
+          {"scallop_grid_error",
+           "the lines may miss the highest cusp: it may stand up to scallop_grid_error_um above "
+           "max_scallop_um (the cusp within spacing/sqrt(2) of a line, the cutting edge's slope "
+           "there over the part's)"},
+          {"scallop_skipped", s.band_lines > 0 ? json(nullptr)
+                                               : json("no two neighbouring passes: a scallop is "
+                                                      "what is left between them")},
+          {"mean_deviation_um", scallop(s.mean_um)},
+          {"rms_deviation_um", scallop(s.rms_um)},
           {"stock_allowance_mm", kStockAllowanceMm}};
 }
 
@@ -137,11 +147,11 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     if (!options->out.empty()) common::checkOutputDirectory(options->out, "--out");
     const Scene scene = loadScene(options->scene, /*read_nominal=*/false);
     const geometry::PathFile path = geometry::readPathFile(options->path);
-    geometry::requireSteadyAxes(path);  // a flipped axis: no motion to sweep
     const common::Progress progress = makeProgressLine(global.quiet);
     if (!scene.tool_given)
       throw InputError(scene.file.string() + ": tool: missing: check needs the cutter (`tool: { "
                                              "shape: ball, radius: R, length: L }`)");
+    pathgen::requireSteadyAxes(path, scene.tool.radius_mm);  // a flipped axis in a pass
     // A flat end's rim is sharp: tilted along the feed, the cut between two stamps is too shallow
     // by up to step · tan(tilt) (30 um at 10 deg; a helper's 10 um ridge passed), not the
     // curvature bound the stamps are spaced by. Ball and torus (the corner's curvature) only.
@@ -187,9 +197,16 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       request.progress = progress;
       surface = checkSurface(request);
     }
-    const char* surface_skipped = !scene.part ? "the scene has no `part`"
-                                  : !surface  ? "the passes do not pass over the part (`part` mesh)"
-                                              : nullptr;
+    // A path that never cuts the stock over the part (another frame or units, a path over
+    // another part) left only the stock's figures: 2000 um of 'scallop' and ok read as a check.
+    const bool never_cut = surface && surface->cut_lines == 0;
+    if (never_cut) surface.reset();
+    const char* surface_skipped =
+        !scene.part ? "the scene has no `part`"
+        : never_cut ? "the tool never cuts the stock over the part (no line lowered): is the part "
+                      "in the path's frame and units?"
+        : !surface  ? "the passes do not pass over the part (`part` mesh)"
+                    : nullptr;
 
     // Why the check fails, one line each (empty: ok): the collisions of `unsafe`, a clearance
     // under the required one, and the gouges (a flank driven into a wall of the part is one).
@@ -282,14 +299,20 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     if (!path.limited.empty())
       std::printf("limits: %zu postures held at an angle limit, %zu of them colliding\n",
                   path.limited.size(), limited_colliding);
-    if (surface)
+    if (surface) {
+      char scallop[160] = "no scallop (no two neighbouring passes)";
+      if (surface->band_lines > 0)
+        std::snprintf(scallop, sizeof scallop,
+                      "max scallop %.1f um (a cusp between the lines up to %.1f um more), rms "
+                      "%.1f um",
+                      surface->max_scallop_um, surface->scallop_grid_error_um, surface->rms_um);
       std::printf(
-          "surface: %zu lines in the band, max gouge %.2f um (%zu lines below %.1f um), max "
-          "scallop %.1f um, rms %.1f um (%s, %.2f s)\n",
-          surface->band_lines, surface->max_gouge_um, surface->gouged_lines, -surface->gouge_tolerance_um,
-          surface->max_scallop_um, surface->rms_um, zbuffer::backendName(surface->backend),
+          "surface: %zu lines in the band, max gouge %.2f um (%zu lines below %.1f um), "
+          "%s (%s, %.2f s)\n",
+          surface->band_lines, surface->max_gouge_um, surface->gouged_lines,
+          -surface->gouge_tolerance_um, scallop, zbuffer::backendName(surface->backend),
           surface->simulation_s);
-    else
+    } else
       std::printf("surface: not checked (%s)\n", surface_skipped);
     for (const std::string& note : tool_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
     for (const std::string& note : obstacle_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
@@ -300,10 +323,10 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                    "note: --spacing %g mm would make more Z-buffer lines than a check takes: "
                    "lines every %.4g mm (check.json `spacing`)\n",
                    options->spacing_mm, surface->grid.dx_mm);
-    if (surface && surface->cut_lines == 0)
+    if (never_cut)
       std::fprintf(stderr,
-                   "warning: the path never reaches the part (no line of the surface cut): the "
-                   "figures above are the stock's; is the part in the path's frame and units?\n");
+                   "warning: the path never reaches the part (no line of the surface cut): is "
+                   "the part in the path's frame and units?\n");
   });
 }
 

@@ -95,7 +95,8 @@ Vec2 contactInPlan(const geometry::Posture& p, double radius_mm, double corner_m
 }
 
 /// The machined band: strips between consecutive passes that are neighbours (their facing points
-/// at most `neighbour_mm` apart on average), and a strip of ±R/2 along a pass with no neighbour.
+/// at most `neighbour_mm` apart on average). A pass with no neighbour has no scallop (the band
+/// of ±R/2 it once had read the ball's own profile as one: 389 µm for a single clean pass).
 /// The passes as their contact points with the part in plan (contactInPlan), not their ball
 /// centres: on a slope those lie R sin(slope) off the contact, and a band of centres took in the
 /// tool's flank beyond the first pass (a tilted plane's 76 um scallop read as 233 um).
@@ -112,7 +113,6 @@ std::vector<char> machinedBand(const zbuffer::Grid& grid, const geometry::PathFi
   }
   std::vector<char> mask(grid.lineCount(), 0);
   const double neighbour_mm = 4.0 * radius_mm;
-  std::vector<char> has_neighbour(passes.size(), 0);
   for (std::size_t k = 0; k + 1 < passes.size(); ++k) {
     const std::size_t n = std::max(passes[k].size(), passes[k + 1].size());
     std::vector<Vec2> a = resampled(passes[k], n), b = resampled(passes[k + 1], n);
@@ -123,23 +123,35 @@ std::vector<char> machinedBand(const zbuffer::Grid& grid, const geometry::PathFi
     }
     if (backward < forward) std::reverse(b.begin(), b.end());  // a zig-zag path
     if (std::min(forward, backward) / n > neighbour_mm) continue;
-    has_neighbour[k] = has_neighbour[k + 1] = 1;
     for (std::size_t j = 0; j + 1 < n; ++j) {
       markTriangle(grid, a[j], a[j + 1], b[j + 1], mask);
       markTriangle(grid, a[j], b[j + 1], b[j], mask);
     }
   }
-  for (std::size_t k = 0; k < passes.size(); ++k) {
-    if (has_neighbour[k]) continue;
-    const auto& line = passes[k];
-    for (std::size_t j = 0; j + 1 < line.size(); ++j) {
-      const Vec2 d = (line[j + 1] - line[j]).normalized();
-      const Vec2 side = 0.5 * radius_mm * Vec2(-d.y(), d.x());
-      markTriangle(grid, line[j] - side, line[j + 1] - side, line[j + 1] + side, mask);
-      markTriangle(grid, line[j] - side, line[j + 1] + side, line[j] + side, mask);
-    }
-  }
   return mask;
+}
+
+/// How far the highest line's deviation `scallop_um` may lie under the highest cusp's (µm), for
+/// lines `spacing_mm` apart, a cutting edge of curvature radius `edge_mm` and the part's upward
+/// normal `n` there (SurfaceResult::scallop_grid_error_um). A cusp of height h between two arcs
+/// of radius ρ meets them at α = asin(√(2ρh − h²)/ρ) from the part's normal; the deviation
+/// (vertical, machined − part) climbs at tan(θ + α) − tan(θ) a mm there, θ the part's slope; the
+/// cusp lies within spacing/√2 of a line. h is the cusp's own, found from the line's by a few
+/// rounds; α + θ is held under 85° (a steeper cusp is a wall's: bounded there, not resolved).
+double scallopGridErrorUm(double scallop_um, double spacing_mm, double edge_mm, const Vec3& n) {
+  if (!(scallop_um > 0.0) || !(edge_mm > 0.0)) return 0.0;
+  const double reach_mm = spacing_mm / std::sqrt(2.0);
+  const double theta = std::acos(std::clamp(n.z(), 0.0, 1.0));
+  const double steepest = 85.0 * M_PI / 180.0;
+  double error_mm = 0.0;
+  for (int round = 0; round < 4; ++round) {
+    const double h = std::min(edge_mm, 1e-3 * scallop_um + error_mm);
+    const double alpha =
+        std::asin(std::min(1.0, std::sqrt(std::max(0.0, 2 * edge_mm * h - h * h)) / edge_mm));
+    const double climb = std::tan(std::min(theta + alpha, steepest)) - std::tan(theta);
+    error_mm = climb * reach_mm;
+  }
+  return 1e3 * error_mm;
 }
 
 /// The path's postures with the motions between them swept: where a motion can reach below
@@ -375,6 +387,7 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   result.in_band = machinedBand(sim.grid, path, radius, edge_mm, nominal);
   result.deviation_um.assign(sim.grid.lineCount(), std::numeric_limits<float>::quiet_NaN());
   double sum = 0, sum2 = 0, min_dev = 0, max_dev = 0;
+  std::size_t highest = 0;  // the band's highest line
   for (std::size_t i = 0; i < nominal.size(); ++i) {
     if (std::isnan(nominal[i])) {
       result.in_band[i] = 0;
@@ -389,11 +402,19 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
     ++result.band_lines;
     sum += d;
     sum2 += d * d;
-    max_dev = std::max(max_dev, d);
+    if (d > max_dev) {
+      max_dev = d;
+      highest = i;
+    }
   }
   if (result.band_lines > 0) {
     result.mean_um = sum / result.band_lines;
     result.rms_um = std::sqrt(sum2 / result.band_lines);
+    const Vec2 at(sim.grid.x0_mm + (highest % sim.grid.nx + 0.5) * sim.grid.dx_mm,
+                  sim.grid.y0_mm + (highest / sim.grid.nx + 0.5) * sim.grid.dy_mm);
+    result.scallop_grid_error_um =
+        scallopGridErrorUm(max_dev, std::max(sim.grid.dx_mm, sim.grid.dy_mm), edge_mm,
+                           partNormal(sim.grid, nominal, at));
   }
   result.max_gouge_um = std::max(0.0, -min_dev);
   result.max_scallop_um = max_dev;

@@ -38,13 +38,18 @@ struct SurfaceResult {
   zbuffer::Grid grid;
   /// Per line: machined height − part height, µm; NaN where the line misses the part.
   std::vector<float> deviation_um;
-  /// Per line: in the machined band (between consecutive neighbouring passes, or near a lone
-  /// pass), where scallops count.
+  /// Per line: in the machined band (between consecutive neighbouring passes), where scallops
+  /// count; a lone pass has none (band_lines 0: no scallop figures).
   std::vector<char> in_band;
   std::size_t part_lines = 0, band_lines = 0;
   std::size_t gouged_lines = 0;  ///< anywhere on the part, deeper than the tolerance
   double gouge_tolerance_um = kGougeToleranceUm;
   double max_gouge_um = 0, max_scallop_um = 0, mean_um = 0, rms_um = 0;  ///< scallop stats: band
+  /// How far the highest line may read the highest cusp low, µm: a cusp between two cuts of the
+  /// cutting edge (curvature radius ρ: a ball's R, a torus's corner r) may fall up to a
+  /// spacing/√2 from every line, where the deviation climbs at most tan(θ + α) − tan(θ) a mm (θ
+  /// the part's slope there, α the edge's angle at a cusp of that height). 0 without a band.
+  double scallop_grid_error_um = 0;
   zbuffer::Backend backend = zbuffer::Backend::Cpu;
   double simulation_s = 0;
   bool coarsened = false;  ///< the spacing was widened to stay within kMaxSurfaceLines

@@ -275,7 +275,7 @@ ViewData gatherView(const ViewRequest& request) {
   if (!path_file.empty()) {
     ViewPath p;
     p.file = geometry::readPathFile(path_file);
-    geometry::requireSteadyAxes(p.file);  // a flipped axis: no motion to sweep
+    pathgen::requireSteadyAxes(p.file, scene.tool.radius_mm);  // a flipped axis in a pass
     p.what = path_file.string();
     d.path = std::move(p);
   } else if (scene.nominal) {

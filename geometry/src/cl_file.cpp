@@ -59,12 +59,6 @@ void requireSteadyAxis(const PathFile& path, std::size_t before, std::size_t i) 
                    " deg between two postures of a pass (a flipped axis?)");
 }
 
-void requireSteadyAxes(const PathFile& path) {
-  for (const PathBlock& block : path.blocks)
-    if (block.kind == PathBlock::Kind::Pass)
-      for (std::size_t i = block.begin + 1; i < block.end; ++i) requireSteadyAxis(path, i - 1, i);
-}
-
 PathFile singlePass(std::vector<Posture> postures) {
   PathFile path;
   if (!postures.empty()) path.blocks.push_back({PathBlock::Kind::Pass, 0, postures.size()});

@@ -14,6 +14,7 @@
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <Eigen/Geometry>
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
 
@@ -43,6 +44,33 @@ struct PositionHash {
 };
 
 /// A one-mesh assimp scene holding `mesh` (assimp stores single precision).
+/// `fill`'s mesh with its faces' own normals on their own corners: the STL exporter writes a
+/// facet's normal as the mean of its corners' (assimp's GenNormals gives a shared corner the
+/// mean of its faces'), and a tool mesh's facets came out up to 66 deg off (a helper's finding).
+void setFaceNormals(aiMesh& out, const TriangleMesh& mesh) {
+  const std::size_t corners = 3 * mesh.triangles.size();
+  delete[] out.mVertices;
+  out.mNumVertices = static_cast<unsigned>(corners);
+  out.mVertices = new aiVector3D[corners];
+  out.mNormals = new aiVector3D[corners];
+  for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
+    const auto& t = mesh.triangles[f];
+    const Eigen::Vector3d n = (mesh.vertices[t[1]] - mesh.vertices[t[0]])
+                                  .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]])
+                                  .normalized();
+    for (int c = 0; c < 3; ++c) {
+      const Eigen::Vector3d& v = mesh.vertices[t[c]];
+      out.mVertices[3 * f + c] = aiVector3D(
+          static_cast<ai_real>(v.x()), static_cast<ai_real>(v.y()), static_cast<ai_real>(v.z()));
+      out.mNormals[3 * f + c] = std::isfinite(n.x()) ? aiVector3D(static_cast<ai_real>(n.x()),
+                                                                  static_cast<ai_real>(n.y()),
+                                                                  static_cast<ai_real>(n.z()))
+                                                     : aiVector3D(0, 0, 0);
+      out.mFaces[f].mIndices[c] = static_cast<unsigned>(3 * f + c);
+    }
+  }
+}
+
 void fillScene(aiScene& scene, const TriangleMesh& mesh) {
   scene.mMaterials = new aiMaterial* [1] { new aiMaterial() };
   scene.mNumMaterials = 1;
@@ -326,6 +354,7 @@ void saveMesh(const TriangleMesh& mesh, const std::filesystem::path& file) {
                      "' (use .stl, .obj or .ply)");
   aiScene scene;
   fillScene(scene, mesh);
+  if (ext == ".stl") setFaceNormals(*scene.mMeshes[0], mesh);
   Assimp::Exporter exporter;
   const aiExportDataBlob* blob = exporter.ExportToBlob(&scene, format);
   if (blob == nullptr)

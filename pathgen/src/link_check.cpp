@@ -54,7 +54,9 @@ GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
   geometry::ToolSpec shrunk = tool;
   shrunk.radius_mm -= by;
   if (shrunk.shape == geometry::ToolShape::Torus) shrunk.corner_radius_mm -= by;
-  shrunk.length_mm -= 2 * by;
+  // Its top `by` under the tool's, but never below its own cutting end (a ball as long as
+  // its radius, L < R + by, was refused as too short for its end after the job's work).
+  shrunk.length_mm = std::max(shrunk.length_mm - 2 * by, geometry::cornerRadius(shrunk));
   geometry::HolderProfile thinner = holder;  // its bottom already `by` up with the tip
   for (auto& station : thinner) station.radius_mm -= by;
   if (!thinner.empty()) thinner.back().z_mm -= 2 * by;

@@ -88,6 +88,22 @@ AxisTurn largestAxisTurn(const PathFile& path, double ball_radius_mm) {
   return out;
 }
 
+void requireSteadyAxes(const PathFile& path, double ball_radius_mm) {
+  std::vector<char> starts(path.postures.size(), 0);  // where passRanges starts a pass
+  for (const auto& range : passRanges(path, 0.0, ball_radius_mm)) starts[range.first] = 1;
+  for (const PathBlock& block : path.blocks) {
+    if (block.kind != PathBlock::Kind::Pass) continue;
+    for (std::size_t i = block.begin + 1; i < block.end; ++i) {
+      // A flipped axis throws the ball centre up to 2R (and so splits the pass at a gap) but
+      // keeps the tip, or moves it R where tip and centre are confused: across a gap the tips
+      // also cross, a turn there is a link's.
+      const double tips_mm = (path.postures[i].tip_mm - path.postures[i - 1].tip_mm).norm();
+      if (starts[i] && tips_mm > 2.0 * ball_radius_mm) continue;
+      geometry::requireSteadyAxis(path, i - 1, i);
+    }
+  }
+}
+
 std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path,
                                                             double pass_gap_mm,
                                                             double ball_radius_mm) {

@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/geometry/mesh_io.h"
@@ -144,6 +145,21 @@ TEST(MeshIo, BinaryStlIsBinary) {
   const fs::path p = tempPath("bin.stl");
   saveMesh(tool, p);
   EXPECT_EQ(fs::file_size(p), 84 + 50 * tool.triangles.size());
+  // Each facet's stored normal is its own (the exporter wrote its corners' mean: up to 66 deg
+  // off on a tool mesh, a helper's finding), against the triangle's cross product.
+  std::ifstream in(p, std::ios::binary);
+  in.seekg(84);
+  for (std::size_t t = 0; t < tool.triangles.size(); ++t) {
+    float record[12];
+    char attribute[2];
+    in.read(reinterpret_cast<char*>(record), sizeof record);
+    in.read(attribute, 2);
+    const auto& tri = tool.triangles[t];
+    const Eigen::Vector3d n = (tool.vertices[tri[1]] - tool.vertices[tri[0]])
+                                  .cross(tool.vertices[tri[2]] - tool.vertices[tri[0]])
+                                  .normalized();
+    EXPECT_GT(n.dot(Eigen::Vector3d(record[0], record[1], record[2])), 1.0 - 1e-6) << "facet " << t;
+  }
 }
 
 TEST(MeshIo, BrokenFilesAreInputErrors) {

@@ -4,6 +4,8 @@
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/pathgen/clearance.h"
+#include "fieldpath/pathgen/link_check.h"
+#include "fixtures.h"
 
 using namespace fieldpath;
 using geometry::Posture;
@@ -126,4 +128,29 @@ TEST(Clearance, BallClearanceIsCentreDistanceLessTheRadius) {
   EXPECT_EQ(obstacle, 0);
   const std::vector<Vec3> touching = {Vec3(4.5, 0, 0)};
   EXPECT_EQ(checker.ballClearance(touching, 1.0), 0.0);
+}
+
+// The moves out of and into passes are checked with the tool 0.1 mm smaller all round, its top
+// 0.1 mm lower: a ball as long as its radius (3 mm, up to 3.1) was refused as "too short for
+// its cutting end" after the job's work (a helper's); it is taken, and still finds a link that
+// runs through a block on the part.
+TEST(Links, ABallAsLongAsItsRadiusIsChecked) {
+  TriangleMesh part;
+  pathgen::test::addBox(part, -10, 50, -10, 10, -5, 0);
+  pathgen::test::addBox(part, 20, 24, -10, 10, 0, 4);
+  for (const double length : {3.0, 3.0001, 3.05, 3.1}) {
+    SCOPED_TRACE(length);
+    const geometry::ToolSpec tool{geometry::ToolShape::Ball, 3.0, 0.0, length};
+    const pathgen::ClearanceChecker checker(geometry::toolMesh(tool, {}, 0.02), {&part, 1}, 0.02);
+    const pathgen::GrazingChecker grazing = pathgen::grazingPartChecker(tool, {}, part);
+    auto at = [](double x, double z) { return Posture{Vec3(x, 0, z), Vec3::UnitZ(), 0.0, false}; };
+    geometry::PathFile path;
+    path.postures = {at(0, 0),  at(10, 0), at(10, 0), at(10, 1),
+                     at(40, 1), at(40, 0), at(40, 0), at(45, 0)};
+    path.blocks = {{geometry::PathBlock::Kind::Pass, 0, 2},
+                   {geometry::PathBlock::Kind::Link, 2, 6},
+                   {geometry::PathBlock::Kind::Pass, 6, 8}};
+    const pathgen::LinkPartResult links = pathgen::checkLinksAgainstPart(checker, grazing, path);
+    EXPECT_EQ(links.motion_contacts, std::vector<std::size_t>{3});
+  }
 }

@@ -573,8 +573,12 @@ TEST(CheckSurface, TheSameJobHighUpInZReadsTheSame) {
                                  ".stl\ntool: { shape: ball, radius: 3, length: 40 }\n");
     std::ostringstream path;
     path.precision(17);
-    path << "# pass 1\n";
-    for (int k = 0; k <= 80; ++k) path << 5.0 + 0.5 * k << " 20 " << lift << " 0 0 1\n";
+    for (const double y : {20.0, 24.0}) {  // two passes: a scallop between them
+      if (y > 20.0)
+        path << "# link\n45 20 " << lift + 8 << " 0 0 1\n5 24 " << lift + 8 << " 0 0 1\n";
+      path << "# pass\n";
+      for (int k = 0; k <= 80; ++k) path << 5.0 + 0.5 * k << ' ' << y << ' ' << lift << " 0 0 1\n";
+    }
     dir.write(tag + ".cl", path.str());
   }
   auto surface = [&](const std::string& tag) {
@@ -587,4 +591,5 @@ TEST(CheckSurface, TheSameJobHighUpInZReadsTheSame) {
   EXPECT_EQ(high["gouged_lines"].get<int>(), 0);
   EXPECT_NEAR(high["max_gouge_um"].get<double>(), low["max_gouge_um"].get<double>(), 1.0);
   EXPECT_NEAR(high["max_scallop_um"].get<double>(), low["max_scallop_um"].get<double>(), 1.0);
+  EXPECT_GT(low["max_scallop_um"].get<double>(), 600.0);  // R - sqrt(R² - 4) = 764 um
 }

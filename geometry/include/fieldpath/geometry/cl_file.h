@@ -156,8 +156,4 @@ constexpr double kMaxPassAxisTurnDeg = 90.0;
 /// posture `before` to posture `i` of a pass.
 void requireSteadyAxis(const PathFile& path, std::size_t before, std::size_t i);
 
-/// requireSteadyAxis for every two consecutive postures of every pass block (a flipped axis:
-/// the motion between them is not one a machine makes, and a check sweeping it cannot bound it).
-void requireSteadyAxes(const PathFile& path);
-
 }  // namespace fieldpath::geometry

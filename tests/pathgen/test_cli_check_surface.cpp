@@ -1,0 +1,125 @@
+/// `check`'s surface figures on a flat plate against their closed forms, through the built
+/// `fieldpath`: the highest cusp between the lines and its stated bound, a lone pass (no
+/// scallop), a path that never cuts (not checked), and a tool axis turned far across a gap
+/// between two passes (taken, as generate takes it).
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "fieldpath/geometry/mesh_io.h"
+#include "fixtures.h"
+#include "run_fieldpath.h"
+
+namespace fs = std::filesystem;
+using namespace fieldpath;
+using test::TempDir;
+
+namespace {
+
+/// A plate (top at z = 0) and an obstacle far from it; a ball R 3 upright.
+void writePlateScene(const TempDir& dir) {
+  geometry::TriangleMesh part, wall;
+  pathgen::test::addBox(part, -10, 30, -15, 15, -5, 0);
+  pathgen::test::addBox(wall, 60, 70, -10, 10, 0, 5);
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
+}
+
+/// Passes along x at y = y0 + k · step_y (k < count), tips at height z, upright, links between.
+std::string passes(int count, double y0, double step_y, double z) {
+  std::ostringstream cl;
+  for (int k = 0; k < count; ++k) {
+    const double y = y0 + k * step_y;
+    if (k > 0) cl << "# link\n20 " << y - step_y << " 8 0 0 1\n0 " << y << " 8 0 0 1\n";
+    cl << "# pass " << k + 1 << "\n";
+    for (int i = 0; i <= 40; ++i) cl << 0.5 * i << ' ' << y << ' ' << z << " 0 0 1\n";
+  }
+  return cl.str();
+}
+
+nlohmann::json check(const TempDir& dir, const std::string& path, const std::string& out,
+                     const std::string& spacing = "0.05") {
+  const auto r = test::runFieldpath(dir, "check scene.yaml --path " + path + " --spacing " +
+                                             spacing + " --backend cpu --out " + out);
+  EXPECT_EQ(r.exit_code, 0) << r.output();
+  return nlohmann::json::parse(test::slurp(dir.path() / out / "check.json"));
+}
+
+}  // namespace
+
+// Passes 2 mm apart on a plate leave R - sqrt(R² - 1) = 171.6 um midway. The lines (every 0.05
+// mm, none on the cusp: y = -3 + (i + 0.5) 0.05 either side of it) read it low (163.8 um, a
+// helper's finding: 4.5 % optimistic, no bound said); the stated bound covers the cusp and is
+// not loose (a cusp's slope 1/sqrt(8) times spacing/sqrt(2): 12.5 um).
+TEST(CheckSurface, TheHighestCuspBetweenTheLinesIsWithinTheStatedBound) {
+  const TempDir dir;
+  writePlateScene(dir);
+  dir.write("two.cl", passes(6, -5.0, 2.0, 0.0));
+  const double exact_um = 1000.0 * (3.0 - std::sqrt(9.0 - 1.0));
+  for (const std::string spacing : {"0.05", "0.02"}) {
+    SCOPED_TRACE(spacing);
+    const auto s = check(dir, "two.cl", "out" + spacing, spacing)["surface"];
+    const double read = s["max_scallop_um"].get<double>();
+    const double bound = s["scallop_grid_error_um"].get<double>();
+    EXPECT_LE(read, exact_um + 0.5) << s;
+    EXPECT_GE(read + bound, exact_um) << s;
+    const double slope = 1.0 / std::sqrt(8.0), spacing_mm = std::stod(spacing);
+    EXPECT_LT(bound, 1.2 * 1000.0 * slope * spacing_mm / std::sqrt(2.0)) << s;
+    EXPECT_TRUE(s["scallop_skipped"].is_null());
+  }
+}
+
+// One pass has no neighbour: no scallop to tell (its band of ±R/2 read the ball's own profile,
+// R - sqrt(R² - (R/2)²) = 402 um, as one), and no gouge either.
+TEST(CheckSurface, ALonePassHasNoScallop) {
+  const TempDir dir;
+  writePlateScene(dir);
+  dir.write("one.cl", passes(1, 0.0, 0.0, 0.0));
+  const auto s = check(dir, "one.cl", "out")["surface"];
+  EXPECT_TRUE(s["max_scallop_um"].is_null()) << s;
+  EXPECT_TRUE(s["rms_deviation_um"].is_null()) << s;
+  EXPECT_EQ(s["band_lines"].get<int>(), 0) << s;
+  EXPECT_TRUE(s["scallop_skipped"].is_string()) << s;
+  EXPECT_LT(s["max_gouge_um"].get<double>(), 0.5) << s;
+}
+
+// Tips 5 mm over the plate (the stock stands 2 mm over it): nothing is cut, so nothing of the
+// surface is checked (it read 2000 um of 'scallop', ok, and surface_skipped null).
+TEST(CheckSurface, APathThatNeverCutsThePartIsNotChecked) {
+  const TempDir dir;
+  writePlateScene(dir);
+  dir.write("above.cl", passes(3, -2.0, 2.0, 5.0));
+  const auto report = check(dir, "above.cl", "out");
+  EXPECT_TRUE(report["surface"].is_null()) << report;
+  ASSERT_TRUE(report["surface_skipped"].is_string()) << report;
+  EXPECT_NE(report["surface_skipped"].get<std::string>().find("never cuts"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir.path() / "out/deviation.npy"));
+}
+
+// Two runs of postures 20 mm apart with the axis at -60 and +60 deg about y: generate reads two
+// passes (split at the gap) and takes it; check refused the 120 deg turn as within a pass. A
+// flip within one run is still refused, naming its line.
+TEST(CheckClearance, AnAxisTurnedFarAcrossAGapIsTakenAFlipInAPassIsNot) {
+  const TempDir dir;
+  writePlateScene(dir);
+  const double s = std::sin(M_PI / 3), c = std::cos(M_PI / 3);
+  std::ostringstream gap, flip;
+  for (int i = 0; i <= 10; ++i) gap << 0.5 * i << " 0 5 " << -s << " 0 " << c << "\n";
+  for (int i = 0; i <= 10; ++i) gap << 25 + 0.5 * i << " 0 5 " << s << " 0 " << c << "\n";
+  for (int i = 0; i <= 10; ++i)
+    flip << 0.5 * i << " 0 5 " << (i == 6 ? s : -s) << " 0 " << c << "\n";
+  dir.write("gap.cl", gap.str());
+  dir.write("flip.cl", flip.str());
+  const auto taken = test::runFieldpath(dir, "check scene.yaml --path gap.cl --backend cpu");
+  EXPECT_EQ(taken.exit_code, 0) << taken.output();
+  const auto refused = test::runFieldpath(dir, "check scene.yaml --path flip.cl --backend cpu");
+  EXPECT_EQ(refused.exit_code, 1) << refused.output();
+  EXPECT_NE(refused.output().find("flip.cl:7"), std::string::npos) << refused.output();
+}
