@@ -97,6 +97,11 @@ std::string at(double s_mm) {
   return out.str();
 }
 
+/// Step of the angles for the field's stiffness (central differences), rad: wide enough to
+/// span a few voxels at the holder (0.3 mm at 60 mm), so that a voxel field's piecewise slopes
+/// give the direct field's stiffness, not their own.
+constexpr double kStiffnessDeltaRad = 5e-3;
+
 /// J θ'' + c θ' + k (θ - θ0(s)) = τ(θ), first-order form, time in s, s = v t.
 class SteeringSystem final : public detail::OdeSystem {
  public:
@@ -106,8 +111,31 @@ class SteeringSystem final : public detail::OdeSystem {
         offsets_mm_(offsetsFromCentre(request.nodes_tool_frame_mm, request.ball_radius_mm)),
         feed_mm_per_s_(request.params.feed_mm_per_min / 60.0),
         inertia_(request.params.inertia),
-        damping_(request.params.effectiveDamping()),
-        stiffness_(request.params.stiffness) {}
+        damping_{request.params.effectiveDamping(), request.params.effectiveDamping()},
+        stiffness_(request.params.stiffness),
+        field_critical_(request.params.damping < 0.0 && request.field != nullptr) {}
+
+  /// `damping: critical` with a field: c = 2 sqrt((k + k_f) J) for each angle, k_f = the
+  /// field's own stiffness -∂τ/∂θ there (fieldStiffness's diagonal, >= 0) at s for state y,
+  /// held until the next call. Near a wall k_f is 10²-10⁴ × k: c = 2 sqrt(k J) left the axis
+  /// ringing (ζ 0.01-0.08), and its first swing drove the shank into the far wall of a
+  /// channel whose nominal path was clear (a helper's). Set at every output station, without
+  /// a threshold (a switch would make paths on two fields differ by where it fell) and without
+  /// restarting the solver (c jumps, the angles and rates do not: the error test sees it).
+  void updateDamping(double s_mm, const std::array<double, kStateSize>& y) {
+    if (!field_critical_) return;
+    const Frames frames = frameAt(s_mm);
+    for (int angle = 0; angle < 2; ++angle) {
+      const double d = angle == 0 ? kStiffnessDeltaRad : 0.0, t = kStiffnessDeltaRad - d;
+      const AxisMoment plus = moment(frames, y[0] + d, y[1] + t);
+      const AxisMoment minus = moment(frames, y[0] - d, y[1] - t);
+      const double torque_change =
+          angle == 0 ? plus.lead_torque - minus.lead_torque : plus.tilt_torque - minus.tilt_torque;
+      const double k_field = std::max(0.0, -torque_change / (2.0 * kStiffnessDeltaRad));
+      const double c = 2.0 * std::sqrt((stiffness_ + k_field) * inertia_);
+      if (std::isfinite(c)) damping_[angle] = c;  // (the moment's own check names a bad field)
+    }
+  }
 
   double feedMmPerS() const { return feed_mm_per_s_; }
 
@@ -123,10 +151,10 @@ class SteeringSystem final : public detail::OdeSystem {
     const PassFrame& pass_frame = frames.pass;
     ydot[0] = y[2];
     ydot[1] = y[3];
-    ydot[2] =
-        (m.lead_torque - damping_ * y[2] - stiffness_ * (y[0] - pass_frame.lead0_rad)) / inertia_;
-    ydot[3] =
-        (m.tilt_torque - damping_ * y[3] - stiffness_ * (y[1] - pass_frame.tilt0_rad)) / inertia_;
+    ydot[2] = (m.lead_torque - damping_[0] * y[2] - stiffness_ * (y[0] - pass_frame.lead0_rad)) /
+              inertia_;
+    ydot[3] = (m.tilt_torque - damping_[1] * y[3] - stiffness_ * (y[1] - pass_frame.tilt0_rad)) /
+              inertia_;
     const bool finite = std::isfinite(ydot[2]) && std::isfinite(ydot[3]);
     return finite ? 0 : 1;  // recoverable: the solver retries a shorter step, then gives up
   }
@@ -183,7 +211,10 @@ class SteeringSystem final : public detail::OdeSystem {
   const Pass& pass_;
   const SteeringRequest& request_;
   std::vector<Vec3> offsets_mm_;
-  double feed_mm_per_s_, inertia_, damping_, stiffness_;
+  double feed_mm_per_s_, inertia_;
+  double damping_[2];  ///< c for lead and tilt
+  double stiffness_;
+  bool field_critical_;                  ///< damping: critical, with a field (updateDamping)
   std::vector<Vec3> nodes_mm_, forces_;  // scratch, reused by every evaluation
 };
 
@@ -324,6 +355,7 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
     }
     LimitCheck check = checkAngles(request.params, request.params.on_limit, y);
     if (check.clamped) integrator->restart(s_mm / v, y.data());
+    if (k < intervals) system.updateDamping(s_mm, y);
     PostureSample sample = system.sample(s_mm, y);
     sample.limited = check.clamped;
     if (!sample.moment.allFinite()) {  // the solver saw it too late (at s = 0) or not at all

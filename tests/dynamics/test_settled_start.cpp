@@ -39,8 +39,9 @@ TEST(SettledStart, IsTheStaticEquilibriumAndThePassStartsAtRestThere) {
   request.initial_tilt_rad = settled.tilt_rad;
   const SteeringResult from_rest = runToleranceStable(pass, request);
   ASSERT_EQ(from_rest.status, Status::Ok) << from_rest.message;
-  // The nominal start swings (1° in its first mm here); the settled one stays.
-  EXPECT_GT(largestStep(from_nominal), 0.1 * expected);
+  // The nominal start moves (0.4° in its first 0.5 mm here, damped critically with the wall's
+  // stiffness: it swung 1° when the spring's alone); the settled one stays.
+  EXPECT_GT(largestStep(from_nominal), 0.03 * expected);
   EXPECT_LT(largestStep(from_rest), 1e-6);
   for (const PostureSample& s : from_rest.samples) EXPECT_NEAR(s.tilt_rad, expected, 2e-6);
   // Both end at rest at the same place.
@@ -78,6 +79,7 @@ TEST(SettledStart, TheSwingToRestIsNotAFailure) {
   const Pass pass = straightPass(20.0);
   request.params.max_tilt_deg = 1.2 * rest / kDeg;  // above the rest, below the nominal swing
   request.params.on_limit = LimitPolicy::Fail;
+  request.params.damping = 2.0;  // critical for the spring alone: the wall's stiffness rings
   ASSERT_EQ(steerPass(pass, request).status, Status::TiltLimit);  // from the nominal axis
   const SettledStart settled = settleAtStart(pass, request);
   ASSERT_TRUE(settled.settled) << settled.why;

@@ -224,8 +224,9 @@ TEST_F(MeshJob, BadNominalPathsAndMeshesAreOneLineErrorsWithNoOutputs) {
   }
 }
 
-// A stiff scene whose tilt runs into max_lead_deg: with on_limit clamp (the default) a path and
-// a count of the postures held at the limit; with fail, exit 1 naming the pass and no outputs.
+// A stiff scene whose tilt rings (damped for the spring alone) into max_lead_deg: with on_limit
+// clamp (the default) a path and a count of the postures held at the limit; with fail, exit 1
+// naming the pass and no outputs.
 TEST(StiffScene, ClampGivesAPathAndACountFailStops) {
   TempDir dir;
   std::string scene = test::slurp(kImpellerScene);
@@ -240,6 +241,7 @@ TEST(StiffScene, ClampGivesAPathAndACountFailStops) {
   set("stiffness", "100");
   set("inertia", "1e-4");
   set("gain", "50");
+  set("damping", "0.2");  // 2 sqrt(kJ): critical for the spring alone, the field's stiffness rings
   dir.write("stiff.yaml", scene);
   const auto clamp = test::runFieldpath(dir, "generate stiff.yaml --out clamp");
   ASSERT_EQ(clamp.exit_code, 0) << clamp.output();
@@ -394,10 +396,10 @@ TEST(CheckClearance, AnOpenObstacleMeshIsSaidToHaveNoInside) {
 }
 
 // A path that is unsafe for one reason and under the required clearance for another carries
-// both marks: a pass started upright beside a wall 0.3 mm from its holder (start: nominal) swings
-// so far (tilt limit 89°) that the holder goes into the part: UNSAFE; the first posture keeps
-// 0.29 mm from the wall: UNDER THE REQUIRED CLEARANCE too (only the first was said: a helper's
-// finding).
+// both marks: a pass started upright beside a wall 0.3 mm from its holder (start: nominal, damped
+// for the spring alone) swings so far (tilt limit 89°) that the holder goes into the part: UNSAFE;
+// the first posture keeps 0.29 mm from the wall: UNDER THE REQUIRED CLEARANCE too (only the first
+// was said: a helper's finding).
 TEST(CheckClearance, UnsafeAndUnderTheClearanceAreBothMarked) {
   const TempDir dir;
   geometry::TriangleMesh wall, part;
@@ -412,7 +414,8 @@ TEST(CheckClearance, UnsafeAndUnderTheClearanceAreBothMarked) {
             "obstacles:\n  - mesh: wall.stl\npart: part.stl\n"
             "tool: { shape: ball, radius: 3, length: 40 }\n"
             "holder: [[40, 6], [55, 6], [55, 12], [90, 12]]\nclearance: 0.5\n"
-            "dynamics: { max_tilt_deg: 89, start: nominal }\npath: { nominal: nominal.cl }\n");
+            "dynamics: { max_tilt_deg: 89, start: nominal, damping: 2 }\n"  // the spring's
+            "path: { nominal: nominal.cl }\n");  // critical alone: the swing rings (damping 2)
   const auto r = test::runFieldpath(dir, "generate scene.yaml --out out");
   ASSERT_EQ(r.exit_code, 0) << r.output();
   const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out" / "report.json"));

@@ -185,3 +185,37 @@ TEST(Generate, APassStartingInCollisionStartsFromTheSettledAxis) {
     EXPECT_NEAR(g.tilt_rad, first_tilt, 0.1 * M_PI / 180.0) << g.s_mm;
   EXPECT_GT(std::abs(swung.postures[1].tilt_rad - swung.postures[0].tilt_rad), 10.0 * M_PI / 180.0);
 }
+
+// A channel 16 mm wide, walls 20 mm high; the pass runs with the ball 1 mm from one wall, its
+// nominal (upright) path clear. The wall's field is 10²-10⁴ times stiffer than the spring, so
+// damping critical for the spring alone (c = 2 sqrt(kJ)) left the axis ringing: it swung past
+// its balance and drove the shank into the far wall's top edge (a helper's scene: 27° against
+// 18.7°, UNSAFE). `damping: critical` now counts the field's stiffness: no collision, no swing.
+TEST(Generate, APassBesideAWallDoesNotRingIntoTheFarWall) {
+  GenerateRequest job;
+  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 30.0};
+  job.holder = {{30, 6}, {45, 6}, {45, 12}, {75, 12}};
+  job.mode = FieldMode::Direct;
+  job.obstacles = {test::boxMesh(-10, 70, 8, 10, 0, 20), test::boxMesh(-10, 70, -10, -8, 0, 20)};
+  job.part = test::boxMesh(-10, 70, -8, 8, -5, 0);
+  std::vector<geometry::Posture> nominal;
+  for (int k = 0; k <= 80; ++k) nominal.push_back({Vec3(0.5 * k, 4, 0), Vec3::UnitZ(), 0.0, false});
+  job.passes = nominalPasses(geometry::singlePass(std::move(nominal)), PathParams{}, 3.0);
+  auto largest_turn_deg = [](const GenerateResult& r) {
+    double turn = 0.0;
+    for (std::size_t i = 1; i < r.postures.size(); ++i)
+      turn = std::max(turn, std::abs(r.postures[i].tilt_rad - r.postures[i - 1].tilt_rad));
+    return turn * 180.0 / M_PI;
+  };
+  const GenerateResult critical = generatePath(job);
+  EXPECT_EQ(critical.clearance.colliding, 0u);
+  EXPECT_EQ(critical.motions.colliding, 0u);
+  EXPECT_GE(critical.clearance.min_clearance_mm, 0.9);  // the nominal path's 1 mm, less the mesh's
+  EXPECT_LT(largest_turn_deg(critical), 4.0);
+
+  GenerateRequest spring_only = job;
+  spring_only.dynamics.damping = 2.0;  // 2 sqrt(kJ), k = J = 1: the field's stiffness left out
+  const GenerateResult ringing = generatePath(spring_only);
+  EXPECT_LT(ringing.clearance.min_clearance_mm, critical.clearance.min_clearance_mm - 0.3);
+  EXPECT_GT(largest_turn_deg(ringing), 2.0 * largest_turn_deg(critical));
+}

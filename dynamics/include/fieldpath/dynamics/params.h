@@ -24,8 +24,11 @@ enum class StartPolicy {
 /// Torques are in the field's unit times mm (τ = Σ (x_i - C) × F(x_i)); time in seconds.
 struct DynamicsParams {
   double inertia = 1.0;  ///< J, torque·s²/rad
-  double damping =
-      -1.0;  ///< c, torque·s/rad; negative = critical for the spring alone, 2·sqrt(k·J)
+  /// c, torque·s/rad; negative = critical: 2·sqrt(k·J) where the field is flat and, with a
+  /// field, 2·sqrt((k + k_f)·J) for each angle, k_f the field's stiffness -∂τ/∂θ (>= 0) at the
+  /// start of each output step (a wall's is 10²-10⁴ × k: the spring's alone left the axis
+  /// ringing into the far wall of a channel).
+  double damping = -1.0;
   double stiffness = 1.0;           ///< k, torque/rad
   double feed_mm_per_min = 1000.0;  ///< v: s = v t
   double rtol = 1.0e-6;
@@ -37,7 +40,8 @@ struct DynamicsParams {
   LimitPolicy on_limit = LimitPolicy::Clamp;
   StartPolicy start = StartPolicy::Auto;
 
-  /// c, with the critical default resolved.
+  /// c, with the critical default resolved for the spring alone (a field adds its stiffness
+  /// during a pass: steering.cpp).
   double effectiveDamping() const {
     return damping >= 0.0 ? damping : 2.0 * std::sqrt(stiffness * inertia);
   }
