@@ -4,6 +4,7 @@
 /// postures bit for bit and `simulate` the same heights. `.npy` has no place for pass and link
 /// blocks or `# limit` marks: converting to it says what was dropped.
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -22,9 +23,10 @@ namespace fs = std::filesystem;
 using geometry::PathFormat;
 
 /// The output format by extension; unlike reading (anything else is `.cl`), a typo in the name
-/// of a file about to be written is refused.
+/// of a file about to be written is refused. Any case, as the readers take it (`X.CL`).
 PathFormat outputFormat(const fs::path& file) {
-  const std::string ext = file.extension().string();
+  std::string ext = file.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext == ".cl") return PathFormat::Cl;
   if (ext == ".apt" || ext == ".cls") return PathFormat::Apt;
   if (ext == ".npy") return PathFormat::Npy;

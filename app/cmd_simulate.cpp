@@ -252,7 +252,11 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     req.progress = makeProgressLine(global.quiet);
     const double prepare_s = prepared.get();
 
-    const zb::SimulationResult res = zb::simulateBlocks(req, [&stream] { return stream.next(); });
+    const zb::SimulationResult res = zb::simulateBlocks(req, [&stream, &req] {
+      const std::span<const zb::Posture> block = stream.next();
+      common::report(req.progress, stream.doneFraction(), "simulate");  // (count unknown)
+      return block;
+    });
     stream.waitAll();  // an error after the last chunk (e.g. no postures at all)
     if (res.postures == 0) throw InputError(o->path + ": no postures");
 

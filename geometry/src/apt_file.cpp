@@ -287,6 +287,11 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
       while (next_unit < c.units.size() && c.units[next_unit].first <= k)
         scale = c.units[next_unit++].second;
       postures[k].tip_mm *= scale;
+      // Checked in mm: 50000 inches passed the readers' +-1e6 as read, then `convert` refused
+      // its own 1.27e6 mm output (a helper's finding).
+      if (scale != 1.0)
+        checkTip(postures[k].tip_mm,
+                 [&] { return file.string() + ":" + std::to_string(c.postures.lines[k]); });
     }
     if (next_unit < c.units.size()) scale = c.units.back().second;
     for (std::size_t k = 0; k < c.inherit_axis; ++k) postures[k].axis = carried_axis;

@@ -269,10 +269,13 @@ TEST(Convert, RoundTripsKeepThePosturesBitForBit) {
   ASSERT_EQ(runFieldpath(f.dir, "convert a.npy b.apt --tool ball:1").exit_code, 0);
   ASSERT_EQ(runFieldpath(f.dir, "convert b.apt c.cl").exit_code, 0);
   ASSERT_EQ(runFieldpath(f.dir, "convert marked.cl d.cls --tool torus:2:0.5").exit_code, 0);
+  // Output names in capitals, as the readers take them (they were refused).
+  ASSERT_EQ(runFieldpath(f.dir, "convert marked.cl E.CL").exit_code, 0);
+  ASSERT_EQ(runFieldpath(f.dir, "convert marked.cl F.NPY").exit_code, 0);
 
   // The reference is the .cl as read (the readers normalise the float-rounded axes).
   marked = geometry::readPathFile(f.dir.path() / "marked.cl");
-  for (const char* file : {"a.npy", "b.apt", "c.cl", "d.cls"}) {
+  for (const char* file : {"a.npy", "b.apt", "c.cl", "d.cls", "E.CL", "F.NPY"}) {
     const PathFile back = geometry::readPathFile(f.dir.path() / file);
     ASSERT_EQ(back.postures.size(), marked.postures.size()) << file;
     for (std::size_t i = 0; i < back.postures.size(); ++i) {

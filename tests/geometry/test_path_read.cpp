@@ -225,6 +225,13 @@ TEST(PathRead, RefusesTipsBeyondAnyMachine) {
   writeNpyFile(npy, postures);
   EXPECT_NE(errorOf(npy, 4096, 0).find(npy.string() + ": row 2: tool tip z"), std::string::npos)
       << errorOf(npy, 4096, 0);
+  // In mm after UNITS/INCHES: 50000 in is 1.27e6 mm (it passed as read, a helper's finding).
+  const fs::path inches =
+      writeBytes("inches.apt", "UNITS/INCHES\nGOTO/0,0,0,0,0,1\nGOTO/50000,0,0\n");
+  for (std::size_t bytes : kChunkBytes)
+    EXPECT_NE(errorOf(inches, bytes, 0).find(inches.string() + ":3: tool tip x = 1.27e+06 mm"),
+              std::string::npos)
+        << errorOf(inches, bytes, 0);
   // 1e6 mm itself is still a coordinate
   EXPECT_EQ(read(writeBytes("edge.cl", "1e6 -1e6 0 0 0 1\n"), 4096, 0).postures.size(), 1u);
 }

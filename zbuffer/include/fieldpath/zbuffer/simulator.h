@@ -127,7 +127,7 @@ struct SimulationRequest {
   Backend backend = Backend::Auto;
   Engine engine = Engine::Fast;
   std::size_t block_postures = std::size_t{1} << 20;  ///< postures per streamed block
-  common::Progress progress;  ///< fraction is postures done / expected_postures (if known)
+  common::Progress progress;  ///< postures done / expected_postures (if known; else the caller's)
   std::size_t expected_postures = 0;
   EngineTuning tuning;
 };
