@@ -1,5 +1,7 @@
 #include "job.h"
 
+#include <cstdio>
+
 #include "fieldpath/common/errors.h"
 
 namespace fieldpath::app {
@@ -35,9 +37,15 @@ pathgen::GenerateRequest sceneJob(const Scene& scene) {
   job.part = scene.part;
   if (job.tool.shape != geometry::ToolShape::Ball)
     throw InputError(toolShapeWhere(scene) + ": the passes are for a ball-end mill (shape: ball)");
-  job.passes = impeller ? pathgen::impellerPasses(*scene.impeller_model, job.path,
-                                                  job.tool.radius_mm)
-                        : pathgen::nominalPasses(*scene.nominal, job.path, job.tool.radius_mm);
+  std::size_t repeated = 0;
+  job.passes =
+      impeller ? pathgen::impellerPasses(*scene.impeller_model, job.path, job.tool.radius_mm)
+               : pathgen::nominalPasses(*scene.nominal, job.path, job.tool.radius_mm, &repeated);
+  if (repeated > 0)  // DESIGN: a posture kept out of the path is reported (they went unsaid)
+    std::fprintf(stderr,
+                 "note: %s: %zu posture%s at the ball centre of the one before dropped (a repeat "
+                 "is no motion)\n",
+                 scene.nominal->file.string().c_str(), repeated, repeated == 1 ? "" : "s");
   return job;
 }
 

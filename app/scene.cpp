@@ -15,6 +15,7 @@
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/input_file.h"
 #include "fieldpath/common/limits.h"
+#include "fieldpath/geometry/mesh.h"
 #include "fieldpath/geometry/mesh_io.h"
 #include "fieldpath/geometry/tool_model.h"
 
@@ -116,6 +117,10 @@ class Reader {
     } catch (const InputError& e) {
       fail(node, key, e.what());
     }
+    // Every triangle degenerate: no surface to sample or to machine (it was read, and the
+    // field was zero everywhere without a word: a helper's finding).
+    if (!(geometry::meshArea(mesh) > 0.0))
+      fail(node, key, p.string() + ": every triangle has zero area: the mesh has no surface");
     // Inward-wound shells would make the field pull into the walls (the samples' normals) and
     // the part's top its bottom: turned, and said.
     if (const std::size_t turned = geometry::orientClosedShells(mesh))

@@ -226,6 +226,25 @@ TEST(Scene, TheSameSurfacesFromTwoFilesAreRefused) {
   EXPECT_EQ(app::loadScene(two).obstacles.size(), 2u);
 }
 
+// A mesh of degenerate triangles only (points on a line) has no surface to repel from: refused,
+// naming the key and the file (its field was zero everywhere without a word).
+TEST(Scene, AMeshWithNoAreaIsRefused) {
+  TempDir dir;
+  dir.write("line.stl",
+            "solid line\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n"
+            "   vertex 2 0 0\n  endloop\n endfacet\nendsolid line\n");
+  dir.write("wall.stl", app::test::squareStl(5));
+  const auto file = dir.write("job.yaml", "obstacles:\n  - mesh: wall.stl\n  - mesh: line.stl\n");
+  try {
+    (void)app::loadScene(file);
+    ADD_FAILURE() << "a mesh with no area was read";
+  } catch (const common::InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(":3: obstacles[2].mesh"), std::string::npos) << message;
+    EXPECT_NE(message.find("line.stl: every triangle has zero area"), std::string::npos) << message;
+  }
+}
+
 // `path.passes` is the parametric impeller's: with a nominal path it was read past (the same
 // path.cl). A ball's corner radius equal to its radius says nothing new and is taken.
 TEST(Scene, KeysThatDoNotApplyAreRefused) {
@@ -277,4 +296,24 @@ TEST(AxisTurn, TheWarningNamesBothPosturesWhateverTheFileNamesLength) {
   EXPECT_EQ(still.at, 0u);
   EXPECT_EQ(still.deg, 0.0);
   EXPECT_DOUBLE_EQ(still.step_mm, 0.5);
+}
+
+// A posture repeated (the same ball centre as the one before) is dropped from its pass, and
+// said (it went unsaid: DESIGN asks for what is kept out of a path to be reported).
+TEST(Scene, RepeatedPosturesDroppedAreSaid) {
+  TempDir dir;
+  dir.write("wall.stl", app::test::squareStl(5));
+  dir.write("nominal.cl",
+            "0 0 1 0 0 1\n1 0 1 0 0 1\n1 0 1 0 0 1\n2 0 1 0 0 1\n2 0 1 0 0 1\n3 0 1 0 0 1\n");
+  const auto file = dir.write("job.yaml",
+                              "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, "
+                              "length: 40 }\npath: { nominal: nominal.cl }\n");
+  const app::Scene scene = app::loadScene(file);
+  testing::internal::CaptureStderr();
+  const auto job = app::sceneJob(scene);
+  const std::string err = testing::internal::GetCapturedStderr();
+  ASSERT_EQ(job.passes.size(), 1u);
+  EXPECT_NE(err.find("nominal.cl: 2 postures at the ball centre of the one before dropped"),
+            std::string::npos)
+      << err;
 }
