@@ -73,40 +73,43 @@ std::string clearanceCsv(const geometry::PathFile& path, const pathgen::Clearanc
 
 json surfaceJson(const SurfaceResult& s) {
   auto scallop = [&s](double um) { return s.band_lines > 0 ? json(um) : json(nullptr); };
-  return {{"grid",
-           {{"origin", {s.grid.x0_mm, s.grid.y0_mm}},
-            {"spacing", {s.grid.dx_mm, s.grid.dy_mm}},
-            {"shape", {s.grid.ny, s.grid.nx}}}},
-          {"spacing_coarsened", s.coarsened},
-          {"backend", zbuffer::backendName(s.backend)},
-          {"simulation_s", s.simulation_s},
-          {"swept",
-           "the Z-buffer cuts at the postures and along every motion between them that can reach "
-           "the stock (tip and axis interpolated linearly, no point of the tool moving more than "
-           "sweep_step_mm between cuts; a ball's cut between two is at most sweep_error_um "
-           "shallower than the swept one)"},
-          {"sweep_step_mm", s.sweep_step_mm},
-          {"sweep_error_um", s.sweep_error_um},
-          {"simulated_postures", s.simulated_postures},
-          {"cut_lines", s.cut_lines},
-          {"part_lines", s.part_lines},
-          {"band_lines", s.band_lines},
-          {"gouged_lines", s.gouged_lines},
-          {"gouge_tolerance_um", s.gouge_tolerance_um},
-          {"max_gouge_um", s.max_gouge_um},
-          // No band (a lone pass, passes too far apart to be neighbours): no scallop to tell.
-          {"max_scallop_um", scallop(s.max_scallop_um)},
-          {"scallop_grid_error_um", scallop(s.scallop_grid_error_um)},
-          {"scallop_grid_error",
-           "the lines may miss the highest cusp: it may stand up to scallop_grid_error_um above "
-           "max_scallop_um (the cusp within spacing/sqrt(2) of a line, the cutting edge's slope "
-           "there over the part's)"},
-          {"scallop_skipped", s.band_lines > 0 ? json(nullptr)
-                                               : json("no two neighbouring passes: a scallop is "
-                                                      "what is left between them")},
-          {"mean_deviation_um", scallop(s.mean_um)},
-          {"rms_deviation_um", scallop(s.rms_um)},
-          {"stock_allowance_mm", kStockAllowanceMm}};
+  return {
+      {"grid",
+       {{"origin", {s.grid.x0_mm, s.grid.y0_mm}},
+        {"spacing", {s.grid.dx_mm, s.grid.dy_mm}},
+        {"shape", {s.grid.ny, s.grid.nx}}}},
+      {"spacing_coarsened", s.coarsened},
+      {"backend", zbuffer::backendName(s.backend)},
+      {"simulation_s", s.simulation_s},
+      {"swept",
+       "the Z-buffer cuts at the postures and along every motion between them that can reach "
+       "the stock (tip and axis interpolated linearly, no point of the tool moving more than "
+       "sweep_step_mm between cuts; a ball's cut between two is at most sweep_error_um "
+       "shallower than the swept one)"},
+      {"sweep_step_mm", s.sweep_step_mm},
+      {"sweep_error_um", s.sweep_error_um},
+      {"simulated_postures", s.simulated_postures},
+      {"cut_lines", s.cut_lines},
+      {"part_lines", s.part_lines},
+      {"band_lines", s.band_lines},
+      {"gouged_lines", s.gouged_lines},
+      {"gouge_tolerance_um", s.gouge_tolerance_um},
+      {"max_gouge_um", s.max_gouge_um},
+      // No band (a lone pass, passes too far apart to be neighbours): no scallop to tell.
+      {"max_scallop_um", scallop(s.max_scallop_um)},
+      {"scallop_grid_error_um",
+       std::isfinite(s.scallop_grid_error_um) ? scallop(s.scallop_grid_error_um) : json(nullptr)},
+      {"scallop_grid_error",
+       "the lines may miss the highest cusp: it may stand up to scallop_grid_error_um above "
+       "max_scallop_um (each cusp within spacing/sqrt(2) of a line, the cutting edge's slope "
+       "there over the part's; null: a band line on a wall of 85 deg or more, where vertical "
+       "lines bound no cusp)"},
+      {"scallop_skipped", s.band_lines > 0 ? json(nullptr)
+                                           : json("no two neighbouring passes: a scallop is "
+                                                  "what is left between them")},
+      {"mean_deviation_um", scallop(s.mean_um)},
+      {"rms_deviation_um", scallop(s.rms_um)},
+      {"stock_allowance_mm", kStockAllowanceMm}};
 }
 
 }  // namespace
@@ -151,7 +154,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     if (!scene.tool_given)
       throw InputError(scene.file.string() + ": tool: missing: check needs the cutter (`tool: { "
                                              "shape: ball, radius: R, length: L }`)");
-    pathgen::requireSteadyAxes(path, scene.tool.radius_mm);  // a flipped axis in a pass
+    pathgen::requireSteadyAxes(path, scene.path.pass_gap_mm,
+                               scene.tool.radius_mm);  // a flipped axis in a pass
     // A flat end's rim is sharp: tilted along the feed, the cut between two stamps is too shallow
     // by up to step · tan(tilt) (30 um at 10 deg; a helper's 10 um ridge passed), not the
     // curvature bound the stamps are spaced by. Ball and torus (the corner's curvature) only.
@@ -301,11 +305,16 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                   path.limited.size(), limited_colliding);
     if (surface) {
       char scallop[160] = "no scallop (no two neighbouring passes)";
-      if (surface->band_lines > 0)
+      if (surface->band_lines > 0 && std::isfinite(surface->scallop_grid_error_um))
         std::snprintf(scallop, sizeof scallop,
                       "max scallop %.1f um (a cusp between the lines up to %.1f um more), rms "
                       "%.1f um",
                       surface->max_scallop_um, surface->scallop_grid_error_um, surface->rms_um);
+      else if (surface->band_lines > 0)
+        std::snprintf(scallop, sizeof scallop,
+                      "max scallop %.1f um (a cusp between the lines on a wall of 85 deg or "
+                      "more: not bounded), rms %.1f um",
+                      surface->max_scallop_um, surface->rms_um);
       std::printf(
           "surface: %zu lines in the band, max gouge %.2f um (%zu lines below %.1f um), "
           "%s (%s, %.2f s)\n",

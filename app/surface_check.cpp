@@ -131,13 +131,13 @@ std::vector<char> machinedBand(const zbuffer::Grid& grid, const geometry::PathFi
   return mask;
 }
 
-/// How far the highest line's deviation `scallop_um` may lie under the highest cusp's (µm), for
-/// lines `spacing_mm` apart, a cutting edge of curvature radius `edge_mm` and the part's upward
-/// normal `n` there (SurfaceResult::scallop_grid_error_um). A cusp of height h between two arcs
-/// of radius ρ meets them at α = asin(√(2ρh − h²)/ρ) from the part's normal; the deviation
-/// (vertical, machined − part) climbs at tan(θ + α) − tan(θ) a mm there, θ the part's slope; the
-/// cusp lies within spacing/√2 of a line. h is the cusp's own, found from the line's by a few
-/// rounds; α + θ is held under 85° (a steeper cusp is a wall's: bounded there, not resolved).
+/// How far a line's deviation `scallop_um` may lie under a cusp's within spacing/√2 of it
+/// (µm), for lines `spacing_mm` apart, a cutting edge of curvature radius `edge_mm` and the
+/// part's upward normal `n` there (SurfaceResult::scallop_grid_error_um). A cusp of height h
+/// between two arcs of radius ρ meets them at α = asin(√(2ρh − h²)/ρ) from the part's normal;
+/// the deviation (vertical, machined − part) climbs at tan(θ + α) − tan(θ) a mm there, θ the
+/// part's slope; h is the cusp's own, found from the line's by a few rounds. Infinite where θ
+/// + α reaches 85°: a cusp against a wall that steep is not bounded by vertical lines.
 double scallopGridErrorUm(double scallop_um, double spacing_mm, double edge_mm, const Vec3& n) {
   if (!(scallop_um > 0.0) || !(edge_mm > 0.0)) return 0.0;
   const double reach_mm = spacing_mm / std::sqrt(2.0);
@@ -148,8 +148,8 @@ double scallopGridErrorUm(double scallop_um, double spacing_mm, double edge_mm, 
     const double h = std::min(edge_mm, 1e-3 * scallop_um + error_mm);
     const double alpha =
         std::asin(std::min(1.0, std::sqrt(std::max(0.0, 2 * edge_mm * h - h * h)) / edge_mm));
-    const double climb = std::tan(std::min(theta + alpha, steepest)) - std::tan(theta);
-    error_mm = climb * reach_mm;
+    if (theta + alpha >= steepest) return std::numeric_limits<double>::infinity();
+    error_mm = (std::tan(theta + alpha) - std::tan(theta)) * reach_mm;
   }
   return 1e3 * error_mm;
 }
@@ -387,7 +387,8 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   result.in_band = machinedBand(sim.grid, path, radius, edge_mm, nominal);
   result.deviation_um.assign(sim.grid.lineCount(), std::numeric_limits<float>::quiet_NaN());
   double sum = 0, sum2 = 0, min_dev = 0, max_dev = 0;
-  std::size_t highest = 0;  // the band's highest line
+  double highest_cusp = 0;  // the highest any line's cusp may stand (scallopGridErrorUm)
+  const double spacing_mm = std::max(sim.grid.dx_mm, sim.grid.dy_mm);
   for (std::size_t i = 0; i < nominal.size(); ++i) {
     if (std::isnan(nominal[i])) {
       result.in_band[i] = 0;
@@ -402,19 +403,17 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
     ++result.band_lines;
     sum += d;
     sum2 += d * d;
-    if (d > max_dev) {
-      max_dev = d;
-      highest = i;
-    }
+    max_dev = std::max(max_dev, d);
+    const Vec2 at(sim.grid.x0_mm + (i % sim.grid.nx + 0.5) * sim.grid.dx_mm,
+                  sim.grid.y0_mm + (i / sim.grid.nx + 0.5) * sim.grid.dy_mm);
+    highest_cusp =
+        std::max(highest_cusp,
+                 d + scallopGridErrorUm(d, spacing_mm, edge_mm, partNormal(sim.grid, nominal, at)));
   }
   if (result.band_lines > 0) {
     result.mean_um = sum / result.band_lines;
     result.rms_um = std::sqrt(sum2 / result.band_lines);
-    const Vec2 at(sim.grid.x0_mm + (highest % sim.grid.nx + 0.5) * sim.grid.dx_mm,
-                  sim.grid.y0_mm + (highest / sim.grid.nx + 0.5) * sim.grid.dy_mm);
-    result.scallop_grid_error_um =
-        scallopGridErrorUm(max_dev, std::max(sim.grid.dx_mm, sim.grid.dy_mm), edge_mm,
-                           partNormal(sim.grid, nominal, at));
+    result.scallop_grid_error_um = highest_cusp - max_dev;
   }
   result.max_gouge_um = std::max(0.0, -min_dev);
   result.max_scallop_um = max_dev;

@@ -45,10 +45,12 @@ struct SurfaceResult {
   std::size_t gouged_lines = 0;  ///< anywhere on the part, deeper than the tolerance
   double gouge_tolerance_um = kGougeToleranceUm;
   double max_gouge_um = 0, max_scallop_um = 0, mean_um = 0, rms_um = 0;  ///< scallop stats: band
-  /// How far the highest line may read the highest cusp low, µm: a cusp between two cuts of the
-  /// cutting edge (curvature radius ρ: a ball's R, a torus's corner r) may fall up to a
+  /// How far the highest cusp may stand above max_scallop_um, µm: a cusp between two cuts of
+  /// the cutting edge (curvature radius ρ: a ball's R, a torus's corner r) may fall up to a
   /// spacing/√2 from every line, where the deviation climbs at most tan(θ + α) − tan(θ) a mm (θ
-  /// the part's slope there, α the edge's angle at a cusp of that height). 0 without a band.
+  /// the part's slope there, α the edge's angle at a cusp of that height): the largest line's
+  /// deviation plus its own bound, over the band, less max_scallop_um. Infinite where a band
+  /// line lies on a wall of 85° with its cusp (not bounded); 0 without a band.
   double scallop_grid_error_um = 0;
   zbuffer::Backend backend = zbuffer::Backend::Cpu;
   double simulation_s = 0;

@@ -275,7 +275,8 @@ ViewData gatherView(const ViewRequest& request) {
   if (!path_file.empty()) {
     ViewPath p;
     p.file = geometry::readPathFile(path_file);
-    pathgen::requireSteadyAxes(p.file, scene.tool.radius_mm);  // a flipped axis in a pass
+    pathgen::requireSteadyAxes(p.file, scene.path.pass_gap_mm,
+                               scene.tool.radius_mm);  // a flipped axis in a pass
     p.what = path_file.string();
     d.path = std::move(p);
   } else if (scene.nominal) {

@@ -7,6 +7,8 @@
 #include <numbers>
 #include <sstream>
 
+#include <Eigen/Eigenvalues>
+
 #include "fieldpath/common/errors.h"
 #include "sundials_support.h"
 
@@ -111,30 +113,40 @@ class SteeringSystem final : public detail::OdeSystem {
         offsets_mm_(offsetsFromCentre(request.nodes_tool_frame_mm, request.ball_radius_mm)),
         feed_mm_per_s_(request.params.feed_mm_per_min / 60.0),
         inertia_(request.params.inertia),
-        damping_{request.params.effectiveDamping(), request.params.effectiveDamping()},
+        damping_(request.params.effectiveDamping() * Eigen::Matrix2d::Identity()),
         stiffness_(request.params.stiffness),
         field_critical_(request.params.damping < 0.0 && request.field != nullptr) {}
 
-  /// `damping: critical` with a field: c = 2 sqrt((k + k_f) J) for each angle, k_f = the
-  /// field's own stiffness -∂τ/∂θ there (fieldStiffness's diagonal, >= 0) at s for state y,
-  /// held until the next call. Near a wall k_f is 10²-10⁴ × k: c = 2 sqrt(k J) left the axis
-  /// ringing (ζ 0.01-0.08), and its first swing drove the shank into the far wall of a
-  /// channel whose nominal path was clear (a helper's). Set at every output station, without
-  /// a threshold (a switch would make paths on two fields differ by where it fell) and without
-  /// restarting the solver (c jumps, the angles and rates do not: the error test sees it).
+  /// `damping: critical` with a field: the damping matrix C = 2 sqrt(J (k I + K_f)), critical
+  /// for every mode of the spring and the field together (K_f = -∂τ/∂θ by central differences,
+  /// fieldStiffness's, made symmetric, its negative modes left to the spring), at s for state y,
+  /// held until the next call. Near a wall K_f is 10²-10⁴ × k: c = 2 sqrt(k J) left the axis
+  /// ringing (ζ 0.01-0.08), and its first swing drove the shank into the far wall of a channel
+  /// whose nominal path was clear (a helper's). The whole matrix, not its diagonal: a wall
+  /// oblique to the frame splits its stiffness between the angles (ζ 0.71 from the diagonal at
+  /// 45°). Set at every output station, without a threshold (a switch would make paths on two
+  /// fields differ by where it fell) and without a restart or a stop time there: the solver
+  /// takes it from where its steps stand, at most one step (<= one output interval) past the
+  /// station (a stop time at every station failed the hard cases' plunge: the frame jumps there).
+  /// The rates are continuous; the error test sees c's jump.
   void updateDamping(double s_mm, const std::array<double, kStateSize>& y) {
     if (!field_critical_) return;
     const Frames frames = frameAt(s_mm);
+    Eigen::Matrix2d k_field;
     for (int angle = 0; angle < 2; ++angle) {
       const double d = angle == 0 ? kStiffnessDeltaRad : 0.0, t = kStiffnessDeltaRad - d;
       const AxisMoment plus = moment(frames, y[0] + d, y[1] + t);
       const AxisMoment minus = moment(frames, y[0] - d, y[1] - t);
-      const double torque_change =
-          angle == 0 ? plus.lead_torque - minus.lead_torque : plus.tilt_torque - minus.tilt_torque;
-      const double k_field = std::max(0.0, -torque_change / (2.0 * kStiffnessDeltaRad));
-      const double c = 2.0 * std::sqrt((stiffness_ + k_field) * inertia_);
-      if (std::isfinite(c)) damping_[angle] = c;  // (the moment's own check names a bad field)
+      k_field(0, angle) = -(plus.lead_torque - minus.lead_torque) / (2.0 * kStiffnessDeltaRad);
+      k_field(1, angle) = -(plus.tilt_torque - minus.tilt_torque) / (2.0 * kStiffnessDeltaRad);
     }
+    if (!k_field.allFinite()) return;  // (the moment's own check names a bad field)
+    const Eigen::Matrix2d total =
+        stiffness_ * Eigen::Matrix2d::Identity() + 0.5 * (k_field + k_field.transpose());
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> modes(total);
+    const Eigen::Vector2d rates = modes.eigenvalues().cwiseMax(stiffness_).cwiseSqrt();
+    damping_ = 2.0 * std::sqrt(inertia_) * modes.eigenvectors() * rates.asDiagonal() *
+               modes.eigenvectors().transpose();
   }
 
   double feedMmPerS() const { return feed_mm_per_s_; }
@@ -151,10 +163,9 @@ class SteeringSystem final : public detail::OdeSystem {
     const PassFrame& pass_frame = frames.pass;
     ydot[0] = y[2];
     ydot[1] = y[3];
-    ydot[2] = (m.lead_torque - damping_[0] * y[2] - stiffness_ * (y[0] - pass_frame.lead0_rad)) /
-              inertia_;
-    ydot[3] = (m.tilt_torque - damping_[1] * y[3] - stiffness_ * (y[1] - pass_frame.tilt0_rad)) /
-              inertia_;
+    const Eigen::Vector2d damped = damping_ * Eigen::Vector2d(y[2], y[3]);
+    ydot[2] = (m.lead_torque - damped[0] - stiffness_ * (y[0] - pass_frame.lead0_rad)) / inertia_;
+    ydot[3] = (m.tilt_torque - damped[1] - stiffness_ * (y[1] - pass_frame.tilt0_rad)) / inertia_;
     const bool finite = std::isfinite(ydot[2]) && std::isfinite(ydot[3]);
     return finite ? 0 : 1;  // recoverable: the solver retries a shorter step, then gives up
   }
@@ -212,7 +223,7 @@ class SteeringSystem final : public detail::OdeSystem {
   const SteeringRequest& request_;
   std::vector<Vec3> offsets_mm_;
   double feed_mm_per_s_, inertia_;
-  double damping_[2];  ///< c for lead and tilt
+  Eigen::Matrix2d damping_;  ///< C, torque·s/rad: (lead, tilt) rates to damping torques
   double stiffness_;
   bool field_critical_;                  ///< damping: critical, with a field (updateDamping)
   std::vector<Vec3> nodes_mm_, forces_;  // scratch, reused by every evaluation
@@ -398,9 +409,21 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
 SettledStart settleAtStart(const Pass& pass, const SteeringRequest& request) {
   validate(pass, request);
   SettledStart out;
-  const double c = request.params.effectiveDamping();
+  // `critical` with a field damps with the field's stiffness too (updateDamping), faster than
+  // the spring's c: chunks of the spring's decay time are generous; with no spring, one of the
+  // field's is read at the first frame's nominal axis.
+  double c = request.params.effectiveDamping();
+  if (!(c > 0.0) && request.params.damping < 0.0 && request.field) {
+    const PassFrame at = pass.frameAt(0.0);
+    const Eigen::Matrix2d k_field = fieldStiffness(
+        *request.field, request.nodes_tool_frame_mm, request.ball_radius_mm, localFrame(at),
+        at.centre_mm, at.lead0_rad, at.tilt0_rad, kStiffnessDeltaRad);
+    c = 2.0 * std::sqrt(std::max(0.0, k_field.diagonal().maxCoeff()) * request.params.inertia);
+  }
   if (!(c > 0.0)) {
-    out.why = "no damping (dynamics.damping: 0): the axis never comes to rest";
+    out.why =
+        "no damping (dynamics.damping: 0, or critical with no spring and no field's "
+        "stiffness there): the axis never comes to rest";
     return out;
   }
   // The first frame held, one decay time 2J/c at a time (as a pass of that length at the feed,

@@ -43,8 +43,8 @@ struct PositionHash {
   }
 };
 
-/// A one-mesh assimp scene holding `mesh` (assimp stores single precision).
-/// `fill`'s mesh with its faces' own normals on their own corners: the STL exporter writes a
+/// `out` (fillScene's mesh of `mesh`) with its faces' own normals on their own corners: the
+/// STL exporter writes a
 /// facet's normal as the mean of its corners' (assimp's GenNormals gives a shared corner the
 /// mean of its faces'), and a tool mesh's facets came out up to 66 deg off (a helper's finding).
 void setFaceNormals(aiMesh& out, const TriangleMesh& mesh) {
@@ -71,6 +71,7 @@ void setFaceNormals(aiMesh& out, const TriangleMesh& mesh) {
   }
 }
 
+/// A one-mesh assimp scene holding `mesh` (assimp stores single precision).
 void fillScene(aiScene& scene, const TriangleMesh& mesh) {
   scene.mMaterials = new aiMaterial* [1] { new aiMaterial() };
   scene.mNumMaterials = 1;

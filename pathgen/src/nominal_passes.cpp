@@ -88,9 +88,9 @@ AxisTurn largestAxisTurn(const PathFile& path, double ball_radius_mm) {
   return out;
 }
 
-void requireSteadyAxes(const PathFile& path, double ball_radius_mm) {
+void requireSteadyAxes(const PathFile& path, double pass_gap_mm, double ball_radius_mm) {
   std::vector<char> starts(path.postures.size(), 0);  // where passRanges starts a pass
-  for (const auto& range : passRanges(path, 0.0, ball_radius_mm)) starts[range.first] = 1;
+  for (const auto& range : passRanges(path, pass_gap_mm, ball_radius_mm)) starts[range.first] = 1;
   for (const PathBlock& block : path.blocks) {
     if (block.kind != PathBlock::Kind::Pass) continue;
     for (std::size_t i = block.begin + 1; i < block.end; ++i) {

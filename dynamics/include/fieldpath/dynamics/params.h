@@ -25,9 +25,10 @@ enum class StartPolicy {
 struct DynamicsParams {
   double inertia = 1.0;  ///< J, torque·s²/rad
   /// c, torque·s/rad; negative = critical: 2·sqrt(k·J) where the field is flat and, with a
-  /// field, 2·sqrt((k + k_f)·J) for each angle, k_f the field's stiffness -∂τ/∂θ (>= 0) at the
-  /// start of each output step (a wall's is 10²-10⁴ × k: the spring's alone left the axis
-  /// ringing into the far wall of a channel).
+  /// field, the matrix 2·sqrt(J·(k + K_f)), K_f the field's stiffness -∂τ/∂θ (its symmetric
+  /// part, negative modes left to the spring) at the start of each output step: critical for
+  /// each mode (a wall's stiffness is 10²-10⁴ × k: the spring's alone left the axis ringing into
+  /// the far wall of a channel).
   double damping = -1.0;
   double stiffness = 1.0;           ///< k, torque/rad
   double feed_mm_per_min = 1000.0;  ///< v: s = v t

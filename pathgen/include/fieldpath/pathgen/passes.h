@@ -76,11 +76,12 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const geometry::Path
                                                             double ball_radius_mm);
 
 /// geometry::requireSteadyAxis for every two consecutive postures of every pass block but
-/// those that passRanges (default gap) puts in two passes with their tips more than 2R apart:
+/// those that passRanges (`pass_gap_mm`: the scene's path.pass_gap, 0 automatic, as generate
+/// splits them) puts in two passes with their tips more than 2R apart:
 /// a flipped axis within a pass is not a cutting move a machine makes; across a gap (a link of
 /// a file without markers) the axis may turn as far as it likes (check refused a 120 deg turn
 /// between two passes 20 mm apart that generate took).
-void requireSteadyAxes(const geometry::PathFile& path, double ball_radius_mm);
+void requireSteadyAxes(const geometry::PathFile& path, double pass_gap_mm, double ball_radius_mm);
 
 /// The largest turn of the tool axis between two consecutive postures of a pass (passRanges
 /// with the default gap: a file of passes with no markers, or an .npy, holds its links in one
