@@ -125,12 +125,9 @@ class SteeringSystem final : public detail::OdeSystem {
   /// whose nominal path was clear (a helper's). The whole matrix, not its diagonal: a wall
   /// oblique to the frame splits its stiffness between the angles (ζ 0.71 from the diagonal at
   /// 45°). Set at every output station, without a threshold (a switch would make paths on two
-  /// fields differ by where it fell) and without a restart or a stop time there: the solver
-  /// takes it from where its steps stand, at most one step (<= one output interval) past the
-  /// station (a stop time at every station failed the hard cases' plunge: the frame jumps there).
-  /// The rates are continuous; the error test sees c's jump.
-  void updateDamping(double s_mm, const std::array<double, kStateSize>& y) {
-    if (!field_critical_) return;
+  /// fields differ by where it fell); true when set (the solver restarts there: steerPass).
+  bool updateDamping(double s_mm, const std::array<double, kStateSize>& y) {
+    if (!field_critical_) return false;
     const Frames frames = frameAt(s_mm);
     Eigen::Matrix2d k_field;
     for (int angle = 0; angle < 2; ++angle) {
@@ -140,13 +137,14 @@ class SteeringSystem final : public detail::OdeSystem {
       k_field(0, angle) = -(plus.lead_torque - minus.lead_torque) / (2.0 * kStiffnessDeltaRad);
       k_field(1, angle) = -(plus.tilt_torque - minus.tilt_torque) / (2.0 * kStiffnessDeltaRad);
     }
-    if (!k_field.allFinite()) return;  // (the moment's own check names a bad field)
+    if (!k_field.allFinite()) return false;  // (the moment's own check names a bad field)
     const Eigen::Matrix2d total =
         stiffness_ * Eigen::Matrix2d::Identity() + 0.5 * (k_field + k_field.transpose());
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> modes(total);
     const Eigen::Vector2d rates = modes.eigenvalues().cwiseMax(stiffness_).cwiseSqrt();
     damping_ = 2.0 * std::sqrt(inertia_) * modes.eigenvectors() * rates.asDiagonal() *
                modes.eigenvectors().transpose();
+    return true;
   }
 
   double feedMmPerS() const { return feed_mm_per_s_; }
@@ -365,8 +363,11 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
       }
     }
     LimitCheck check = checkAngles(request.params, request.params.on_limit, y);
-    if (check.clamped) integrator->restart(s_mm / v, y.data());
-    if (k < intervals) system.updateDamping(s_mm, y);
+    // The damping follows the field from this station on: the solver restarts here with it (its
+    // steps stand anywhere up to one interval past; taking it from there made the angles depend
+    // on the tolerances, 0.05° on an oblique wall's approach against DESIGN's 0.01°).
+    const bool damping_follows = k < intervals && system.updateDamping(s_mm, y);
+    if (check.clamped || damping_follows) integrator->restart(s_mm / v, y.data());
     PostureSample sample = system.sample(s_mm, y);
     sample.limited = check.clamped;
     if (!sample.moment.allFinite()) {  // the solver saw it too late (at s = 0) or not at all

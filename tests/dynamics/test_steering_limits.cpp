@@ -40,7 +40,9 @@ TEST(Limits, ClampHoldsTheAxisAtTheLimit) {
   const SteeringResult result = runToleranceStable(straightPass(300.0), request);
   ASSERT_EQ(result.status, Status::Ok) << result.message;
   EXPECT_GT(result.clamped_samples, 0);
-  EXPECT_EQ(result.stats.restarts, result.clamped_samples);
+  // A restart at every clamp (and at every station, where the critical damping follows the
+  // field).
+  EXPECT_GE(result.stats.restarts, result.clamped_samples);
   for (const PostureSample& s : result.samples) EXPECT_LE(s.tilt_rad, 3.0 * kDeg * (1 + 1e-12));
   EXPECT_NEAR(result.samples.back().tilt_rad, 3.0 * kDeg, 1e-12);
   EXPECT_TRUE(result.samples.back().limited);
