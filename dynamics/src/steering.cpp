@@ -42,6 +42,23 @@ AxisMoment momentOfNodes(const field::ForceField& field, std::span<const Vec3> o
   return out;
 }
 
+/// The field's stiffness -∂τ/∂θ about (lead, tilt) by central differences of `delta_rad`
+/// (column: the angle moved; row: lead, tilt torque); `moment(lead, tilt)` gives the AxisMoment.
+/// One for fieldStiffness and the critical damping (SteeringSystem::updateDamping).
+template <class Moment>
+Eigen::Matrix2d centralStiffness(Moment&& moment, double lead_rad, double tilt_rad,
+                                 double delta_rad) {
+  Eigen::Matrix2d k;
+  for (int column = 0; column < 2; ++column) {
+    const double dl = column == 0 ? delta_rad : 0.0, dt = column == 1 ? delta_rad : 0.0;
+    const AxisMoment plus = moment(lead_rad + dl, tilt_rad + dt);
+    const AxisMoment minus = moment(lead_rad - dl, tilt_rad - dt);
+    k(0, column) = -(plus.lead_torque - minus.lead_torque) / (2.0 * delta_rad);
+    k(1, column) = -(plus.tilt_torque - minus.tilt_torque) / (2.0 * delta_rad);
+  }
+  return k;
+}
+
 /// Node offsets from the ball centre in the tool frame: x - (0, 0, R).
 std::vector<Vec3> offsetsFromCentre(std::span<const Vec3> nodes_tool_frame_mm,
                                     double ball_radius_mm) {
@@ -129,14 +146,9 @@ class SteeringSystem final : public detail::OdeSystem {
   bool updateDamping(double s_mm, const std::array<double, kStateSize>& y) {
     if (!field_critical_) return false;
     const Frames frames = frameAt(s_mm);
-    Eigen::Matrix2d k_field;
-    for (int angle = 0; angle < 2; ++angle) {
-      const double d = angle == 0 ? kStiffnessDeltaRad : 0.0, t = kStiffnessDeltaRad - d;
-      const AxisMoment plus = moment(frames, y[0] + d, y[1] + t);
-      const AxisMoment minus = moment(frames, y[0] - d, y[1] - t);
-      k_field(0, angle) = -(plus.lead_torque - minus.lead_torque) / (2.0 * kStiffnessDeltaRad);
-      k_field(1, angle) = -(plus.tilt_torque - minus.tilt_torque) / (2.0 * kStiffnessDeltaRad);
-    }
+    const Eigen::Matrix2d k_field =
+        centralStiffness([&](double lead, double tilt) { return moment(frames, lead, tilt); }, y[0],
+                         y[1], kStiffnessDeltaRad);
     if (!k_field.allFinite()) return false;  // (the moment's own check names a bad field)
     const Eigen::Matrix2d total =
         stiffness_ * Eigen::Matrix2d::Identity() + 0.5 * (k_field + k_field.transpose());
@@ -294,17 +306,11 @@ Eigen::Matrix2d fieldStiffness(const field::ForceField& field,
                                double tilt_rad, double delta_rad) {
   const std::vector<Vec3> offsets = offsetsFromCentre(nodes_tool_frame_mm, ball_radius_mm);
   std::vector<Vec3> nodes_mm, forces;
-  Eigen::Matrix2d k;
-  for (int column = 0; column < 2; ++column) {
-    const double dl = column == 0 ? delta_rad : 0.0, dt = column == 1 ? delta_rad : 0.0;
-    const AxisMoment plus = momentOfNodes(field, offsets, frame, centre_mm, lead_rad + dl,
-                                          tilt_rad + dt, nodes_mm, forces);
-    const AxisMoment minus = momentOfNodes(field, offsets, frame, centre_mm, lead_rad - dl,
-                                           tilt_rad - dt, nodes_mm, forces);
-    k(0, column) = -(plus.lead_torque - minus.lead_torque) / (2.0 * delta_rad);
-    k(1, column) = -(plus.tilt_torque - minus.tilt_torque) / (2.0 * delta_rad);
-  }
-  return k;
+  return centralStiffness(
+      [&](double lead, double tilt) {
+        return momentOfNodes(field, offsets, frame, centre_mm, lead, tilt, nodes_mm, forces);
+      },
+      lead_rad, tilt_rad, delta_rad);
 }
 
 SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
