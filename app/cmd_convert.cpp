@@ -4,7 +4,6 @@
 /// postures bit for bit and `simulate` the same heights. `.npy` has no place for pass and link
 /// blocks or `# limit` marks: converting to it says what was dropped.
 #include <algorithm>
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -12,6 +11,7 @@
 #include "commands.h"
 #include "errors.h"
 #include "fieldpath/common/atomic_file.h"
+#include "fieldpath/common/file_names.h"
 #include "fieldpath/common/limits.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/tool_model.h"
@@ -25,8 +25,7 @@ using geometry::PathFormat;
 /// The output format by extension; unlike reading (anything else is `.cl`), a typo in the name
 /// of a file about to be written is refused. Any case, as the readers take it (`X.CL`).
 PathFormat outputFormat(const fs::path& file) {
-  std::string ext = file.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = common::lowerExtension(file);
   if (ext == ".cl") return PathFormat::Cl;
   if (ext == ".apt" || ext == ".cls") return PathFormat::Apt;
   if (ext == ".npy") return PathFormat::Npy;

@@ -10,9 +10,10 @@
 #include <vector>
 
 #include "commands.h"
-#include "fieldpath/common/input_file.h"
 #include "errors.h"
 #include "fieldpath/common/atomic_file.h"
+#include "fieldpath/common/file_names.h"
+#include "fieldpath/common/input_file.h"
 #include "fieldpath/common/limits.h"
 #include "fieldpath/field/direct_field.h"
 #include "fieldpath/field/voxel_field.h"
@@ -142,6 +143,9 @@ void probe(const FieldOptions& o, const GlobalOptions& global) {
 }
 
 void build(const FieldOptions& o, const GlobalOptions& global) {
+  // The file is OpenVDB whatever its name: a `field.txt` would be a binary file misnamed.
+  if (common::lowerExtension(o.out) != ".vdb")
+    throw InputError("--out " + o.out + ": the field is written as OpenVDB, name it *.vdb");
   common::checkOutputFile(o.out, "--out");  // before the work, not after
   const Obstacles obstacles = loadObstacles(o);
   const field::VoxelRequest request = voxelRequest(o, obstacles.scene, global.quiet);

@@ -54,6 +54,9 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
   json passes = json::array();
   json settled = json::array();  // 1-based, as per_pass
   for (const int p : r.settled_starts) settled.push_back(p + 1);
+  json settle_failures = json::array();
+  for (const auto& f : r.settle_failures)
+    settle_failures.push_back({{"pass", f.pass + 1}, {"why", f.why}});
   for (const pathgen::Pass& pass : r.passes) {
     double min_clearance = INFINITY, max_tilt = 0;
     int postures = 0, colliding = 0;
@@ -139,7 +142,10 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"max_tilt_deg", r.max_tilt_deg},
       {"max_lead_deg", r.max_lead_deg},
       {"axis_turn", axisTurnJson(axis_turn)},
-      {"start", {{"policy", startPolicyName(job.dynamics.start)}, {"settled_passes", settled}}},
+      {"start",
+       {{"policy", startPolicyName(job.dynamics.start)},
+        {"settled_passes", settled},
+        {"settle_failures", settle_failures}}},
       {"solver",
        {{"steps", r.solver_steps},
         {"rhs_evals", r.rhs_evals},
@@ -299,6 +305,14 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     // narrower than the holder; unsafe there too, but the turn is its own warning)
     if (const std::string turn = axisTurnWarning(result.path, axis_turn); !turn.empty())
       std::fprintf(stderr, "warning: %s (report.json axis_turn)\n", turn.c_str());
+    if (!result.settle_failures.empty())
+      std::fprintf(stderr,
+                   "warning: %zu pass%s (first: pass %d) could not start from the axis settled "
+                   "under the field and started from the nominal axis instead: %s "
+                   "(report.json start.settle_failures)\n",
+                   result.settle_failures.size(), result.settle_failures.size() == 1 ? "" : "es",
+                   result.settle_failures.front().pass + 1,
+                   result.settle_failures.front().why.c_str());
     if (scene.nominal)
       for (const std::string& note : cutterNotes(scene.tool, *scene.nominal))
         std::printf("note: %s\n", note.c_str());

@@ -95,6 +95,23 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // `fieldpath frobnicate`: CLI11 says "a subcommand is required", which hides the typo.
+    if (app.get_subcommands().empty()) {
+      for (int i = 1; i < argc; ++i) {
+        const std::string arg = argv[i];
+        if (arg == "--max-memory") {
+          ++i;  // its value
+          continue;
+        }
+        if (arg.empty() || arg[0] == '-') continue;
+        std::string known;
+        for (const CLI::App* sub : app.get_subcommands({}))
+          known += (known.empty() ? "" : ", ") + sub->get_name();
+        std::fprintf(stderr, "fieldpath: error: unknown command '%s' (commands: %s; see --help)\n",
+                     oneLine(arg.c_str()).c_str(), known.c_str());
+        return 1;
+      }
+    }
     // A usage error is bad input: one line, exit 1 (CLI11's own report adds a second line).
     std::fprintf(stderr, "fieldpath: error: %s (see --help)\n", oneLine(e.what()).c_str());
     return 1;

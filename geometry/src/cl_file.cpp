@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "fieldpath/common/atomic_file.h"
+#include "fieldpath/common/file_names.h"
 
 #include "path_chunks.h"
 #include "path_text.h"
@@ -79,8 +80,7 @@ PathFile readPathFile(const std::filesystem::path& file, const PathReadOptions& 
 }
 
 PathFormat pathFormatOf(const std::filesystem::path& file) {
-  std::string ext = file.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = common::lowerExtension(file);
   if (ext == ".npy") return PathFormat::Npy;
   if (ext == ".apt" || ext == ".cls") return PathFormat::Apt;
   return PathFormat::Cl;

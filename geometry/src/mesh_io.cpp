@@ -20,6 +20,7 @@
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/file_names.h"
 #include "fieldpath/common/input_file.h"
 #include "fieldpath/common/limits.h"
 
@@ -27,12 +28,7 @@ namespace fieldpath::geometry {
 namespace {
 
 using common::InputError;
-
-std::string lowerExtension(const std::filesystem::path& file) {
-  std::string ext = file.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
+using common::lowerExtension;
 
 /// Hash of a position's exact bits (joining needs equality, not nearness).
 struct PositionHash {

@@ -166,6 +166,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
                        r)) < request.clearance_mm);
     }
   std::vector<char> started_settled(result.passes.size(), 0);
+  std::vector<std::string> settle_failed(result.passes.size());  // why, where settling failed
   struct Steered {
     std::vector<GeneratedPosture> postures;
     dynamics::SolverStats stats;
@@ -177,6 +178,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
                          const dynamics::DynamicsParams& params) {
     std::vector<Steered> steered_passes(result.passes.size());
     std::fill(started_settled.begin(), started_settled.end(), 0);  // this steering's own
+    std::fill(settle_failed.begin(), settle_failed.end(), std::string());
     int passes_done = 0;
     // Each pass's fraction done (its solver's intervals): the bar moves within a pass too (a
     // wide r0 makes one pass take minutes).
@@ -236,6 +238,8 @@ GenerateResult generatePath(const GenerateRequest& request) {
           steer.initial_lead_rad = at_rest.lead_rad;
           steer.initial_tilt_rad = at_rest.tilt_rad;
           started_settled[p] = 1;
+        } else {
+          settle_failed[p] = at_rest.why.empty() ? "the settling failed" : at_rest.why;
         }
       }
       const dynamics::SteeringResult steered = dynamics::steerPass(dyn_pass, steer);
@@ -417,8 +421,11 @@ GenerateResult generatePath(const GenerateRequest& request) {
   // The first failure in pass order, as the serial loop would have thrown it.
   for (const Steered& s : steered_passes)
     if (s.error) std::rethrow_exception(s.error);
-  for (std::size_t p = 0; p < result.passes.size(); ++p)
+  for (std::size_t p = 0; p < result.passes.size(); ++p) {
     if (started_settled[p]) result.settled_starts.push_back(result.passes[p].index);
+    if (!settle_failed[p].empty())
+      result.settle_failures.push_back({result.passes[p].index, settle_failed[p]});
+  }
   for (Steered& s : steered_passes) {
     for (GeneratedPosture& g : s.postures) {
       if (g.limited && result.first_limited == ClearanceResult::npos)

@@ -108,3 +108,27 @@ TEST(CliField, BadInputExitsOneWithOneLine) {
     EXPECT_TRUE(run.out.empty()) << run.out;
   }
 }
+
+TEST(CliField, BuildRefusesAnOutputNotNamedVdb) {
+  TempDir dir;
+  planeScene(dir);
+  // The file would be OpenVDB's binary whatever its name: a typo is refused before the work.
+  const Outcome run = runFieldpath(dir, "field build scene.yaml --voxel 1 --out field.txt");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_EQ(lines(run.err), 1u) << run.err;
+  EXPECT_NE(run.err.find("field.txt"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "field.txt"));
+  EXPECT_EQ(runFieldpath(dir, "field build scene.yaml --voxel 1 --out FIELD.VDB").exit_code, 0);
+}
+
+TEST(CliField, AnUnknownCommandIsNamed) {
+  TempDir dir;
+  // CLI11 alone says "a subcommand is required", which hides the typo.
+  for (const std::string args : {"fields build x.yaml", "--max-memory 1G genrate x.yaml"}) {
+    const Outcome run = runFieldpath(dir, args);
+    EXPECT_EQ(run.exit_code, 1) << args;
+    EXPECT_EQ(lines(run.err), 1u) << run.err;
+    const std::string typo = args.starts_with("--") ? "'genrate'" : "'fields'";
+    EXPECT_NE(run.err.find("unknown command " + typo), std::string::npos) << run.err;
+  }
+}

@@ -184,6 +184,17 @@ TEST(Generate, APassStartingInCollisionStartsFromTheSettledAxis) {
   for (const GeneratedPosture& g : settled.postures)
     EXPECT_NEAR(g.tilt_rad, first_tilt, 0.1 * M_PI / 180.0) << g.s_mm;
   EXPECT_GT(std::abs(swung.postures[1].tilt_rad - swung.postures[0].tilt_rad), 10.0 * M_PI / 180.0);
+  EXPECT_TRUE(settled.settle_failures.empty());
+
+  // With no damping the axis never comes to rest: the pass starts nominal, and says why.
+  GenerateRequest undamped = job;
+  undamped.dynamics.damping = 0.0;
+  const GenerateResult unsettled = generatePath(undamped);
+  EXPECT_TRUE(unsettled.settled_starts.empty());
+  ASSERT_EQ(unsettled.settle_failures.size(), 1u);
+  EXPECT_EQ(unsettled.settle_failures.front().pass, 0);
+  EXPECT_NE(unsettled.settle_failures.front().why.find("no damping"), std::string::npos);
+  EXPECT_LE(unsettled.postures.front().clearance_mm, 0.0);  // the nominal start, in the wall
 }
 
 // A channel 16 mm wide, walls 20 mm high; the pass runs with the ball 1 mm from one wall, its

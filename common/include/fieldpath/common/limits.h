@@ -110,7 +110,8 @@ inline std::size_t parseMemorySize(const std::string& text, const std::string& o
   if (text.empty() || used != text.size() || !std::isfinite(bytes) || bytes < 1024.0 * 1024 ||
       bytes > 1e18)
     throw InputError(option + " '" + text +
-                     "': expected a size of at least 1 MiB: a number of MiB, or e.g. 512M, 2G");
+                     "': expected a size from 1 MiB to 1 EB (a number of MiB, or e.g. 512M, "
+                     "2G)");
   return static_cast<std::size_t>(bytes);
 }
 

@@ -130,6 +130,13 @@ struct GenerateResult {
   /// Passes started from the axis settled at their start (dynamics.start: settled, or auto where
   /// the nominal start posture was within `clearance`), by Pass::index.
   std::vector<int> settled_starts;
+  /// Passes that were to start settled but could not (no damping, the solver failing at rest):
+  /// they start from the nominal axis, which may lie within `clearance`. By Pass::index, why.
+  struct SettleFailure {
+    int pass = 0;
+    std::string why;
+  };
+  std::vector<SettleFailure> settle_failures;
   StageTimes times;
   std::size_t obstacle_points = 0;  ///< field samples
   std::size_t tool_nodes = 0;       ///< tool + holder nodes of the moment
