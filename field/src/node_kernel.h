@@ -90,6 +90,7 @@ struct Rules {
 };
 
 constexpr double kOverCos = 0.7;  ///< |cos| of the field's angle to n* over the surface
+constexpr double kPlaneFit = 0.1;  ///< voxel_field.h kPlaneFitTolerance (a device constant)
 
 /// A running sum of eq. 1 and the nearest sample (by squared distance, then lowest id).
 struct Accum {
@@ -278,7 +279,7 @@ FP_HD NodeValue nodeValue(Hood& hood, const Law& L, const Rules& R, D3 x) {
   }
   // The plane ratio (node_build.cpp planeRatio).
   const double eta = p.height_mm;
-  const bool over = over_surface && (!p.has_force || fabs(dot(p.force, p.n)) >= kOverCos * norm(p.force));
+  bool over = over_surface && (!p.has_force || fabs(dot(p.force, p.n)) >= kOverCos * norm(p.force));
   const double sign = L.gain < 0.0 ? -1.0 : 1.0;
   double s_mm;
   D3 g;
@@ -303,9 +304,19 @@ FP_HD NodeValue nodeValue(Hood& hood, const Law& L, const Rules& R, D3 x) {
       if (hood.pending()) return out;
       f = lifted.has_force ? lifted.force : D3{0, 0, 0};
     }
-    const double e = L.planeHeight(norm(f));
-    const double plane = L.planeAt(e);
+    double e = L.planeHeight(norm(f));
+    double plane = L.planeAt(e);
     s_mm = e - lift_mm;
+    // The continuation at the node itself, against the node's exact force: where it gives more
+    // than kPlaneFit above it, the node's own force (voxel_build.cpp planeRatio).
+    if (lift_mm > 0.0 && plane > 0.0 &&
+        L.planeAt(s_mm) * norm(f) > (1.0 + kPlaneFit) * plane * norm(p.force)) {
+      f = p.force;
+      e = L.planeHeight(norm(f));
+      plane = L.planeAt(e);
+      s_mm = e;
+      over = false;
+    }
     g = plane > 0.0 ? D3{f.x / plane, f.y / plane, f.z / plane} : D3{0, 0, 0};
   }
   out.closeness = float(L.r0 - s_mm);

@@ -295,19 +295,230 @@ static __attribute__((target("avx512f"))) void laneSums512(const Law& L, const S
   }
 }
 
-/// AVX-512 where the CPU has it, unless FIELDPATH_LANES=generic (to run the generic loops on
-/// such a CPU: they are what a machine without AVX-512 runs).
-static const bool kUseAvx512 = [] {
-  const char* lanes = std::getenv("FIELDPATH_LANES");
-  if (lanes && std::strcmp(lanes, "generic") == 0) return false;
-  return bool(__builtin_cpu_supports("avx512f"));
+/// gatherGeneric in AVX2 lanes (4 samples a step): the same test and order; the positions
+/// written branch-free, each at the count so far (Picks::reserveFor's room past it).
+static __attribute__((target("avx2,fma"))) void gather256(const SampleSpan& f, const Box& box,
+                                                          double near_sq, double far_sq,
+                                                          Picks& near, Picks* far) {
+  const __m256d zero = _mm256_setzero_pd();
+  __m256d blo[3], bhi[3];
+  for (int a = 0; a < 3; ++a) {
+    blo[a] = _mm256_set1_pd(box.lo[a]);
+    bhi[a] = _mm256_set1_pd(box.hi[a]);
+  }
+  const __m256d vnear = _mm256_set1_pd(near_sq), vfar = _mm256_set1_pd(far ? far_sq : near_sq);
+  std::int32_t* near_at = near.at.data();
+  std::int32_t* far_at = far ? far->at.data() : nullptr;
+  int n_near = 0, n_far = 0, t = 0;
+  for (; t + 4 <= f.count; t += 4) {
+    const __m256d p[3] = {_mm256_loadu_pd(f.x + t), _mm256_loadu_pd(f.y + t),
+                          _mm256_loadu_pd(f.z + t)};
+    __m256d d[3];
+    for (int a = 0; a < 3; ++a)
+      d[a] = _mm256_max_pd(zero,
+                           _mm256_max_pd(_mm256_sub_pd(blo[a], p[a]), _mm256_sub_pd(p[a], bhi[a])));
+    const __m256d d2 =
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d[0], d[0]), _mm256_mul_pd(d[1], d[1])),
+                      _mm256_mul_pd(d[2], d[2]));
+    const int in_near = _mm256_movemask_pd(_mm256_cmp_pd(d2, vnear, _CMP_LE_OQ));
+    for (int b = 0; b < 4; ++b) {
+      near_at[n_near] = t + b;
+      n_near += (in_near >> b) & 1;
+    }
+    if (far) {
+      const int in_far = _mm256_movemask_pd(_mm256_cmp_pd(d2, vfar, _CMP_LE_OQ)) & ~in_near;
+      for (int b = 0; b < 4; ++b) {
+        far_at[n_far] = t + b;
+        n_far += (in_far >> b) & 1;
+      }
+    }
+  }
+  for (; t < f.count; ++t) {  // the last few, as gatherGeneric
+    const double dx = gapTo(f.x[t], box.lo[0], box.hi[0]);
+    const double dy = gapTo(f.y[t], box.lo[1], box.hi[1]);
+    const double dz = gapTo(f.z[t], box.lo[2], box.hi[2]);
+    const double d2 = dx * dx + dy * dy + dz * dz;
+    if (d2 <= near_sq)
+      near_at[n_near++] = t;
+    else if (far && d2 <= far_sq)
+      far_at[n_far++] = t;
+  }
+  near.count = n_near;
+  if (far) far->count = n_far;
+}
+
+/// The nearest sample per lane so far, 4 lanes (laneSums256).
+struct Nearest256 {
+  __m256d best;
+  __m256i id;
+};
+static __attribute__((target("avx2,fma"), always_inline)) inline void trackNearest256(Nearest256& n,
+                                                                                      __m256d r2,
+                                                                                      __m256i vid) {
+  const __m256d closer =
+      _mm256_or_pd(_mm256_cmp_pd(r2, n.best, _CMP_LT_OQ),
+                   _mm256_and_pd(_mm256_cmp_pd(r2, n.best, _CMP_EQ_OQ),
+                                 _mm256_castsi256_pd(_mm256_cmpgt_epi64(n.id, vid))));
+  n.best = _mm256_blendv_pd(n.best, r2, closer);
+  n.id = _mm256_castpd_si256(
+      _mm256_blendv_pd(_mm256_castsi256_pd(n.id), _mm256_castsi256_pd(vid), closer));
+}
+
+/// Squared distances below this (mm², a node within 1e-15 mm of a sample, yet not on it) are
+/// past the float estimate of 1/r: such a call runs the generic loops.
+constexpr double kLeast256Sq = 1e-30;
+
+struct LaneConsts256 {
+  __m256d r0_sq, inv_r_min, inv_r0, half, three_eighths, one, least, zero;
+};
+/// The term of sample j at 4 points (ax, ay, az): laneTerm512's. 1/r from the 12-bit float
+/// estimate and two third-order steps (relative error ~1e-10 after the first, rounding after
+/// the second); lanes under kLeast256Sq add nothing here and flag `tiny` (a lane on the sample,
+/// r² 0, adds nothing in laneTerm512 either: addZeroTerms gives its term).
+template <bool Track>
+static __attribute__((target("avx2,fma"), always_inline)) inline void laneTerm256(
+    const LaneConsts256& k, const SampleSpan& s, int j, __m256d ax, __m256d ay, __m256d az,
+    __m256d& fx, __m256d& fy, __m256d& fz, Nearest256& near, __m256d& lowest, __m256d& tiny) {
+  const __m256d dx = _mm256_sub_pd(ax, _mm256_set1_pd(s.x[j]));
+  const __m256d dy = _mm256_sub_pd(ay, _mm256_set1_pd(s.y[j]));
+  const __m256d dz = _mm256_sub_pd(az, _mm256_set1_pd(s.z[j]));
+  const __m256d r2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)),
+                                   _mm256_mul_pd(dz, dz));
+  const __m256d usable = _mm256_cmp_pd(r2, k.least, _CMP_GE_OQ);
+  const __m256d in = _mm256_and_pd(_mm256_cmp_pd(r2, k.r0_sq, _CMP_LT_OQ), usable);
+  tiny = _mm256_or_pd(tiny, _mm256_andnot_pd(usable, _mm256_cmp_pd(r2, k.zero, _CMP_GT_OQ)));
+  lowest = _mm256_min_pd(lowest, r2);
+  // the estimate from r² held within float's range (out-of-range lanes are masked off below)
+  const __m256d r2s = _mm256_min_pd(_mm256_max_pd(r2, k.least), k.r0_sq);
+  __m256d y = _mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(r2s)));
+  for (int step = 0; step < 2; ++step) {
+    const __m256d e = _mm256_fnmadd_pd(_mm256_mul_pd(r2s, y), y, k.one);
+    y = _mm256_fmadd_pd(y, _mm256_mul_pd(e, _mm256_fmadd_pd(e, k.three_eighths, k.half)), y);
+  }
+  const __m256d inv_rc = _mm256_min_pd(y, k.inv_r_min);
+  const __m256d phi = _mm256_mul_pd(_mm256_sub_pd(inv_rc, k.inv_r0), _mm256_mul_pd(inv_rc, inv_rc));
+  const __m256d c = _mm256_and_pd(in, _mm256_mul_pd(_mm256_mul_pd(_mm256_set1_pd(s.w[j]), phi), y));
+  fx = _mm256_fmadd_pd(c, dx, fx);
+  fy = _mm256_fmadd_pd(c, dy, fy);
+  fz = _mm256_fmadd_pd(c, dz, fz);
+  if constexpr (Track) trackNearest256(near, r2, _mm256_set1_epi64x(s.id[j]));
+}
+
+/// The sums of 4 of the 8 lanes (`first`: lanes first..first+3) over the picks, in laneSums512's
+/// order: samples c and c + 1 of a step in two sets, added at the end, the nearest of the two
+/// merged (ties: lowest id); stored to f, best, id, low at `first`. AVX2 has 16 registers: a
+/// set of 8 lanes (laneSums512's) would spill, so the halves run one after the other.
+template <bool Track>
+static __attribute__((target("avx2,fma"))) void halfSums256(
+    const LaneConsts256& k, const SampleSpan& s, const Picks& core, const double* px,
+    const double* py, const double* pz, const double* init_sq, int first, double (*f)[kLanes],
+    double* best, std::int64_t* id, double* low, __m256d& tiny) {
+  const __m256d ax = _mm256_loadu_pd(px + first), ay = _mm256_loadu_pd(py + first),
+                az = _mm256_loadu_pd(pz + first);
+  __m256d fx = k.zero, fy = k.zero, fz = k.zero, gx = k.zero, gy = k.zero, gz = k.zero;
+  __m256d lowest = _mm256_set1_pd(HUGE_VAL);
+  Nearest256 near{_mm256_loadu_pd(init_sq + first), _mm256_set1_epi64x(-1)};
+  Nearest256 near2 = near;
+  const std::int32_t* picked = core.at.data();
+  int c = 0;
+  for (; c + 1 < core.count; c += 2) {
+    laneTerm256<Track>(k, s, picked[c], ax, ay, az, fx, fy, fz, near, lowest, tiny);
+    laneTerm256<Track>(k, s, picked[c + 1], ax, ay, az, gx, gy, gz, near2, lowest, tiny);
+  }
+  if (c < core.count)
+    laneTerm256<Track>(k, s, picked[c], ax, ay, az, fx, fy, fz, near, lowest, tiny);
+  const __m256d take =
+      _mm256_or_pd(_mm256_cmp_pd(near2.best, near.best, _CMP_LT_OQ),
+                   _mm256_and_pd(_mm256_cmp_pd(near2.best, near.best, _CMP_EQ_OQ),
+                                 _mm256_castsi256_pd(_mm256_cmpgt_epi64(near.id, near2.id))));
+  _mm256_storeu_pd(f[0] + first, _mm256_add_pd(fx, gx));
+  _mm256_storeu_pd(f[1] + first, _mm256_add_pd(fy, gy));
+  _mm256_storeu_pd(f[2] + first, _mm256_add_pd(fz, gz));
+  _mm256_storeu_pd(best + first, _mm256_blendv_pd(near.best, near2.best, take));
+  _mm256_storeu_pd(
+      reinterpret_cast<double*>(id + first),
+      _mm256_blendv_pd(_mm256_castsi256_pd(near.id), _mm256_castsi256_pd(near2.id), take));
+  _mm256_storeu_pd(low + first, lowest);
+}
+
+/// laneSums in AVX2 (a CPU without AVX-512): laneSums512's terms, order and nearest, 4 lanes at
+/// a time (halfSums256); the generic loops where a lane falls under kLeast256Sq of a sample.
+static __attribute__((target("avx2,fma"))) void laneSums256(const Law& L, const SampleSpan& s,
+                                                            const Picks& core, const Picks& ring,
+                                                            const double* px, const double* py,
+                                                            const double* pz, const double* init_sq,
+                                                            Accum* out) {
+  const LaneConsts256 k{_mm256_set1_pd(L.r0_sq),     _mm256_set1_pd(L.inv_r_min),
+                        _mm256_set1_pd(L.inv_r0),    _mm256_set1_pd(0.5),
+                        _mm256_set1_pd(0.375),       _mm256_set1_pd(1.0),
+                        _mm256_set1_pd(kLeast256Sq), _mm256_setzero_pd()};
+  bool track = false;
+  for (int l = 0; l < kLanes; ++l) track = track || init_sq[l] > 0.0;
+  alignas(32) double f[3][kLanes], b[kLanes], low[kLanes];
+  alignas(32) std::int64_t bid[kLanes];
+  __m256d tiny = k.zero;
+  for (int first = 0; first < kLanes; first += 4) {
+    if (track)
+      halfSums256<true>(k, s, core, px, py, pz, init_sq, first, f, b, bid, low, tiny);
+    else
+      halfSums256<false>(k, s, core, px, py, pz, init_sq, first, f, b, bid, low, tiny);
+  }
+  if (_mm256_movemask_pd(tiny) != 0)
+    return laneSumsGeneric(L, s, core, ring, px, py, pz, init_sq, out);
+  // The ring's samples lie farther than r0 from every point: only a shell point's nearest.
+  bool shell = false;
+  for (int l = 0; l < kLanes; ++l) shell = shell || b[l] >= L.r0_sq;
+  if (track && shell)
+    for (int first = 0; first < kLanes; first += 4) {
+      const __m256d ax = _mm256_loadu_pd(px + first), ay = _mm256_loadu_pd(py + first),
+                    az = _mm256_loadu_pd(pz + first);
+      Nearest256 near{_mm256_load_pd(b + first),
+                      _mm256_load_si256(reinterpret_cast<const __m256i*>(bid + first))};
+      for (int r = 0; r < ring.count; ++r) {
+        const int j = ring.at[std::size_t(r)];
+        const __m256d dx = _mm256_sub_pd(ax, _mm256_set1_pd(s.x[j]));
+        const __m256d dy = _mm256_sub_pd(ay, _mm256_set1_pd(s.y[j]));
+        const __m256d dz = _mm256_sub_pd(az, _mm256_set1_pd(s.z[j]));
+        trackNearest256(near,
+                        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)),
+                                      _mm256_mul_pd(dz, dz)),
+                        _mm256_set1_epi64x(s.id[j]));
+      }
+      _mm256_store_pd(b + first, near.best);
+      _mm256_store_si256(reinterpret_cast<__m256i*>(bid + first), near.id);
+    }
+  for (int l = 0; l < kLanes; ++l) {
+    Accum& a = out[l];
+    a = Accum{};
+    a.fx = f[0][l];
+    a.fy = f[1][l];
+    a.fz = f[2][l];
+    a.best_sq = b[l];
+    a.best_id = int(bid[l]);
+    if (low[l] == 0.0) addZeroTerms(L, s, core, D3{px[l], py[l], pz[l]}, a);
+  }
+}
+
+/// Which lanes run: AVX-512 where the CPU has it, else AVX2 with FMA, else the generic loops;
+/// FIELDPATH_LANES=generic or =avx2 asks for those (what a CPU without AVX-512 runs, on one that
+/// has it; the suite runs the build tests so: tests/field/CMakeLists.txt), never for more than
+/// the CPU has.
+enum class LaneKind { Generic, Avx2, Avx512 };
+static const LaneKind kLaneKind = [] {
+  const char* asked = std::getenv("FIELDPATH_LANES");
+  const bool has512 = __builtin_cpu_supports("avx512f");
+  const bool has256 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  if (asked && std::strcmp(asked, "generic") == 0) return LaneKind::Generic;
+  if (asked && std::strcmp(asked, "avx2") == 0) return has256 ? LaneKind::Avx2 : LaneKind::Generic;
+  return has512 ? LaneKind::Avx512 : has256 ? LaneKind::Avx2 : LaneKind::Generic;
 }();
 #endif
 
 void gather(const SampleSpan& from, const Box& box, double near_sq, double far_sq, Picks& near,
             Picks* far) {
 #if defined(__x86_64__)
-  if (kUseAvx512) return gather512(from, box, near_sq, far_sq, near, far);
+  if (kLaneKind == LaneKind::Avx512) return gather512(from, box, near_sq, far_sq, near, far);
+  if (kLaneKind == LaneKind::Avx2) return gather256(from, box, near_sq, far_sq, near, far);
 #endif
   gatherGeneric(from, box, near_sq, far_sq, near, far);
 }
@@ -316,7 +527,9 @@ void laneSums(const Law& L, const SampleSpan& from, const Picks& core, const Pic
               const double* px, const double* py, const double* pz, const double* init_sq,
               Accum* out) {
 #if defined(__x86_64__)
-  if (kUseAvx512) {
+  if (kLaneKind == LaneKind::Avx2)
+    return laneSums256(L, from, core, ring, px, py, pz, init_sq, out);
+  if (kLaneKind == LaneKind::Avx512) {
     int tracked = 0;
     for (int l = 0; l < kLanes; ++l) tracked += init_sq[l] > 0.0;
     if (tracked == kLanes)

@@ -43,6 +43,8 @@ bool overSurface(const detail::Probe& p, double over_mm) {
 }
 
 constexpr double kOverCos = 0.7;  ///< |cos| of the field's angle to n* over the surface
+static_assert(kernel::kPlaneFit == kPlaneFitTolerance && kernel::kOverCos == kOverCos,
+              "the block and CUDA builds' rules are the reference's");
 
 /// One node of the plane ratio: s (mm), G, and whether it lies over/under the surface.
 struct RatioNode {
@@ -81,14 +83,21 @@ RatioNode planeRatio(const detail::Probe& p, const Vec3& x, const Vec3& q, const
     if (eta >= 0.0) return {std::max(eta, law.r0_mm), sign * n, true};
     return {-std::max(-eta, law.r0_mm), Vec3::Zero(), true};
   }
-  auto ratioOf = [&](const Vec3& f, double lift_mm) {
+  auto ratioOf = [&](const Vec3& f, double lift_mm, bool is_over) {
     const double e = law.height(f.norm());
     const double plane = law.at(e);
-    return RatioNode{e - lift_mm, plane > 0.0 ? Vec3(f / plane) : Vec3::Zero(), over};
+    return RatioNode{e - lift_mm, plane > 0.0 ? Vec3(f / plane) : Vec3::Zero(), is_over};
   };
-  if (!over || eta >= near_mm) return ratioOf(*p.force, 0.0);
+  if (!over || eta >= near_mm) return ratioOf(*p.force, 0.0, over);
   const double lift_mm = near_mm - eta;
-  return ratioOf(field_at(Vec3(x + lift_mm * n)), lift_mm);
+  const Vec3 lifted = field_at(Vec3(x + lift_mm * n));
+  const RatioNode continued = ratioOf(lifted, lift_mm, over);
+  // The continuation at the node itself, against the node's exact force (kPlaneFitTolerance).
+  const double plane = law.at(continued.s_mm + lift_mm);
+  if (plane > 0.0 &&
+      law.at(continued.s_mm) * lifted.norm() > (1.0 + kPlaneFitTolerance) * plane * p.force->norm())
+    return ratioOf(*p.force, 0.0, false);
+  return continued;
 }
 
 /// What the node values of every level are made from.
