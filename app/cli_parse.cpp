@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cstdio>
+#include <filesystem>
 #include <cmath>
 #include <limits>
 
@@ -21,9 +22,17 @@ bool isAnalyticToolText(const std::string& text) {
   return text.rfind("ball:", 0) == 0 || text.rfind("torus:", 0) == 0 || text.rfind("flat:", 0) == 0;
 }
 
+/// `ball`, `torus` or `flat` alone (no such file): a shape whose sizes were left out, not a mesh.
+bool isBareShapeName(const std::string& text) {
+  return (text == "ball" || text == "torus" || text == "flat") && !std::filesystem::exists(text);
+}
+
 }  // namespace
 
 zb::Tool parseTool(const std::string& text) {
+  if (isBareShapeName(text))
+    throw InputError("--tool " + text + ": the shape needs its sizes: " +
+                     (text == "torus" ? "torus:R:r[:L]" : text + ":R[:L]") + " (mm)");
   if (isAnalyticToolText(text)) {
     const geometry::ToolSpec spec = geometry::parseToolSpec(text);
     switch (spec.shape) {

@@ -232,7 +232,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"path_digest", common::fileDigest(options->path)},
         {"scene_digest", sceneDigest(scene)},
         {"postures", path.postures.size()},
-        {"passes", path.count(geometry::PathBlock::Kind::Pass)},
+        // As generate reads them: pass blocks split at gaps (a file without markers), links out.
+        {"passes", pathgen::passRanges(path, scene.path.pass_gap_mm, scene.tool.radius_mm).size()},
         {"links", path.count(geometry::PathBlock::Kind::Link)},
         {"clearance", clearanceJson(clearance, scene.clearance_mm, pathgen::kClearanceMeshTolMm)},
         {"motions", motionsJson(motions, scene.clearance_mm, motion_request.resolution_mm)},

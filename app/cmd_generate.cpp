@@ -230,7 +230,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
       } catch (const InputError& e) {
         const std::string file = scene.file.string();
         if (std::string_view(e.what()).starts_with(file)) throw;
-        throw InputError(file + ": " + e.what());
+        const std::string placed = placeSceneKey(e.what());  // a key's line, where it names one
+        throw InputError(placed != e.what() ? placed : file + ": " + e.what());
       }
     }();
 

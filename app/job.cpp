@@ -8,23 +8,24 @@ namespace fieldpath::app {
 
 pathgen::GenerateRequest sceneJob(const Scene& scene) {
   using common::InputError;
-  const std::string where = scene.file.string() + ": ";
   const bool impeller = scene.impeller_model && scene.guide_impeller;
   if (scene.nominal && impeller)
-    throw InputError(where +
-                     "path.nominal: the passes come from one source: a nominal path file or the "
+    throw InputError(sceneWhere(scene, "path.nominal") +
+                     ": the passes come from one source: a nominal path file or the "
                      "parametric impeller's hub (`guide: { impeller: hub }`), not both");
   if (!scene.nominal && !impeller)
-    throw InputError(where +
-                     "path.nominal: missing: generate needs the nominal path (`path: { nominal: "
+    throw InputError(sceneWhere(scene, "path.nominal") +
+                     ": missing: generate needs the nominal path (`path: { nominal: "
                      "FILE }`, .cl, APT or .npy) or the parametric impeller (`guide: { impeller: "
                      "hub }` with `- impeller:` among the obstacles)");
   if (scene.nominal && scene.path.passes_given)
-    throw InputError(where + "path.passes: the parametric impeller's pass count (with `guide: { "
-                             "impeller: hub }`); a nominal path's passes are its own");
+    throw InputError(sceneWhere(scene, "path.passes") +
+                     ": the parametric impeller's pass count (with `guide: { "
+                     "impeller: hub }`); a nominal path's passes are its own");
   if (!scene.tool_given)
-    throw InputError(where + "tool: missing: generate needs the cutter (`tool: { shape: ball, "
-                             "radius: R, length: L }`)");
+    throw InputError(scene.file.string() +
+                     ": tool: missing: generate needs the cutter (`tool: { shape: ball, "
+                     "radius: R, length: L }`)");
   pathgen::GenerateRequest job;
   job.path = scene.path;
   job.links = scene.links;
@@ -46,6 +47,21 @@ pathgen::GenerateRequest sceneJob(const Scene& scene) {
                  "note: %s: %zu posture%s at the ball centre of the one before dropped (a repeat "
                  "is no motion)\n",
                  scene.nominal->file.string().c_str(), repeated, repeated == 1 ? "" : "s");
+  if (!impeller) {  // link blocks are dropped (links are made anew): said, with their size, as
+    // a `# link` with no `# pass` or blank line after its moves takes the cutting that follows
+    std::size_t blocks = 0, postures = 0, first = 0;
+    for (const geometry::PathBlock& b : scene.nominal->blocks)
+      if (b.kind == geometry::PathBlock::Kind::Link) {
+        if (blocks++ == 0) first = b.begin;
+        postures += b.size();
+      }
+    if (blocks > 0)
+      std::fprintf(stderr,
+                   "note: %s: %zu posture%s in %zu `# link` block%s (RAPID moves in APT) not cut: "
+                   "generate makes the links anew; a pass starts at `# pass` or a blank line\n",
+                   scene.nominal->where(first).c_str(), postures, postures == 1 ? "" : "s", blocks,
+                   blocks == 1 ? "" : "s");
+  }
   return job;
 }
 

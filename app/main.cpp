@@ -13,6 +13,7 @@
 #include "errors.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/limits.h"
+#include "scene.h"
 
 #ifndef FIELDPATH_VERSION
 #define FIELDPATH_VERSION "unknown"
@@ -117,7 +118,8 @@ int main(int argc, char** argv) {
     return 1;
   } catch (const InputError& e) {
     fieldpath::common::removeWrittenOutputs();  // a failed run leaves no partial set of outputs
-    std::fprintf(stderr, "fieldpath: error: %s\n", oneLine(e.what()).c_str());
+    std::fprintf(stderr, "fieldpath: error: %s\n",
+                 oneLine(placeSceneKey(e.what()).c_str()).c_str());
     return 1;
   } catch (const std::filesystem::filesystem_error& e) {
     // Reading or writing a path the user gave (an --out that is a file, a directory without

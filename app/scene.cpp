@@ -1,10 +1,12 @@
 #include "scene.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
 #include <initializer_list>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -15,6 +17,7 @@
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/input_file.h"
 #include "fieldpath/common/limits.h"
+#include "fieldpath/common/short_number.h"
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/geometry/mesh_io.h"
 #include "fieldpath/geometry/tool_model.h"
@@ -243,8 +246,8 @@ void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
   if (!(f.r_min_mm < f.r0_mm)) {
     const YAML::Node at = node["r_min"] ? node["r_min"] : node["r0"];
     r.fail(at, "field.r_min",
-           "must be < r0 (r_min " + std::to_string(f.r_min_mm) + ", r0 " + std::to_string(f.r0_mm) +
-               ")");
+           "must be < r0 (r_min " + common::shortNumber(f.r_min_mm) + ", r0 " +
+               common::shortNumber(f.r0_mm) + ")");
   }
   // A negative gain attracts the tool to the obstacles (it was accepted: every posture pulled
   // into the walls); 0 turns the field off (the nominal path).
@@ -295,8 +298,14 @@ void readDynamics(const Reader& r, const YAML::Node& node, dynamics::DynamicsPar
                "max_lead_deg", "on_limit", "integrator", "start"});
   if (node["inertia"]) d.inertia = r.positive(node["inertia"], "dynamics.inertia");
   if (node["damping"]) {
-    if (node["damping"].IsScalar() && node["damping"].Scalar() == "critical")
+    const YAML::Node damping = node["damping"];
+    if (damping.IsScalar() && damping.Scalar() == "critical")
       d.damping = -1.0;
+    else if (damping.IsScalar() && !damping.Scalar().empty() &&
+             std::isalpha(static_cast<unsigned char>(damping.Scalar()[0])) &&
+             damping.Scalar() != "inf" && damping.Scalar() != "nan")
+      r.fail(damping, "dynamics.damping",
+             "expected a number >= 0 or `critical`, got '" + damping.Scalar() + "'");
     else
       d.damping = r.number(
           node["damping"], "dynamics.damping", [](double v) { return v >= 0.0; },
@@ -368,6 +377,53 @@ void readLinks(const Reader& r, const YAML::Node& node, pathgen::LinkParams& lin
 
 }  // namespace
 
+namespace {
+
+/// The scene this process read and the 1-based line of each of its keys, top level and one
+/// below (`links.safe_z`): for placeSceneKey. One scene a process; written before any worker.
+struct SceneKeyLines {
+  std::filesystem::path file;
+  std::map<std::string, int> lines;
+};
+SceneKeyLines& sceneKeyLines() {
+  static SceneKeyLines keys;
+  return keys;
+}
+
+void recordKeyLines(const std::filesystem::path& file, const YAML::Node& root) {
+  SceneKeyLines& keys = sceneKeyLines();
+  keys.file = file;
+  keys.lines.clear();
+  for (const auto& kv : root) {
+    const std::string key = kv.first.Scalar();
+    if (kv.first.Mark().line >= 0) keys.lines[key] = kv.first.Mark().line + 1;
+    if (!kv.second.IsMap()) continue;
+    for (const auto& sub : kv.second)
+      if (sub.first.IsScalar() && sub.first.Mark().line >= 0)
+        keys.lines[key + "." + sub.first.Scalar()] = sub.first.Mark().line + 1;
+  }
+}
+
+}  // namespace
+
+std::string sceneWhere(const Scene& scene, const std::string& key) {
+  const SceneKeyLines& keys = sceneKeyLines();
+  const auto at = keys.lines.find(key);
+  return scene.file.string() +
+         (keys.file == scene.file && at != keys.lines.end() ? ":" + std::to_string(at->second)
+                                                            : "") +
+         ": " + key;
+}
+
+std::string placeSceneKey(const std::string& message) {
+  const SceneKeyLines& keys = sceneKeyLines();
+  const std::size_t colon = message.find(": ");
+  if (keys.file.empty() || colon == std::string::npos) return message;
+  const auto at = keys.lines.find(message.substr(0, colon));
+  if (at == keys.lines.end()) return message;
+  return keys.file.string() + ":" + std::to_string(at->second) + ": " + message;
+}
+
 Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
   common::requireRegularFile(file, "scene file (YAML)");
   YAML::Node root;
@@ -392,6 +448,7 @@ Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
   r.expectMap(root, "",
               {"obstacles", "part", "guide", "tool", "holder", "clearance", "field", "dynamics",
                "path", "links"});
+  recordKeyLines(file, root);
 
   Scene scene;
   scene.file = file;

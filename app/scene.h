@@ -61,6 +61,14 @@ struct Scene {
 /// scene's `path.nominal` is then not read (a stale or broken one does not stop them).
 Scene loadScene(const std::filesystem::path& file, bool read_nominal = true);
 
+/// A refusal raised below the app that begins with a key of the scene this process read
+/// ("links.safe_z: must be ...", "field.refine_tolerance: ..."): the scene's file and the key's
+/// line put in front, as the scene's own checks write them. Any other message as it is.
+std::string placeSceneKey(const std::string& message);
+
+/// "FILE:LINE: key" (LINE where the scene gives the key): the start of a refusal of one setting.
+std::string sceneWhere(const Scene& scene, const std::string& key);
+
 /// "FILE:LINE: tool.shape" (LINE where known): the start of a refusal of the scene's tool.
 inline std::string toolShapeWhere(const Scene& scene) {
   return scene.file.string() +

@@ -96,20 +96,28 @@ void fillScene(aiScene& scene, const TriangleMesh& mesh) {
   }
 }
 
-/// A binary STL's size is fixed by its header: 84 bytes and 50 a triangle. One whose count does
-/// not match (truncated, or a count that lies) is refused saying so, where assimp would only say
-/// it cannot tell ASCII from binary. A file that starts with `solid` and does not match is left
-/// to assimp as ASCII.
+/// How assimp is to read an STL: the file as it is, or a copy in memory (`length` bytes of it,
+/// in lower case where `lower`).
+struct StlFeed {
+  bool copy = false;
+  bool lower = false;
+  std::uintmax_t length = 0;
+};
+
 /// assimp reads an ASCII STL cut after a facet (no `endsolid`) and a facet loop of 4 vertices
 /// (some exporters' quads: half the face lost) without a word: every facet must have 3
-/// `vertex` lines and the file must end with `endsolid`.
-/// Returns whether a keyword is written in capitals anywhere (`FACET NORMAL`, `Vertex`, also
-/// after a lower-case `solid`): assimp takes them in lower case only.
-bool checkAsciiStl(const std::filesystem::path& file) {
+/// `vertex` lines and the last solid must end with `endsolid`. Text after it that is no STL (an
+/// exporter's `% exported ...` line) is left out of what assimp reads, where it made assimp
+/// look for another solid; a `solid` after it is another solid of the file and must end too.
+/// assimp takes keywords in lower case only: a keyword in capitals anywhere (`FACET NORMAL`,
+/// `Vertex`, also after a lower-case `solid`) has the text read in lower case.
+StlFeed checkAsciiStl(const std::filesystem::path& file, std::uintmax_t size) {
   std::ifstream in(file, std::ios::binary);
-  std::string line, last;
+  std::string line;
   std::size_t number = 0, facet_line = 0, vertices = 0;
-  bool in_facet = false, capitals = false;
+  bool in_facet = false, capitals = false, in_solid = false;
+  std::uintmax_t offset = 0, solid_end = 0;  // bytes read; the end of the last `endsolid` line
+  std::size_t trailing_line = 0;             // the first line of text after it, if any
   // The first word of each line, lower case (a scan by hand: a million facets are 7 M lines).
   const auto firstWord = [&capitals](const std::string& text) {
     std::size_t b = 0;
@@ -125,10 +133,19 @@ bool checkAsciiStl(const std::filesystem::path& file) {
   };
   while (std::getline(in, line)) {
     ++number;
+    offset += line.size() + 1;
+    const bool was_capital = capitals;
     const std::string word = firstWord(line);
     if (word.empty()) continue;
-    last = word;
-    if (word == "facet") {
+    if (!in_solid && word != "solid") {  // text after the last `endsolid`: not STL
+      capitals = was_capital;            // (its words are not keywords)
+      if (trailing_line == 0) trailing_line = number;
+      continue;
+    }
+    if (word == "solid") {
+      in_solid = true;
+      trailing_line = 0;
+    } else if (word == "facet") {
       in_facet = true;
       facet_line = number;
       vertices = 0;
@@ -140,18 +157,26 @@ bool checkAsciiStl(const std::filesystem::path& file) {
                          ": ASCII STL facet with " + std::to_string(vertices) +
                          " vertices (an STL facet has 3)");
       in_facet = false;
+    } else if (word == "endsolid") {
+      in_solid = false;
+      solid_end = std::min(offset, size);
     }
   }
-  if (last != "endsolid")
+  if (in_solid || solid_end == 0)
     throw InputError(file.string() + ": ASCII STL without `endsolid` at its end (truncated?)");
-  return capitals;
+  StlFeed feed;
+  feed.lower = capitals;
+  feed.copy = capitals || trailing_line > 0;
+  feed.length = trailing_line > 0 ? solid_end : size;
+  return feed;
 }
 
-/// Returns whether the file is an ASCII STL with keywords in capitals (`SOLID`, `FACET NORMAL`, as
-/// some CAD systems write it, or in mixed case): assimp takes its keywords in lower case only
-/// (and the file for binary).
-bool checkStlSize(const std::filesystem::path& file, std::uintmax_t size) {
-  if (lowerExtension(file) != ".stl") return false;
+/// A binary STL's size is fixed by its header: 84 bytes and 50 a triangle. One shorter than its
+/// count says (truncated, or a count that lies) is refused saying so, where assimp would only say
+/// it cannot tell ASCII from binary; up to 49 bytes more (an exporter's padding, less than a
+/// triangle) are read past. A file that starts with `solid` and does not match is ASCII.
+StlFeed checkStl(const std::filesystem::path& file, std::uintmax_t size) {
+  if (lowerExtension(file) != ".stl") return {};
   std::ifstream in(file, std::ios::binary);
   unsigned char header[84] = {};
   in.read(reinterpret_cast<char*>(header), sizeof header);
@@ -162,14 +187,25 @@ bool checkStlSize(const std::filesystem::path& file, std::uintmax_t size) {
                          ? std::string(reinterpret_cast<const char*>(header) + first, 5)
                          : std::string();
   for (char& c : word) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const auto binaryFits = [size](std::uintmax_t needed) {
+    return size >= needed && size - needed < 50;
+  };
+  // assimp takes a binary STL of its exact size only: the padding is left out of its copy.
+  const auto binaryFeed = [size](std::uintmax_t needed) {
+    StlFeed feed;
+    feed.copy = size != needed;
+    feed.length = needed;
+    return feed;
+  };
   if (word == "solid") {
     // ASCII, unless a binary one whose header starts so (its size matches its count).
     if (got == 84) {
       const std::uint32_t count = std::uint32_t(header[80]) | std::uint32_t(header[81]) << 8 |
                                   std::uint32_t(header[82]) << 16 | std::uint32_t(header[83]) << 24;
-      if (84 + 50 * std::uintmax_t(count) == size) return false;
+      if (binaryFits(84 + 50 * std::uintmax_t(count)))
+        return binaryFeed(84 + 50 * std::uintmax_t(count));
     }
-    return checkAsciiStl(file);
+    return checkAsciiStl(file, size);
   }
   if (got < 84)
     throw InputError(file.string() + ": binary STL of " + std::to_string(size) +
@@ -177,11 +213,11 @@ bool checkStlSize(const std::filesystem::path& file, std::uintmax_t size) {
   const std::uint32_t count = std::uint32_t(header[80]) | std::uint32_t(header[81]) << 8 |
                               std::uint32_t(header[82]) << 16 | std::uint32_t(header[83]) << 24;
   const std::uintmax_t needed = 84 + 50 * std::uintmax_t(count);
-  if (needed != size)
+  if (!binaryFits(needed))
     throw InputError(file.string() + ": binary STL: its header says " + std::to_string(count) +
                      " triangles (" + std::to_string(needed) + " bytes), the file has " +
                      std::to_string(size) + " bytes (truncated, or not STL)");
-  return false;
+  return binaryFeed(needed);
 }
 
 /// assimp's PLY loader trusts what a header says and loops forever on some malformed ones (no
@@ -266,7 +302,7 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
   common::requireMemory(file.string(), 16.0 * static_cast<double>(size), "mesh file of " +
                         std::to_string(size >> 20) + " MiB");
   checkPlyHeader(file, size);
-  const bool capital_stl = checkStlSize(file, size);
+  const StlFeed stl = checkStl(file, size);
 
   Assimp::Importer importer;
   const aiScene* scene = nullptr;
@@ -274,10 +310,13 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
     // No post-processing but validation: assimp's steps trust the loaders' output and abort
     // (ai_assert in Triangulate) or crash on malformed files (found by tests/fuzz fuzz_mesh), so
     // polygons are split and node transforms applied below, with every index checked.
-    if (capital_stl) {  // its text in lower case (keywords, the E of exponents, the name)
+    if (stl.copy) {  // its solids or triangles only; lower case where asked (keywords, exponents)
       std::ifstream in(file, std::ios::binary);
-      std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-      for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      std::string text(static_cast<std::size_t>(stl.length), '\0');
+      in.read(text.data(), static_cast<std::streamsize>(text.size()));
+      text.resize(static_cast<std::size_t>(in.gcount()));
+      if (stl.lower)
+        for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
       scene = importer.ReadFileFromMemory(text.data(), text.size(), aiProcess_ValidateDataStructure,
                                           "stl");
     } else {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/short_number.h"
 
 namespace fieldpath::geometry {
 namespace {
@@ -267,11 +268,7 @@ namespace {
 /// they size meshes, node sets and reach boxes.
 constexpr double kMaxToolSizeMm = 1e4;
 
-std::string shortNumber(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", value);
-  return text;
-}
+using common::shortNumber;
 }  // namespace
 
 void validateToolSpec(const ToolSpec& tool) {
@@ -299,15 +296,15 @@ void validateHolderProfile(const HolderProfile& holder) {
   for (std::size_t i = 0; i < holder.size(); ++i) {
     const HolderStation& s = holder[i];
     if (!std::isfinite(s.z_mm) || !std::isfinite(s.radius_mm) || !(s.radius_mm > 0))
-      throw InputError("station " + std::to_string(i) + ": z must be finite and radius > 0");
+      throw InputError("station " + std::to_string(i + 1) + ": z must be finite and radius > 0");
     if (std::abs(s.z_mm) > kMaxToolSizeMm || s.radius_mm > kMaxToolSizeMm)
-      throw InputError("station " + std::to_string(i) + ": " + shortNumber(s.z_mm) + ":" +
+      throw InputError("station " + std::to_string(i + 1) + ": " + shortNumber(s.z_mm) + ":" +
                        shortNumber(s.radius_mm) + " is beyond " + shortNumber(kMaxToolSizeMm) +
                        " mm (no spindle takes it)");
     if (i > 0 && !(s.z_mm > holder[i - 1].z_mm) &&
         !(s.z_mm == holder[i - 1].z_mm && s.radius_mm != holder[i - 1].radius_mm))
-      throw InputError("station " + std::to_string(i) +
-                       ": z must increase (equal z only for a step to another radius)");
+      throw InputError("station " + std::to_string(i + 1) + " (z " + shortNumber(s.z_mm) +
+                       "): z must increase (equal z only for a step to another radius)");
   }
   if (holder.size() == 1) throw InputError("a holder needs at least two stations");
   if (!holder.empty() && !(holder.back().z_mm > holder.front().z_mm))

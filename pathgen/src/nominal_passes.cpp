@@ -110,15 +110,20 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
   auto centre = [&](std::size_t i) {
     return geometry::ballCentre(path.postures[i], ball_radius_mm);
   };
+  auto tipStep = [&](std::size_t i) {
+    return (path.postures[i].tip_mm - path.postures[i - 1].tip_mm).norm();
+  };
   std::vector<std::pair<std::size_t, std::size_t>> ranges;
   for (const PathBlock& block : path.blocks) {
     if (block.kind != PathBlock::Kind::Pass) continue;
-    std::vector<double> steps;
+    std::vector<double> steps, tip_steps;
     for (std::size_t i = block.begin + 1; i < block.end; ++i) {
       const double d = (centre(i) - centre(i - 1)).norm();
       if (d > kRepeatMm) steps.push_back(d);
+      if (tipStep(i) > kRepeatMm) tip_steps.push_back(tipStep(i));
     }
     const double gap = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(steps);
+    const double tip_gap = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(tip_steps);
     std::size_t begin = block.begin;
     // The last few feed directions of the pass (repeats skipped): a feed that turns back past
     // 90 deg from one of them (a zig-zag's return leg after its step-over) starts a new pass.
@@ -128,7 +133,10 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
     std::vector<Vec3> recent;
     for (std::size_t i = block.begin + 1; i < block.end; ++i) {
       const Vec3 step = centre(i) - centre(i - 1);
-      if (gap > 0.0 && step.norm() > gap) {  // the gap is the link between the two
+      // DESIGN's gap is the tips'; the centres' too, so that an axis swung about a steady tip
+      // (the centre thrown up to 2R) or about a steady centre (the tip thrown) stays in its
+      // pass: such a turn is the axis's, counted and named at its line, not a link.
+      if (gap > 0.0 && step.norm() > gap && tipStep(i) > tip_gap) {  // the link between the two
         ranges.emplace_back(begin, i);
         begin = i;
         recent.clear();

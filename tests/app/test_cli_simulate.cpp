@@ -163,6 +163,12 @@ TEST(CliSimulate, BadInputIsExitOneWithOneLineAndNoOutputs) {
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << args << ": " << run.err;
     EXPECT_FALSE(std::filesystem::exists(dir.path() / "out")) << args;
   }
+  // A shape without its sizes is said to be one (it read as a missing mesh file).
+  const Outcome bare = runFieldpath(dir, "simulate --tool torus --path path.cl --out out");
+  EXPECT_EQ(bare.exit_code, 1);
+  EXPECT_NE(bare.err.find("--tool torus: the shape needs its sizes: torus:R:r[:L]"),
+            std::string::npos)
+      << bare.err;
 }
 
 }  // namespace

@@ -152,6 +152,12 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
       {"obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, corner_radius: 1 }\n",
        "tool.corner_radius", 3},
       {"obstacles:\n  - mesh: wall.stl\nholder: [[40, 6], [30, 6]]\n", "holder", 3},
+      // Stations counted from 1, as holder[K] is, with the z that fails.
+      {"obstacles:\n  - mesh: wall.stl\nholder: [[40, 6], [50, 6], [45, 6]]\n",
+       "station 3 (z 45): z must increase", 3},
+      {"obstacles:\n  - mesh: wall.stl\ndynamics: { damping: heavy }\n",
+       "dynamics.damping: expected a number >= 0 or `critical`, got 'heavy'", 3},
+      {"obstacles:\n  - mesh: wall.stl\nfield: { r0: 2, r_min: 3 }\n", "(r_min 3, r0 2)", 3},
       {"obstacles:\n  - mesh: wall.stl\nholder: [[40, 6], [50]]\n", "holder[2]", 3},
       {"obstacles:\n  - mesh: wall.stl\nclearance: -0.1\n", "clearance", 3},
       {"obstacles:\n  - mesh: wall.stl\ndynamics:\n  max_tilt_deg: 95\n", "dynamics.max_tilt_deg",

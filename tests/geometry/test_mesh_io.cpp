@@ -236,3 +236,33 @@ TEST(MeshIo, DefectiveMeshesLoadAndAreReported) {
       "flipped.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 3 2 4\n"));
   EXPECT_GT(validateMesh(flipped).inconsistent_edges, 0u);
 }
+
+// Exporters' extras around a whole STL: text after `endsolid` (a `% exported ...` line) and a
+// few bytes of padding after a binary STL's last triangle. The same tetrahedron is read; a
+// second solid left open, or a padding of a whole triangle or more (a count that lies), is not.
+TEST(MeshIo, ExportersTrailingTextAndPaddingAreReadPast) {
+  const std::string tetra = kAsciiTetra;
+  for (const std::string& tail : {std::string("% exported 2024\n"), std::string("\r\n  \nEND\n"),
+                                  std::string("% a line with no end")}) {
+    const TriangleMesh m = loadMesh(writeBytes("trailing.stl", tetra + tail));
+    EXPECT_EQ(m.triangles.size(), 4u) << tail;
+    EXPECT_EQ(m.vertices.size(), 4u) << tail;
+  }
+  std::string shouting = tetra;  // capitals and a tail: both handled in the one copy
+  for (char& c : shouting) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  EXPECT_EQ(loadMesh(writeBytes("TRAILING.STL", shouting + "% EXPORTED\n")).triangles.size(), 4u);
+  EXPECT_THROW(
+      loadMesh(writeBytes("open_second.stl", tetra + "solid second\nfacet normal 0 0 1\n")),
+      InputError);
+
+  const TriangleMesh ascii = loadMesh(writeBytes("tetra.stl", tetra));
+  const fs::path binary = tempPath("tetra_bin.stl");
+  saveMesh(ascii, binary);
+  std::ifstream in(binary, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(bytes.size(), 84u + 50u * 4u);
+  const TriangleMesh padded = loadMesh(writeBytes("padded.stl", bytes + std::string(2, '\0')));
+  EXPECT_EQ(padded.triangles.size(), 4u);
+  EXPECT_EQ(padded.vertices, ascii.vertices);
+  EXPECT_THROW(loadMesh(writeBytes("overlong.stl", bytes + std::string(50, '\0'))), InputError);
+}

@@ -118,6 +118,41 @@ TEST_F(MeshJob, ASafeZAtTheLeastAcceptedIsSaid) {
   }
 }
 
+// The nominal path's `# link` blocks are not cut (links are made anew): said with their size
+// and the first one's line, as a `# link` with no `# pass` after its moves takes the cutting
+// that follows (a helper's file lost two thirds of its passes without a word).
+TEST_F(MeshJob, LinkBlocksOfTheNominalPathAreSaidNotCut) {
+  const PathFile nominal = geometry::readPathFile(dir_->path() / "nominal.cl");
+  std::size_t blocks = 0, postures = 0, first = 0;
+  for (const PathBlock& b : nominal.blocks)
+    if (b.kind == PathBlock::Kind::Link) {
+      if (blocks++ == 0) first = b.begin;
+      postures += b.size();
+    }
+  ASSERT_GT(blocks, 0u);
+  dir_->write("linked.yaml", sceneText("nominal.cl"));
+  const auto r = test::runFieldpath(*dir_, "generate linked.yaml --out out_linked");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const std::string said = fs::path(nominal.where(first)).filename().string() + ": " + std::to_string(postures) +
+                           " postures in " + std::to_string(blocks) + " `# link` blocks";
+  EXPECT_NE(r.err.find(said), std::string::npos) << said << "\n" << r.err;
+}
+
+// A setting refused below the app (links.safe_z under the meshes, found once they are read)
+// names the scene's file and the key's line, as the scene's own checks do.
+TEST_F(MeshJob, ASettingRefusedByTheJobNamesItsLine) {
+  const std::string text = sceneText("nominal.cl", "links:\n  retract: 2\n  safe_z: -50\n");
+  dir_->write("low.yaml", text);
+  const int line =
+      1 + static_cast<int>(std::count(text.begin(),
+                                      text.begin() + static_cast<long>(text.find("safe_z")), '\n'));
+  const auto r = test::runFieldpath(*dir_, "generate low.yaml --out out_low");
+  EXPECT_EQ(r.exit_code, 1) << r.output();
+  EXPECT_NE(r.err.find("low.yaml:" + std::to_string(line) + ": links.safe_z: "), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir_->path() / "out_low" / "path.cl"));
+}
+
 TEST_F(MeshJob, BladesWoundAwayFromThePassesAreTurnedToFaceThem) {
   // The blades are open sheets: wound the other way their field would pull the tool into them.
   // Turned before sampling, the job is the same, bit for bit.

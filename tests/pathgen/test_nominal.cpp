@@ -128,6 +128,20 @@ TEST(PathBlocks, GapsSplitPassesAtFourMedianSteps) {
   PathParams wide;
   wide.pass_gap_mm = 3.0;
   EXPECT_EQ(nominalPasses(path, wide, kR).size(), 1u);
+
+  // DESIGN's gap is the tips': tips 0.5 mm apart whose axis swings 60 deg once throw the ball
+  // centre 3 mm (> 4 × 0.5), one pass still (it read as two, with a link generate made in it,
+  // where check read one); a flip so is named at its line, not called a pass of its own.
+  std::string swing, flip;
+  for (int k = 0; k < 12; ++k) {
+    const std::string tip = std::to_string(0.5 * k) + " 20 0 ";
+    swing += tip + (k < 6 ? "0 0 1\n" : "0 -0.8660254037844386 0.5\n");
+    flip += tip + (k < 6 ? "0 0 1\n" : "0 0 -1\n");
+  }
+  EXPECT_EQ(passRanges(geometry::readPathFile(dir.write("swing.cl", swing)), 0.0, kR).size(), 1u);
+  const std::string m =
+      errorOf([&] { nominalPasses(geometry::readPathFile(dir.write("flip6.cl", flip)), {}, kR); });
+  EXPECT_NE(m.find("flip6.cl:7: the tool axis turns 180 deg"), std::string::npos) << m;
 }
 
 TEST(NominalPasses, FramesFollowThePolylineAndKeepPosturesOneForOne) {

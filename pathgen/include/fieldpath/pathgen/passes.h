@@ -56,7 +56,8 @@ std::vector<Pass> impellerPasses(const Impeller& impeller, const PathParams& pat
                                  double ball_radius_mm);
 
 /// The passes of a nominal path: its pass blocks (link blocks dropped), each split where two
-/// consecutive tips are farther apart than `path.pass_gap` (0: 4 × the block's median step);
+/// consecutive tips (and ball centres) are farther apart than `path.pass_gap` (0: 4 × the
+/// block's median step; passRanges);
 /// consecutive postures with the same ball centre are dropped (counted in `repeated`). Stations:
 /// the postures one for one, or every `path.step` mm when `path.step_given`. Throws
 /// common::InputError naming the file and line for a pass with fewer than two distinct postures
@@ -65,12 +66,15 @@ std::vector<Pass> nominalPasses(const geometry::PathFile& path, const PathParams
                                 double ball_radius_mm, std::size_t* repeated = nullptr);
 
 /// Posture ranges [begin, end) of the passes of a path: its pass blocks (link blocks dropped),
-/// each split where two consecutive ball centres (R = `ball_radius_mm` up the axis from the tip)
-/// are farther apart than `pass_gap_mm` (0: 4 × the block's median step), and where their feed
-/// turns back more than 90° from one of its last three directions (a zig-zag's legs: the new
-/// pass starts with the step that turns back). The centres, not the tips: the programmed path
-/// is the centre's, and a tip moves back when the axis leans forward faster than the centre
-/// moves on (a 45° swing in 1 mm read as a new pass, and its turn went uncounted).
+/// each split where two consecutive tips are farther apart than `pass_gap_mm` (0: 4 × the
+/// block's median tip step), as DESIGN reads a gap, and their ball centres (R = `ball_radius_mm`
+/// up the axis from the tip) too (0: 4 × the median centre step): an axis swung about a steady
+/// tip or a steady centre is a turn within the pass (counted, and refused at its line where it
+/// flips), not a link; and where the centres' feed turns back more than 90° from one of its last
+/// three directions (a zig-zag's legs: the new pass starts with the step that turns back). The
+/// feed is the centres', not the tips': the programmed path is the centre's, and a tip moves
+/// back when the axis leans forward faster than the centre moves on (a 45° swing in 1 mm read as
+/// a new pass, and its turn went uncounted).
 std::vector<std::pair<std::size_t, std::size_t>> passRanges(const geometry::PathFile& path,
                                                             double pass_gap_mm,
                                                             double ball_radius_mm);
