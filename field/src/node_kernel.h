@@ -314,7 +314,7 @@ FP_HD NodeValue nodeValue(Hood& hood, const Law& L, const Rules& R, D3 x) {
       f = p.force;
       e = L.planeHeight(norm(f));
       plane = L.planeAt(e);
-      s_mm = e;
+      s_mm = eta < 0.0 ? -e : e;  // under: still inside for the refinement (voxel_refine.cpp)
       over = false;
     }
     g = plane > 0.0 ? D3{f.x / plane, f.y / plane, f.z / plane} : D3{0, 0, 0};

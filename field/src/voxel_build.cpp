@@ -94,9 +94,14 @@ RatioNode planeRatio(const detail::Probe& p, const Vec3& x, const Vec3& q, const
   const RatioNode continued = ratioOf(lifted, lift_mm, over);
   // The continuation at the node itself, against the node's exact force (kPlaneFitTolerance).
   const double plane = law.at(continued.s_mm + lift_mm);
-  if (plane > 0.0 &&
-      law.at(continued.s_mm) * lifted.norm() > (1.0 + kPlaneFitTolerance) * plane * p.force->norm())
-    return ratioOf(*p.force, 0.0, false);
+  if (plane > 0.0 && law.at(continued.s_mm) * lifted.norm() >
+                         (1.0 + kPlaneFitTolerance) * plane * p.force->norm()) {
+    // The node's own force; under the surface s keeps its sign, so that the refinement still
+    // reads the node as inside (an s < 0 not over the surface: only such a node).
+    RatioNode own = ratioOf(*p.force, 0.0, false);
+    if (eta < 0.0) own.s_mm = -own.s_mm;
+    return own;
+  }
   return continued;
 }
 

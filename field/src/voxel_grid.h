@@ -139,10 +139,14 @@ struct Accessors {
 /// where corners under the surface (s < 0) meet corners that are not (beyond the edge of an open
 /// wall, where s > 0 on both sides of the wall's plane; past the inner end of the inside band).
 /// s jumps there, and P(s~) would read the wall's r_min value in mid-air; the corner forces are
-/// blended instead.
+/// blended instead. A cell wholly under the surface holds it too (s~ < 0 throughout), also with
+/// corners not over it: nodes under a surface that is no plane's hold their own force with
+/// s = -P⁻¹(|F|) (kPlaneFitTolerance), whose decay the blend follows where forces blended
+/// trilinearly overshoot (+27 % 1 mm under a lone triangle at h = 0.5).
 inline bool ratioHolds(const double (&s)[8], const bool (&over)[8]) {
   const bool under = std::any_of(s, s + 8, [](double v) { return v < 0.0; });
-  return !under || std::all_of(over, over + 8, [](bool v) { return v; });
+  return !under || std::all_of(over, over + 8, [](bool v) { return v; }) ||
+         std::all_of(s, s + 8, [](double v) { return v < 0.0; });
 }
 
 

@@ -24,8 +24,8 @@ class NodeCurvature {
     if (law) closeness_.emplace(level.closeness->getConstAccessor());
   }
 
-  /// Of a built node (its value on) of `leaf` (closeness: its closeness leaf); `inside`: over
-  /// the surface's normal and s <= -depth_mm.
+  /// Of a built node (its value on) of `leaf` (closeness: its closeness leaf); `inside`:
+  /// s <= -depth_mm (under the surface).
   void at(const Leaf& leaf, const FloatLeaf* closeness, openvdb::Index offset, double depth_mm,
           double& force, double& error, bool& inside) {
     if (leaf_ != &leaf) {  // the leaf's buffers read directly (no out-of-core check a value)
@@ -37,7 +37,9 @@ class NodeCurvature {
     }
     const openvdb::Coord ijk = leaf.offsetToGlobalCoord(offset);
     const Read here = read(ijk);
-    inside = law_ && here.s <= -depth_mm && here.over;
+    // s < 0 only over the surface, or at a node under it that holds its own force (the plane's
+    // continuation did not fit there: voxel_build.cpp planeRatio).
+    inside = law_ && here.s <= -depth_mm;
     double slope = 0.0, plane = 0.0;
     if (law_) {
       constexpr double kStepMm = 1e-4;

@@ -84,7 +84,8 @@ inline constexpr double kRefinedNearFactor = 1.4;
 /// own exact force within this fraction above it (or less): under a lone small triangle it gave
 /// 35 × the law's largest value (a wall's plane continued 5 mm into a solid that is not there),
 /// on a face between its samples 2.7 × the direct field. A node it does not fit holds its own
-/// force (s = P⁻¹(|F|), G = F / P(s)) and is not counted over the surface.
+/// force (s = ±P⁻¹(|F|), negative under the surface, G = F / P(|s|)) and is not counted over
+/// the surface: its cells blend the corner forces, and the refinement still reads it inside.
 inline constexpr double kPlaneFitTolerance = 0.1;
 /// The refinement floor: a fraction of the plane law at 2 r_min (VoxelRequest::refine_tolerance).
 inline constexpr double kRefineFloorFraction = 0.005;
