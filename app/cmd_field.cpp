@@ -143,10 +143,10 @@ void probe(const FieldOptions& o, const GlobalOptions& global) {
 }
 
 void build(const FieldOptions& o, const GlobalOptions& global) {
+  common::checkOutputFile(o.out, "--out");  // before the work, not after
   // The file is OpenVDB whatever its name: a `field.txt` would be a binary file misnamed.
   if (common::lowerExtension(o.out) != ".vdb")
     throw InputError("--out " + o.out + ": the field is written as OpenVDB, name it *.vdb");
-  common::checkOutputFile(o.out, "--out");  // before the work, not after
   const Obstacles obstacles = loadObstacles(o);
   const field::VoxelRequest request = voxelRequest(o, obstacles.scene, global.quiet);
   // CUDA's start-up (the device's context, once per process) before the timed build.

@@ -304,7 +304,7 @@ FP_HD NodeValue nodeValue(Hood& hood, const Law& L, const Rules& R, D3 x) {
       if (hood.pending()) return out;
       f = lifted.has_force ? lifted.force : D3{0, 0, 0};
     }
-    double e = L.planeHeight(norm(f));
+    const double e = L.planeHeight(norm(f));
     double plane = L.planeAt(e);
     s_mm = e - lift_mm;
     // The continuation at the node itself, against the node's exact force: where it gives more
@@ -312,9 +312,9 @@ FP_HD NodeValue nodeValue(Hood& hood, const Law& L, const Rules& R, D3 x) {
     if (lift_mm > 0.0 && plane > 0.0 &&
         L.planeAt(s_mm) * norm(f) > (1.0 + kPlaneFit) * plane * norm(p.force)) {
       f = p.force;
-      e = L.planeHeight(norm(f));
-      plane = L.planeAt(e);
-      s_mm = eta < 0.0 ? -e : e;  // under: still inside for the refinement (voxel_refine.cpp)
+      s_mm = L.planeHeight(norm(f));
+      if (eta < 0.0) s_mm = dmax(-s_mm, eta);  // under, no deeper than the node (voxel_refine)
+      plane = L.planeAt(s_mm);
       over = false;
     }
     g = plane > 0.0 ? D3{f.x / plane, f.y / plane, f.z / plane} : D3{0, 0, 0};

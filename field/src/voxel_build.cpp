@@ -91,18 +91,19 @@ RatioNode planeRatio(const detail::Probe& p, const Vec3& x, const Vec3& q, const
   if (!over || eta >= near_mm) return ratioOf(*p.force, 0.0, over);
   const double lift_mm = near_mm - eta;
   const Vec3 lifted = field_at(Vec3(x + lift_mm * n));
-  const RatioNode continued = ratioOf(lifted, lift_mm, over);
-  // The continuation at the node itself, against the node's exact force (kPlaneFitTolerance).
-  const double plane = law.at(continued.s_mm + lift_mm);
-  if (plane > 0.0 && law.at(continued.s_mm) * lifted.norm() >
-                         (1.0 + kPlaneFitTolerance) * plane * p.force->norm()) {
-    // The node's own force; under the surface s keeps its sign, so that the refinement still
-    // reads the node as inside (an s < 0 not over the surface: only such a node).
-    RatioNode own = ratioOf(*p.force, 0.0, false);
-    if (eta < 0.0) own.s_mm = -own.s_mm;
-    return own;
+  // The continuation at the node itself, against the node's exact force (kPlaneFitTolerance):
+  // where it overstates it, the node's own force, s = P⁻¹(|F|); under the surface s < 0 and
+  // no deeper than the node (η <= s: the refinement's inside test reads s as a height).
+  const double e = law.height(lifted.norm());
+  const double plane = law.at(e);
+  if (plane > 0.0 &&
+      law.at(e - lift_mm) * lifted.norm() > (1.0 + kPlaneFitTolerance) * plane * p.force->norm()) {
+    double s_mm = law.height(p.force->norm());
+    if (eta < 0.0) s_mm = std::max(-s_mm, eta);
+    const double own = law.at(s_mm);
+    return {s_mm, own > 0.0 ? Vec3(*p.force / own) : Vec3::Zero(), false};
   }
-  return continued;
+  return {e - lift_mm, plane > 0.0 ? Vec3(lifted / plane) : Vec3::Zero(), over};
 }
 
 /// What the node values of every level are made from.

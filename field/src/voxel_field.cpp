@@ -435,7 +435,7 @@ void VoxelField::evaluate(std::span<const Vec3> points_mm, std::span<Vec3> force
         cellCorners(*acc.closeness, ijk, cc, over);
         double s[8];
         for (int k = 0; k < 8; ++k) s[k] = law.r0_mm - cc[k];
-        if (!ratioHolds(s, over)) {
+        if (!ratioHolds(s, over, /*whole_under_holds=*/false)) {
           for (int k = 0; k < 8; ++k) c[k] *= float(law.at(s[k]));  // the node forces
           forces[i] = blend(c, p - base);
           return;

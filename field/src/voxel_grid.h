@@ -143,12 +143,13 @@ struct Accessors {
 /// corners not over it: nodes under a surface that is no plane's hold their own force with
 /// s = -P⁻¹(|F|) (kPlaneFitTolerance), whose decay the blend follows where forces blended
 /// trilinearly overshoot (+27 % 1 mm under a lone triangle at h = 0.5).
-inline bool ratioHolds(const double (&s)[8], const bool (&over)[8]) {
+/// (`whole_under_holds` false: not so for quadratic interpolation, whose 27 nodes reach past
+/// the cell's 8 corners this tests.)
+inline bool ratioHolds(const double (&s)[8], const bool (&over)[8], bool whole_under_holds = true) {
   const bool under = std::any_of(s, s + 8, [](double v) { return v < 0.0; });
   return !under || std::all_of(over, over + 8, [](bool v) { return v; }) ||
-         std::all_of(s, s + 8, [](double v) { return v < 0.0; });
+         (whole_under_holds && std::all_of(s, s + 8, [](double v) { return v < 0.0; }));
 }
-
 
 using IndexGrid = openvdb::Int32Grid;
 constexpr int kBlockDim = kLeafDim + 1;                         ///< a leaf's nodes and the +1 layer
@@ -272,8 +273,9 @@ void matchCoarserLevels(Level& fine, const std::vector<Level>& coarser, bool rat
 /// interpolation's error is h²/8 |f''|) as a force error, |dP/ds|·|G|·|Δ²s| + P(s)·|Δ²G| or
 /// |Δ²F|; a cell's is the largest of its corners' over max(their mean force, floor). The nodes'
 /// are computed once, by leaves in parallel (the level's blocks made: makeBlocks).
-/// A plane-ratio cell whose built corners (at least one) all lie under the surface, deeper than half its diagonal
-/// (over, s <= -√3 h / 2), is wholly inside the obstacle (s is the signed height, 1-Lipschitz):
+/// A plane-ratio cell whose built corners (at least one) all lie under the surface, deeper than
+/// half its diagonal (s <= -√3 h / 2: over the surface s is the signed height; a node under it
+/// holding its own force has η <= s < 0) is wholly inside the obstacle (the height is 1-Lipschitz):
 /// no tool node of a valid path is ever there, and one that has entered still gets the coarse
 /// level's outward field, so its error is 0 and it is never split (issue 15: these cells were
 /// 59 % of the finest nodes of the impeller refined to 0.5 %).

@@ -37,8 +37,9 @@ class NodeCurvature {
     }
     const openvdb::Coord ijk = leaf.offsetToGlobalCoord(offset);
     const Read here = read(ijk);
-    // s < 0 only over the surface, or at a node under it that holds its own force (the plane's
-    // continuation did not fit there: voxel_build.cpp planeRatio).
+    // s < 0 only over the surface (the signed height), or at a node under it that holds its own
+    // force (the plane's continuation did not fit there), whose height is η <= s
+    // (voxel_build.cpp planeRatio).
     inside = law_ && here.s <= -depth_mm;
     double slope = 0.0, plane = 0.0;
     if (law_) {

@@ -136,10 +136,14 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
       // DESIGN's gap is the tips'; the centres' too, so that an axis swung about a steady tip
       // (the centre thrown up to 2R) or about a steady centre (the tip thrown) stays in its
       // pass: such a turn is the axis's, counted and named at its line, not a link.
-      if (gap > 0.0 && step.norm() > gap && tipStep(i) > tip_gap) {  // the link between the two
-        ranges.emplace_back(begin, i);
-        begin = i;
-        recent.clear();
+      if (gap > 0.0 && step.norm() > gap) {
+        if (tipStep(i) > tip_gap) {  // the link between the two
+          ranges.emplace_back(begin, i);
+          begin = i;
+          recent.clear();
+        }
+        // else the axis swung about a steady tip: its centre's jump is no feed direction (a
+        // swing along the feed read as a turn back and left a pass of one posture)
         continue;
       }
       if (step.norm() <= kRepeatMm) continue;

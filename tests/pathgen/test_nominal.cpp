@@ -139,6 +139,12 @@ TEST(PathBlocks, GapsSplitPassesAtFourMedianSteps) {
     flip += tip + (k < 6 ? "0 0 1\n" : "0 0 -1\n");
   }
   EXPECT_EQ(passRanges(geometry::readPathFile(dir.write("swing.cl", swing)), 0.0, kR).size(), 1u);
+  // ... also swung along the feed (about the binormal): the centre's jump back is no zig-zag.
+  std::string lead;
+  for (int k = 0; k < 12; ++k)
+    lead +=
+        std::to_string(0.5 * k) + " 20 0 " + (k < 6 ? "0 0 1\n" : "-0.8660254037844386 0 0.5\n");
+  EXPECT_EQ(nominalPasses(geometry::readPathFile(dir.write("lead.cl", lead)), {}, kR).size(), 1u);
   const std::string m =
       errorOf([&] { nominalPasses(geometry::readPathFile(dir.write("flip6.cl", flip)), {}, kR); });
   EXPECT_NE(m.find("flip6.cl:7: the tool axis turns 180 deg"), std::string::npos) << m;
