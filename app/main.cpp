@@ -1,4 +1,5 @@
 /// fieldpath: collision-free 5-axis ball-end paths through a repulsive field, and their proof.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -6,6 +7,7 @@
 #include <exception>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -96,22 +98,43 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-    // `fieldpath frobnicate`: CLI11 says "a subcommand is required", which hides the typo.
-    if (app.get_subcommands().empty()) {
-      for (int i = 1; i < argc; ++i) {
-        const std::string arg = argv[i];
-        if (arg == "--max-memory") {
-          ++i;  // its value
-          continue;
-        }
-        if (arg.empty() || arg[0] == '-') continue;
+    // `fieldpath frobnicate`, `fieldpath field prob`: CLI11 says "a subcommand is required",
+    // which hides the typo. The words are walked down the commands; the first that is none
+    // where one is required is named.
+    const CLI::App* at = &app;
+    std::string chain = "fieldpath";
+    for (int i = 1; i < argc; ++i) {
+      const std::string arg = argv[i];
+      if (at == &app && arg == "--max-memory") {
+        ++i;  // its value
+        continue;
+      }
+      if (arg.empty() || arg[0] == '-') continue;
+      const std::vector<const CLI::App*> subs = at->get_subcommands({});
+      const auto sub = std::find_if(subs.begin(), subs.end(),
+                                    [&arg](const CLI::App* c) { return c->get_name() == arg; });
+      if (sub != subs.end()) {
+        at = *sub;
+        chain += " " + arg;
+        continue;
+      }
+      if (at->get_require_subcommand_min() > 0 && !subs.empty()) {
         std::string known;
-        for (const CLI::App* sub : app.get_subcommands({}))
-          known += (known.empty() ? "" : ", ") + sub->get_name();
-        std::fprintf(stderr, "fieldpath: error: unknown command '%s' (commands: %s; see --help)\n",
-                     oneLine(arg.c_str()).c_str(), known.c_str());
+        for (const CLI::App* c : subs) known += (known.empty() ? "" : ", ") + c->get_name();
+        std::fprintf(stderr,
+                     "fieldpath: error: unknown command '%s' (%s takes: %s; see --help)\n",
+                     oneLine(arg.c_str()).c_str(), chain.c_str(), known.c_str());
         return 1;
       }
+      break;  // the command's own arguments
+    }
+    if (at->get_require_subcommand_min() > 0 && at->get_subcommands().empty()) {
+      std::string known;  // `fieldpath` or `fieldpath field` alone
+      for (const CLI::App* c : at->get_subcommands({}))
+        known += (known.empty() ? "" : ", ") + c->get_name();
+      std::fprintf(stderr, "fieldpath: error: %s needs a command: %s (see --help)\n",
+                   chain.c_str(), known.c_str());
+      return 1;
     }
     // A usage error is bad input: one line, exit 1 (CLI11's own report adds a second line).
     std::fprintf(stderr, "fieldpath: error: %s (see --help)\n", oneLine(e.what()).c_str());

@@ -124,11 +124,19 @@ TEST(CliField, BuildRefusesAnOutputNotNamedVdb) {
 TEST(CliField, AnUnknownCommandIsNamed) {
   TempDir dir;
   // CLI11 alone says "a subcommand is required", which hides the typo.
-  for (const std::string args : {"fields build x.yaml", "--max-memory 1G genrate x.yaml"}) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"fields build x.yaml", "'fields'"},
+      {"--max-memory 1G genrate x.yaml", "'genrate'"},
+      {"--quiet field prob x.yaml --points p.txt", "'prob' (fieldpath field takes: probe, build"}};
+  // and a command left out is asked for, with the list.
+  const Outcome bare = runFieldpath(dir, "--quiet field");
+  EXPECT_EQ(bare.exit_code, 1);
+  EXPECT_NE(bare.err.find("fieldpath field needs a command: probe, build"), std::string::npos)
+      << bare.err;
+  for (const auto& [args, said] : cases) {
     const Outcome run = runFieldpath(dir, args);
     EXPECT_EQ(run.exit_code, 1) << args;
     EXPECT_EQ(lines(run.err), 1u) << run.err;
-    const std::string typo = args.starts_with("--") ? "'genrate'" : "'fields'";
-    EXPECT_NE(run.err.find("unknown command " + typo), std::string::npos) << run.err;
+    EXPECT_NE(run.err.find("unknown command " + said), std::string::npos) << run.err;
   }
 }
