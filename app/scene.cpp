@@ -27,6 +27,31 @@ namespace {
 
 using common::InputError;
 
+/// The scene this process read and the 1-based line of each of its keys, top level and one
+/// below (`links.safe_z`): for placeSceneKey. One scene a process; written before any worker.
+struct SceneKeyLines {
+  std::filesystem::path file;
+  std::map<std::string, int> lines;
+};
+SceneKeyLines& sceneKeyLines() {
+  static SceneKeyLines keys;
+  return keys;
+}
+
+void recordKeyLines(const std::filesystem::path& file, const YAML::Node& root) {
+  SceneKeyLines& keys = sceneKeyLines();
+  keys.file = file;
+  keys.lines.clear();
+  for (const auto& kv : root) {
+    const std::string key = kv.first.Scalar();
+    if (kv.first.Mark().line >= 0) keys.lines[key] = kv.first.Mark().line + 1;
+    if (!kv.second.IsMap()) continue;
+    for (const auto& sub : kv.second)
+      if (sub.first.IsScalar() && sub.first.Mark().line >= 0)
+        keys.lines[key + "." + sub.first.Scalar()] = sub.first.Mark().line + 1;
+  }
+}
+
 /// Where a value came from: the file, and the dotted key of the node being read.
 class Reader {
  public:
@@ -36,7 +61,12 @@ class Reader {
   [[noreturn]] void fail(const YAML::Node& at, const std::string& key,
                          const std::string& why) const {
     std::string where = file_.string();
-    if (at.IsDefined() && at.Mark().line >= 0) where += ":" + std::to_string(at.Mark().line + 1);
+    int line = at.IsDefined() && at.Mark().line >= 0 ? at.Mark().line + 1 : 0;
+    // An empty value (`tool:` alone) is marked where the next key starts: the key's own line.
+    const SceneKeyLines& keys = sceneKeyLines();
+    if ((!at.IsDefined() || at.IsNull()) && keys.file == file_)
+      if (const auto it = keys.lines.find(key); it != keys.lines.end()) line = it->second;
+    if (line > 0) where += ":" + std::to_string(line);
     throw InputError(where + ": " + key + ": " + why);
   }
 
@@ -377,34 +407,6 @@ void readLinks(const Reader& r, const YAML::Node& node, pathgen::LinkParams& lin
 
 }  // namespace
 
-namespace {
-
-/// The scene this process read and the 1-based line of each of its keys, top level and one
-/// below (`links.safe_z`): for placeSceneKey. One scene a process; written before any worker.
-struct SceneKeyLines {
-  std::filesystem::path file;
-  std::map<std::string, int> lines;
-};
-SceneKeyLines& sceneKeyLines() {
-  static SceneKeyLines keys;
-  return keys;
-}
-
-void recordKeyLines(const std::filesystem::path& file, const YAML::Node& root) {
-  SceneKeyLines& keys = sceneKeyLines();
-  keys.file = file;
-  keys.lines.clear();
-  for (const auto& kv : root) {
-    const std::string key = kv.first.Scalar();
-    if (kv.first.Mark().line >= 0) keys.lines[key] = kv.first.Mark().line + 1;
-    if (!kv.second.IsMap()) continue;
-    for (const auto& sub : kv.second)
-      if (sub.first.IsScalar() && sub.first.Mark().line >= 0)
-        keys.lines[key + "." + sub.first.Scalar()] = sub.first.Mark().line + 1;
-  }
-}
-
-}  // namespace
 
 std::string sceneWhere(const Scene& scene, const std::string& key) {
   const SceneKeyLines& keys = sceneKeyLines();
@@ -425,6 +427,7 @@ std::string placeSceneKey(const std::string& message) {
 }
 
 Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
+  sceneKeyLines() = SceneKeyLines{};  // none of another scene's
   common::requireRegularFile(file, "scene file (YAML)");
   YAML::Node root;
   try {

@@ -155,6 +155,9 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
       // Stations counted from 1, as holder[K] is, with the z that fails.
       {"obstacles:\n  - mesh: wall.stl\nholder: [[40, 6], [50, 6], [45, 6]]\n",
        "station 3 (z 45): z must increase", 3},
+      // An empty value is reported at its key's line (YAML marks it where the next key starts).
+      {"obstacles:\n  - mesh: wall.stl\ntool:\nclearance: 0.5\n", "tool", 3},
+      {"obstacles:\n  - mesh: wall.stl\nfield:\n  r0:\n  r_min: 0.2\n", "field.r0", 4},
       {"obstacles:\n  - mesh: wall.stl\ndynamics: { damping: heavy }\n",
        "dynamics.damping: expected a number >= 0 or `critical`, got 'heavy'", 3},
       {"obstacles:\n  - mesh: wall.stl\nfield: { r0: 2, r_min: 3 }\n", "(r_min 3, r0 2)", 3},
