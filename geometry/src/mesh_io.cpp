@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cctype>
+#include <utility>
 #include <cstdint>
 #include <cmath>
 #include <exception>
@@ -186,7 +187,7 @@ StlFeed checkStl(const std::filesystem::path& file, std::uintmax_t size) {
   std::string word = got >= first + 5
                          ? std::string(reinterpret_cast<const char*>(header) + first, 5)
                          : std::string();
-  for (char& c : word) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  word = common::lowerCase(std::move(word));
   const auto binaryFits = [size](std::uintmax_t needed) {
     return size >= needed && size - needed < 50;
   };
@@ -316,7 +317,7 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
       in.read(text.data(), static_cast<std::streamsize>(text.size()));
       text.resize(static_cast<std::size_t>(in.gcount()));
       if (stl.lower)
-        for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        text = common::lowerCase(std::move(text));
       scene = importer.ReadFileFromMemory(text.data(), text.size(), aiProcess_ValidateDataStructure,
                                           "stl");
     } else {
