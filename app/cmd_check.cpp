@@ -79,6 +79,9 @@ json surfaceJson(const SurfaceResult& s) {
         {"spacing", {s.grid.dx_mm, s.grid.dy_mm}},
         {"shape", {s.grid.ny, s.grid.nx}}}},
       {"spacing_coarsened", s.coarsened},
+      {"deviation",
+       "along the part's normal, um: a line's machined height less the part's, times the "
+       "cosine of the slope of the part's facet under it (exact over a plane facet)"},
       {"backend", zbuffer::backendName(s.backend)},
       {"simulation_s", s.simulation_s},
       {"swept",
@@ -138,7 +141,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(positiveFinite("mm"))
       ->capture_default_str();
   cmd->add_option("--gouge-tol", options->gouge_tol_um,
-                  "Depth below the part that counts as a gouge, um (the part mesh's own chordal "
+                  "Depth under the part, along its normal, that counts as a gouge, um (the part "
+                  "mesh's own chordal "
                   "error reads as a gouge where it is concave)")
       ->check(positiveFinite("um"))
       ->capture_default_str();

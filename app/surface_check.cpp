@@ -137,7 +137,9 @@ std::vector<char> machinedBand(const zbuffer::Grid& grid, const geometry::PathFi
 /// between two arcs of radius ρ meets them at α = asin(√(2ρh − h²)/ρ) from the part's normal;
 /// the deviation (vertical, machined − part) climbs at tan(θ + α) − tan(θ) a mm there, θ the
 /// part's slope; h is the cusp's own, found from the line's by a few rounds. Infinite where θ
-/// + α reaches 85°: a cusp against a wall that steep is not bounded by vertical lines.
+/// + α reaches 85°: a cusp against a wall that steep is not bounded by vertical lines. The
+/// deviations here are vertical (`scallop_um` and the bound); h, along the normal, is their
+/// cos θ.
 double scallopGridErrorUm(double scallop_um, double spacing_mm, double edge_mm, const Vec3& n) {
   if (!(scallop_um > 0.0) || !(edge_mm > 0.0)) return 0.0;
   const double reach_mm = spacing_mm / std::sqrt(2.0);
@@ -145,7 +147,7 @@ double scallopGridErrorUm(double scallop_um, double spacing_mm, double edge_mm, 
   const double steepest = 85.0 * M_PI / 180.0;
   double error_mm = 0.0;
   for (int round = 0; round < 4; ++round) {
-    const double h = std::min(edge_mm, 1e-3 * scallop_um + error_mm);
+    const double h = std::min(edge_mm, (1e-3 * scallop_um + error_mm) * std::cos(theta));
     const double alpha =
         std::asin(std::min(1.0, std::sqrt(std::max(0.0, 2 * edge_mm * h - h * h)) / edge_mm));
     if (theta + alpha >= steepest) return std::numeric_limits<double>::infinity();
@@ -357,7 +359,11 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   std::vector<geometry::Posture> postures_local = path.postures;
   for (geometry::Posture& p : postures_local) p.tip_mm.z() -= z0;
   const zbuffer::ToolMesh part_mesh = toZbuffer(part_local);
-  const std::vector<float> nominal = zbuffer::partTop(sim.grid, part_mesh.vertices, part_mesh.triangles);
+  // Each line's facet slope: deviations are told along the part's normal, as a profile
+  // tolerance is; vertical ones read 1/cos(slope) deeper (a 3 um overcut of a 60 deg wall: 6 um).
+  std::vector<float> facet_nz;
+  const std::vector<float> nominal =
+      zbuffer::partTop(sim.grid, part_mesh.vertices, part_mesh.triangles, &facet_nz);
   float top = -std::numeric_limits<float>::infinity();
   for (float h : nominal)
     if (!std::isnan(h)) top = std::max(top, h);
@@ -394,7 +400,9 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
       result.in_band[i] = 0;
       continue;
     }
-    const double d = 1000.0 * (double(simulated.heights_mm[i]) - double(nominal[i]));
+    const double vertical_um = 1000.0 * (double(simulated.heights_mm[i]) - double(nominal[i]));
+    const double cos_slope = double(facet_nz[i]);
+    const double d = vertical_um * cos_slope;
     result.deviation_um[i] = static_cast<float>(d);
     ++result.part_lines;
     min_dev = std::min(min_dev, d);
@@ -406,9 +414,9 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
     max_dev = std::max(max_dev, d);
     const Vec2 at(sim.grid.x0_mm + (i % sim.grid.nx + 0.5) * sim.grid.dx_mm,
                   sim.grid.y0_mm + (i / sim.grid.nx + 0.5) * sim.grid.dy_mm);
-    highest_cusp =
-        std::max(highest_cusp,
-                 d + scallopGridErrorUm(d, spacing_mm, edge_mm, partNormal(sim.grid, nominal, at)));
+    const double bound_um =
+        scallopGridErrorUm(vertical_um, spacing_mm, edge_mm, partNormal(sim.grid, nominal, at));
+    highest_cusp = std::max(highest_cusp, (vertical_um + bound_um) * cos_slope);
   }
   if (result.band_lines > 0) {
     result.mean_um = sum / result.band_lines;

@@ -1,7 +1,9 @@
 #pragma once
 /// The machined surface of a path against its part (`check`, DESIGN.md): the Z-buffer simulates
-/// the path's postures and the motions between them over the part's region, starting a stock allowance above the part, and
-/// every line is compared with the part's own height: gouge (below) and scallop (above), µm.
+/// the path's postures and the motions between them over the part's region, starting a stock
+/// allowance above the part, and every line is compared with the part's own height: gouge (below)
+/// and scallop (above), µm, told along the part's normal (the vertical difference times the cosine
+/// of the slope of the facet under the line: exact over a plane facet), as a profile tolerance is.
 #include <cstddef>
 #include <filesystem>
 #include <optional>
@@ -36,7 +38,8 @@ struct SurfaceRequest {
 
 struct SurfaceResult {
   zbuffer::Grid grid;
-  /// Per line: machined height − part height, µm; NaN where the line misses the part.
+  /// Per line: (machined height − part height) · |n_z| of the part's facet there, µm: the
+  /// deviation along the part's normal; NaN where the line misses the part.
   std::vector<float> deviation_um;
   /// Per line: in the machined band (between consecutive neighbouring passes), where scallops
   /// count; a lone pass has none (band_lines 0: no scallop figures).
@@ -47,9 +50,10 @@ struct SurfaceResult {
   double max_gouge_um = 0, max_scallop_um = 0, mean_um = 0, rms_um = 0;  ///< scallop stats: band
   /// How far the highest cusp may stand above max_scallop_um, µm: a cusp between two cuts of
   /// the cutting edge (curvature radius ρ: a ball's R, a torus's corner r) may fall up to a
-  /// spacing/√2 from every line, where the deviation climbs at most tan(θ + α) − tan(θ) a mm (θ
-  /// the part's slope there, α the edge's angle at a cusp of that height): the largest line's
-  /// deviation plus its own bound, over the band, less max_scallop_um. Infinite where a band
+  /// spacing/√2 from every line, where the vertical deviation climbs at most tan(θ + α) − tan(θ)
+  /// a mm (θ the part's slope there, α the edge's angle at a cusp of that height): the largest
+  /// line's deviation plus its own bound (along the normal, as the deviation), over the band,
+  /// less max_scallop_um. Infinite where a band
   /// line lies on a wall of 85° with its cusp (not bounded); 0 without a band.
   double scallop_grid_error_um = 0;
   zbuffer::Backend backend = zbuffer::Backend::Cpu;

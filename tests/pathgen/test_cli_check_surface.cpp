@@ -1,7 +1,7 @@
 /// `check`'s surface figures on a flat plate against their closed forms, through the built
-/// `fieldpath`: the highest cusp between the lines and its stated bound, a lone pass (no
-/// scallop), a path that never cuts (not checked), and a tool axis turned far across a gap
-/// between two passes (taken, as generate takes it).
+/// `fieldpath`: the highest cusp between the lines and its stated bound, a slope's gouge and
+/// scallop along its normal, a lone pass (no scallop), a path that never cuts (not checked), and a
+/// tool axis turned far across a gap between two passes (taken, as generate takes it).
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -52,7 +52,82 @@ nlohmann::json check(const TempDir& dir, const std::string& path, const std::str
   return nlohmann::json::parse(test::slurp(dir.path() / out / "check.json"));
 }
 
+/// A wedge whose top is the plane z = y tan(slope) over x in [-10, 30], y in [-4, 4], closed
+/// 20 mm under it; `wall.stl` far from it as in writePlateScene.
+void writeSlopeScene(const TempDir& dir, double slope_rad) {
+  geometry::TriangleMesh part, wall;
+  const double t = std::tan(slope_rad), x0 = -10, x1 = 30, y0 = -4, y1 = 4, bottom = -20;
+  const auto v = [&part](double x, double y, double z) {
+    part.vertices.emplace_back(x, y, z);
+    return static_cast<int>(part.vertices.size() - 1);
+  };
+  // Corners: top (z on the plane) then bottom, at (x0,y0), (x1,y0), (x1,y1), (x0,y1).
+  const int a = v(x0, y0, y0 * t), b = v(x1, y0, y0 * t), c = v(x1, y1, y1 * t),
+            d = v(x0, y1, y1 * t), e = v(x0, y0, bottom), f = v(x1, y0, bottom),
+            g = v(x1, y1, bottom), h = v(x0, y1, bottom);
+  const auto quad = [&part](int p, int q, int r, int s) {  // counter-clockwise from outside
+    part.triangles.push_back({p, q, r});
+    part.triangles.push_back({p, r, s});
+  };
+  quad(a, b, c, d);  // top
+  quad(e, h, g, f);  // bottom
+  quad(a, e, f, b);  // y0 side
+  quad(d, c, g, h);  // y1 side
+  quad(a, d, h, e);  // x0 side
+  quad(b, f, g, c);  // x1 side
+  pathgen::test::addBox(wall, 60, 70, -10, 10, 0, 5);
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
+}
+
+/// Passes along x on the wedge's plane, upright ball R 3: pass k's ball stands `depth_mm` into
+/// the plane along its normal at the contact u_k = u0 + k · step (distance up the plane, mm).
+std::string slopePasses(double slope_rad, int count, double u0, double step, double depth_mm) {
+  const double R = 3.0, sn = std::sin(slope_rad), cs = std::cos(slope_rad);
+  std::ostringstream cl;
+  cl.precision(12);
+  for (int k = 0; k < count; ++k) {
+    const double u = u0 + k * step;
+    // Contact (y, z) = u (cos, sin); the normal (-sin, cos); the tip R under the centre.
+    const double y = u * cs - (R - depth_mm) * sn, z = u * sn + (R - depth_mm) * cs - R;
+    if (k > 0) cl << "# link\n20 " << y << " 12 0 0 1\n0 " << y << " 12 0 0 1\n";
+    cl << "# pass " << k + 1 << "\n";
+    for (int i = 0; i <= 40; ++i) cl << 0.5 * i << ' ' << y << ' ' << z << " 0 0 1\n";
+  }
+  return cl.str();
+}
+
 }  // namespace
+
+// A 60 deg slope, told along its normal as a profile tolerance is: the vertical lines read
+// 1/cos 60 = 2x the normal depth. A ball 3 um into the plane is a 3 um gouge (it read 6 um, over
+// the 5 um tolerance); passes 2 mm apart up the plane leave R - sqrt(R² - 1) = 171.6 um along
+// the normal (343 um vertically).
+TEST(CheckSurface, ASlopesGougeAndScallopAreToldAlongItsNormal) {
+  const TempDir dir;
+  const double slope = M_PI / 3;
+  writeSlopeScene(dir, slope);
+  dir.write("gouge.cl", slopePasses(slope, 1, 0.0, 0.0, 0.003));
+  const auto gouge = check(dir, "gouge.cl", "gouge", "0.02")["surface"];
+  EXPECT_NEAR(gouge["max_gouge_um"].get<double>(), 3.0, 0.15) << gouge;
+  EXPECT_EQ(gouge["gouged_lines"].get<int>(), 0) << gouge;
+  dir.write("deep.cl", slopePasses(slope, 1, 0.0, 0.0, 0.008));
+  const auto deep = check(dir, "deep.cl", "deep", "0.02")["surface"];
+  EXPECT_NEAR(deep["max_gouge_um"].get<double>(), 8.0, 0.15) << deep;
+  EXPECT_GT(deep["gouged_lines"].get<int>(), 0) << deep;
+  dir.write("passes.cl", slopePasses(slope, 3, -2.0, 2.0, 0.0));
+  const auto band = check(dir, "passes.cl", "band", "0.02")["surface"];
+  const double exact_um = 1000.0 * (3.0 - std::sqrt(9.0 - 1.0));
+  const double read = band["max_scallop_um"].get<double>();
+  // Over by at most the stamps' cusps along the passes (sweep_error_um).
+  EXPECT_LE(read, exact_um + band["sweep_error_um"].get<double>()) << band;
+  EXPECT_GE(read, exact_um - 5.0) << band;
+  EXPECT_GE(read + band["scallop_grid_error_um"].get<double>(), exact_um) << band;
+  EXPECT_LT(band["max_gouge_um"].get<double>(), 0.5) << band;
+}
 
 // Passes 2 mm apart on a plate leave R - sqrt(R² - 1) = 171.6 um midway. The lines (every 0.05
 // mm, none on the cusp: y = -3 + (i + 0.5) 0.05 either side of it) read it low (163.8 um, a

@@ -150,21 +150,36 @@ void checkGridFits(const Grid& grid, std::size_t available_bytes) {
 }
 
 std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
-                           std::span<const std::array<std::uint32_t, 3>> triangles) {
+                           std::span<const std::array<std::uint32_t, 3>> triangles,
+                           std::vector<float>* normal_z) {
   if (triangles.empty()) throw InputError("part: mesh has no triangles");
   const GridView g = detail::makeGridView(grid);
   std::vector<float> top(grid.lineCount(), -FLT_MAX);
+  if (normal_z) normal_z->assign(grid.lineCount(), std::numeric_limits<float>::quiet_NaN());
   for (const auto& t : triangles) {
     if (t[0] >= vertices.size() || t[1] >= vertices.size() || t[2] >= vertices.size())
       throw InputError("part: triangle index out of range");
+    const Vec3f a = vertices[t[0]], b = vertices[t[1]], c = vertices[t[2]];
+    float nz = 0.f;  // the facet's |n_z|, in double: a sliver's cross product loses floats
+    if (normal_z) {
+      const double ux = double(b.x) - a.x, uy = double(b.y) - a.y, uz = double(b.z) - a.z;
+      const double vx = double(c.x) - a.x, vy = double(c.y) - a.y, vz = double(c.z) - a.z;
+      const double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, n_z = ux * vy - uy * vx;
+      const double length = std::sqrt(nx * nx + ny * ny + n_z * n_z);
+      nz = length > 0.0 ? static_cast<float>(std::abs(n_z) / length) : 0.f;
+    }
     // Either way round: an open sheet wound downward (as CAD exports of surfaces often are)
     // is still the part's top; on a closed solid the highest crossing faces up anyway.
     for (const float sign : {1.f, -1.f})
-      rasterTriangle(g, vertices[t[0]], vertices[t[1]], vertices[t[2]], sign,
-                     [&](int ix, int iy, float z) {
-                       float& h = top[std::size_t(iy) * grid.nx + ix];
-                       h = std::max(h, z);
-                     });
+      rasterTriangle(g, a, b, c, sign, [&](int ix, int iy, float z) {
+        const std::size_t i = std::size_t(iy) * grid.nx + ix;
+        float& h = top[i];
+        if (normal_z && z >= h) {
+          float& n = (*normal_z)[i];
+          n = z > h || std::isnan(n) ? nz : std::max(n, nz);
+        }
+        h = std::max(h, z);
+      });
   }
   for (auto& h : top)
     if (h == -FLT_MAX) h = std::numeric_limits<float>::quiet_NaN();

@@ -166,9 +166,12 @@ void checkGridFits(const Grid& grid, std::size_t available_bytes = 0);
 
 /// The highest point of a part mesh on each line (world frame, mm), whichever way its triangles
 /// face (an open sheet wound downward is the top all the same); NaN where the line misses the
-/// part.
+/// part. With `normal_z`, also each line's |n_z| of the facet that gives its top (the cosine of
+/// the part's slope there: a vertical deviation d stands d·|n_z| off that facet's plane; where
+/// facets meet on a line, the flattest's); NaN where the line misses the part.
 std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
-                           std::span<const std::array<std::uint32_t, 3>> triangles);
+                           std::span<const std::array<std::uint32_t, 3>> triangles,
+                           std::vector<float>* normal_z = nullptr);
 
 /// Stock as the top of a part mesh (world frame, mm): the highest up-facing point on each line;
 /// lines that miss the part start at its lowest z.
