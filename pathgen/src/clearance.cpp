@@ -46,6 +46,10 @@ struct ClearanceChecker::Impl {
   /// obstacle, or an obstacle wholly inside the tool, touches no triangle (FCL: clear).
   std::optional<ClosedShells> tool_solid;
   std::vector<ClosedShells> obstacle_solids;
+  /// Per obstacle, a vertex of each open shell (a sheet, a lone triangle), sorted by x: a sheet
+  /// wholly inside the tool meets none of its triangles either (a fin inside the shank read
+  /// 1.56 mm clear). One vertex tells: a sheet partly inside crosses the tool's surface.
+  std::vector<std::vector<Eigen::Vector3d>> sheet_anchors;
 
   /// A point of the tool mesh's surface (tool frame): a vertex of its first triangle (the tip for
   /// a whole tool; a point of the holder for geometry::holderMesh, whose tip is not its own).
@@ -62,6 +66,15 @@ struct ClearanceChecker::Impl {
     const Eigen::Isometry3d to_tool = placed.inverse();
     for (const Eigen::Vector3d& anchor : solid.anchors())
       if (tool_solid->contains(to_tool * anchor)) return true;
+    // Sheets: only those within the tool's reach of its tip (a soup of unjoined triangles has
+    // an anchor each).
+    const std::vector<Eigen::Vector3d>& sheets = sheet_anchors[i];
+    const Eigen::Vector3d tip = placed.translation();
+    const auto byX = [](const Eigen::Vector3d& p, double x) { return p.x() < x; };
+    for (auto it = std::lower_bound(sheets.begin(), sheets.end(), tip.x() - reach_mm, byX);
+         it != sheets.end() && it->x() <= tip.x() + reach_mm; ++it)
+      if ((*it - tip).squaredNorm() <= reach_mm * reach_mm && tool_solid->contains(to_tool * *it))
+        return true;
     return false;
   }
 };
@@ -79,6 +92,12 @@ ClearanceChecker::ClearanceChecker(const geometry::TriangleMesh& tool_mesh,
   for (size_t i = 0; i < obstacles.size(); ++i) {
     impl->obstacles.push_back(buildModel(obstacles[i], "obstacle " + std::to_string(i + 1)));
     impl->obstacle_solids.emplace_back(obstacles[i]);
+    std::vector<Eigen::Vector3d>& sheets = impl->sheet_anchors.emplace_back();
+    for (const std::vector<int>& shell : geometry::openShells(obstacles[i]))
+      sheets.push_back(obstacles[i].vertices[static_cast<std::size_t>(
+          obstacles[i].triangles[static_cast<std::size_t>(shell.front())][0])]);
+    std::sort(sheets.begin(), sheets.end(),
+              [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.x() < b.x(); });
   }
   impl->chord_tol_mm = tool_chord_tol_mm;
   for (const auto& v : tool_mesh.vertices) impl->reach_mm = std::max(impl->reach_mm, v.norm());

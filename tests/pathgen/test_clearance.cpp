@@ -36,6 +36,30 @@ TriangleMesh wall(double x0) {
 
 }  // namespace
 
+// FCL measures between surfaces, so an open sheet (a fin, a lone triangle) wholly inside the tool
+// touches none of its triangles: it read 1.56 mm clear from inside a shank (a helper's finding).
+// Inside the box tool: colliding, whichever sheet; moved beside it: the closed-form distance.
+TEST(Clearance, ASheetWhollyInsideTheToolCollides) {
+  const TriangleMesh tool = box(Vec3(-1, -1, 0), Vec3(1, 1, 10));
+  TriangleMesh fin;  // 1 × 4 mm in the plane y = 0, 5..9 mm up, and a lone triangle by the tip
+  fin.vertices = {{-0.5, 0, 5}, {0.5, 0, 5},   {0.5, 0, 9},  {-0.5, 0, 9},
+                  {0, 0.5, 1},  {0.5, 0.5, 1}, {0, 0.5, 1.5}};
+  fin.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}};
+  const std::vector<TriangleMesh> obstacles = {wall(-20.0), fin};
+  const pathgen::ClearanceChecker checker(tool, obstacles);
+  Posture inside;
+  int obstacle = -1;
+  EXPECT_EQ(checker.clearance(inside, &obstacle), 0.0);
+  EXPECT_EQ(obstacle, 1);
+  TriangleMesh triangle_only = fin;  // the lone triangle alone: the fin is not what tells
+  triangle_only.triangles = {{4, 5, 6}};
+  const std::vector<TriangleMesh> one = {triangle_only};
+  EXPECT_EQ(pathgen::ClearanceChecker(tool, one).clearance(inside), 0.0);
+  Posture beside;  // the tool 3 mm along -x: the fin's nearest point (-0.5, 0) is 1.5 from x = -2
+  beside.tip_mm = Vec3(-3, 0, 0);
+  EXPECT_NEAR(checker.clearance(beside), 1.5, 1e-9);
+}
+
 // Closed form: a 2 × 2 × 10 "tool" (tool frame, tip at the origin) beside the wall x = 5.
 TEST(Clearance, BoxToolBesideAWallClosedForm) {
   const TriangleMesh tool = box(Vec3(-1, -1, 0), Vec3(1, 1, 10));
