@@ -379,7 +379,10 @@ void readPath(const Reader& r, const YAML::Node& node, pathgen::PathParams& p) {
     p.passes_given = true;
   }
   if (node["step"]) {
-    p.step_mm = r.positive(node["step"], "path.step");
+    p.step_mm = r.number(
+        node["step"], "path.step", [](double v) { return v >= pathgen::kMinPathStepMm; },
+        ">= " + common::shortNumber(pathgen::kMinPathStepMm) +
+            " mm (a machine's resolution: a finer step only multiplies the postures)");
     p.step_given = true;
   }
   if (node["lead_deg"])

@@ -169,8 +169,8 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
                                 double ball_radius_mm, std::size_t* repeated) {
   if (!std::isfinite(params.pass_gap_mm) || params.pass_gap_mm < 0.0)
     throw InputError("path.pass_gap: must be a finite distance >= 0 mm (0: automatic)");
-  if (params.step_given && (!std::isfinite(params.step_mm) || params.step_mm <= 0.0))
-    throw InputError("path.step: must be a finite number > 0");
+  if (params.step_given && (!std::isfinite(params.step_mm) || !(params.step_mm >= kMinPathStepMm)))
+    throw InputError("path.step: must be a finite number >= 0.001 mm (a machine's resolution)");
   if (!std::isfinite(params.lead_deg) || std::abs(params.lead_deg) >= 60.0)
     throw InputError("path.lead_deg: must be a finite angle with |lead| < 60 deg");
   if (!std::isfinite(ball_radius_mm) || ball_radius_mm <= 0.0)

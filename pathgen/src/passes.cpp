@@ -36,8 +36,8 @@ std::vector<Pass> impellerPasses(const Impeller& impeller, const PathParams& pat
   using common::InputError;
   if (path.passes < 1)
     throw InputError("path.passes: must be >= 1 (got " + std::to_string(path.passes) + ")");
-  if (!std::isfinite(path.step_mm) || path.step_mm <= 0.0)
-    throw InputError("path.step: must be a finite number > 0");
+  if (!(path.step_mm >= kMinPathStepMm) || !std::isfinite(path.step_mm))
+    throw InputError("path.step: must be a finite number >= 0.001 mm (a machine's resolution)");
   if (!std::isfinite(path.lead_deg) || std::abs(path.lead_deg) >= 60.0)
     throw InputError("path.lead_deg: must be a finite angle with |lead| < 60 deg");
   if (!std::isfinite(ball_radius_mm) || ball_radius_mm <= 0.0)

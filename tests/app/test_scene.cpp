@@ -167,6 +167,9 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
        4},
       {"obstacles:\n  - mesh: wall.stl\ndynamics:\n  integrator: rk4\n", "dynamics.integrator", 4},
       {"obstacles:\n  - mesh: wall.stl\npath:\n  passes: 2.5\n", "path.passes", 4},
+      // Finer than a machine's resolution: 8 M postures on 80 mm, minutes without a word.
+      {"obstacles:\n  - mesh: wall.stl\npath:\n  step: 0.00001\n", "path.step: must be >= 0.001 mm",
+       4},
       {"obstacles:\n  - mesh: wall.stl\npart: hub.stl\n", "part", 3},
       {"obstacles:\n  - mesh: wall.stl\npath: { nominal: none.cl }\n", "path.nominal", 3},
       {"obstacles:\n  - mesh: wall.stl\ndynamics: { on_limit: stop }\n", "dynamics.on_limit", 3},
