@@ -267,6 +267,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         zbuffer::writeHeightsNpy(out / "deviation.npy", surface->grid, surface->deviation_um);
         zbuffer::writeHeightsJson(out / "deviation.json", surface->grid);
         writeDeviationPng(out / "deviation.png", *surface);
+      } else {
+        common::removeStaleOutputs(out, {"deviation.npy", "deviation.json", "deviation.png"});
       }
       common::writeTextAtomically(
           out / "clearance.csv",

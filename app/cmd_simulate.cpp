@@ -150,7 +150,8 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   cmd->add_option("--outputs", o->outputs,
                   "Which of npy (heights.npy), json (heights.json), stl (surface.stl), png "
-                  "(heights.png) to write; simulate.json is always written")
+                  "(heights.png) to write; simulate.json is always written (those left out that an "
+                  "earlier run wrote in --out are removed)")
       ->capture_default_str();
   cmd->add_option("--block", o->block_postures,
                   "Postures per chunk read and cut together (default: 4 MB of text); the heights "
@@ -279,6 +280,11 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
       write([&] { zb::writeReliefPng(out / "heights.png", req.grid, res.heights_mm); });
     for (auto& w : writing) w.wait();
     for (auto& w : writing) w.get();  // the first failure, after every writer stopped
+    for (const auto& [key, name] : {std::pair{"npy", "heights.npy"},
+                                    {"json", "heights.json"},
+                                    {"stl", "surface.stl"},
+                                    {"png", "heights.png"}})
+      if (!outputs.count(key)) common::removeStaleOutputs(out, {name});
     const double write_s = secondsSince(write_start);
 
     const auto [lo, hi] = std::minmax_element(res.heights_mm.begin(), res.heights_mm.end());

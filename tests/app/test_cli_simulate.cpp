@@ -147,6 +147,14 @@ TEST(CliSimulate, ASurfaceStlFarFromTheOriginIsSaidToBeCoarse) {
       dir, "simulate --tool ball:2 --path far.cl --grid 20x20 --stock 1 --outputs npy --out npy");
   ASSERT_EQ(npy_only.exit_code, 0) << npy_only.err;
   EXPECT_EQ(npy_only.err.find("note:"), std::string::npos) << npy_only.err;
+  // Into a folder of an earlier run with every output: those not written now are removed (a
+  // folder never mixes two runs: `view --surface` read the earlier heights.png's run).
+  const Outcome again = runFieldpath(
+      dir, "simulate --tool ball:2 --path far.cl --grid 20x20 --stock 1 --outputs npy --out near");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "near/heights.npy"));
+  for (const char* stale : {"heights.json", "surface.stl", "heights.png"})
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / "near" / stale)) << stale;
 }
 
 TEST(CliSimulate, BadInputIsExitOneWithOneLineAndNoOutputs) {

@@ -171,11 +171,17 @@ TEST(CheckSurface, APathThatNeverCutsThePartIsNotChecked) {
   const TempDir dir;
   writePlateScene(dir);
   dir.write("above.cl", passes(3, -2.0, 2.0, 5.0));
+  // Into the folder of a path that cut: its deviation.* go (view --check showed them as this
+  // path's surface, a helper's finding).
+  dir.write("cuts.cl", passes(1, 0.0, 0.0, 0.0));
+  ASSERT_FALSE(check(dir, "cuts.cl", "out")["surface"].is_null());
+  ASSERT_TRUE(fs::exists(dir.path() / "out/deviation.png"));
   const auto report = check(dir, "above.cl", "out");
   EXPECT_TRUE(report["surface"].is_null()) << report;
   ASSERT_TRUE(report["surface_skipped"].is_string()) << report;
   EXPECT_NE(report["surface_skipped"].get<std::string>().find("never cuts"), std::string::npos);
-  EXPECT_FALSE(fs::exists(dir.path() / "out/deviation.npy"));
+  for (const char* stale : {"deviation.npy", "deviation.json", "deviation.png"})
+    EXPECT_FALSE(fs::exists(dir.path() / "out" / stale)) << stale;
 }
 
 // Two runs of postures 20 mm apart with the axis at -60 and +60 deg about y: generate reads two

@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <initializer_list>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -247,6 +248,20 @@ inline void removeWrittenOutputs() {
     std::filesystem::remove(file, ignored);
   }
   detail::written_outputs.clear();
+}
+
+/// Removes the files `names` from `dir` where an earlier run left them and this one does not
+/// write them (a check that read no surface, a simulate without `--outputs png`): a folder never
+/// mixes two runs' outputs (`view --check` showed an earlier path's surface as this one's).
+inline void removeStaleOutputs(const std::filesystem::path& dir,
+                               std::initializer_list<const char*> names) {
+  for (const char* name : names) {
+    std::error_code ec;
+    std::filesystem::remove(dir / name, ec);
+    if (ec && ec != std::errc::no_such_file_or_directory)
+      throw InputError((dir / name).string() +
+                       ": cannot remove the earlier run's file: " + ec.message());
+  }
 }
 
 /// Writes `text` atomically (see writeFileAtomically).
