@@ -141,10 +141,4 @@ std::span<const zbuffer::Posture> PostureStream::next() {
   }
 }
 
-double PostureStream::doneFraction() const {
-  std::lock_guard lock(mutex_);
-  if (!started_ || chunks_.empty() || next_ == 0) return 0.0;
-  return double(next_ - 1) / double(chunks_.size());
-}
-
 }  // namespace fieldpath::app

@@ -45,9 +45,6 @@ class PostureStream {
   /// The next chunk in file order (waits for it), an empty span after the last; the previous
   /// chunk is released. Rethrows the reading's error when it reaches it.
   std::span<const zbuffer::Posture> next();
-  /// The share of the file's chunks handed out before the one `next` returned last (cut by the
-  /// time `next` is called again): the simulation's progress when the posture count is unknown.
-  double doneFraction() const;
 
  private:
   struct Chunk {
