@@ -12,6 +12,8 @@
 #include <fstream>
 #include <iterator>
 #include <optional>
+#include <span>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -32,22 +34,71 @@ std::string upperCase(std::string_view text) {
   return s;
 }
 
-void appendGoto(std::string& text, const Posture& p) {
-  text += "GOTO/";
-  const double values[] = {p.tip_mm.x(), p.tip_mm.y(), p.tip_mm.z(),
-                           p.axis.x(),   p.axis.y(),   p.axis.z()};
-  for (double v : values) {
-    appendNumber(text, v);
-    text += ',';
+/// The columns of an APT card: a record is continued on the next line with `$` past them.
+constexpr std::size_t kAptColumns = 72;
+/// The text of a PPRINT or PARTNO card after its `/`.
+constexpr std::size_t kAptTextColumns = kAptColumns - 7;
+
+/// `MAJOR/` followed by `values` (numbers as the shortest text that reads back the same double),
+/// on cards of kAptColumns: a line that would run past them ends after a comma with `$`, and the
+/// record goes on in the next (a fixed-format post-processor cut the 131-column GOTOs).
+void appendRecord(std::string& text, std::string_view major, std::span<const double> values) {
+  std::string line(major);
+  line += '/';
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    std::string number;
+    appendNumber(number, values[k]);
+    if (k + 1 < values.size()) number += ',';
+    // Room for the number and, unless it ends the record, a `$` after it.
+    if (line.size() + number.size() + (k + 1 < values.size() ? 1 : 0) > kAptColumns &&
+        line.back() == ',') {
+      text += line + "$\n";
+      line.clear();
+    }
+    line += number;
   }
-  text.back() = '\n';
+  text += line + '\n';
 }
 
-/// A line's content without its `$$` comment and surrounding blanks.
+void appendGoto(std::string& text, const Posture& p) {
+  const double values[] = {p.tip_mm.x(), p.tip_mm.y(), p.tip_mm.z(),
+                           p.axis.x(),   p.axis.y(),   p.axis.z()};
+  appendRecord(text, "GOTO", values);
+}
+
+/// `major/text` as cards of kAptTextColumns characters of text, split between words where it
+/// can (a PPRINT has no continuation: each card is a PPRINT of its own).
+void appendTextCards(std::string& text, std::string_view major, std::string_view words) {
+  do {
+    std::size_t take = std::min(words.size(), kAptTextColumns);
+    if (take < words.size())
+      if (const auto blank = words.substr(0, take + 1).rfind(' ');
+          blank != std::string_view::npos && blank > 0)
+        take = blank;
+    text += std::string(major) + "/" + std::string(words.substr(0, take)) + "\n";
+    words.remove_prefix(take);
+    while (!words.empty() && words.front() == ' ') words.remove_prefix(1);
+  } while (!words.empty());
+}
+
+/// PPRINT and PARTNO carry text: a `$` at their end is the text's (it swallowed the next GOTO).
+bool isTextRecord(std::string_view content) {
+  const std::string head = upperCase(std::string(trimmed(content).substr(0, 6)));
+  return head == "PPRINT" || head == "PARTNO";
+}
+
+/// A line's content without its `$$` comment and surrounding blanks. A single `$` continues the
+/// statement on the next line and what follows it is a remark (`GOTO/0,0,-0.5,$ first part`
+/// was refused as a bad number); the content then ends at that `$`. Not in PPRINT and PARTNO,
+/// whose text may hold a `$`.
 std::string_view aptContent(std::string_view line) {
   if (const auto comment = line.find("$$"); comment != std::string_view::npos)
     line = line.substr(0, comment);
-  return trimmed(line);
+  line = trimmed(line);
+  if (!isTextRecord(line))
+    if (const auto dollar = line.find('$'); dollar != std::string_view::npos)
+      line = trimmed(line.substr(0, dollar + 1));
+  return line;
 }
 
 /// What one chunk of an APT file leaves to the chunks around it.
@@ -95,12 +146,6 @@ double unitScale(std::string_view value) {
   if (value == "MM" || value == "MILLIMETERS" || value == "MILLIMETRES") return 1.0;
   if (value == "INCHES" || value == "INCH" || value == "IN") return 25.4;
   return 0.0;
-}
-
-/// PPRINT and PARTNO carry text: a `$` at their end is the text's (it swallowed the next GOTO).
-bool isTextRecord(std::string_view content) {
-  const std::string head = upperCase(std::string(trimmed(content).substr(0, 6)));
-  return head == "PPRINT" || head == "PARTNO";
 }
 
 /// Whether a line's content goes on in the next line (`$` at its end, not a text record's).
@@ -330,21 +375,20 @@ void writeAptFile(const std::filesystem::path& file, const PathFile& path,
   // taper angles a, b (0 for these tools), height h.
   const ToolSpec& t = header.tool;
   const double corner_mm = cornerRadius(t);
-  std::string text = "PARTNO/" + header.part_name + "\n";
+  // PARTNO is one card: a longer name is cut.
+  std::string text =
+      "PARTNO/" + header.part_name.substr(0, std::min(header.part_name.size(), kAptTextColumns)) +
+      "\n";
   for (const std::string& remark : header.remarks) {
     std::string line = upperCase(remark);
     for (char& c : line)
       if (c == '\n' || c == '\r' || c == '$') c = ' ';  // one record, no continuation
-    text += "PPRINT/" + line + "\n";
+    appendTextCards(text, "PPRINT", line);
   }
-  text += "UNITS/MM\nMULTAX/ON\nCUTTER/";
+  text += "UNITS/MM\nMULTAX/ON\n";
   const double cutter[] = {2 * t.radius_mm, corner_mm, t.radius_mm - corner_mm, corner_mm, 0.0, 0.0,
                            t.length_mm};
-  for (double v : cutter) {
-    appendNumber(text, v);
-    text += ',';
-  }
-  text.back() = '\n';
+  appendRecord(text, "CUTTER", cutter);
   std::string feed = "FEDRAT/MMPM,";
   appendNumber(feed, header.feed_mm_per_min);
   feed += '\n';

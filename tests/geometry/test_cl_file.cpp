@@ -188,8 +188,15 @@ TEST(AptFile, WritesHeaderAndParsesBackExactly) {
   EXPECT_EQ(l4, "CUTTER/10,1,4,1,0,0,30");
   EXPECT_EQ(l5, "FEDRAT/MMPM,1500");
   EXPECT_EQ(l6.rfind("GOTO/", 0), 0u);
+  // Cards of 72 columns: a GOTO of 17-digit numbers (131 columns) goes on after a `$`.
   std::string last, line;
-  while (std::getline(in, line)) last = line;
+  std::size_t continued = 0;
+  while (std::getline(in, line)) {
+    EXPECT_LE(line.size(), 72u) << line;
+    continued += !line.empty() && line.back() == '$';
+    last = line;
+  }
+  EXPECT_GT(continued, 0u);
   EXPECT_EQ(last, "FINI");
 
   auto back = readAptFile(p);
@@ -210,6 +217,11 @@ TEST(AptFile, ReadsContinuationAndRejectsBadGoto) {
   EXPECT_THROW(readAptFile(writeBytes("b.apt", "PARTNO/X\nFINI\n")), InputError);
   // A record still continued at the end of the file: truncated.
   EXPECT_THROW(readAptFile(writeBytes("b.apt", "GOTO/1,2,3\nGOTO/1,2,$\n")), InputError);
+  // What follows a single `$` on its line is a remark (it was read as a bad number).
+  const auto remark = readAptFile(writeBytes("r.apt", "GOTO/0,0,-0.5,$ first part\n0,1,0\n"));
+  ASSERT_EQ(remark.size(), 1u);
+  EXPECT_EQ(remark[0].tip_mm, Vec3(0, 0, -0.5));
+  EXPECT_EQ(remark[0].axis, Vec3::UnitY());
 }
 
 // A UTF-8 byte-order mark at the start (Windows editors) is not a number of line 1.
@@ -248,6 +260,21 @@ TEST(AptFile, UnitsFiniAndRemarks) {
   std::getline(in, l1), std::getline(in, l2);
   EXPECT_EQ(l2, "PPRINT/UNSAFE TO RUN: A   AND A NEWLINE");
   EXPECT_EQ(readAptFile(w).size(), 3u);
+  // A remark past a PPRINT card's 65 characters of text goes on in PPRINT cards of its own,
+  // split between words; the safety mark stays on the first.
+  header.remarks = {
+      "UNSAFE TO RUN: 49 motions touch an obstacle (first: posture 114 to the "
+      "next) and 47 postures"};
+  writeAptFile(w, p, header);
+  std::ifstream cards(w);
+  std::string c1, c2, c3, c4;
+  std::getline(cards, c1), std::getline(cards, c2), std::getline(cards, c3),
+      std::getline(cards, c4);
+  EXPECT_EQ(c2, "PPRINT/UNSAFE TO RUN: 49 MOTIONS TOUCH AN OBSTACLE (FIRST: POSTURE 114");
+  EXPECT_EQ(c3, "PPRINT/TO THE NEXT) AND 47 POSTURES");
+  EXPECT_EQ(c4, "UNITS/MM");
+  const PathFile marked = readPathFile(w);
+  EXPECT_EQ(marked.warnings.size(), 1u);
 }
 
 // A motion the reader does not take is refused with its line (each lost a posture silently),
