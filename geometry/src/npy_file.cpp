@@ -1,6 +1,7 @@
 /// Postures as NumPy `.npy` (DESIGN.md command line): float32 or float64, little-endian, shape
 /// N×6 (x y z i j k) or N×7 (+ spindle angle, rad), C order. Anything else is refused with one
 /// line naming the file; a bad row names the row.
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -76,6 +77,25 @@ struct NpyRows {
   const char* data = nullptr;
   std::uint64_t rows = 0, columns = 0;
   std::size_t item = 0;  ///< 4 (float32) or 8 (float64)
+  bool big_endian = false;  ///< `>f4`, `>f8` (numpy reads both byte orders)
+  bool fortran =
+      false;  ///< column after column (`fortran_order: True`, e.g. a transposed array saved)
+
+  /// Element (r, c) as a double.
+  double at(std::uint64_t r, std::uint64_t c) const {
+    const char* p = data + (fortran ? c * rows + r : r * columns + c) * item;
+    char b[8];
+    std::memcpy(b, p, item);
+    if (big_endian) std::reverse(b, b + item);
+    if (item == 8) {
+      double v;
+      std::memcpy(&v, b, 8);
+      return v;
+    }
+    float f;
+    std::memcpy(&f, b, 4);
+    return f;
+  }
 };
 
 NpyRows checkedRows(const std::filesystem::path& file, std::string_view bytes) {
@@ -103,15 +123,14 @@ NpyRows checkedRows(const std::filesystem::path& file, std::string_view bytes) {
   if (!descr || !fortran || !shape_text)
     bad(file, "npy header lacks descr, fortran_order or shape");
   std::size_t item = 0;
-  if (*descr == "<f8" || *descr == "=f8")
-    item = 8;
-  else if (*descr == "<f4" || *descr == "=f4")
-    item = 4;
+  const std::string& type = *descr;
+  if (type.size() == 3 && (type[0] == '<' || type[0] == '=' || type[0] == '>') && type[1] == 'f' &&
+      (type[2] == '4' || type[2] == '8'))
+    item = type[2] == '8' ? 8 : 4;
   else
-    bad(file, "npy dtype '" + *descr + "': expected float32 or float64, little-endian (<f4, <f8)");
-  if (*fortran == "True") bad(file, "npy array in Fortran order: expected C order");
-  if (*fortran != "False")
-    bad(file, "npy fortran_order '" + *fortran + "': expected False (or True, refused)");
+    bad(file, "npy dtype '" + *descr + "': expected float32 or float64 (<f4, <f8, >f4, >f8)");
+  if (*fortran != "False" && *fortran != "True")
+    bad(file, "npy fortran_order '" + *fortran + "': expected False or True");
   const std::vector<std::uint64_t> shape = parseShape(file, *shape_text);
   if (shape.size() != 2 || (shape[1] != 6 && shape[1] != 7))
     bad(file, "npy shape (" + *shape_text + "): expected N×6 (x y z i j k) or N×7 (+ spindle)");
@@ -126,21 +145,15 @@ NpyRows checkedRows(const std::filesystem::path& file, std::string_view bytes) {
     bad(file, "npy data is " + std::to_string(data_size) + " bytes, shape (" +
                   std::to_string(rows) + ", " + std::to_string(columns) + ") needs " +
                   std::to_string(rows * columns * item) + " (trailing bytes)");
-  return {bytes.data() + offset + header_size, rows, columns, item};
+  return {
+      bytes.data() + offset + header_size, rows, columns, item, type[0] == '>', *fortran == "True"};
 }
 
 /// Row r as a posture, checked like a `.cl` line ("FILE: row R: ...").
 Posture rowPosture(const std::filesystem::path& file, const NpyRows& a, std::uint64_t r) {
   double v[7];
-  const char* row = a.data + r * a.columns * a.item;
   for (std::size_t c = 0; c < a.columns; ++c) {
-    if (a.item == 8) {
-      std::memcpy(&v[c], row + 8 * c, 8);
-    } else {
-      float f;
-      std::memcpy(&f, row + 4 * c, 4);
-      v[c] = f;
-    }
+    v[c] = a.at(r, c);
     if (!std::isfinite(v[c]))
       bad(file, "row " + std::to_string(r) + ", column " + std::to_string(c) + ": not finite");
   }

@@ -199,9 +199,13 @@ TEST(SimulateFormats, BadNpyIsOneLineAndNoOutputs) {
   };
   const std::vector<Case> cases = {
       {"int.npy", npyBytes(rowsDict("<i4", p.size(), 6), rows), "dtype"},
-      {"big.npy", npyBytes(rowsDict(">f4", p.size(), 6), rows), "dtype"},
       {"five.npy", npyBytes(rowsDict("<f4", p.size() * 6 / 5, 5), rows), "shape"},
-      {"fortran.npy", npyBytes(rowsDict("<f4", p.size(), 6, true), rows), "fortran"},
+      {"order.npy",
+       npyBytes(
+           "{'descr': '<f4', 'fortran_order': 1, 'shape': (" + std::to_string(p.size()) + ", 6), }",
+           rows),
+       "fortran_order"},
+      {"big64.npy", npyBytes(rowsDict(">i8", p.size(), 6), rows), "dtype"},
       {"short.npy", npyBytes(rowsDict("<f4", p.size(), 6), rows.substr(0, rows.size() - 10)),
        "truncated"},
       {"nan.npy", npyBytes(rowsDict("<f4", p.size(), 6), with_nan), "row 3"},
@@ -222,6 +226,27 @@ TEST(SimulateFormats, BadNpyIsOneLineAndNoOutputs) {
       EXPECT_FALSE(fs::exists(f.dir.path() / "out")) << c.name << extra;
     }
   }
+}
+
+/// A big-endian array and one in Fortran order (a transposed array saved: numpy reads both)
+/// give the heights of the same rows in C order, little-endian (both were refused).
+TEST(SimulateFormats, BigEndianAndFortranOrderNpyAreRead) {
+  const Formats f;
+  const std::string whole = f.heights("path32.npy", "");
+  const std::string rows = float32Rows(f.path.postures);
+  const std::size_t n = f.path.postures.size();
+  std::string big = rows, fortran(rows.size(), '\0');
+  for (std::size_t i = 0; i < rows.size(); i += 4)
+    std::reverse(big.begin() + i, big.begin() + i + 4);
+  for (std::size_t r = 0; r < n; ++r)
+    for (std::size_t c = 0; c < 6; ++c)
+      std::memcpy(fortran.data() + (c * n + r) * 4, rows.data() + (r * 6 + c) * 4, 4);
+  f.dir.write("big.npy", npyBytes(rowsDict(">f4", n, 6), big));
+  f.dir.write("fortran.npy", npyBytes(rowsDict("<f4", n, 6, true), fortran));
+  EXPECT_TRUE(f.heights("big.npy", "") == whole);
+  EXPECT_TRUE(f.heights("fortran.npy", "") == whole);
+  EXPECT_TRUE(f.heights("fortran.npy", "--region -11.2,-5.2,10.2,-1.8 --stock 1 --block 13") ==
+              f.heights("path32.npy", "--region -11.2,-5.2,10.2,-1.8 --stock 1 --block 13"));
 }
 
 /// A bad line far into a big `.cl`: the blocks before it were cut already (streamed); still one
