@@ -97,6 +97,19 @@ void fillScene(aiScene& scene, const TriangleMesh& mesh) {
   }
 }
 
+/// assimp's validation speaks of its own structures (`aiMesh::mFaces[0] is a LINE but
+/// aiMesh::mPrimitiveTypes ...`): the two a user's file causes said in the file's terms, the
+/// rest as assimp says it.
+std::string readableAssimpError(const std::string& why) {
+  if (why.find("is a LINE") != std::string::npos || why.find("is a POINT") != std::string::npos)
+    return "a face with fewer than 3 vertices (a line or a point; a mesh needs triangles or "
+           "polygons) [" +
+           why + "]";
+  if (why.find("mIndices[") != std::string::npos && why.find("out of range") != std::string::npos)
+    return "a face names a vertex the file does not have (index out of range) [" + why + "]";
+  return why;
+}
+
 /// How assimp is to read an STL: the file as it is, or a copy in memory (`length` bytes of it,
 /// in lower case where `lower`).
 struct StlFeed {
@@ -152,6 +165,22 @@ StlFeed checkAsciiStl(const std::filesystem::path& file, std::uintmax_t size) {
       vertices = 0;
     } else if (word == "vertex") {
       ++vertices;
+      // x y z: assimp's own word on a short line names no line ("Cannot parse string ...").
+      std::size_t tokens = 0, at = line.find_first_of("xX") + 1;
+      bool numbers = true;
+      while (true) {
+        at = line.find_first_not_of(" \t\r", at);
+        if (at == std::string::npos) break;
+        const char c = line[at];
+        numbers = numbers &&
+                  (std::isdigit(static_cast<unsigned char>(c)) || c == '-' || c == '+' || c == '.');
+        ++tokens;
+        at = line.find_first_of(" \t\r", at);
+        if (at == std::string::npos) break;
+      }
+      if (tokens != 3 || !numbers)
+        throw InputError(file.string() + ":" + std::to_string(number) +
+                         ": ASCII STL vertex line needs 3 numbers (x y z)");
     } else if (word == "endfacet") {
       if (in_facet && vertices != 3)
         throw InputError(file.string() + ":" + std::to_string(facet_line) +
@@ -324,13 +353,13 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
       scene = importer.ReadFile(file.string(), aiProcess_ValidateDataStructure);
     }
   } catch (const std::exception& e) {
-    throw InputError(file.string() + ": cannot read mesh: " + e.what());
+    throw InputError(file.string() + ": cannot read mesh: " + readableAssimpError(e.what()));
   }
   if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 ||
       scene->mRootNode == nullptr) {
     const std::string why = importer.GetErrorString();
     throw InputError(file.string() + ": cannot read mesh" +
-                     (why.empty() ? std::string() : ": " + why));
+                     (why.empty() ? std::string() : ": " + readableAssimpError(why)));
   }
 
   // Identical positions are joined across faces and meshes (STL stores every corner per face).

@@ -196,7 +196,8 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
           << (end - begin == 1 ? "a single posture"
                                : std::to_string(end - begin) + " postures at one place")
           << ": a pass needs two distinct postures (passes break at `# pass`, blank lines, "
-             "RAPID moves and gaps over path.pass_gap)";
+             "RAPID moves, gaps over path.pass_gap and where the feed turns back: a zig-zag's "
+             "return leg)";
       throw InputError(msg.str());
     }
     // A cutting move does not turn the axis over (repeats dropped: between the kept postures).

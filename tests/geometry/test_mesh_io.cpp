@@ -219,6 +219,21 @@ TEST(MeshIo, BrokenFilesAreInputErrors) {
   expectMessage(writeBytes("long.ply", ply_header + "3 0 2 3\n3 0 1 3\n"),
                 "declares 6 element lines, the file has 7");
   EXPECT_EQ(loadMesh(writeBytes("whole.ply", ply_header + "3 0 2 3\n")).triangles.size(), 2u);
+  // Said in the file's terms, with the line where we can (assimp's own words named neither).
+  std::string short_vertex = tetra;
+  short_vertex.replace(short_vertex.find("vertex 1 0 0"), 12, "vertex 1 0");
+  const std::size_t short_line =
+      1 + std::count(tetra.begin(), tetra.begin() + tetra.find("vertex 1 0 0"), '\n');
+  expectMessage(
+      writeBytes("short_vertex.stl", short_vertex),
+      "short_vertex.stl:" + std::to_string(short_line) + ": ASCII STL vertex line needs 3 numbers");
+  expectMessage(writeBytes("line.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n"),
+                "a face with fewer than 3 vertices");
+  expectMessage(writeBytes("index.ply", ply_header.substr(0, ply_header.find("element face 2")) +
+                                            "element face 1\nproperty list uchar int "
+                                            "vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n"
+                                            "0 1 0\n3 0 1 7\n"),
+                "a face names a vertex the file does not have");
 }
 
 TEST(MeshIo, DefectiveMeshesLoadAndAreReported) {
