@@ -135,8 +135,10 @@ void probe(const FieldOptions& o, const GlobalOptions& global) {
       "# x y z Fx Fy Fz (mm; " + std::string(voxel ? "voxel" : "direct") + " field)\n";
   char line[256];
   for (std::size_t i = 0; i < points.size(); ++i) {
+    // + 0.0: a component the interpolation left at -0 prints 0.
     std::snprintf(line, sizeof line, "%.9g %.9g %.9g %.9g %.9g %.9g\n", points[i].x(),
-                  points[i].y(), points[i].z(), forces[i].x(), forces[i].y(), forces[i].z());
+                  points[i].y(), points[i].z(), forces[i].x() + 0.0, forces[i].y() + 0.0,
+                  forces[i].z() + 0.0);
     out += line;
   }
   std::fputs(out.c_str(), stdout);

@@ -55,10 +55,16 @@ pathgen::GenerateRequest sceneJob(const Scene& scene) {
         if (blocks++ == 0) first = b.begin;
         postures += b.size();
       }
-    if (blocks > 0)
+    const bool apt = geometry::pathFormatOf(scene.nominal->file) == geometry::PathFormat::Apt;
+    if (blocks > 0 && apt)
       std::fprintf(stderr,
-                   "note: %s: %zu posture%s in %zu `# link` block%s (RAPID moves in APT) not cut: "
-                   "generate makes the links anew; a pass starts at `# pass` or a blank line\n",
+                   "note: %s: %zu rapid posture%s (a GOTO after RAPID) not cut: generate makes "
+                   "the links anew\n",
+                   scene.nominal->where(first).c_str(), postures, postures == 1 ? "" : "s");
+    else if (blocks > 0)
+      std::fprintf(stderr,
+                   "note: %s: %zu posture%s in %zu `# link` block%s not cut: generate makes the "
+                   "links anew; a pass starts at `# pass` or a blank line\n",
                    scene.nominal->where(first).c_str(), postures, postures == 1 ? "" : "s", blocks,
                    blocks == 1 ? "" : "s");
   }

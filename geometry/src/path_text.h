@@ -64,8 +64,15 @@ inline double parseFinite(std::string_view token, const std::filesystem::path& f
   double value = 0;
   const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
   if (ec == std::errc::result_out_of_range) fail(file, line, quoted(token) + " is out of range");
-  if (ec != std::errc() || end != digits.data() + digits.size())
-    fail(file, line, quoted(token) + " is not a number");
+  if (ec != std::errc() || end != digits.data() + digits.size()) {
+    // `PARTNO/...`, `$$ ...`, `GOTO/...` in a file read as `.cl` (by its name): APT renamed.
+    const bool apt_like = token.find('/') != std::string_view::npos || token.rfind("$$", 0) == 0;
+    fail(file, line,
+         quoted(token) + " is not a number" +
+             (apt_like && pathFormatOf(file) == PathFormat::Cl
+                  ? " (APT CLDATA? the format is told by the name: .apt or .cls)"
+                  : ""));
+  }
   if (!std::isfinite(value)) fail(file, line, quoted(token) + " is not finite");
   return value;
 }

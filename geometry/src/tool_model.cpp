@@ -1,10 +1,11 @@
 #include "fieldpath/geometry/tool_model.h"
 
 #include <algorithm>
-#include <limits>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -189,6 +190,11 @@ double angularStep(double radius_mm, double sagitta_mm) {
 }
 
 double parseNumberField(std::string_view token, std::string_view what, std::string_view text) {
+  // Blanks around a number are a list's spacing (`40:6 ,55:6`), not part of it.
+  while (!token.empty() && std::isspace(static_cast<unsigned char>(token.front())))
+    token.remove_prefix(1);
+  while (!token.empty() && std::isspace(static_cast<unsigned char>(token.back())))
+    token.remove_suffix(1);
   double value = 0;
   const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
   if (token.empty() || ec != std::errc() || end != token.data() + token.size() ||
