@@ -60,9 +60,12 @@ TEST(ToolModel, ParseToolSpec) {
   EXPECT_EQ(parseToolSpec("flat:2:7").length_mm, 7.0);
   for (const char* bad :
        {"", "ball", "ball:", "ball:-1", "ball:0", "ball:3:2", "ball:3:x", "ball:3:12:1", "torus:3",
-        "torus:3:4", "torus:3:0", "cone:3", "flat:nan", "flat:inf", "ball:3 ", "ball:1e999"}) {
+        "torus:3:4", "torus:3:0", "cone:3", "flat:nan", "flat:inf", "ball:1e999"}) {
     EXPECT_THROW(parseToolSpec(bad), InputError) << bad;
   }
+  // Blanks around a number are spacing (`40:6 ,55:6` was refused as "'6 ' is not a number").
+  EXPECT_EQ(parseToolSpec("ball:3 ").radius_mm, 3.0);
+  EXPECT_EQ(parseHolderProfile("40:6 , 55:6").size(), 2u);
 }
 
 TEST(ToolModel, ParseHolderProfile) {
