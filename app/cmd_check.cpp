@@ -151,7 +151,11 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   cmd->callback([options, &global] {
     const zbuffer::Backend backend = zbuffer::backendFromName(options->backend, "--backend");
-    if (!options->out.empty()) common::checkOutputDirectory(options->out, "--out");
+    if (!options->out.empty()) {
+      common::checkOutputDirectory(options->out, "--out");
+      common::claimOutputs(options->out, {"check.json", "clearance.csv", "deviation.npy",
+                                          "deviation.json", "deviation.png"});
+    }
     const Scene scene = loadScene(options->scene, /*read_nominal=*/false);
     const geometry::PathFile path = geometry::readPathFile(options->path);
     const common::Progress progress = makeProgressLine(global.quiet);

@@ -203,6 +203,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--out", options->out, "Output folder")->required();
   cmd->callback([options, &global] {
     common::checkOutputDirectory(options->out, "--out");  // before the work, not after
+    common::claimOutputs(options->out, {"path.cl", "path.apt", "angles.csv", "report.json"});
     const Scene scene = loadScene(options->scene);
     pathgen::GenerateRequest job = sceneJob(scene);
     job.mode = options->direct ? pathgen::FieldMode::Direct : pathgen::FieldMode::Voxel;

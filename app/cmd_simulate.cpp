@@ -167,6 +167,8 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     const std::set<std::string> outputs = parseOutputs(o->outputs);
     const fs::path out = o->out;
     common::checkOutputDirectory(out, "--out");  // before the work, not after
+    common::claimOutputs(
+        out, {"heights.npy", "heights.json", "surface.stl", "heights.png", "simulate.json"});
     const auto [nx, ny] = parseGrid(o->grid);
     std::vector<double> region;
     if (!o->region.empty()) region = parseNumbers(o->region, "--region", 4);

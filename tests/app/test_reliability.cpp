@@ -118,6 +118,24 @@ TEST(AtomicOutput, AFailedRunRemovesWhatItWrote) {
   EXPECT_TRUE(filesUnder(dir.path() / "out").empty());
 }
 
+// A run that fails leaves no earlier run's outputs either: a generate whose scene is refused
+// took away the path.cl of the run before (a script posting out/path.apt after a failed generate
+// sent the old path to the machine), and a refused check its check.json ("ok": true); files
+// that are not the command's stay.
+TEST(AtomicOutput, AFailedRunLeavesNoEarlierRunsOutputs) {
+  const TempDir dir;
+  for (const char* name : {"path.cl", "path.apt", "report.json", "check.json", "mine.txt"})
+    dir.write(std::string("out/") + name, "earlier\n");
+  dir.write("scene.yaml", "obstacles:\n  - mesh: missing.stl\n");
+  const auto generate = test::runFieldpath(dir, "generate scene.yaml --out out");
+  EXPECT_EQ(generate.exit_code, 1) << generate.output();
+  EXPECT_EQ(filesUnder(dir.path() / "out"), (std::vector<std::string>{"check.json", "mine.txt"}));
+  dir.write("p.cl", "0 0 0 0 0 1\n");
+  const auto check = test::runFieldpath(dir, "check scene.yaml --path p.cl --out out");
+  EXPECT_EQ(check.exit_code, 1) << check.output();
+  EXPECT_EQ(filesUnder(dir.path() / "out"), std::vector<std::string>{"mine.txt"});
+}
+
 // A legal name of 250 bytes (names run to 255): written, and its temporary stayed under the
 // limit too (`.NAME.tmp-PID` of it was 263 bytes: "File name too long"); two long names that
 // share their first 180 bytes get temporaries of their own.

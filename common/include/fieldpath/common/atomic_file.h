@@ -76,6 +76,8 @@ inline std::string writeReason(int error, const std::filesystem::path& dir) {
 /// The outputs this process has put in place, for removeWrittenOutputs().
 inline std::mutex written_mutex;
 inline std::vector<std::filesystem::path> written_outputs;
+/// The outputs a command writes on success (claimOutputs): removed on failure wherever they are.
+inline std::vector<std::filesystem::path> claimed_outputs;
 
 }  // namespace detail
 
@@ -248,6 +250,23 @@ inline void removeWrittenOutputs() {
     std::filesystem::remove(file, ignored);
   }
   detail::written_outputs.clear();
+  for (const auto& file : detail::claimed_outputs) {
+    std::error_code ignored;  // regular files only: a FIFO or a link the user put there stays
+    if (std::filesystem::symlink_status(file, ignored).type() ==
+        std::filesystem::file_type::regular)
+      std::filesystem::remove(file, ignored);
+  }
+  detail::claimed_outputs.clear();
+}
+
+/// The files `names` in `dir` are this command's outputs: a run that fails (exit 1 or 2) removes
+/// them where an earlier run left them, as it removes its own (removeWrittenOutputs). A folder
+/// then never holds an earlier run's path.cl beside a failed run's error: a script that posts
+/// out/path.apt after `generate` would have sent the old path to the machine.
+inline void claimOutputs(const std::filesystem::path& dir,
+                         std::initializer_list<const char*> names) {
+  const std::lock_guard<std::mutex> lock(detail::written_mutex);
+  for (const char* name : names) detail::claimed_outputs.push_back(dir / name);
 }
 
 /// Removes the files `names` from `dir` where an earlier run left them and this one does not
