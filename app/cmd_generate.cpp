@@ -54,6 +54,13 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
   json passes = json::array();
   json settled = json::array();  // 1-based, as per_pass
   for (const int p : r.settled_starts) settled.push_back(p + 1);
+  json balls_under = json::array();
+  for (const auto& b : r.balls_under_clearance)
+    balls_under.push_back({{"pass", b.pass + 1},
+                           {"at", b.label},
+                           {"s_mm", b.s_mm},
+                           {"ball_clearance_mm", b.clearance_mm},
+                           {"obstacle", b.obstacle + 1}});
   json settle_failures = json::array();
   for (const auto& f : r.settle_failures)
     settle_failures.push_back({{"pass", f.pass + 1}, {"why", f.why}});
@@ -141,6 +148,8 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
                                       {"s_mm", r.postures[r.first_limited].s_mm}})}}},
       {"max_tilt_deg", r.max_tilt_deg},
       {"max_lead_deg", r.max_lead_deg},
+      // The balls themselves within `clearance` (no axis clears them): what marks such a path.
+      {"balls_under_clearance", balls_under},
       {"axis_turn", axisTurnJson(axis_turn)},
       {"start",
        {{"policy", startPolicyName(job.dynamics.start)},
@@ -288,13 +297,14 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     const auto& c = result.clearance;
     const auto& m = result.motions;
     std::printf(
-        "%s: %zu postures on %zu passes (%.1f mm) + %zu link postures; max tilt %.2f deg, max "
+        "%s: %zu postures on %zu pass%s (%.1f mm) + %zu link postures; max tilt %.2f deg, max "
         "lead %.2f deg, %zu postures held at a limit; min clearance %.3f mm (required %.3f), "
         "%zu colliding postures, %zu colliding motions (of %zu, min >= %.3f mm); %.2f s -> %s\n",
-        what.c_str(), result.postures.size(), result.passes.size(), result.path_length_mm,
-        result.link_postures, result.max_tilt_deg, result.max_lead_deg, result.limited_postures,
-        c.min_clearance_mm, job.clearance_mm, c.colliding, m.colliding, m.motions,
-        m.min_clearance_mm, result.times.total_s, out.string().c_str());
+        what.c_str(), result.postures.size(), result.passes.size(),
+        result.passes.size() == 1 ? "" : "es", result.path_length_mm, result.link_postures,
+        result.max_tilt_deg, result.max_lead_deg, result.limited_postures, c.min_clearance_mm,
+        job.clearance_mm, c.colliding, m.colliding, m.motions, m.min_clearance_mm,
+        result.times.total_s, out.string().c_str());
     if (!unsafe.empty()) std::fprintf(stderr, "warning: %s\n", unsafe_text.c_str());
     if (under_required)
       std::fprintf(stderr,
@@ -307,6 +317,16 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     // narrower than the holder; unsafe there too, but the turn is its own warning)
     if (const std::string turn = axisTurnWarning(result.path, axis_turn); !turn.empty())
       std::fprintf(stderr, "warning: %s (report.json axis_turn)\n", turn.c_str());
+    if (!result.balls_under_clearance.empty()) {
+      const auto& b = result.balls_under_clearance.front();
+      std::fprintf(stderr,
+                   "warning: %zu pass%s run the ball itself within `clearance` of an obstacle "
+                   "(first: %s at s = %.3f mm, %.6g mm from obstacle %d): its centre is held, no "
+                   "axis clears it (report.json balls_under_clearance)\n",
+                   result.balls_under_clearance.size(),
+                   result.balls_under_clearance.size() == 1 ? "" : "es", b.label.c_str(), b.s_mm,
+                   b.clearance_mm, b.obstacle + 1);
+    }
     if (!result.settle_failures.empty())
       std::fprintf(stderr,
                    "warning: %zu pass%s (first: pass %d) could not start from the axis settled "

@@ -49,11 +49,14 @@ common::Progress scaled(const common::Progress& progress, double begin, double e
   };
 }
 
-/// Every pass station's ball must clear the obstacles by `clearance_mm` (whatever the axis).
-/// `progress` after each pass (10 000 passes took minutes without a word).
+/// Every pass station's ball must stay clear of the obstacles (whatever the axis): one that
+/// touches is refused; one within `clearance_mm` of them is reported in `under` (the smallest of
+/// each pass) and the job goes on. `progress` after each pass (10 000 passes took minutes
+/// without a word).
 void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>& passes,
                         double ball_radius_mm, double clearance_mm,
-                        const common::Progress& progress) {
+                        const common::Progress& progress,
+                        std::vector<GenerateResult::BallUnderClearance>& under) {
   for (std::size_t k = 0; k < passes.size(); ++k) {
     const Pass& pass = passes[k];
     common::report(progress, static_cast<double>(k) / passes.size(), "balls");
@@ -62,18 +65,16 @@ void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>
     size_t at = 0;
     int obstacle = -1;
     const double d = checker.ballClearance(centres, ball_radius_mm, &at, &obstacle);
-    if (d < clearance_mm) {
+    if (d <= 0.0) {
       std::ostringstream msg;
-      msg << pass.label << ": at s = " << pass.samples[at].s_mm << " mm the ball ";
-      if (d <= 0.0)
-        msg << "touches or enters obstacle " << obstacle + 1
-            << ": the channel is narrower than the ball there, or the pass runs through the "
-               "obstacle (in another frame or units?)";
-      else
-        msg << "is " << d << " mm from obstacle " << obstacle + 1 << ", less than `clearance` = "
-            << clearance_mm << " mm: the channel is narrower than the ball there";
+      msg << pass.label << ": at s = " << pass.samples[at].s_mm << " mm the ball touches or "
+          << "enters obstacle " << obstacle + 1
+          << ": the passage is narrower than the ball there, or the pass runs through the "
+             "obstacle (in another frame or units?)";
       throw InputError(msg.str());
     }
+    if (d < clearance_mm)
+      under.push_back({pass.index, pass.label, pass.samples[at].s_mm, d, obstacle});
   }
 }
 
@@ -129,7 +130,8 @@ GenerateResult generatePath(const GenerateRequest& request) {
   result.tool_triangles = tool_mesh.triangles.size();
   const ClearanceChecker checker(tool_mesh, obstacles, kClearanceMeshTolMm);
   checkBallClearance(checker, result.passes, r, request.clearance_mm,
-                     scaled(request.progress, 0.0, kBallShare, "balls"));
+                     scaled(request.progress, 0.0, kBallShare, "balls"),
+                     result.balls_under_clearance);
   // The links' travel plane, checked before any work.
   double safe_z_mm = 0.0;
   if (!request.passes_only) {

@@ -137,6 +137,17 @@ struct GenerateResult {
     std::string why;
   };
   std::vector<SettleFailure> settle_failures;
+  /// Passes whose ball (its centre is held: only the axis turns) comes within `clearance` of an
+  /// obstacle without touching it: no axis can clear that, so the job goes on and the path is
+  /// marked under the required clearance (it refused the whole job over 0.0001 mm of a mesh's
+  /// rounding). A ball that touches an obstacle is refused (the pass runs through it).
+  struct BallUnderClearance {
+    int pass = 0;       ///< Pass::index
+    std::string label;  ///< the pass and its line
+    double s_mm = 0, clearance_mm = 0;
+    int obstacle = 0;  ///< 0-based
+  };
+  std::vector<BallUnderClearance> balls_under_clearance;
   StageTimes times;
   std::size_t obstacle_points = 0;  ///< field samples
   std::size_t tool_nodes = 0;       ///< tool + holder nodes of the moment

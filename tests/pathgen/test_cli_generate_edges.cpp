@@ -1,0 +1,62 @@
+/// `generate` at the edges of what a scene allows, through the built `fieldpath`: a nominal pass
+/// whose ball itself comes within `clearance` of a wall (no axis can clear it).
+#include <filesystem>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "fieldpath/geometry/mesh_io.h"
+#include "fixtures.h"
+#include "run_fieldpath.h"
+
+namespace fs = std::filesystem;
+using namespace fieldpath;
+using test::TempDir;
+
+// A pass along a wall with the ball 0.3 mm from it (clearance 0.5): the ball's centre is held,
+// so no axis clears it. The job was refused whole ("less than `clearance`", a helper's finding:
+// 0.0001 mm of a mesh's rounding under it); it is written now, marked under the required
+// clearance as README says such paths are, with the ball named in a warning and report.json.
+// A ball that enters the wall is still refused.
+TEST(GenerateEdges, ABallWithinTheClearanceIsWrittenAndMarkedOneInsideIsRefused) {
+  const TempDir dir;
+  geometry::TriangleMesh wall, plate;
+  pathgen::test::addBox(wall, 10, 12, -20, 20, -5, 20);
+  pathgen::test::addBox(plate, -10, 9.9, -20, 20, -5, 0);
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  geometry::saveMesh(plate, dir.path() / "plate.stl");
+  const auto pass = [](double x) {
+    std::ostringstream cl;
+    cl << "# pass 1\n";
+    for (int i = -20; i <= 20; ++i) cl << x << ' ' << 0.5 * i << " 0 0 0 1\n";
+    return cl.str();
+  };
+  dir.write("near.cl", pass(6.7));    // the ball 0.3 mm from the wall's face x = 10
+  dir.write("inside.cl", pass(7.2));  // 0.2 mm into it
+  for (const char* name : {"near", "inside"})
+    dir.write(std::string(name) + ".yaml",
+              "obstacles:\n  - mesh: wall.stl\npart: plate.stl\n"
+              "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n"
+              "path: { nominal: " +
+                  std::string(name) + ".cl }\n");
+  const auto near = test::runFieldpath(dir, "generate near.yaml --out near");
+  ASSERT_EQ(near.exit_code, 0) << near.output();
+  EXPECT_NE(near.err.find("run the ball itself within `clearance`"), std::string::npos) << near.err;
+  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "near/report.json"));
+  ASSERT_EQ(report["balls_under_clearance"].size(), 1u) << report;
+  EXPECT_NEAR(report["balls_under_clearance"][0]["ball_clearance_mm"].get<double>(), 0.3, 1e-3);
+  EXPECT_EQ(report["balls_under_clearance"][0]["pass"].get<int>(), 1);
+  const std::string path = test::slurp(dir.path() / "near/path.cl");
+  EXPECT_EQ(path.rfind("# UNDER THE REQUIRED CLEARANCE", 0), 0u) << path.substr(0, 200);
+  // The postures keep the ball: less the clearance mesh's chordal error, no more.
+  EXPECT_GT(report["clearance"]["min_mm"].get<double>(), 0.25) << report["clearance"];
+  EXPECT_LT(report["clearance"]["min_mm"].get<double>(), 0.3) << report["clearance"];
+
+  const auto inside = test::runFieldpath(dir, "generate inside.yaml --out inside");
+  EXPECT_EQ(inside.exit_code, 1) << inside.output();
+  EXPECT_NE(inside.err.find("the ball touches or enters obstacle 1"), std::string::npos)
+      << inside.err;
+  EXPECT_FALSE(fs::exists(dir.path() / "inside/path.cl"));
+}
