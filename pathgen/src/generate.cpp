@@ -251,7 +251,9 @@ GenerateResult generatePath(const GenerateRequest& request) {
         if (steered.status == dynamics::Status::SolverFailed)  // what to change, not CVODE's words
           msg << " (the spring-damper is too stiff for the integrator here: raise "
                  "dynamics.inertia or dynamics.damping, lower field.gain or dynamics.stiffness, "
-                 "or relax dynamics.rtol)";
+                 "or relax dynamics.rtol; or the tool has no room there: the field pushes the "
+                 "tool or holder from both sides, a passage narrower than they are, and "
+                 "`generate --nominal` marks where the path collides)";
         throw InputError(msg.str());
       }
       for (const dynamics::PostureSample& s : steered.samples) {

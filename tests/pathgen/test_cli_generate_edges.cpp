@@ -1,5 +1,6 @@
 /// `generate` at the edges of what a scene allows, through the built `fieldpath`: a nominal pass
-/// whose ball itself comes within `clearance` of a wall (no axis can clear it).
+/// whose ball itself comes within `clearance` of a wall (no axis can clear it); a voxel grid
+/// coarse against r0.
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -59,4 +60,28 @@ TEST(GenerateEdges, ABallWithinTheClearanceIsWrittenAndMarkedOneInsideIsRefused)
   EXPECT_NE(inside.err.find("the ball touches or enters obstacle 1"), std::string::npos)
       << inside.err;
   EXPECT_FALSE(fs::exists(dir.path() / "inside/path.cl"));
+}
+
+// h up to r0 is allowed, but a coarse grid steers by a field far from eq. 1 (16.5 deg of lead in
+// a channel uniform along the feed, 1.4 direct): said in a note; none at r0 / 10.
+TEST(GenerateEdges, ACoarseVoxelGridIsSaid) {
+  const TempDir dir;
+  geometry::TriangleMesh wall;
+  pathgen::test::addBox(wall, 10, 12, -20, 20, -5, 20);
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  std::ostringstream cl;
+  cl << "# pass 1\n";
+  for (int i = -10; i <= 10; ++i) cl << "4 " << 0.5 * i << " 0 0 0 1\n";
+  dir.write("p.cl", cl.str());
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, length: 20 }\n"
+            "clearance: 0.5\nfield: { r0: 5 }\npath: { nominal: p.cl }\n");
+  const auto coarse = test::runFieldpath(dir, "generate scene.yaml --voxel 2 --out coarse");
+  ASSERT_EQ(coarse.exit_code, 0) << coarse.output();
+  EXPECT_NE(coarse.err.find("note: --voxel 2 mm is coarse against field.r0 (5 mm)"),
+            std::string::npos)
+      << coarse.err;
+  const auto fine = test::runFieldpath(dir, "generate scene.yaml --voxel 0.5 --out fine");
+  ASSERT_EQ(fine.exit_code, 0) << fine.output();
+  EXPECT_EQ(fine.err.find("is coarse against"), std::string::npos) << fine.err;
 }
