@@ -271,9 +271,12 @@ void writeDeviationPng(const std::filesystem::path& file, const SurfaceResult& s
   for (int py = 0; py < map_h; ++py) {
     for (int px = 0; px < map_w; ++px) {
       const int ix = px * k, iy = (map_h - 1 - py) * k;
-      const float d = dev_um[static_cast<std::size_t>(iy) * grid.nx + ix];
+      const std::size_t line = static_cast<std::size_t>(iy) * grid.nx + ix;
+      const float d = dev_um[line];
+      const bool stock = !stats.lowered.empty() && !stats.lowered[line];
       img.set(px, py,
               std::isnan(d) ? std::array<std::uint8_t, 3>{200, 200, 200}
+              : stock       ? std::array<std::uint8_t, 3>{235, 222, 179}  // never cut: the stock
                             : deviationColour(d, gouge_scale, scallop_scale));
     }
   }
@@ -392,6 +395,9 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   result.cut_lines = simulated.lines_lowered;
   result.in_band = machinedBand(sim.grid, path, radius, edge_mm, nominal);
   result.deviation_um.assign(sim.grid.lineCount(), std::numeric_limits<float>::quiet_NaN());
+  result.lowered.assign(sim.grid.lineCount(), 0);
+  for (std::size_t i = 0; i < result.lowered.size(); ++i)
+    result.lowered[i] = simulated.heights_mm[i] < sim.initial_heights_mm[i];
   double sum = 0, sum2 = 0, min_dev = 0, max_dev = 0;
   double highest_cusp = 0;  // the highest any line's cusp may stand (scallopGridErrorUm)
   const double spacing_mm = std::max(sim.grid.dx_mm, sim.grid.dy_mm);

@@ -44,6 +44,9 @@ struct SurfaceResult {
   /// Per line: in the machined band (between consecutive neighbouring passes), where scallops
   /// count; a lone pass has none (band_lines 0: no scallop figures).
   std::vector<char> in_band;
+  /// Per line: 1 where the tool lowered it (0: the stock allowance stands; deviation.png shows
+  /// such lines in the stock's colour, not as the largest scallop).
+  std::vector<char> lowered;
   std::size_t part_lines = 0, band_lines = 0;
   std::size_t gouged_lines = 0;  ///< anywhere on the part, deeper than the tolerance
   double gouge_tolerance_um = kGougeToleranceUm;
@@ -71,8 +74,8 @@ struct SurfaceResult {
 /// check: the clearance checks still stand).
 std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request);
 
-/// deviation.png: the map (row 0 = largest y, grey off the part) with a colour bar and its scale
-/// in µm on the right.
+/// deviation.png: the map (row 0 = largest y, grey off the part, sand where no pass cut: the
+/// stock allowance) with a colour bar and its scale in µm on the right.
 void writeDeviationPng(const std::filesystem::path& file, const SurfaceResult& surface);
 
 }  // namespace fieldpath::app
