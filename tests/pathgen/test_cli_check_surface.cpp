@@ -20,16 +20,22 @@ using test::TempDir;
 
 namespace {
 
-/// A plate (top at z = 0) and an obstacle far from it; a ball R 3 upright.
-void writePlateScene(const TempDir& dir) {
-  geometry::TriangleMesh part, wall;
-  pathgen::test::addBox(part, -10, 30, -15, 15, -5, 0);
+/// The scene of a `part` and an obstacle far from it (a scene needs one); a ball R 3 upright.
+void writeSceneOfPart(const TempDir& dir, const geometry::TriangleMesh& part) {
+  geometry::TriangleMesh wall;
   pathgen::test::addBox(wall, 60, 70, -10, 10, 0, 5);
   geometry::saveMesh(part, dir.path() / "part.stl");
   geometry::saveMesh(wall, dir.path() / "wall.stl");
   dir.write("scene.yaml",
             "obstacles:\n  - mesh: wall.stl\npart: part.stl\n"
             "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
+}
+
+/// A plate (top at z = 0).
+void writePlateScene(const TempDir& dir) {
+  geometry::TriangleMesh part;
+  pathgen::test::addBox(part, -10, 30, -15, 15, -5, 0);
+  writeSceneOfPart(dir, part);
 }
 
 /// Passes along x at y = y0 + k · step_y (k < count), tips at height z, upright, links between.
@@ -53,9 +59,9 @@ nlohmann::json check(const TempDir& dir, const std::string& path, const std::str
 }
 
 /// A wedge whose top is the plane z = y tan(slope) over x in [-10, 30], y in [-4, 4], closed
-/// 20 mm under it; `wall.stl` far from it as in writePlateScene.
+/// 20 mm under it.
 void writeSlopeScene(const TempDir& dir, double slope_rad) {
-  geometry::TriangleMesh part, wall;
+  geometry::TriangleMesh part;
   const double t = std::tan(slope_rad), x0 = -10, x1 = 30, y0 = -4, y1 = 4, bottom = -20;
   const auto v = [&part](double x, double y, double z) {
     part.vertices.emplace_back(x, y, z);
@@ -75,12 +81,7 @@ void writeSlopeScene(const TempDir& dir, double slope_rad) {
   quad(d, c, g, h);  // y1 side
   quad(a, d, h, e);  // x0 side
   quad(b, f, g, c);  // x1 side
-  pathgen::test::addBox(wall, 60, 70, -10, 10, 0, 5);
-  geometry::saveMesh(part, dir.path() / "part.stl");
-  geometry::saveMesh(wall, dir.path() / "wall.stl");
-  dir.write("scene.yaml",
-            "obstacles:\n  - mesh: wall.stl\npart: part.stl\n"
-            "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
+  writeSceneOfPart(dir, part);
 }
 
 /// Passes along x on the wedge's plane, upright ball R 3: pass k's ball stands `depth_mm` into
