@@ -57,7 +57,11 @@ TEST(View, PageAgreesWithCheckJson) {
     EXPECT_EQ(countBit(flags, 2), 1u);
     EXPECT_EQ(countBit(flags, 1), 2u);  // the link's postures
     EXPECT_TRUE(meta["missing"].empty());
-    EXPECT_TRUE(meta["warnings"].empty()) << meta["warnings"];
+    // The collisions in the banner too: the one warning.
+    ASSERT_EQ(meta["warnings"].size(), 1u) << meta["warnings"];
+    EXPECT_EQ(meta["warnings"][0].get<std::string>(),
+              "UNSAFE TO RUN: " + std::to_string(colliding) + " postures and " +
+                  std::to_string(motions) + " motions touch an obstacle (red on the path)");
     // The scene's passes give the frames: the axis stays on the nominal one.
     EXPECT_NE(meta["path"]["angles_source"].get<std::string>().find("frames of the scene's passes"),
               std::string::npos);
