@@ -84,8 +84,8 @@ std::pair<int, int> parseGrid(const std::string& text) {
     if (s.empty() || ec != std::errc() || end != s.data() + s.size())
       throw InputError("--grid '" + text + "': expected NXxNY, e.g. 1024x1024");
   }
-  if (v[0] < 2 || v[1] < 2)  // a surface needs two lines each way (1x1 wrote an empty STL)
-    throw InputError("--grid '" + text + "': needs at least 2 lines each way");
+  if (v[0] <= 0 || v[1] <= 0)
+    throw InputError("--grid '" + text + "': needs at least one line each way");
   if (v[0] > std::numeric_limits<int>::max() / 2 || v[1] > std::numeric_limits<int>::max() / 2)
     throw InputError("--grid '" + text + "' is too large: it needs about " +
                      std::to_string(static_cast<long double>(v[0]) * v[1] * 12 / (1 << 20)) +

@@ -153,8 +153,10 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     const zbuffer::Backend backend = zbuffer::backendFromName(options->backend, "--backend");
     if (!options->out.empty()) {
       common::checkOutputDirectory(options->out, "--out");
-      common::claimOutputs(options->out, {"check.json", "clearance.csv", "deviation.npy",
-                                          "deviation.json", "deviation.png"});
+      common::claimOutputs(
+          options->out,
+          {"check.json", "clearance.csv", "deviation.npy", "deviation.json", "deviation.png"},
+          {options->scene, options->path});
     }
     const Scene scene = loadScene(options->scene, /*read_nominal=*/false);
     const geometry::PathFile path = geometry::readPathFile(options->path);

@@ -212,7 +212,10 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
   cmd->add_option("--out", options->out, "Output folder")->required();
   cmd->callback([options, &global] {
     common::checkOutputDirectory(options->out, "--out");  // before the work, not after
-    common::claimOutputs(options->out, {"path.cl", "path.apt", "angles.csv", "report.json"});
+    // Claimed before the scene is read (a refused scene takes the earlier run's path away), but
+    // never the scene's own files (a nominal path.cl in --out).
+    common::claimOutputs(options->out, {"path.cl", "path.apt", "angles.csv", "report.json"},
+                         {options->scene, nominalPathOf(options->scene)});
     const Scene scene = loadScene(options->scene);
     pathgen::GenerateRequest job = sceneJob(scene);
     job.mode = options->direct ? pathgen::FieldMode::Direct : pathgen::FieldMode::Voxel;
@@ -224,7 +227,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
       checkVoxelSize(scene, h, key);
       // Allowed up to r0, but coarse grids steer by a field far from eq. 1 (a channel uniform
       // along x read 16.5 deg of lead at h 3.3, r0 5, against 1.4 direct: a helper's finding).
-      if (h > 0.25 * r0)
+      if (h > 0.2 * r0)
         std::fprintf(stderr,
                      "note: %s %g mm is coarse against field.r0 (%g mm): the interpolated field "
                      "is off by up to 100 %% near the obstacles (the impeller's study: 106 %% at "
@@ -331,12 +334,12 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (!result.balls_under_clearance.empty()) {
       const auto& b = result.balls_under_clearance.front();
       std::fprintf(stderr,
-                   "warning: %zu pass%s run the ball itself within `clearance` of an obstacle "
+                   "warning: %zu pass%s the ball itself within `clearance` of an obstacle "
                    "(first: %s at s = %.3f mm, %.6g mm from obstacle %d): its centre is held, no "
                    "axis clears it (report.json balls_under_clearance)\n",
                    result.balls_under_clearance.size(),
-                   result.balls_under_clearance.size() == 1 ? "" : "es", b.label.c_str(), b.s_mm,
-                   b.clearance_mm, b.obstacle + 1);
+                   result.balls_under_clearance.size() == 1 ? " runs" : "es run", b.label.c_str(),
+                   b.s_mm, b.clearance_mm, b.obstacle + 1);
     }
     if (!result.settle_failures.empty())
       std::fprintf(stderr,

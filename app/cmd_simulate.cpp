@@ -92,13 +92,29 @@ double estimatePostures(const fs::path& file) {
   std::error_code ec;
   const double bytes = double(fs::file_size(file, ec));
   if (ec) return 0.0;
-  if (geometry::pathFormatOf(file) == geometry::PathFormat::Npy) return bytes / 24.0;
   std::ifstream in(file, std::ios::binary);
   std::string head(std::size_t{1} << 16, '\0');
   in.read(head.data(), std::streamsize(head.size()));
   const std::size_t got = std::size_t(in.gcount());
-  const auto lines = std::count(head.begin(), head.begin() + std::ptrdiff_t(got), '\n');
-  return lines > 0 ? bytes * double(lines) / double(got) : bytes / 30.0;
+  head.resize(got);
+  const geometry::PathFormat format = geometry::pathFormatOf(file);
+  if (format == geometry::PathFormat::Npy) {  // the rows its header says (float32 or 64)
+    const auto shape = head.find("'shape': (");
+    if (shape != std::string::npos) {
+      const double rows = std::strtod(head.c_str() + shape + 10, nullptr);
+      if (rows > 0) return rows;
+    }
+    return bytes / 24.0;
+  }
+  // A posture a line in .cl, a GOTO in APT (a GOTO may take two lines: cards of 72 columns).
+  std::size_t count = 0;
+  if (format == geometry::PathFormat::Apt)
+    for (std::size_t at = head.find("GOTO"); at != std::string::npos;
+         at = head.find("GOTO", at + 4))
+      ++count;
+  else
+    count = std::count(head.begin(), head.end(), '\n');
+  return count > 0 ? bytes * double(count) / double(std::max<std::size_t>(got, 1)) : bytes / 30.0;
 }
 
 }  // namespace
@@ -168,8 +184,12 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     const fs::path out = o->out;
     common::checkOutputDirectory(out, "--out");  // before the work, not after
     common::claimOutputs(
-        out, {"heights.npy", "heights.json", "surface.stl", "heights.png", "simulate.json"});
+        out, {"heights.npy", "heights.json", "surface.stl", "heights.png", "simulate.json"},
+        {o->path, o->part});
     const auto [nx, ny] = parseGrid(o->grid);
+    if (outputs.count("stl") && (nx < 2 || ny < 2))  // (1x1 wrote an STL of no triangles)
+      throw InputError("--grid '" + o->grid +
+                       "': surface.stl needs 2 lines each way (or --outputs without stl)");
     std::vector<double> region;
     if (!o->region.empty()) region = parseNumbers(o->region, "--region", 4);
     req.tool = parseTool(o->tool);

@@ -535,4 +535,16 @@ std::vector<std::string> openObstacleNotes(const Scene& scene) {
   return notes;
 }
 
+std::filesystem::path nominalPathOf(const std::filesystem::path& file) {
+  try {
+    const YAML::Node root = YAML::LoadFile(file.string());
+    const YAML::Node node = root["path"] ? root["path"]["nominal"] : YAML::Node();
+    if (!node || !node.IsScalar() || node.Scalar().empty()) return {};
+    const std::filesystem::path p = node.Scalar();
+    return p.is_absolute() ? p : file.parent_path() / p;
+  } catch (const std::exception&) {
+    return {};  // loadScene says what is wrong
+  }
+}
+
 }  // namespace fieldpath::app

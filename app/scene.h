@@ -60,6 +60,9 @@ struct Scene {
 /// `read_nominal`: false for the commands given their own path (`check --path`, `view`): the
 /// scene's `path.nominal` is then not read (a stale or broken one does not stop them).
 Scene loadScene(const std::filesystem::path& file, bool read_nominal = true);
+/// The scene's `path.nominal` file, where the file reads as YAML that names one (else empty):
+/// what a command must not take for an output of its own before the scene is loaded.
+std::filesystem::path nominalPathOf(const std::filesystem::path& file);
 
 /// A refusal raised below the app that begins with a key of the scene this process read
 /// ("links.safe_z: must be ...", "field.refine_tolerance: ..."): the scene's file and the key's

@@ -425,8 +425,10 @@ ViewData gatherView(const ViewRequest& request) {
     // In the banner above the page too, as path.cl's mark says it (only the counts said it).
     if (p.colliding_postures > 0 || p.colliding_motions > 0)
       d.warnings.push_back("UNSAFE TO RUN: " + std::to_string(p.colliding_postures) +
-                           " postures and " + std::to_string(p.colliding_motions) +
-                           " motions touch an obstacle (red on the path)");
+                           (p.colliding_postures == 1 ? " posture and " : " postures and ") +
+                           std::to_string(p.colliding_motions) +
+                           (p.colliding_motions == 1 ? " motion" : " motions") +
+                           " touch an obstacle (red on the path)");
     for (std::size_t i : p.file.limited) p.limited_colliding += p.clearance_mm[i] <= 0.0;
     if (check && (check->colliding_postures != p.colliding_postures ||
                   check->colliding_motions != p.colliding_motions))

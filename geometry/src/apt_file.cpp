@@ -81,23 +81,27 @@ void appendTextCards(std::string& text, std::string_view major, std::string_view
   } while (!words.empty());
 }
 
-/// PPRINT and PARTNO carry text: a `$` at their end is the text's (it swallowed the next GOTO).
+/// PPRINT, PARTNO, INSERT and REMARK carry text: a `$` in it is the text's (at its end it
+/// swallowed the next GOTO; a Siemens post's `INSERT/R1=$P_TOOLNO` names a variable).
 bool isTextRecord(std::string_view content) {
   const std::string head = upperCase(std::string(trimmed(content).substr(0, 6)));
-  return head == "PPRINT" || head == "PARTNO";
+  return head == "PPRINT" || head == "PARTNO" || head == "INSERT" || head == "REMARK";
 }
 
-/// A line's content without its `$$` comment and surrounding blanks. A single `$` continues the
-/// statement on the next line and what follows it is a remark (`GOTO/0,0,-0.5,$ first part`
-/// was refused as a bad number); the content then ends at that `$`. Not in PPRINT and PARTNO,
-/// whose text may hold a `$`.
+/// A line's content without its `$$` comment and surrounding blanks. A single `$` followed by a
+/// blank continues the statement on the next line and what follows it is a remark
+/// (`GOTO/0,0,-0.5,$ first part` was refused as a bad number); the content then ends at that
+/// `$`. Not in text records, whose text may hold a `$`.
 std::string_view aptContent(std::string_view line) {
   if (const auto comment = line.find("$$"); comment != std::string_view::npos)
     line = line.substr(0, comment);
   line = trimmed(line);
   if (!isTextRecord(line))
-    if (const auto dollar = line.find('$'); dollar != std::string_view::npos)
-      line = trimmed(line.substr(0, dollar + 1));
+    if (const auto dollar = line.find("$ "); dollar != std::string_view::npos)
+      line = line.substr(0, dollar + 1);
+  if (!isTextRecord(line))
+    if (const auto dollar = line.find("$\t"); dollar != std::string_view::npos)
+      line = line.substr(0, dollar + 1);
   return line;
 }
 
@@ -161,6 +165,7 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
   bool own_axis = false;  // a 6-number GOTO or a TLAXIS seen in this chunk
   Vec3 axis_now = Vec3::UnitZ();  // the axis of a 3-number GOTO here (once own_axis)
   std::string record;  // a statement, with `$` continuation lines joined
+  bool in_mark = false;  // the record before was a PPRINT safety mark's card
   std::size_t record_line = 0, line = first_line;
   PathChunk& chunk = out.postures;
   for (std::size_t pos = 0; pos < text.size(); ++line) {
@@ -182,9 +187,18 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
     const auto slash = statement.find('/');
     const std::string_view major =
         trimmed(std::string_view(statement).substr(0, std::min(slash, statement.size())));
-    if (major == "PPRINT" && slash != std::string::npos)
-      if (std::string mark = safetyMark(std::string_view(record).substr(slash + 1)); !mark.empty())
-        chunk.warnings.push_back(std::move(mark));
+    // A safety mark goes on in the PPRINT cards right after it (the writer splits a long one).
+    const bool pprint = major == "PPRINT" && slash != std::string::npos;
+    std::string mark = pprint ? safetyMark(std::string_view(record).substr(slash + 1)) : "";
+    if (!mark.empty()) {
+      chunk.warnings.push_back(std::move(mark));
+      in_mark = true;
+    } else if (pprint && in_mark) {
+      chunk.warnings.back() +=
+          " " + std::string(trimmed(std::string_view(record).substr(slash + 1)));
+    } else {
+      in_mark = false;
+    }
     record.clear();
     if (major == "RAPID") {
       rapid = true;

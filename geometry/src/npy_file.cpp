@@ -1,6 +1,6 @@
-/// Postures as NumPy `.npy` (DESIGN.md command line): float32 or float64, little-endian, shape
-/// N×6 (x y z i j k) or N×7 (+ spindle angle, rad), C order. Anything else is refused with one
-/// line naming the file; a bad row names the row.
+/// Postures as NumPy `.npy` (DESIGN.md command line): float32 or float64, either byte order,
+/// shape N×6 (x y z i j k) or N×7 (+ spindle angle, rad), C or Fortran order (written: <f8, C
+/// order). Anything else is refused with one line naming the file; a bad row names the row.
 #include <algorithm>
 #include <cstdint>
 #include <cstring>

@@ -155,6 +155,16 @@ TEST(CliSimulate, ASurfaceStlFarFromTheOriginIsSaidToBeCoarse) {
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "near/heights.npy"));
   for (const char* stale : {"heights.json", "surface.stl", "heights.png"})
     EXPECT_FALSE(std::filesystem::exists(dir.path() / "near" / stale)) << stale;
+  // One line each way is a profile: heights, yes; a surface (STL) of no triangles, no.
+  EXPECT_EQ(runFieldpath(dir,
+                         "simulate --tool ball:2 --path near.cl --grid 1x1 --stock 1 "
+                         "--outputs npy --out one")
+                .exit_code,
+            0);
+  const Outcome stl =
+      runFieldpath(dir, "simulate --tool ball:2 --path near.cl --grid 1x1 --stock 1 --out one");
+  EXPECT_EQ(stl.exit_code, 1) << stl.err;
+  EXPECT_NE(stl.err.find("surface.stl needs 2 lines each way"), std::string::npos) << stl.err;
 }
 
 TEST(CliSimulate, BadInputIsExitOneWithOneLineAndNoOutputs) {

@@ -134,6 +134,12 @@ TEST(AtomicOutput, AFailedRunLeavesNoEarlierRunsOutputs) {
   const auto check = test::runFieldpath(dir, "check scene.yaml --path p.cl --out out");
   EXPECT_EQ(check.exit_code, 1) << check.output();
   EXPECT_EQ(filesUnder(dir.path() / "out"), std::vector<std::string>{"mine.txt"});
+  // The scene's own nominal path in --out is an input: a refused scene leaves it (a reviewer's
+  // finding: `generate job/scene.yaml --out job` with `nominal: path.cl` lost it).
+  dir.write("job/path.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
+  dir.write("job/scene.yaml", "obstacles:\n  - mesh: missing.stl\npath: { nominal: path.cl }\n");
+  EXPECT_EQ(test::runFieldpath(dir, "generate job/scene.yaml --out job").exit_code, 1);
+  EXPECT_EQ(filesUnder(dir.path() / "job"), (std::vector<std::string>{"path.cl", "scene.yaml"}));
 }
 
 // A legal name of 250 bytes (names run to 255): written, and its temporary stayed under the

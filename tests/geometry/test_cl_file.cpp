@@ -217,11 +217,17 @@ TEST(AptFile, ReadsContinuationAndRejectsBadGoto) {
   EXPECT_THROW(readAptFile(writeBytes("b.apt", "PARTNO/X\nFINI\n")), InputError);
   // A record still continued at the end of the file: truncated.
   EXPECT_THROW(readAptFile(writeBytes("b.apt", "GOTO/1,2,3\nGOTO/1,2,$\n")), InputError);
-  // What follows a single `$` on its line is a remark (it was read as a bad number).
+  // What follows a single `$` and a blank on its line is a remark (it was read as a bad number);
+  // a `$` in a text record's text is the text's (a Siemens post's INSERT/R1=$P_TOOLNO took the
+  // RAPID after it into itself: a rapid move read as a feed move).
   const auto remark = readAptFile(writeBytes("r.apt", "GOTO/0,0,-0.5,$ first part\n0,1,0\n"));
   ASSERT_EQ(remark.size(), 1u);
   EXPECT_EQ(remark[0].tip_mm, Vec3(0, 0, -0.5));
   EXPECT_EQ(remark[0].axis, Vec3::UnitY());
+  const PathFile insert = readPathFile(writeBytes(
+      "i.apt", "GOTO/0,0,0,0,0,1\nINSERT/R1=$ P_TOOLNO\nRAPID\nGOTO/0,0,9\nGOTO/1,0,9\n"));
+  ASSERT_EQ(insert.postures.size(), 3u);
+  EXPECT_EQ(insert.count(PathBlock::Kind::Link), 1u);
 }
 
 // A UTF-8 byte-order mark at the start (Windows editors) is not a number of line 1.
@@ -274,7 +280,10 @@ TEST(AptFile, UnitsFiniAndRemarks) {
   EXPECT_EQ(c3, "PPRINT/TO THE NEXT) AND 47 POSTURES");
   EXPECT_EQ(c4, "UNITS/MM");
   const PathFile marked = readPathFile(w);
-  EXPECT_EQ(marked.warnings.size(), 1u);
+  ASSERT_EQ(marked.warnings.size(), 1u);  // the mark whole, read back from its cards
+  EXPECT_EQ(marked.warnings[0],
+            "UNSAFE TO RUN: 49 MOTIONS TOUCH AN OBSTACLE (FIRST: POSTURE 114 "
+            "TO THE NEXT) AND 47 POSTURES");
 }
 
 // A motion the reader does not take is refused with its line (each lost a posture silently),

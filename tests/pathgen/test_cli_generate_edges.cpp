@@ -44,7 +44,8 @@ TEST(GenerateEdges, ABallWithinTheClearanceIsWrittenAndMarkedOneInsideIsRefused)
                   std::string(name) + ".cl }\n");
   const auto near = test::runFieldpath(dir, "generate near.yaml --out near");
   ASSERT_EQ(near.exit_code, 0) << near.output();
-  EXPECT_NE(near.err.find("run the ball itself within `clearance`"), std::string::npos) << near.err;
+  EXPECT_NE(near.err.find("runs the ball itself within `clearance`"), std::string::npos)
+      << near.err;
   const auto report = nlohmann::json::parse(test::slurp(dir.path() / "near/report.json"));
   ASSERT_EQ(report["balls_under_clearance"].size(), 1u) << report;
   EXPECT_NEAR(report["balls_under_clearance"][0]["ball_clearance_mm"].get<double>(), 0.3, 1e-3);

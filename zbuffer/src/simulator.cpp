@@ -174,9 +174,15 @@ std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
       rasterTriangle(g, a, b, c, sign, [&](int ix, int iy, float z) {
         const std::size_t i = std::size_t(iy) * grid.nx + ix;
         float& h = top[i];
-        if (normal_z && z >= h) {
+        if (normal_z) {
+          // Two facets meeting on a line give its height a few ulps apart (each interpolates
+          // its own plane): within 4 ulps they tie, and the flattest facet's |n_z| counts.
+          const float tie = 4.f * FLT_EPSILON * std::max(1.f, std::abs(z));
           float& n = (*normal_z)[i];
-          n = z > h || std::isnan(n) ? nz : std::max(n, nz);
+          if (z > h + tie || std::isnan(n))
+            n = nz;
+          else if (z >= h - tie)
+            n = std::max(n, nz);
         }
         h = std::max(h, z);
       });

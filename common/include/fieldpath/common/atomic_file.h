@@ -263,10 +263,18 @@ inline void removeWrittenOutputs() {
 /// them where an earlier run left them, as it removes its own (removeWrittenOutputs). A folder
 /// then never holds an earlier run's path.cl beside a failed run's error: a script that posts
 /// out/path.apt after `generate` would have sent the old path to the machine.
-inline void claimOutputs(const std::filesystem::path& dir,
-                         std::initializer_list<const char*> names) {
+/// Files in `inputs` are never claimed: a scene whose nominal path is `--out`'s path.cl keeps it.
+inline void claimOutputs(const std::filesystem::path& dir, std::initializer_list<const char*> names,
+                         std::initializer_list<std::filesystem::path> inputs = {}) {
   const std::lock_guard<std::mutex> lock(detail::written_mutex);
-  for (const char* name : names) detail::claimed_outputs.push_back(dir / name);
+  for (const char* name : names) {
+    bool input = false;
+    for (const auto& file : inputs) {
+      std::error_code ec;
+      input = input || (!file.empty() && std::filesystem::equivalent(dir / name, file, ec));
+    }
+    if (!input) detail::claimed_outputs.push_back(dir / name);
+  }
 }
 
 /// Removes the files `names` from `dir` where an earlier run left them and this one does not
@@ -275,7 +283,10 @@ inline void claimOutputs(const std::filesystem::path& dir,
 inline void removeStaleOutputs(const std::filesystem::path& dir,
                                std::initializer_list<const char*> names) {
   for (const char* name : names) {
-    std::error_code ec;
+    std::error_code ec;  // regular files only: a FIFO or a link the user put there stays
+    if (std::filesystem::symlink_status(dir / name, ec).type() !=
+        std::filesystem::file_type::regular)
+      continue;
     std::filesystem::remove(dir / name, ec);
     if (ec && ec != std::errc::no_such_file_or_directory)
       throw InputError((dir / name).string() +
