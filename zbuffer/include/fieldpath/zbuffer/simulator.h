@@ -129,6 +129,9 @@ struct SimulationRequest {
   std::size_t block_postures = std::size_t{1} << 20;  ///< postures per streamed block
   common::Progress progress;  ///< postures done / expected_postures (if known; else the caller's)
   std::size_t expected_postures = 0;
+  /// On the CPU, with a progress: a block is cut in pieces of about this long (≥ 4096 postures)
+  /// so that the progress moves within it; a block faster than that is cut in two calls.
+  double progress_piece_s = 0.5;
   EngineTuning tuning;
 };
 
