@@ -142,6 +142,30 @@ TEST(AtomicOutput, AFailedRunLeavesNoEarlierRunsOutputs) {
   EXPECT_EQ(filesUnder(dir.path() / "job"), (std::vector<std::string>{"path.cl", "scene.yaml"}));
 }
 
+// An interrupted run (Ctrl-C, `timeout`'s SIGTERM) leaves no earlier run's outputs either, as a
+// failed one: a script running `timeout 60 fieldpath generate` and then posting out/path.apt
+// sent the old path. A FIFO under a claimed name, a file not claimed and an input stay.
+TEST(AtomicOutput, AnInterruptedRunLeavesNoEarlierRunsOutputs) {
+  for (int sig : {SIGINT, SIGTERM}) {
+    const TempDir dir;
+    for (const char* name : {"path.cl", "report.json", "mine.txt", "nominal.cl"})
+      dir.write(std::string("out/") + name, "earlier\n");
+    ASSERT_EQ(mkfifo((dir.path() / "out" / "path.apt").c_str(), 0600), 0);
+    const pid_t pid = fork();
+    if (pid == 0) {
+      common::installTemporaryCleanupOnSignals();
+      common::claimOutputs(dir.path() / "out", {"path.cl", "path.apt", "report.json", "nominal.cl"},
+                           {dir.path() / "out" / "nominal.cl"});
+      raise(sig);  // the user presses Ctrl-C before the run writes anything
+      _exit(0);
+    }
+    EXPECT_EQ(finish(pid), 128 + sig);
+    EXPECT_EQ(filesUnder(dir.path() / "out"), (std::vector<std::string>{"mine.txt", "nominal.cl"}))
+        << "signal " << sig;
+    EXPECT_TRUE(fs::is_fifo(dir.path() / "out" / "path.apt")) << "signal " << sig;
+  }
+}
+
 // A legal name of 250 bytes (names run to 255): written, and its temporary stayed under the
 // limit too (`.NAME.tmp-PID` of it was 263 bytes: "File name too long"); two long names that
 // share their first 180 bytes get temporaries of their own.

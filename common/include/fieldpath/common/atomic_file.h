@@ -37,17 +37,29 @@ inline TemporarySlot temporary_slots[kTemporarySlots];
 
 /// Lists `path` for removal on a signal; returns its slot, or -1 when every slot is taken or the
 /// name is too long (the file is then still written atomically, just not removed on a signal).
-inline int listTemporary(const std::string& path) {
+
+/// The outputs claimed by this run (claimOutputs), for a signal handler: an interrupted run, like
+/// a failed one, leaves no earlier run's path.cl behind (a script that runs `timeout 60 fieldpath
+/// generate` and then posts out/path.apt would have sent the old path).
+inline constexpr int kClaimedSlots = 16;
+inline TemporarySlot claimed_slots[kClaimedSlots];
+
+/// Lists `path` in `slots` (n of them); -1 when all are taken or the name is too long.
+inline int listInSlots(TemporarySlot* slots, int n, const std::string& path) {
   if (path.size() >= sizeof(TemporarySlot::path)) return -1;
-  for (int i = 0; i < kTemporarySlots; ++i) {
+  for (int i = 0; i < n; ++i) {
     int expected = 0;
-    if (temporary_slots[i].state.compare_exchange_strong(expected, 1)) {
-      std::memcpy(temporary_slots[i].path, path.c_str(), path.size() + 1);
-      temporary_slots[i].state.store(2);
+    if (slots[i].state.compare_exchange_strong(expected, 1)) {
+      std::memcpy(slots[i].path, path.c_str(), path.size() + 1);
+      slots[i].state.store(2);
       return i;
     }
   }
   return -1;
+}
+
+inline int listTemporary(const std::string& path) {
+  return listInSlots(temporary_slots, kTemporarySlots, path);
 }
 
 inline void unlistTemporary(int slot) {
@@ -88,15 +100,27 @@ inline void removeTemporariesNow() noexcept {
     if (slot.state.load() == 2) ::unlink(slot.path);
 }
 
+/// Removes the outputs this run claimed (claimOutputs), regular files only (lstat, unlink:
+/// async-signal-safe), as a failed run does: for a SIGINT/SIGTERM handler.
+inline void removeClaimedOutputsNow() noexcept {
+  for (auto& slot : detail::claimed_slots) {
+    struct stat info {};
+    if (slot.state.load() == 2 && ::lstat(slot.path, &info) == 0 && S_ISREG(info.st_mode))
+      ::unlink(slot.path);
+  }
+}
+
 namespace detail {
 extern "C" inline void removeTemporariesAndDie(int signal_number) {
   removeTemporariesNow();
+  removeClaimedOutputsNow();
   ::raise(signal_number);  // SA_RESETHAND restored the default action: die of the signal
 }
 }  // namespace detail
 
-/// SIGINT/SIGTERM remove the temporaries being written (no partial file under any name), then
-/// end the process by the signal as usual. The CLI's main() installs it first thing.
+/// SIGINT/SIGTERM remove the temporaries being written (no partial file under any name) and the
+/// outputs the run claimed (no earlier run's file beside an interrupted one), then end the process
+/// by the signal as usual. The CLI's main() installs it first thing.
 inline void installTemporaryCleanupOnSignals() {
   struct sigaction action {};
   action.sa_handler = detail::removeTemporariesAndDie;
@@ -257,6 +281,7 @@ inline void removeWrittenOutputs() {
       std::filesystem::remove(file, ignored);
   }
   detail::claimed_outputs.clear();
+  for (auto& slot : detail::claimed_slots) slot.state.store(0);
 }
 
 /// The files `names` in `dir` are this command's outputs: a run that fails (exit 1 or 2) removes
@@ -273,7 +298,9 @@ inline void claimOutputs(const std::filesystem::path& dir, std::initializer_list
       std::error_code ec;
       input = input || (!file.empty() && std::filesystem::equivalent(dir / name, file, ec));
     }
-    if (!input) detail::claimed_outputs.push_back(dir / name);
+    if (input) continue;
+    detail::claimed_outputs.push_back(dir / name);
+    detail::listInSlots(detail::claimed_slots, detail::kClaimedSlots, (dir / name).string());
   }
 }
 
