@@ -30,7 +30,9 @@ void PostureStream::read(const std::filesystem::path& file,
     TipBounds b{DBL_MAX, DBL_MAX, -DBL_MAX, -DBL_MAX, -DBL_MAX};
     for (std::size_t k = 0; k < in.size(); ++k) {
       const geometry::CompactPosture& p = in[k];
-      out[k] = {{p.tip_mm[0], p.tip_mm[1], p.tip_mm[2]}, {p.axis[0], p.axis[1], p.axis[2]}};
+      out[k] = {{p.tip_mm[0], p.tip_mm[1], p.tip_mm[2]},
+                {p.axis[0], p.axis[1], p.axis[2]},
+                p.spindle_rad};
       b.xmin = std::min(b.xmin, double(p.tip_mm[0]));
       b.xmax = std::max(b.xmax, double(p.tip_mm[0]));
       b.ymin = std::min(b.ymin, double(p.tip_mm[1]));

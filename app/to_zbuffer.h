@@ -11,13 +11,14 @@
 
 namespace fieldpath::app {
 
-/// Tool tips and axes (mm, world frame), rounded to float.
+/// Tool tips, axes (mm, world frame) and spindle angles (rad), rounded to float.
 inline std::vector<zbuffer::Posture> toZbuffer(std::span<const geometry::Posture> path) {
   std::vector<zbuffer::Posture> out;
   out.reserve(path.size());
   for (const auto& p : path)
     out.push_back({{float(p.tip_mm.x()), float(p.tip_mm.y()), float(p.tip_mm.z())},
-                   {float(p.axis.x()), float(p.axis.y()), float(p.axis.z())}});
+                   {float(p.axis.x()), float(p.axis.y()), float(p.axis.z())},
+                   p.has_spindle ? float(p.spindle_rad) : 0.f});
   return out;
 }
 

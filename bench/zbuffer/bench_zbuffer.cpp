@@ -353,9 +353,12 @@ void writeCaseFiles(const std::string& stem, const std::vector<zb::Posture>& pos
   const char size[2] = {char(header.size() & 0xff), char(header.size() >> 8)};
   npy.write(size, 2);
   npy << header;
-  static_assert(sizeof(zb::Posture) == 24, "6 floats, no padding");
-  npy.write(reinterpret_cast<const char*>(postures.data()),
-            std::streamsize(postures.size() * sizeof(zb::Posture)));
+  std::vector<float> rows;  // x y z i j k (the spindle angle, 0 in these cases, left out)
+  rows.reserve(postures.size() * 6);
+  for (const zb::Posture& p : postures)
+    rows.insert(rows.end(), {p.tip_mm.x, p.tip_mm.y, p.tip_mm.z, p.axis.x, p.axis.y, p.axis.z});
+  npy.write(reinterpret_cast<const char*>(rows.data()),
+            std::streamsize(rows.size() * sizeof(float)));
   std::fprintf(stderr, "wrote %s.cl and %s.npy (%zu postures)\n", stem.c_str(), stem.c_str(),
                postures.size());
 }

@@ -246,6 +246,52 @@ TEST(Mesh, FastBvhAgreesWithCoarseRasteriser) {
   EXPECT_LE(differ, int(fast.size() / 200));  // only grazing lines on vertical walls may differ
 }
 
+/// A blade: a box x 0..3, y -0.5..0.5, z 0..10 (tool frame), turned by `angle` about +z. Not a
+/// body of revolution: the spindle angle decides where it cuts.
+ToolMesh bladeMesh(double angle_rad) {
+  ToolMesh m;
+  const double c = std::cos(angle_rad), s = std::sin(angle_rad);
+  for (int k = 0; k < 8; ++k) {
+    const double x = (k & 1) ? 3.0 : 0.0, y = (k & 2) ? 0.5 : -0.5, z = (k & 4) ? 10.0 : 0.0;
+    m.vertices.push_back({float(c * x - s * y), float(s * x + c * y), float(z)});
+  }
+  m.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  return m;
+}
+
+// The 7th column turns a mesh tool about its own axis before the axis is placed (the seed's
+// "Cutting" case: a worn edge and the spindle's turn): simulate ignored it, a blade cut the same
+// at 0 and at 90 degrees. Vertical at pi/2 the blade lies along +y: the line at (0, 2) is cut to
+// the tip, (2, 0) is not; on tilted postures a spindle angle cuts as the mesh turned beforehand.
+TEST(Mesh, TheSpindleAngleTurnsAMeshToolAboutItsAxis) {
+  const Grid g = Grid::fromRegion(-4, -4, 4, 4, 80, 80);
+  Posture upright = pose(0, 0, 1, 0, 0, 1);
+  upright.spindle_rad = float(std::numbers::pi / 2);
+  const auto h = runCpu(g, Tool::fromMesh(bladeMesh(0)), {upright}).heights_mm;
+  const auto at = [&](double x, double y) {
+    return h[std::size_t(std::floor((y + 4) / 0.1)) * 80 + std::size_t(std::floor((x + 4) / 0.1))];
+  };
+  EXPECT_EQ(at(0.05, 2.05), 1.f);
+  EXPECT_EQ(at(2.05, 0.05), kStock);
+  EXPECT_EQ(at(0.05, -0.35), kStock);  // the blade's back is at -x, 0.5 from the axis
+
+  const float angle = 0.7f;
+  auto turned = awkwardPostures(12, 29);
+  for (auto& p : turned) p.spindle_rad = angle;
+  const auto unturned = awkwardPostures(12, 29);
+  for (Engine engine : {Engine::Fast, Engine::Coarse}) {
+    const auto a = runCpu(g, Tool::fromMesh(bladeMesh(0)), turned, engine).heights_mm;
+    const auto b = runCpu(g, Tool::fromMesh(bladeMesh(angle)), unturned, engine).heights_mm;
+    const auto c = runCpu(g, Tool::fromMesh(bladeMesh(0)), unturned, engine).heights_mm;
+    int differ_from_unturned = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      EXPECT_NEAR(a[i], b[i], 1e-4) << i;  // float rounding of the turn, vertices or rotation
+      differ_from_unturned += std::abs(a[i] - c[i]) > 0.01f;
+    }
+    EXPECT_GT(differ_from_unturned, 100);
+  }
+}
 
 TEST(Mesh, LinesThroughSharedVerticesAndEdgesAreNeverMissed) {
   const Tool tool = Tool::fromMesh(gridBottomTool());

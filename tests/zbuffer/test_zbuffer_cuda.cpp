@@ -104,6 +104,16 @@ TEST_F(CpuVsCuda, MeshToolBitIdenticalFastAndCoarse) {
   expectSameBits(g, mesh, p, Engine::Coarse);
 }
 
+// Spindle angles (the 7th column) turn a mesh tool on both backends the same, bit for bit.
+TEST_F(CpuVsCuda, SpindleAnglesBitIdentical) {
+  const Grid g = Grid::fromRegion(-20, -20, 20, 20, 200, 200);
+  auto p = randomPostures(2000, 5, 18);
+  for (std::size_t k = 0; k < p.size(); ++k) p[k].spindle_rad = 0.37f * float(k % 17) - 3.0f;
+  const Tool mesh = Tool::fromMesh(analyticToolMesh(Tool::torus(3, 1, 12), 7, 4));
+  expectSameBits(g, mesh, p, Engine::Fast);
+  expectSameBits(g, mesh, p, Engine::Coarse);
+}
+
 TEST_F(CpuVsCuda, EveryTuningVariantBitIdentical) {
   // Small footprints (thread per posture) and large ones (warp per posture) in one run: a fine
   // ball over a coarse grid, tilted postures reach far; each variant of the GPU engine must give

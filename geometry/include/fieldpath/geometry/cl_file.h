@@ -88,10 +88,12 @@ PathFile readNpyPath(const std::filesystem::path& file, const PathReadOptions& o
 struct CompactPosture {
   float tip_mm[3];
   float axis[3];
+  float spindle_rad;  ///< 0 where the file has no 7th column
 };
 inline CompactPosture compact(const Posture& p) {
   return {{float(p.tip_mm.x()), float(p.tip_mm.y()), float(p.tip_mm.z())},
-          {float(p.axis.x()), float(p.axis.y()), float(p.axis.z())}};
+          {float(p.axis.x()), float(p.axis.y()), float(p.axis.z())},
+          p.has_spindle ? float(p.spindle_rad) : 0.f};
 }
 
 /// Where scanPathFile hands the postures over.

@@ -29,9 +29,13 @@ FIELDPATH_HD float maxf(float a, float b) { return a > b ? a : b; }
 FIELDPATH_HD float absf(float a) { return a < 0.f ? -a : a; }
 
 /// Tool posture (DESIGN.md): tip p (mm, world) and unit axis a from the tip towards the spindle.
+/// `spindle_rad` (the optional 7th column): the tool turned by that angle about its own axis
+/// first, for a mesh tool with cutting edges (the seed's worn-edge "Cutting" case); a revolved
+/// tool reads the same at any angle.
 struct Posture {
   Vec3f tip_mm;
   Vec3f axis{0.f, 0.f, 1.f};
+  float spindle_rad = 0.f;
 };
 
 /// Row-major 3×3 rotation, tool frame → world frame.
@@ -77,6 +81,23 @@ FIELDPATH_HD Vec3f mul(const Mat3f& r, Vec3f v) {
           r.m[1][0] * v.x + r.m[1][1] * v.y + r.m[1][2] * v.z,
           r.m[2][0] * v.x + r.m[2][1] * v.y + r.m[2][2] * v.z};
 }
+/// Tool frame → world frame of a posture: the turn by the spindle angle about the tool's +z, then
+/// the minimal rotation onto the axis (DESIGN.md). At angle 0 exactly rotationFromZ, bit for bit.
+FIELDPATH_HD Mat3f postureRotation(const Posture& pose) {
+  Mat3f r = rotationFromZ(pose.axis);
+  if (pose.spindle_rad == 0.f) return r;
+  // In double, then rounded: the device's cosf/sinf differ from the host's by an ulp or two; the
+  // doubles' ulp is 2^29 times finer, so their floats agree (CPU and CUDA stay bit-identical).
+  const float c = static_cast<float>(cos(static_cast<double>(pose.spindle_rad)));
+  const float s = static_cast<float>(sin(static_cast<double>(pose.spindle_rad)));
+  for (int row = 0; row < 3; ++row) {  // r · Rz: columns x, y turned; z (the axis) kept
+    const float x = r.m[row][0], y = r.m[row][1];
+    r.m[row][0] = c * x + s * y;
+    r.m[row][1] = -s * x + c * y;
+  }
+  return r;
+}
+
 FIELDPATH_HD Vec3f mulTransposed(const Mat3f& r, Vec3f v) {
   return {r.m[0][0] * v.x + r.m[1][0] * v.y + r.m[2][0] * v.z,
           r.m[0][1] * v.x + r.m[1][1] * v.y + r.m[2][1] * v.z,

@@ -49,7 +49,7 @@ FIELDPATH_HD void setFootprint(const GridView& g, PreparedPosture& pp, float hul
 /// Lowest possible world z of the placed tool and its footprint on the grid.
 FIELDPATH_HD PreparedPosture preparePosture(const GridView& g, const ToolView& tool, Posture pose) {
   PreparedPosture pp;
-  pp.rot = rotationFromZ(pose.axis);
+  pp.rot = postureRotation(pose);
   pp.tip_mm = pose.tip_mm;
   const float i = pp.rot.m[0][2], j = pp.rot.m[1][2], k = pp.rot.m[2][2];
   pp.dir = {pp.rot.m[2][0], pp.rot.m[2][1], pp.rot.m[2][2]};
@@ -494,7 +494,7 @@ FIELDPATH_HD void rasterTriangle(const GridView& g, Vec3f w0, Vec3f w1, Vec3f w2
 template <class Lower>
 FIELDPATH_HD void coarsePosture(const GridView& g, const ToolView& tool, Posture pose,
                                 Lower lower) {
-  const Mat3f rot = rotationFromZ(pose.axis);
+  const Mat3f rot = postureRotation(pose);
   for (int t = 0; t < tool.triangle_count; ++t) {
     const Vec3f w0 = mul(rot, tool.vertices[tool.indices[3 * t]]) + pose.tip_mm;
     const Vec3f w1 = mul(rot, tool.vertices[tool.indices[3 * t + 1]]) + pose.tip_mm;

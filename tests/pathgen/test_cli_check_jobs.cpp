@@ -1,0 +1,359 @@
+/// `check` on small parts through the built `fieldpath`, each against a closed form or an
+/// independent count: a torus end mill's cusp and gouge, a scallop on a slope between the contact
+/// lines, an open obstacle mesh (no inside: said), unsafe and under-the-clearance marks, the motion
+/// between two postures cut, a shank driven into a wall of the part, passes beside the part, and
+/// the same job high up in z.
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "fieldpath/geometry/cl_file.h"
+#include "fieldpath/geometry/mesh_io.h"
+#include "fixtures.h"
+#include "run_fieldpath.h"
+
+namespace fs = std::filesystem;
+using namespace fieldpath;
+using test::TempDir;
+
+// `check` with a torus end mill (it took ball-end mills only): two straight passes along x over a
+// plate (top at z = 0), tips on it, 5 mm apart in y. Midway (2.5 mm from each axis) a torus R 3
+// r 1 leaves its corner's height there, r - sqrt(r² - (2.5 - (R - r))²) = 134 um, and no gouge;
+// the same passes 0.3 mm lower gouge 300 um. A flat end mill is refused.
+TEST(CheckSurface, TorusEndMillsAreCheckedAgainstTheirClosedFormAndFlatOnesRefused) {
+  const TempDir dir;
+  geometry::TriangleMesh part, wall;
+  pathgen::test::addBox(part, -10, 30, -15, 15, -5, 0);
+  pathgen::test::addBox(wall, 60, 70, -10, 10, 0, 5);  // an obstacle far away (a scene needs one)
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  auto passes = [](double z) {
+    std::ostringstream cl;
+    cl << "# pass 1\n";
+    for (int k = 0; k <= 40; ++k) cl << 0.5 * k << " -2.5 " << z << " 0 0 1\n";
+    cl << "# link\n20 -2.5 5 0 0 1\n0 2.5 5 0 0 1\n# pass 2\n";
+    for (int k = 0; k <= 40; ++k) cl << 0.5 * k << " 2.5 " << z << " 0 0 1\n";
+    return cl.str();
+  };
+  dir.write("on.cl", passes(0.0));
+  dir.write("low.cl", passes(-0.3));
+  auto surface = [&](const std::string& tool, const std::string& path) {
+    dir.write("scene.yaml", "obstacles:\n  - mesh: wall.stl\npart: part.stl\ntool: " + tool +
+                                "\nclearance: 0.5\n");
+    const std::string out = "out_" + std::to_string(std::hash<std::string>{}(tool + path));
+    const auto r = test::runFieldpath(
+        dir, "check scene.yaml --path " + path + " --spacing 0.02 --backend cpu --out " + out);
+    EXPECT_EQ(r.exit_code, 0) << r.output();
+    return nlohmann::json::parse(test::slurp(dir.path() / out / "check.json"))["surface"];
+  };
+  const std::string torus = "{ shape: torus, radius: 3, corner_radius: 1, length: 20 }";
+  const std::string flat = "{ shape: flat, radius: 3, length: 20 }";
+  const double scallop_um = 1000.0 * (1.0 - std::sqrt(1.0 - 0.5 * 0.5));
+  // Lines within half a spacing of the midline: the corner's slope there 0.5 / sqrt(0.75).
+  const double tolerance_um = 1000.0 * 0.01 * 0.5 / std::sqrt(0.75) + 1.0;
+  const auto t = surface(torus, "on.cl");
+  EXPECT_NEAR(t["max_scallop_um"].get<double>(), scallop_um, tolerance_um) << t;
+  EXPECT_LT(t["max_gouge_um"].get<double>(), 0.5) << t;
+  const auto low = surface(torus, "low.cl");
+  EXPECT_NEAR(low["max_gouge_um"].get<double>(), 300.0, 1.0) << low;
+  // A flat end is refused, naming the line of tool.shape: its sharp rim tilted 10 deg along the
+  // feed left a 10 um ridge 9.8 um proud between the stamps (a helper's), read as 4.6 um.
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\npart: part.stl\ntool: " + flat + "\nclearance: 0.5\n");
+  const auto refused = test::runFieldpath(dir, "check scene.yaml --path on.cl --out flat_out");
+  EXPECT_EQ(refused.exit_code, 1) << refused.output();
+  EXPECT_NE(refused.err.find("scene.yaml:4: tool.shape: check proves ball and torus tools"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_FALSE(fs::exists(dir.path() / "flat_out"));
+}
+
+// The scallop statistics are taken between the passes' contact lines, not their ball centres: on
+// the plane z = 0.1 x + 0.4 y a vertical ball R 3 on six passes along x, contact lines 1.2 mm
+// apart in y, leaves R - sqrt(R² - d²/4) across the centre lines' spacing d (70.3 um normal to
+// the plane, as check tells it; 76.1 um in z); the band of the centres, 1.1 mm downhill of the
+// first contact line, took in the ball's flank over unmachined stock (232.7 um, a helper's
+// finding).
+TEST(CheckSurface, ScallopOnASlopeIsBetweenTheContactLines) {
+  const TempDir dir;
+  const double sx = 0.1, sy = 0.4, R = 3.0, p = 1.2;
+  auto z = [&](double x, double y) { return sx * x + sy * y; };
+  geometry::TriangleMesh plane, wall;
+  for (const auto& [x, y] : {std::pair{-5.0, -5.0}, {25.0, -5.0}, {25.0, 15.0}, {-5.0, 15.0}})
+    plane.vertices.emplace_back(x, y, z(x, y));
+  plane.triangles = {{0, 1, 2}, {0, 2, 3}};
+  pathgen::test::addBox(wall, 60, 70, 60, 70, 0, 10);  // far away (a scene needs an obstacle)
+  geometry::saveMesh(plane, dir.path() / "plane.stl");
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  const Eigen::Vector3d n = Eigen::Vector3d(-sx, -sy, 1.0).normalized();
+  std::ostringstream cl;
+  cl.precision(12);
+  for (int k = 0; k < 6; ++k) {
+    if (k > 0) cl << "# link\n20 " << (k - 1) * p << " 20 0 0 1\n0 " << k * p << " 20 0 0 1\n";
+    cl << "# pass " << k + 1 << "\n";
+    for (int i = 0; i <= 40; ++i) {  // the ball centre R along the normal from its contact
+      const Eigen::Vector3d c = Eigen::Vector3d(0.5 * i, k * p, z(0.5 * i, k * p)) + R * n;
+      cl << c.x() << " " << c.y() << " " << c.z() - R << " 0 0 1\n";
+    }
+  }
+  dir.write("slope.cl", cl.str());
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\npart: plane.stl\n"
+            "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
+  const auto r = test::runFieldpath(
+      dir, "check scene.yaml --path slope.cl --spacing 0.02 --backend cpu --out out");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const auto surface =
+      nlohmann::json::parse(test::slurp(dir.path() / "out" / "check.json"))["surface"];
+  // The centre lines' spacing: the step (0, p, sy p) less its part along the passes (1, 0, sx).
+  const Eigen::Vector3d along = Eigen::Vector3d(1, 0, sx).normalized(), step(0, p, sy * p);
+  const double d = (step - step.dot(along) * along).norm();
+  const double scallop_um = 1000.0 * (R - std::sqrt(R * R - 0.25 * d * d));
+  // Lines within half a spacing of a cusp's ridge: the ball's slope there (d/2) / sqrt(R² - d²/4).
+  const double tolerance_um = 1000.0 * 0.01 * 0.5 * d / std::sqrt(R * R - 0.25 * d * d) + 1.0;
+  EXPECT_NEAR(surface["max_scallop_um"].get<double>(), scallop_um, tolerance_um) << surface;
+  EXPECT_LT(surface["max_gouge_um"].get<double>(), 0.5) << surface;
+}
+
+// A block missing one facet is an open shell: no inside, so a tool buried in it reads as clear
+// (FCL measures surfaces; only closed shells have an inside). Said, naming the file, by `check`
+// and `generate` and in check.json `obstacle_notes` (it was silent: a helper's finding); the
+// closed block makes the same postures colliding and gets no note.
+TEST(CheckClearance, AnOpenObstacleMeshIsSaidToHaveNoInside) {
+  const TempDir dir;
+  geometry::TriangleMesh closed;
+  pathgen::test::addBox(closed, -50, 50, -50, 50, -50, 50);
+  geometry::TriangleMesh holed = closed;
+  holed.triangles.pop_back();
+  geometry::saveMesh(closed, dir.path() / "closed.stl");
+  geometry::saveMesh(holed, dir.path() / "holed.stl");
+  dir.write("in.cl", "# pass 1\n0 0 -20 0 0 1\n1 0 -20 0 0 1\n");
+  for (const std::string mesh : {"closed.stl", "holed.stl"}) {
+    dir.write("scene.yaml", "obstacles:\n  - mesh: " + mesh +
+                                "\ntool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
+    const auto r = test::runFieldpath(dir, "check scene.yaml --path in.cl --out out_" + mesh);
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    const auto check =
+        nlohmann::json::parse(test::slurp(dir.path() / ("out_" + mesh) / "check.json"));
+    const bool open = mesh == "holed.stl";
+    EXPECT_EQ(check["obstacle_notes"].size(), open ? 1u : 0u) << check["obstacle_notes"];
+    EXPECT_EQ(
+        r.err.find("holed.stl: 1 shell is open (3 edges with one triangle)") != std::string::npos,
+        open)
+        << r.err;
+    EXPECT_EQ(check["clearance"]["colliding_postures"].get<int>(), open ? 0 : 2);
+  }
+}
+
+// A path that is unsafe for one reason and under the required clearance for another carries
+// both marks: a pass started upright beside a wall 0.3 mm from its holder (start: nominal, damped
+// for the spring alone) swings so far (tilt limit 89°) that the holder goes into the part: UNSAFE;
+// the first posture keeps 0.29 mm from the wall: UNDER THE REQUIRED CLEARANCE too (only the first
+// was said: a helper's finding).
+TEST(CheckClearance, UnsafeAndUnderTheClearanceAreBothMarked) {
+  const TempDir dir;
+  geometry::TriangleMesh wall, part;
+  pathgen::test::addBox(wall, -20, 120, 12.3, 14, -2, 60);  // 0.3 mm from the holder's r 12
+  pathgen::test::addBox(part, -30, 130, -40, 40, -5, 0);
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  std::string cl = "# pass 1\n";
+  for (int i = 0; i <= 100; ++i) cl += std::to_string(i) + " 0 0 0 0 1\n";
+  dir.write("nominal.cl", cl);
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 40 }\n"
+            "holder: [[40, 6], [55, 6], [55, 12], [90, 12]]\nclearance: 0.5\n"
+            "dynamics: { max_tilt_deg: 89, start: nominal, damping: 2 }\n"  // the spring's
+            "path: { nominal: nominal.cl }\n");  // critical alone: the swing rings (damping 2)
+  const auto r = test::runFieldpath(dir, "generate scene.yaml --out out");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out" / "report.json"));
+  ASSERT_FALSE(report["unsafe"].empty()) << report["unsafe"];  // the holder into the part
+  ASSERT_EQ(report["clearance"]["colliding_postures"].get<int>(), 0);
+  ASSERT_LT(report["clearance"]["min_mm"].get<double>(), 0.5);
+  const std::string cl_out = test::slurp(dir.path() / "out" / "path.cl");
+  const std::string apt = test::slurp(dir.path() / "out" / "path.apt");
+  for (const std::string& text : {cl_out, apt}) {
+    EXPECT_NE(text.find("UNSAFE TO RUN"), std::string::npos) << text.substr(0, 400);
+    EXPECT_NE(text.find("UNDER THE REQUIRED CLEARANCE"), std::string::npos) << text.substr(0, 400);
+  }
+  EXPECT_NE(r.err.find("warning: UNSAFE TO RUN"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("closer to the obstacles than `clearance`"), std::string::npos) << r.err;
+  EXPECT_EQ(geometry::readPathFile(dir.path() / "out" / "path.cl").warnings.size(), 2u);
+}
+
+// `check` cuts along the motions, not only at the postures: two postures on a floor either side
+// of a ridge 1 mm high, each clear of it, and the straight move between them through the ridge.
+// The gouge is the ridge's height (1000 um, less the sweep's bound); the same postures with the
+// move lifted over the ridge (up, across 0.5 mm above it, down) gouge nothing.
+TEST(CheckSurface, TheMotionBetweenTwoPosturesIsCut) {
+  const TempDir dir;
+  geometry::TriangleMesh part, wall;
+  pathgen::test::addBox(part, -10, 20, -10, 10, -5, 0);  // the floor, top at z = 0
+  pathgen::test::addBox(part, 4, 6, -10, 10, 0, 1);      // the ridge
+  pathgen::test::addBox(wall, 60, 70, -10, 10, 0, 5);    // an obstacle far away (a scene needs one)
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 40 }\nclearance: 0.5\n");
+  dir.write("through.cl", "# pass 1\n0 0 0 0 0 1\n10 0 0 0 0 1\n");
+  dir.write("over.cl", "# pass 1\n0 0 0 0 0 1\n0 0 1.5 0 0 1\n10 0 1.5 0 0 1\n10 0 0 0 0 1\n");
+  auto gouge = [&](const std::string& path) {
+    const auto r = test::runFieldpath(
+        dir, "check scene.yaml --path " + path + " --spacing 0.1 --out out_" + path);
+    EXPECT_EQ(r.exit_code, 0) << r.output();
+    const auto check =
+        nlohmann::json::parse(test::slurp(dir.path() / ("out_" + path) / "check.json"));
+    return check["surface"];
+  };
+  const auto through = gouge("through.cl");
+  EXPECT_GT(through["max_gouge_um"].get<double>(), 1000.0 - 10.0);
+  EXPECT_LE(through["max_gouge_um"].get<double>(), 1000.0 + 1.0);
+  EXPECT_GT(through["gouged_lines"].get<int>(), 100);
+  EXPECT_GT(through["simulated_postures"].get<int>(), 50);  // 10 mm at <= 0.17 mm
+  const auto over = gouge("over.cl");
+  EXPECT_EQ(over["gouged_lines"].get<int>(), 0);
+}
+
+// A tilted tool's shank cuts beside the ball's footprint: a pass on a floor with the axis tilted
+// 20° towards a wall of the part 7 mm off drives the shank ~4 mm into the wall. The Z-buffer's
+// region reached only the balls (0 um of gouge); it now reaches the shank's plan up to the
+// part's top. The same pass tilted away gouges nothing.
+TEST(CheckSurface, AShankDrivenIntoAWallOfThePartIsAGouge) {
+  const TempDir dir;
+  geometry::TriangleMesh part, far;
+  pathgen::test::addBox(part, -30, 7, -30, 30, -10, 0);  // the floor
+  pathgen::test::addBox(part, 8, 30, -30, 30, -10, 60);  // a wall beside the pass
+  pathgen::test::addBox(far, -100, -90, -100, -90, -50, -40);
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(far, dir.path() / "far.stl");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: far.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 40 }\n");
+  const double s = std::sin(20.0 * M_PI / 180.0), c = std::cos(20.0 * M_PI / 180.0);
+  for (const double side : {1.0, -1.0}) {
+    std::ostringstream path;
+    path.precision(17);
+    path << "# pass 1\n";
+    // the ball resting on the floor: its centre at z = 3 over x = -1, the tip R below it
+    for (int k = 0; k <= 40; ++k)
+      path << -1 - 3 * side * s << ' ' << -5 + 0.25 * k << ' ' << 3 - 3 * c << ' ' << side * s
+           << " 0 " << c << '\n';
+    dir.write(side > 0 ? "towards.cl" : "away.cl", path.str());
+  }
+  auto checked = [&](const std::string& name) {
+    const auto r = test::runFieldpath(
+        dir, "check scene.yaml --path " + name + ".cl --spacing 0.1 --out out_" + name);
+    EXPECT_EQ(r.exit_code, 0) << r.output();
+    return nlohmann::json::parse(test::slurp(dir.path() / ("out_" + name) / "check.json"));
+  };
+  const auto towards = checked("towards"), away = checked("away");
+  EXPECT_GT(towards["surface"]["max_gouge_um"].get<double>(), 3000.0);
+  EXPECT_GT(towards["surface"]["gouged_lines"].get<int>(), 100);
+  EXPECT_FALSE(towards["ok"].get<bool>());
+  ASSERT_EQ(towards["not_ok_because"].size(), 1u);  // the gouge said as the reason
+  EXPECT_NE(towards["not_ok_because"][0].get<std::string>().find("below the part"),
+            std::string::npos);
+  EXPECT_EQ(away["surface"]["gouged_lines"].get<int>(), 0);
+  EXPECT_TRUE(away["ok"].get<bool>()) << away["not_ok_because"];
+}
+
+// Passes that do not cross the part leave no surface to check, but their clearance still
+// counts: `check` refused the whole job (exit 1) and never said that the shank, tilted 40°
+// into a wall, collides.
+TEST(CheckSurface, PassesBesideThePartAreStillCheckedForClearance) {
+  const TempDir dir;
+  geometry::TriangleMesh part, wall;
+  pathgen::test::addBox(part, -40, -20, -30, 30, -10, 0);  // a plate well away from the pass
+  pathgen::test::addBox(wall, 8, 20, -30, 30, -10, 60);    // an obstacle beside the pass
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 40 }\nclearance: 0.5\n");
+  const double s = std::sin(40.0 * M_PI / 180.0), c = std::cos(40.0 * M_PI / 180.0);
+  std::ostringstream path;
+  path.precision(17);
+  path << "# pass 1\n";
+  for (int k = 0; k <= 10; ++k) path << "0 " << -5 + k << " 0 " << s << " 0 " << c << '\n';
+  dir.write("lean.cl", path.str());
+  const auto r = test::runFieldpath(dir, "check scene.yaml --path lean.cl --out out");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  EXPECT_NE(r.output().find("surface: not checked (the passes do not pass over the part"),
+            std::string::npos)
+      << r.output();
+  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out" / "check.json"));
+  EXPECT_TRUE(report["surface"].is_null());
+  EXPECT_NE(report["surface_skipped"].get<std::string>().find("do not pass over the part"),
+            std::string::npos);
+  // The shank's axis reaches x = 8 (the wall) 8 / sin 40° = 12.4 mm up: every posture collides.
+  EXPECT_EQ(report["clearance"]["colliding_postures"].get<int>(), 11);
+  EXPECT_FALSE(report["ok"].get<bool>());
+  // The axis holds its 40° all along: no turn, no warning.
+  EXPECT_NEAR(report["axis_turn"]["max_deg"].get<double>(), 0.0, 1e-6);
+  EXPECT_EQ(report["axis_turn"]["posture"].get<int>(), 0);  // the first pair: none turns more
+  EXPECT_EQ(r.err.find("the tool axis turns"), std::string::npos) << r.err;
+  // The same pass with the axis snapping upright half-way: the turn said, naming the lines.
+  std::ostringstream snap;
+  snap.precision(17);
+  snap << "# pass 1\n";
+  for (int k = 0; k <= 10; ++k)
+    snap << "0 " << -5 + k
+         << (k < 6 ? " 0 " + std::to_string(s) + " 0 " + std::to_string(c)
+                   : std::string(" 0 0 0 1"))
+         << '\n';
+  dir.write("snap.cl", snap.str());
+  const auto t = test::runFieldpath(dir, "check scene.yaml --path snap.cl --out snapped");
+  ASSERT_EQ(t.exit_code, 0) << t.output();
+  EXPECT_NE(t.err.find("warning: the tool axis turns 40.0 deg between postures 5 (snap.cl:7) and "
+                       "6 (snap.cl:8)"),
+            std::string::npos)
+      << t.err;
+  const auto snapped = nlohmann::json::parse(test::slurp(dir.path() / "snapped" / "check.json"));
+  EXPECT_NEAR(snapped["axis_turn"]["max_deg"].get<double>(), 40.0, 1e-4);
+  EXPECT_EQ(snapped["axis_turn"]["posture"].get<int>(), 5);
+}
+
+TEST(CheckSurface, TheSameJobHighUpInZReadsTheSame) {
+  // A pass along a plate, and the whole job lifted 1e5 mm in z: the same surface figures
+  // (float heights held there read a clean pass as 7.8 um of gouge on 498 lines).
+  const TempDir dir;
+  for (const double lift : {0.0, 1e5}) {
+    geometry::TriangleMesh part, wall;
+    pathgen::test::addBox(part, 0, 50, 0, 50, lift - 10, lift);
+    pathgen::test::addBox(wall, 0, 50, 30, 35, lift - 5, lift + 20);
+    const std::string tag = lift == 0.0 ? "low" : "high";
+    geometry::saveMesh(part, dir.path() / ("part_" + tag + ".stl"));
+    geometry::saveMesh(wall, dir.path() / ("wall_" + tag + ".stl"));
+    dir.write(tag + ".yaml", "obstacles:\n  - mesh: wall_" + tag + ".stl\npart: part_" + tag +
+                                 ".stl\ntool: { shape: ball, radius: 3, length: 40 }\n");
+    std::ostringstream path;
+    path.precision(17);
+    for (const double y : {20.0, 24.0}) {  // two passes: a scallop between them
+      if (y > 20.0)
+        path << "# link\n45 20 " << lift + 8 << " 0 0 1\n5 24 " << lift + 8 << " 0 0 1\n";
+      path << "# pass\n";
+      for (int k = 0; k <= 80; ++k) path << 5.0 + 0.5 * k << ' ' << y << ' ' << lift << " 0 0 1\n";
+    }
+    dir.write(tag + ".cl", path.str());
+  }
+  auto surface = [&](const std::string& tag) {
+    const auto r =
+        test::runFieldpath(dir, "check " + tag + ".yaml --path " + tag + ".cl --out out_" + tag);
+    EXPECT_EQ(r.exit_code, 0) << r.output();
+    return nlohmann::json::parse(
+        test::slurp(dir.path() / ("out_" + tag) / "check.json"))["surface"];
+  };
+  const auto low = surface("low"), high = surface("high");
+  EXPECT_EQ(low["gouged_lines"].get<int>(), 0);
+  EXPECT_EQ(high["gouged_lines"].get<int>(), 0);
+  EXPECT_NEAR(high["max_gouge_um"].get<double>(), low["max_gouge_um"].get<double>(), 1.0);
+  EXPECT_NEAR(high["max_scallop_um"].get<double>(), low["max_scallop_um"].get<double>(), 1.0);
+  EXPECT_GT(low["max_scallop_um"].get<double>(), 600.0);  // R - sqrt(R² - 4) = 764 um
+}
