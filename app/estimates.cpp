@@ -170,7 +170,7 @@ void checkVoxelSize(const Scene& scene, double voxel_mm, const std::string& key)
   const double r0 = scene.field.r0_mm;
   // The field build refuses it too, but only when it comes (study: after its direct variants).
   if (voxel_mm > r0)
-    throw common::InputError(scene.file.string() + ": " + key + ": " + fmt(voxel_mm) +
+    throw common::InputError(sceneWhere(scene, key) + ": " + fmt(voxel_mm) +
                              " mm is coarser than field.r0 (" + fmt(r0) +
                              " mm): the grid cannot hold a field that ends within r0 "
                              "of the surfaces; use at most r0 (r0 / 10 for an accurate one)");

@@ -1,5 +1,6 @@
 #include "scene.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -172,13 +173,14 @@ class Reader {
     return mesh;
   }
 
-  /// Runs a module's own validation, naming the key and line in its error.
+  /// Runs a module's own validation, naming the key and line in its error: the line of the
+  /// map's key that the message names (`tool length must cover...`: `length`'s), else the map's.
   void check(const YAML::Node& node, const std::string& key,
              const std::function<void()>& validate) const {
     try {
       validate();
     } catch (const InputError& e) {
-      fail(node, key, e.what());
+      fail(valueNamedIn(node, e.what()), key, e.what());
     }
   }
 
@@ -199,7 +201,11 @@ struct MeshLoad {
 
 void readObstacles(const Reader& r, const YAML::Node& node, Scene& scene,
                    std::vector<MeshLoad>& loads) {
-  if (!node.IsSequence() || node.size() == 0)
+  if (node.IsSequence() && node.size() == 0)
+    r.fail(node, "obstacles",
+           "the list is empty: a scene needs at least one obstacle (`- mesh: FILE` or "
+           "`- impeller: {...}`)");
+  if (!node.IsSequence())
     r.fail(node, "obstacles", "expected a list of `- mesh: FILE` or `- impeller: {...}`");
   for (std::size_t i = 0; i < node.size(); ++i) {
     const YAML::Node item = node[i];
@@ -343,8 +349,12 @@ void readDynamics(const Reader& r, const YAML::Node& node, dynamics::DynamicsPar
   }
   if (node["stiffness"]) d.stiffness = r.positive(node["stiffness"], "dynamics.stiffness");
   if (node["feed"]) d.feed_mm_per_min = r.positive(node["feed"], "dynamics.feed");
-  if (node["rtol"]) d.rtol = r.positive(node["rtol"], "dynamics.rtol");
-  if (node["atol"]) d.atol = r.positive(node["atol"], "dynamics.atol");
+  // Tolerances of 1 or more accept any step (rtol 1e6 moved the lead by 1.6 deg without a word).
+  const auto tolerance = [](double v) { return v > 0.0 && v < 1.0; };
+  if (node["rtol"])
+    d.rtol = r.number(node["rtol"], "dynamics.rtol", tolerance, "in (0, 1), e.g. 1e-6");
+  if (node["atol"])
+    d.atol = r.number(node["atol"], "dynamics.atol", tolerance, "in (0, 1) rad, e.g. 1e-9");
   auto angle = [&](const char* key) {
     return r.number(
         node[key], std::string("dynamics.") + key, [](double v) { return v > 0.0 && v < 90.0; },
@@ -410,6 +420,28 @@ void readLinks(const Reader& r, const YAML::Node& node, pathgen::LinkParams& lin
 
 }  // namespace
 
+YAML::Node valueNamedIn(const YAML::Node& map, const std::string& message) {
+  if (!map.IsMap()) return map;
+  YAML::Node best = map;
+  std::size_t best_at = std::string::npos;
+  const auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  for (const auto& kv : map) {
+    if (!kv.first.IsScalar() || kv.first.Scalar().empty()) continue;
+    std::string spaced = kv.first.Scalar();
+    std::replace(spaced.begin(), spaced.end(), '_', ' ');
+    for (const std::string& name : {kv.first.Scalar(), spaced})
+      for (std::size_t at = message.find(name); at != std::string::npos && at < best_at;
+           at = message.find(name, at + 1)) {
+        const std::size_t end = at + name.size();
+        if ((at == 0 || !word(message[at - 1])) && (end == message.size() || !word(message[end]))) {
+          best_at = at;
+          best = kv.second.IsDefined() && kv.second.Mark().line >= 0 ? kv.second : kv.first;
+          break;
+        }
+      }
+  }
+  return best;
+}
 
 std::string sceneWhere(const Scene& scene, const std::string& key) {
   const SceneKeyLines& keys = sceneKeyLines();

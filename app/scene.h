@@ -72,6 +72,10 @@ std::string placeSceneKey(const std::string& message);
 /// "FILE:LINE: key" (LINE where the scene gives the key): the start of a refusal of one setting.
 std::string sceneWhere(const Scene& scene, const std::string& key);
 
+/// The value of `map`'s key that a module's error `message` names first as a whole word
+/// (`corner_radius` also as `corner radius`), else `map` itself: its line is the key's.
+YAML::Node valueNamedIn(const YAML::Node& map, const std::string& message);
+
 /// "FILE:LINE: tool.shape" (LINE where known): the start of a refusal of the scene's tool.
 inline std::string toolShapeWhere(const Scene& scene) {
   return scene.file.string() +

@@ -90,7 +90,7 @@ void resolveImpeller(Scene& scene) {
   try {
     scene.impeller_model.emplace(params);
   } catch (const InputError& e) {
-    throw InputError(where(scene, node) + "obstacles." + e.what());
+    throw InputError(where(scene, valueNamedIn(node, e.what())) + "obstacles." + e.what());
   }
   checkImpellerSize(*scene.impeller_model, where(scene, node));  // before the meshes are made
   for (auto& blade : pathgen::bladeMeshes(*scene.impeller_model))

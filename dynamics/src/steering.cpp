@@ -83,8 +83,8 @@ void validate(const Pass& pass, const SteeringRequest& request) {
               p.stiffness);
   requireThat(std::isfinite(p.feed_mm_per_min) && p.feed_mm_per_min > 0.0, "dynamics.feed", "> 0",
               p.feed_mm_per_min);
-  requireThat(std::isfinite(p.rtol) && p.rtol > 0.0, "dynamics.rtol", "> 0", p.rtol);
-  requireThat(std::isfinite(p.atol) && p.atol > 0.0, "dynamics.atol", "> 0", p.atol);
+  requireThat(p.rtol > 0.0 && p.rtol < 1.0, "dynamics.rtol", "in (0, 1)", p.rtol);
+  requireThat(p.atol > 0.0 && p.atol < 1.0, "dynamics.atol", "in (0, 1)", p.atol);
   requireThat(p.max_tilt_deg > 0.0 && p.max_tilt_deg <= 90.0, "dynamics.max_tilt_deg", "in (0, 90]",
               p.max_tilt_deg);
   requireThat(p.max_lead_deg > 0.0 && p.max_lead_deg <= 90.0, "dynamics.max_lead_deg", "in (0, 90]",

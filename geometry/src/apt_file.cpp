@@ -6,6 +6,7 @@
 /// `FINI` ends the program (nothing after it is read); motions it does not take (arcs, cycles,
 /// relative and drive-surface moves) are refused; every other record is read past.
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <exception>
@@ -88,11 +89,29 @@ bool isTextRecord(std::string_view content) {
   return head == "PPRINT" || head == "PARTNO" || head == "INSERT" || head == "REMARK";
 }
 
+/// A line without the sequence field of an 80-column card: up to 8 letters or digits in columns
+/// 73-80 after a blank column 72 (classic CLDATA decks number their cards so; such a deck's GOTOs
+/// were refused as bad numbers). Not where the text before ends in a separator (`,` `/` `=`): a
+/// free-format record's last number may stand past column 72.
+std::string_view withoutCardSequence(std::string_view line) {
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  if (line.size() <= kAptColumns || line.size() > 80 || line[kAptColumns - 1] != ' ') return line;
+  const std::string_view field = trimmed(line.substr(kAptColumns));
+  const bool sequence = !field.empty() && std::all_of(field.begin(), field.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0;
+  });
+  const std::string_view card = trimmed(line.substr(0, kAptColumns));
+  if (!sequence || card.empty() || card.back() == ',' || card.back() == '/' || card.back() == '=')
+    return line;
+  return line.substr(0, kAptColumns);
+}
+
 /// A line's content without its `$$` comment and surrounding blanks. A single `$` followed by a
 /// blank continues the statement on the next line and what follows it is a remark
 /// (`GOTO/0,0,-0.5,$ first part` was refused as a bad number); the content then ends at that
 /// `$`. Not in text records, whose text may hold a `$`.
 std::string_view aptContent(std::string_view line) {
+  line = withoutCardSequence(line);
   if (const auto comment = line.find("$$"); comment != std::string_view::npos)
     line = line.substr(0, comment);
   line = trimmed(line);

@@ -1,17 +1,19 @@
 #include "fieldpath/geometry/mesh_io.h"
 
+#include <algorithm>
 #include <array>
 #include <cctype>
-#include <utility>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
 #include <exception>
 #include <fstream>
-#include <iterator>
 #include <functional>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <unordered_map>
+#include <utility>
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -166,21 +168,28 @@ StlFeed checkAsciiStl(const std::filesystem::path& file, std::uintmax_t size) {
     } else if (word == "vertex") {
       ++vertices;
       // x y z: assimp's own word on a short line names no line ("Cannot parse string ...").
+      // Each a whole number (`2x6` made assimp quote the file in a 1.6 kB line), and finite.
       std::size_t tokens = 0, at = line.find_first_of("xX") + 1;
-      bool numbers = true;
+      std::string bad;
       while (true) {
         at = line.find_first_not_of(" \t\r", at);
         if (at == std::string::npos) break;
-        const char c = line[at];
-        numbers = numbers &&
-                  (std::isdigit(static_cast<unsigned char>(c)) || c == '-' || c == '+' || c == '.');
+        const std::size_t end = std::min(line.find_first_of(" \t\r", at), line.size());
+        const std::string token = line.substr(at, end - at);
+        char* stop = nullptr;
+        const double value = std::strtod(token.c_str(), &stop);
+        if (bad.empty() && (stop != token.c_str() + token.size() || !std::isfinite(value)))
+          bad = token;
         ++tokens;
-        at = line.find_first_of(" \t\r", at);
-        if (at == std::string::npos) break;
+        at = end;
       }
-      if (tokens != 3 || !numbers)
-        throw InputError(file.string() + ":" + std::to_string(number) +
-                         ": ASCII STL vertex line needs 3 numbers (x y z)");
+      const std::string where = file.string() + ":" + std::to_string(number) + ": ";
+      if (tokens != 3)
+        throw InputError(where + "ASCII STL vertex line needs 3 numbers (x y z), it has " +
+                         std::to_string(tokens));
+      if (!bad.empty())
+        throw InputError(where + "ASCII STL vertex: '" + bad.substr(0, 40) +
+                         "' is not a finite number");
     } else if (word == "endfacet") {
       if (in_facet && vertices != 3)
         throw InputError(file.string() + ":" + std::to_string(facet_line) +
@@ -201,10 +210,20 @@ StlFeed checkAsciiStl(const std::filesystem::path& file, std::uintmax_t size) {
   return feed;
 }
 
+/// Whether the first 64 KiB hold a NUL byte: binary (an ASCII STL has none; a binary one's
+/// floats and attribute counts have many).
+bool hasNulByte(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string head(1 << 16, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  return head.find('\0') != std::string::npos;
+}
+
 /// A binary STL's size is fixed by its header: 84 bytes and 50 a triangle. One shorter than its
 /// count says (truncated, or a count that lies) is refused saying so, where assimp would only say
 /// it cannot tell ASCII from binary; up to 49 bytes more (an exporter's padding, less than a
-/// triangle) are read past. A file that starts with `solid` and does not match is ASCII.
+/// triangle) are read past. A file that starts with `solid` and has no NUL byte is ASCII.
 StlFeed checkStl(const std::filesystem::path& file, std::uintmax_t size) {
   if (lowerExtension(file) != ".stl") return {};
   std::ifstream in(file, std::ios::binary);
@@ -227,15 +246,14 @@ StlFeed checkStl(const std::filesystem::path& file, std::uintmax_t size) {
     feed.length = needed;
     return feed;
   };
-  if (word == "solid") {
-    // ASCII, unless a binary one whose header starts so (its size matches its count).
-    if (got == 84) {
-      const std::uint32_t count = std::uint32_t(header[80]) | std::uint32_t(header[81]) << 8 |
-                                  std::uint32_t(header[82]) << 16 | std::uint32_t(header[83]) << 24;
-      if (binaryFits(84 + 50 * std::uintmax_t(count)))
-        return binaryFeed(84 + 50 * std::uintmax_t(count));
-    }
-    return checkAsciiStl(file, size);
+  if (word == "solid" && !hasNulByte(file)) return checkAsciiStl(file, size);
+  if (word == "solid" && got == 84) {
+    // A binary STL whose header starts so (CAD exports): its size must match its count, as any
+    // binary one's (below); it was read as ASCII "without `endsolid`" when it did not.
+    const std::uint32_t count = std::uint32_t(header[80]) | std::uint32_t(header[81]) << 8 |
+                                std::uint32_t(header[82]) << 16 | std::uint32_t(header[83]) << 24;
+    if (binaryFits(84 + 50 * std::uintmax_t(count)))
+      return binaryFeed(84 + 50 * std::uintmax_t(count));
   }
   if (got < 84)
     throw InputError(file.string() + ": binary STL of " + std::to_string(size) +

@@ -58,7 +58,9 @@ std::vector<std::uint64_t> parseShape(const std::filesystem::path& file, const s
   std::string_view rest(text);
   while (!trimmed(rest).empty()) {
     const auto comma = rest.find(',');
-    const std::string_view item = trimmed(rest.substr(0, comma));
+    std::string_view item = trimmed(rest.substr(0, comma));
+    if (!item.empty() && (item.back() == 'L' || item.back() == 'l'))  // Python 2's long: (243L, 6L)
+      item.remove_suffix(1);
     if (!item.empty()) {
       std::uint64_t value = 0;
       const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
@@ -122,11 +124,17 @@ NpyRows checkedRows(const std::filesystem::path& file, std::string_view bytes) {
   const auto shape_text = headerValue(header, "shape");
   if (!descr || !fortran || !shape_text)
     bad(file, "npy header lacks descr, fortran_order or shape");
+  // As numpy.load takes them: a byte order (< = > |, none: this machine's, little) and a float
+  // type by code (f4 f8 f d) or name (float32 float64 single double).
   std::size_t item = 0;
   const std::string& type = *descr;
-  if (type.size() == 3 && (type[0] == '<' || type[0] == '=' || type[0] == '>') && type[1] == 'f' &&
-      (type[2] == '4' || type[2] == '8'))
-    item = type[2] == '8' ? 8 : 4;
+  const bool ordered =
+      !type.empty() && std::string_view("<=>|").find(type[0]) != std::string_view::npos;
+  const std::string_view code = std::string_view(type).substr(ordered ? 1 : 0);
+  if (code == "f4" || code == "f" || code == "float32" || code == "single")
+    item = 4;
+  else if (code == "f8" || code == "d" || code == "float64" || code == "double")
+    item = 8;
   else
     bad(file, "npy dtype '" + *descr + "': expected float32 or float64 (<f4, <f8, >f4, >f8)");
   if (*fortran != "False" && *fortran != "True")
@@ -145,8 +153,12 @@ NpyRows checkedRows(const std::filesystem::path& file, std::string_view bytes) {
     bad(file, "npy data is " + std::to_string(data_size) + " bytes, shape (" +
                   std::to_string(rows) + ", " + std::to_string(columns) + ") needs " +
                   std::to_string(rows * columns * item) + " (trailing bytes)");
-  return {
-      bytes.data() + offset + header_size, rows, columns, item, type[0] == '>', *fortran == "True"};
+  return {bytes.data() + offset + header_size,
+          rows,
+          columns,
+          item,
+          ordered && type[0] == '>',
+          *fortran == "True"};
 }
 
 /// Row r as a posture, checked like a `.cl` line ("FILE: row R: ...").

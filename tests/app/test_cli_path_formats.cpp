@@ -247,6 +247,16 @@ TEST(SimulateFormats, BigEndianAndFortranOrderNpyAreRead) {
   EXPECT_TRUE(f.heights("fortran.npy", "") == whole);
   EXPECT_TRUE(f.heights("fortran.npy", "--region -11.2,-5.2,10.2,-1.8 --stock 1 --block 13") ==
               f.heights("path32.npy", "--region -11.2,-5.2,10.2,-1.8 --stock 1 --block 13"));
+  // dtypes as numpy.load takes them (`<f`, `float32`, no byte order) and Python 2's long sizes
+  // in a version-1 header (`(243L, 6L)`): the same rows (they were refused).
+  const std::string sizes = "(" + std::to_string(n) + "L, 6L)";
+  for (const std::string dict :
+       {"{'descr': '<f', 'fortran_order': False, 'shape': (" + std::to_string(n) + ", 6), }",
+        "{'descr': 'float32', 'fortran_order': False, 'shape': (" + std::to_string(n) + ", 6), }",
+        "{'descr': 'f4', 'fortran_order': False, 'shape': " + sizes + ", }"}) {
+    f.dir.write("variant.npy", npyBytes(dict, rows));
+    EXPECT_TRUE(f.heights("variant.npy", "") == whole) << dict;
+  }
 }
 
 /// A bad line far into a big `.cl`: the blocks before it were cut already (streamed); still one

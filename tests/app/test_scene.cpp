@@ -142,7 +142,17 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
       {"obstacles:\n  - mesh: wall.stl\nfield: 5\n", "field", 3},
       {"obstacles:\n  - mesh: wall.stl\n    impeller: {}\n", "obstacles[1]", 2},
       {"field:\n  r0: 5\n", "obstacles", 0},
-      {"obstacles: []\n", "obstacles", 1},
+      {"obstacles: []\n", "obstacles: the list is empty", 1},
+      // Tolerances of 1 or more accept any step (rtol 1e6 moved the lead 1.6 deg, unsaid).
+      {"obstacles:\n  - mesh: wall.stl\ndynamics:\n  rtol: 2\n", "dynamics.rtol: must be in (0, 1)",
+       4},
+      {"obstacles:\n  - mesh: wall.stl\ndynamics:\n  atol: 1\n", "dynamics.atol: must be in (0, 1)",
+       4},
+      // A module's refusal names the line of the key it names, not its map's first line.
+      {"obstacles:\n  - mesh: wall.stl\ntool:\n  shape: ball\n  radius: 3\n  length: 1\n",
+       "tool length", 6},
+      {"obstacles:\n  - impeller:\n      length: 80\n      chord_tol: 0\n",
+       "obstacles.impeller.chord_tol", 4},
       {"obstacles:\n  - mesh: wall.stl\ntool: { shape: torus, radius: 3 }\n", "tool.corner_radius",
        3},
       {"obstacles:\n  - mesh: wall.stl\ntool: { shape: cone }\n", "tool.shape", 3},

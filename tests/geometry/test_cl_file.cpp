@@ -318,6 +318,28 @@ TEST(AptFile, MotionsNotReadAreRefusedAndPprintKeepsItsDollar) {
                                              "GOTO/0,0,0,0,0,1\n")).size(), 1u);
 }
 
+// Classic 80-column cards number themselves in columns 73-80 (after a blank column 72): read
+// past (such decks were refused as bad numbers); a free-format record's number past column 72 is
+// still the record's.
+TEST(AptFile, CardSequenceNumbersAreReadPast) {
+  const auto card = [](std::string text, const std::string& sequence) {
+    text.resize(72, ' ');
+    return text + sequence + "\r\n";
+  };
+  const auto p = readAptFile(writeBytes(
+      "seq.apt",
+      card("MULTAX/ON", "00000010") + card("GOTO/0.0000,10.0000,0.0000,0.,0.,1.", "00000020") +
+          card("GOTO/0.5000,10.0000,0.0000,0.,0.,1.", "PART0030") + card("FINI", "00000040")));
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_EQ(p[1].tip_mm, Vec3(0.5, 10, 0));
+  EXPECT_EQ(p[1].axis, Vec3::UnitZ());
+  std::string free_format = "GOTO / 10.0000000000, 20.0000000000, 30.0000000000, 0.0000000000, ";
+  free_format.resize(72, ' ');  // the last number stands alone past column 72
+  const auto q = readAptFile(writeBytes("free.apt", free_format + "0, 1\n"));
+  ASSERT_EQ(q.size(), 1u);
+  EXPECT_EQ(q[0].tip_mm, Vec3(10, 20, 30));
+}
+
 // TLAXIS/i,j,k sets the axis of the 3-value GOTOs after it (APT's modal axis: they kept the old
 // one).
 TEST(AptFile, TlaxisSetsTheAxisOfThreeValueGotos) {

@@ -227,6 +227,26 @@ TEST(MeshIo, BrokenFilesAreInputErrors) {
   expectMessage(
       writeBytes("short_vertex.stl", short_vertex),
       "short_vertex.stl:" + std::to_string(short_line) + ": ASCII STL vertex line needs 3 numbers");
+  // A number that is no number, or not finite, named with its line (`2x6`: assimp quoted the
+  // file in a 1.6 kB line; `nan`: "needs 3 numbers" of a line that has three).
+  for (const char* bad : {"2x6", "nan", "inf"}) {
+    std::string text = tetra;
+    text.replace(text.find("vertex 1 0 0"), 12, std::string("vertex 1 ") + bad + " 0");
+    expectMessage(writeBytes("bad_number.stl", text),
+                  "bad_number.stl:" + std::to_string(short_line) + ": ASCII STL vertex: '" + bad +
+                      "' is not a finite number");
+  }
+  // A binary STL whose header starts with `solid` (CAD exports) and whose size is not its
+  // count's: said as a binary one (it was "ASCII STL without `endsolid`").
+  std::string solid_header = "solid exported by a CAD system";
+  solid_header.resize(80, ' ');
+  const std::uint32_t two = 2;
+  solid_header.append(reinterpret_cast<const char*>(&two), 4);
+  std::string facet(50, '\0');
+  expectMessage(writeBytes("solid_binary_cut.stl", solid_header + facet + facet.substr(0, 30)),
+                "binary STL: its header says 2 triangles (184 bytes), the file has 164");
+  expectMessage(writeBytes("solid_binary_long.stl", solid_header + facet + facet + facet),
+                "binary STL: its header says 2 triangles (184 bytes), the file has 234");
   expectMessage(writeBytes("line.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n"),
                 "a face with fewer than 3 vertices");
   expectMessage(writeBytes("index.ply", ply_header.substr(0, ply_header.find("element face 2")) +
