@@ -155,6 +155,22 @@ class Reader {
     // field was zero everywhere without a word: a helper's finding).
     if (!(geometry::meshArea(mesh) > 0.0))
       fail(node, key, p.string() + ": every triangle has zero area: the mesh has no surface");
+    // A solid exported with a T-junction, a sliver or a facet wound the wrong way had no inside:
+    // a tool wholly inside it read as clear. Mended where that closes it, and said.
+    if (const geometry::ShellRepair mend = geometry::repairShells(mesh); mend.any()) {
+      std::string what;
+      const auto add = [&what](std::size_t n, const char* one, const char* many) {
+        if (n == 0) return;
+        what += (what.empty() ? "" : ", ") + std::to_string(n) + " " + (n == 1 ? one : many);
+      };
+      add(mend.edges_split, "T-junction edge split", "T-junction edges split");
+      add(mend.slivers_removed, "sliver of no area left out", "slivers of no area left out");
+      add(mend.facets_turned, "facet turned to agree with its neighbours",
+          "facets turned to agree with their neighbours");
+      std::fprintf(
+          stderr, "note: %s: mended as exported solids need (%s): %zu open edges before, %zu now\n",
+          p.string().c_str(), what.c_str(), mend.open_edges_before, mend.open_edges_after);
+    }
     // Inward-wound shells would make the field pull into the walls (the samples' normals) and
     // the part's top its bottom: turned, and said.
     if (const std::size_t turned = geometry::orientClosedShells(mesh))

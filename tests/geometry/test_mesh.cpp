@@ -123,3 +123,51 @@ TEST(Mesh, OrientClosedShellsTurnsInwardShellsOnly) {
   EXPECT_EQ(orientClosedShells(open), 0u);
   EXPECT_EQ(open.triangles, before.triangles);
 }
+
+// Export defects that left a solid's shell open (its inside unknown: a tool wholly inside read
+// clear), each mended to the closed cube of the same surface: a T-junction (the top face split at
+// a point on one of its edges, the face beside it not), a sliver of no area on an edge, facets
+// wound against their neighbours. A sheet and a closed cube are left as they are.
+TEST(Mesh, RepairShellsClosesExportDefectsOnly) {
+  TriangleMesh t_junction = unitCube();  // the top (z = 1: 4 5 7 6) fanned from the middle of 4-5
+  t_junction.vertices.emplace_back(0.5, 0, 1);
+  const int m = 8;
+  t_junction.triangles[2] = Eigen::Vector3i(4, m, 6);
+  t_junction.triangles[3] = Eigen::Vector3i(m, 7, 6);
+  t_junction.triangles.emplace_back(m, 5, 7);
+  ASSERT_GT(validateMesh(t_junction).open_edges, 0u);
+  const ShellRepair mended = repairShells(t_junction);
+  EXPECT_EQ(mended.edges_split, 1u);
+  EXPECT_EQ(mended.open_edges_after, 0u);
+  EXPECT_TRUE(validateMesh(t_junction).closed()) << validateMesh(t_junction).summary();
+  EXPECT_NEAR(meshArea(t_junction), 6.0, 1e-12);
+  EXPECT_NEAR(meshVolume(t_junction), 1.0, 1e-12);
+  EXPECT_EQ(closedShells(t_junction).size(), 1u);
+
+  TriangleMesh sliver = unitCube();  // a zero-area triangle on the edge 0-1, through its middle
+  sliver.vertices.emplace_back(0.5, 0, 0);
+  sliver.triangles.emplace_back(0, 1, 8);
+  ASSERT_GT(validateMesh(sliver).open_edges, 0u);
+  const ShellRepair unslivered = repairShells(sliver);
+  EXPECT_EQ(unslivered.slivers_removed, 1u);
+  EXPECT_TRUE(validateMesh(sliver).closed()) << validateMesh(sliver).summary();
+  EXPECT_EQ(sliver.triangles.size(), 12u);
+
+  for (const std::vector<int> turned : {std::vector<int>{1}, std::vector<int>{0, 3, 4, 7, 8, 11}}) {
+    TriangleMesh flipped = unitCube();
+    for (const int i : turned) std::swap(flipped.triangles[i][1], flipped.triangles[i][2]);
+    ASSERT_GT(validateMesh(flipped).inconsistent_edges, 0u);
+    EXPECT_EQ(repairShells(flipped).facets_turned, turned.size());
+    EXPECT_TRUE(validateMesh(flipped).closed()) << validateMesh(flipped).summary();
+    EXPECT_NEAR(std::abs(meshVolume(flipped)), 1.0, 1e-12);
+  }
+
+  TriangleMesh sheet = unitCube();  // a face missing: open, and stays so
+  sheet.triangles.resize(10);
+  const TriangleMesh sheet_before = sheet;
+  EXPECT_FALSE(repairShells(sheet).any());
+  EXPECT_EQ(sheet.triangles, sheet_before.triangles);
+  TriangleMesh cube = unitCube();
+  EXPECT_FALSE(repairShells(cube).any());
+  EXPECT_EQ(cube.triangles, unitCube().triangles);
+}

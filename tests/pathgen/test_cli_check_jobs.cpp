@@ -149,6 +149,48 @@ TEST(CheckClearance, AnOpenObstacleMeshIsSaidToHaveNoInside) {
   }
 }
 
+// The same box as exported solids often come: a T-junction on its top (a face split at a point
+// on an edge its neighbour keeps whole), or one facet wound the wrong way. Read as open, a tool
+// wholly inside read clear ("ok": true: a helper's finding); mended (said), its inside counts.
+TEST(CheckClearance, ABoxWithExportDefectsIsMendedAndItsInsideCounts) {
+  const TempDir dir;
+  geometry::TriangleMesh box;
+  pathgen::test::addBox(box, -50, 50, -50, 50, -50, 50);
+  // addBox's top face: the two triangles whose vertices all have z = 50.
+  std::vector<int> top;
+  for (int t = 0; t < int(box.triangles.size()); ++t)
+    if ((box.triangles[t].unaryExpr([&](int v) {
+          return box.vertices[v].z() == 50 ? 1 : 0;
+        })).sum() == 3)
+      top.push_back(t);
+  ASSERT_EQ(top.size(), 2u);
+  geometry::TriangleMesh flipped = box;
+  std::swap(flipped.triangles[top[0]][1], flipped.triangles[top[0]][2]);
+  // The T-junction: the first top triangle split at the middle of one of its edges, alone.
+  geometry::TriangleMesh split = box;
+  const Eigen::Vector3i t = split.triangles[top[0]];
+  split.vertices.push_back(0.5 * (split.vertices[t[0]] + split.vertices[t[1]]));
+  const int m = int(split.vertices.size()) - 1;
+  split.triangles[top[0]] = Eigen::Vector3i(t[0], m, t[2]);
+  split.triangles.emplace_back(m, t[1], t[2]);
+  ASSERT_GT(geometry::validateMesh(split).open_edges, 0u);
+  geometry::saveMesh(flipped, dir.path() / "flipped.stl");
+  geometry::saveMesh(split, dir.path() / "split.stl");
+  dir.write("in.cl", "# pass 1\n0 0 -20 0 0 1\n1 0 -20 0 0 1\n");
+  for (const std::string mesh : {"flipped.stl", "split.stl"}) {
+    dir.write("scene.yaml", "obstacles:\n  - mesh: " + mesh +
+                                "\ntool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
+    const auto r = test::runFieldpath(dir, "check scene.yaml --path in.cl --out out_" + mesh);
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    EXPECT_NE(r.err.find(mesh + ": mended as exported solids need"), std::string::npos) << r.err;
+    const auto check =
+        nlohmann::json::parse(test::slurp(dir.path() / ("out_" + mesh) / "check.json"));
+    EXPECT_EQ(check["obstacle_notes"].size(), 0u) << check["obstacle_notes"];
+    EXPECT_EQ(check["clearance"]["colliding_postures"].get<int>(), 2) << mesh;
+    EXPECT_FALSE(check["ok"].get<bool>()) << mesh;
+  }
+}
+
 // A path that is unsafe for one reason and under the required clearance for another carries
 // both marks: a pass started upright beside a wall 0.3 mm from its holder (start: nominal, damped
 // for the spring alone) swings so far (tilt limit 89°) that the holder goes into the part: UNSAFE;

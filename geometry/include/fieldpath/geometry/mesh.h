@@ -46,6 +46,22 @@ std::vector<std::vector<int>> closedShells(const TriangleMesh& mesh);
 /// The other shells (triangles joined through their vertices): open sheets, or not closed.
 std::vector<std::vector<int>> openShells(const TriangleMesh& mesh);
 
+/// What repairShells mended.
+struct ShellRepair {
+  std::size_t slivers_removed = 0;  ///< triangles of no area (height <= 1e-6 of their size)
+  std::size_t edges_split = 0;      ///< T-junctions: an open edge split at a vertex lying on it
+  std::size_t facets_turned = 0;    ///< wound against their neighbours in a closed shell
+  std::size_t open_edges_before = 0, open_edges_after = 0;
+  bool any() const { return slivers_removed + edges_split + facets_turned > 0; }
+};
+
+/// Mends the export defects that leave a solid's shell open or inconsistent, so that its inside
+/// is known: slivers of no area are left out, an open edge with open-edge vertices lying on it (a
+/// T-junction) is split at them, and in a closed shell the facets wound against the most of
+/// their neighbours are turned. The surface is the same. Left as it is where that closes nothing
+/// (a sheet), where the mesh is closed already, or where the search would be a soup's.
+ShellRepair repairShells(TriangleMesh& mesh);
+
 /// Turns every closed, consistently wound shell (a connected set of triangles whose every edge is
 /// used twice, once each way) that is wound inward (negative enclosed volume: CAD exports with the
 /// normals flipped) outward, and returns how many it turned. Open or inconsistent shells are left
