@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <sstream>
 
@@ -153,6 +154,16 @@ void checkSceneSize(const Scene& scene) {
                        " mm exceeds the obstacles' extent plus the tool's reach (" + fmt(limit) +
                        " mm): every sample would act on every node at a cost growing as r0^3");
   }
+
+  // Lengths are millimetres: a scene written in metres (a tool radius of 0.003) ran for minutes
+  // and marked every posture (a helper's finding); micro tools are real, so a note, not a refusal.
+  const double tool_radius = scene.tool.radius_mm;
+  const double span = box.empty() ? 0.0 : box.diagonal();
+  if (tool_radius < 0.01 || (!box.empty() && span < 1.0))
+    std::fprintf(stderr,
+                 "note: %s: the tool radius is %s mm and the obstacles span %s mm: every length "
+                 "is read in millimetres (is the scene in metres?)\n",
+                 scene.file.string().c_str(), fmt(tool_radius).c_str(), fmt(span).c_str());
 
   // Output postures: path.step against the passes' length (and path.passes).
   const PassLength length = passLength(scene);
