@@ -8,6 +8,8 @@
 #include <limits>
 #include <string>
 
+#include <tbb/parallel_for.h>
+
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/errors.h"
 #include "fieldpath/pathgen/passes.h"
@@ -296,6 +298,47 @@ void writeDeviationPng(const std::filesystem::path& file, const SurfaceResult& s
   common::writeTextAtomically(file, png);
 }
 
+namespace {
+
+/// Deviations below the part (`deviation_um`, µm: the vertical times the facet's |n_z|) made no
+/// deeper than the cut point's horizontal distance to air: the part is a height field (its top
+/// over each line), so a point cut to height h is at most as deep as the nearest line whose top
+/// is at or below h (or off the part), measured to the near edge of that line's cell (± half a
+/// spacing: where the wall stands within it is not known). The vertical holds where the facet
+/// above is the nearest surface; beside a wall it does not: a shank 0.03 mm into a wall lowered
+/// the lines on the wall's top by its height, 7.4 mm read. Only lines deeper than half the
+/// tolerance are searched, ring by ring up to their vertical depth (at most kMaxRings).
+void gougeDepthsToAir(const zbuffer::Grid& grid, const std::vector<float>& top_mm,
+                      const std::vector<float>& cut_mm, double tolerance_um,
+                      std::vector<float>& deviation_um) {
+  constexpr int kMaxRings = 256;
+  const double dx = grid.dx_mm, dy = grid.dy_mm;
+  tbb::parallel_for(std::size_t{0}, deviation_um.size(), [&](std::size_t i) {
+    if (!(deviation_um[i] < -0.5 * tolerance_um)) return;
+    const int ix = static_cast<int>(i % grid.nx), iy = static_cast<int>(i / grid.nx);
+    double best_mm = -1e-3 * deviation_um[i];
+    const float h = cut_mm[i];
+    for (int ring = 1; ring <= kMaxRings; ++ring) {
+      // The nearest a cell of this ring can be (its near edge): past the best, nothing nearer.
+      if ((ring - 0.5) * std::min(dx, dy) >= best_mm) break;
+      for (int jy = iy - ring; jy <= iy + ring; ++jy)
+        for (int jx = ix - ring; jx <= ix + ring; ++jx) {
+          if (std::max(std::abs(jx - ix), std::abs(jy - iy)) != ring) continue;  // the ring only
+          // Past the grid the part is not known (it may go on): no air is taken from there.
+          if (jx < 0 || jy < 0 || jx >= grid.nx || jy >= grid.ny) continue;
+          const float column_top = top_mm[std::size_t(jy) * grid.nx + jx];
+          if (!(std::isnan(column_top) || column_top <= h)) continue;  // material there at h
+          const double gx = std::max(0.0, (std::abs(jx - ix) - 0.5) * dx);
+          const double gy = std::max(0.0, (std::abs(jy - iy) - 0.5) * dy);
+          best_mm = std::min(best_mm, std::hypot(gx, gy));
+        }
+    }
+    deviation_um[i] = static_cast<float>(-1e3 * best_mm);
+  });
+}
+
+}  // namespace
+
 std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   const geometry::TriangleMesh& part = *request.part;
   const geometry::PathFile& path = *request.path;
@@ -398,6 +441,16 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   result.lowered.assign(sim.grid.lineCount(), 0);
   for (std::size_t i = 0; i < result.lowered.size(); ++i)
     result.lowered[i] = simulated.heights_mm[i] < sim.initial_heights_mm[i];
+  const auto lineAt = [&](std::size_t i) {
+    return Vec2(sim.grid.x0_mm + (i % sim.grid.nx + 0.5) * sim.grid.dx_mm,
+                sim.grid.y0_mm + (i / sim.grid.nx + 0.5) * sim.grid.dy_mm);
+  };
+  for (std::size_t i = 0; i < nominal.size(); ++i)
+    if (!std::isnan(nominal[i]))
+      result.deviation_um[i] = static_cast<float>(
+          1000.0 * (double(simulated.heights_mm[i]) - double(nominal[i])) * double(facet_nz[i]));
+  gougeDepthsToAir(sim.grid, nominal, simulated.heights_mm, request.gouge_tolerance_um,
+                   result.deviation_um);
   double sum = 0, sum2 = 0, min_dev = 0, max_dev = 0;
   double highest_cusp = 0;  // the highest any line's cusp may stand (scallopGridErrorUm)
   const double spacing_mm = std::max(sim.grid.dx_mm, sim.grid.dy_mm);
@@ -408,8 +461,7 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
     }
     const double vertical_um = 1000.0 * (double(simulated.heights_mm[i]) - double(nominal[i]));
     const double cos_slope = double(facet_nz[i]);
-    const double d = vertical_um * cos_slope;
-    result.deviation_um[i] = static_cast<float>(d);
+    const double d = result.deviation_um[i];
     ++result.part_lines;
     min_dev = std::min(min_dev, d);
     result.gouged_lines += d < -request.gouge_tolerance_um;
@@ -418,8 +470,7 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
     sum += d;
     sum2 += d * d;
     max_dev = std::max(max_dev, d);
-    const Vec2 at(sim.grid.x0_mm + (i % sim.grid.nx + 0.5) * sim.grid.dx_mm,
-                  sim.grid.y0_mm + (i / sim.grid.nx + 0.5) * sim.grid.dy_mm);
+    const Vec2 at = lineAt(i);
     const double bound_um =
         scallopGridErrorUm(vertical_um, spacing_mm, edge_mm, partNormal(sim.grid, nominal, at));
     highest_cusp = std::max(highest_cusp, (vertical_um + bound_um) * cos_slope);

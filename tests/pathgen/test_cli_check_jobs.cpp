@@ -231,8 +231,9 @@ TEST(CheckClearance, UnsafeAndUnderTheClearanceAreBothMarked) {
 
 // `check` cuts along the motions, not only at the postures: two postures on a floor either side
 // of a ridge 1 mm high, each clear of it, and the straight move between them through the ridge.
-// The gouge is the ridge's height (1000 um, less the sweep's bound); the same postures with the
-// move lifted over the ridge (up, across 0.5 mm above it, down) gouge nothing.
+// The gouge is the ridge's depth at the lines (1000 um in its middle, 2 mm wide, less half the
+// 0.1 mm spacing and the sweep's bound); the same postures with the move lifted over the ridge
+// (up, across 0.5 mm above it, down) gouge nothing.
 TEST(CheckSurface, TheMotionBetweenTwoPosturesIsCut) {
   const TempDir dir;
   geometry::TriangleMesh part, wall;
@@ -255,7 +256,7 @@ TEST(CheckSurface, TheMotionBetweenTwoPosturesIsCut) {
     return check["surface"];
   };
   const auto through = gouge("through.cl");
-  EXPECT_GT(through["max_gouge_um"].get<double>(), 1000.0 - 10.0);
+  EXPECT_GT(through["max_gouge_um"].get<double>(), 1000.0 - 50.0 - 10.0);
   EXPECT_LE(through["max_gouge_um"].get<double>(), 1000.0 + 1.0);
   EXPECT_GT(through["gouged_lines"].get<int>(), 100);
   EXPECT_GT(through["simulated_postures"].get<int>(), 50);  // 10 mm at <= 0.17 mm
@@ -304,6 +305,33 @@ TEST(CheckSurface, AShankDrivenIntoAWallOfThePartIsAGouge) {
             std::string::npos);
   EXPECT_EQ(away["surface"]["gouged_lines"].get<int>(), 0);
   EXPECT_TRUE(away["ok"].get<bool>()) << away["not_ok_because"];
+}
+
+// A shank 0.3 mm into a vertical wall of the part gouges 0.3 mm (along the wall's normal), not
+// the wall's height: lines on the wall's top cut 10 mm down by the shank read 10 mm (a helper's
+// 7.4 mm for 0.03 mm). Depth to the nearest uncut line's cell, within half a line spacing.
+TEST(CheckSurface, AShankIntoAWallGougesItsDepthNotTheWallsHeight) {
+  const TempDir dir;
+  geometry::TriangleMesh part, far;
+  pathgen::test::addBox(part, -30, 30, -30, 5, -10, 0);  // the floor
+  pathgen::test::addBox(part, -30, 30, 5, 15, -10, 10);  // a wall at y = 5, 10 mm high
+  pathgen::test::addBox(far, -100, -90, -100, -90, -50, -40);
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(far, dir.path() / "far.stl");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: far.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 40 }\n");
+  std::ostringstream path;
+  path << "# pass 1\n";
+  for (int k = 0; k <= 40; ++k) path << -5 + 0.25 * k << " 2.3 0 0 0 1\n";  // shank to y = 5.3
+  dir.write("wall.cl", path.str());
+  const auto r = test::runFieldpath(dir, "check scene.yaml --path wall.cl --out out");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const auto check = nlohmann::json::parse(test::slurp(dir.path() / "out" / "check.json"));
+  const double gouge = check["surface"]["max_gouge_um"].get<double>();
+  EXPECT_GT(gouge, 300.0 - 25.0 - 1.0);
+  EXPECT_LT(gouge, 300.0 + 25.0 + 1.0);
+  EXPECT_FALSE(check["ok"].get<bool>());
 }
 
 // Passes that do not cross the part leave no surface to check, but their clearance still
