@@ -47,6 +47,15 @@ double secondsSince(Clock::time_point start) {
 const char* const kOutputNames[] = {"npy", "json", "stl", "png"};
 
 /// "npy,json,stl,png" (any subset, any order) → the set; one line naming the bad item otherwise.
+/// ", every 3rd line, each the lowest of its block" where surface.stl keeps fewer lines than the
+/// grid has (writeSurfaceStl's default 2048 a side), else "".
+std::string stlStrideNote(const zbuffer::Grid& grid) {
+  const int k = std::max((grid.nx + 2047) / 2048, (grid.ny + 2047) / 2048);
+  if (k <= 1) return "";
+  const std::string nth = k == 2 ? "2nd" : k == 3 ? "3rd" : std::to_string(k) + "th";
+  return ", every " + nth + " line and the last, each the lowest of those it stands for";
+}
+
 std::set<std::string> parseOutputs(const std::string& text) {
   std::set<std::string> out;
   std::size_t pos = 0;
@@ -382,7 +391,8 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
       const std::string file = std::string(name) == "npy"    ? "heights.npy"
                                : std::string(name) == "json" ? "heights.json"
                                : std::string(name) == "stl"
-                                   ? "surface.stl (" + std::to_string(stl_triangles) + " triangles)"
+                                   ? "surface.stl (" + std::to_string(stl_triangles) +
+                                         " triangles" + stlStrideNote(req.grid) + ")"
                                    : "heights.png";
       names += file + ", ";
     }

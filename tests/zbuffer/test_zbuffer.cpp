@@ -479,6 +479,28 @@ TEST(Outputs, NpyJsonStlPngAreWellFormed) {
     const float n[3] = {-1.f, -3.f, 1.f};
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(f[k], n[k] / std::sqrt(11.f), 1e-6f) << k;
   }
+  {
+    // Every 3rd line of an 11 x 11 grid at most 4 a side: lines 0 3 6 9 and 10 (the last, the
+    // region's edge, was dropped); a cut two lines wide between kept lines stays as the lowest
+    // of the lines a kept one stands for (it vanished: a helper's finding).
+    const Grid big = Grid::fromRegion(0, 0, 11, 11, 11, 11);
+    std::vector<float> flat(121, 1.f);
+    flat[4 * 11 + 4] = flat[4 * 11 + 5] = -0.5f;  // lines (4, 4) and (5, 4)
+    EXPECT_EQ(writeSurfaceStl(dir / "big.stl", big, flat, 4), 2u * 4u * 4u);
+    std::ifstream stl(dir / "big.stl", std::ios::binary);
+    const std::string s((std::istreambuf_iterator<char>(stl)), {});
+    ASSERT_EQ(s.size(), 84u + 32 * 50);
+    float lowest = 1.f, x_max = 0.f;
+    for (std::size_t t = 0; t < 32; ++t)
+      for (int v = 0; v < 3; ++v) {
+        float p3[3];
+        std::memcpy(p3, s.data() + 84 + t * 50 + 12 + v * 12, sizeof p3);
+        lowest = std::min(lowest, p3[2]);
+        x_max = std::max(x_max, p3[0]);
+      }
+    EXPECT_EQ(lowest, -0.5f);
+    EXPECT_EQ(x_max, 10.5f);  // the last line's centre
+  }
   writeReliefPng(dir / "r.png", g, h);
   std::ifstream png(dir / "r.png", std::ios::binary);
   std::string p((std::istreambuf_iterator<char>(png)), {});

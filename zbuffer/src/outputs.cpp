@@ -151,16 +151,42 @@ void writeHeightsJson(const std::filesystem::path& file, const Grid& grid) {
   common::writeTextAtomically(file, os.str());
 }
 
+/// The lines a side keeps at stride k: every k-th from the first, and the last (the region's
+/// edge: it was dropped), each standing for the lines nearer to it than to its neighbours.
+std::vector<int> keptLines(int n, int k) {
+  std::vector<int> kept;
+  for (int i = 0; i < n; i += k) kept.push_back(i);
+  if (kept.back() != n - 1) kept.push_back(n - 1);
+  return kept;
+}
+
 std::size_t writeSurfaceStl(const std::filesystem::path& file, const Grid& grid,
                             std::span<const float> heights_mm, int max_side) {
   const int sx = strideFor(grid.nx, max_side), sy = strideFor(grid.ny, max_side);
-  const int mx = (grid.nx - 1) / sx + 1, my = (grid.ny - 1) / sy + 1;
+  const std::vector<int> xs = keptLines(grid.nx, sx), ys = keptLines(grid.ny, sy);
+  const int mx = static_cast<int>(xs.size()), my = static_cast<int>(ys.size());
   const std::size_t count = mx > 1 && my > 1 ? 2 * std::size_t(mx - 1) * std::size_t(my - 1) : 0;
+  // Each kept line at the lowest height of the lines it stands for: a cut narrower than the
+  // stride (a gouge) stays in the surface (a 0.5 mm cut two lines wide vanished at 6000 lines).
+  const auto span = [](const std::vector<int>& kept, int i, int n) {
+    const int lo = i == 0 ? 0 : (kept[i - 1] + kept[i]) / 2 + 1;
+    const int hi = i + 1 == int(kept.size()) ? n - 1 : (kept[i] + kept[i + 1]) / 2;
+    return std::pair<int, int>(lo, hi);
+  };
+  std::vector<float> lowest(std::size_t(mx) * my);
+  for (int j = 0; j < my; ++j)
+    for (int i = 0; i < mx; ++i) {
+      const auto [x0, x1] = span(xs, i, grid.nx);
+      const auto [y0, y1] = span(ys, j, grid.ny);
+      float z = heights_mm[std::size_t(ys[j]) * grid.nx + xs[i]];
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) z = std::min(z, heights_mm[std::size_t(y) * grid.nx + x]);
+      lowest[std::size_t(j) * mx + i] = z;
+    }
   const auto point = [&](int i, int j) {
-    const int ix = i * sx, iy = j * sy;
-    return Vec3f{static_cast<float>(grid.x0_mm + (ix + 0.5) * grid.dx_mm),
-                 static_cast<float>(grid.y0_mm + (iy + 0.5) * grid.dy_mm),
-                 heights_mm[std::size_t(iy) * grid.nx + ix]};
+    return Vec3f{static_cast<float>(grid.x0_mm + (xs[i] + 0.5) * grid.dx_mm),
+                 static_cast<float>(grid.y0_mm + (ys[j] + 0.5) * grid.dy_mm),
+                 lowest[std::size_t(j) * mx + i]};
   };
   common::writeFileAtomically(
       file,

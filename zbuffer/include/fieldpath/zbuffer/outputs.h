@@ -16,8 +16,9 @@ void writeHeightsNpy(const std::filesystem::path& file, const Grid& grid,
 /// heights.json: {"origin":[x0,y0],"spacing":[dx,dy],"shape":[ny,nx]}.
 void writeHeightsJson(const std::filesystem::path& file, const Grid& grid);
 /// Binary STL of the simulated surface: two triangles per cell between line centres, facing up.
-/// Grids above max_side lines per side are sampled every k-th line (k = ceil(side / max_side)).
-/// Returns the triangle count.
+/// Grids above max_side lines per side keep every k-th line (k = ceil(side / max_side)) and the
+/// last, each at the lowest height of the lines nearest to it (a gouge narrower than k lines
+/// stays). Returns the triangle count.
 std::size_t writeSurfaceStl(const std::filesystem::path& file, const Grid& grid,
                             std::span<const float> heights_mm, int max_side = 2048);
 /// Shaded relief (8-bit RGB PNG, light from the north-west, tinted by height), at most max_side
