@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <set>
@@ -452,6 +453,18 @@ ViewData gatherView(const ViewRequest& request) {
       number("gouge_tolerance_um", figures.gouge_tolerance_um);
       number("max_scallop_um", figures.max_scallop_um);
       number("max_gouge_um", figures.max_gouge_um);
+      // A gouge lies under the part's surface, which the page draws over it: said in the banner
+      // (a page of a path that gouged 2.2 mm looked like a clean part: a helper's finding).
+      double gouged_lines = 0.0;
+      number("gouged_lines", gouged_lines);
+      if (gouged_lines > 0.0) {
+        char text[200];
+        std::snprintf(text, sizeof text,
+                      "GOUGE: %.0f lines cut up to %.1f um below the part (tolerance %.1f um): "
+                      "blue on the surface, under the part (hide the part to see it)",
+                      gouged_lines, figures.max_gouge_um, figures.gouge_tolerance_um);
+        d.warnings.push_back(text);
+      }
     }
     d.surface = readSurface(surface_dir, scene, request.max_surface_lines, figures, d.warnings);
   }

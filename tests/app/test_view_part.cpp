@@ -59,6 +59,12 @@ TEST(View, PartContactsAreMarkedAsCheckFindsThem) {
     const std::string html = slurp(dir.path() / "v.html");
     const json meta = pageMeta(html);
     EXPECT_EQ(meta["path"]["counts"]["part_contact_postures"], 1) << args;
+    // The dip gouges the floor (check's surface): the banner says so where the page shows the
+    // check's surface (it lies under the part, drawn over it).
+    if (args == "--check chk") {
+      ASSERT_GT(report["surface"]["gouged_lines"].get<int>(), 0) << report["surface"];
+      EXPECT_NE(meta["warnings"].dump().find("GOUGE: "), std::string::npos) << meta["warnings"];
+    }
     EXPECT_EQ(meta["path"]["counts"]["part_contact_motions"], 2) << args;
     const auto flags = pageFlags(html, meta);
     ASSERT_EQ(flags.size(), 43u);
