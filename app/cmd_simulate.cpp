@@ -257,7 +257,12 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
           req.backend = zb::Backend::Cpu;
           choice = "auto: cpu (estimated " + std::to_string(cpu_s).substr(0, 5) +
                    " s, less than the GPU takes to start)";
+        } else {
+          choice = "auto: the GPU where there is one (the CPU estimated " +
+                   std::to_string(cpu_s).substr(0, 5) + " s, more than the GPU takes to start)";
         }
+      } else {
+        choice = "auto: the GPU where there is one (over 5e6 postures)";
       }
     }
     const auto prepare_start = Clock::now();
