@@ -3,10 +3,12 @@
 /// lines, an open obstacle mesh (no inside: said), unsafe and under-the-clearance marks, the motion
 /// between two postures cut, a shank driven into a wall of the part, passes beside the part, and
 /// the same job high up in z.
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -119,6 +121,38 @@ TEST(CheckSurface, ScallopOnASlopeIsBetweenTheContactLines) {
   EXPECT_LT(surface["max_gouge_um"].get<double>(), 0.5) << surface;
 }
 
+namespace {
+
+/// `check` of two upright postures 30 mm inside the 100 mm box of `mesh` (in `dir`), a ball R 3:
+/// the run and its check.json.
+std::pair<test::Outcome, nlohmann::json> checkInsideBox(const TempDir& dir,
+                                                        const std::string& mesh) {
+  dir.write("in.cl", "# pass 1\n0 0 -20 0 0 1\n1 0 -20 0 0 1\n");
+  dir.write("scene.yaml", "obstacles:\n  - mesh: " + mesh +
+                              "\ntool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
+  const auto r = test::runFieldpath(dir, "check scene.yaml --path in.cl --out out_" + mesh);
+  EXPECT_EQ(r.exit_code, 0) << r.output();
+  const fs::path file = dir.path() / ("out_" + mesh) / "check.json";
+  return {r, fs::exists(file) ? nlohmann::json::parse(test::slurp(file)) : nlohmann::json()};
+}
+
+/// A part of a floor and a wall (boxes x0 x1 y0 y1 z0 z1, mm) and an obstacle far away (a scene
+/// needs one); a ball-end mill R 3 up to 40.
+void writeFloorAndWall(const TempDir& dir, const std::array<double, 6>& floor,
+                       const std::array<double, 6>& wall) {
+  geometry::TriangleMesh part, far;
+  for (const auto& b : {floor, wall})
+    pathgen::test::addBox(part, b[0], b[1], b[2], b[3], b[4], b[5]);
+  pathgen::test::addBox(far, -100, -90, -100, -90, -50, -40);
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(far, dir.path() / "far.stl");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: far.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 40 }\n");
+}
+
+}  // namespace
+
 // A block missing one facet is an open shell: no inside, so a tool buried in it reads as clear
 // (FCL measures surfaces; only closed shells have an inside). Said, naming the file, by `check`
 // and `generate` and in check.json `obstacle_notes` (it was silent: a helper's finding); the
@@ -131,14 +165,8 @@ TEST(CheckClearance, AnOpenObstacleMeshIsSaidToHaveNoInside) {
   holed.triangles.pop_back();
   geometry::saveMesh(closed, dir.path() / "closed.stl");
   geometry::saveMesh(holed, dir.path() / "holed.stl");
-  dir.write("in.cl", "# pass 1\n0 0 -20 0 0 1\n1 0 -20 0 0 1\n");
   for (const std::string mesh : {"closed.stl", "holed.stl"}) {
-    dir.write("scene.yaml", "obstacles:\n  - mesh: " + mesh +
-                                "\ntool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
-    const auto r = test::runFieldpath(dir, "check scene.yaml --path in.cl --out out_" + mesh);
-    ASSERT_EQ(r.exit_code, 0) << r.output();
-    const auto check =
-        nlohmann::json::parse(test::slurp(dir.path() / ("out_" + mesh) / "check.json"));
+    const auto [r, check] = checkInsideBox(dir, mesh);
     const bool open = mesh == "holed.stl";
     EXPECT_EQ(check["obstacle_notes"].size(), open ? 1u : 0u) << check["obstacle_notes"];
     EXPECT_EQ(
@@ -176,15 +204,9 @@ TEST(CheckClearance, ABoxWithExportDefectsIsMendedAndItsInsideCounts) {
   ASSERT_GT(geometry::validateMesh(split).open_edges, 0u);
   geometry::saveMesh(flipped, dir.path() / "flipped.stl");
   geometry::saveMesh(split, dir.path() / "split.stl");
-  dir.write("in.cl", "# pass 1\n0 0 -20 0 0 1\n1 0 -20 0 0 1\n");
   for (const std::string mesh : {"flipped.stl", "split.stl"}) {
-    dir.write("scene.yaml", "obstacles:\n  - mesh: " + mesh +
-                                "\ntool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
-    const auto r = test::runFieldpath(dir, "check scene.yaml --path in.cl --out out_" + mesh);
-    ASSERT_EQ(r.exit_code, 0) << r.output();
+    const auto [r, check] = checkInsideBox(dir, mesh);
     EXPECT_NE(r.err.find(mesh + ": mended as exported solids need"), std::string::npos) << r.err;
-    const auto check =
-        nlohmann::json::parse(test::slurp(dir.path() / ("out_" + mesh) / "check.json"));
     EXPECT_EQ(check["obstacle_notes"].size(), 0u) << check["obstacle_notes"];
     EXPECT_EQ(check["clearance"]["colliding_postures"].get<int>(), 2) << mesh;
     EXPECT_FALSE(check["ok"].get<bool>()) << mesh;
@@ -270,15 +292,7 @@ TEST(CheckSurface, TheMotionBetweenTwoPosturesIsCut) {
 // part's top. The same pass tilted away gouges nothing.
 TEST(CheckSurface, AShankDrivenIntoAWallOfThePartIsAGouge) {
   const TempDir dir;
-  geometry::TriangleMesh part, far;
-  pathgen::test::addBox(part, -30, 7, -30, 30, -10, 0);  // the floor
-  pathgen::test::addBox(part, 8, 30, -30, 30, -10, 60);  // a wall beside the pass
-  pathgen::test::addBox(far, -100, -90, -100, -90, -50, -40);
-  geometry::saveMesh(part, dir.path() / "part.stl");
-  geometry::saveMesh(far, dir.path() / "far.stl");
-  dir.write("scene.yaml",
-            "obstacles:\n  - mesh: far.stl\npart: part.stl\n"
-            "tool: { shape: ball, radius: 3, length: 40 }\n");
+  writeFloorAndWall(dir, {-30, 7, -30, 30, -10, 0}, {8, 30, -30, 30, -10, 60});  // wall beside
   const double s = std::sin(20.0 * M_PI / 180.0), c = std::cos(20.0 * M_PI / 180.0);
   for (const double side : {1.0, -1.0}) {
     std::ostringstream path;
@@ -312,15 +326,7 @@ TEST(CheckSurface, AShankDrivenIntoAWallOfThePartIsAGouge) {
 // 7.4 mm for 0.03 mm). Depth to the nearest uncut line's cell, within half a line spacing.
 TEST(CheckSurface, AShankIntoAWallGougesItsDepthNotTheWallsHeight) {
   const TempDir dir;
-  geometry::TriangleMesh part, far;
-  pathgen::test::addBox(part, -30, 30, -30, 5, -10, 0);  // the floor
-  pathgen::test::addBox(part, -30, 30, 5, 15, -10, 10);  // a wall at y = 5, 10 mm high
-  pathgen::test::addBox(far, -100, -90, -100, -90, -50, -40);
-  geometry::saveMesh(part, dir.path() / "part.stl");
-  geometry::saveMesh(far, dir.path() / "far.stl");
-  dir.write("scene.yaml",
-            "obstacles:\n  - mesh: far.stl\npart: part.stl\n"
-            "tool: { shape: ball, radius: 3, length: 40 }\n");
+  writeFloorAndWall(dir, {-30, 30, -30, 5, -10, 0}, {-30, 30, 5, 15, -10, 10});  // wall at y = 5
   std::ostringstream path;
   path << "# pass 1\n";
   for (int k = 0; k <= 40; ++k) path << -5 + 0.25 * k << " 2.3 0 0 0 1\n";  // shank to y = 5.3
