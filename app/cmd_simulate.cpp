@@ -206,12 +206,14 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     // The path is read on all cores; beside it, the tool and the device get ready.
     geometry::PathReadOptions read_options;
     if (o->block_postures > 0) read_options.chunk_bytes = o->block_postures * 40;  // ~40 B a line
-    // Until cut, the postures are held as 24-byte floats (all of them where the reading runs
-    // ahead of the cutting): refused before anything is read when that cannot fit.
+    // Until cut, the postures are held as floats (all of them where the reading runs ahead of the
+    // cutting): refused before anything is read when that cannot fit.
     const double postures_estimate = estimatePostures(o->path);
-    common::requireMemory("--path " + o->path, postures_estimate * 24.0,
+    constexpr std::size_t kPostureBytes = sizeof(geometry::CompactPosture);
+    static_assert(kPostureBytes == sizeof(zb::Posture), "read and cut postures alike");
+    common::requireMemory("--path " + o->path, postures_estimate * double(kPostureBytes),
                           "about " + std::to_string(std::llround(postures_estimate)) +
-                              " postures of 24 bytes");
+                              " postures of " + std::to_string(kPostureBytes) + " bytes");
     PostureStream stream(o->path, read_options);
     // The part (--part) read beside the path: its top bounds the default region.
     std::optional<geometry::TriangleMesh> part;

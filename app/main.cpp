@@ -155,5 +155,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fieldpath: internal error: %s\n", oneLine(e.what()).c_str());
     return 2;
   }
+  fieldpath::common::releaseClaimedOutputs();  // done: a late signal takes nothing away
   return 0;
 }

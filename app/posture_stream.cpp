@@ -32,7 +32,8 @@ void PostureStream::read(const std::filesystem::path& file,
       const geometry::CompactPosture& p = in[k];
       out[k] = {{p.tip_mm[0], p.tip_mm[1], p.tip_mm[2]},
                 {p.axis[0], p.axis[1], p.axis[2]},
-                p.spindle_rad};
+                p.spindle_cos,
+                p.spindle_sin};
       b.xmin = std::min(b.xmin, double(p.tip_mm[0]));
       b.xmax = std::max(b.xmax, double(p.tip_mm[0]));
       b.ymin = std::min(b.ymin, double(p.tip_mm[1]));

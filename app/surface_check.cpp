@@ -302,36 +302,63 @@ namespace {
 
 /// Deviations below the part (`deviation_um`, µm: the vertical times the facet's |n_z|) made no
 /// deeper than the cut point's horizontal distance to air: the part is a height field (its top
-/// over each line), so a point cut to height h is at most as deep as the nearest line whose top
-/// is at or below h (or off the part), measured to the near edge of that line's cell (± half a
-/// spacing: where the wall stands within it is not known). The vertical holds where the facet
-/// above is the nearest surface; beside a wall it does not: a shank 0.03 mm into a wall lowered
-/// the lines on the wall's top by its height, 7.4 mm read. Only lines deeper than half the
-/// tolerance are searched, ring by ring up to their vertical depth (at most kMaxRings).
+/// over each line), so a point cut to height h is at most as deep as the distance to the centre
+/// of the nearest line whose top is at or below h, or that lies off the part (a surface lies
+/// between them; the centre's distance, where the wall stands between the two is not known: up
+/// to a spacing more than the depth, never less). The vertical holds where the facet above is
+/// the nearest surface; beside a wall it does not: a shank 0.03 mm into a wall lowered the lines
+/// on the wall's top by its height, 7.4 mm read. Only lines deeper than half the tolerance are
+/// searched, ring by ring (a ring's border only) up to their vertical depth and at most
+/// kMaxRings lines away (deeper, the vertical stands: it errs deep). Off the part means a line
+/// whose ray missed the part joined to the grid's border through such lines: one inside the
+/// part is a crack between its patches, not air.
 void gougeDepthsToAir(const zbuffer::Grid& grid, const std::vector<float>& top_mm,
                       const std::vector<float>& cut_mm, double tolerance_um,
                       std::vector<float>& deviation_um) {
-  constexpr int kMaxRings = 256;
+  constexpr int kMaxRings = 32;
+  const int nx = grid.nx, ny = grid.ny;
+  // Lines off the part: no part under them, joined to the border (a flood fill, 4 neighbours).
+  std::vector<std::uint8_t> off(top_mm.size(), 0);
+  std::vector<std::size_t> queue;
+  const auto seed = [&](int x, int y) {
+    const std::size_t j = std::size_t(y) * nx + x;
+    if (!off[j] && std::isnan(top_mm[j])) {
+      off[j] = 1;
+      queue.push_back(j);
+    }
+  };
+  for (int x = 0; x < nx; ++x) seed(x, 0), seed(x, ny - 1);
+  for (int y = 0; y < ny; ++y) seed(0, y), seed(nx - 1, y);
+  for (std::size_t k = 0; k < queue.size(); ++k) {
+    const int x = int(queue[k] % nx), y = int(queue[k] / nx);
+    if (x > 0) seed(x - 1, y);
+    if (x + 1 < nx) seed(x + 1, y);
+    if (y > 0) seed(x, y - 1);
+    if (y + 1 < ny) seed(x, y + 1);
+  }
   const double dx = grid.dx_mm, dy = grid.dy_mm;
   tbb::parallel_for(std::size_t{0}, deviation_um.size(), [&](std::size_t i) {
     if (!(deviation_um[i] < -0.5 * tolerance_um)) return;
-    const int ix = static_cast<int>(i % grid.nx), iy = static_cast<int>(i / grid.nx);
+    const int ix = static_cast<int>(i % nx), iy = static_cast<int>(i / nx);
     double best_mm = -1e-3 * deviation_um[i];
     const float h = cut_mm[i];
+    const auto visit = [&](int jx, int jy) {
+      // Past the grid the part is not known (it may go on): no air is taken from there.
+      if (jx < 0 || jy < 0 || jx >= nx || jy >= ny) return;
+      const std::size_t j = std::size_t(jy) * nx + jx;
+      if (!(off[j] || top_mm[j] <= h)) return;  // material there at h (or a crack)
+      best_mm = std::min(best_mm, std::hypot((jx - ix) * dx, (jy - iy) * dy));
+    };
     for (int ring = 1; ring <= kMaxRings; ++ring) {
-      // The nearest a cell of this ring can be (its near edge): past the best, nothing nearer.
-      if ((ring - 0.5) * std::min(dx, dy) >= best_mm) break;
-      for (int jy = iy - ring; jy <= iy + ring; ++jy)
-        for (int jx = ix - ring; jx <= ix + ring; ++jx) {
-          if (std::max(std::abs(jx - ix), std::abs(jy - iy)) != ring) continue;  // the ring only
-          // Past the grid the part is not known (it may go on): no air is taken from there.
-          if (jx < 0 || jy < 0 || jx >= grid.nx || jy >= grid.ny) continue;
-          const float column_top = top_mm[std::size_t(jy) * grid.nx + jx];
-          if (!(std::isnan(column_top) || column_top <= h)) continue;  // material there at h
-          const double gx = std::max(0.0, (std::abs(jx - ix) - 0.5) * dx);
-          const double gy = std::max(0.0, (std::abs(jy - iy) - 0.5) * dy);
-          best_mm = std::min(best_mm, std::hypot(gx, gy));
-        }
+      if (ring * std::min(dx, dy) >= best_mm) break;  // no line of this ring is nearer
+      for (int k = -ring; k <= ring; ++k) {
+        visit(ix + k, iy - ring);
+        visit(ix + k, iy + ring);
+      }
+      for (int k = -ring + 1; k <= ring - 1; ++k) {
+        visit(ix - ring, iy + k);
+        visit(ix + ring, iy + k);
+      }
     }
     deviation_um[i] = static_cast<float>(-1e3 * best_mm);
   });

@@ -5,6 +5,7 @@
 #include <span>
 #include <vector>
 
+#include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/geometry/posture.h"
 #include "fieldpath/zbuffer/simulator.h"
@@ -15,10 +16,13 @@ namespace fieldpath::app {
 inline std::vector<zbuffer::Posture> toZbuffer(std::span<const geometry::Posture> path) {
   std::vector<zbuffer::Posture> out;
   out.reserve(path.size());
-  for (const auto& p : path)
-    out.push_back({{float(p.tip_mm.x()), float(p.tip_mm.y()), float(p.tip_mm.z())},
-                   {float(p.axis.x()), float(p.axis.y()), float(p.axis.z())},
-                   p.has_spindle ? float(p.spindle_rad) : 0.f});
+  for (const auto& p : path) {
+    const geometry::CompactPosture c = geometry::compact(p);  // the spindle's cos and sin too
+    out.push_back({{c.tip_mm[0], c.tip_mm[1], c.tip_mm[2]},
+                   {c.axis[0], c.axis[1], c.axis[2]},
+                   c.spindle_cos,
+                   c.spindle_sin});
+  }
   return out;
 }
 

@@ -246,15 +246,16 @@ StlFeed checkStl(const std::filesystem::path& file, std::uintmax_t size) {
     feed.length = needed;
     return feed;
   };
-  if (word == "solid" && !hasNulByte(file)) return checkAsciiStl(file, size);
   if (word == "solid" && got == 84) {
-    // A binary STL whose header starts so (CAD exports): its size must match its count, as any
-    // binary one's (below); it was read as ASCII "without `endsolid`" when it did not.
+    // A binary STL whose header starts so (CAD exports): its size matches its count.
     const std::uint32_t count = std::uint32_t(header[80]) | std::uint32_t(header[81]) << 8 |
                                 std::uint32_t(header[82]) << 16 | std::uint32_t(header[83]) << 24;
     if (binaryFits(84 + 50 * std::uintmax_t(count)))
       return binaryFeed(84 + 50 * std::uintmax_t(count));
   }
+  // Else ASCII, unless it holds a NUL byte: a binary one cut short or padded (it was read as
+  // ASCII "without `endsolid`"); its counts are said below.
+  if (word == "solid" && !hasNulByte(file)) return checkAsciiStl(file, size);
   if (got < 84)
     throw InputError(file.string() + ": binary STL of " + std::to_string(size) +
                      " bytes, shorter than its 84-byte header (truncated, or not STL)");

@@ -50,9 +50,9 @@ int usesOf(const std::vector<std::pair<std::uint64_t, int>>& uses, std::uint64_t
   return it != uses.end() && it->first == key ? it->second : 0;
 }
 
-/// The vertices lying on edge u-v strictly between its ends, ordered from u; `budget` counts the
-/// tests made.
-std::vector<int> pointsOnEdge(const TriangleMesh& mesh, int u, int v,
+/// The vertices lying on edge u-v strictly between its ends, ordered from u, from `by_x` (sorted
+/// on `axis`); `budget` counts the tests made.
+std::vector<int> pointsOnEdge(const TriangleMesh& mesh, int u, int v, int axis,
                               const std::vector<std::pair<double, int>>& by_x,
                               std::size_t& budget) {
   const Eigen::Vector3d& a = mesh.vertices[u];
@@ -61,7 +61,7 @@ std::vector<int> pointsOnEdge(const TriangleMesh& mesh, int u, int v,
   const double length = d.norm();
   if (!(length > 0.0)) return {};
   const double tol = kFlatRelative * (length + a.cwiseAbs().maxCoeff() + b.cwiseAbs().maxCoeff());
-  const double x0 = std::min(a.x(), b.x()) - tol, x1 = std::max(a.x(), b.x()) + tol;
+  const double x0 = std::min(a[axis], b[axis]) - tol, x1 = std::max(a[axis], b[axis]) + tol;
   std::vector<std::pair<double, int>> found;
   for (auto it = std::lower_bound(by_x.begin(), by_x.end(), std::make_pair(x0, -1));
        it != by_x.end() && it->first <= x1; ++it) {
@@ -80,6 +80,27 @@ std::vector<int> pointsOnEdge(const TriangleMesh& mesh, int u, int v,
   return out;
 }
 
+/// A triangle of no area whose apex stands strictly inside its longest edge (the edge's
+/// neighbours then meet the apex: a T-junction, mended below). A needle (two corners nearly one:
+/// an edge too short to weld here) is no sliver: left out, it would leave a hole.
+bool isSliver(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d* p[3] = {&a, &b, &c};
+  int longest = 0;
+  double longest2 = 0.0;
+  for (int e = 0; e < 3; ++e) {
+    const double l2 = (*p[(e + 1) % 3] - *p[e]).squaredNorm();
+    if (l2 > longest2) longest2 = l2, longest = e;
+  }
+  if (!((b - a).cross(c - a).norm() <= kFlatRelative * longest2)) return false;
+  const Eigen::Vector3d& u = *p[longest];
+  const Eigen::Vector3d& v = *p[(longest + 1) % 3];
+  const Eigen::Vector3d& apex = *p[(longest + 2) % 3];
+  const double t = (apex - u).dot(v - u) / longest2;
+  const double margin = kFlatRelative * (1.0 + (u.cwiseAbs().maxCoeff() + v.cwiseAbs().maxCoeff()) /
+                                                   std::sqrt(longest2));
+  return t > margin && t < 1.0 - margin;
+}
+
 /// Splits every open edge at the open-edge vertices that lie on it (a T-junction: one side's edge
 /// is two of the other side's), one edge a triangle a round, until none is left. Returns the
 /// splits made, or 0 with the mesh unchanged where the search gives up.
@@ -88,11 +109,21 @@ std::size_t splitTJunctions(TriangleMesh& mesh) {
   std::vector<Eigen::Vector3i> triangles = mesh.triangles;
   for (int round = 0; round < 8; ++round) {
     const auto uses = edgeUses(triangles);
-    std::vector<std::pair<double, int>> by_x;  // the open edges' vertices, by x
+    // The open edges' vertices, sorted along the axis they spread most on (a sheet in a plane
+    // x = const along x was one run of every vertex).
+    std::vector<int> open_vertices;
+    Eigen::AlignedBox3d spread;
     for (const auto& [key, count] : uses)
       if (count == 1)
-        for (const int w : {int(key >> 32), int(key & 0xffffffffu)})
-          by_x.emplace_back(mesh.vertices[w].x(), w);
+        for (const int w : {int(key >> 32), int(key & 0xffffffffu)}) {
+          open_vertices.push_back(w);
+          spread.extend(mesh.vertices[w]);
+        }
+    if (open_vertices.empty()) break;
+    Eigen::Index axis = 0;
+    spread.sizes().maxCoeff(&axis);
+    std::vector<std::pair<double, int>> by_x;  // (coordinate on that axis, vertex)
+    for (const int w : open_vertices) by_x.emplace_back(mesh.vertices[w][axis], w);
     std::sort(by_x.begin(), by_x.end());
     by_x.erase(std::unique(by_x.begin(), by_x.end()), by_x.end());
     if (by_x.empty()) break;
@@ -104,7 +135,7 @@ std::size_t splitTJunctions(TriangleMesh& mesh) {
       for (int e = 0; e < 3 && !split; ++e) {
         const int a = t[e], b = t[(e + 1) % 3], c = t[(e + 2) % 3];
         if (usesOf(uses, edgeKey(a, b)) != 1) continue;
-        const std::vector<int> on = pointsOnEdge(mesh, a, b, by_x, budget);
+        const std::vector<int> on = pointsOnEdge(mesh, a, b, int(axis), by_x, budget);
         if (budget > kMaxTests) return 0;
         if (on.empty()) continue;
         // (a, b, c) → (a, p1, c), (p1, p2, c), ..., (pk, b, c): the same winding, the same surface.
@@ -208,10 +239,7 @@ ShellRepair repairShells(TriangleMesh& mesh) {
     const Eigen::Vector3d& a = mesh.vertices[t[0]];
     const Eigen::Vector3d& b = mesh.vertices[t[1]];
     const Eigen::Vector3d& c = mesh.vertices[t[2]];
-    const double longest2 =
-        std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
-    const bool sliver = t[0] == t[1] || t[1] == t[2] || t[2] == t[0] ||
-                        (b - a).cross(c - a).norm() <= kFlatRelative * longest2;
+    const bool sliver = t[0] == t[1] || t[1] == t[2] || t[2] == t[0] || isSliver(a, b, c);
     if (sliver)
       ++out.slivers_removed;
     else
@@ -221,11 +249,16 @@ ShellRepair repairShells(TriangleMesh& mesh) {
   TriangleMesh mended{mesh.vertices, std::move(kept)};
   out.edges_split = splitTJunctions(mended);
   out.facets_turned = agreeWindings(mended);
-  // Kept only where it closes something: a sheet stays as it came.
+  // Kept only where it closes something and nothing gets worse: no count up, no closed shell
+  // opened (a multi-body file's closed body opened by a mend of another lost its inside).
   const MeshReport after = validateMesh(mended);
-  if (after.open_edges >= before.open_edges &&
-      after.inconsistent_edges >= before.inconsistent_edges)
-    return {};
+  const bool better =
+      after.open_edges < before.open_edges || after.inconsistent_edges < before.inconsistent_edges;
+  const bool worse = after.open_edges > before.open_edges ||
+                     after.inconsistent_edges > before.inconsistent_edges ||
+                     after.non_manifold_edges > before.non_manifold_edges ||
+                     closedShells(mended).size() < closedShells(mesh).size();
+  if (!better || worse) return {};
   out.open_edges_before = before.open_edges;
   out.open_edges_after = after.open_edges;
   mesh = std::move(mended);

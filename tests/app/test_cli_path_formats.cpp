@@ -276,7 +276,7 @@ TEST(SimulateFormats, BadClLineAfterManyBlocksIsOneLineAndNoOutputs) {
     EXPECT_NE(run.err.find("big.cl:4321"), std::string::npos) << run.err;
     EXPECT_FALSE(fs::exists(dir.path() / "out")) << extra;
   }
-  // 60000 postures of 24 bytes (1.4 MB) against a 1 MiB limit: refused before reading, naming
+  // 60000 postures of 32 bytes (1.9 MB) against a 1 MiB limit: refused before reading, naming
   // the file and the estimate
   std::string many;
   for (int i = 0; i < 60000; ++i) many += "1 2 3 0 0 1\n";
@@ -284,7 +284,7 @@ TEST(SimulateFormats, BadClLineAfterManyBlocksIsOneLineAndNoOutputs) {
   const Outcome big =
       runFieldpath(dir, "--max-memory 1M simulate --tool ball:1 --path many.cl --out out");
   EXPECT_EQ(big.exit_code, 1) << big.err;
-  EXPECT_NE(big.err.find("--path many.cl: needs about 1.37 MiB"), std::string::npos) << big.err;
+  EXPECT_NE(big.err.find("--path many.cl: needs about 1.83 MiB"), std::string::npos) << big.err;
   EXPECT_FALSE(fs::exists(dir.path() / "out"));
 }
 

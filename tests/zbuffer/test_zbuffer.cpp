@@ -263,7 +263,8 @@ ToolMesh bladeMesh(double angle_rad) {
 TEST(Mesh, TheSpindleAngleTurnsAMeshToolAboutItsAxis) {
   const Grid g = Grid::fromRegion(-4, -4, 4, 4, 80, 80);
   Posture upright = pose(0, 0, 1, 0, 0, 1);
-  upright.spindle_rad = float(std::numbers::pi / 2);
+  upright.spindle_cos = float(std::cos(std::numbers::pi / 2));
+  upright.spindle_sin = 1.f;
   const auto h = runCpu(g, Tool::fromMesh(bladeMesh(0)), {upright}).heights_mm;
   const auto at = [&](double x, double y) {
     return h[std::size_t(std::floor((y + 4) / 0.1)) * 80 + std::size_t(std::floor((x + 4) / 0.1))];
@@ -274,7 +275,10 @@ TEST(Mesh, TheSpindleAngleTurnsAMeshToolAboutItsAxis) {
 
   const float angle = 0.7f;
   auto turned = awkwardPostures(12, 29);
-  for (auto& p : turned) p.spindle_rad = angle;
+  for (auto& p : turned) {
+    p.spindle_cos = std::cos(angle);
+    p.spindle_sin = std::sin(angle);
+  }
   const auto unturned = awkwardPostures(12, 29);
   for (Engine engine : {Engine::Fast, Engine::Coarse}) {
     const auto a = runCpu(g, Tool::fromMesh(bladeMesh(0)), turned, engine).heights_mm;

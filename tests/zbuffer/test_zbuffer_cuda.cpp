@@ -108,7 +108,11 @@ TEST_F(CpuVsCuda, MeshToolBitIdenticalFastAndCoarse) {
 TEST_F(CpuVsCuda, SpindleAnglesBitIdentical) {
   const Grid g = Grid::fromRegion(-20, -20, 20, 20, 200, 200);
   auto p = randomPostures(2000, 5, 18);
-  for (std::size_t k = 0; k < p.size(); ++k) p[k].spindle_rad = 0.37f * float(k % 17) - 3.0f;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const double angle = 0.37 * double(k % 17) - 3.0;
+    p[k].spindle_cos = float(std::cos(angle));
+    p[k].spindle_sin = float(std::sin(angle));
+  }
   const Tool mesh = Tool::fromMesh(analyticToolMesh(Tool::torus(3, 1, 12), 7, 4));
   expectSameBits(g, mesh, p, Engine::Fast);
   expectSameBits(g, mesh, p, Engine::Coarse);

@@ -223,10 +223,17 @@ void writeReliefPng(const std::filesystem::path& file, const Grid& grid,
                     std::span<const float> heights_mm, int max_side) {
   const int s = std::max(strideFor(grid.nx, max_side), strideFor(grid.ny, max_side));
   const int w = (grid.nx - 1) / s + 1, h = (grid.ny - 1) / s + 1;
+  // A pixel of s × s lines shows their lowest (a cut narrower than a pixel stays in the picture).
+  std::vector<float> lowest(std::size_t(w) * h, FLT_MAX);
+  for (int y = 0; y < grid.ny; ++y)
+    for (int x = 0; x < grid.nx; ++x) {
+      float& z = lowest[std::size_t(std::min(y / s, h - 1)) * w + std::min(x / s, w - 1)];
+      z = std::min(z, heights_mm[std::size_t(y) * grid.nx + x]);
+    }
   const auto at = [&](int i, int j) {
     i = std::clamp(i, 0, w - 1);
     j = std::clamp(j, 0, h - 1);
-    return heights_mm[std::size_t(j * s) * grid.nx + std::size_t(i * s)];
+    return lowest[std::size_t(j) * w + i];
   };
   float lo = FLT_MAX, hi = -FLT_MAX;
   for (float z : heights_mm) {

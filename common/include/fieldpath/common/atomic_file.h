@@ -304,6 +304,14 @@ inline void claimOutputs(const std::filesystem::path& dir, std::initializer_list
   }
 }
 
+/// The run succeeded: its outputs are no longer taken away by a failure or a late signal (one in
+/// the process's teardown removed the good outputs of a finished run).
+inline void releaseClaimedOutputs() {
+  const std::lock_guard<std::mutex> lock(detail::written_mutex);
+  for (auto& slot : detail::claimed_slots) slot.state.store(0);
+  detail::claimed_outputs.clear();
+}
+
 /// Removes the files `names` from `dir` where an earlier run left them and this one does not
 /// write them (a check that read no surface, a simulate without `--outputs png`): a folder never
 /// mixes two runs' outputs (`view --check` showed an earlier path's surface as this one's).

@@ -3,6 +3,7 @@
 /// `.cl` (x y z i j k [spindle_rad] per line, `#` comments, `# pass K` / `# link` block markers),
 /// APT CLDATA (`GOTO/`, `RAPID` before link moves, `$` continuations, `$$` comments) and NumPy
 /// `.npy` (float32 | float64, shape N×6 or N×7, C order).
+#include <cmath>
 #include <cstddef>
 #include <filesystem>
 #include <functional>
@@ -88,12 +89,15 @@ PathFile readNpyPath(const std::filesystem::path& file, const PathReadOptions& o
 struct CompactPosture {
   float tip_mm[3];
   float axis[3];
-  float spindle_rad;  ///< 0 where the file has no 7th column
+  /// cos, sin of the spindle angle (1, 0 where the file has no 7th column), from the double.
+  float spindle_cos, spindle_sin;
 };
 inline CompactPosture compact(const Posture& p) {
+  const bool turned = p.has_spindle && p.spindle_rad != 0.0;
   return {{float(p.tip_mm.x()), float(p.tip_mm.y()), float(p.tip_mm.z())},
           {float(p.axis.x()), float(p.axis.y()), float(p.axis.z())},
-          p.has_spindle ? float(p.spindle_rad) : 0.f};
+          turned ? float(std::cos(p.spindle_rad)) : 1.f,
+          turned ? float(std::sin(p.spindle_rad)) : 0.f};
 }
 
 /// Where scanPathFile hands the postures over.

@@ -29,13 +29,14 @@ FIELDPATH_HD float maxf(float a, float b) { return a > b ? a : b; }
 FIELDPATH_HD float absf(float a) { return a < 0.f ? -a : a; }
 
 /// Tool posture (DESIGN.md): tip p (mm, world) and unit axis a from the tip towards the spindle.
-/// `spindle_rad` (the optional 7th column): the tool turned by that angle about its own axis
-/// first, for a mesh tool with cutting edges (the seed's worn-edge "Cutting" case); a revolved
-/// tool reads the same at any angle.
+/// The spindle angle φ (the optional 7th column) as cos φ, sin φ: the tool turned by φ about its
+/// own axis first, for a mesh tool with cutting edges (the seed's worn-edge "Cutting" case); a
+/// revolved tool reads the same at any angle. Rounded from doubles on the host where the posture
+/// is made, so that the CPU and CUDA backends turn it by the same floats.
 struct Posture {
   Vec3f tip_mm;
   Vec3f axis{0.f, 0.f, 1.f};
-  float spindle_rad = 0.f;
+  float spindle_cos = 1.f, spindle_sin = 0.f;
 };
 
 /// Row-major 3×3 rotation, tool frame → world frame.
@@ -85,11 +86,8 @@ FIELDPATH_HD Vec3f mul(const Mat3f& r, Vec3f v) {
 /// the minimal rotation onto the axis (DESIGN.md). At angle 0 exactly rotationFromZ, bit for bit.
 FIELDPATH_HD Mat3f postureRotation(const Posture& pose) {
   Mat3f r = rotationFromZ(pose.axis);
-  if (pose.spindle_rad == 0.f) return r;
-  // In double, then rounded: the device's cosf/sinf differ from the host's by an ulp or two; the
-  // doubles' ulp is 2^29 times finer, so their floats agree (CPU and CUDA stay bit-identical).
-  const float c = static_cast<float>(cos(static_cast<double>(pose.spindle_rad)));
-  const float s = static_cast<float>(sin(static_cast<double>(pose.spindle_rad)));
+  if (pose.spindle_sin == 0.f && pose.spindle_cos == 1.f) return r;
+  const float c = pose.spindle_cos, s = pose.spindle_sin;
   for (int row = 0; row < 3; ++row) {  // r · Rz: columns x, y turned; z (the axis) kept
     const float x = r.m[row][0], y = r.m[row][1];
     r.m[row][0] = c * x + s * y;
