@@ -157,7 +157,13 @@ class Reader {
       fail(node, key, p.string() + ": every triangle has zero area: the mesh has no surface");
     // A solid exported with a T-junction, a sliver or a facet wound the wrong way had no inside:
     // a tool wholly inside it read as clear. Mended where that closes it, and said.
-    if (const geometry::ShellRepair mend = geometry::repairShells(mesh); mend.any()) {
+    const geometry::ShellRepair mend = geometry::repairShells(mesh);
+    if (mend.search_given_up)
+      std::fprintf(stderr,
+                   "note: %s: %zu open edges; the search for T-junctions to mend them was given up "
+                   "(a triangle soup?): the shells stay as they came\n",
+                   p.string().c_str(), mend.open_edges_before);
+    if (mend.any()) {
       std::string what;
       const auto add = [&what](std::size_t n, const char* one, const char* many) {
         if (n == 0) return;

@@ -103,8 +103,8 @@ bool isSliver(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::V
 
 /// Splits every open edge at the open-edge vertices that lie on it (a T-junction: one side's edge
 /// is two of the other side's), one edge a triangle a round, until none is left. Returns the
-/// splits made, or 0 with the mesh unchanged where the search gives up.
-std::size_t splitTJunctions(TriangleMesh& mesh) {
+/// splits made, or 0 with the mesh unchanged and `gave_up` set where the search gives up.
+std::size_t splitTJunctions(TriangleMesh& mesh, bool& gave_up) {
   std::size_t splits = 0, budget = 0;
   std::vector<Eigen::Vector3i> triangles = mesh.triangles;
   for (int round = 0; round < 8; ++round) {
@@ -136,7 +136,10 @@ std::size_t splitTJunctions(TriangleMesh& mesh) {
         const int a = t[e], b = t[(e + 1) % 3], c = t[(e + 2) % 3];
         if (usesOf(uses, edgeKey(a, b)) != 1) continue;
         const std::vector<int> on = pointsOnEdge(mesh, a, b, int(axis), by_x, budget);
-        if (budget > kMaxTests) return 0;
+        if (budget > kMaxTests) {
+          gave_up = true;
+          return 0;
+        }
         if (on.empty()) continue;
         // (a, b, c) → (a, p1, c), (p1, p2, c), ..., (pk, b, c): the same winding, the same surface.
         int from = a;
@@ -247,7 +250,14 @@ ShellRepair repairShells(TriangleMesh& mesh) {
   }
   if (kept.empty()) return {};  // all slivers: left for the caller's "no surface"
   TriangleMesh mended{mesh.vertices, std::move(kept)};
-  out.edges_split = splitTJunctions(mended);
+  bool gave_up = false;
+  out.edges_split = splitTJunctions(mended, gave_up);
+  if (gave_up) {  // no mend at all rather than a part of one, and said
+    ShellRepair said;
+    said.search_given_up = true;
+    said.open_edges_before = said.open_edges_after = before.open_edges;
+    return said;
+  }
   out.facets_turned = agreeWindings(mended);
   // Kept only where it closes something and nothing gets worse: no count up, no closed shell
   // opened (a multi-body file's closed body opened by a mend of another lost its inside).

@@ -52,6 +52,9 @@ struct ShellRepair {
   std::size_t edges_split = 0;      ///< T-junctions: an open edge split at a vertex lying on it
   std::size_t facets_turned = 0;    ///< wound against their neighbours in a closed shell
   std::size_t open_edges_before = 0, open_edges_after = 0;
+  /// The T-junction search passed its budget (a triangle soup's every edge is open): nothing
+  /// mended.
+  bool search_given_up = false;
   bool any() const { return slivers_removed + edges_split + facets_turned > 0; }
 };
 
