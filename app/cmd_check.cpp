@@ -40,7 +40,8 @@ namespace {
 using nlohmann::json;
 
 /// Per posture: block, clearance and the lower bound of the motion to the next one.
-/// clearance.csv: a row a posture; the last two columns say where the links or the holder touch
+/// clearance.csv: a row a posture; the last two columns say where the links, the holder or the
+/// cutter (beyond the gouge tolerance) touch
 /// the part (1 / 0; empty when the scene has no part), at the posture and on the motion to the
 /// next (`view --check` colours them).
 std::string clearanceCsv(const geometry::PathFile& path, const pathgen::ClearanceResult& c,
@@ -192,7 +193,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     // The links (rapid moves) and the holder (it never cuts) must not touch the part.
     pathgen::PartContacts contacts;
     if (scene.part)
-      contacts = pathgen::checkAgainstPart(scene.tool, scene.holder, *scene.part, path);
+      contacts = pathgen::checkAgainstPart(scene.tool, scene.holder, *scene.part, path,
+                                           1e-3 * options->gouge_tol_um, progress);
     const std::optional<pathgen::LinkPartResult>& link_part = contacts.links;
     const std::optional<pathgen::LinkPartResult>& holder_part = contacts.holder;
     std::size_t limited_colliding = 0;
@@ -224,7 +226,9 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
 
     // Why the check fails, one line each (empty: ok): the collisions of `unsafe`, a clearance
     // under the required one, and the gouges (a flank driven into a wall of the part is one).
-    std::vector<std::string> not_ok = unsafeReasons(clearance, motions, link_part, holder_part);
+    const std::optional<pathgen::CutterPartResult>& cutter_part = contacts.cutter;
+    std::vector<std::string> not_ok =
+        unsafeReasons(clearance, motions, link_part, holder_part, cutter_part);
     if (clearance.colliding == 0 && clearance.min_clearance_mm < scene.clearance_mm)
       not_ok.push_back("postures come within " + std::to_string(clearance.min_clearance_mm) +
                        " mm of the obstacles, under the required clearance");
@@ -254,7 +258,9 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"holder_part", holderPartJson(holder_part)},
         {"holder_part_skipped",
          holder_part ? json(nullptr) : json("no `part` or no `holder` in the scene")},
-        {"unsafe", unsafeReasons(clearance, motions, link_part, holder_part)},
+        {"cutter_part", cutterPartJson(cutter_part)},
+        {"cutter_part_skipped", cutter_part ? json(nullptr) : json("no `part` in the scene")},
+        {"unsafe", unsafeReasons(clearance, motions, link_part, holder_part, cutter_part)},
         {"tool_notes", tool_notes},
         {"obstacle_notes", obstacle_notes},
         {"axis_turn", axisTurnJson(axis_turn)},
@@ -313,6 +319,14 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                     what, (*contacts)->postures, (*contacts)->motions,
                     (*contacts)->min_clearance_mm, (*contacts)->colliding_postures,
                     (*contacts)->colliding_motions, (*contacts)->collides() ? " (COLLISIONS)" : "");
+    if (cutter_part)
+      std::printf(
+          "cutter vs part: %zu stamps, %zu postures and %zu motions enter it deeper than "
+          "%.1f um, max %.1f um (%s)%s\n",
+          cutter_part->stamps, cutter_part->gouging_postures, cutter_part->gouging_motions,
+          1e3 * cutter_part->tolerance_mm, 1e3 * cutter_part->max_depth_mm,
+          cutter_part->corner_checked ? "ball and shank, exact" : "shank only",
+          cutter_part->gouges() ? " (GOUGES)" : "");
     if (!path.limited.empty())
       std::printf("limits: %zu postures held at an angle limit, %zu of them colliding\n",
                   path.limited.size(), limited_colliding);
@@ -343,7 +357,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     if (surface && surface->coarsened)
       std::fprintf(stderr,
                    "note: --spacing %g mm would make more Z-buffer lines than a check takes: "
-                   "lines every %.4g mm (check.json `spacing`)\n",
+                   "lines every %.4g mm (check.json `surface.grid.spacing`)\n",
                    options->spacing_mm, surface->grid.dx_mm);
     if (never_cut)
       std::fprintf(stderr,

@@ -84,9 +84,12 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
                       {"colliding_postures", colliding},
                       {"settled_start", std::find(r.settled_starts.begin(), r.settled_starts.end(),
                                                   pass.index) != r.settled_starts.end()}});
+    if (std::isnan(pass.v))  // a null beside its reason (DESIGN.md)
+      passes.back()["v_skipped"] = "a pass of a nominal path has no channel coordinate v";
   }
   const auto& box = r.reach_box_mm;
-  const std::vector<std::string> unsafe = unsafeReasons(r.clearance, r.motions, r.link_part, r.holder_part);
+  const std::vector<std::string> unsafe =
+      unsafeReasons(r.clearance, r.motions, r.link_part, r.holder_part, r.cutter_part);
   return {
       {"scene", scene.file.string()},
       {"field_mode", job.nominal ? "nominal" : pathgen::fieldModeNames(job.mode).id},
@@ -121,6 +124,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"motions", motionsJson(r.motions, job.clearance_mm, pathgen::MotionRequest{}.resolution_mm)},
       {"link_part", linkPartJson(r.link_part)},
       {"holder_part", holderPartJson(r.holder_part)},
+      {"cutter_part", cutterPartJson(r.cutter_part)},
       {"link_part_skipped",
        r.link_part ? json(nullptr) : json("no `part` in the scene, or no links")},
       {"safe", unsafe.empty()},
@@ -263,8 +267,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     const std::filesystem::path out = options->out;
     const std::string what = job.nominal ? "nominal path" : "field path";
     // A path that collides is still written (to look at, and `check`), marked in both files.
-    const std::vector<std::string> unsafe =
-        unsafeReasons(result.clearance, result.motions, result.link_part, result.holder_part);
+    const std::vector<std::string> unsafe = unsafeReasons(
+        result.clearance, result.motions, result.link_part, result.holder_part, result.cutter_part);
     std::string unsafe_text;
     for (const std::string& reason : unsafe)
       unsafe_text += (unsafe_text.empty() ? "" : "; ") + reason;
@@ -354,16 +358,19 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
         std::printf("note: %s\n", note.c_str());
     for (const std::string& note : openObstacleNotes(scene))
       std::printf("note: %s\n", note.c_str());
-    if (scene.nominal && !job.nominal) {  // a lead in the file is not kept: n is ⊥ the feed
+    // A lead in the file is not kept: n is ⊥ the feed, steered (the field) or written as it is
+    // (--nominal: the written axes were up to 5.6 deg off the file's, unsaid: a helper's finding).
+    if (scene.nominal) {
       const pathgen::Pass* leanest = nullptr;
       for (const pathgen::Pass& p : job.passes)
         if (!leanest || p.nominal_lean_deg > leanest->nominal_lean_deg) leanest = &p;
       if (leanest && leanest->nominal_lean_deg > kNoteLeanDeg)
-        std::printf("note: %s: the nominal axes lean along the feed by up to %.1f deg: the "
-                    "steering starts from the axis made square to the feed and path.lead_deg "
-                    "(%g deg), not from the file's lead\n",
-                    leanest->nominal_lean_at.c_str(), leanest->nominal_lean_deg,
-                    job.path.lead_deg);
+        std::printf(
+            "note: %s: the nominal axes lean along the feed by up to %.1f deg: %s from "
+            "the axis made square to the feed and path.lead_deg (%g deg), not from the "
+            "file's lead\n",
+            leanest->nominal_lean_at.c_str(), leanest->nominal_lean_deg,
+            job.nominal ? "the path is written" : "the steering starts", job.path.lead_deg);
     }
     if (!result.settled_starts.empty() && job.dynamics.start == dynamics::StartPolicy::Auto)
       std::printf(

@@ -159,11 +159,14 @@ void checkSceneSize(const Scene& scene) {
   // and marked every posture (a helper's finding); micro tools are real, so a note, not a refusal.
   const double tool_radius = scene.tool.radius_mm;
   const double span = box.empty() ? 0.0 : box.diagonal();
-  if (tool_radius < 0.01 || (!box.empty() && span < 1.0))
+  // A field-only scene has no tool: the default radius is nobody's (a helper's finding).
+  const std::string tool_said =
+      scene.tool_given ? "the tool radius is " + fmt(tool_radius) + " mm and " : "";
+  if ((scene.tool_given && tool_radius < 0.01) || (!box.empty() && span < 1.0))
     std::fprintf(stderr,
-                 "note: %s: the tool radius is %s mm and the obstacles span %s mm: every length "
-                 "is read in millimetres (is the scene in metres?)\n",
-                 scene.file.string().c_str(), fmt(tool_radius).c_str(), fmt(span).c_str());
+                 "note: %s: %sthe obstacles span %s mm: every length is read in millimetres (is "
+                 "the scene in metres?)\n",
+                 scene.file.string().c_str(), tool_said.c_str(), fmt(span).c_str());
 
   // Output postures: path.step against the passes' length (and path.passes).
   const PassLength length = passLength(scene);

@@ -1,6 +1,7 @@
 #pragma once
 /// The job of a scene, shared by `generate`, `study` and the benchmark (defined in job.cpp), and
 /// the JSON blocks that `generate` and `check` both write.
+#include <algorithm>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -50,26 +51,29 @@ inline nlohmann::json clearanceJson(const pathgen::ClearanceResult& c, double re
 /// The `motions` block of report.json and check.json (motion i: posture i → i + 1).
 inline nlohmann::json motionsJson(const pathgen::MotionResult& m, double required_mm,
                                   double resolution_mm) {
-  return {{"motions", m.motions},
-          {"method",
-           "tip and axis interpolated linearly; adaptive sampling with a certified lower bound "
-           "(tool + holder move at most |dtip| + reach * dangle between samples; the distance "
-           "is 1-Lipschitz in that): halved until the bound reaches max(required_mm, closest "
-           "posture - max(0.01 mm, 1 % of it)), a sample touches, or the sub-motion moves <= 2 "
-           "* resolution_mm"},
-          {"resolution_mm", resolution_mm},
-          {"min_mm", jsonNumber(m.min_clearance_mm)},
-          {"min_is",
-           "a lower bound, within max(0.01 mm, 1 % of the closest posture's clearance) of the "
-           "true minimum when that is above required_mm"},
-          {"min_motion", jsonIndex(m.min_index)},
-          {"colliding_motions", m.colliding},
-          {"first_colliding_motion", jsonIndex(m.first_colliding)},
-          {"motions_under_required", m.under_required},
-          {"first_motion_under_required", jsonIndex(m.first_under_required)},
-          {"samples", m.samples},
-          {"ok", m.colliding == 0 && m.under_required == 0 &&
-                     !(m.min_clearance_mm < required_mm)}};
+  nlohmann::json out = {
+      {"motions", m.motions},
+      {"method",
+       "tip and axis interpolated linearly; adaptive sampling with a certified lower bound "
+       "(tool + holder move at most |dtip| + reach * dangle between samples; the distance "
+       "is 1-Lipschitz in that): halved until the bound reaches max(required_mm, closest "
+       "posture - max(0.01 mm, 1 % of it)), a sample touches, or the sub-motion moves <= 2 "
+       "* resolution_mm"},
+      {"resolution_mm", resolution_mm},
+      {"min_mm", jsonNumber(m.min_clearance_mm)},
+      {"min_is",
+       "a lower bound, within max(0.01 mm, 1 % of the closest posture's clearance) of the "
+       "true minimum when that is above required_mm"},
+      {"min_motion", jsonIndex(m.min_index)},
+      {"colliding_motions", m.colliding},
+      {"first_colliding_motion", jsonIndex(m.first_colliding)},
+      {"motions_under_required", m.under_required},
+      {"first_motion_under_required", jsonIndex(m.first_under_required)},
+      {"samples", m.samples},
+      {"ok", m.colliding == 0 && m.under_required == 0 && !(m.min_clearance_mm < required_mm)}};
+  // A null beside its reason (DESIGN.md): a path of one posture has no motion.
+  if (m.motions == 0) out["min_skipped"] = "no motion: the path has one posture";
+  return out;
 }
 
 /// A block of the part's contacts (LinkPartResult) as report.json and check.json write it, its
@@ -107,6 +111,33 @@ inline nlohmann::json holderPartJson(const std::optional<pathgen::LinkPartResult
       *h, "postures", "motions",
       "the holder (the stations above the tool: it never cuts) against the part mesh at every "
       "posture and motion, passes and links (as `motions`, required 0)");
+}
+
+/// The `cutter_part` block of report.json and check.json: the cutter against the part, exactly
+/// (null with the reason when the job has no part or a flat end).
+inline nlohmann::json cutterPartJson(const std::optional<pathgen::CutterPartResult>& c) {
+  if (!c) return nullptr;
+  return {
+      {"stamps", c->stamps},
+      {"tolerance_um", 1e3 * c->tolerance_mm},
+      {"step_mm", c->step_mm},
+      {"between_stamps_um", 1e3 * c->between_stamps_mm},
+      {"tested", c->corner_checked ? "the ball and the shank"
+                                   : "the shank above the corner (the torus corner: the "
+                                     "Z-buffer's lines only)"},
+      {"gouging_postures", c->gouging_postures},
+      {"gouging_motions", c->gouging_motions},
+      {"first_gouging_posture", jsonIndex(c->first_gouging_posture)},
+      {"first_gouging_motion", jsonIndex(c->first_gouging_motion)},
+      {"max_depth_um", 1e3 * c->max_depth_mm},
+      {"deepest_posture", c->deepest_on_motion ? nlohmann::json(nullptr) : jsonIndex(c->deepest)},
+      {"deepest_motion", c->deepest_on_motion ? jsonIndex(c->deepest) : nlohmann::json(nullptr)},
+      {"method",
+       "the cutter shrunk all round by tolerance_um (FCL's sphere and cylinder: exact "
+       "surfaces) against the part's triangles and inside, at every posture and at stamps "
+       "step_mm apart along the motions near the part; between two stamps an entry may be "
+       "up to between_stamps_um deeper; max_depth_um to 0.1 um, at most the tool radius"},
+      {"ok", !c->gouges()}};
 }
 
 /// The digest of what a check reads of its scene: the scene file and every mesh it loads (the
@@ -149,10 +180,11 @@ inline std::string axisTurnWarning(const geometry::PathFile& path, const pathgen
 /// Why a path is not safe to run as it stands (empty: it is): postures or motions that touch an
 /// obstacle, links that touch the part, the holder touching the part. Postures numbered from 0,
 /// as in the JSON and clearance.csv; motion i from posture i to i + 1.
-inline std::vector<std::string> unsafeReasons(const pathgen::ClearanceResult& c,
-                                              const pathgen::MotionResult& m,
-                                              const std::optional<pathgen::LinkPartResult>& l,
-                                              const std::optional<pathgen::LinkPartResult>& h) {
+inline std::vector<std::string> unsafeReasons(
+    const pathgen::ClearanceResult& c, const pathgen::MotionResult& m,
+    const std::optional<pathgen::LinkPartResult>& l,
+    const std::optional<pathgen::LinkPartResult>& h,
+    const std::optional<pathgen::CutterPartResult>& cut = std::nullopt) {
   std::vector<std::string> out;
   auto first = [](std::size_t i) { return std::to_string(i); };
   if (c.colliding)
@@ -177,6 +209,15 @@ inline std::vector<std::string> unsafeReasons(const pathgen::ClearanceResult& c,
     out.push_back(std::to_string(h->colliding_motions) +
                   " motions put the holder into the part (first: posture " +
                   first(h->first_colliding_motion) + " to the next)");
+  if (cut && cut->gouges()) {
+    char depth[32];
+    std::snprintf(depth, sizeof depth, "%.0f", 1e3 * cut->max_depth_mm);
+    const std::size_t first = std::min(cut->first_gouging_posture, cut->first_gouging_motion);
+    out.push_back("the cutter enters the part deeper than the gouge tolerance at " +
+                  std::to_string(cut->gouging_postures) + " postures and " +
+                  std::to_string(cut->gouging_motions) + " motions (max " + depth +
+                  " um; first: posture " + std::to_string(first) + ")");
+  }
   return out;
 }
 

@@ -17,11 +17,10 @@
 #include "estimates.h"
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/input_file.h"
-#include "fieldpath/common/limits.h"
 #include "fieldpath/common/short_number.h"
 #include "fieldpath/geometry/mesh.h"
-#include "fieldpath/geometry/mesh_io.h"
 #include "fieldpath/geometry/tool_model.h"
+#include "scene_mesh.h"
 
 namespace fieldpath::app {
 namespace {
@@ -142,57 +141,14 @@ class Reader {
     return p.is_absolute() ? p : file_.parent_path() / p;
   }
 
-  /// Loads a mesh, naming the scene's key and line in the error.
+  /// Loads a mesh (loadSceneMesh: read, mended, turned outward), naming the scene's key and
+  /// line in the error.
   geometry::TriangleMesh mesh(const YAML::Node& node, const std::string& key) const {
-    const auto p = path(node, key);
-    geometry::TriangleMesh mesh;
     try {
-      mesh = geometry::loadMesh(p);
+      return loadSceneMesh(path(node, key));
     } catch (const InputError& e) {
       fail(node, key, e.what());
     }
-    // Every triangle degenerate: no surface to sample or to machine (it was read, and the
-    // field was zero everywhere without a word: a helper's finding).
-    if (!(geometry::meshArea(mesh) > 0.0))
-      fail(node, key, p.string() + ": every triangle has zero area: the mesh has no surface");
-    // A solid exported with a T-junction, a sliver or a facet wound the wrong way had no inside:
-    // a tool wholly inside it read as clear. Mended where that closes it, and said.
-    const geometry::ShellRepair mend = geometry::repairShells(mesh);
-    if (mend.search_given_up)
-      std::fprintf(stderr,
-                   "note: %s: %zu open edges; the search for T-junctions to mend them was given up "
-                   "(a triangle soup?): the shells stay as they came\n",
-                   p.string().c_str(), mend.open_edges_before);
-    if (mend.any()) {
-      std::string what;
-      const auto add = [&what](std::size_t n, const char* one, const char* many) {
-        if (n == 0) return;
-        what += (what.empty() ? "" : ", ") + std::to_string(n) + " " + (n == 1 ? one : many);
-      };
-      add(mend.edges_split, "T-junction edge split", "T-junction edges split");
-      add(mend.slivers_removed, "sliver of no area left out", "slivers of no area left out");
-      add(mend.facets_turned, "facet turned to agree with its neighbours",
-          "facets turned to agree with their neighbours");
-      std::fprintf(
-          stderr, "note: %s: mended as exported solids need (%s): %zu open edges before, %zu now\n",
-          p.string().c_str(), what.c_str(), mend.open_edges_before, mend.open_edges_after);
-    }
-    // Inward-wound shells would make the field pull into the walls (the samples' normals) and
-    // the part's top its bottom: turned, and said.
-    if (const std::size_t turned = geometry::orientClosedShells(mesh))
-      std::fprintf(stderr, "note: %s: %zu closed shell%s wound inward (normals flipped), turned "
-                           "outward\n", p.string().c_str(), turned, turned == 1 ? "" : "s");
-    // Mesh files are read in single precision (binary STL stores floats; assimp reads every
-    // format so): far from the origin their points move by half a float's step, which check
-    // then reads as microns of gouge or clearance (5e5 mm: 32 um, 32 769 false gouged lines).
-    double far_mm = 0.0;
-    for (const auto& v : mesh.vertices) far_mm = std::max(far_mm, v.cwiseAbs().maxCoeff());
-    if (far_mm > common::kFloatExactMm)
-      std::fprintf(stderr,
-                   "note: %s: points up to %.4g mm from the origin, read in single precision "
-                   "(steps of %.2g mm there): place the job near the origin for micron figures\n",
-                   p.string().c_str(), far_mm, common::floatStepMm(far_mm));
-    return mesh;
   }
 
   /// Runs a module's own validation, naming the key and line in its error: the line of the

@@ -412,11 +412,13 @@ ViewData gatherView(const ViewRequest& request) {
         p.part_contact_to_next = std::move(marks.motion);
         check->link_part = std::move(contacts.links);
         check->holder_part = std::move(contacts.holder);
+        check->cutter_part = std::move(contacts.cutter);
       }
       p.clearance_known = true;
     }
     if (check)
-      for (const std::string& reason : unsafeReasons({}, {}, check->link_part, check->holder_part))
+      for (const std::string& reason :
+           unsafeReasons({}, {}, check->link_part, check->holder_part, check->cutter_part))
         d.warnings.push_back("UNSAFE TO RUN: " + reason);
     for (std::size_t i = 0; i < n; ++i) {
       p.colliding_postures += p.clearance_mm[i] <= 0.0;

@@ -142,6 +142,19 @@ CheckJson readCheckJson(const fs::path& dir) {
   };
   c.link_part = contacts("link_part");
   c.holder_part = contacts("holder_part");
+  if (const json cut = j.value("cutter_part", json()); cut.is_object()) {
+    pathgen::CutterPartResult& r = c.cutter_part.emplace();
+    r.gouging_postures =
+        count(cut.value("gouging_postures", json()), file, "cutter_part.gouging_postures");
+    r.gouging_motions =
+        count(cut.value("gouging_motions", json()), file, "cutter_part.gouging_motions");
+    if (cut.value("first_gouging_posture", json()).is_number_unsigned())
+      r.first_gouging_posture = cut["first_gouging_posture"].get<std::size_t>();
+    if (cut.value("first_gouging_motion", json()).is_number_unsigned())
+      r.first_gouging_motion = cut["first_gouging_motion"].get<std::size_t>();
+    if (cut.value("max_depth_um", json()).is_number())
+      r.max_depth_mm = 1e-3 * cut["max_depth_um"].get<double>();
+  }
   return c;
 }
 

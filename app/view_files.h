@@ -31,6 +31,8 @@ struct CheckJson {
   /// check.json `link_part` and `holder_part`: the part's contacts (the page's colours are the
   /// obstacles'), where check found them.
   std::optional<pathgen::LinkPartResult> link_part, holder_part;
+  /// check.json `cutter_part`: the counts, the first gouging posture and motion, the depth.
+  std::optional<pathgen::CutterPartResult> cutter_part;
 };
 /// check.json of a `check --out` folder (`--check DIR`).
 CheckJson readCheckJson(const std::filesystem::path& dir);

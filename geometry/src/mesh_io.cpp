@@ -15,6 +15,8 @@
 #include <unordered_map>
 #include <utility>
 
+#include <unistd.h>
+
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <Eigen/Geometry>
@@ -117,6 +119,9 @@ std::string readableAssimpError(const std::string& why) {
 struct StlFeed {
   bool copy = false;
   bool lower = false;
+  /// A binary header starting with a UTF-8 byte-order mark's bytes: assimp skips them as text
+  /// (and misreads the count, "Failed to determine STL storage"), so the copy has them blank.
+  bool blank_mark = false;
   std::uintmax_t length = 0;
 };
 
@@ -178,7 +183,8 @@ StlFeed checkAsciiStl(const std::filesystem::path& file, std::uintmax_t size) {
         const std::string token = line.substr(at, end - at);
         char* stop = nullptr;
         const double value = std::strtod(token.c_str(), &stop);
-        if (bad.empty() && (stop != token.c_str() + token.size() || !std::isfinite(value)))
+        if (bad.empty() && (stop != token.c_str() + token.size() || !std::isfinite(value) ||
+                            std::abs(value) > common::kMaxCoordinateMm))
           bad = token;
         ++tokens;
         at = end;
@@ -189,7 +195,7 @@ StlFeed checkAsciiStl(const std::filesystem::path& file, std::uintmax_t size) {
                          std::to_string(tokens));
       if (!bad.empty())
         throw InputError(where + "ASCII STL vertex: '" + bad.substr(0, 40) +
-                         "' is not a finite number");
+                         "' is not a finite number within +-1e6 mm");
     } else if (word == "endfacet") {
       if (in_facet && vertices != 3)
         throw InputError(file.string() + ":" + std::to_string(facet_line) +
@@ -240,9 +246,11 @@ StlFeed checkStl(const std::filesystem::path& file, std::uintmax_t size) {
     return size >= needed && size - needed < 50;
   };
   // assimp takes a binary STL of its exact size only: the padding is left out of its copy.
-  const auto binaryFeed = [size](std::uintmax_t needed) {
+  const bool marked = got >= 3 && header[0] == 0xEF && header[1] == 0xBB && header[2] == 0xBF;
+  const auto binaryFeed = [size, marked](std::uintmax_t needed) {
     StlFeed feed;
-    feed.copy = size != needed;
+    feed.copy = size != needed || marked;
+    feed.blank_mark = marked;
     feed.length = needed;
     return feed;
   };
@@ -339,6 +347,64 @@ void checkPlyHeader(const std::filesystem::path& file, std::uintmax_t size) {
   throw InputError(file.string() + ": PLY header without `end_header` in its first 64 KiB");
 }
 
+/// A text mesh saved with a UTF-8 byte-order mark (Windows editors write one): assimp and the
+/// checks above read it as binary or as a bad first line ("header says 170926129 triangles",
+/// "vertex index out of range"). Not a binary STL whose 80-byte header happens to start so (its
+/// size fits its count).
+bool startsWithByteOrderMark(const std::filesystem::path& file, std::uintmax_t size) {
+  std::ifstream in(file, std::ios::binary);
+  unsigned char head[84] = {};
+  in.read(reinterpret_cast<char*>(head), sizeof head);
+  const std::streamsize got = in.gcount();
+  if (got < 3 || head[0] != 0xEF || head[1] != 0xBB || head[2] != 0xBF) return false;
+  if (lowerExtension(file) == ".stl" && got == 84) {
+    const std::uint32_t count = std::uint32_t(head[80]) | std::uint32_t(head[81]) << 8 |
+                                std::uint32_t(head[82]) << 16 | std::uint32_t(head[83]) << 24;
+    const std::uintmax_t needed = 84 + 50 * std::uintmax_t(count);
+    if (size >= needed && size - needed < 50) return false;
+  }
+  return true;
+}
+
+/// The file read past its byte-order mark: a copy without it (same name, in a folder of its own
+/// under the temporary directory, removed after), its messages naming the file itself.
+TriangleMesh loadWithoutByteOrderMark(const std::filesystem::path& file) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path folder =
+      fs::temp_directory_path(ec) / ("fieldpath-bom-" + std::to_string(::getpid()));
+  const fs::path copy = folder / file.filename();
+  if (file.parent_path() == folder)
+    throw InputError(file.string() + ": starts with two UTF-8 byte-order marks");
+  struct Cleanup {
+    fs::path folder;
+    ~Cleanup() {
+      std::error_code ignored;
+      fs::remove_all(folder, ignored);
+    }
+  } cleanup{folder};
+  {
+    fs::create_directories(folder, ec);
+    std::ifstream in(file, std::ios::binary);
+    in.seekg(3);
+    std::ofstream out(copy, std::ios::binary);
+    out << in.rdbuf();
+    if (ec || !out.flush())
+      throw InputError(file.string() +
+                       ": starts with a UTF-8 byte-order mark, and no copy "
+                       "without it could be made: save it without the mark");
+  }
+  try {
+    return loadMesh(copy);
+  } catch (const InputError& e) {
+    std::string why = e.what();
+    for (std::size_t at = why.find(copy.string()); at != std::string::npos;
+         at = why.find(copy.string(), at + file.string().size()))
+      why.replace(at, copy.string().size(), file.string());
+    throw InputError(why);
+  }
+}
+
 }  // namespace
 
 TriangleMesh loadMesh(const std::filesystem::path& file) {
@@ -346,6 +412,7 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
   common::requireRegularFile(file, "mesh file");
   const std::uintmax_t size = std::filesystem::file_size(file, ec);
   if (ec || size == 0) throw InputError(file.string() + ": empty file");
+  if (startsWithByteOrderMark(file, size)) return loadWithoutByteOrderMark(file);
   // assimp's scene, our joined copy and the hash that joins them: about 16 bytes per file byte
   // (a binary STL's 50-byte facet becomes 3 aiVector3D, a face, 3 map entries, 1.5 vertices).
   common::requireMemory(file.string(), 16.0 * static_cast<double>(size), "mesh file of " +
@@ -366,6 +433,7 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
       text.resize(static_cast<std::size_t>(in.gcount()));
       if (stl.lower)
         text = common::lowerCase(std::move(text));
+      if (stl.blank_mark) text.replace(0, 3, 3, ' ');
       scene = importer.ReadFileFromMemory(text.data(), text.size(), aiProcess_ValidateDataStructure,
                                           "stl");
     } else {

@@ -489,6 +489,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
       PartContacts contacts = checkAgainstPart(tool, request.holder, *request.part, result.path);
       result.link_part = std::move(contacts.links);
       result.holder_part = std::move(contacts.holder);
+      result.cutter_part = std::move(contacts.cutter);
     }
   }
   for (GeneratedPosture& g : result.postures) {

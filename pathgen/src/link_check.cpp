@@ -134,7 +134,8 @@ std::optional<LinkPartResult> checkHolderAgainstPart(const geometry::ToolSpec& t
 }
 
 PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
-                              const geometry::TriangleMesh& part, const geometry::PathFile& path) {
+                              const geometry::TriangleMesh& part, const geometry::PathFile& path,
+                              double gouge_tolerance_mm, const common::Progress& progress) {
   PartContacts out;
   if (path.count(geometry::PathBlock::Kind::Link) > 0) {
     const ClearanceChecker whole(geometry::toolMesh(tool, holder, kClearanceMeshTolMm),
@@ -142,18 +143,23 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
     out.links = checkLinksAgainstPart(whole, grazingPartChecker(tool, holder, part), path);
   }
   out.holder = checkHolderAgainstPart(tool, holder, part, path.postures);
+  if (tool.shape != geometry::ToolShape::Flat)
+    out.cutter = checkCutterAgainstPart(tool, part, path.postures, gouge_tolerance_mm, progress);
   return out;
 }
 
 PartContacts::Marks PartContacts::marks(std::size_t n) const {
   Marks out{std::vector<std::uint8_t>(n, 0), std::vector<std::uint8_t>(n, 0)};
-  for (const std::optional<LinkPartResult>* r : {&links, &holder}) {
-    if (!*r) continue;
-    for (std::size_t i : (*r)->posture_contacts)
+  const auto mark = [&out, n](const std::vector<std::size_t>& postures,
+                              const std::vector<std::size_t>& motions) {
+    for (std::size_t i : postures)
       if (i < n) out.posture[i] = 1;
-    for (std::size_t i : (*r)->motion_contacts)
+    for (std::size_t i : motions)
       if (i < n) out.motion[i] = 1;
-  }
+  };
+  for (const std::optional<LinkPartResult>* r : {&links, &holder})
+    if (*r) mark((*r)->posture_contacts, (*r)->motion_contacts);
+  if (cutter) mark(cutter->posture_contacts, cutter->motion_contacts);
   return out;
 }
 

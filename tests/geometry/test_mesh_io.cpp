@@ -117,6 +117,39 @@ TEST(MeshIo, AsciiPlyAndObjWithQuadsClosedForm) {
   }
 }
 
+// Saved by a Windows editor with a UTF-8 byte-order mark: the same meshes (the ASCII STL was read
+// as binary, "header says 170926129 triangles"; the OBJ lost its first vertex; the PLY's first
+// line was not `ply`). A binary STL whose header starts with those bytes stays binary.
+TEST(MeshIo, TextMeshesWithAByteOrderMarkAreTheSame) {
+  const std::string bom = "\xEF\xBB\xBF";
+  const TriangleMesh stl = loadMesh(writeBytes("bom.stl", bom + kAsciiTetra));
+  EXPECT_EQ(stl.triangles.size(), 4u);
+  EXPECT_NEAR(meshVolume(stl), 1.0 / 6.0, 1e-12);
+  const std::string obj =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  const TriangleMesh plain = loadMesh(writeBytes("plain.obj", obj));
+  const TriangleMesh marked = loadMesh(writeBytes("bom.obj", bom + obj));
+  EXPECT_EQ(marked.vertices, plain.vertices);
+  EXPECT_EQ(marked.triangles, plain.triangles);
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  EXPECT_NEAR(meshArea(loadMesh(writeBytes("bom.ply", bom + ply))), 0.5, 1e-12);
+  // An error in a marked file names the file itself (not the copy read past the mark).
+  const fs::path bad =
+      writeBytes("bom_bad.stl", bom + std::string("solid x\nfacet normal 0 0 1\n"));
+  expectInputErrorNamingFile(bad);
+  // A binary STL of one triangle whose 80-byte header starts with the mark's bytes.
+  std::string binary = bom + std::string(77, ' ');
+  const std::uint32_t one = 1;
+  binary.append(reinterpret_cast<const char*>(&one), 4);
+  const float facet[12] = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+  binary.append(reinterpret_cast<const char*>(facet), sizeof facet);
+  binary.append(2, '\0');
+  EXPECT_NEAR(meshArea(loadMesh(writeBytes("bom_binary.stl", binary))), 0.5, 1e-12);
+}
+
 TEST(MeshIo, RoundTripsStlObjPly) {
   const TriangleMesh tool =
       toolMesh(parseToolSpec("torus:5:1:20"), parseHolderProfile("20:8,35:8"), 0.01);

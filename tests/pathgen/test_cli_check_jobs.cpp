@@ -314,9 +314,14 @@ TEST(CheckSurface, AShankDrivenIntoAWallOfThePartIsAGouge) {
   EXPECT_GT(towards["surface"]["max_gouge_um"].get<double>(), 3000.0);
   EXPECT_GT(towards["surface"]["gouged_lines"].get<int>(), 100);
   EXPECT_FALSE(towards["ok"].get<bool>());
-  ASSERT_EQ(towards["not_ok_because"].size(), 1u);  // the gouge said as the reason
-  EXPECT_NE(towards["not_ok_because"][0].get<std::string>().find("below the part"),
+  // The gouge said as the reasons: the cutter's exact entry, then the Z-buffer's lines.
+  ASSERT_EQ(towards["not_ok_because"].size(), 2u) << towards["not_ok_because"];
+  EXPECT_NE(towards["not_ok_because"][0].get<std::string>().find("the cutter enters the part"),
             std::string::npos);
+  EXPECT_NE(towards["not_ok_because"][1].get<std::string>().find("below the part"),
+            std::string::npos);
+  EXPECT_EQ(towards["cutter_part"]["gouging_postures"].get<int>(), 41);
+  EXPECT_EQ(away["cutter_part"]["gouging_postures"].get<int>(), 0);
   EXPECT_EQ(away["surface"]["gouged_lines"].get<int>(), 0);
   EXPECT_TRUE(away["ok"].get<bool>()) << away["not_ok_because"];
 }
@@ -339,6 +344,38 @@ TEST(CheckSurface, AShankIntoAWallGougesItsDepthNotTheWallsHeight) {
   EXPECT_GT(gouge, 300.0 - 1.0);
   EXPECT_LT(gouge, 300.0 + 50.0 + 1.0);
   EXPECT_FALSE(check["ok"].get<bool>());
+  // The exact test of the cutter: 300 um to its 0.1 um, at every posture.
+  EXPECT_NEAR(check["cutter_part"]["max_depth_um"].get<double>(), 300.0, 0.2);
+  EXPECT_EQ(check["cutter_part"]["gouging_postures"].get<int>(), 41);
+}
+
+// A shank 0.02 mm into a wall can fall between the Z-buffer's lines (0.05 mm apart): the exact
+// test of the cutter against the part sees it at every posture, 20 um deep, and `check` is not
+// ok (a helper's case; it passed as clean). 0.004 mm, inside the 5 um tolerance, stays ok.
+TEST(CheckSurface, AShankGrazingAWallBetweenTheLinesIsSeenExactly) {
+  const TempDir dir;
+  writeFloorAndWall(dir, {-30, 30, -30, 5, -10, 0}, {-30, 30, 5, 15, -10, 10});  // wall at y = 5
+  for (const double entry : {0.02, 0.004}) {
+    std::ostringstream path;
+    path.precision(17);
+    path << "# pass 1\n";
+    for (int k = 0; k <= 40; ++k) path << -5 + 0.25 * k << ' ' << 2.0 + entry << " 0 0 0 1\n";
+    dir.write("graze.cl", path.str());
+    const auto r = test::runFieldpath(dir, "check scene.yaml --path graze.cl --out out");
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    const auto check = nlohmann::json::parse(test::slurp(dir.path() / "out" / "check.json"));
+    const auto& cutter = check["cutter_part"];
+    if (entry > 0.005) {
+      EXPECT_NEAR(cutter["max_depth_um"].get<double>(), 1e3 * entry, 0.2) << cutter;
+      EXPECT_EQ(cutter["gouging_postures"].get<int>(), 41);
+      EXPECT_EQ(cutter["gouging_motions"].get<int>(), 40);
+      EXPECT_FALSE(check["ok"].get<bool>());
+      EXPECT_NE(r.out.find("(GOUGES)"), std::string::npos) << r.out;
+    } else {
+      EXPECT_EQ(cutter["gouging_postures"].get<int>(), 0) << cutter;
+      EXPECT_EQ(cutter["max_depth_um"].get<double>(), 0.0);
+    }
+  }
 }
 
 // Passes that do not cross the part leave no surface to check, but their clearance still

@@ -1,6 +1,7 @@
 /// `generate` at the edges of what a scene allows, through the built `fieldpath`: a nominal pass
 /// whose ball itself comes within `clearance` of a wall (no axis can clear it); a voxel grid
 /// coarse against r0.
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -108,4 +109,61 @@ TEST(GenerateEdges, ASceneInMetresIsSaid) {
     ASSERT_EQ(r.exit_code, 0) << r.output();
     EXPECT_EQ(r.err.find("is the scene in metres?") != std::string::npos, scale < 0.01) << r.err;
   }
+}
+
+// A field-only scene (no `tool:`) that spans 0.1 mm: the note names the obstacles' span, not the
+// default tool's radius (it said "the tool radius is 3 mm" of a scene with none).
+TEST(GenerateEdges, ATinySceneWithoutAToolNamesNoTool) {
+  const TempDir dir;
+  geometry::TriangleMesh wall;
+  pathgen::test::addBox(wall, 0.01, 0.012, -0.02, 0.02, -0.005, 0.02);
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\n"
+            "field: { r0: 0.005, r_min: 0.00025, sample_step: 0.001 }\n");
+  dir.write("points.txt", "0 0 0\n");
+  const auto r = test::runFieldpath(dir, "field probe scene.yaml --points points.txt --direct");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  EXPECT_NE(r.err.find("is the scene in metres?"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("tool radius"), std::string::npos) << r.err;
+}
+
+// Axes leaning 10° along the feed are made square to it (plus path.lead_deg) by both runs: the
+// steered one starts there, --nominal writes them so. Both say it (--nominal was silent, its
+// axes 10° off the file's: a helper's finding).
+TEST(GenerateEdges, ANominalPathsLeadNotKeptIsSaidByBothRuns) {
+  const TempDir dir;
+  geometry::TriangleMesh wall;
+  pathgen::test::addBox(wall, 30, 32, -20, 20, -5, 20);
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  const double s = std::sin(10.0 * M_PI / 180.0), c = std::cos(10.0 * M_PI / 180.0);
+  std::ostringstream cl;
+  cl.precision(17);
+  cl << "# pass 1\n";
+  for (int i = -10; i <= 10; ++i) cl << 0.0 << ' ' << i << " 0 0 " << s << ' ' << c << '\n';
+  dir.write("lean.cl", cl.str());
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, length: 20 }\n"
+            "path: { nominal: lean.cl }\n");
+  const auto field = test::runFieldpath(dir, "generate scene.yaml --direct --out field");
+  ASSERT_EQ(field.exit_code, 0) << field.output();
+  EXPECT_NE(field.out.find("lean along the feed by up to 10.0 deg: the steering starts"),
+            std::string::npos)
+      << field.out;
+  const auto nominal = test::runFieldpath(dir, "generate scene.yaml --nominal --out nominal");
+  ASSERT_EQ(nominal.exit_code, 0) << nominal.output();
+  EXPECT_NE(nominal.out.find("lean along the feed by up to 10.0 deg: the path is written"),
+            std::string::npos)
+      << nominal.out;
+  // A pass of a nominal path has no channel coordinate: v is null with its reason beside it.
+  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "field" / "report.json"));
+  EXPECT_TRUE(report["per_pass"][0]["v"].is_null());
+  EXPECT_TRUE(report["per_pass"][0]["v_skipped"].is_string()) << report["per_pass"][0];
+  // One posture, no motion: the motions' minimum null with its reason.
+  dir.write("one.cl", "0 0 0 0 0 1\n");
+  const auto one = test::runFieldpath(dir, "check scene.yaml --path one.cl --out one");
+  ASSERT_EQ(one.exit_code, 0) << one.output();
+  const auto check = nlohmann::json::parse(test::slurp(dir.path() / "one" / "check.json"));
+  EXPECT_TRUE(check["motions"]["min_mm"].is_null());
+  EXPECT_TRUE(check["motions"]["min_skipped"].is_string()) << check["motions"];
 }

@@ -118,6 +118,9 @@ struct GenerateResult {
   /// The holder against the part at every posture and motion (when the job has a part and a
   /// holder): it never cuts, so touching is a crash.
   std::optional<LinkPartResult> holder_part;
+  /// The cutter against the part, exactly (when the job has a part and a ball or torus tool):
+  /// entries deeper than kGougeToleranceMm.
+  std::optional<CutterPartResult> cutter_part;
   double safe_z_mm = 0.0;     ///< the links' travel plane
   /// A given links.safe_z below this (mm) lets the links pass within the checks' own margin of
   /// `clearance` (the tool mesh's chordal tolerance, the motions' resolution): they may read as

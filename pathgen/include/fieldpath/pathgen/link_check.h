@@ -14,6 +14,7 @@
 #include "fieldpath/geometry/tool.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/pathgen/clearance.h"
+#include "fieldpath/pathgen/cutter_part.h"
 
 namespace fieldpath::pathgen {
 
@@ -69,18 +70,22 @@ std::optional<LinkPartResult> checkHolderAgainstPart(const geometry::ToolSpec& t
                                                      std::span<const geometry::Posture> postures);
 
 /// What a path must not do to the part, as generate, check and view all check it: its links
-/// (checkLinksAgainstPart, when it has link blocks) and its holder (checkHolderAgainstPart, when
-/// there is one); each nullopt when not checked.
+/// (checkLinksAgainstPart, when it has link blocks), its holder (checkHolderAgainstPart, when
+/// there is one), each nullopt when not checked, and its cutter entering the part deeper than
+/// the gouge tolerance (checkCutterAgainstPart; a flat end: nullopt).
 struct PartContacts {
   std::optional<LinkPartResult> links, holder;
-  /// Per posture of a path of n: 1 where the links or the holder touch the part there (posture)
-  /// or on the motion to the next (motion), from both results' contact lists.
+  std::optional<CutterPartResult> cutter;
+  /// Per posture of a path of n: 1 where the links, the holder or the cutter touch the part there
+  /// (posture) or on the motion to the next (motion), from the results' contact lists.
   struct Marks {
     std::vector<std::uint8_t> posture, motion;
   };
   Marks marks(std::size_t n) const;
 };
 PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
-                              const geometry::TriangleMesh& part, const geometry::PathFile& path);
+                              const geometry::TriangleMesh& part, const geometry::PathFile& path,
+                              double gouge_tolerance_mm = kGougeToleranceMm,
+                              const common::Progress& progress = {});
 
 }  // namespace fieldpath::pathgen

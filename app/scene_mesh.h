@@ -1,0 +1,15 @@
+#pragma once
+/// A scene's mesh file made ready for the job (an obstacle's or the part's): read, refused when it
+/// has no surface, mended where an exported solid needs it, its closed shells wound outward, and
+/// the notes of what was done said on stderr. Split from scene.cpp, which reads the keys.
+#include <filesystem>
+
+#include "fieldpath/geometry/mesh.h"
+
+namespace fieldpath::app {
+
+/// Loads `file` and prepares it as above. Throws common::InputError (naming the file) where it
+/// cannot be read or has no surface; the scene reader adds the key and line.
+geometry::TriangleMesh loadSceneMesh(const std::filesystem::path& file);
+
+}  // namespace fieldpath::app

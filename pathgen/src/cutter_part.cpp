@@ -1,0 +1,179 @@
+/// pathgen/cutter_part.h: the cutter against the part, exactly.
+#include "fieldpath/pathgen/cutter_part.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <memory>
+#include <optional>
+
+#include <fcl/geometry/bvh/BVH_model.h>
+#include <fcl/geometry/shape/cylinder.h>
+#include <fcl/geometry/shape/sphere.h>
+#include <fcl/narrowphase/collision.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "closed_shells.h"
+
+namespace fieldpath::pathgen {
+namespace {
+
+using Model = fcl::BVHModel<fcl::OBBRSSd>;
+using geometry::Posture;
+using geometry::Vec3;
+
+/// One stamp: a pose of the tool, at posture `index` (on_motion false) or on the motion from
+/// posture `index` to the next.
+struct Stamp {
+  Posture pose;
+  std::size_t index;
+  bool on_motion;
+};
+
+/// The part as FCL's bounding-volume tree and its closed shells (a cutter wholly inside a closed
+/// part meets none of its triangles).
+class Part {
+ public:
+  explicit Part(const geometry::TriangleMesh& mesh) : shells_(mesh) {
+    std::vector<fcl::Vector3d> points(mesh.vertices.begin(), mesh.vertices.end());
+    std::vector<fcl::Triangle> triangles;
+    triangles.reserve(mesh.triangles.size());
+    for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
+    model_ = std::make_shared<Model>();
+    model_->beginModel(static_cast<int>(triangles.size()), static_cast<int>(points.size()));
+    model_->addSubModel(points, triangles);
+    model_->endModel();
+    model_->computeLocalAABB();
+    for (const Vec3& v : mesh.vertices) box_.extend(v);
+  }
+
+  const Eigen::AlignedBox3d& box() const { return box_; }
+
+  /// Whether the cutter shrunk by `shrink_mm` (ball: radius R − s about the ball's centre; shank:
+  /// radius R − s from the corner's top to L − s) meets the part at `pose`.
+  bool touches(const geometry::ToolSpec& tool, const Posture& pose, double shrink_mm) const {
+    const double corner = geometry::cornerRadius(tool);
+    const double radius = tool.radius_mm - shrink_mm;
+    if (!(radius > 0.0)) return false;
+    const Eigen::Matrix3d turn = geometry::rotationFromZ(pose.axis);
+    const fcl::Transform3d identity = fcl::Transform3d::Identity();
+    const auto meets = [&](const fcl::CollisionGeometryd& shape, const Vec3& centre) {
+      fcl::Transform3d at = fcl::Transform3d::Identity();
+      at.linear() = turn;
+      at.translation() = centre;
+      fcl::CollisionRequestd request;
+      fcl::CollisionResultd result;
+      return fcl::collide(&shape, at, model_.get(), identity, request, result) > 0;
+    };
+    const Vec3 axis = turn.col(2);
+    if (tool.shape == geometry::ToolShape::Ball) {
+      const Vec3 centre = pose.tip_mm + corner * axis;
+      if (meets(fcl::Sphered(radius), centre)) return true;
+      if (shells_.contains(centre)) return true;  // wholly inside a closed part
+    }
+    const double bottom = corner, top = tool.length_mm - shrink_mm;
+    if (top > bottom) {
+      const Vec3 middle = pose.tip_mm + 0.5 * (bottom + top) * axis;
+      if (meets(fcl::Cylinderd(radius, top - bottom), middle)) return true;
+      if (shells_.contains(middle)) return true;
+    }
+    return false;
+  }
+
+ private:
+  std::shared_ptr<Model> model_;
+  ClosedShells shells_;
+  Eigen::AlignedBox3d box_;
+};
+
+/// The deepest shrink at which the cutter still meets the part at `pose`, given that it meets it
+/// at `known_mm`: bisection to kGougeDepthResolutionMm (the cutter shrunk more lies inside the
+/// cutter shrunk less, so meeting is monotone in the shrink).
+double entryDepthMm(const Part& part, const geometry::ToolSpec& tool, const Posture& pose,
+                    double known_mm) {
+  double inside = known_mm, clear = tool.radius_mm;
+  while (clear - inside > kGougeDepthResolutionMm) {
+    const double mid = 0.5 * (inside + clear);
+    (part.touches(tool, pose, mid) ? inside : clear) = mid;
+  }
+  return inside;
+}
+
+/// The postures and the stamps along the motions that come within the tool's length of the
+/// part's box, `step_mm` apart at most for any point of the tool (geometry::motionSweepMm).
+std::vector<Stamp> stampsNearPart(std::span<const Posture> postures, const Part& part,
+                                  double reach_mm, double step_mm) {
+  Eigen::AlignedBox3d near = part.box();
+  near.min().array() -= reach_mm;
+  near.max().array() += reach_mm;
+  std::vector<Stamp> out;
+  out.reserve(postures.size());
+  for (std::size_t i = 0; i < postures.size(); ++i) {
+    if (near.contains(postures[i].tip_mm)) out.push_back({postures[i], i, false});
+    if (i + 1 == postures.size()) break;
+    const Posture& a = postures[i];
+    const Posture& b = postures[i + 1];
+    Eigen::AlignedBox3d motion(a.tip_mm);
+    motion.extend(b.tip_mm);
+    if (!motion.intersects(near)) continue;
+    const auto steps =
+        static_cast<std::size_t>(std::ceil(geometry::motionSweepMm(a, b, reach_mm) / step_mm));
+    for (std::size_t k = 1; k < steps; ++k)
+      out.push_back({geometry::alongMotion(a, b, double(k) / double(steps)), i, true});
+  }
+  return out;
+}
+
+}  // namespace
+
+CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
+                                        const geometry::TriangleMesh& part_mesh,
+                                        std::span<const Posture> postures, double tolerance_mm,
+                                        const common::Progress& progress) {
+  CutterPartResult result;
+  result.tolerance_mm = tolerance_mm;
+  result.corner_checked = tool.shape == geometry::ToolShape::Ball;
+  if (tool.shape == geometry::ToolShape::Flat || part_mesh.triangles.empty() ||
+      !(tolerance_mm > 0.0) || !(tolerance_mm < tool.radius_mm))
+    return result;
+  const Part part(part_mesh);
+  // A cutting edge of curvature radius ρ (the ball's R; the shank's R) swept between two stamps
+  // s apart stands at most s² / (8 ρ) beyond both: a quarter of the tolerance.
+  result.step_mm = std::sqrt(2.0 * tool.radius_mm * tolerance_mm);
+  result.between_stamps_mm = result.step_mm * result.step_mm / (8.0 * tool.radius_mm);
+  const std::vector<Stamp> stamps = stampsNearPart(postures, part, tool.length_mm, result.step_mm);
+  result.stamps = stamps.size();
+  std::vector<char> gouging(stamps.size(), 0);
+  constexpr std::size_t kBatch = 4096;
+  for (std::size_t begin = 0; begin < stamps.size(); begin += kBatch) {
+    const std::size_t end = std::min(stamps.size(), begin + kBatch);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end), [&](const auto& range) {
+      for (std::size_t i = range.begin(); i != range.end(); ++i)
+        gouging[i] = part.touches(tool, stamps[i].pose, tolerance_mm);
+    });
+    common::report(progress, double(end) / double(stamps.size()), "cutter vs part");
+  }
+  // The depth of the deepest: each gouging stamp bisected only where it goes deeper than the
+  // deepest so far (few stamps gouge in a path worth running).
+  for (std::size_t i = 0; i < stamps.size(); ++i) {
+    if (!gouging[i]) continue;
+    const Stamp& s = stamps[i];
+    (s.on_motion ? result.motion_contacts : result.posture_contacts).push_back(s.index);
+    const double known = std::max(tolerance_mm, result.max_depth_mm);
+    if (result.max_depth_mm > 0.0 && !part.touches(tool, s.pose, known + kGougeDepthResolutionMm))
+      continue;
+    result.max_depth_mm = entryDepthMm(part, tool, s.pose, known);
+    result.deepest = s.index;
+    result.deepest_on_motion = s.on_motion;
+  }
+  for (std::vector<std::size_t>* list : {&result.posture_contacts, &result.motion_contacts})
+    list->erase(std::unique(list->begin(), list->end()), list->end());
+  result.gouging_postures = result.posture_contacts.size();
+  result.gouging_motions = result.motion_contacts.size();
+  if (!result.posture_contacts.empty()) result.first_gouging_posture = result.posture_contacts[0];
+  if (!result.motion_contacts.empty()) result.first_gouging_motion = result.motion_contacts[0];
+  return result;
+}
+
+}  // namespace fieldpath::pathgen

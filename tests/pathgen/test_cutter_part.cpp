@@ -1,0 +1,115 @@
+/// The cutter against the part, exactly (pathgen/cutter_part.h), against closed forms: an
+/// upright shank beside a wall enters it by the wall's distance short of R; a shank tilted
+/// towards a wall meets it with its top rim, e/(sin θ + cos θ) in the shrunk-all-round measure;
+/// a rib passed by a motion between two clear postures; a cutter wholly inside a closed part.
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "fieldpath/geometry/mesh.h"
+#include "fieldpath/pathgen/cutter_part.h"
+#include "fixtures.h"
+
+using namespace fieldpath;
+using namespace fieldpath::pathgen;
+using geometry::Posture;
+using pathgen::test::boxMesh;
+
+namespace {
+
+/// A ball-end mill R 3, L 20.
+geometry::ToolSpec ball() { return {geometry::ToolShape::Ball, 3.0, 0.0, 20.0}; }
+
+Posture upright(double x, double y, double z) {
+  Posture p;
+  p.tip_mm = {x, y, z};
+  return p;
+}
+
+/// The depth's own resolution and FCL's (GJK) tolerance on the cylinder, mm.
+constexpr double kDepthTolMm = 2e-4;
+
+}  // namespace
+
+// An upright tool whose ball and shank reach x = 3: a wall at x = 3 − e is entered by e along
+// its normal, which is also the distance from the cutter's side to the deepest part point.
+TEST(CutterPart, AShankBesideAWallEntersItByTheGapShortOfItsRadius) {
+  const std::vector<Posture> at = {upright(0, 0, 0)};
+  for (const double e : {0.02, 0.3, 1.5}) {
+    const geometry::TriangleMesh wall = boxMesh(3.0 - e, 13, -30, 30, -10, 30);
+    const CutterPartResult r = checkCutterAgainstPart(ball(), wall, at);
+    EXPECT_EQ(r.stamps, 1u);
+    EXPECT_EQ(r.gouging_postures, 1u) << e;
+    EXPECT_EQ(r.first_gouging_posture, 0u);
+    EXPECT_EQ(r.gouging_motions, 0u);
+    EXPECT_NEAR(r.max_depth_mm, e, kDepthTolMm) << e;
+    EXPECT_FALSE(r.deepest_on_motion);
+  }
+  // Within the tolerance (5 um) and clear: nothing.
+  for (const double e : {0.004, 0.0, -0.1}) {
+    const CutterPartResult r =
+        checkCutterAgainstPart(ball(), boxMesh(3.0 - e, 13, -30, 30, -10, 30), at);
+    EXPECT_FALSE(r.gouges()) << e;
+    EXPECT_EQ(r.max_depth_mm, 0.0);
+  }
+}
+
+// Tilted θ = 10° towards a wall, the shank's top rim reaches x = L sin θ + R cos θ. With the wall
+// e = 0.05 mm short of it, the cutter shrunk by s (radius R − s, top L − s) stops meeting the
+// wall at s = e / (sin θ + cos θ) = 0.0432 mm: the distance from the cutter's surface to the
+// wall's deepest point inside it.
+TEST(CutterPart, ATiltedShankMeetsAWallWithItsTopRim) {
+  const double theta = 10.0 * M_PI / 180.0, e = 0.05;
+  Posture p;
+  p.axis = {std::sin(theta), 0.0, std::cos(theta)};
+  const double reach = 20.0 * std::sin(theta) + 3.0 * std::cos(theta);
+  const geometry::TriangleMesh wall = boxMesh(reach - e, reach + 10, -30, 30, -10, 30);
+  const CutterPartResult r = checkCutterAgainstPart(ball(), wall, std::vector<Posture>{p});
+  ASSERT_TRUE(r.gouges());
+  EXPECT_NEAR(r.max_depth_mm, e / (std::sin(theta) + std::cos(theta)), kDepthTolMm);
+  // Tilted away, the same wall is 2 L sin θ farther than the ball's side: clear.
+  p.axis.x() = -p.axis.x();
+  EXPECT_FALSE(checkCutterAgainstPart(ball(), wall, std::vector<Posture>{p}).gouges());
+}
+
+// A rib 1 mm wide standing 0.05 mm into the shank's way between two postures 20 mm apart, both
+// clear: the stamps along the motion (0.17 mm apart) find it, on motion 0, 0.05 mm deep.
+TEST(CutterPart, AMotionBetweenTwoClearPosturesIsStamped) {
+  const geometry::TriangleMesh rib = boxMesh(2.95, 12, -0.5, 0.5, -10, 30);
+  const std::vector<Posture> path = {upright(0, -10, 0), upright(0, 10, 0)};
+  const CutterPartResult r = checkCutterAgainstPart(ball(), rib, path);
+  EXPECT_NEAR(r.step_mm, std::sqrt(2.0 * 3.0 * kGougeToleranceMm), 1e-12);
+  EXPECT_NEAR(r.between_stamps_mm, kGougeToleranceMm / 4.0, 1e-12);
+  EXPECT_GE(r.stamps, 2u + static_cast<std::size_t>(20.0 / r.step_mm) - 1);
+  EXPECT_EQ(r.gouging_postures, 0u);
+  EXPECT_EQ(r.gouging_motions, 1u);
+  EXPECT_EQ(r.first_gouging_motion, 0u);
+  EXPECT_TRUE(r.deepest_on_motion);
+  EXPECT_NEAR(r.max_depth_mm, 0.05, kDepthTolMm);
+}
+
+// FCL meets surfaces only: a cutter wholly inside a closed part touches no triangle. Its inside
+// counts: the depth reads the cutter's radius (the most this measure gives).
+TEST(CutterPart, ACutterWhollyInsideAClosedPartReadsItsRadius) {
+  const geometry::TriangleMesh block = boxMesh(-50, 50, -50, 50, -50, 50);
+  const CutterPartResult r =
+      checkCutterAgainstPart(ball(), block, std::vector<Posture>{upright(0, 0, -40)});
+  ASSERT_TRUE(r.gouges());
+  EXPECT_NEAR(r.max_depth_mm, 3.0, kDepthTolMm + 1e-4);
+}
+
+// A torus tool's shank above its corner is tested, its corner is not (the Z-buffer's); a flat
+// end is not tested at all.
+TEST(CutterPart, ATorusIsTestedOnItsShankAndAFlatEndNot) {
+  const geometry::ToolSpec torus{geometry::ToolShape::Torus, 3.0, 1.0, 20.0};
+  const std::vector<Posture> at = {upright(0, 0, 0)};
+  const CutterPartResult shank =
+      checkCutterAgainstPart(torus, boxMesh(2.9, 13, -30, 30, 5, 30), at);
+  EXPECT_FALSE(shank.corner_checked);
+  EXPECT_NEAR(shank.max_depth_mm, 0.1, kDepthTolMm);
+  // A floor 0.1 mm above the tip cuts into the corner only (below its top at r = 1): not seen.
+  EXPECT_FALSE(checkCutterAgainstPart(torus, boxMesh(-20, 20, -20, 20, -10, 0.1), at).gouges());
+  const geometry::ToolSpec flat{geometry::ToolShape::Flat, 3.0, 0.0, 20.0};
+  EXPECT_EQ(checkCutterAgainstPart(flat, boxMesh(2.9, 13, -30, 30, -10, 30), at).stamps, 0u);
+}
