@@ -46,13 +46,7 @@ constexpr double kPointRadiusMm = 1e-6;
 /// channel the passes cover (impeller u_range), line b crosses it in the middle of that part.
 constexpr double kLineBladeT = 0.5;
 
-common::Progress scaled(const common::Progress& progress, double begin, double end,
-                        const std::string& label) {
-  if (!progress) return {};
-  return [=](double fraction, std::string_view) {
-    return progress(begin + (end - begin) * fraction, label);
-  };
-}
+using common::scaled;
 
 /// A study line's points: t along the polyline, wall distances from FCL.
 StudyLine makeLine(std::string name, std::string description, std::vector<Vec3> points,

@@ -15,19 +15,18 @@
 
 #include "closed_shells.h"
 #include "fieldpath/common/errors.h"
+#include "obstacle_model.h"
 
 namespace fieldpath::pathgen {
-namespace {
 
-using Model = fcl::BVHModel<fcl::OBBRSSd>;
-
-std::shared_ptr<Model> buildModel(const geometry::TriangleMesh& mesh, const std::string& what) {
+std::shared_ptr<BvhModel> buildBvhModel(const geometry::TriangleMesh& mesh,
+                                        const std::string& what) {
   if (mesh.triangles.empty()) throw common::InputError(what + ": empty mesh, nothing to check");
   std::vector<fcl::Vector3d> points(mesh.vertices.begin(), mesh.vertices.end());
   std::vector<fcl::Triangle> triangles;
   triangles.reserve(mesh.triangles.size());
   for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
-  auto model = std::make_shared<Model>();
+  auto model = std::make_shared<BvhModel>();
   model->beginModel(static_cast<int>(triangles.size()), static_cast<int>(points.size()));
   model->addSubModel(points, triangles);
   model->endModel();
@@ -35,21 +34,35 @@ std::shared_ptr<Model> buildModel(const geometry::TriangleMesh& mesh, const std:
   return model;
 }
 
+ObstacleModel::ObstacleModel(const geometry::TriangleMesh& mesh, const std::string& what)
+    : tree(buildBvhModel(mesh, what)), solids(mesh) {
+  for (const std::vector<int>& shell : geometry::openShells(mesh))
+    sheet_anchors.push_back(mesh.vertices[static_cast<std::size_t>(
+        mesh.triangles[static_cast<std::size_t>(shell.front())][0])]);
+  std::sort(sheet_anchors.begin(), sheet_anchors.end(),
+            [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.x() < b.x(); });
+  for (const Eigen::Vector3d& v : mesh.vertices) box.extend(v);
+}
+
+std::shared_ptr<const ObstacleModel> prepareObstacle(const geometry::TriangleMesh& mesh,
+                                                     const std::string& what) {
+  return std::make_shared<const ObstacleModel>(mesh, what);
+}
+
+namespace {
+
+using Model = BvhModel;
+
 }  // namespace
 
 struct ClearanceChecker::Impl {
   std::shared_ptr<Model> tool;
-  std::vector<std::shared_ptr<Model>> obstacles;
+  std::vector<std::shared_ptr<const ObstacleModel>> obstacles;
   double chord_tol_mm = 0.0;
   double reach_mm = 0.0;
-  /// The closed shells of the tool (tool frame) and of each obstacle: a tool wholly inside an
-  /// obstacle, or an obstacle wholly inside the tool, touches no triangle (FCL: clear).
+  /// The closed shells of the tool (tool frame): an obstacle wholly inside the tool touches no
+  /// triangle (FCL: clear). The obstacles' own are in their ObstacleModel.
   std::optional<ClosedShells> tool_solid;
-  std::vector<ClosedShells> obstacle_solids;
-  /// Per obstacle, a vertex of each open shell (a sheet, a lone triangle), sorted by x: a sheet
-  /// wholly inside the tool meets none of its triangles either (a fin inside the shank read
-  /// 1.56 mm clear). One vertex tells: a sheet partly inside crosses the tool's surface.
-  std::vector<std::vector<Eigen::Vector3d>> sheet_anchors;
 
   /// A point of the tool mesh's surface (tool frame): a vertex of its first triangle (the tip for
   /// a whole tool; a point of the holder for geometry::holderMesh, whose tip is not its own).
@@ -60,7 +73,7 @@ struct ClearanceChecker::Impl {
   /// vertex inside it. (The tip was taken for the point: for the holder alone, a tip resting on
   /// the part's top read as the holder inside the part.)
   bool enclosed(const Eigen::Isometry3d& placed, std::size_t i) const {
-    const ClosedShells& solid = obstacle_solids[i];
+    const ClosedShells& solid = obstacles[i]->solids;
     if (!solid.empty() && solid.contains(placed * tool_anchor)) return true;
     if (!tool_solid || tool_solid->empty()) return false;
     const Eigen::Isometry3d to_tool = placed.inverse();
@@ -68,7 +81,7 @@ struct ClearanceChecker::Impl {
       if (tool_solid->contains(to_tool * anchor)) return true;
     // Sheets: only those within the tool's reach of its tip (a soup of unjoined triangles has
     // an anchor each).
-    const std::vector<Eigen::Vector3d>& sheets = sheet_anchors[i];
+    const std::vector<Eigen::Vector3d>& sheets = obstacles[i]->sheet_anchors;
     const Eigen::Vector3d tip = placed.translation();
     const auto byX = [](const Eigen::Vector3d& p, double x) { return p.x() < x; };
     for (auto it = std::lower_bound(sheets.begin(), sheets.end(), tip.x() - reach_mm, byX);
@@ -79,26 +92,34 @@ struct ClearanceChecker::Impl {
   }
 };
 
+namespace {
+
+std::vector<std::shared_ptr<const ObstacleModel>> prepareAll(
+    std::span<const geometry::TriangleMesh> obstacles) {
+  std::vector<std::shared_ptr<const ObstacleModel>> out;
+  for (std::size_t i = 0; i < obstacles.size(); ++i)
+    out.push_back(prepareObstacle(obstacles[i], "obstacle " + std::to_string(i + 1)));
+  return out;
+}
+
+}  // namespace
+
 ClearanceChecker::ClearanceChecker(const geometry::TriangleMesh& tool_mesh,
                                    std::span<const geometry::TriangleMesh> obstacles,
+                                   double tool_chord_tol_mm)
+    : ClearanceChecker(tool_mesh, prepareAll(obstacles), tool_chord_tol_mm) {}
+
+ClearanceChecker::ClearanceChecker(const geometry::TriangleMesh& tool_mesh,
+                                   std::span<const std::shared_ptr<const ObstacleModel>> obstacles,
                                    double tool_chord_tol_mm) {
   if (!std::isfinite(tool_chord_tol_mm) || tool_chord_tol_mm < 0.0)
     throw common::InputError("tool mesh chordal tolerance: must be finite and >= 0");
   auto impl = std::make_shared<Impl>();
-  impl->tool = buildModel(tool_mesh, "tool mesh");
+  impl->tool = buildBvhModel(tool_mesh, "tool mesh");
   impl->tool_solid.emplace(tool_mesh);
   if (!tool_mesh.triangles.empty())
     impl->tool_anchor = tool_mesh.vertices[static_cast<std::size_t>(tool_mesh.triangles[0][0])];
-  for (size_t i = 0; i < obstacles.size(); ++i) {
-    impl->obstacles.push_back(buildModel(obstacles[i], "obstacle " + std::to_string(i + 1)));
-    impl->obstacle_solids.emplace_back(obstacles[i]);
-    std::vector<Eigen::Vector3d>& sheets = impl->sheet_anchors.emplace_back();
-    for (const std::vector<int>& shell : geometry::openShells(obstacles[i]))
-      sheets.push_back(obstacles[i].vertices[static_cast<std::size_t>(
-          obstacles[i].triangles[static_cast<std::size_t>(shell.front())][0])]);
-    std::sort(sheets.begin(), sheets.end(),
-              [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return a.x() < b.x(); });
-  }
+  impl->obstacles.assign(obstacles.begin(), obstacles.end());
   impl->chord_tol_mm = tool_chord_tol_mm;
   for (const auto& v : tool_mesh.vertices) impl->reach_mm = std::max(impl->reach_mm, v.norm());
   impl_ = std::move(impl);
@@ -114,7 +135,8 @@ namespace {
 /// the exact distance. The geometry overloads of FCL avoid CollisionObject, whose constructor
 /// recomputes the model's bounding box on every query.
 double nearestObstacle(const Model& model, const fcl::Transform3d& pose,
-                       const std::vector<std::shared_ptr<Model>>& obstacles, int* obstacle) {
+                       const std::vector<std::shared_ptr<const ObstacleModel>>& obstacles,
+                       int* obstacle) {
   const fcl::Transform3d identity = fcl::Transform3d::Identity();
   double best = std::numeric_limits<double>::infinity();
   int best_index = -1;
@@ -122,13 +144,14 @@ double nearestObstacle(const Model& model, const fcl::Transform3d& pose,
     fcl::CollisionRequestd collision_request;
     fcl::CollisionResultd collision_result;
     double d;
-    if (fcl::collide(&model, pose, obstacles[i].get(), identity, collision_request,
+    if (fcl::collide(&model, pose, obstacles[i]->tree.get(), identity, collision_request,
                      collision_result) > 0) {
       d = 0.0;
     } else {
       fcl::DistanceRequestd request;  // rel_err = abs_err = 0: exact triangle distances
       fcl::DistanceResultd result;
-      d = std::max(0.0, fcl::distance(&model, pose, obstacles[i].get(), identity, request, result));
+      d = std::max(
+          0.0, fcl::distance(&model, pose, obstacles[i]->tree.get(), identity, request, result));
     }
     if (d < best) {
       best = d;
@@ -167,7 +190,8 @@ double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double 
     pose.translation() = centres_mm[i];
     distance[i] = nearestObstacle(*ball, pose, impl_->obstacles, &nearest[i]);
     for (std::size_t k = 0; k < impl_->obstacles.size() && distance[i] > 0.0; ++k)
-      if (!impl_->obstacle_solids[k].empty() && impl_->obstacle_solids[k].contains(centres_mm[i])) {
+      if (!impl_->obstacles[k]->solids.empty() &&
+          impl_->obstacles[k]->solids.contains(centres_mm[i])) {
         distance[i] = 0.0;  // the centre inside an obstacle: the ball is in it
         nearest[i] = static_cast<int>(k);
       }

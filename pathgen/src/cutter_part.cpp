@@ -14,12 +14,11 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "closed_shells.h"
+#include "obstacle_model.h"
 
 namespace fieldpath::pathgen {
 namespace {
 
-using Model = fcl::BVHModel<fcl::OBBRSSd>;
 using geometry::Posture;
 using geometry::Vec3;
 
@@ -31,24 +30,12 @@ struct Stamp {
   bool on_motion;
 };
 
-/// The part as FCL's bounding-volume tree and its closed shells (a cutter wholly inside a closed
-/// part meets none of its triangles).
+/// The part (its shared ObstacleModel) as the cutter meets it.
 class Part {
  public:
-  explicit Part(const geometry::TriangleMesh& mesh) : shells_(mesh) {
-    std::vector<fcl::Vector3d> points(mesh.vertices.begin(), mesh.vertices.end());
-    std::vector<fcl::Triangle> triangles;
-    triangles.reserve(mesh.triangles.size());
-    for (const auto& t : mesh.triangles) triangles.emplace_back(t[0], t[1], t[2]);
-    model_ = std::make_shared<Model>();
-    model_->beginModel(static_cast<int>(triangles.size()), static_cast<int>(points.size()));
-    model_->addSubModel(points, triangles);
-    model_->endModel();
-    model_->computeLocalAABB();
-    for (const Vec3& v : mesh.vertices) box_.extend(v);
-  }
+  explicit Part(const ObstacleModel& model) : model_(model) {}
 
-  const Eigen::AlignedBox3d& box() const { return box_; }
+  const Eigen::AlignedBox3d& box() const { return model_.box; }
 
   /// Whether the cutter shrunk by `shrink_mm` (ball: radius R − s about the ball's centre; shank:
   /// radius R − s from the corner's top to L − s) meets the part at `pose`.
@@ -64,27 +51,25 @@ class Part {
       at.translation() = centre;
       fcl::CollisionRequestd request;
       fcl::CollisionResultd result;
-      return fcl::collide(&shape, at, model_.get(), identity, request, result) > 0;
+      return fcl::collide(&shape, at, model_.tree.get(), identity, request, result) > 0;
     };
     const Vec3 axis = turn.col(2);
     if (tool.shape == geometry::ToolShape::Ball) {
       const Vec3 centre = pose.tip_mm + corner * axis;
       if (meets(fcl::Sphered(radius), centre)) return true;
-      if (shells_.contains(centre)) return true;  // wholly inside a closed part
+      if (model_.solids.contains(centre)) return true;  // wholly inside a closed part
     }
     const double bottom = corner, top = tool.length_mm - shrink_mm;
     if (top > bottom) {
       const Vec3 middle = pose.tip_mm + 0.5 * (bottom + top) * axis;
       if (meets(fcl::Cylinderd(radius, top - bottom), middle)) return true;
-      if (shells_.contains(middle)) return true;
+      if (model_.solids.contains(middle)) return true;
     }
     return false;
   }
 
  private:
-  std::shared_ptr<Model> model_;
-  ClosedShells shells_;
-  Eigen::AlignedBox3d box_;
+  const ObstacleModel& model_;
 };
 
 /// The deepest shrink at which the cutter still meets the part at `pose`, given that it meets it
@@ -131,13 +116,27 @@ CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
                                         const geometry::TriangleMesh& part_mesh,
                                         std::span<const Posture> postures, double tolerance_mm,
                                         const common::Progress& progress) {
+  if (tool.shape == geometry::ToolShape::Flat || part_mesh.triangles.empty()) {
+    CutterPartResult result;
+    result.tolerance_mm = tolerance_mm;
+    result.corner_checked = tool.shape == geometry::ToolShape::Ball;
+    return result;
+  }
+  return checkCutterAgainstPart(tool, prepareObstacle(part_mesh, "part"), postures, tolerance_mm,
+                                progress);
+}
+
+CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
+                                        const std::shared_ptr<const ObstacleModel>& part_model,
+                                        std::span<const Posture> postures, double tolerance_mm,
+                                        const common::Progress& progress) {
   CutterPartResult result;
   result.tolerance_mm = tolerance_mm;
   result.corner_checked = tool.shape == geometry::ToolShape::Ball;
-  if (tool.shape == geometry::ToolShape::Flat || part_mesh.triangles.empty() ||
-      !(tolerance_mm > 0.0) || !(tolerance_mm < tool.radius_mm))
+  if (tool.shape == geometry::ToolShape::Flat || !part_model || !(tolerance_mm > 0.0) ||
+      !(tolerance_mm < tool.radius_mm))
     return result;
-  const Part part(part_mesh);
+  const Part part(*part_model);
   // A cutting edge of curvature radius ρ (the ball's R; the shank's R) swept between two stamps
   // s apart stands at most s² / (8 ρ) beyond both: a quarter of the tolerance.
   result.step_mm = std::sqrt(2.0 * tool.radius_mm * tolerance_mm);

@@ -40,14 +40,7 @@ double seconds(Clock::time_point since) {
   return std::chrono::duration<double>(Clock::now() - since).count();
 }
 
-/// Fraction [begin, end) of the whole job reported by `progress` with its own label.
-common::Progress scaled(const common::Progress& progress, double begin, double end,
-                        std::string label) {
-  if (!progress) return {};
-  return [=](double fraction, std::string_view) {
-    return progress(begin + (end - begin) * fraction, label);
-  };
-}
+using common::scaled;
 
 /// Every pass station's ball must stay clear of the obstacles (whatever the axis): one that
 /// touches is refused; one within `clearance_mm` of them is reported in `under` (the smallest of

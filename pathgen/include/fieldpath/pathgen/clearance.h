@@ -5,6 +5,7 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "fieldpath/common/progress.h"
@@ -71,6 +72,13 @@ struct ClearanceResult {
   std::vector<double> clearance_mm;  ///< per posture, mm; 0 for colliding ones (if per_posture)
 };
 
+/// An obstacle mesh as the exact checks test it (FCL's tree, its closed shells, its sheets), built
+/// once and shared by the checkers that test against the same mesh (a part is tested for its
+/// links, the moves into passes, the holder and the cutter). Opaque outside pathgen.
+struct ObstacleModel;
+std::shared_ptr<const ObstacleModel> prepareObstacle(const geometry::TriangleMesh& mesh,
+                                                     const std::string& what);
+
 /// Tool + holder mesh (tool frame: tip at the origin, axis +z) against fixed obstacle meshes.
 /// Copies share the built hierarchies; queries are const and thread-safe.
 class ClearanceChecker {
@@ -81,6 +89,10 @@ class ClearanceChecker {
   /// optimistic (DESIGN.md "Links and motion").
   ClearanceChecker(const geometry::TriangleMesh& tool_mesh,
                    std::span<const geometry::TriangleMesh> obstacles,
+                   double tool_chord_tol_mm = 0.0);
+  /// The same against obstacles prepared once (prepareObstacle), shared with other checkers.
+  ClearanceChecker(const geometry::TriangleMesh& tool_mesh,
+                   std::span<const std::shared_ptr<const ObstacleModel>> obstacles,
                    double tool_chord_tol_mm = 0.0);
 
   /// Distance (mm) from the placed tool to the nearest obstacle less the chordal tolerance, 0 if

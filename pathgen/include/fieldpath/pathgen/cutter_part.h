@@ -9,6 +9,7 @@
 /// left to the Z-buffer's lines).
 #include <cstddef>
 #include <limits>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/geometry/posture.h"
 #include "fieldpath/geometry/tool.h"
+#include "fieldpath/pathgen/clearance.h"  // ObstacleModel, prepareObstacle
 
 namespace fieldpath::pathgen {
 
@@ -53,6 +55,12 @@ struct CutterPartResult {
 /// entry between two stamps is at most a quarter of the tolerance deeper than at them.
 CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
                                         const geometry::TriangleMesh& part,
+                                        std::span<const geometry::Posture> postures,
+                                        double tolerance_mm = kGougeToleranceMm,
+                                        const common::Progress& progress = {});
+/// The same against the part prepared once (prepareObstacle), shared with the other checks.
+CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
+                                        const std::shared_ptr<const ObstacleModel>& part,
                                         std::span<const geometry::Posture> postures,
                                         double tolerance_mm = kGougeToleranceMm,
                                         const common::Progress& progress = {});

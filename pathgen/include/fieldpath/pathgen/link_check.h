@@ -47,6 +47,10 @@ struct GrazingChecker {
 GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
                                   const geometry::HolderProfile& holder,
                                   const geometry::TriangleMesh& part);
+/// The same against the part prepared once (prepareObstacle).
+GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
+                                  const geometry::HolderProfile& holder,
+                                  const std::shared_ptr<const ObstacleModel>& part);
 
 /// Every posture of the path's link blocks and every motion between two of them, against
 /// `part` (a ClearanceChecker of the tool + holder whose only obstacle is the part mesh), and
@@ -68,6 +72,11 @@ std::optional<LinkPartResult> checkHolderAgainstPart(const geometry::ToolSpec& t
                                                      const geometry::HolderProfile& holder,
                                                      const geometry::TriangleMesh& part,
                                                      std::span<const geometry::Posture> postures);
+/// The same against the part prepared once (prepareObstacle), reporting to `progress`.
+std::optional<LinkPartResult> checkHolderAgainstPart(
+    const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
+    const std::shared_ptr<const ObstacleModel>& part, std::span<const geometry::Posture> postures,
+    const common::Progress& progress = {});
 
 /// What a path must not do to the part, as generate, check and view all check it: its links
 /// (checkLinksAgainstPart, when it has link blocks), its holder (checkHolderAgainstPart, when
