@@ -383,11 +383,15 @@ TriangleMesh loadWithoutByteOrderMark(const std::filesystem::path& file) {
       fs::remove_all(folder, ignored);
     }
   } cleanup{folder};
+  // Removed on Ctrl-C too, as the outputs' temporaries are (common::removeTemporariesNow).
+  const common::detail::TemporaryListing listing{common::detail::listTemporary(copy.string())};
   {
     fs::create_directories(folder, ec);
     std::ifstream in(file, std::ios::binary);
     in.seekg(3);
+    common::detail::beginCreating(listing.slot);
     std::ofstream out(copy, std::ios::binary);
+    common::detail::endCreating(listing.slot);
     out << in.rdbuf();
     if (ec || !out.flush())
       throw InputError(file.string() +

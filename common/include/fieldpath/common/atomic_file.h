@@ -6,6 +6,7 @@
 #include <signal.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -27,7 +28,8 @@ namespace fieldpath::common {
 
 namespace detail {
 
-/// One temporary being written. `state`: 0 free, 1 being claimed, 2 live (path valid).
+/// One temporary being written. `state`: 0 free, 1 being claimed, 2 live (path valid), 3 being
+/// opened (created) by its writer.
 struct TemporarySlot {
   std::atomic<int> state{0};
   char path[4096];
@@ -66,6 +68,26 @@ inline void unlistTemporary(int slot) {
   if (slot >= 0) temporary_slots[slot].state.store(0);
 }
 
+/// Set by the signal handler before it removes the temporaries: a writer about to create its
+/// temporary then does not (else one created just after the handler's sweep was left behind: a
+/// flaky interrupt test, `.heights.npy.tmp-PID`).
+inline std::atomic<int> exiting{0};
+
+/// Brackets the creation of slot `slot`'s file against the handler's sweep (Dekker's pattern on
+/// seq_cst atomics: the writer marks the slot, then reads `exiting`; the handler sets `exiting`,
+/// then reads the slot; one of them sees the other). Returns only when the file may be created;
+/// once the handler has begun, it never returns (the handler ends the process).
+inline void beginCreating(int slot) {
+  if (slot < 0) return;
+  temporary_slots[slot].state.store(3);
+  if (!exiting.load()) return;
+  temporary_slots[slot].state.store(2);  // nothing created: the handler need not wait
+  while (true) ::pause();
+}
+inline void endCreating(int slot) {
+  if (slot >= 0) temporary_slots[slot].state.store(2);
+}
+
 /// Unlists the temporary slot when the write ends, however it ends.
 struct TemporaryListing {
   int slot;
@@ -96,8 +118,15 @@ inline std::vector<std::filesystem::path> claimed_outputs;
 /// Removes every temporary being written. Async-signal-safe (lock-free atomics and unlink only):
 /// call it from a SIGINT/SIGTERM handler before re-raising the signal.
 inline void removeTemporariesNow() noexcept {
-  for (auto& slot : detail::temporary_slots)
-    if (slot.state.load() == 2) ::unlink(slot.path);
+  detail::exiting.store(1);
+  for (auto& slot : detail::temporary_slots) {
+    // A writer creating its file: waited for, up to 0.2 s (the handler may be running on the
+    // writer's own thread, which then never finishes creating it).
+    const struct timespec step { 0, 1'000'000 };
+    for (int waited = 0; slot.state.load() == 3 && waited < 200; ++waited)
+      ::nanosleep(&step, nullptr);
+    if (slot.state.load() >= 2) ::unlink(slot.path);
+  }
 }
 
 /// Removes the outputs this run claimed (claimOutputs), regular files only (lstat, unlink:
@@ -235,7 +264,9 @@ inline void writeFileAtomically(const std::filesystem::path& given,
   try {
     {
       errno = 0;
+      detail::beginCreating(listing.slot);
       std::ofstream out(tmp, mode | std::ios::trunc);
+      detail::endCreating(listing.slot);
       if (!out)
         throw InputError(path.string() + ": cannot open for writing: " +
                          detail::systemReason(errno));
