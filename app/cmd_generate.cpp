@@ -89,7 +89,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
   }
   const auto& box = r.reach_box_mm;
   const std::vector<std::string> unsafe =
-      unsafeReasons(r.clearance, r.motions, r.link_part, r.holder_part, r.cutter_part);
+      unsafeReasons(r.clearance, r.motions, r.link_part, r.holder_part);
   return {
       {"scene", scene.file.string()},
       {"field_mode", job.nominal ? "nominal" : pathgen::fieldModeNames(job.mode).id},
@@ -125,6 +125,8 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"link_part", linkPartJson(r.link_part)},
       {"holder_part", holderPartJson(r.holder_part)},
       {"cutter_part", cutterPartJson(r.cutter_part)},
+      {"cutter_part_skipped",
+       r.cutter_part ? json(nullptr) : json("no `part` in the scene, or a flat end")},
       {"link_part_skipped",
        r.link_part ? json(nullptr) : json("no `part` in the scene, or no links")},
       {"safe", unsafe.empty()},
@@ -267,8 +269,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     const std::filesystem::path out = options->out;
     const std::string what = job.nominal ? "nominal path" : "field path";
     // A path that collides is still written (to look at, and `check`), marked in both files.
-    const std::vector<std::string> unsafe = unsafeReasons(
-        result.clearance, result.motions, result.link_part, result.holder_part, result.cutter_part);
+    const std::vector<std::string> unsafe =
+        unsafeReasons(result.clearance, result.motions, result.link_part, result.holder_part);
     std::string unsafe_text;
     for (const std::string& reason : unsafe)
       unsafe_text += (unsafe_text.empty() ? "" : "; ") + reason;
@@ -324,6 +326,11 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
         job.clearance_mm, c.colliding, m.colliding, m.motions, m.min_clearance_mm,
         result.times.total_s, out.string().c_str());
     if (!unsafe.empty()) std::fprintf(stderr, "warning: %s\n", unsafe_text.c_str());
+    if (const std::string gouge = cutterGougeReason(result.cutter_part); !gouge.empty())
+      std::fprintf(stderr,
+                   "warning: %s: a gouge, or the part's chordal error where it is concave "
+                   "(report.json cutter_part; `check --gouge-tol` sets the tolerance)\n",
+                   gouge.c_str());
     if (under_required)
       std::fprintf(stderr,
                    "warning: the path comes closer to the obstacles than `clearance` (%.3f mm): "

@@ -136,7 +136,10 @@ inline nlohmann::json cutterPartJson(const std::optional<pathgen::CutterPartResu
        "the cutter shrunk all round by tolerance_um (FCL's sphere and cylinder: exact "
        "surfaces) against the part's triangles and inside, at every posture and at stamps "
        "step_mm apart along the motions near the part; between two stamps an entry may be "
-       "up to between_stamps_um deeper; max_depth_um to 0.1 um, at most the tool radius"},
+       "up to between_stamps_um deeper (at the shank's top rim up to half a step: the holder "
+       "above it is tested on its own); max_depth_um to 0.1 um, at most the tool radius; not "
+       "part of `unsafe`: a concave part meshed with a chordal error reads a path on its true "
+       "surface as entering it by up to that error"},
       {"ok", !c->gouges()}};
 }
 
@@ -209,16 +212,29 @@ inline std::vector<std::string> unsafeReasons(
     out.push_back(std::to_string(h->colliding_motions) +
                   " motions put the holder into the part (first: posture " +
                   first(h->first_colliding_motion) + " to the next)");
-  if (cut && cut->gouges()) {
-    char depth[32];
-    std::snprintf(depth, sizeof depth, "%.0f", 1e3 * cut->max_depth_mm);
-    const std::size_t first = std::min(cut->first_gouging_posture, cut->first_gouging_motion);
-    out.push_back("the cutter enters the part deeper than the gouge tolerance at " +
-                  std::to_string(cut->gouging_postures) + " postures and " +
-                  std::to_string(cut->gouging_motions) + " motions (max " + depth +
-                  " um; first: posture " + std::to_string(first) + ")");
-  }
   return out;
+}
+
+/// What the cutter does to the part, beyond the gouge tolerance (empty: nothing): not a crash and
+/// not in `unsafe` (a part meshed with a 20 um chordal error reads a path on its true surface as
+/// entering it by up to that, where it is concave: a reviewer's case), but `check`'s not-ok and
+/// `generate`'s warning. Postures numbered from 0; motion i from posture i to i + 1.
+inline std::string cutterGougeReason(const std::optional<pathgen::CutterPartResult>& cut) {
+  if (!cut || !cut->gouges()) return {};
+  char depth[32], tolerance[32];
+  std::snprintf(depth, sizeof depth, "%.1f", 1e3 * cut->max_depth_mm);
+  std::snprintf(tolerance, sizeof tolerance, "%g", 1e3 * cut->tolerance_mm);
+  const auto index = [](std::size_t i) {
+    return i == pathgen::CutterPartResult::npos ? std::string("-") : std::to_string(i);
+  };
+  const std::string first =
+      cut->first_gouging_posture <= cut->first_gouging_motion
+          ? "posture " + index(cut->first_gouging_posture)
+          : "the motion from posture " + index(cut->first_gouging_motion) + " to the next";
+  return "the cutter enters the part deeper than the gouge tolerance (" + std::string(tolerance) +
+         " um) at " + std::to_string(cut->gouging_postures) + " postures and " +
+         std::to_string(cut->gouging_motions) + " motions (max " + depth + " um; first: " + first +
+         ")";
 }
 
 }  // namespace fieldpath::app

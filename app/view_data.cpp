@@ -417,9 +417,11 @@ ViewData gatherView(const ViewRequest& request) {
       p.clearance_known = true;
     }
     if (check)
-      for (const std::string& reason :
-           unsafeReasons({}, {}, check->link_part, check->holder_part, check->cutter_part))
+      for (const std::string& reason : unsafeReasons({}, {}, check->link_part, check->holder_part))
         d.warnings.push_back("UNSAFE TO RUN: " + reason);
+    if (check)
+      if (const std::string gouge = cutterGougeReason(check->cutter_part); !gouge.empty())
+        d.warnings.push_back("GOUGE: " + gouge);
     for (std::size_t i = 0; i < n; ++i) {
       p.colliding_postures += p.clearance_mm[i] <= 0.0;
       p.colliding_motions += p.motion_mm[i] <= 0.0;

@@ -371,11 +371,22 @@ bool startsWithByteOrderMark(const std::filesystem::path& file, std::uintmax_t s
 TriangleMesh loadWithoutByteOrderMark(const std::filesystem::path& file) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  const fs::path folder =
-      fs::temp_directory_path(ec) / ("fieldpath-bom-" + std::to_string(::getpid()));
-  const fs::path copy = folder / file.filename();
-  if (file.parent_path() == folder)
+  if (std::filesystem::file_size(file, ec) <= 3 && !ec)
+    throw InputError(file.string() + ": empty file (a UTF-8 byte-order mark and nothing else)");
+  if (file.parent_path().filename().string().rfind("fieldpath-bom-", 0) == 0)
     throw InputError(file.string() + ": starts with two UTF-8 byte-order marks");
+  // A private folder of its own (mkdtemp: created new, mode 0700): a predictable name could be
+  // made ahead by another user with a link in it (a reviewer overwrote a file so) or be another
+  // run's.
+  fs::path base = fs::temp_directory_path(ec);
+  if (ec) base = "/tmp";
+  std::string pattern = (base / "fieldpath-bom-XXXXXX").string();
+  if (::mkdtemp(pattern.data()) == nullptr)
+    throw InputError(file.string() +
+                     ": starts with a UTF-8 byte-order mark, and no copy "
+                     "without it could be made: save it without the mark");
+  const fs::path folder = pattern;
+  const fs::path copy = folder / file.filename();
   struct Cleanup {
     fs::path folder;
     ~Cleanup() {
@@ -386,14 +397,13 @@ TriangleMesh loadWithoutByteOrderMark(const std::filesystem::path& file) {
   // Removed on Ctrl-C too, as the outputs' temporaries are (common::removeTemporariesNow).
   const common::detail::TemporaryListing listing{common::detail::listTemporary(copy.string())};
   {
-    fs::create_directories(folder, ec);
     std::ifstream in(file, std::ios::binary);
     in.seekg(3);
     common::detail::beginCreating(listing.slot);
     std::ofstream out(copy, std::ios::binary);
     common::detail::endCreating(listing.slot);
     out << in.rdbuf();
-    if (ec || !out.flush())
+    if (!out.flush())
       throw InputError(file.string() +
                        ": starts with a UTF-8 byte-order mark, and no copy "
                        "without it could be made: save it without the mark");

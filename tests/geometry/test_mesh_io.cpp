@@ -136,6 +136,13 @@ TEST(MeshIo, TextMeshesWithAByteOrderMarkAreTheSame) {
       "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
       "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
   EXPECT_NEAR(meshArea(loadMesh(writeBytes("bom.ply", bom + ply))), 0.5, 1e-12);
+  // The mark and nothing else: an empty file.
+  try {
+    loadMesh(writeBytes("bom_only.obj", bom));
+    ADD_FAILURE() << "no error for a mark alone";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("empty file"), std::string::npos) << e.what();
+  }
   // An error in a marked file names the file itself (not the copy read past the mark).
   const fs::path bad =
       writeBytes("bom_bad.stl", bom + std::string("solid x\nfacet normal 0 0 1\n"));

@@ -321,6 +321,8 @@ TEST(CheckSurface, AShankDrivenIntoAWallOfThePartIsAGouge) {
   EXPECT_NE(towards["not_ok_because"][1].get<std::string>().find("below the part"),
             std::string::npos);
   EXPECT_EQ(towards["cutter_part"]["gouging_postures"].get<int>(), 41);
+  // A gouge, not a crash: not in `unsafe` (a concave part's chordal error reads as one too).
+  EXPECT_TRUE(towards["unsafe"].empty()) << towards["unsafe"];
   EXPECT_EQ(away["cutter_part"]["gouging_postures"].get<int>(), 0);
   EXPECT_EQ(away["surface"]["gouged_lines"].get<int>(), 0);
   EXPECT_TRUE(away["ok"].get<bool>()) << away["not_ok_because"];

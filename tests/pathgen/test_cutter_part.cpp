@@ -99,6 +99,26 @@ TEST(CutterPart, ACutterWhollyInsideAClosedPartReadsItsRadius) {
   EXPECT_NEAR(r.max_depth_mm, 3.0, kDepthTolMm + 1e-4);
 }
 
+// A closed box with a sliver of no area on its top edge (as an export closes a T-junction): FCL's
+// sphere-triangle test took its zero normal for "inside" and met a ball 0.54 mm clear of the
+// edge (841 um of false gouge: a reviewer's case). Such triangles are not in the tree.
+TEST(CutterPart, ASliverOfNoAreaIsNoSurface) {
+  geometry::TriangleMesh box = boxMesh(-10, 10, -10, 10, -10, 0);
+  const int a = static_cast<int>(box.vertices.size());
+  box.vertices.emplace_back(0, 10, 0);
+  box.vertices.emplace_back(10, 10, 0);
+  box.vertices.emplace_back(-10, 10, 0);
+  box.triangles.emplace_back(a, a + 1, a + 2);
+  // The ball's centre 2.5 mm out and 2.5 mm up from the edge: 3.54 from it, R 3.
+  const std::vector<Posture> at = {upright(0, 12.5, -0.5)};
+  EXPECT_FALSE(checkCutterAgainstPart(ball(), box, at).gouges());
+  // 0.1 mm nearer the edge than R on the same diagonal: 0.1 mm deep, sliver or not.
+  const double d = (3.0 - 0.1) / std::sqrt(2.0);
+  const CutterPartResult near =
+      checkCutterAgainstPart(ball(), box, std::vector<Posture>{upright(0, 10 + d, d - 3.0)});
+  EXPECT_NEAR(near.max_depth_mm, 0.1, kDepthTolMm);
+}
+
 // A torus tool's shank above its corner is tested, its corner is not (the Z-buffer's); a flat
 // end is not tested at all.
 TEST(CutterPart, ATorusIsTestedOnItsShankAndAFlatEndNot) {
