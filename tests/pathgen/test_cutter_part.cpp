@@ -89,6 +89,20 @@ TEST(CutterPart, AMotionBetweenTwoClearPosturesIsStamped) {
   EXPECT_NEAR(r.max_depth_mm, 0.05, kDepthTolMm);
 }
 
+// A rib 0.02 mm wide, narrower than a stamp step, 0.05 mm into the shank's way: the stamps need
+// not fall on it, and the entry read is at most between_stamps_mm (the shank's circle, R, over
+// half a step) short of the true 0.05 mm, never more than it.
+TEST(CutterPart, ARibNarrowerThanAStepReadsWithinTheStampBound) {
+  const geometry::TriangleMesh rib = boxMesh(2.95, 12, -0.01, 0.01, -10, 30);
+  for (const double start : {-10.0, -10.05, -10.11}) {  // stamps falling anywhere on the rib
+    const std::vector<Posture> path = {upright(0, start, 0), upright(0, 10, 0)};
+    const CutterPartResult r = checkCutterAgainstPart(ball(), rib, path);
+    ASSERT_TRUE(r.gouges()) << start;
+    EXPECT_GE(r.max_depth_mm, 0.05 - r.between_stamps_mm - kDepthTolMm) << start;
+    EXPECT_LE(r.max_depth_mm, 0.05 + kDepthTolMm) << start;
+  }
+}
+
 // FCL meets surfaces only: a cutter wholly inside a closed part touches no triangle. Its inside
 // counts: the depth reads the cutter's radius (the most this measure gives).
 TEST(CutterPart, ACutterWhollyInsideAClosedPartReadsItsRadius) {
