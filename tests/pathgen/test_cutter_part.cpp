@@ -79,9 +79,8 @@ TEST(CutterPart, AMotionBetweenTwoClearPosturesIsStamped) {
   const geometry::TriangleMesh rib = boxMesh(2.95, 12, -0.5, 0.5, -10, 30);
   const std::vector<Posture> path = {upright(0, -10, 0), upright(0, 10, 0)};
   const CutterPartResult r = checkCutterAgainstPart(ball(), rib, path);
-  EXPECT_NEAR(r.step_mm, std::sqrt(2.0 * 3.0 * kGougeToleranceMm), 1e-12);
-  EXPECT_NEAR(r.between_stamps_mm, kGougeToleranceMm / 4.0, 1e-12);
-  EXPECT_GE(r.stamps, 2u + static_cast<std::size_t>(20.0 / r.step_mm) - 1);
+  // (That the stamps are close enough is the narrow rib's test below, against the bound.)
+  EXPECT_GT(r.stamps, 2u);
   EXPECT_EQ(r.gouging_postures, 0u);
   EXPECT_EQ(r.gouging_motions, 1u);
   EXPECT_EQ(r.first_gouging_motion, 0u);
@@ -98,7 +97,8 @@ TEST(CutterPart, ARibNarrowerThanAStepReadsWithinTheStampBound) {
     const std::vector<Posture> path = {upright(0, start, 0), upright(0, 10, 0)};
     const CutterPartResult r = checkCutterAgainstPart(ball(), rib, path);
     ASSERT_TRUE(r.gouges()) << start;
-    EXPECT_GE(r.max_depth_mm, 0.05 - r.between_stamps_mm - kDepthTolMm) << start;
+    // The header's promise: a quarter of the tolerance (not the figure the code reports).
+    EXPECT_GE(r.max_depth_mm, 0.05 - kGougeToleranceMm / 4.0 - kDepthTolMm) << start;
     EXPECT_LE(r.max_depth_mm, 0.05 + kDepthTolMm) << start;
   }
 }
