@@ -330,10 +330,9 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     if (cutter_part)
       std::printf(
           "cutter vs part: %zu stamps, %zu postures and %zu motions enter it deeper than "
-          "%.1f um, max %.1f um (%s)%s\n",
+          "%.1f um, max %.1f um (corner and shank, exact)%s\n",
           cutter_part->stamps, cutter_part->gouging_postures, cutter_part->gouging_motions,
           1e3 * cutter_part->tolerance_mm, 1e3 * cutter_part->max_depth_mm,
-          cutter_part->corner_checked ? "ball and shank, exact" : "shank only",
           cutter_part->gouges() ? " (GOUGES)" : "");
     if (!path.limited.empty())
       std::printf("limits: %zu postures held at an angle limit, %zu of them colliding\n",

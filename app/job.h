@@ -122,9 +122,9 @@ inline nlohmann::json cutterPartJson(const std::optional<pathgen::CutterPartResu
       {"tolerance_um", 1e3 * c->tolerance_mm},
       {"step_mm", c->step_mm},
       {"between_stamps_um", 1e3 * c->between_stamps_mm},
-      {"tested", c->corner_checked ? "the ball and the shank"
-                                   : "the shank above the corner (the torus corner: the "
-                                     "Z-buffer's lines only)"},
+      {"tested",
+       "the corner (a ball's sphere, a torus's ring and the slab inside it) and the "
+       "shank"},
       {"gouging_postures", c->gouging_postures},
       {"gouging_motions", c->gouging_motions},
       {"first_gouging_posture", jsonIndex(c->first_gouging_posture)},
@@ -134,7 +134,8 @@ inline nlohmann::json cutterPartJson(const std::optional<pathgen::CutterPartResu
       {"deepest_motion", c->deepest_on_motion ? jsonIndex(c->deepest) : nlohmann::json(nullptr)},
       {"method",
        "the cutter shrunk all round by tolerance_um (FCL's sphere and cylinder: exact "
-       "surfaces) against the part's triangles and inside, at every posture and at stamps "
+       "surfaces; a torus's ring: the part's triangles near it each measured from its disc, "
+       "GJK to ~1e-7 mm) against the part's triangles and inside, at every posture and at stamps "
        "step_mm apart along the motions near the part; between two stamps an entry may be "
        "up to between_stamps_um deeper (at the shank's top rim up to half a step: the holder "
        "above it is tested on its own); max_depth_um to 0.1 um, at most the tool radius; not "

@@ -11,6 +11,7 @@
 #include <fcl/geometry/shape/cylinder.h>
 #include <fcl/geometry/shape/sphere.h>
 #include <fcl/narrowphase/collision.h>
+#include <fcl/narrowphase/detail/gjk_solver_libccd.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -39,33 +40,73 @@ class Part {
 
   const Eigen::AlignedBox3d& box() const { return model_.box; }
 
-  /// Whether the cutter shrunk by `shrink_mm` (ball: radius R − s about the ball's centre; shank:
-  /// radius R − s from the corner's top to L − s) meets the part at `pose`.
+  /// Whether the cutter shrunk by `shrink_mm` meets the part at `pose`: a ball, radius R − s
+  /// about its centre; a torus's corner, the points within r − s of its disc (radius R − r, at
+  /// height r, square to the axis: the corner eroded by s is exactly that); the shank, radius
+  /// R − s from the corner's top to L − s.
   bool touches(const geometry::ToolSpec& tool, const Posture& pose, double shrink_mm) const {
     const double corner = geometry::cornerRadius(tool);
     const double radius = tool.radius_mm - shrink_mm;
     if (!(radius > 0.0)) return false;
     const Eigen::Matrix3d turn = geometry::rotationFromZ(pose.axis);
-    const fcl::Transform3d identity = fcl::Transform3d::Identity();
-    const auto meets = [&](const fcl::CollisionGeometryd& shape, const Vec3& centre) {
-      fcl::Transform3d at = fcl::Transform3d::Identity();
-      at.linear() = turn;
-      at.translation() = centre;
-      fcl::CollisionRequestd request;
-      fcl::CollisionResultd result;
-      return fcl::collide(&shape, at, model_.tree.get(), identity, request, result) > 0;
-    };
     const Vec3 axis = turn.col(2);
-    if (tool.shape == geometry::ToolShape::Ball) {
-      const Vec3 centre = pose.tip_mm + corner * axis;
-      if (meets(fcl::Sphered(radius), centre)) return true;
-      if (model_.solids.contains(centre)) return true;  // wholly inside a closed part
-    }
+    if (corner - shrink_mm > 0.0 &&
+        cornerMeets(pose.tip_mm + corner * axis, turn, tool.radius_mm - corner, corner - shrink_mm))
+      return true;
     const double bottom = corner, top = tool.length_mm - shrink_mm;
     if (top > bottom) {
       const Vec3 middle = pose.tip_mm + 0.5 * (bottom + top) * axis;
-      if (meets(fcl::Cylinderd(radius, top - bottom), middle)) return true;
+      if (meets(fcl::Cylinderd(radius, top - bottom), placed(turn, middle))) return true;
       if (model_.solids.contains(middle)) return true;
+    }
+    return false;
+  }
+
+ private:
+  static fcl::Transform3d placed(const Eigen::Matrix3d& turn, const Vec3& centre) {
+    fcl::Transform3d at = fcl::Transform3d::Identity();
+    at.linear() = turn;
+    at.translation() = centre;
+    return at;
+  }
+
+  bool meets(const fcl::CollisionGeometryd& shape, const fcl::Transform3d& at) const {
+    fcl::CollisionRequestd request;
+    fcl::CollisionResultd result;
+    return fcl::collide(&shape, at, model_.tree.get(), fcl::Transform3d::Identity(), request,
+                        result) > 0;
+  }
+
+  /// Whether the part comes within `reach_mm` of the disc of radius `disc_mm` about `centre`,
+  /// square to the axis (a ball's corner: a disc of no radius, the sphere; a torus's: the ring).
+  bool cornerMeets(const Vec3& centre, const Eigen::Matrix3d& turn, double disc_mm,
+                   double reach_mm) const {
+    if (model_.solids.contains(centre)) return true;  // wholly inside a closed part
+    const fcl::Transform3d at = placed(turn, centre);
+    if (!(disc_mm > 1e-9)) return meets(fcl::Sphered(reach_mm), at);
+    // Over the disc the eroded corner is a slab: FCL's cylinder, exactly.
+    if (meets(fcl::Cylinderd(disc_mm, 2.0 * reach_mm), at)) return true;
+    // Around it a ring (a torus: no FCL shape). The triangles in the cylinder that bounds it are
+    // each measured from the disc (GJK, ~1e-7 mm): within reach, they enter the ring.
+    fcl::CollisionRequestd request(std::size_t{1} << 22);
+    fcl::CollisionResultd result;
+    const fcl::Cylinderd bound(disc_mm + reach_mm, 2.0 * reach_mm);
+    if (fcl::collide(&bound, at, model_.tree.get(), fcl::Transform3d::Identity(), request,
+                     result) == 0)
+      return false;
+    const fcl::Cylinderd disc(disc_mm, 0.0);
+    const fcl::detail::GJKSolver_libccd<double> solver;
+    const auto& tree = *model_.tree;
+    for (std::size_t i = 0; i < result.numContacts(); ++i) {
+      // FCL meets a shape with a mesh as the mesh with the shape: the triangle is the side whose
+      // object is the tree (b1 here, not b2).
+      const fcl::Contactd& contact = result.getContact(i);
+      const fcl::Triangle& t = tree.tri_indices[contact.o1 == &tree ? contact.b1 : contact.b2];
+      double distance = 0.0;
+      if (!solver.shapeTriangleDistance(disc, at, tree.vertices[t[0]], tree.vertices[t[1]],
+                                        tree.vertices[t[2]], &distance) ||
+          distance <= reach_mm)
+        return true;
     }
     return false;
   }
@@ -134,7 +175,6 @@ CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
   if (tool.shape == geometry::ToolShape::Flat || part_mesh.triangles.empty()) {
     CutterPartResult result;
     result.tolerance_mm = tolerance_mm;
-    result.corner_checked = tool.shape == geometry::ToolShape::Ball;
     return result;
   }
   return checkCutterAgainstPart(tool, prepareObstacle(part_mesh, "part"), postures, tolerance_mm,
@@ -147,15 +187,16 @@ CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
                                         const common::Progress& progress) {
   CutterPartResult result;
   result.tolerance_mm = tolerance_mm;
-  result.corner_checked = tool.shape == geometry::ToolShape::Ball;
   if (tool.shape == geometry::ToolShape::Flat || !part_model || !(tolerance_mm > 0.0) ||
       !(tolerance_mm < tool.radius_mm))
     return result;
   const Part part(*part_model);
-  // A cutting edge of curvature radius ρ (the ball's R; the shank's R) swept between two stamps
-  // s apart stands at most s² / (8 ρ) beyond both: a quarter of the tolerance.
-  result.step_mm = std::sqrt(2.0 * tool.radius_mm * tolerance_mm);
-  result.between_stamps_mm = result.step_mm * result.step_mm / (8.0 * tool.radius_mm);
+  // A cutting surface whose tightest curvature radius is ρ (a ball's R, a torus's corner r; the
+  // shank's R is no tighter) swept between two stamps s apart stands at most s² / (8 ρ) beyond
+  // both: a quarter of the tolerance.
+  const double tightest = geometry::cornerRadius(tool);
+  result.step_mm = std::sqrt(2.0 * tightest * tolerance_mm);
+  result.between_stamps_mm = result.step_mm * result.step_mm / (8.0 * tightest);
   // The farthest any point of the cutter lies from its tip: the top rim's (or the ball's far
   // side, for a ball shorter than its diameter).
   const double reach =

@@ -133,17 +133,52 @@ TEST(CutterPart, ASliverOfNoAreaIsNoSurface) {
   EXPECT_NEAR(near.max_depth_mm, 0.1, kDepthTolMm);
 }
 
-// A torus tool's shank above its corner is tested, its corner is not (the Z-buffer's); a flat
-// end is not tested at all.
-TEST(CutterPart, ATorusIsTestedOnItsShankAndAFlatEndNot) {
+// A torus tool R 3, r 1: its corner shrunk by s is the points within r − s of its disc (radius
+// R − r = 2 at height r). A floor 0.1 mm above the tip meets the slab over the disc: 0.1 deep.
+TEST(CutterPart, ATorusFloorIsEnteredByItsHeightAboveTheTip) {
   const geometry::ToolSpec torus{geometry::ToolShape::Torus, 3.0, 1.0, 20.0};
   const std::vector<Posture> at = {upright(0, 0, 0)};
-  const CutterPartResult shank =
-      checkCutterAgainstPart(torus, boxMesh(2.9, 13, -30, 30, 5, 30), at);
-  EXPECT_FALSE(shank.corner_checked);
-  EXPECT_NEAR(shank.max_depth_mm, 0.1, kDepthTolMm);
-  // A floor 0.1 mm above the tip cuts into the corner only (below its top at r = 1): not seen.
-  EXPECT_FALSE(checkCutterAgainstPart(torus, boxMesh(-20, 20, -20, 20, -10, 0.1), at).gouges());
+  EXPECT_NEAR(checkCutterAgainstPart(torus, boxMesh(-20, 20, -20, 20, -10, 0.1), at).max_depth_mm,
+              0.1, kDepthTolMm);
+  EXPECT_FALSE(checkCutterAgainstPart(torus, boxMesh(-20, 20, -20, 20, -10, 0.0), at).gouges());
+}
+
+// A wall whose top (z 0.5) stands below the corner's top (z 1) is met by the ring alone (the
+// shank starts at z 1): its top edge at x = 3 − e lies sqrt((1 − e)² + 0.5²) from the disc's rim,
+// so the corner enters it by 1 − that (the Z-buffer's vertical lines see only the wall's top).
+TEST(CutterPart, ATorusCornerEntersAWallBelowItsShankByTheRingsClosedForm) {
+  const geometry::ToolSpec torus{geometry::ToolShape::Torus, 3.0, 1.0, 20.0};
+  const std::vector<Posture> at = {upright(0, 0, 0)};
+  for (const double e : {0.3, 0.6}) {
+    const CutterPartResult r =
+        checkCutterAgainstPart(torus, boxMesh(3.0 - e, 13, -30, 30, -10, 0.5), at);
+    EXPECT_NEAR(r.max_depth_mm, 1.0 - std::hypot(1.0 - e, 0.5), kDepthTolMm) << e;
+  }
+  // Whose top edge stays farther than r from the rim: clear (e = 0.1: 0.9 and 0.5 → 1.03).
+  EXPECT_FALSE(checkCutterAgainstPart(torus, boxMesh(2.9, 13, -30, 30, -10, 0.5), at).gouges());
+}
+
+// Tilted θ = 20° away from a wall at +x (axis (−sin θ, 0, cos θ)), the torus reaches farthest
+// with its ring: x = −r sin θ + (R − r) cos θ + r = 2.537 mm, past its shank's lowest rim
+// (−r sin θ + R cos θ = 2.477). A wall e = 0.04 short of the ring's reach is entered by e.
+TEST(CutterPart, ATiltedTorusCornerEntersAWallByItsReachPastIt) {
+  const geometry::ToolSpec torus{geometry::ToolShape::Torus, 3.0, 1.0, 20.0};
+  const double theta = 20.0 * M_PI / 180.0, e = 0.04;
+  Posture p = upright(0, 0, 0);
+  p.axis = {-std::sin(theta), 0.0, std::cos(theta)};
+  const double reach = -std::sin(theta) + 2.0 * std::cos(theta) + 1.0;
+  const CutterPartResult r = checkCutterAgainstPart(torus, boxMesh(reach - e, 20, -30, 30, -10, 30),
+                                                    std::vector<Posture>{p});
+  EXPECT_NEAR(r.max_depth_mm, e, kDepthTolMm);
+  // The stamps along a motion: no farther apart than √(2 r tol) (the corner's curvature), r = 1.
+  EXPECT_LE(r.step_mm, std::sqrt(2.0 * 1.0 * kGougeToleranceMm) + 1e-12);
+}
+
+// A flat end's sharp rim is not tested (`check` refuses the tool).
+TEST(CutterPart, AFlatEndIsNotTested) {
   const geometry::ToolSpec flat{geometry::ToolShape::Flat, 3.0, 0.0, 20.0};
-  EXPECT_EQ(checkCutterAgainstPart(flat, boxMesh(2.9, 13, -30, 30, -10, 30), at).stamps, 0u);
+  EXPECT_EQ(checkCutterAgainstPart(flat, boxMesh(2.9, 13, -30, 30, -10, 30),
+                                   std::vector<Posture>{upright(0, 0, 0)})
+                .stamps,
+            0u);
 }

@@ -5,8 +5,9 @@
 /// 0.05 mm went unseen). Here the cutter, shrunk all round by the gouge tolerance, is tested
 /// against the part's triangles (and, for a closed part, its inside) at every posture and at
 /// stamps along every motion: a ball tool as its ball and its shank, FCL's sphere and cylinder
-/// (exact surfaces, not tessellated); a torus tool as its shank above the corner (the corner is
-/// left to the Z-buffer's lines).
+/// (exact surfaces, not tessellated); a torus tool as its corner (the slab over its disc, FCL's
+/// cylinder; the ring around it, the part's triangles there each measured from the disc by GJK)
+/// and its shank.
 #include <cstddef>
 #include <limits>
 #include <memory>
@@ -34,7 +35,6 @@ struct CutterPartResult {
   double tolerance_mm = 0;       ///< the shrink: entries shallower than this are not counted
   double step_mm = 0;            ///< stamps along a motion: no point of the tool moves farther
   double between_stamps_mm = 0;  ///< how much deeper an entry may be between two stamps
-  bool corner_checked = true;    ///< false for a torus: its shank only
   std::size_t gouging_postures = 0, gouging_motions = 0;
   std::size_t first_gouging_posture = npos, first_gouging_motion = npos;
   /// The deepest entry of the cutter into the part over the stamps, mm (to
@@ -48,11 +48,11 @@ struct CutterPartResult {
   bool gouges() const { return gouging_postures + gouging_motions > 0; }
 };
 
-/// Tests the cutter of `tool` (ball or torus; a flat end has no shank above a corner to test
-/// apart from its rim: nothing tested, stamps 0), shrunk by `tolerance_mm`, against `part` at
-/// every posture and along every motion that comes within the cutter's length of the part, with
-/// stamps no farther apart than √(2 ρ tolerance) (ρ: the ball's R; a torus's shank: R) so that an
-/// entry between two stamps is at most a quarter of the tolerance deeper than at them.
+/// Tests the cutter of `tool` (ball or torus; a flat end's sharp rim is not: nothing tested,
+/// stamps 0), shrunk by `tolerance_mm`, against `part` at every posture and along every motion
+/// that comes within the cutter's length of the part, with stamps no farther apart than
+/// √(2 ρ tolerance) (ρ: the ball's R; a torus's corner r) so that an entry between two stamps is
+/// at most a quarter of the tolerance deeper than at them.
 CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
                                         const geometry::TriangleMesh& part,
                                         std::span<const geometry::Posture> postures,
