@@ -95,6 +95,14 @@ json surfaceJson(const SurfaceResult& s) {
       {"sweep_error_um", s.sweep_error_um},
       {"simulated_postures", s.simulated_postures},
       {"cut_lines", s.cut_lines},
+      {"beneath_lines", s.beneath_lines},
+      {"beneath_unmeasured_lines", s.beneath_unmeasured},
+      {"beneath",
+       "lines the tool reached beneath the underside of the part's top layer (under an "
+       "overhang, or through the part): a line keeps the tool's lowest point only, which says "
+       "nothing of that layer there; they are measured against the part's next top below "
+       "(beneath_unmeasured_lines: none, not measured); the layer's underside is the cutter "
+       "test's (cutter_part, exact)"},
       {"part_lines", s.part_lines},
       {"band_lines", s.band_lines},
       {"gouged_lines", s.gouged_lines},
@@ -361,6 +369,13 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     for (const std::string& note : obstacle_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
     if (const std::string turn = axisTurnWarning(path, axis_turn); !turn.empty())
       std::fprintf(stderr, "warning: %s (check.json axis_turn)\n", turn.c_str());
+    if (surface && surface->beneath_lines > 0)
+      std::fprintf(stderr,
+                   "note: the tool passed beneath the part's top layer on %zu Z-buffer lines "
+                   "(under an overhang, or through the part): there they are measured against the "
+                   "part below that layer (%zu with none: not measured); the overhang itself is "
+                   "the cutter test's (check.json `surface.beneath`)\n",
+                   surface->beneath_lines, surface->beneath_unmeasured);
     if (surface && surface->coarsened)
       std::fprintf(stderr,
                    "note: --spacing %g mm would make more Z-buffer lines than a check takes: "

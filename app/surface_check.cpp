@@ -392,7 +392,7 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
     }
   passes_box.min().array() -= radius;
   passes_box.max().array() += radius;
-  const Eigen::AlignedBox2d region = passes_box.intersection(part_box);
+  Eigen::AlignedBox2d region = passes_box.intersection(part_box);
   if (region.isEmpty() || !(region.sizes().minCoeff() > 0.0)) return std::nullopt;
   SurfaceResult result;
   double spacing = request.spacing_mm;
@@ -409,6 +409,14 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
     spacing = std::sqrt(area / static_cast<double>(kMaxSurfaceLines));
     result.coarsened = true;
   }
+  // Two lines past the part's edge, where the passes reach there: off the part is air, so a cut
+  // into a side of the part at the region's edge is told by its distance to that air
+  // (gougeDepthsToAir), not by the side's height (a shank 0.05 mm into a 29 mm wall read 29 mm
+  // where the grid stopped at the wall).
+  Eigen::AlignedBox2d part_margin = part_box;
+  part_margin.min().array() -= 2.0 * spacing;
+  part_margin.max().array() += 2.0 * spacing;
+  region = passes_box.intersection(part_margin);
   const int nx = std::max(2, static_cast<int>(std::ceil(region.sizes().x() / spacing)));
   const int ny = std::max(2, static_cast<int>(std::ceil(region.sizes().y() / spacing)));
   zbuffer::SimulationRequest sim;
@@ -472,22 +480,38 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
     return Vec2(sim.grid.x0_mm + (i % sim.grid.nx + 0.5) * sim.grid.dx_mm,
                 sim.grid.y0_mm + (i / sim.grid.nx + 0.5) * sim.grid.dy_mm);
   };
+  // The surface each line is measured against: the part's top, or, where the tool passed
+  // beneath the top's layer (under an overhang), the top of what lies under it (the Z-buffer
+  // keeps a line's lowest tool point only: under an overhang it is no cut of the overhang,
+  // which read 14.5 mm of gouge for a clear tool; the overhang's underside is the cutter's exact
+  // test's). A line with nothing under the layer is not measured.
+  std::vector<float> reference = nominal, reference_nz = facet_nz;
+  const zbuffer::PartLayers layers =
+      zbuffer::partLayers(sim.grid, part_mesh.vertices, part_mesh.triangles, nominal);
   for (std::size_t i = 0; i < nominal.size(); ++i)
-    if (!std::isnan(nominal[i]))
-      result.deviation_um[i] = static_cast<float>(
-          1000.0 * (double(simulated.heights_mm[i]) - double(nominal[i])) * double(facet_nz[i]));
-  gougeDepthsToAir(sim.grid, nominal, simulated.heights_mm, request.gouge_tolerance_um,
+    if (simulated.heights_mm[i] < layers.underside_mm[i]) {  // false where NaN
+      ++result.beneath_lines;
+      result.beneath_unmeasured += std::isnan(layers.next_top_mm[i]);
+      reference[i] = layers.next_top_mm[i];
+      reference_nz[i] = layers.next_normal_z[i];
+    }
+  for (std::size_t i = 0; i < reference.size(); ++i)
+    if (!std::isnan(reference[i]))
+      result.deviation_um[i] =
+          static_cast<float>(1000.0 * (double(simulated.heights_mm[i]) - double(reference[i])) *
+                             double(reference_nz[i]));
+  gougeDepthsToAir(sim.grid, reference, simulated.heights_mm, request.gouge_tolerance_um,
                    result.deviation_um);
   double sum = 0, sum2 = 0, min_dev = 0, max_dev = 0;
   double highest_cusp = 0;  // the highest any line's cusp may stand (scallopGridErrorUm)
   const double spacing_mm = std::max(sim.grid.dx_mm, sim.grid.dy_mm);
-  for (std::size_t i = 0; i < nominal.size(); ++i) {
-    if (std::isnan(nominal[i])) {
+  for (std::size_t i = 0; i < reference.size(); ++i) {
+    if (std::isnan(reference[i])) {
       result.in_band[i] = 0;
       continue;
     }
-    const double vertical_um = 1000.0 * (double(simulated.heights_mm[i]) - double(nominal[i]));
-    const double cos_slope = double(facet_nz[i]);
+    const double vertical_um = 1000.0 * (double(simulated.heights_mm[i]) - double(reference[i]));
+    const double cos_slope = double(reference_nz[i]);
     const double d = result.deviation_um[i];
     ++result.part_lines;
     min_dev = std::min(min_dev, d);
@@ -499,7 +523,7 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
     max_dev = std::max(max_dev, d);
     const Vec2 at = lineAt(i);
     const double bound_um =
-        scallopGridErrorUm(vertical_um, spacing_mm, edge_mm, partNormal(sim.grid, nominal, at));
+        scallopGridErrorUm(vertical_um, spacing_mm, edge_mm, partNormal(sim.grid, reference, at));
     highest_cusp = std::max(highest_cusp, (vertical_um + bound_um) * cos_slope);
   }
   if (result.band_lines > 0) {

@@ -68,6 +68,10 @@ struct SurfaceResult {
   double sweep_step_mm = 0, sweep_error_um = 0;
   std::size_t simulated_postures = 0;  ///< the path's and the interpolated ones
   std::size_t cut_lines = 0;           ///< lines the tool lowered (0: it never reached the part)
+  /// Lines the tool reached beneath the layer of the part's top (under an overhang, or through
+  /// the part): measured against the top of the part under that layer, if any
+  /// (`beneath_unmeasured` have none: not measured, as lines off the part).
+  std::size_t beneath_lines = 0, beneath_unmeasured = 0;
 };
 
 /// Simulates and compares; nothing when the passes do not pass over the part (no surface to

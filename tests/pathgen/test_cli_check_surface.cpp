@@ -185,6 +185,37 @@ TEST(CheckSurface, APathThatNeverCutsThePartIsNotChecked) {
     EXPECT_FALSE(fs::exists(dir.path() / "out" / stale)) << stale;
 }
 
+// A shelf (z 8..10 over y 5..15) above the plate (top z 0): a ball whose centre runs at y 6, its
+// shank tilted 60° out from under the shelf (0.83 mm clear of its edge), cuts the plate beneath
+// the shelf. The Z-buffer keeps each line's lowest tool point: against the shelf's top those
+// lines read 10 mm of gouge (a helper's undercut case: 14.5 mm, "not ok", no contact). They are
+// measured against the plate under the shelf: no gouge; 0.1 mm lower, the plate's 100 um.
+TEST(CheckSurface, ALinePassedBeneathAnOverhangIsMeasuredAgainstThePartUnderIt) {
+  const TempDir dir;
+  geometry::TriangleMesh part;
+  pathgen::test::addBox(part, -10, 30, -15, 15, -5, 0);
+  pathgen::test::addBox(part, -10, 30, 5, 15, 8, 10);
+  writeSceneOfPart(dir, part);
+  const double tilt = 60.0 * M_PI / 180.0, ay = -std::sin(tilt), az = std::cos(tilt);
+  const auto pass = [&](double centre_z) {
+    std::ostringstream cl;
+    cl << "# pass 1\n";
+    for (int i = 0; i <= 40; ++i)  // the tip: the ball's centre less R along the axis
+      cl << 0.5 * i << ' ' << 6.0 - 3.0 * ay << ' ' << centre_z - 3.0 * az << ' ' << 0 << ' ' << ay
+         << ' ' << az << '\n';
+    return cl.str();
+  };
+  dir.write("beneath.cl", pass(3.0));
+  dir.write("gouge.cl", pass(2.9));
+  const auto clear = check(dir, "beneath.cl", "out")["surface"];
+  EXPECT_GT(clear["beneath_lines"].get<int>(), 1000) << clear;
+  EXPECT_EQ(clear["beneath_unmeasured_lines"].get<int>(), 0) << clear;
+  EXPECT_LT(clear["max_gouge_um"].get<double>(), 0.5) << clear;
+  EXPECT_EQ(clear["gouged_lines"].get<int>(), 0) << clear;
+  const auto gouge = check(dir, "gouge.cl", "out")["surface"];
+  EXPECT_NEAR(gouge["max_gouge_um"].get<double>(), 100.0, 1.0) << gouge;
+}
+
 // Two runs of postures 20 mm apart with the axis at -60 and +60 deg about y: generate reads two
 // passes (split at the gap) and takes it; check refused the 120 deg turn as within a pass. A
 // flip within one run is still refused, naming its line.

@@ -192,6 +192,53 @@ std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
   return top;
 }
 
+PartLayers partLayers(const Grid& grid, std::span<const Vec3f> vertices,
+                      std::span<const std::array<std::uint32_t, 3>> triangles,
+                      const std::vector<float>& top_mm) {
+  const GridView g = detail::makeGridView(grid);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  PartLayers out;
+  out.underside_mm.assign(grid.lineCount(), nan);
+  out.next_top_mm.assign(grid.lineCount(), nan);
+  out.next_normal_z.assign(grid.lineCount(), nan);
+  // Two crossings closer than this are one surface (facets meeting on a line interpolate its
+  // height a few ulps apart; a layer thinner than 0.1 um is no layer).
+  const auto below = [](float z, float above) {
+    return z < above - std::max(1e-4f, 4.f * FLT_EPSILON * std::abs(above));
+  };
+  // The up-facing triangles rasterise with sign +1, the down-facing with −1 (rasterTriangle
+  // keeps those whose projection turns the sign's way).
+  const auto each = [&](float sign, auto&& visit) {
+    for (const auto& t : triangles) {
+      const Vec3f a = vertices[t[0]], b = vertices[t[1]], c = vertices[t[2]];
+      const double ux = double(b.x) - a.x, uy = double(b.y) - a.y, uz = double(b.z) - a.z;
+      const double vx = double(c.x) - a.x, vy = double(c.y) - a.y, vz = double(c.z) - a.z;
+      const double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+      const double length = std::sqrt(nx * nx + ny * ny + nz * nz);
+      const float cos_slope = length > 0.0 ? static_cast<float>(std::abs(nz) / length) : 0.f;
+      rasterTriangle(g, a, b, c, sign, [&](int ix, int iy, float z) {
+        visit(std::size_t(iy) * grid.nx + ix, z, cos_slope);
+      });
+    }
+  };
+  each(-1.f, [&](std::size_t i, float z, float) {
+    float& u = out.underside_mm[i];
+    if (below(z, top_mm[i]) && !(z <= u)) u = z;
+  });
+  each(+1.f, [&](std::size_t i, float z, float cos_slope) {
+    const float u = out.underside_mm[i];
+    float& n = out.next_top_mm[i];
+    if (std::isnan(u) || !below(z, u)) return;
+    if (std::isnan(n) || z > n) {
+      n = z;
+      out.next_normal_z[i] = cos_slope;
+    } else if (z == n) {
+      out.next_normal_z[i] = std::max(out.next_normal_z[i], cos_slope);
+    }
+  });
+  return out;
+}
+
 std::vector<float> stockFromPart(const Grid& grid, std::span<const Vec3f> vertices,
                                  std::span<const std::array<std::uint32_t, 3>> triangles) {
   std::vector<float> top = partTop(grid, vertices, triangles);

@@ -176,6 +176,20 @@ std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
                            std::span<const std::array<std::uint32_t, 3>> triangles,
                            std::vector<float>* normal_z = nullptr);
 
+/// Under each line's top (partTop): where the part overhangs, the line meets it again below.
+/// For a part wound outward (a closed solid, as read), per line: `underside_mm`, the highest
+/// down-facing crossing below the top (the underside of the layer the top belongs to: an
+/// overhang's, or the part's bottom); `next_top_mm`, the highest up-facing crossing below that
+/// (the top of the material under the overhang) and `next_normal_z` its facet's |n_z|. NaN
+/// where there is none. A tool whose cut in a line reaches under `underside_mm` passed beneath
+/// the layer (or through it): the line's lowest tool point says nothing of the layer's surface.
+struct PartLayers {
+  std::vector<float> underside_mm, next_top_mm, next_normal_z;
+};
+PartLayers partLayers(const Grid& grid, std::span<const Vec3f> vertices,
+                      std::span<const std::array<std::uint32_t, 3>> triangles,
+                      const std::vector<float>& top_mm);
+
 /// Stock as the top of a part mesh (world frame, mm): the highest up-facing point on each line;
 /// lines that miss the part start at its lowest z.
 std::vector<float> stockFromPart(const Grid& grid, std::span<const Vec3f> vertices,
