@@ -71,7 +71,8 @@ struct FieldOptions {
   std::string interpolation;  ///< "" : the scene's
   std::string out;
   std::string save_field;
-  double max_memory_mib = 0.0;  ///< 0: the global --max-memory (common::memoryLimitBytes)
+  /// As the global --max-memory (512, 512M, 4G); empty: the global (common::memoryLimitBytes).
+  std::string max_memory;
   std::string backend;            ///< "" : the scene's field.backend
   double refine_tolerance = -1.0; ///< < 0: the scene's field.refine_tolerance
 };
@@ -84,9 +85,9 @@ struct Obstacles {
 };
 
 Obstacles loadObstacles(const FieldOptions& o) {
-  // The sub-command's --max-memory (MiB) is the limit of every estimate, the scene's included.
-  if (o.max_memory_mib > 0.0)
-    common::setMemoryLimitBytes(static_cast<std::size_t>(o.max_memory_mib * 1024.0 * 1024.0));
+  // The sub-command's --max-memory is the limit of every estimate, the scene's included.
+  if (!o.max_memory.empty())
+    common::setMemoryLimitBytes(common::parseMemorySize(o.max_memory, "--max-memory"));
   Obstacles result{loadScene(o.scene), nullptr, 0.0};
   const auto start = std::chrono::steady_clock::now();
   const Scene& s = result.scene;
@@ -103,9 +104,7 @@ field::VoxelRequest voxelRequest(const FieldOptions& o, const Scene& scene, bool
   if (!o.interpolation.empty())
     request.interpolation = o.interpolation == "quadratic" ? field::Interpolation::Quadratic
                                                            : field::Interpolation::Trilinear;
-  request.max_memory_bytes = o.max_memory_mib > 0.0
-                                 ? static_cast<std::size_t>(o.max_memory_mib * 1024.0 * 1024.0)
-                                 : common::memoryLimitBytes();
+  request.max_memory_bytes = common::memoryLimitBytes();  // loadObstacles set --max-memory
   if (!o.backend.empty()) request.backend = *field::fieldBackendNamed(o.backend);
   if (o.refine_tolerance >= 0.0) request.refine_tolerance = o.refine_tolerance;
   request.progress = makeProgressLine(quiet);
@@ -210,10 +209,9 @@ void addFieldCommand(CLI::App& app, const GlobalOptions& global) {
       ->add_option("--save-field", options->save_field,
                    "Also write the voxel field to this .vdb file")
       ->excludes(direct);
-  probe_cmd
-      ->add_option("--max-memory", options->max_memory_mib,
-                   "Refuse voxel fields estimated above this, MiB")
-      ->check(positiveFinite("MiB"));
+  probe_cmd->add_option(
+      "--max-memory", options->max_memory,
+      "Refuse work estimated above this (MiB, or 512M, 4G; as before the command)");
   probe_cmd->callback([options, &global] { probe(*options, global); });
 
   auto* build_cmd =
@@ -238,10 +236,9 @@ void addFieldCommand(CLI::App& app, const GlobalOptions& global) {
                    "Split cells whose error estimate exceeds this fraction (default: the "
                    "scene's field.refine_tolerance; 0: uniform)")
       ->check(finiteNumber("", true));
-  build_cmd
-      ->add_option("--max-memory", options->max_memory_mib,
-                   "Refuse voxel fields estimated above this, MiB")
-      ->check(positiveFinite("MiB"));
+  build_cmd->add_option(
+      "--max-memory", options->max_memory,
+      "Refuse work estimated above this (MiB, or 512M, 4G; as before the command)");
   build_cmd->callback([options, &global] { build(*options, global); });
 }
 

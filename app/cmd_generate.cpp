@@ -223,6 +223,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     common::claimOutputs(options->out, {"path.cl", "path.apt", "angles.csv", "report.json"},
                          {options->scene, nominalPathOf(options->scene)});
     const Scene scene = loadScene(options->scene);
+    common::refuseOutputsOverInputs(options->out,
+                                    {"path.cl", "path.apt", "angles.csv", "report.json"}, "--out");
     pathgen::GenerateRequest job = sceneJob(scene);
     job.mode = options->direct ? pathgen::FieldMode::Direct : pathgen::FieldMode::Voxel;
     // 0: not given (positiveFinite rejects anything else that is not > 0).

@@ -308,9 +308,13 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     const auto write = [&writing](auto job) {
       writing.push_back(std::async(std::launch::async, job));
     };
+    // The earlier run's set goes first and the grid's description comes after the heights: a
+    // run killed while writing (SIGKILL, the OOM killer) left a new heights.json beside the old
+    // heights.npy, a grid read onto heights it does not describe.
+    common::removeStaleOutputs(
+        out, {"heights.npy", "heights.json", "surface.stl", "heights.png", "simulate.json"});
     if (outputs.count("npy"))
       write([&] { zb::writeHeightsNpy(out / "heights.npy", req.grid, res.heights_mm); });
-    if (outputs.count("json")) write([&] { zb::writeHeightsJson(out / "heights.json", req.grid); });
     if (outputs.count("stl"))
       write([&] {
         stl_triangles = zb::writeSurfaceStl(out / "surface.stl", req.grid, res.heights_mm);
@@ -319,6 +323,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
       write([&] { zb::writeReliefPng(out / "heights.png", req.grid, res.heights_mm); });
     for (auto& w : writing) w.wait();
     for (auto& w : writing) w.get();  // the first failure, after every writer stopped
+    if (outputs.count("json")) zb::writeHeightsJson(out / "heights.json", req.grid);
     for (const auto& [key, name] : {std::pair{"npy", "heights.npy"},
                                     {"json", "heights.json"},
                                     {"stl", "surface.stl"},

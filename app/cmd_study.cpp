@@ -10,6 +10,7 @@
 #include "commands.h"
 #include "errors.h"
 #include "estimates.h"
+#include "fieldpath/common/atomic_file.h"
 #include "fieldpath/field/voxel_field.h"
 #include "job.h"
 #include "progress.h"
@@ -37,6 +38,12 @@ struct StudyOptions {
 };
 
 void run(const StudyOptions& o, const GlobalOptions& global, const std::string& command_line) {
+  common::checkOutputDirectory(o.out, "--out");  // before the work, not after
+  // A failed or interrupted study takes the earlier one's files away too (they stayed, read by a
+  // script that did not look at the exit code as this run's), as generate, check and simulate do.
+  common::claimOutputs(o.out,
+                       {"study.csv", "lines.csv", "tilt.csv", "study.md", "speed_vs_error.png",
+                        "force_error_lines.png", "tilt_along_path.png"});
   StudyRequest request;
   request.voxel_sizes_mm = parseVoxelSizes(o.voxels, "--voxels");
   request.interpolations = parseInterpolations(o.interpolations, "--interp");
@@ -72,6 +79,10 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
   const StudyResult result = runStudy(request);
   const std::filesystem::path dir = o.out;
   writeStudy(result, dir, command_line, "");
+  // The plots are redrawn from this run's tables, or not at all (no matplotlib): never an earlier
+  // run's beside them.
+  common::removeStaleOutputs(
+      dir, {"speed_vs_error.png", "force_error_lines.png", "tilt_along_path.png"});
   std::string message;
   if (!plotStudy(dir, &message)) std::fprintf(stderr, "fieldpath study: %s\n", message.c_str());
 

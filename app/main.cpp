@@ -1,12 +1,15 @@
 /// fieldpath: collision-free 5-axis ball-end paths through a repulsive field, and their proof.
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <new>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -65,6 +68,7 @@ int main(int argc, char** argv) {
   using namespace fieldpath::app;
   const StartupTrace trace;
   fieldpath::common::installTemporaryCleanupOnSignals();  // no partial outputs on Ctrl-C
+  fieldpath::common::guardInputs();  // no output written over a file the run read
   CLI::App app{
       "fieldpath: collision-free 5-axis ball-end milling paths (repulsive field), "
       "clearance check and Z-buffer machining simulation"};
@@ -150,10 +154,34 @@ int main(int argc, char** argv) {
     fieldpath::common::removeWrittenOutputs();
     std::fprintf(stderr, "fieldpath: error: %s\n", oneLine(e.what()).c_str());
     return 1;
+  } catch (const std::bad_alloc&) {
+    // The machine's memory or the process's limit (`ulimit -v`): their environment, not a bug.
+    fieldpath::common::removeWrittenOutputs();
+    std::fprintf(
+        stderr,
+        "fieldpath: error: out of memory (the machine's, or a limit such as ulimit -v: "
+        "%s left to this process; --max-memory refuses large work before it starts)\n",
+        fieldpath::common::formatBytes(double(fieldpath::common::processHeadroomBytes())).c_str());
+    return 1;
+  } catch (const std::system_error& e) {
+    // A thread or a file the system would not give (`ulimit -u`, `ulimit -v` too small for a
+    // thread's stack): the environment again.
+    fieldpath::common::removeWrittenOutputs();
+    std::fprintf(stderr, "fieldpath: error: the system refused a resource: %s\n",
+                 oneLine(e.what()).c_str());
+    return 1;
   } catch (const std::exception& e) {
     fieldpath::common::removeWrittenOutputs();
     std::fprintf(stderr, "fieldpath: internal error: %s\n", oneLine(e.what()).c_str());
     return 2;
+  }
+  // What a command prints is its result (`field probe`'s values): a full disk, `ulimit -f` or a
+  // closed stdout lost it, read as success.
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    fieldpath::common::removeWrittenOutputs();
+    std::fprintf(stderr, "fieldpath: error: cannot write the standard output: %s\n",
+                 std::strerror(errno));
+    return 1;
   }
   fieldpath::common::releaseClaimedOutputs();  // done: a late signal takes nothing away
   return 0;

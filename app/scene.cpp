@@ -546,6 +546,8 @@ std::vector<std::string> openObstacleNotes(const Scene& scene) {
 }
 
 std::filesystem::path nominalPathOf(const std::filesystem::path& file) {
+  std::error_code ec;  // a FIFO would block the read before loadScene refuses it
+  if (!std::filesystem::is_regular_file(file, ec)) return {};
   try {
     const YAML::Node root = YAML::LoadFile(file.string());
     const YAML::Node node = root["path"] ? root["path"]["nominal"] : YAML::Node();

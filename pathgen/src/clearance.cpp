@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <new>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include <fcl/geometry/bvh/BVH_model.h>
@@ -39,9 +41,16 @@ std::shared_ptr<BvhModel> buildBvhModel(const geometry::TriangleMesh& mesh,
   if (triangles.empty())
     throw common::InputError(what + ": every triangle has zero area, nothing to check");
   auto model = std::make_shared<BvhModel>();
-  model->beginModel(static_cast<int>(triangles.size()), static_cast<int>(points.size()));
-  model->addSubModel(points, triangles);
-  model->endModel();
+  // FCL reports a failed allocation as a code (and a line on stderr) and leaves the tree
+  // unusable: under `ulimit -v` the next query crashed. As the allocation it is: std::bad_alloc.
+  for (const int code :
+       {model->beginModel(static_cast<int>(triangles.size()), static_cast<int>(points.size())),
+        model->addSubModel(points, triangles), model->endModel()})
+    if (code == fcl::BVH_ERR_MODEL_OUT_OF_MEMORY)
+      throw std::bad_alloc();
+    else if (code != fcl::BVH_OK)
+      throw std::runtime_error(what + ": FCL could not build its tree (code " +
+                               std::to_string(code) + ")");
   model->computeLocalAABB();
   return model;
 }

@@ -72,12 +72,16 @@ TEST(CliField, BuildWritesTheVdbAndReportsNodes) {
   EXPECT_NE(run.out.find("build "), std::string::npos) << run.out;
   EXPECT_GT(std::filesystem::file_size(dir.path() / "out/field.vdb"), 1000u);
 
-  const Outcome refused =
-      runFieldpath(dir, "field build scene.yaml --voxel 0.01 --max-memory 64 --out big.vdb");
-  EXPECT_EQ(refused.exit_code, 1);
-  EXPECT_NE(refused.err.find("estimated"), std::string::npos) << refused.err;
-  EXPECT_EQ(lines(refused.err), 1u) << refused.err;
-  EXPECT_FALSE(std::filesystem::exists(dir.path() / "big.vdb"));
+  // As the global option, with a unit or without (MiB): `512M` after the command was refused.
+  for (const char* limit : {"64", "64M"}) {
+    const Outcome refused =
+        runFieldpath(dir, std::string("field build scene.yaml --voxel 0.01 --max-memory ") + limit +
+                              " --out big.vdb");
+    EXPECT_EQ(refused.exit_code, 1);
+    EXPECT_NE(refused.err.find("estimated"), std::string::npos) << refused.err;
+    EXPECT_EQ(lines(refused.err), 1u) << refused.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / "big.vdb"));
+  }
 }
 
 TEST(CliField, BadInputExitsOneWithOneLine) {

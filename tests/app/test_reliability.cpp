@@ -130,6 +130,11 @@ TEST(AtomicOutput, AFailedRunLeavesNoEarlierRunsOutputs) {
   const auto generate = test::runFieldpath(dir, "generate scene.yaml --out out");
   EXPECT_EQ(generate.exit_code, 1) << generate.output();
   EXPECT_EQ(filesUnder(dir.path() / "out"), (std::vector<std::string>{"check.json", "mine.txt"}));
+  // A study too (its tables and plots stayed, a helper's sweep).
+  for (const char* name : {"study.csv", "study.md", "speed_vs_error.png"})
+    dir.write(std::string("out/") + name, "earlier\n");
+  EXPECT_EQ(test::runFieldpath(dir, "study scene.yaml --out out").exit_code, 1);
+  EXPECT_EQ(filesUnder(dir.path() / "out"), (std::vector<std::string>{"check.json", "mine.txt"}));
   dir.write("p.cl", "0 0 0 0 0 1\n");
   const auto check = test::runFieldpath(dir, "check scene.yaml --path p.cl --out out");
   EXPECT_EQ(check.exit_code, 1) << check.output();

@@ -485,3 +485,39 @@ TEST(ViewBrowser, ImpellerPageRendersAndTheSliderMovesTheTool) {
   // No console message in any run (errors, warnings, logs).
   EXPECT_TRUE(browser.console.empty()) << browser.console.front();
 }
+
+// An output never replaces an input of the run, by any name (a helper's sweep): a scene whose
+// nominal path is --out's path.cl lost it to `generate` (the next run then steered generate's own
+// output), and `view --out floor.stl` wrote its page over the part's mesh.
+TEST(Outputs, NeverReplaceAnInputOfTheRun) {
+  const TempDir dir;
+  writeBlockScene(dir);
+  const std::string path = slurp(dir.path() / "path.cl"), floor = slurp(dir.path() / "floor.stl");
+  const Outcome generate = runFieldpath(dir, "generate scene.yaml --out .");
+  EXPECT_EQ(generate.exit_code, 1) << generate.output();
+  EXPECT_NE(generate.err.find("would replace this run's input"), std::string::npos) << generate.err;
+  EXPECT_EQ(slurp(dir.path() / "path.cl"), path);
+  const Outcome view = runFieldpath(dir, "view scene.yaml --path path.cl --out floor.stl");
+  EXPECT_EQ(view.exit_code, 1) << view.output();
+  EXPECT_NE(view.err.find("is an input of this run"), std::string::npos) << view.err;
+  EXPECT_EQ(slurp(dir.path() / "floor.stl"), floor);
+  fs::create_symlink("floor.stl", dir.path() / "page.html");  // by another name
+  EXPECT_EQ(runFieldpath(dir, "view scene.yaml --path path.cl --out page.html").exit_code, 1);
+  EXPECT_EQ(slurp(dir.path() / "floor.stl"), floor);
+}
+
+// What a command prints is its result: to a full device it is lost, and the run says so and
+// leaves nothing (`field probe > /dev/full` exited 0, its values gone).
+TEST(Outputs, AStandardOutputThatCannotBeWrittenFailsTheRun) {
+  const TempDir dir;
+  const std::string command = "cd '" + dir.path().string() +
+                              "' && '" FIELDPATH_EXE
+                              "' --quiet tool --shape ball:3 --out t.stl > /dev/full 2> err.txt";
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  EXPECT_NE(slurp(dir.path() / "err.txt").find("cannot write the standard output"),
+            std::string::npos)
+      << slurp(dir.path() / "err.txt");
+  EXPECT_FALSE(fs::exists(dir.path() / "t.stl"));
+}

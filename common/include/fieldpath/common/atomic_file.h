@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/input_file.h"
 
 namespace fieldpath::common {
 
@@ -147,16 +148,20 @@ extern "C" inline void removeTemporariesAndDie(int signal_number) {
 }
 }  // namespace detail
 
-/// SIGINT/SIGTERM remove the temporaries being written (no partial file under any name) and the
-/// outputs the run claimed (no earlier run's file beside an interrupted one), then end the process
-/// by the signal as usual. The CLI's main() installs it first thing.
+/// SIGINT, SIGTERM, SIGHUP (the terminal closed), SIGQUIT and SIGPIPE (`| head` done reading)
+/// remove the temporaries being written (no partial file under any name) and the outputs the run
+/// claimed (no earlier run's file beside an interrupted one), then end the process by the signal
+/// as usual. SIGXFSZ (`ulimit -f`) is ignored: the write fails, the run reports it as any
+/// failed write and removes its files (killed by it, its temporaries stayed). The CLI's main()
+/// installs it first thing.
 inline void installTemporaryCleanupOnSignals() {
   struct sigaction action {};
   action.sa_handler = detail::removeTemporariesAndDie;
   sigemptyset(&action.sa_mask);
   action.sa_flags = SA_RESETHAND;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE})
+    sigaction(signal_number, &action, nullptr);
+  ::signal(SIGXFSZ, SIG_IGN);
 }
 
 /// Makes `dir` (and its parents) a directory for outputs. Throws InputError (one line naming the
@@ -237,6 +242,12 @@ inline void writeFileAtomically(const std::filesystem::path& given,
     path = target.is_absolute() ? target : path.parent_path() / target;
   }
   const fs::file_status status = fs::status(path, status_ec);
+  // An input of this run by any name (a scene's nominal path as --out's path.cl, `view --out`
+  // naming the part's mesh): replaced, it was lost without a word.
+  if (fs::is_regular_file(status))
+    if (const fs::path input = inputAt(path); !input.empty())
+      throw InputError(given.string() + ": is an input of this run (" + input.string() +
+                       "): writing the output there would replace it; choose another output");
   if (fs::exists(status) && !fs::is_regular_file(status) && !fs::is_directory(status)) {
     errno = 0;
     std::ofstream out(path, mode);
@@ -284,6 +295,8 @@ inline void writeFileAtomically(const std::filesystem::path& given,
     std::error_code ec;
     if (fs::is_directory(path, ec))
       throw InputError(path.string() + ": is a directory, cannot write a file there");
+    // A file replaced keeps its permissions (a 0600 file written through a link became 0644).
+    if (fs::is_regular_file(status)) fs::permissions(tmp, status.permissions(), ec);
     fs::rename(tmp, path, ec);
     if (ec) throw InputError(path.string() + ": cannot rename into place: " + ec.message());
     const std::lock_guard<std::mutex> lock(detail::written_mutex);
@@ -308,7 +321,8 @@ inline void removeWrittenOutputs() {
   for (const auto& file : detail::claimed_outputs) {
     std::error_code ignored;  // regular files only: a FIFO or a link the user put there stays
     if (std::filesystem::symlink_status(file, ignored).type() ==
-        std::filesystem::file_type::regular)
+            std::filesystem::file_type::regular &&
+        inputAt(file).empty())  // nor an input the run read under an output's name
       std::filesystem::remove(file, ignored);
   }
   detail::claimed_outputs.clear();
@@ -333,6 +347,18 @@ inline void claimOutputs(const std::filesystem::path& dir, std::initializer_list
     detail::claimed_outputs.push_back(dir / name);
     detail::listInSlots(detail::claimed_slots, detail::kClaimedSlots, (dir / name).string());
   }
+}
+
+/// Refuses, before the work, outputs `names` in `dir` that are inputs this run has read (a scene
+/// whose nominal path is --out's path.cl: generate wrote over it, and the next run steered its
+/// own output).
+inline void refuseOutputsOverInputs(const std::filesystem::path& dir,
+                                    std::initializer_list<const char*> names,
+                                    const std::string& option) {
+  for (const char* name : names)
+    if (const std::filesystem::path input = inputAt(dir / name); !input.empty())
+      throw InputError(option + ": " + (dir / name).string() + " would replace this run's input " +
+                       input.string() + "; choose another " + option);
 }
 
 /// The run succeeded: its outputs are no longer taken away by a failure or a late signal (one in

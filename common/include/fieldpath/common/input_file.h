@@ -1,20 +1,58 @@
 #pragma once
 /// The one check every reader of a user's file makes first: it is a regular file. A directory,
 /// a FIFO (which would block the reader) or a device (/dev/zero: endless) is refused with what it
-/// is, a missing file as missing.
+/// is, a missing file as missing, an unreadable one as unreadable. The files that pass are this
+/// run's inputs: the writers refuse to write over them (writeFileAtomically).
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
+#include <mutex>
 #include <string>
+#include <vector>
 
 #include "fieldpath/common/errors.h"
 
 namespace fieldpath::common {
+
+namespace detail {
+inline std::mutex inputs_mutex;
+inline std::vector<std::filesystem::path> input_files;
+inline bool guard_inputs = false;
+}  // namespace detail
+
+/// The CLI's main() turns it on: one process is one run, and what it reads it must not write
+/// over. A library caller (the tests: write, read back, write again) is a run of many.
+inline void guardInputs() {
+  const std::lock_guard<std::mutex> lock(detail::inputs_mutex);
+  detail::guard_inputs = true;
+}
+
+/// The input of this run that `file` is (the same file by any name), or an empty path.
+inline std::filesystem::path inputAt(const std::filesystem::path& file) {
+  const std::lock_guard<std::mutex> lock(detail::inputs_mutex);
+  for (const std::filesystem::path& input : detail::input_files) {
+    std::error_code ec;
+    if (std::filesystem::equivalent(file, input, ec)) return input;
+  }
+  return {};
+}
 
 /// Throws InputError "FILE: no such WHAT" / "FILE: is a directory, expected a WHAT" / "FILE: not
 /// a regular file (a FIFO, socket or device), expected a WHAT" unless `file` is a regular file.
 inline void requireRegularFile(const std::filesystem::path& file, const std::string& what = "file") {
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(file, ec);
-  if (std::filesystem::is_regular_file(status)) return;
+  if (std::filesystem::is_regular_file(status)) {
+    // Unreadable (permissions): said so, not as the empty or cut-short file a reader then sees
+    // ("binary STL ... shorter than its 84-byte header").
+    if (::access(file.c_str(), R_OK) != 0)
+      throw InputError(file.string() + ": cannot read the " + what + ": " + std::strerror(errno));
+    const std::lock_guard<std::mutex> lock(detail::inputs_mutex);
+    if (detail::guard_inputs) detail::input_files.push_back(file);
+    return;
+  }
   if (std::filesystem::is_directory(status))
     throw InputError(file.string() + ": is a directory, expected a " + what);
   if (std::filesystem::exists(status))

@@ -2,13 +2,16 @@
 /// The memory limit that size estimates are checked against before anything is allocated
 /// (DESIGN.md: "sizes are estimated before allocation and refused with the estimate"), and the
 /// coordinate range beyond which a number cannot come from any machine.
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <sstream>
 #include <string>
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include "fieldpath/common/errors.h"
@@ -51,10 +54,31 @@ inline std::size_t availableMemoryBytes() {
 /// Sets the limit (`--max-memory`); 0 restores the default (the available memory).
 inline void setMemoryLimitBytes(std::size_t bytes) { detail::memory_limit_bytes = bytes; }
 
-/// The limit in force, bytes.
+/// What the process may still map under its own limits (`ulimit -v`, `ulimit -d`), bytes: the
+/// limit less the address space it holds now (/proc/self/statm); unlimited: SIZE_MAX. Under a
+/// `ulimit -v` of 200 MB the machine's free memory let FCL's tree allocation fail (and crash).
+inline std::size_t processHeadroomBytes() {
+  rlim_t limit = RLIM_INFINITY;
+  for (const int resource : {RLIMIT_AS, RLIMIT_DATA}) {
+    rlimit r{};
+    if (getrlimit(resource, &r) == 0 && r.rlim_cur != RLIM_INFINITY)
+      limit = std::min(limit, r.rlim_cur);
+  }
+  if (limit == RLIM_INFINITY) return SIZE_MAX;
+  unsigned long long pages = 0;
+  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
+    if (std::fscanf(f, "%llu", &pages) != 1) pages = 0;
+    std::fclose(f);
+  }
+  const double held = double(pages) * double(sysconf(_SC_PAGE_SIZE));
+  return double(limit) > held ? static_cast<std::size_t>(double(limit) - held) : 0;
+}
+
+/// The limit in force, bytes: `--max-memory`, or the available memory; never past what the
+/// process's own limits leave it.
 inline std::size_t memoryLimitBytes() {
   const std::size_t set = detail::memory_limit_bytes;
-  return set != 0 ? set : availableMemoryBytes();
+  return std::min(set != 0 ? set : availableMemoryBytes(), processHeadroomBytes());
 }
 
 /// "1.5 GiB", "320 MiB", "12 KiB" (for messages); huge and non-finite values stay readable.
