@@ -75,7 +75,18 @@ double median(std::vector<double> values) {
 
 AxisTurn largestAxisTurn(const PathFile& path, double ball_radius_mm) {
   AxisTurn out;
-  for (const auto& [begin, end] : passRanges(path, 0.0, ball_radius_mm))
+  // A file with markers says which moves are cut: every move within a pass block runs at feed,
+  // wherever passRanges splits it (a posture turned 15° about its tip threw the ball centre back,
+  // split the pass there, and its turn went uncounted, unwarned). Without markers the links are in
+  // the one block: passRanges tells them by their gaps.
+  std::vector<std::pair<std::size_t, std::size_t>> ranges;
+  if (path.blocks.size() > 1) {
+    for (const PathBlock& block : path.blocks)
+      if (block.kind == PathBlock::Kind::Pass) ranges.emplace_back(block.begin, block.end);
+  } else {
+    ranges = passRanges(path, 0.0, ball_radius_mm);
+  }
+  for (const auto& [begin, end] : ranges)
     for (std::size_t i = begin + 1; i < end; ++i) {
       const Posture &a = path.postures[i - 1], &b = path.postures[i];
       const double deg = geometry::axisAngle(a.axis, b.axis) * 180.0 / M_PI;

@@ -415,6 +415,17 @@ TEST(NominalPasses, LargestAxisTurnIsOfThePassesAndItsClosedForm) {
   EXPECT_EQ(f.at, 0u);
   EXPECT_NEAR(f.step_mm, 1.0, 1e-12);
   EXPECT_EQ(passRanges(forward, 0.0, 3.0).size(), 1u);
+  // A file with markers: every move of a pass block is cut. A posture turned 15 deg about its
+  // tip throws the ball centre 0.78 mm on, past the next one: passRanges splits the block there,
+  // and the turn went unwarned (a newcomer's audit).
+  PathFile marked;
+  marked.postures = {at(0, 0), at(0.5, 0), at(1, 15), at(1.5, 0), at(2, 0), at(20, 0), at(21, 0)};
+  marked.blocks = {
+      {PathBlock::Kind::Pass, 0, 5}, {PathBlock::Kind::Link, 5, 6}, {PathBlock::Kind::Pass, 6, 7}};
+  ASSERT_GT(passRanges(marked, 0.0, 3.0).size(), 2u);
+  const AxisTurn m = largestAxisTurn(marked, 3.0);
+  EXPECT_NEAR(m.deg, 15.0, 1e-9);
+  EXPECT_EQ(m.at, 1u);
   // No pass of two postures: no turn.
   PathFile single = geometry::singlePass({at(0, 0)});
   EXPECT_EQ(largestAxisTurn(single, 3.0).at, static_cast<std::size_t>(-1));

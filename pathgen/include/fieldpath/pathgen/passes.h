@@ -87,12 +87,13 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const geometry::Path
 /// between two passes 20 mm apart that generate took).
 void requireSteadyAxes(const geometry::PathFile& path, double pass_gap_mm, double ball_radius_mm);
 
-/// The largest turn of the tool axis between two consecutive postures of a pass (passRanges
-/// with the default gap: a file of passes with no markers, or an .npy, holds its links in one
-/// block): `deg`, from posture `at` to at + 1, over `step_mm` of ball-centre travel (`at` npos:
-/// no pass has two postures; ties: the first). A machine's rotary axes follow a few degrees a
-/// millimetre at cutting feed; the steered impeller example turns under 0.5 deg a posture, a
-/// field pushing a tool with no room to move turned 30 deg in 0.5 mm.
+/// The largest turn of the tool axis between two consecutive postures of a pass (a file with
+/// markers: within its pass blocks, every move; without, passRanges with the default gap: a file
+/// of passes with no markers, or an .npy, holds its links in one block): `deg`, from posture `at`
+/// to at + 1, over `step_mm` of ball-centre travel (`at` npos: no pass has two postures; ties: the
+/// first). A machine's rotary axes follow a few degrees a millimetre at cutting feed; the steered
+/// impeller example turns under 0.5 deg a posture, a field pushing a tool with no room to move
+/// turned 30 deg in 0.5 mm.
 struct AxisTurn {
   double deg = 0.0, step_mm = 0.0;
   std::size_t at = static_cast<std::size_t>(-1);
