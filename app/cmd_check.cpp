@@ -232,8 +232,14 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     // another part) left only the stock's figures: 2000 um of 'scallop' and ok read as a check.
     const bool never_cut = surface && surface->cut_lines == 0;
     if (never_cut) surface.reset();
+    // The cutter entering the part is no path in another frame (a side cut under the stock's
+    // lines asked 'is the part in the path's frame?' while cutter_part read its 9.9 um).
+    const bool touches_part = contacts.cutter && contacts.cutter->gouges();
     const char* surface_skipped =
         !scene.part ? "the scene has no `part`"
+        : never_cut && touches_part
+            ? "the tool lowers no line of the stock over the part (it enters the part where no "
+              "line falls: cutter_part)"
         : never_cut ? "the tool never cuts the stock over the part (no line lowered): is the part "
                       "in the path's frame and units?"
         : !surface  ? "the passes do not pass over the part (`part` mesh)"
@@ -381,7 +387,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                    "note: --spacing %g mm would make more Z-buffer lines than a check takes: "
                    "lines every %.4g mm (check.json `surface.grid.spacing`)\n",
                    options->spacing_mm, surface->grid.dx_mm);
-    if (never_cut)
+    if (never_cut && !touches_part)
       std::fprintf(stderr,
                    "warning: the path never reaches the part (no line of the surface cut): is "
                    "the part in the path's frame and units?\n");

@@ -222,6 +222,14 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
       part = geometry::loadMesh(o->part);
       for (const auto& v : part->vertices) part_top_z = std::max(part_top_z, double(v.z()));
     }
+    // A first cut's surface.stl as the next one's --part, into the same --out: refused before the
+    // work (its writing over the input is refused anyway, after it).
+    for (const auto& [key, name] : {std::pair{"npy", "heights.npy"},
+                                    {"json", "heights.json"},
+                                    {"stl", "surface.stl"},
+                                    {"png", "heights.png"},
+                                    {"", "simulate.json"}})
+      if (!*key || outputs.count(key)) common::refuseOutputsOverInputs(out, {name}, "--out");
     const bool streamed = !region.empty();
     bool have_grid = false;
     const auto makeGrid = [&] {

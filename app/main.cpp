@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -62,6 +63,18 @@ std::string oneLine(const char* what) {
   return out;
 }
 
+/// What a command prints is its result (`field probe`'s values, `--help`): a full disk,
+/// `ulimit -f` or a closed stdout lost it, read as success. Says so; true when it was lost.
+bool standardOutputLost() {
+  errno = 0;
+  const bool flushed = std::fflush(stdout) == 0;
+  const int error = errno;
+  if (flushed && !std::ferror(stdout)) return false;
+  std::fprintf(stderr, "fieldpath: error: cannot write the standard output%s%s\n",
+               error != 0 ? ": " : "", error != 0 ? std::strerror(error) : "");
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -101,7 +114,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    if (e.get_exit_code() == 0) {  // --help, --version
+      const int code = app.exit(e);
+      return standardOutputLost() ? 1 : code;
+    }
     // `fieldpath frobnicate`, `fieldpath field prob`: CLI11 says "a subcommand is required",
     // which hides the typo. The words are walked down the commands; the first that is none
     // where one is required is named.
@@ -157,11 +173,15 @@ int main(int argc, char** argv) {
   } catch (const std::bad_alloc&) {
     // The machine's memory or the process's limit (`ulimit -v`): their environment, not a bug.
     fieldpath::common::removeWrittenOutputs();
-    std::fprintf(
-        stderr,
-        "fieldpath: error: out of memory (the machine's, or a limit such as ulimit -v: "
-        "%s left to this process; --max-memory refuses large work before it starts)\n",
-        fieldpath::common::formatBytes(double(fieldpath::common::processHeadroomBytes())).c_str());
+    const std::size_t headroom = fieldpath::common::processHeadroomBytes();
+    const std::string limit = headroom == SIZE_MAX
+                                  ? std::string()
+                                  : ", or the process's ulimit -v / -d (" +
+                                        fieldpath::common::formatBytes(double(headroom)) + " left)";
+    std::fprintf(stderr,
+                 "fieldpath: error: out of memory (the machine's%s; --max-memory refuses large "
+                 "work before it starts)\n",
+                 limit.c_str());
     return 1;
   } catch (const std::system_error& e) {
     // A thread or a file the system would not give (`ulimit -u`, `ulimit -v` too small for a
@@ -175,12 +195,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fieldpath: internal error: %s\n", oneLine(e.what()).c_str());
     return 2;
   }
-  // What a command prints is its result (`field probe`'s values): a full disk, `ulimit -f` or a
-  // closed stdout lost it, read as success.
-  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+  if (standardOutputLost()) {
     fieldpath::common::removeWrittenOutputs();
-    std::fprintf(stderr, "fieldpath: error: cannot write the standard output: %s\n",
-                 std::strerror(errno));
     return 1;
   }
   fieldpath::common::releaseClaimedOutputs();  // done: a late signal takes nothing away

@@ -161,7 +161,7 @@ double scallopGridErrorUm(double scallop_um, double spacing_mm, double edge_mm, 
 /// The path's postures with the motions between them swept: where a motion can reach below
 /// `stock_top_mm` (its lower tip less the tool's reach), postures along it as `check`'s motions
 /// are (geometry::alongMotion) so that no point of the tool moves more than `step_mm` between two
-/// of them (geometry::motionSweepMm).
+/// of them (geometry::forEachPoseBetween, as cutter_part's stamps).
 std::vector<geometry::Posture> sweptPostures(const std::vector<geometry::Posture>& postures,
                                              double reach_mm, double step_mm, double stock_top_mm) {
   std::vector<geometry::Posture> out;
@@ -172,13 +172,8 @@ std::vector<geometry::Posture> sweptPostures(const std::vector<geometry::Posture
     const geometry::Posture& a = postures[i];
     const geometry::Posture& b = postures[i + 1];
     if (std::min(a.tip_mm.z(), b.tip_mm.z()) - reach_mm > stock_top_mm) continue;  // above it all
-    const double moved_mm = geometry::motionSweepMm(a, b, reach_mm);
-    const auto steps = static_cast<std::size_t>(std::ceil(moved_mm / step_mm));
-    for (std::size_t k = 1; k < steps; ++k) {
-      const geometry::Posture p =
-          geometry::alongMotion(a, b, static_cast<double>(k) / static_cast<double>(steps));
-      out.push_back(p);
-    }
+    geometry::forEachPoseBetween(a, b, reach_mm, step_mm,
+                                 [&out](const geometry::Posture& p) { out.push_back(p); });
   }
   return out;
 }
@@ -486,14 +481,17 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   // which read 14.5 mm of gouge for a clear tool; the overhang's underside is the cutter's exact
   // test's). A line with nothing under the layer is not measured.
   std::vector<float> reference = nominal, reference_nz = facet_nz;
-  const zbuffer::PartLayers layers =
-      zbuffer::partLayers(sim.grid, part_mesh.vertices, part_mesh.triangles, nominal);
+  std::vector<std::uint8_t> open(part_local.triangles.size(), 0);
+  for (const std::vector<int>& shell : geometry::openShells(part_local))
+    for (const int k : shell) open[static_cast<std::size_t>(k)] = 1;
+  const zbuffer::PartUnderCut under = zbuffer::partUnderCut(
+      sim.grid, part_mesh.vertices, part_mesh.triangles, nominal, simulated.heights_mm, open);
   for (std::size_t i = 0; i < nominal.size(); ++i)
-    if (simulated.heights_mm[i] < layers.underside_mm[i]) {  // false where NaN
+    if (under.beneath[i]) {
       ++result.beneath_lines;
-      result.beneath_unmeasured += std::isnan(layers.next_top_mm[i]);
-      reference[i] = layers.next_top_mm[i];
-      reference_nz[i] = layers.next_normal_z[i];
+      result.beneath_unmeasured += std::isnan(under.surface_mm[i]);
+      reference[i] = under.surface_mm[i];
+      reference_nz[i] = under.normal_z[i];
     }
   for (std::size_t i = 0; i < reference.size(); ++i)
     if (!std::isnan(reference[i]))

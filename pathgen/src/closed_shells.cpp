@@ -49,38 +49,58 @@ ClosedShells::ClosedShells(const geometry::TriangleMesh& mesh)
         for (int iy = cellY(tb.min().y()); iy <= cellY(tb.max().y()); ++iy)
           shell.cells[static_cast<std::size_t>(ix) * n + iy].push_back(t);
     }
+    // The signed volume (divergence theorem): a cavity's shell, wound into the void, is < 0.
+    for (int t : shell_triangles) {
+      const Eigen::Vector3d& a = vertices_[triangles_[t][0]];
+      shell.volume_mm3 +=
+          a.dot(vertices_[triangles_[t][1]].cross(vertices_[triangles_[t][2]])) / 6.0;
+    }
     anchors_.push_back(vertices_[triangles_[shell_triangles.front()][0]]);
     shells_.push_back(std::move(shell));
   }
+  // A shell wound inward inside another one is a void of it: its inside is not the part's (a
+  // tool in a 200 mm box's void read as buried, "2999.9 um"). Wound inward and inside none, it is
+  // a solid exported inside out, its inside the part's all the same.
+  for (std::size_t i = 0; i < shells_.size(); ++i) {
+    if (shells_[i].volume_mm3 >= 0.0) continue;
+    for (std::size_t j = 0; j < shells_.size() && shells_[i].sign > 0; ++j)
+      if (j != i && shells_[j].volume_mm3 > 0.0 && crossings(shells_[j], anchors_[i]) % 2 == 1)
+        shells_[i].sign = -1;
+  }
+}
+
+int ClosedShells::crossings(const Shell& shell, const Eigen::Vector3d& p) const {
+  if (!shell.box.contains(p)) return 0;
+  const Vec2 q(p.x(), p.y());
+  const int ix =
+      std::clamp(static_cast<int>((p.x() - shell.box.min().x()) / shell.cell_x), 0, shell.nx - 1);
+  const int iy =
+      std::clamp(static_cast<int>((p.y() - shell.box.min().y()) / shell.cell_y), 0, shell.ny - 1);
+  int count = 0;
+  for (int t : shell.cells[static_cast<std::size_t>(ix) * shell.ny + iy]) {
+    Eigen::Vector3d a = vertices_[triangles_[t][0]], b = vertices_[triangles_[t][1]],
+                    c = vertices_[triangles_[t][2]];
+    Vec2 a2(a.x(), a.y()), b2(b.x(), b.y()), c2(c.x(), c.y());
+    const double area = orient(a2, b2, c2);
+    if (area == 0.0) continue;  // seen edge-on: the ray grazes it
+    if (area < 0.0) {           // counter-clockwise in projection
+      std::swap(b, c);
+      std::swap(b2, c2);
+    }
+    const double wa = orient(b2, c2, q), wb = orient(c2, a2, q), wc = orient(a2, b2, q);
+    if (!owns(wa, b2, c2) || !owns(wb, c2, a2) || !owns(wc, a2, b2)) continue;
+    const double z = (wa * a.z() + wb * b.z() + wc * c.z()) / (wa + wb + wc);
+    count += z > p.z();
+  }
+  return count;
 }
 
 bool ClosedShells::contains(const Eigen::Vector3d& p) const {
-  const Vec2 q(p.x(), p.y());
-  for (const Shell& shell : shells_) {
-    if (!shell.box.contains(p)) continue;
-    const int ix = std::clamp(static_cast<int>((p.x() - shell.box.min().x()) / shell.cell_x), 0,
-                              shell.nx - 1);
-    const int iy = std::clamp(static_cast<int>((p.y() - shell.box.min().y()) / shell.cell_y), 0,
-                              shell.ny - 1);
-    int crossings = 0;
-    for (int t : shell.cells[static_cast<std::size_t>(ix) * shell.ny + iy]) {
-      Eigen::Vector3d a = vertices_[triangles_[t][0]], b = vertices_[triangles_[t][1]],
-                      c = vertices_[triangles_[t][2]];
-      Vec2 a2(a.x(), a.y()), b2(b.x(), b.y()), c2(c.x(), c.y());
-      const double area = orient(a2, b2, c2);
-      if (area == 0.0) continue;  // seen edge-on: the ray grazes it
-      if (area < 0.0) {           // counter-clockwise in projection
-        std::swap(b, c);
-        std::swap(b2, c2);
-      }
-      const double wa = orient(b2, c2, q), wb = orient(c2, a2, q), wc = orient(a2, b2, q);
-      if (!owns(wa, b2, c2) || !owns(wb, c2, a2) || !owns(wc, a2, b2)) continue;
-      const double z = (wa * a.z() + wb * b.z() + wc * c.z()) / (wa + wb + wc);
-      crossings += z > p.z();
-    }
-    if (crossings % 2 == 1) return true;
-  }
-  return false;
+  // The winding number: +1 inside each solid's shell, -1 inside each void's.
+  int winding = 0;
+  for (const Shell& shell : shells_)
+    if (crossings(shell, p) % 2 == 1) winding += shell.sign;
+  return winding > 0;
 }
 
 }  // namespace fieldpath::pathgen

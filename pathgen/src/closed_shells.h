@@ -17,9 +17,10 @@ class ClosedShells {
   /// no inside and are left out.
   explicit ClosedShells(const geometry::TriangleMesh& mesh);
 
-  /// Whether p lies inside one of the shells: the parity of the crossings of the vertical ray
-  /// from p upward, each triangle's projection taking the points of its edges by the
-  /// top-left rule (so that a ray through an edge or a vertex is counted once).
+  /// Whether p lies inside the part: inside more solids' shells than voids' (a shell wound
+  /// inward inside another is a void), each shell's inside by the parity of the crossings of the
+  /// vertical ray from p upward, each triangle's projection taking the points of its edges by
+  /// the top-left rule (so that a ray through an edge or a vertex is counted once).
   bool contains(const Eigen::Vector3d& p) const;
   /// A vertex of each shell: a shell wholly inside a solid has them all inside.
   const std::vector<Eigen::Vector3d>& anchors() const { return anchors_; }
@@ -31,7 +32,11 @@ class ClosedShells {
     int nx = 1, ny = 1;
     double cell_x = 1, cell_y = 1;
     std::vector<std::vector<int>> cells;  ///< per xy cell: the triangles whose box meets it
+    double volume_mm3 = 0.0;              ///< signed: < 0 wound inward
+    int sign = 1;                         ///< -1: a void (wound inward, inside a solid)
   };
+  /// The crossings of the vertical ray from p upward with `shell`'s triangles.
+  int crossings(const Shell& shell, const Eigen::Vector3d& p) const;
   std::vector<Eigen::Vector3d> vertices_;
   std::vector<Eigen::Vector3i> triangles_;
   std::vector<Shell> shells_;

@@ -53,7 +53,8 @@ class Part {
     if (corner - shrink_mm > 0.0 &&
         cornerMeets(pose.tip_mm + corner * axis, turn, tool.radius_mm - corner, corner - shrink_mm))
       return true;
-    const double bottom = corner, top = tool.length_mm - shrink_mm;
+    // Shrunk past its corner radius, a torus's bottom rises with the shrink (its flat end).
+    const double bottom = std::max(corner, shrink_mm), top = tool.length_mm - shrink_mm;
     if (top > bottom) {
       const Vec3 middle = pose.tip_mm + 0.5 * (bottom + top) * axis;
       if (meets(fcl::Cylinderd(radius, top - bottom), placed(turn, middle))) return true;
@@ -88,12 +89,14 @@ class Part {
     if (meets(fcl::Cylinderd(disc_mm, 2.0 * reach_mm), at)) return true;
     // Around it a ring (a torus: no FCL shape). The triangles in the cylinder that bounds it are
     // each measured from the disc (GJK, ~1e-7 mm): within reach, they enter the ring.
-    fcl::CollisionRequestd request(std::size_t{1} << 22);
+    constexpr std::size_t kMaxContacts = std::size_t{1} << 22;
+    fcl::CollisionRequestd request(kMaxContacts);
     fcl::CollisionResultd result;
     const fcl::Cylinderd bound(disc_mm + reach_mm, 2.0 * reach_mm);
     if (fcl::collide(&bound, at, model_.tree.get(), fcl::Transform3d::Identity(), request,
                      result) == 0)
       return false;
+    if (result.numContacts() >= kMaxContacts) return true;  // the list cut short: not cleared
     const fcl::Cylinderd disc(disc_mm, 0.0);
     const fcl::detail::GJKSolver_libccd<double> solver;
     const auto& tree = *model_.tree;
@@ -129,7 +132,7 @@ double entryDepthMm(const Part& part, const geometry::ToolSpec& tool, const Post
 }
 
 /// The postures and the stamps along the motions that come within the tool's length of the
-/// part's box, `step_mm` apart at most for any point of the tool (geometry::motionSweepMm).
+/// part's box, `step_mm` apart at most for any point of the tool (geometry::forEachPoseBetween).
 std::vector<Stamp> stampsNearPart(std::span<const Posture> postures, const Part& part,
                                   double reach_mm, double step_mm) {
   Eigen::AlignedBox3d near = part.box();
@@ -145,7 +148,7 @@ std::vector<Stamp> stampsNearPart(std::span<const Posture> postures, const Part&
   double count = 0;
   for (std::size_t i = 0; i + 1 < postures.size(); ++i)
     if (motionNear(postures[i], postures[i + 1]))
-      count += std::ceil(geometry::motionSweepMm(postures[i], postures[i + 1], reach_mm) / step_mm);
+      count += geometry::motionSteps(postures[i], postures[i + 1], reach_mm, step_mm);
   common::requireMemory("the cutter's test against the part",
                         (count + double(postures.size())) * double(sizeof(Stamp)),
                         common::shortNumber(count) + " stamps along the motions, " +
@@ -158,10 +161,9 @@ std::vector<Stamp> stampsNearPart(std::span<const Posture> postures, const Part&
     const Posture& a = postures[i];
     const Posture& b = postures[i + 1];
     if (!motionNear(a, b)) continue;
-    const auto steps =
-        static_cast<std::size_t>(std::ceil(geometry::motionSweepMm(a, b, reach_mm) / step_mm));
-    for (std::size_t k = 1; k < steps; ++k)
-      out.push_back({geometry::alongMotion(a, b, double(k) / double(steps)), i, true});
+    geometry::forEachPoseBetween(a, b, reach_mm, step_mm, [&](const Posture& pose) {
+      out.push_back({pose, i, true});
+    });
   }
   return out;
 }

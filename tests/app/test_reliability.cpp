@@ -184,6 +184,46 @@ TEST(AtomicOutput, NamesUpToTheLimitAreWritten) {
   EXPECT_EQ(filesUnder(dir.path()).size(), 2u);  // no temporary left
 }
 
+// A file replaced keeps its permissions, through a link too (a 0600 file became 0644: a helper's
+// sweep).
+TEST(AtomicOutput, AReplacedFileKeepsItsPermissions) {
+  const TempDir dir;
+  dir.write("secret.cl", "0 0 0 0 0 1\n");
+  ASSERT_EQ(::chmod((dir.path() / "secret.cl").c_str(), 0600), 0);
+  fs::create_symlink("secret.cl", dir.path() / "link.cl");
+  for (const char* name : {"secret.cl", "link.cl"}) {
+    common::writeTextAtomically(dir.path() / name, "1 0 0 0 0 1\n");
+    struct stat info {};
+    ASSERT_EQ(::stat((dir.path() / "secret.cl").c_str(), &info), 0);
+    EXPECT_EQ(info.st_mode & 0777, 0600u) << name;
+  }
+  EXPECT_TRUE(fs::is_symlink(dir.path() / "link.cl"));
+}
+
+// A signal the run was started ignoring stays ignored (under `nohup` a HUP killed the run and
+// took its outputs: a reviewer's case); the others clean up; SIGXFSZ is ignored (a write past
+// `ulimit -f` fails, and the run cleans up, rather than dying with its temporaries left).
+TEST(AtomicOutput, SignalsIgnoredAtStartStayIgnored) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    ::signal(SIGHUP, SIG_IGN);
+    common::installTemporaryCleanupOnSignals();
+    struct sigaction hup {
+    }, term{}, xfsz{};
+    sigaction(SIGHUP, nullptr, &hup);
+    sigaction(SIGTERM, nullptr, &term);
+    sigaction(SIGXFSZ, nullptr, &xfsz);
+    _exit(hup.sa_handler == SIG_IGN && term.sa_handler != SIG_DFL && term.sa_handler != SIG_IGN &&
+                  xfsz.sa_handler == SIG_IGN
+              ? 0
+              : 1);
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+}
+
 // An output name that is a FIFO (or /dev/null, a device) is written into, not replaced by a
 // regular file (renaming over /dev/null made it one), and a failed run leaves it; a name that is a
 // symbolic link is written through it, the link kept.

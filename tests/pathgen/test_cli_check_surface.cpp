@@ -191,29 +191,65 @@ TEST(CheckSurface, APathThatNeverCutsThePartIsNotChecked) {
 // lines read 10 mm of gouge (a helper's undercut case: 14.5 mm, "not ok", no contact). They are
 // measured against the plate under the shelf: no gouge; 0.1 mm lower, the plate's 100 um.
 TEST(CheckSurface, ALinePassedBeneathAnOverhangIsMeasuredAgainstThePartUnderIt) {
+  // The shelf a closed box, or an open sheet at z 9 wound up or down (a sheet's winding says
+  // nothing: a reviewer's case read 7936 um either way).
+  // Two shelves stacked: the lines are measured against the plate under both, not the lower
+  // shelf's top (a helper's case read 10 mm).
+  for (const char* shelf : {"box", "two boxes", "sheet up", "sheet down"}) {
+    const TempDir dir;
+    geometry::TriangleMesh part;
+    pathgen::test::addBox(part, -10, 30, -15, 15, -5, 0);
+    if (std::string(shelf) == "box" || std::string(shelf) == "two boxes") {
+      pathgen::test::addBox(part, -10, 30, 5, 15, 8, 10);
+      if (std::string(shelf) == "two boxes") pathgen::test::addBox(part, -10, 30, 5, 15, 12, 14);
+    } else {
+      const int a = static_cast<int>(part.vertices.size());
+      for (const auto& [x, y] : {std::pair{-10.0, 5.0}, {30.0, 5.0}, {30.0, 15.0}, {-10.0, 15.0}})
+        part.vertices.emplace_back(x, y, 9.0);
+      if (std::string(shelf) == "sheet up") {
+        part.triangles.emplace_back(a, a + 1, a + 2);
+        part.triangles.emplace_back(a, a + 2, a + 3);
+      } else {
+        part.triangles.emplace_back(a, a + 2, a + 1);
+        part.triangles.emplace_back(a, a + 3, a + 2);
+      }
+    }
+    writeSceneOfPart(dir, part);
+    const double tilt = 60.0 * M_PI / 180.0, ay = -std::sin(tilt), az = std::cos(tilt);
+    const auto pass = [&](double centre_z) {
+      std::ostringstream cl;
+      cl << "# pass 1\n";
+      for (int i = 0; i <= 40; ++i)  // the tip: the ball's centre less R along the axis
+        cl << 0.5 * i << ' ' << 6.0 - 3.0 * ay << ' ' << centre_z - 3.0 * az << ' ' << 0 << ' '
+           << ay << ' ' << az << '\n';
+      return cl.str();
+    };
+    dir.write("beneath.cl", pass(3.0));
+    dir.write("gouge.cl", pass(2.9));
+    const auto clear = check(dir, "beneath.cl", "out")["surface"];
+    EXPECT_GT(clear["beneath_lines"].get<int>(), 1000) << shelf << clear;
+    EXPECT_EQ(clear["beneath_unmeasured_lines"].get<int>(), 0) << shelf << clear;
+    EXPECT_LT(clear["max_gouge_um"].get<double>(), 0.5) << shelf << clear;
+    EXPECT_EQ(clear["gouged_lines"].get<int>(), 0) << shelf << clear;
+    const auto gouge = check(dir, "gouge.cl", "out")["surface"];
+    EXPECT_NEAR(gouge["max_gouge_um"].get<double>(), 100.0, 1.0) << shelf << gouge;
+  }
+}
+
+// A lone sheet (nothing under it) is a layer of no thickness: a tool 0.1 mm under it went through
+// it, a gouge, not a line passed beneath.
+TEST(CheckSurface, ACutBelowALoneSheetIsAGouge) {
   const TempDir dir;
   geometry::TriangleMesh part;
-  pathgen::test::addBox(part, -10, 30, -15, 15, -5, 0);
-  pathgen::test::addBox(part, -10, 30, 5, 15, 8, 10);
+  for (const auto& [x, y] : {std::pair{-10.0, -15.0}, {30.0, -15.0}, {30.0, 15.0}, {-10.0, 15.0}})
+    part.vertices.emplace_back(x, y, 0.0);
+  part.triangles.emplace_back(0, 2, 1);  // wound down, as surfaces are often exported
+  part.triangles.emplace_back(0, 3, 2);
   writeSceneOfPart(dir, part);
-  const double tilt = 60.0 * M_PI / 180.0, ay = -std::sin(tilt), az = std::cos(tilt);
-  const auto pass = [&](double centre_z) {
-    std::ostringstream cl;
-    cl << "# pass 1\n";
-    for (int i = 0; i <= 40; ++i)  // the tip: the ball's centre less R along the axis
-      cl << 0.5 * i << ' ' << 6.0 - 3.0 * ay << ' ' << centre_z - 3.0 * az << ' ' << 0 << ' ' << ay
-         << ' ' << az << '\n';
-    return cl.str();
-  };
-  dir.write("beneath.cl", pass(3.0));
-  dir.write("gouge.cl", pass(2.9));
-  const auto clear = check(dir, "beneath.cl", "out")["surface"];
-  EXPECT_GT(clear["beneath_lines"].get<int>(), 1000) << clear;
-  EXPECT_EQ(clear["beneath_unmeasured_lines"].get<int>(), 0) << clear;
-  EXPECT_LT(clear["max_gouge_um"].get<double>(), 0.5) << clear;
-  EXPECT_EQ(clear["gouged_lines"].get<int>(), 0) << clear;
-  const auto gouge = check(dir, "gouge.cl", "out")["surface"];
-  EXPECT_NEAR(gouge["max_gouge_um"].get<double>(), 100.0, 1.0) << gouge;
+  dir.write("under.cl", passes(1, 0.0, 0.0, -0.1));
+  const auto s = check(dir, "under.cl", "out")["surface"];
+  EXPECT_NEAR(s["max_gouge_um"].get<double>(), 100.0, 1.0) << s;
+  EXPECT_EQ(s["beneath_lines"].get<int>(), 0) << s;
 }
 
 // Two runs of postures 20 mm apart with the axis at -60 and +60 deg about y: generate reads two

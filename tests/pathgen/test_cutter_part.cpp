@@ -113,6 +113,23 @@ TEST(CutterPart, ACutterWhollyInsideAClosedPartReadsItsRadius) {
   EXPECT_NEAR(r.max_depth_mm, 3.0, kDepthTolMm + 1e-4);
 }
 
+// A hollow block: its void's shell is wound inward, into the void. A cutter in the void touches
+// nothing and is inside no material (it read as buried, its radius: a helper's case); one in
+// the block's wall is inside.
+TEST(CutterPart, ACutterInAVoidOfAClosedPartIsClear) {
+  geometry::TriangleMesh hollow = boxMesh(-50, 50, -50, 50, -50, 50);
+  const geometry::TriangleMesh cavity = boxMesh(-20, 20, -20, 20, -20, 20);
+  const int base = static_cast<int>(hollow.vertices.size());
+  hollow.vertices.insert(hollow.vertices.end(), cavity.vertices.begin(), cavity.vertices.end());
+  for (const auto& t : cavity.triangles)  // wound the other way: facing into the void
+    hollow.triangles.emplace_back(base + t[0], base + t[2], base + t[1]);
+  EXPECT_FALSE(
+      checkCutterAgainstPart(ball(), hollow, std::vector<Posture>{upright(0, 0, -10)}).gouges());
+  const CutterPartResult wall =
+      checkCutterAgainstPart(ball(), hollow, std::vector<Posture>{upright(35, 0, -10)});
+  EXPECT_NEAR(wall.max_depth_mm, 3.0, kDepthTolMm + 1e-4);
+}
+
 // A closed box with a sliver of no area on its top edge (as an export closes a T-junction): FCL's
 // sphere-triangle test took its zero normal for "inside" and met a ball 0.54 mm clear of the
 // edge (841 um of false gouge: a reviewer's case). Such triangles are not in the tree.
@@ -141,6 +158,10 @@ TEST(CutterPart, ATorusFloorIsEnteredByItsHeightAboveTheTip) {
   EXPECT_NEAR(checkCutterAgainstPart(torus, boxMesh(-20, 20, -20, 20, -10, 0.1), at).max_depth_mm,
               0.1, kDepthTolMm);
   EXPECT_FALSE(checkCutterAgainstPart(torus, boxMesh(-20, 20, -20, 20, -10, 0.0), at).gouges());
+  // Plunged 2 mm, past its corner radius: shrunk by s > r the torus is a flat end whose bottom
+  // stands s over the tip (read R, 3 mm, while its bottom stayed at r).
+  EXPECT_NEAR(checkCutterAgainstPart(torus, boxMesh(-20, 20, -20, 20, -10, 2.0), at).max_depth_mm,
+              2.0, kDepthTolMm);
 }
 
 // A wall whose top (z 0.5) stands below the corner's top (z 1) is met by the ring alone (the

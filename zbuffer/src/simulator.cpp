@@ -149,6 +149,19 @@ void checkGridFits(const Grid& grid, std::size_t available_bytes) {
   }
 }
 
+namespace {
+
+/// A facet's |n_z| (the cosine of its slope), in double: a sliver's cross product loses floats.
+float facetCosSlope(const Vec3f& a, const Vec3f& b, const Vec3f& c) {
+  const double ux = double(b.x) - a.x, uy = double(b.y) - a.y, uz = double(b.z) - a.z;
+  const double vx = double(c.x) - a.x, vy = double(c.y) - a.y, vz = double(c.z) - a.z;
+  const double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+  const double length = std::sqrt(nx * nx + ny * ny + nz * nz);
+  return length > 0.0 ? static_cast<float>(std::abs(nz) / length) : 0.f;
+}
+
+}  // namespace
+
 std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
                            std::span<const std::array<std::uint32_t, 3>> triangles,
                            std::vector<float>* normal_z) {
@@ -160,14 +173,7 @@ std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
     if (t[0] >= vertices.size() || t[1] >= vertices.size() || t[2] >= vertices.size())
       throw InputError("part: triangle index out of range");
     const Vec3f a = vertices[t[0]], b = vertices[t[1]], c = vertices[t[2]];
-    float nz = 0.f;  // the facet's |n_z|, in double: a sliver's cross product loses floats
-    if (normal_z) {
-      const double ux = double(b.x) - a.x, uy = double(b.y) - a.y, uz = double(b.z) - a.z;
-      const double vx = double(c.x) - a.x, vy = double(c.y) - a.y, vz = double(c.z) - a.z;
-      const double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, n_z = ux * vy - uy * vx;
-      const double length = std::sqrt(nx * nx + ny * ny + n_z * n_z);
-      nz = length > 0.0 ? static_cast<float>(std::abs(n_z) / length) : 0.f;
-    }
+    const float nz = normal_z ? facetCosSlope(a, b, c) : 0.f;
     // Either way round: an open sheet wound downward (as CAD exports of surfaces often are)
     // is still the part's top; on a closed solid the highest crossing faces up anyway.
     for (const float sign : {1.f, -1.f})
@@ -192,50 +198,56 @@ std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
   return top;
 }
 
-PartLayers partLayers(const Grid& grid, std::span<const Vec3f> vertices,
-                      std::span<const std::array<std::uint32_t, 3>> triangles,
-                      const std::vector<float>& top_mm) {
+PartUnderCut partUnderCut(const Grid& grid, std::span<const Vec3f> vertices,
+                          std::span<const std::array<std::uint32_t, 3>> triangles,
+                          const std::vector<float>& top_mm, const std::vector<float>& cut_mm,
+                          std::span<const std::uint8_t> open) {
   const GridView g = detail::makeGridView(grid);
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  PartLayers out;
-  out.underside_mm.assign(grid.lineCount(), nan);
-  out.next_top_mm.assign(grid.lineCount(), nan);
-  out.next_normal_z.assign(grid.lineCount(), nan);
+  PartUnderCut out;
+  out.surface_mm.assign(grid.lineCount(), nan);
+  out.normal_z.assign(grid.lineCount(), nan);
+  out.beneath.assign(grid.lineCount(), 0);
   // Two crossings closer than this are one surface (facets meeting on a line interpolate its
   // height a few ulps apart; a layer thinner than 0.1 um is no layer).
-  const auto below = [](float z, float above) {
-    return z < above - std::max(1e-4f, 4.f * FLT_EPSILON * std::abs(above));
-  };
-  // The up-facing triangles rasterise with sign +1, the down-facing with −1 (rasterTriangle
-  // keeps those whose projection turns the sign's way).
-  const auto each = [&](float sign, auto&& visit) {
-    for (const auto& t : triangles) {
+  const auto tie = [](float z) { return std::max(1e-4f, 4.f * FLT_EPSILON * std::abs(z)); };
+  // A closed shell's facets face out: up-facing ones rasterise with sign +1 (a layer's top),
+  // down-facing ones with −1 (an underside); rasterTriangle keeps those whose projection turns
+  // the sign's way. An open sheet's winding says nothing: both, a layer of no thickness.
+  const auto each = [&](auto&& visit) {
+    for (std::size_t k = 0; k < triangles.size(); ++k) {
+      const auto& t = triangles[k];
       const Vec3f a = vertices[t[0]], b = vertices[t[1]], c = vertices[t[2]];
-      const double ux = double(b.x) - a.x, uy = double(b.y) - a.y, uz = double(b.z) - a.z;
-      const double vx = double(c.x) - a.x, vy = double(c.y) - a.y, vz = double(c.z) - a.z;
-      const double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
-      const double length = std::sqrt(nx * nx + ny * ny + nz * nz);
-      const float cos_slope = length > 0.0 ? static_cast<float>(std::abs(nz) / length) : 0.f;
-      rasterTriangle(g, a, b, c, sign, [&](int ix, int iy, float z) {
-        visit(std::size_t(iy) * grid.nx + ix, z, cos_slope);
-      });
+      const float cos_slope = facetCosSlope(a, b, c);
+      const bool sheet = k < open.size() && open[k];
+      for (const float sign : {1.f, -1.f})
+        rasterTriangle(g, a, b, c, sign, [&](int ix, int iy, float z) {
+          visit(std::size_t(iy) * grid.nx + ix, z, sheet || sign > 0, sheet || sign < 0, cos_slope);
+        });
     }
   };
-  each(-1.f, [&](std::size_t i, float z, float) {
-    float& u = out.underside_mm[i];
-    if (below(z, top_mm[i]) && !(z <= u)) u = z;
+  // The lowest underside above the line's cut: the tool's lowest point is beneath it.
+  std::vector<float> roof(grid.lineCount(), HUGE_VALF);
+  each([&](std::size_t i, float z, bool, bool underside, float) {
+    if (underside && z > cut_mm[i] + tie(cut_mm[i])) roof[i] = std::min(roof[i], z);
   });
-  each(+1.f, [&](std::size_t i, float z, float cos_slope) {
-    const float u = out.underside_mm[i];
-    float& n = out.next_top_mm[i];
-    if (std::isnan(u) || !below(z, u)) return;
-    if (std::isnan(n) || z > n) {
-      n = z;
-      out.next_normal_z[i] = cos_slope;
-    } else if (z == n) {
-      out.next_normal_z[i] = std::max(out.next_normal_z[i], cos_slope);
+  // The surface measured: the highest top under that roof (the top itself without one).
+  each([&](std::size_t i, float z, bool top, bool, float cos_slope) {
+    if (!top || !(z < roof[i] - tie(roof[i]))) return;
+    float& s = out.surface_mm[i];
+    if (std::isnan(s) || z > s) {
+      s = z;
+      out.normal_z[i] = cos_slope;
+    } else if (z == s) {
+      out.normal_z[i] = std::max(out.normal_z[i], cos_slope);
     }
   });
+  for (std::size_t i = 0; i < roof.size(); ++i) {
+    if (std::isnan(top_mm[i]) || roof[i] == HUGE_VALF) continue;  // off the part; under no roof
+    // Nothing under a roof that is the top itself: a lone sheet, which the cut went through.
+    if (std::isnan(out.surface_mm[i]) && roof[i] >= top_mm[i] - tie(top_mm[i])) continue;
+    out.beneath[i] = 1;
+  }
   return out;
 }
 

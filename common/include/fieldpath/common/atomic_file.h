@@ -135,7 +135,8 @@ inline void removeTemporariesNow() noexcept {
 inline void removeClaimedOutputsNow() noexcept {
   for (auto& slot : detail::claimed_slots) {
     struct stat info {};
-    if (slot.state.load() == 2 && ::lstat(slot.path, &info) == 0 && S_ISREG(info.st_mode))
+    if (slot.state.load() == 2 && ::lstat(slot.path, &info) == 0 && S_ISREG(info.st_mode) &&
+        !isInputNow(slot.path))
       ::unlink(slot.path);
   }
 }
@@ -159,8 +160,13 @@ inline void installTemporaryCleanupOnSignals() {
   action.sa_handler = detail::removeTemporariesAndDie;
   sigemptyset(&action.sa_mask);
   action.sa_flags = SA_RESETHAND;
-  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE})
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE}) {
+    // A signal the run was started ignoring stays ignored (`nohup`, a shell's background job:
+    // a HUP then killed the run and took its outputs).
+    struct sigaction before {};
+    if (sigaction(signal_number, nullptr, &before) == 0 && before.sa_handler == SIG_IGN) continue;
     sigaction(signal_number, &action, nullptr);
+  }
   ::signal(SIGXFSZ, SIG_IGN);
 }
 
@@ -377,7 +383,8 @@ inline void removeStaleOutputs(const std::filesystem::path& dir,
   for (const char* name : names) {
     std::error_code ec;  // regular files only: a FIFO or a link the user put there stays
     if (std::filesystem::symlink_status(dir / name, ec).type() !=
-        std::filesystem::file_type::regular)
+            std::filesystem::file_type::regular ||
+        !inputAt(dir / name).empty())  // nor an input (`simulate --part out/surface.stl`)
       continue;
     std::filesystem::remove(dir / name, ec);
     if (ec && ec != std::errc::no_such_file_or_directory)

@@ -3,8 +3,11 @@
 /// a FIFO (which would block the reader) or a device (/dev/zero: endless) is refused with what it
 /// is, a missing file as missing, an unreadable one as unreadable. The files that pass are this
 /// run's inputs: the writers refuse to write over them (writeFileAtomically).
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -20,7 +23,27 @@ namespace detail {
 inline std::mutex inputs_mutex;
 inline std::vector<std::filesystem::path> input_files;
 inline bool guard_inputs = false;
+/// The inputs' (device, inode), lock-free, for a signal handler (isInputNow).
+struct InputId {
+  std::atomic<unsigned long long> device{0}, inode{0};
+};
+inline constexpr int kInputIds = 64;
+inline InputId input_ids[kInputIds];
+inline std::atomic<int> input_id_count{0};
 }  // namespace detail
+
+/// Whether `path` is one of this run's inputs (stat and lock-free atomics: async-signal-safe, for
+/// the handler that removes a run's claimed outputs; an input is never one of them).
+inline bool isInputNow(const char* path) noexcept {
+  struct stat info {};
+  if (::stat(path, &info) != 0) return false;
+  const int n = std::min(detail::input_id_count.load(), detail::kInputIds);
+  for (int i = 0; i < n; ++i)
+    if (detail::input_ids[i].device.load() == static_cast<unsigned long long>(info.st_dev) &&
+        detail::input_ids[i].inode.load() == static_cast<unsigned long long>(info.st_ino))
+      return true;
+  return false;
+}
 
 /// The CLI's main() turns it on: one process is one run, and what it reads it must not write
 /// over. A library caller (the tests: write, read back, write again) is a run of many.
@@ -50,7 +73,17 @@ inline void requireRegularFile(const std::filesystem::path& file, const std::str
     if (::access(file.c_str(), R_OK) != 0)
       throw InputError(file.string() + ": cannot read the " + what + ": " + std::strerror(errno));
     const std::lock_guard<std::mutex> lock(detail::inputs_mutex);
-    if (detail::guard_inputs) detail::input_files.push_back(file);
+    if (!detail::guard_inputs) return;
+    detail::input_files.push_back(file);
+    struct stat info {};
+    if (::stat(file.c_str(), &info) == 0) {
+      const int i = detail::input_id_count.load();
+      if (i < detail::kInputIds) {
+        detail::input_ids[i].device.store(static_cast<unsigned long long>(info.st_dev));
+        detail::input_ids[i].inode.store(static_cast<unsigned long long>(info.st_ino));
+        detail::input_id_count.store(i + 1);
+      }
+    }
     return;
   }
   if (std::filesystem::is_directory(status))

@@ -8,8 +8,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include <sys/resource.h>
 #include <unistd.h>
@@ -54,24 +56,35 @@ inline std::size_t availableMemoryBytes() {
 /// Sets the limit (`--max-memory`); 0 restores the default (the available memory).
 inline void setMemoryLimitBytes(std::size_t bytes) { detail::memory_limit_bytes = bytes; }
 
-/// What the process may still map under its own limits (`ulimit -v`, `ulimit -d`), bytes: the
-/// limit less the address space it holds now (/proc/self/statm); unlimited: SIZE_MAX. Under a
-/// `ulimit -v` of 200 MB the machine's free memory let FCL's tree allocation fail (and crash).
+/// What the process may still take under its own limits, bytes: `ulimit -v` (RLIMIT_AS) less the
+/// address space it holds (VmSize), `ulimit -d` (RLIMIT_DATA) less its data (VmData: the kernel
+/// counts that one against it, not the reservations of libraries); SIZE_MAX when neither is set.
+/// Under a `ulimit -v` of 200 MB the machine's free memory let FCL's tree allocation fail (and
+/// crash).
 inline std::size_t processHeadroomBytes() {
-  rlim_t limit = RLIM_INFINITY;
-  for (const int resource : {RLIMIT_AS, RLIMIT_DATA}) {
+  double headroom = HUGE_VAL;
+  const auto held = [](const char* key) {  // kB of /proc/self/status, as bytes
+    double bytes = 0.0;
+    if (std::FILE* f = std::fopen("/proc/self/status", "r")) {
+      char line[256];
+      unsigned long long kib = 0;
+      const std::size_t n = std::strlen(key);
+      while (std::fgets(line, sizeof line, f))
+        if (std::strncmp(line, key, n) == 0 && std::sscanf(line + n, " %llu", &kib) == 1) {
+          bytes = 1024.0 * double(kib);
+          break;
+        }
+      std::fclose(f);
+    }
+    return bytes;
+  };
+  for (const auto& [resource, key] : {std::pair{RLIMIT_AS, "VmSize:"}, {RLIMIT_DATA, "VmData:"}}) {
     rlimit r{};
     if (getrlimit(resource, &r) == 0 && r.rlim_cur != RLIM_INFINITY)
-      limit = std::min(limit, r.rlim_cur);
+      headroom = std::min(headroom, double(r.rlim_cur) - held(key));
   }
-  if (limit == RLIM_INFINITY) return SIZE_MAX;
-  unsigned long long pages = 0;
-  if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
-    if (std::fscanf(f, "%llu", &pages) != 1) pages = 0;
-    std::fclose(f);
-  }
-  const double held = double(pages) * double(sysconf(_SC_PAGE_SIZE));
-  return double(limit) > held ? static_cast<std::size_t>(double(limit) - held) : 0;
+  if (headroom == HUGE_VAL) return SIZE_MAX;
+  return headroom > 0.0 ? static_cast<std::size_t>(headroom) : 0;
 }
 
 /// The limit in force, bytes: `--max-memory`, or the available memory; never past what the
@@ -104,9 +117,10 @@ inline void requireMemory(const std::string& what, double estimate_bytes,
                           const std::string& detail = {}) {
   const double limit = static_cast<double>(memoryLimitBytes());
   if (estimate_bytes <= limit) return;
+  const bool ulimit = static_cast<double>(processHeadroomBytes()) <= limit;
   throw InputError(what + ": needs about " + formatBytes(estimate_bytes) + " of memory" +
                    (detail.empty() ? "" : " (" + detail + ")") + ", limit " + formatBytes(limit) +
-                   " (--max-memory)");
+                   (ulimit ? " (what the process's ulimit -v / -d leaves it)" : " (--max-memory)"));
 }
 
 /// Parses a `--max-memory` value: a number of MiB, or a number with a K, M, G or T suffix (binary

@@ -3,6 +3,7 @@
 /// spindle, and the rigid transform that places a tool-frame object (tip at origin, axis +z) at a
 /// posture.
 #include <cmath>
+#include <cstddef>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -57,6 +58,22 @@ inline double axisAngle(const Vec3& a, const Vec3& b) { return std::atan2(a.cros
 /// |Δtip| + reach · Δθ.
 inline double motionSweepMm(const Posture& a, const Posture& b, double reach_mm) {
   return (b.tip_mm - a.tip_mm).norm() + reach_mm * axisAngle(a.axis, b.axis);
+}
+
+/// The equal steps of the motion a → b in which no point within `reach_mm` of the tip moves more
+/// than `step_mm` (0 for no motion), as a double: a count estimated before the poses are made.
+inline double motionSteps(const Posture& a, const Posture& b, double reach_mm, double step_mm) {
+  return std::ceil(motionSweepMm(a, b, reach_mm) / step_mm);
+}
+
+/// Calls `visit(pose)` for the poses strictly inside the motion a → b, one step of motionSteps
+/// apart, in order: the stamps every sweeping check cuts or tests between two postures.
+template <class Visit>
+void forEachPoseBetween(const Posture& a, const Posture& b, double reach_mm, double step_mm,
+                        Visit&& visit) {
+  const auto steps = static_cast<std::size_t>(motionSteps(a, b, reach_mm, step_mm));
+  for (std::size_t k = 1; k < steps; ++k)
+    visit(alongMotion(a, b, static_cast<double>(k) / static_cast<double>(steps)));
 }
 
 /// The same pose: tips within 1e-9 mm, axes within 1e-12 (a posture written twice).

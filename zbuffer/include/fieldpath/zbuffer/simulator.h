@@ -176,19 +176,25 @@ std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
                            std::span<const std::array<std::uint32_t, 3>> triangles,
                            std::vector<float>* normal_z = nullptr);
 
-/// Under each line's top (partTop): where the part overhangs, the line meets it again below.
-/// For a part wound outward (a closed solid, as read), per line: `underside_mm`, the highest
-/// down-facing crossing below the top (the underside of the layer the top belongs to: an
-/// overhang's, or the part's bottom); `next_top_mm`, the highest up-facing crossing below that
-/// (the top of the material under the overhang) and `next_normal_z` its facet's |n_z|. NaN
-/// where there is none. A tool whose cut in a line reaches under `underside_mm` passed beneath
-/// the layer (or through it): the line's lowest tool point says nothing of the layer's surface.
-struct PartLayers {
-  std::vector<float> underside_mm, next_top_mm, next_normal_z;
+/// The part's surface a line's cut is measured against, where the tool passed beneath an
+/// overhang. A Z-buffer line keeps the tool's lowest point only (`cut_mm`): under an overhang that
+/// point is in the air beneath it, and against the part's top it read as a cut through the
+/// overhang (14.5 mm of gouge for a clear tool). Per line: `beneath` 1 where an underside of the
+/// part lies above the cut (a closed shell's down-facing crossing, its shells wound outward as
+/// read; or an open sheet's crossing, `open[k]` for its triangles: a surface of no thickness,
+/// either winding), and then `surface_mm`, the highest top (up-facing or sheet crossing) under
+/// the lowest such underside, with its facet's |n_z| in `normal_z`; NaN where there is none (a
+/// closed overhang with nothing under it, or a cut through the part's bottom: the cutter's exact
+/// test tells those). Under a lone sheet (nothing under it) a cut went through the sheet:
+/// `beneath` 0, measured against the top as any line.
+struct PartUnderCut {
+  std::vector<float> surface_mm, normal_z;
+  std::vector<std::uint8_t> beneath;
 };
-PartLayers partLayers(const Grid& grid, std::span<const Vec3f> vertices,
-                      std::span<const std::array<std::uint32_t, 3>> triangles,
-                      const std::vector<float>& top_mm);
+PartUnderCut partUnderCut(const Grid& grid, std::span<const Vec3f> vertices,
+                          std::span<const std::array<std::uint32_t, 3>> triangles,
+                          const std::vector<float>& top_mm, const std::vector<float>& cut_mm,
+                          std::span<const std::uint8_t> open);
 
 /// Stock as the top of a part mesh (world frame, mm): the highest up-facing point on each line;
 /// lines that miss the part start at its lowest z.
