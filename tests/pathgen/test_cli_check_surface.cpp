@@ -252,6 +252,21 @@ TEST(CheckSurface, ACutBelowALoneSheetIsAGouge) {
   EXPECT_EQ(s["beneath_lines"].get<int>(), 0) << s;
 }
 
+// A box exported with a facet missing is an open shell: a tool buried in it reads its depth under
+// the top. An open shell's crossing is a top only where it faces up (read as a sheet either way,
+// the box's bottom was taken for a top under the tool: ok, a helper's case).
+TEST(CheckSurface, AToolBuriedInABoxWithAFacetMissingIsAGouge) {
+  const TempDir dir;
+  geometry::TriangleMesh part;
+  pathgen::test::addBox(part, -10, 30, -15, 15, -5, 0);
+  part.triangles.erase(part.triangles.begin());  // one triangle of the x = -10 side
+  writeSceneOfPart(dir, part);
+  dir.write("buried.cl", passes(1, 0.0, 0.0, -3.0));
+  const auto s = check(dir, "buried.cl", "out")["surface"];
+  EXPECT_NEAR(s["max_gouge_um"].get<double>(), 3000.0, 30.0) << s;
+  EXPECT_EQ(s["beneath_lines"].get<int>(), 0) << s;
+}
+
 // Two runs of postures 20 mm apart with the axis at -60 and +60 deg about y: generate reads two
 // passes (split at the gap) and takes it; check refused the 120 deg turn as within a pass. A
 // flip within one run is still refused, naming its line.

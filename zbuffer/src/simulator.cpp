@@ -222,7 +222,7 @@ PartUnderCut partUnderCut(const Grid& grid, std::span<const Vec3f> vertices,
       const bool sheet = k < open.size() && open[k];
       for (const float sign : {1.f, -1.f})
         rasterTriangle(g, a, b, c, sign, [&](int ix, int iy, float z) {
-          visit(std::size_t(iy) * grid.nx + ix, z, sheet || sign > 0, sheet || sign < 0, cos_slope);
+          visit(std::size_t(iy) * grid.nx + ix, z, sign > 0, sheet || sign < 0, cos_slope);
         });
     }
   };

@@ -180,13 +180,13 @@ std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
 /// overhang. A Z-buffer line keeps the tool's lowest point only (`cut_mm`): under an overhang that
 /// point is in the air beneath it, and against the part's top it read as a cut through the
 /// overhang (14.5 mm of gouge for a clear tool). Per line: `beneath` 1 where an underside of the
-/// part lies above the cut (a closed shell's down-facing crossing, its shells wound outward as
-/// read; or an open sheet's crossing, `open[k]` for its triangles: a surface of no thickness,
-/// either winding), and then `surface_mm`, the highest top (up-facing or sheet crossing) under
-/// the lowest such underside, with its facet's |n_z| in `normal_z`; NaN where there is none (a
-/// closed overhang with nothing under it, or a cut through the part's bottom: the cutter's exact
-/// test tells those). Under a lone sheet (nothing under it) a cut went through the sheet:
-/// `beneath` 0, measured against the top as any line.
+/// part lies above the cut (a down-facing crossing, shells wound outward as read; or any crossing
+/// of an open sheet, `open[k]` for its triangles: a surface of no thickness, either winding), and
+/// then `surface_mm`, the highest top (an up-facing crossing) under the lowest such underside, with
+/// its facet's |n_z| in `normal_z`; NaN where there is none (a closed overhang with nothing under
+/// it, or a cut through the part's bottom: the cutter's exact test tells those). Under a lone sheet
+/// (nothing under it) a cut went through the sheet: `beneath` 0, measured against the top as any
+/// line.
 struct PartUnderCut {
   std::vector<float> surface_mm, normal_z;
   std::vector<std::uint8_t> beneath;
