@@ -26,7 +26,8 @@ bool owns(double w, const Vec2& u, const Vec2& v) { return w > 0.0 || (w == 0.0 
 
 ClosedShells::ClosedShells(const geometry::TriangleMesh& mesh)
     : vertices_(mesh.vertices), triangles_(mesh.triangles) {
-  for (const std::vector<int>& shell_triangles : geometry::closedShells(mesh)) {
+  const std::vector<std::vector<int>> shell_list = geometry::closedShells(mesh);
+  for (const std::vector<int>& shell_triangles : shell_list) {
     Shell shell;
     for (int t : shell_triangles)
       for (int e = 0; e < 3; ++e) shell.box.extend(vertices_[triangles_[t][e]]);
@@ -49,11 +50,15 @@ ClosedShells::ClosedShells(const geometry::TriangleMesh& mesh)
         for (int iy = cellY(tb.min().y()); iy <= cellY(tb.max().y()); ++iy)
           shell.cells[static_cast<std::size_t>(ix) * n + iy].push_back(t);
     }
-    // The signed volume (divergence theorem): a cavity's shell, wound into the void, is < 0.
+    // The signed volume (divergence theorem, about a vertex of the shell: far from the origin
+    // the products cancel): a cavity's shell, wound into the void, is < 0.
+    const Eigen::Vector3d origin = vertices_[triangles_[shell_triangles.front()][0]];
     for (int t : shell_triangles) {
-      const Eigen::Vector3d& a = vertices_[triangles_[t][0]];
+      const Eigen::Vector3d a = vertices_[triangles_[t][0]] - origin;
       shell.volume_mm3 +=
-          a.dot(vertices_[triangles_[t][1]].cross(vertices_[triangles_[t][2]])) / 6.0;
+          a.dot(
+              (vertices_[triangles_[t][1]] - origin).cross(vertices_[triangles_[t][2]] - origin)) /
+          6.0;
     }
     anchors_.push_back(vertices_[triangles_[shell_triangles.front()][0]]);
     shells_.push_back(std::move(shell));
@@ -61,11 +66,18 @@ ClosedShells::ClosedShells(const geometry::TriangleMesh& mesh)
   // A shell wound inward inside another one is a void of it: its inside is not the part's (a
   // tool in a 200 mm box's void read as buried, "2999.9 um"). Wound inward and inside none, it is
   // a solid exported inside out, its inside the part's all the same.
+  // Wholly inside: every vertex (one inside, the rest out, is a body overlapping it, wound
+  // inward: a reviewer's case).
   for (std::size_t i = 0; i < shells_.size(); ++i) {
     if (shells_[i].volume_mm3 >= 0.0) continue;
-    for (std::size_t j = 0; j < shells_.size() && shells_[i].sign > 0; ++j)
-      if (j != i && shells_[j].volume_mm3 > 0.0 && crossings(shells_[j], anchors_[i]) % 2 == 1)
-        shells_[i].sign = -1;
+    for (std::size_t j = 0; j < shells_.size() && shells_[i].sign > 0; ++j) {
+      if (j == i || !(shells_[j].volume_mm3 > 0.0)) continue;
+      bool inside = true;
+      for (std::size_t k = 0; inside && k < shell_list[i].size(); ++k)
+        for (int e = 0; inside && e < 3; ++e)
+          inside = crossings(shells_[j], vertices_[triangles_[shell_list[i][k]][e]]) % 2 == 1;
+      if (inside) shells_[i].sign = -1;
+    }
   }
 }
 

@@ -128,6 +128,17 @@ TEST(CutterPart, ACutterInAVoidOfAClosedPartIsClear) {
   const CutterPartResult wall =
       checkCutterAgainstPart(ball(), hollow, std::vector<Posture>{upright(35, 0, -10)});
   EXPECT_NEAR(wall.max_depth_mm, 3.0, kDepthTolMm + 1e-4);
+  // A body wound inward that only overlaps the block (one corner inside it) is no void of it: a
+  // cutter inside both is inside the part (one vertex decided it: a reviewer's case).
+  geometry::TriangleMesh overlap = boxMesh(-50, 50, -50, 50, -50, 50);
+  const geometry::TriangleMesh other = boxMesh(40, 80, -30, 30, -30, 30);
+  const int at = static_cast<int>(overlap.vertices.size());
+  overlap.vertices.insert(overlap.vertices.end(), other.vertices.begin(), other.vertices.end());
+  for (const auto& t : other.triangles)
+    overlap.triangles.emplace_back(at + t[0], at + t[2], at + t[1]);
+  EXPECT_NEAR(checkCutterAgainstPart(ball(), overlap, std::vector<Posture>{upright(45, 0, -10)})
+                  .max_depth_mm,
+              3.0, kDepthTolMm + 1e-4);
 }
 
 // A closed box with a sliver of no area on its top edge (as an export closes a T-junction): FCL's
