@@ -100,8 +100,9 @@ json surfaceJson(const SurfaceResult& s) {
       {"beneath",
        "lines the tool reached beneath the underside of the part's top layer (under an "
        "overhang, or through the part): a line keeps the tool's lowest point only, which says "
-       "nothing of that layer there; they are measured against the part's next top below "
-       "(beneath_unmeasured_lines: none, not measured); the layer's underside is the cutter "
+       "nothing of that layer there; they are measured against the highest top of the part under "
+       "the lowest underside above the cut (beneath_unmeasured_lines: none, not measured); the "
+       "layer's underside is the cutter "
        "test's (cutter_part, exact)"},
       {"part_lines", s.part_lines},
       {"band_lines", s.band_lines},
@@ -289,7 +290,13 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"limits",
          {{"limited_postures", path.limited.size()},
           {"limited_colliding", limited_colliding},
-          {"first_limited", path.limited.empty() ? json(nullptr) : json(path.limited.front())}}},
+          // An object, as generate's report.json `limits.first_limited` is (was a bare number).
+          {"first_limited", path.limited.empty()
+                                ? json(nullptr)
+                                : json({{"posture", path.limited.front()},
+                                        {"at", path.limited.front() < path.lines.size()
+                                                   ? json(path.where(path.limited.front()))
+                                                   : json(nullptr)}})}}},
         {"surface", surface ? surfaceJson(*surface) : json(nullptr)},
         {"surface_skipped", surface_skipped ? json(surface_skipped) : json(nullptr)},
         {"ok", not_ok.empty()},

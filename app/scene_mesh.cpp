@@ -46,11 +46,12 @@ geometry::TriangleMesh loadSceneMesh(const std::filesystem::path& file) {
     throw common::InputError(file.string() +
                              ": every triangle has zero area: the mesh has no surface");
   mendExportDefects(mesh, file);
-  // Inward-wound shells would make the field pull into the walls (the samples' normals) and the
-  // part's top its bottom: turned, and said.
+  // Shells wound against their kind would make the field pull into the walls (the samples'
+  // normals) and the part's top its bottom: turned, and said.
   if (const std::size_t turned = geometry::orientClosedShells(mesh))
     std::fprintf(stderr,
-                 "note: %s: %zu closed shell%s wound inward (normals flipped), turned outward\n",
+                 "note: %s: %zu closed shell%s wound the wrong way round (normals into a solid "
+                 "or out of a void), turned\n",
                  file.string().c_str(), turned, turned == 1 ? "" : "s");
   // Mesh files are read in single precision (binary STL stores floats; assimp reads every format
   // so): far from the origin their points move by half a float's step, which check then reads

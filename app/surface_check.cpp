@@ -481,12 +481,18 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   // which read 14.5 mm of gouge for a clear tool; the overhang's underside is the cutter's exact
   // test's). A line with nothing under the layer is not measured.
   std::vector<float> reference = nominal, reference_nz = facet_nz;
-  std::vector<std::uint8_t> open(part_local.triangles.size(), 0);
-  for (const std::vector<int>& shell : geometry::openShells(part_local))
-    for (const int k : shell) open[static_cast<std::size_t>(k)] = 1;
-  const zbuffer::PartUnderCut under = zbuffer::partUnderCut(
-      sim.grid, part_mesh.vertices, part_mesh.triangles, nominal, simulated.heights_mm, open);
-  for (std::size_t i = 0; i < nominal.size(); ++i)
+  zbuffer::PartUnderCut under;
+  // Only a line cut under its top by more than the tolerance can be beneath a layer (none on a
+  // clean path: the four rasterisations and the shells are skipped).
+  const float layer_mm = static_cast<float>(tol_mm);
+  if (zbuffer::anyCutUnderTop(nominal, simulated.heights_mm, layer_mm)) {
+    std::vector<std::uint8_t> open(part_local.triangles.size(), 0);
+    for (const std::vector<int>& shell : geometry::openShells(part_local))
+      for (const int k : shell) open[static_cast<std::size_t>(k)] = 1;
+    under = zbuffer::partUnderCut(sim.grid, part_mesh.vertices, part_mesh.triangles, nominal,
+                                  simulated.heights_mm, open, layer_mm);
+  }
+  for (std::size_t i = 0; i < under.beneath.size(); ++i)
     if (under.beneath[i]) {
       ++result.beneath_lines;
       result.beneath_unmeasured += std::isnan(under.surface_mm[i]);

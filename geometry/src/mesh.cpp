@@ -1,5 +1,7 @@
 #include "fieldpath/geometry/mesh.h"
 
+#include "fieldpath/geometry/closed_shells.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -188,27 +190,13 @@ std::vector<std::vector<int>> openShells(const TriangleMesh& mesh) {
 }
 
 std::size_t orientClosedShells(TriangleMesh& mesh) {
-  const std::vector<std::vector<int>> shells = closedShells(mesh);
-  std::vector<double> volume(shells.size(), 0.0);
-  std::vector<Eigen::AlignedBox3d> box(shells.size());
-  for (std::size_t s = 0; s < shells.size(); ++s)
-    for (int i : shells[s]) {
-      const auto& t = mesh.triangles[i];
-      const auto& a = mesh.vertices[t[0]];
-      volume[s] += a.dot(mesh.vertices[t[1]].cross(mesh.vertices[t[2]])) / 6.0;
-      for (int e = 0; e < 3; ++e) box[s].extend(mesh.vertices[t[e]]);
-    }
-  // A shell inside another one's box may be a cavity, rightly wound inward: left alone.
-  const auto inAnother = [&](std::size_t s) {
-    for (std::size_t o = 0; o < shells.size(); ++o)
-      if (o != s && box[o].contains(box[s])) return true;
-    return false;
-  };
+  const ClosedShells shells(mesh);
   std::size_t turned = 0;
   for (std::size_t s = 0; s < shells.size(); ++s) {
-    if (!(volume[s] < 0.0) || inAnother(s)) continue;
+    // A solid's shell faces out of it, a void's into the void (out of the solid around it).
+    if ((shells.volumeMm3(s) < 0.0) == (shells.sign(s) < 0)) continue;
     ++turned;
-    for (int i : shells[s]) std::swap(mesh.triangles[i][1], mesh.triangles[i][2]);
+    for (int i : shells.triangles(s)) std::swap(mesh.triangles[i][1], mesh.triangles[i][2]);
   }
   return turned;
 }

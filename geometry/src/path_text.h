@@ -154,11 +154,25 @@ inline std::string_view trimmed(std::string_view text) {
   return text;
 }
 
-/// Shortest decimal form that reads back as the same double.
+/// Below this magnitude a path number is written 0: far under any machine's resolution (mm, or an
+/// axis component), and its fixed form would run past an APT card.
+inline constexpr double kPathZero = 1e-12;
+
+/// The shortest decimal form that reads back as the same double, without an exponent: many APT
+/// and CL post-processors and controllers refuse "4.8e-05" (an axis component of the impeller's
+/// path was written so). Magnitudes under kPathZero are written 0 (or -0); past 1e32, where no
+/// path goes (scene coordinates stop at 1e6 mm), with an exponent.
 inline void appendNumber(std::string& out, double value) {
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-  out.append(buffer, result.ptr);
+  char buffer[64];
+  const auto fixed = std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed);
+  if (fixed.ec == std::errc() && fixed.ptr - buffer <= 32) {
+    out.append(buffer, fixed.ptr);
+  } else if (std::abs(value) < kPathZero) {
+    out.append(std::signbit(value) ? "-0" : "0");
+  } else {
+    const auto general = std::to_chars(buffer, buffer + sizeof buffer, value);
+    out.append(buffer, general.ptr);
+  }
 }
 
 /// A path file's text as the readers take it: without a UTF-8 byte-order mark at its start

@@ -12,7 +12,7 @@
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <Eigen/Core>
 
-#include "closed_shells.h"
+#include "fieldpath/geometry/closed_shells.h"
 #include "fieldpath/geometry/mesh.h"
 
 namespace fieldpath::pathgen {
@@ -26,7 +26,7 @@ std::shared_ptr<BvhModel> buildBvhModel(const geometry::TriangleMesh& mesh,
 struct ObstacleModel {
   ObstacleModel(const geometry::TriangleMesh& mesh, const std::string& what);
   std::shared_ptr<BvhModel> tree;
-  ClosedShells solids;
+  geometry::ClosedShells solids;
   /// A vertex of each open shell, sorted by x.
   std::vector<Eigen::Vector3d> sheet_anchors;
   Eigen::AlignedBox3d box;  ///< of the vertices

@@ -184,6 +184,9 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
       {"obstacles:\n  - mesh: wall.stl\npath: { nominal: none.cl }\n", "path.nominal", 3},
       {"obstacles:\n  - mesh: wall.stl\ndynamics: { on_limit: stop }\n", "dynamics.on_limit", 3},
       {"obstacles:\n  - mesh: wall.stl\nlinks: { retract: -1 }\n", "links.retract", 3},
+      // 0: each link's last rapid move ended on the part, at the pass's first posture.
+      {"obstacles:\n  - mesh: wall.stl\nlinks: { retract: 0 }\n",
+       "links.retract: must be a distance in (0", 3},
       {"obstacles:\n  - mesh: wall.stl\nlinks: { safe_z: high }\n", "links.safe_z", 3},
       {"obstacles:\n  - mesh: wall.stl\nfield: { r0: [5\n", "YAML syntax", 0},
       // A key given twice (YAML keeps one of them without a word), at the top and inside.

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <limits>
 #include <random>
+#include <regex>
 
 #include <gtest/gtest.h>
 
@@ -53,6 +54,25 @@ std::vector<Posture> randomPostures(std::size_t n, bool spindle) {
   return out;
 }
 
+/// The postures as a path file holds them: magnitudes under 1e-12 (mm, axis components) are 0.
+std::vector<Posture> writtenAs(std::vector<Posture> postures) {
+  const auto zeroTiny = [](double& v) {
+    if (std::abs(v) < 1e-12) v = std::signbit(v) ? -0.0 : 0.0;
+  };
+  for (Posture& p : postures)
+    for (int c = 0; c < 3; ++c) zeroTiny(p.tip_mm[c]), zeroTiny(p.axis[c]);
+  return postures;
+}
+
+/// No number of the file in exponent form ("4.8e-05"): post-processors refuse it.
+void expectNoExponent(const fs::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  const std::regex exponent("[0-9.][eE][-+]?[0-9]");
+  while (std::getline(in, line))
+    EXPECT_FALSE(std::regex_search(line, exponent)) << file << ": " << line;
+}
+
 /// Expects readClFile to throw an InputError naming `file:line:` and containing `what`.
 void expectClError(const std::string& text, int line, const std::string& what) {
   const fs::path p = writeBytes("bad.cl", text);
@@ -86,7 +106,8 @@ TEST(ClFile, RoundTripsExactly) {
     const auto postures = randomPostures(1000, spindle);
     const fs::path p = tempPath("rt.cl");
     writeClFile(p, postures, "fieldpath test\nsecond line");
-    expectSame(readClFile(p), postures);
+    expectSame(readClFile(p), writtenAs(postures));
+    expectNoExponent(p);
     EXPECT_FALSE(fs::exists(p.string() + ".tmp"));
   }
 }
@@ -201,8 +222,8 @@ TEST(AptFile, WritesHeaderAndParsesBackExactly) {
 
   auto back = readAptFile(p);
   for (auto& b : back) b.has_spindle = false;
-  auto expected = postures;
-  expectSame(back, expected);
+  expectSame(back, writtenAs(postures));
+  expectNoExponent(p);
 }
 
 TEST(AptFile, ReadsContinuationAndRejectsBadGoto) {

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "fieldpath/geometry/closed_shells.h"
 #include "fieldpath/geometry/mesh.h"
 
 using namespace fieldpath::geometry;
@@ -122,6 +123,75 @@ TEST(Mesh, OrientClosedShellsTurnsInwardShellsOnly) {
   const TriangleMesh before = open;
   EXPECT_EQ(orientClosedShells(open), 0u);
   EXPECT_EQ(open.triangles, before.triangles);
+}
+
+// The kinds of nested shells, read the same whichever way the whole mesh is wound: a 10 mm block
+// [0,10]³ with a 6 mm void [2,8]³ holding a 2 mm island [4,6]³, each point's inside known by
+// construction. Flipped whole (outer inward, void outward, island inward), the void read as a
+// solid: a tool in it "999.9 um" deep (a helper's case).
+TEST(Mesh, NestedShellsKeepTheirKindsWhenTheWholeMeshIsFlipped) {
+  TriangleMesh nested;
+  appendShell(nested, unitCube(), 10.0, Eigen::Vector3d(0, 0, 0), false);
+  appendShell(nested, unitCube(), 6.0, Eigen::Vector3d(2, 2, 2), true);
+  appendShell(nested, unitCube(), 2.0, Eigen::Vector3d(4, 4, 4), false);
+  const Eigen::Vector3d wall(1, 5.3, 5.1), in_void(3, 5.3, 5.1), in_island(5, 5.3, 5.1),
+      outside(11, 5.3, 5.1);
+  for (const bool flipped : {false, true}) {
+    TriangleMesh mesh = nested;
+    if (flipped)
+      for (auto& t : mesh.triangles) std::swap(t[1], t[2]);
+    const ClosedShells shells(mesh);
+    EXPECT_TRUE(shells.contains(wall)) << flipped;
+    EXPECT_FALSE(shells.contains(in_void)) << flipped;
+    EXPECT_TRUE(shells.contains(in_island)) << flipped;
+    EXPECT_FALSE(shells.contains(outside)) << flipped;
+    EXPECT_EQ(orientClosedShells(mesh), flipped ? 3u : 0u);
+    EXPECT_EQ(mesh.triangles, nested.triangles);  // wound as a solid's and a void's shells are
+  }
+}
+
+// A void that shares the block's top plane (a skin of no thickness over it) is a void of it: its
+// top vertices lie on the block's surface, not inside (the crossing test cannot say which).
+// A body wound as the block, wholly inside it, is more of the solid (assemblies overlap); one
+// wound inward that only overlaps it is a solid exported inside out.
+TEST(Mesh, AVoidTouchingItsSolidAndBodiesInsideOrAcrossIt) {
+  TriangleMesh touching;
+  appendShell(touching, unitCube(), 4.0, Eigen::Vector3d(0, 0, 0), false);
+  appendShell(touching, unitCube(), 2.0, Eigen::Vector3d(1, 1, 2), true);  // z 2..4
+  EXPECT_FALSE(ClosedShells(touching).contains(Eigen::Vector3d(2, 2.1, 3)));
+  EXPECT_TRUE(ClosedShells(touching).contains(Eigen::Vector3d(2, 2.1, 1)));
+  TriangleMesh flipped = touching;
+  for (auto& t : flipped.triangles) std::swap(t[1], t[2]);
+  EXPECT_EQ(orientClosedShells(flipped), 2u);
+  EXPECT_EQ(flipped.triangles, touching.triangles);
+
+  TriangleMesh embedded;
+  appendShell(embedded, unitCube(), 4.0, Eigen::Vector3d(0, 0, 0), false);
+  appendShell(embedded, unitCube(), 2.0, Eigen::Vector3d(1, 1, 1), false);
+  EXPECT_TRUE(ClosedShells(embedded).contains(Eigen::Vector3d(2, 2.1, 2)));
+  EXPECT_EQ(orientClosedShells(embedded), 0u);
+
+  TriangleMesh across;
+  appendShell(across, unitCube(), 4.0, Eigen::Vector3d(0, 0, 0), false);
+  appendShell(across, unitCube(), 2.0, Eigen::Vector3d(3, 1, 1), true);  // x 3..5
+  EXPECT_TRUE(ClosedShells(across).contains(Eigen::Vector3d(3.5, 2.1, 2)));
+  EXPECT_TRUE(ClosedShells(across).contains(Eigen::Vector3d(4.5, 2.1, 2)));
+  EXPECT_EQ(orientClosedShells(across), 1u);
+}
+
+// A closed shell wound inward inside an open shell's box (a part with a face missing, its cavity
+// closed): its winding is all there is to tell, and it says a void. Turned outward, it read as a
+// body: a tool in it 999.9 um deep (a helper's case).
+TEST(Mesh, AnInwardShellInsideAnOpenShellStaysAVoid) {
+  TriangleMesh part = unitCube();
+  for (auto& v : part.vertices) v *= 10.0;
+  part.triangles.pop_back();  // one face half missing: open
+  part.triangles.pop_back();
+  appendShell(part, unitCube(), 4.0, Eigen::Vector3d(3, 3, 3), true);
+  const TriangleMesh before = part;
+  EXPECT_EQ(orientClosedShells(part), 0u);
+  EXPECT_EQ(part.triangles, before.triangles);
+  EXPECT_FALSE(ClosedShells(part).contains(Eigen::Vector3d(5, 5.1, 5)));
 }
 
 // Export defects that left a solid's shell open (its inside unknown: a tool wholly inside read

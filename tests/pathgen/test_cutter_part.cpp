@@ -3,6 +3,7 @@
 /// towards a wall meets it with its top rim, e/(sin θ + cos θ) in the shrunk-all-round measure;
 /// a rib passed by a motion between two clear postures; a cutter wholly inside a closed part.
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -128,6 +129,15 @@ TEST(CutterPart, ACutterInAVoidOfAClosedPartIsClear) {
   const CutterPartResult wall =
       checkCutterAgainstPart(ball(), hollow, std::vector<Posture>{upright(35, 0, -10)});
   EXPECT_NEAR(wall.max_depth_mm, 3.0, kDepthTolMm + 1e-4);
+  // The same block with every facet flipped (its void wound outward): the same part. Its void
+  // read as a body, a cutter in it 999.9 um deep (a helper's case).
+  geometry::TriangleMesh flipped = hollow;
+  for (auto& t : flipped.triangles) std::swap(t[1], t[2]);
+  EXPECT_FALSE(
+      checkCutterAgainstPart(ball(), flipped, std::vector<Posture>{upright(0, 0, -10)}).gouges());
+  EXPECT_NEAR(checkCutterAgainstPart(ball(), flipped, std::vector<Posture>{upright(35, 0, -10)})
+                  .max_depth_mm,
+              3.0, kDepthTolMm + 1e-4);
   // A body wound inward that only overlaps the block (one corner inside it) is no void of it: a
   // cutter inside both is inside the part (one vertex decided it: a reviewer's case).
   geometry::TriangleMesh overlap = boxMesh(-50, 50, -50, 50, -50, 50);

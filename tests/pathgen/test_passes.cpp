@@ -103,6 +103,20 @@ TEST(Passes, AZigZagInOnePassBlockIsOnePassALeg) {
   EXPECT_EQ(ranges[0], std::make_pair(std::size_t{0}, std::size_t{11}));
   EXPECT_EQ(ranges[1], std::make_pair(std::size_t{11}, std::size_t{22}));
   EXPECT_EQ(ranges[2], std::make_pair(std::size_t{22}, std::size_t{33}));
+  // A block that starts with its step-over, where the block before ended (a continuous zig-zag
+  // cut into `# pass` blocks, a helper's file): the step-over's start is no pass of its own
+  // (nominalPasses refused it: "pass 2 has a single posture").
+  geometry::PathFile continued;
+  for (int k = 0; k <= 10; ++k) continued.postures.push_back({Vec3(k, 0, 0), Vec3::UnitZ()});
+  continued.postures.push_back({Vec3(10, 0, 0), Vec3::UnitZ()});  // 11: where block 1 ended
+  continued.postures.push_back({Vec3(11, 1, 0), Vec3::UnitZ()});  // 12: a step-over on the skew
+  for (int k = 1; k <= 11; ++k) continued.postures.push_back({Vec3(11 - k, 1, 0), Vec3::UnitZ()});
+  continued.blocks = {{geometry::PathBlock::Kind::Pass, 0, 11},
+                      {geometry::PathBlock::Kind::Pass, 11, continued.postures.size()}};
+  const auto legs = passRanges(continued, 0.0, 1.0);
+  ASSERT_EQ(legs.size(), 2u);
+  EXPECT_EQ(legs[0], std::make_pair(std::size_t{0}, std::size_t{11}));
+  EXPECT_EQ(legs[1], std::make_pair(std::size_t{12}, std::size_t{24}));
   // A corner of 90 deg (an L) is one pass still.
   geometry::PathFile corner;
   for (int k = 0; k <= 10; ++k) corner.postures.push_back({Vec3(k, 0, 0), Vec3::UnitZ()});

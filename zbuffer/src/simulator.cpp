@@ -198,19 +198,53 @@ std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
   return top;
 }
 
+namespace {
+
+/// Two crossings closer than this are one surface (facets meeting on a line interpolate its
+/// height a few ulps apart; a layer thinner than 0.1 um is no layer).
+float crossingTie(float z) { return std::max(1e-4f, 4.f * FLT_EPSILON * std::abs(z)); }
+
+/// A line whose cut lies under its top by more than `depth_mm`: only such a line can have the
+/// part above its cut (a layer thinner than that is no layer to the check).
+bool cutUnderTop(float top_mm, float cut_mm, float depth_mm) {
+  return !std::isnan(top_mm) && cut_mm < top_mm - std::max(depth_mm, crossingTie(top_mm));
+}
+
+}  // namespace
+
+bool anyCutUnderTop(const std::vector<float>& top_mm, const std::vector<float>& cut_mm,
+                    float depth_mm) {
+  for (std::size_t i = 0; i < top_mm.size() && i < cut_mm.size(); ++i)
+    if (cutUnderTop(top_mm[i], cut_mm[i], depth_mm)) return true;
+  return false;
+}
+
 PartUnderCut partUnderCut(const Grid& grid, std::span<const Vec3f> vertices,
                           std::span<const std::array<std::uint32_t, 3>> triangles,
                           const std::vector<float>& top_mm, const std::vector<float>& cut_mm,
-                          std::span<const std::uint8_t> open) {
+                          std::span<const std::uint8_t> open, float depth_mm) {
   const GridView g = detail::makeGridView(grid);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   PartUnderCut out;
   out.surface_mm.assign(grid.lineCount(), nan);
   out.normal_z.assign(grid.lineCount(), nan);
   out.beneath.assign(grid.lineCount(), 0);
-  // Two crossings closer than this are one surface (facets meeting on a line interpolate its
-  // height a few ulps apart; a layer thinner than 0.1 um is no layer).
-  const auto tie = [](float z) { return std::max(1e-4f, 4.f * FLT_EPSILON * std::abs(z)); };
+  // Only lines cut under their top can be beneath anything (on a clean path: none, gouges only):
+  // the part's facets are rasterised over the box of those lines alone, or not at all.
+  std::vector<std::uint8_t> under(grid.lineCount(), 0);
+  int ix0 = grid.nx, ix1 = -1, iy0 = grid.ny, iy1 = -1;
+  for (std::size_t i = 0; i < under.size(); ++i) {
+    if (!(under[i] = cutUnderTop(top_mm[i], cut_mm[i], depth_mm))) continue;
+    const int ix = int(i % grid.nx), iy = int(i / grid.nx);
+    ix0 = std::min(ix0, ix), ix1 = std::max(ix1, ix), iy0 = std::min(iy0, iy),
+    iy1 = std::max(iy1, iy);
+  }
+  if (ix1 < 0) return out;
+  // The candidates' box in mm, a line wider each way than the rasteriser's reach.
+  const float bx0 = float(grid.x0_mm + (ix0 - 1) * grid.dx_mm);
+  const float bx1 = float(grid.x0_mm + (ix1 + 2) * grid.dx_mm);
+  const float by0 = float(grid.y0_mm + (iy0 - 1) * grid.dy_mm);
+  const float by1 = float(grid.y0_mm + (iy1 + 2) * grid.dy_mm);
   // A closed shell's facets face out: up-facing ones rasterise with sign +1 (a layer's top),
   // down-facing ones with −1 (an underside); rasterTriangle keeps those whose projection turns
   // the sign's way. An open sheet's winding says nothing: both, a layer of no thickness.
@@ -218,22 +252,26 @@ PartUnderCut partUnderCut(const Grid& grid, std::span<const Vec3f> vertices,
     for (std::size_t k = 0; k < triangles.size(); ++k) {
       const auto& t = triangles[k];
       const Vec3f a = vertices[t[0]], b = vertices[t[1]], c = vertices[t[2]];
+      if (std::max({a.x, b.x, c.x}) < bx0 || std::min({a.x, b.x, c.x}) > bx1 ||
+          std::max({a.y, b.y, c.y}) < by0 || std::min({a.y, b.y, c.y}) > by1)
+        continue;
       const float cos_slope = facetCosSlope(a, b, c);
       const bool sheet = k < open.size() && open[k];
       for (const float sign : {1.f, -1.f})
         rasterTriangle(g, a, b, c, sign, [&](int ix, int iy, float z) {
-          visit(std::size_t(iy) * grid.nx + ix, z, sign > 0, sheet || sign < 0, cos_slope);
+          const std::size_t i = std::size_t(iy) * grid.nx + ix;
+          if (under[i]) visit(i, z, sign > 0, sheet || sign < 0, cos_slope);
         });
     }
   };
   // The lowest underside above the line's cut: the tool's lowest point is beneath it.
   std::vector<float> roof(grid.lineCount(), HUGE_VALF);
   each([&](std::size_t i, float z, bool, bool underside, float) {
-    if (underside && z > cut_mm[i] + tie(cut_mm[i])) roof[i] = std::min(roof[i], z);
+    if (underside && z > cut_mm[i] + crossingTie(cut_mm[i])) roof[i] = std::min(roof[i], z);
   });
   // The surface measured: the highest top under that roof (the top itself without one).
   each([&](std::size_t i, float z, bool top, bool, float cos_slope) {
-    if (!top || !(z < roof[i] - tie(roof[i]))) return;
+    if (!top || !(z < roof[i] - crossingTie(roof[i]))) return;
     float& s = out.surface_mm[i];
     if (std::isnan(s) || z > s) {
       s = z;
@@ -243,9 +281,9 @@ PartUnderCut partUnderCut(const Grid& grid, std::span<const Vec3f> vertices,
     }
   });
   for (std::size_t i = 0; i < roof.size(); ++i) {
-    if (std::isnan(top_mm[i]) || roof[i] == HUGE_VALF) continue;  // off the part; under no roof
+    if (!under[i] || roof[i] == HUGE_VALF) continue;  // not cut under its top; under no roof
     // Nothing under a roof that is the top itself: a lone sheet, which the cut went through.
-    if (std::isnan(out.surface_mm[i]) && roof[i] >= top_mm[i] - tie(top_mm[i])) continue;
+    if (std::isnan(out.surface_mm[i]) && roof[i] >= top_mm[i] - crossingTie(top_mm[i])) continue;
     out.beneath[i] = 1;
   }
   return out;

@@ -65,11 +65,12 @@ struct ShellRepair {
 /// (a sheet), where the mesh is closed already, or where the search would be a soup's.
 ShellRepair repairShells(TriangleMesh& mesh);
 
-/// Turns every closed, consistently wound shell (a connected set of triangles whose every edge is
-/// used twice, once each way) that is wound inward (negative enclosed volume: CAD exports with the
-/// normals flipped) outward, and returns how many it turned. Open or inconsistent shells are left
-/// as they are (their inside is not defined), and so is a shell whose box lies in another closed
-/// shell's box (a cavity is wound inward on purpose).
+/// Winds every closed, consistently wound shell (a connected set of triangles whose every edge is
+/// used twice, once each way) as its kind (ClosedShells: from its nesting and its winding against
+/// the shell it lies in): a solid's shell outward, a void's inward. CAD exports with the normals
+/// flipped, the whole mesh or one body, read the same part. Returns how many shells it turned.
+/// Open or inconsistent shells are left as they are (their inside is not defined: their winding
+/// is all there is to tell a box with a face missing from a pocket).
 std::size_t orientClosedShells(TriangleMesh& mesh);
 
 }  // namespace fieldpath::geometry

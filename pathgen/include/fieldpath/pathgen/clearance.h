@@ -28,11 +28,13 @@ struct ClearanceRequest {
 /// D = |Δtip| + ρ_max Δθ (ρ_max: the farthest point from the tip, Δθ: the angle between the
 /// axes), and the distance to the obstacles is 1-Lipschitz in that motion. Over a sub-motion
 /// whose ends are d0 and d1 away the distance is at least (d0 + d1 - D) / 2. Sub-motions are
-/// halved until that bound reaches max(required_mm, closest − slack), slack = max(tighten_mm,
-/// tighten_fraction × closest), closest: the closest posture; or a sample touches, or D ≤ 2
-/// `resolution_mm`. The smallest bound is then within `slack` of the true minimum wherever that
-/// is above required_mm. The slack is relative far from the obstacles: a fixed 0.01 mm refined a
-/// job 10× the size (tool, path, clearances) into 27 s of samples, and 100× into minutes.
+/// halved, the lowest bound first, until that bound reaches max(required_mm, closest − slack),
+/// slack = max(tighten_mm, tighten_fraction × closest), closest: the closest posture, or (above
+/// 0 and required_mm) the lowest distance sampled on the motion less its slack; or a sample
+/// touches, or D ≤ 2 `resolution_mm`. The smallest bound is then within `slack` of the true
+/// minimum wherever that is above required_mm. The slack is relative far from the obstacles: a
+/// fixed 0.01 mm refined a job 10× the size (tool, path, clearances) into 27 s of samples, and 100×
+/// into minutes.
 struct MotionRequest {
   double required_mm = 0.0;     ///< stop refining a motion once certified at this clearance
   double resolution_mm = 0.005;  ///< halve sub-motions no shorter (in D) than 2 × this

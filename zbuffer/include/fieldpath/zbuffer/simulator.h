@@ -186,15 +186,20 @@ std::vector<float> partTop(const Grid& grid, std::span<const Vec3f> vertices,
 /// its facet's |n_z| in `normal_z`; NaN where there is none (a closed overhang with nothing under
 /// it, or a cut through the part's bottom: the cutter's exact test tells those). Under a lone sheet
 /// (nothing under it) a cut went through the sheet: `beneath` 0, measured against the top as any
-/// line.
+/// line. Only lines cut under their top by more than `depth_mm` are looked at (anyCutUnderTop).
 struct PartUnderCut {
   std::vector<float> surface_mm, normal_z;
   std::vector<std::uint8_t> beneath;
 };
+/// Whether any line's cut lies under its top by more than `depth_mm` (and 0.1 um): without one, no
+/// line is beneath anything and `partUnderCut` need not run (a clean path's check, `depth_mm` the
+/// gouge tolerance: a layer thinner than it is no layer to the check).
+bool anyCutUnderTop(const std::vector<float>& top_mm, const std::vector<float>& cut_mm,
+                    float depth_mm);
 PartUnderCut partUnderCut(const Grid& grid, std::span<const Vec3f> vertices,
                           std::span<const std::array<std::uint32_t, 3>> triangles,
                           const std::vector<float>& top_mm, const std::vector<float>& cut_mm,
-                          std::span<const std::uint8_t> open);
+                          std::span<const std::uint8_t> open, float depth_mm);
 
 /// Stock as the top of a part mesh (world frame, mm): the highest up-facing point on each line;
 /// lines that miss the part start at its lowest z.
