@@ -211,7 +211,8 @@ std::string farLinkNote(const Scene& scene, const geometry::PathFile& path) {
   }
   if (!(farthest_mm > 0.25 * box.sizes().maxCoeff())) return {};
   std::ostringstream note;
-  note.precision(3);
+  note << std::fixed;
+  note.precision(0);
   note << "the links climb along the tool axis to the travel plane: posture " << at
        << " of path.cl lies " << farthest_mm
        << " mm outside the meshes' x-y box; fixtures and the machine's travel are not in the "

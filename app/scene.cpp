@@ -18,6 +18,7 @@
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/input_file.h"
 #include "fieldpath/common/short_number.h"
+#include "fieldpath/geometry/closed_shells.h"
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "scene_mesh.h"
@@ -385,8 +386,8 @@ void readLinks(const Reader& r, const YAML::Node& node, pathgen::LinkParams& lin
   if (node["retract"])
     links.retract_mm = r.number(
         node["retract"], "links.retract", [](double v) { return v > 0.0 && v <= 1e4; },
-        "a distance in (0, 10000] mm: at 0 each link's last rapid move ends on the part, at "
-        "the pass's first posture");
+        "a distance in (0, 10000] mm (at 0 each link's last rapid move would end on the part, "
+        "at the pass's first posture)");
   if (node["safe_z"]) {
     if (node["safe_z"].IsScalar() && node["safe_z"].Scalar() == "auto")
       links.safe_z_mm.reset();
@@ -530,33 +531,6 @@ Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
   return scene;
 }
 
-namespace {
-
-/// The open shells of `mesh` whose open edges are short against their area (length / sqrt(area)
-/// under 3: a box with a face missing 1.8, a hemisphere 2.5; a flat disc 3.5, a square sheet 4, a
-/// tube 4, the mesh example's hub 4.8): a solid with facets missing rather than a sheet.
-std::size_t nearlyClosedShells(const geometry::TriangleMesh& mesh) {
-  std::size_t count = 0;
-  for (const std::vector<int>& shell : geometry::openShells(mesh)) {
-    std::map<std::pair<int, int>, int> uses;
-    double area_mm2 = 0.0;
-    for (const int k : shell) {
-      const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(k)];
-      area_mm2 += 0.5 * (mesh.vertices[t[1]] - mesh.vertices[t[0]])
-                            .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]])
-                            .norm();
-      for (int e = 0; e < 3; ++e) ++uses[std::minmax(t[e], t[(e + 1) % 3])];
-    }
-    double open_mm = 0.0;
-    for (const auto& [edge, n] : uses)
-      if (n == 1) open_mm += (mesh.vertices[edge.second] - mesh.vertices[edge.first]).norm();
-    count += area_mm2 > 0.0 && open_mm < 3.0 * std::sqrt(area_mm2);
-  }
-  return count;
-}
-
-}  // namespace
-
 std::vector<std::string> openObstacleNotes(const Scene& scene) {
   std::vector<std::string> notes;
   if (scene.part && scene.part_file) {
@@ -564,7 +538,7 @@ std::vector<std::string> openObstacleNotes(const Scene& scene) {
     // solid missing a face. Geometry cannot tell them: said, so that a mesh exported with a face
     // missing and its normals flipped is not taken on trust (a helper's buried tool read ok).
     // Sheets (a machined surface exported open, as the mesh example's hub) are no such doubt.
-    const std::size_t closing = nearlyClosedShells(*scene.part);
+    const std::size_t closing = geometry::nearlyClosedOpenShells(*scene.part).size();
     if (closing > 0)
       notes.push_back(
           scene.part_file->string() + ": " + std::to_string(closing) +

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <utility>
 
 namespace fieldpath::geometry {
@@ -96,30 +97,50 @@ ClosedShells::ClosedShells(const TriangleMesh& mesh)
   const auto size = [&](std::size_t s) { return std::abs(shells_[s].volume_mm3); };
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t a, std::size_t b) { return size(a) > size(b); });
-  std::vector<Eigen::AlignedBox3d> open_boxes;
-  for (const std::vector<int>& open : openShells(mesh)) {
-    Eigen::AlignedBox3d box;
-    for (int t : open)
-      for (int e = 0; e < 3; ++e) box.extend(vertices_[triangles_[t][e]]);
-    open_boxes.push_back(box);
-  }
+  // The boxes of the open shells that nearly close (a part left open: a void inside one has only
+  // its winding to tell it), found once and only when a shell in no other is wound inward.
+  std::optional<std::vector<Eigen::AlignedBox3d>> open_boxes;
+  const auto inOpen = [&](const Eigen::AlignedBox3d& box) {
+    if (!open_boxes) {
+      open_boxes.emplace();
+      for (const std::vector<int>& open : nearlyClosedOpenShells(mesh)) {
+        Eigen::AlignedBox3d b;
+        for (int t : open)
+          for (int e = 0; e < 3; ++e) b.extend(vertices_[triangles_[t][e]]);
+        open_boxes->push_back(b);
+      }
+    }
+    return std::any_of(open_boxes->begin(), open_boxes->end(),
+                       [&](const auto& b) { return b.contains(box); });
+  };
   for (std::size_t k = 0; k < order.size(); ++k) {
     Shell& shell = shells_[order[k]];
     const Shell* parent = nullptr;
     for (std::size_t j = k; j-- > 0;) {  // the smallest first
       const Shell& other = shells_[order[j]];
-      if (other.box.contains(shell.box) && within(shell, other)) {
+      Eigen::AlignedBox3d reach = other.box;  // its surface's tolerance about it
+      reach.min().array() -= surfaceTolMm(other);
+      reach.max().array() += surfaceTolMm(other);
+      if (reach.contains(shell.box) && within(shell, other)) {
         parent = &other;
         break;
       }
     }
-    const bool inward = shell.volume_mm3 < 0.0;
+    // A shell of no volume (a sheet closed on itself, both sides) has no winding to read: its
+    // volume's sign is rounding's.
+    const auto inward = [](const Shell& s) {
+      const double size = s.box.diagonal().norm();
+      return s.volume_mm3 < -1e-9 * size * size * size;
+    };
     if (parent) {
-      shell.sign = inward == (parent->volume_mm3 < 0.0) ? parent->sign : -parent->sign;
-    } else {
-      const bool in_open = std::any_of(open_boxes.begin(), open_boxes.end(),
-                                       [&](const auto& box) { return box.contains(shell.box); });
-      shell.sign = inward && in_open ? -1 : 1;
+      // In a void, an island whichever way it is wound (air in air is nothing: a helper's island
+      // wound inward read as a void, a tool buried in it ok); in a solid, a void when wound the
+      // other way, a body overlapping it when wound the same way.
+      shell.sign = parent->sign < 0 || inward(shell) == inward(*parent) ? 1 : -1;
+      shell.weight = shell.sign;
+    } else if (inward(shell) && inOpen(shell.box)) {
+      shell.sign = -1;  // a void of an open shell: air, whose inside counts for nothing
+      shell.weight = 0;
     }
   }
 }
@@ -141,23 +162,27 @@ bool ClosedShells::onSurface(const Shell& shell, const Eigen::Vector3d& p, doubl
   return false;
 }
 
+double ClosedShells::surfaceTolMm(const Shell& shell) {
+  // A millionth of the shell's size: a void that shares a face's plane with its solid (read in
+  // floats, the same coordinates or a step apart) lies on it.
+  return 1e-6 * std::max(1.0, shell.box.diagonal().norm());
+}
+
 bool ClosedShells::within(const Shell& inner, const Shell& outer) const {
-  // On the surface within a millionth of the outer shell's size: a void that shares a face's
-  // plane with its solid (read in floats, the same coordinates) is in it.
-  const double tol_mm = 1e-6 * std::max(1.0, outer.box.diagonal().norm());
-  bool any_inside = false;
+  const double tol_mm = surfaceTolMm(outer);
+  std::vector<int> ids;  // each vertex once
+  ids.reserve(inner.triangles.size() * 3);
   for (int t : inner.triangles)
-    for (int e = 0; e < 3; ++e) {
-      const Eigen::Vector3d& v = vertices_[triangles_[t][e]];
-      if (!outer.box.contains(v)) {
-        if (!onSurface(outer, v, tol_mm)) return false;
-        continue;
-      }
-      if (crossings(outer, v) % 2 == 1)
-        any_inside = true;
-      else if (!onSurface(outer, v, tol_mm))
-        return false;
-    }
+    for (int e = 0; e < 3; ++e) ids.push_back(triangles_[t][e]);
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  bool any_inside = false;  // strictly: a vertex off the surface, inside it
+  for (int id : ids) {
+    const Eigen::Vector3d& v = vertices_[id];
+    if (onSurface(outer, v, tol_mm)) continue;
+    if (crossings(outer, v) % 2 == 0) return false;
+    any_inside = true;
+  }
   return any_inside;
 }
 
@@ -187,8 +212,35 @@ bool ClosedShells::contains(const Eigen::Vector3d& p) const {
   // The winding number: +1 inside each solid's shell, -1 inside each void's.
   int winding = 0;
   for (const Shell& shell : shells_)
-    if (crossings(shell, p) % 2 == 1) winding += shell.sign;
+    if (crossings(shell, p) % 2 == 1) winding += shell.weight;
   return winding > 0;
+}
+
+std::vector<std::vector<int>> nearlyClosedOpenShells(const TriangleMesh& mesh) {
+  std::vector<std::vector<int>> out;
+  for (std::vector<int>& shell : openShells(mesh)) {
+    std::vector<std::pair<int, int>> edges;  // each triangle's edges, sorted: a lone one is open
+    edges.reserve(shell.size() * 3);
+    double area_mm2 = 0.0;
+    for (const int k : shell) {
+      const Eigen::Vector3i& t = mesh.triangles[static_cast<std::size_t>(k)];
+      area_mm2 += 0.5 * (mesh.vertices[t[1]] - mesh.vertices[t[0]])
+                            .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]])
+                            .norm();
+      for (int e = 0; e < 3; ++e) edges.push_back(std::minmax(t[e], t[(e + 1) % 3]));
+    }
+    std::sort(edges.begin(), edges.end());
+    double open_mm = 0.0;
+    for (std::size_t i = 0; i < edges.size();) {
+      std::size_t j = i + 1;
+      while (j < edges.size() && edges[j] == edges[i]) ++j;
+      if (j - i == 1)
+        open_mm += (mesh.vertices[edges[i].second] - mesh.vertices[edges[i].first]).norm();
+      i = j;
+    }
+    if (area_mm2 > 0.0 && open_mm < 3.0 * std::sqrt(area_mm2)) out.push_back(std::move(shell));
+  }
+  return out;
 }
 
 }  // namespace fieldpath::geometry

@@ -163,12 +163,14 @@ inline constexpr double kPathZero = 1e-12;
 /// path was written so). Magnitudes under kPathZero are written 0 (or -0); past 1e32, where no
 /// path goes (scene coordinates stop at 1e6 mm), with an exponent.
 inline void appendNumber(std::string& out, double value) {
+  if (std::abs(value) < kPathZero) {
+    out.append(std::signbit(value) ? "-0" : "0");
+    return;
+  }
   char buffer[64];
   const auto fixed = std::to_chars(buffer, buffer + sizeof buffer, value, std::chars_format::fixed);
   if (fixed.ec == std::errc() && fixed.ptr - buffer <= 32) {
     out.append(buffer, fixed.ptr);
-  } else if (std::abs(value) < kPathZero) {
-    out.append(std::signbit(value) ? "-0" : "0");
   } else {
     const auto general = std::to_chars(buffer, buffer + sizeof buffer, value);
     out.append(buffer, general.ptr);

@@ -80,8 +80,8 @@ LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part,
   auto same = [&](std::size_t i, std::size_t j) { return geometry::samePose(all[i], all[j]); };
   for (geometry::PathBlock block : path.blocks) {
     if (block.kind != geometry::PathBlock::Kind::Link) continue;
-    // A link posture where the pass beside it starts or ends (links.retract: 0) is that pass's:
-    // the ball cuts there.
+    // A link posture where the pass beside it starts or ends (a path written with no retract) is
+    // that pass's: the ball cuts there.
     if (block.begin > 0 && block.begin < block.end && same(block.begin, block.begin - 1)) ++block.begin;
     if (block.end < all.size() && block.begin < block.end && same(block.end - 1, block.end)) --block.end;
     if (block.size() == 0) continue;

@@ -88,8 +88,10 @@ double resolveSafeZ(std::optional<double> given_mm, double top_mm, double cleara
 geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
                               const LinkRequest& request) {
   const LinkParams& params = request.params;
-  if (!std::isfinite(params.retract_mm) || params.retract_mm < 0.0)
-    throw InputError("links.retract: must be a finite distance >= 0 mm");
+  if (!std::isfinite(params.retract_mm) || params.retract_mm <= 0.0)
+    throw InputError(
+        "links.retract: must be a finite distance > 0 mm (at 0 a link's last rapid "
+        "move ends on the part)");
   if (!std::isfinite(request.safe_z_mm)) throw InputError("links.safe_z: must be finite");
   geometry::PathFile out;
   auto add = [&](PathBlock::Kind kind, const Posture& p) {

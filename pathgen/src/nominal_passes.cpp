@@ -164,9 +164,11 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
       // axis's fault, named at its line by nominalPasses, not a new leg.
       back = back && path.postures[i].axis.dot(path.postures[i - 1].axis) > 0.0;
       if (back) {  // the new pass starts where this step does; the step-over before is the link
-        // A leg of one posture is the step-over's start alone (a pass that begins with its
-        // step-over, where the last one ended): no pass of its own (was "a single posture").
-        if (i - 1 > begin + 1) ranges.emplace_back(begin, i - 1);
+        // A block that begins with its step-over (where the last one ended) leaves a leg of one
+        // posture, the step-over's start: no pass of its own (was "a single posture"). Elsewhere
+        // a leg of one posture stays an error of nominalPasses (a jitter back in a pass).
+        const bool step_over_start = begin == block.begin && i - 1 == begin + 1;
+        if (i - 1 > begin && !step_over_start) ranges.emplace_back(begin, i - 1);
         begin = i - 1;
         recent.clear();
       }

@@ -2,6 +2,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <random>
 #include <regex>
@@ -110,6 +111,30 @@ TEST(ClFile, RoundTripsExactly) {
     expectNoExponent(p);
     EXPECT_FALSE(fs::exists(p.string() + ".tmp"));
   }
+}
+
+// Numbers as post-processors read them: no exponent ("4.8e-05" was written for an axis component
+// of the impeller's path), the shortest fixed form that reads back the same; under 1e-12, 0.
+TEST(ClFile, WritesNumbersWithoutAnExponent) {
+  std::vector<Posture> postures(2);
+  postures[0].tip_mm = Vec3(-4.8037586702237175e-05, 1e-13, -1e-20);
+  postures[0].axis = Vec3(4.8037586702237175e-05, 0, 1).normalized();
+  postures[1].tip_mm = Vec3(123456.789, -0.1, 1e6);
+  postures[1].axis = Vec3(0, -1, 1e-14).normalized();
+  const fs::path p = tempPath("numbers.cl");
+  writeClFile(p, postures, "");
+  expectNoExponent(p);
+  const auto back = readClFile(p);
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[0].tip_mm.x(), -4.8037586702237175e-05);
+  EXPECT_EQ(back[0].tip_mm.y(), 0.0);
+  EXPECT_TRUE(std::signbit(back[0].tip_mm.z()));  // -0: the sign kept
+  EXPECT_EQ(back[0].axis, postures[0].axis);
+  EXPECT_EQ(back[1].tip_mm, postures[1].tip_mm);
+  EXPECT_EQ(back[1].axis, Vec3(0, -1, 0));
+  std::ifstream in(p);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("-0.000048037586702237175 0 -0 "), std::string::npos) << text;
 }
 
 TEST(ClFile, NormalisesNearlyUnitAxes) {

@@ -148,6 +148,15 @@ TEST(Mesh, NestedShellsKeepTheirKindsWhenTheWholeMeshIsFlipped) {
     EXPECT_EQ(orientClosedShells(mesh), flipped ? 3u : 0u);
     EXPECT_EQ(mesh.triangles, nested.triangles);  // wound as a solid's and a void's shells are
   }
+  // The island alone wound inward (as its void is): still an island, air in air meaning nothing
+  // (read as a void, a tool buried in it passed: a helper's case).
+  TriangleMesh island_flipped = nested;
+  for (std::size_t t = 24; t < 36; ++t)
+    std::swap(island_flipped.triangles[t][1], island_flipped.triangles[t][2]);
+  EXPECT_TRUE(ClosedShells(island_flipped).contains(in_island));
+  EXPECT_FALSE(ClosedShells(island_flipped).contains(in_void));
+  EXPECT_EQ(orientClosedShells(island_flipped), 1u);
+  EXPECT_EQ(island_flipped.triangles, nested.triangles);
 }
 
 // A void that shares the block's top plane (a skin of no thickness over it) is a void of it: its

@@ -20,11 +20,11 @@ class ClosedShells {
   /// shell it lies in (wholly: every vertex inside or on it), so that a mesh whose every facet is
   /// flipped reads as the same part:
   /// - a shell in no other is a solid, whichever way it is wound (a solid exported inside out),
-  ///   but for one wound inward inside an open shell's box (a cavity of a part left open: its
-  ///   winding is all there is to tell);
-  /// - a shell in another (the smallest that holds it) is of the other kind when wound the other
-  ///   way (a void of a solid, an island in a void), of the same kind when wound the same way (a
-  ///   body inside another, as assemblies overlap).
+  ///   but for one wound inward inside the box of an open shell that nearly closes (a cavity of a
+  ///   part left open: its winding is all there is to tell), whose inside counts for nothing;
+  /// - a shell in another (the smallest that holds it) is, in a solid, a void when wound the other
+  ///   way and a body overlapping it when wound the same way (as assemblies overlap); in a void,
+  ///   an island whichever way it is wound (air in air means nothing).
   explicit ClosedShells(const TriangleMesh& mesh);
 
   /// Whether p lies inside the part: inside more solids' shells than voids' (the union of the
@@ -53,7 +53,11 @@ class ClosedShells {
     std::vector<std::vector<int>> cells;  ///< per xy cell: the triangles whose box meets it
     double volume_mm3 = 0.0;              ///< signed: < 0 wound inward
     int sign = 1;                         ///< -1: a void
+    /// What its inside adds to a point's winding: its sign, but 0 for a void of an open shell
+    /// (air around which no closed shell counts).
+    int weight = 1;
   };
+  static double surfaceTolMm(const Shell& shell);
   const std::vector<int>& cellAt(const Shell& shell, const Eigen::Vector3d& p) const;
   /// The crossings of the vertical ray from p upward with `shell`'s triangles.
   int crossings(const Shell& shell, const Eigen::Vector3d& p) const;
@@ -66,5 +70,11 @@ class ClosedShells {
   std::vector<Shell> shells_;
   std::vector<Eigen::Vector3d> anchors_;
 };
+
+/// The open shells of `mesh` that nearly enclose a volume: their open edges short against their
+/// area (length / sqrt(area) under 3: a box with a face missing 1.8, a hemisphere 2.5, a bore's
+/// wall longer than 2.8 radii; a flat disc 3.5, a square sheet 4, the mesh example's hub 4.8).
+/// A solid exported with facets missing, rather than a sheet; triangle indices per shell.
+std::vector<std::vector<int>> nearlyClosedOpenShells(const TriangleMesh& mesh);
 
 }  // namespace fieldpath::geometry

@@ -58,7 +58,7 @@ GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
 /// first posture against `grazing` (grazingPartChecker): they start or end where the ball cuts
 /// the part, so they may touch it, not enter it by more than kPassGrazeMm (a retract along an
 /// axis leaning over a fin of the part did). Link postures at a pass's first or last posture
-/// (links.retract: 0) are that pass's.
+/// (a path written with no retract) are that pass's.
 LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part,
                                      const GrazingChecker& grazing,
                                      const geometry::PathFile& path);
