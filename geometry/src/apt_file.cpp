@@ -422,6 +422,12 @@ void writeAptFile(const std::filesystem::path& file, const PathFile& path,
   const double cutter[] = {2 * t.radius_mm, corner_mm, t.radius_mm - corner_mm, corner_mm, 0.0, 0.0,
                            t.length_mm};
   appendRecord(text, "CUTTER", cutter);
+  // A path marked unsafe halts before its first motion (STOP: M00 on post-processors): a PPRINT
+  // is only read, and the program ran on (a machine-safety helper's finding).
+  if (std::any_of(header.remarks.begin(), header.remarks.end(), [](const std::string& remark) {
+        return upperCase(detail::safetyMark(remark)).rfind("UNSAFE TO RUN", 0) == 0;
+      }))
+    text += "STOP\n";
   std::string feed = "FEDRAT/MMPM,";
   appendNumber(feed, header.feed_mm_per_min);
   feed += '\n';

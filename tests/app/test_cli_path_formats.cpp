@@ -392,6 +392,9 @@ TEST(Convert, SafetyMarksGoWithThePathOrTheirLossIsSaid) {
   const std::string apt = slurp(dir.path() / "u.apt");
   EXPECT_NE(apt.find("PPRINT/UNSAFE TO RUN: 2 POSTURES TOUCH"), std::string::npos) << apt;
   EXPECT_NE(apt.find("PPRINT/UNDER THE REQUIRED CLEARANCE"), std::string::npos) << apt;
+  // ... and the machine halts before the first motion (a PPRINT is only read).
+  ASSERT_NE(apt.find("\nSTOP\n"), std::string::npos) << apt;
+  EXPECT_LT(apt.find("\nSTOP\n"), apt.find("GOTO/")) << apt;
   EXPECT_EQ(geometry::readPathFile(dir.path() / "u.apt").warnings.size(), 2u);
   ASSERT_EQ(runFieldpath(dir, "convert u.apt back.cl").exit_code, 0);
   const PathFile back = geometry::readPathFile(dir.path() / "back.cl");

@@ -325,11 +325,23 @@ TEST(AptFile, UnitsFiniAndRemarks) {
   EXPECT_EQ(c2, "PPRINT/UNSAFE TO RUN: 49 MOTIONS TOUCH AN OBSTACLE (FIRST: POSTURE 114");
   EXPECT_EQ(c3, "PPRINT/TO THE NEXT) AND 47 POSTURES");
   EXPECT_EQ(c4, "UNITS/MM");
+  // An unsafe path halts before its first motion (STOP: M00), read past; under the clearance
+  // only, it runs.
+  const std::string halted((std::istreambuf_iterator<char>(cards)),
+                           std::istreambuf_iterator<char>());
+  ASSERT_NE(halted.find("\nSTOP\n"), std::string::npos) << halted;
+  EXPECT_LT(halted.find("\nSTOP\n"), halted.find("GOTO/")) << halted;
   const PathFile marked = readPathFile(w);
+  EXPECT_EQ(marked.postures.size(), 3u);
   ASSERT_EQ(marked.warnings.size(), 1u);  // the mark whole, read back from its cards
   EXPECT_EQ(marked.warnings[0],
             "UNSAFE TO RUN: 49 MOTIONS TOUCH AN OBSTACLE (FIRST: POSTURE 114 "
             "TO THE NEXT) AND 47 POSTURES");
+  header.remarks = {"UNDER THE REQUIRED CLEARANCE: postures min 0.3 mm"};
+  writeAptFile(w, p, header);
+  std::ifstream under(w);
+  const std::string runs((std::istreambuf_iterator<char>(under)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(runs.find("STOP"), std::string::npos) << runs;
 }
 
 // A motion the reader does not take is refused with its line (each lost a posture silently),
