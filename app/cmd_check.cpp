@@ -40,6 +40,29 @@ namespace {
 
 using nlohmann::json;
 
+/// The links whose last posture is the next pass's first, where the ball cuts: their rapid move
+/// ends on the part (a path written with no retract; generate refuses links.retract 0). The
+/// links' part check takes such a posture for the pass's, so it said nothing of it (a machine
+/// safety helper's finding). Returns (count, path index of the first such posture).
+std::pair<std::size_t, std::size_t> rapidsOntoPasses(const geometry::PathFile& path) {
+  std::size_t count = 0, first = 0;
+  for (std::size_t k = 0; k + 1 < path.blocks.size(); ++k) {
+    const geometry::PathBlock& link = path.blocks[k];
+    const geometry::PathBlock& pass = path.blocks[k + 1];
+    if (link.kind != geometry::PathBlock::Kind::Link ||
+        pass.kind != geometry::PathBlock::Kind::Pass || link.size() == 0 || pass.size() == 0)
+      continue;
+    // The rapid into the link's last posture: from the posture before it (the link's own, or the
+    // pass before when the link holds one), unless that is the same place (no move).
+    const std::size_t end = link.end - 1;
+    if (!geometry::samePose(path.postures[end], path.postures[pass.begin]) || end == 0 ||
+        geometry::samePose(path.postures[end - 1], path.postures[end]))
+      continue;
+    if (count++ == 0) first = end;
+  }
+  return {count, first};
+}
+
 /// Per posture: block, clearance and the lower bound of the motion to the next one.
 /// clearance.csv: a row a posture; the last two columns say where the links, the holder or the
 /// cutter (beyond the gouge tolerance) touch
@@ -249,7 +272,14 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     // Why the check fails, one line each (empty: ok): the collisions of `unsafe`, a clearance
     // under the required one, and the gouges (a flank driven into a wall of the part is one).
     const std::optional<pathgen::CutterPartResult>& cutter_part = contacts.cutter;
-    std::vector<std::string> not_ok = unsafeReasons(clearance, motions, link_part, holder_part);
+    std::vector<std::string> unsafe = unsafeReasons(clearance, motions, link_part, holder_part);
+    const auto [rapids_onto_passes, first_rapid_onto_pass] = rapidsOntoPasses(path);
+    if (rapids_onto_passes > 0)
+      unsafe.push_back(std::to_string(rapids_onto_passes) +
+                       " links end with a rapid move onto a pass's first posture, where the ball "
+                       "cuts (first: posture " +
+                       std::to_string(first_rapid_onto_pass) + "): no retract before the pass");
+    std::vector<std::string> not_ok = unsafe;
     if (const std::string gouge = cutterGougeReason(cutter_part); !gouge.empty())
       not_ok.push_back(gouge);
     if (clearance.colliding == 0 && clearance.min_clearance_mm < scene.clearance_mm)
@@ -283,7 +313,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
          holder_part ? json(nullptr) : json("no `part` or no `holder` in the scene")},
         {"cutter_part", cutterPartJson(cutter_part)},
         {"cutter_part_skipped", cutter_part ? json(nullptr) : json("no `part` in the scene")},
-        {"unsafe", unsafeReasons(clearance, motions, link_part, holder_part)},
+        {"unsafe", unsafe},
         {"tool_notes", tool_notes},
         {"obstacle_notes", obstacle_notes},
         {"axis_turn", axisTurnJson(axis_turn)},
@@ -394,6 +424,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                    "note: --spacing %g mm would make more Z-buffer lines than a check takes: "
                    "lines every %.4g mm (check.json `surface.grid.spacing`)\n",
                    options->spacing_mm, surface->grid.dx_mm);
+    if (rapids_onto_passes > 0)
+      std::fprintf(stderr, "warning: %s (check.json unsafe)\n", unsafe.back().c_str());
     if (never_cut && !touches_part)
       std::fprintf(stderr,
                    "warning: the path never reaches the part (no line of the surface cut): is "

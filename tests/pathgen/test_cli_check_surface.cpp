@@ -267,6 +267,32 @@ TEST(CheckSurface, AToolBuriedInABoxWithAFacetMissingIsAGouge) {
   EXPECT_EQ(s["beneath_lines"].get<int>(), 0) << s;
 }
 
+// A link whose last posture is the next pass's first (a path written with no retract): its rapid
+// move ends where the ball cuts. The links' part check takes that posture for the pass's and said
+// nothing (a machine-safety helper's finding); now `unsafe`. The same path with the link ending
+// 8 mm above the pass start is not.
+TEST(CheckLinks, ARapidMoveOntoAPassStartIsUnsafe) {
+  const TempDir dir;
+  writePlateScene(dir);
+  std::string cl = passes(2, 0.0, 1.0, 0.0);
+  dir.write("retracted.cl", cl);
+  const std::string link = "0 1 8 0 0 1\n";
+  cl.replace(cl.find(link), link.size(), link + "0 1 0 0 0 1\n");
+  dir.write("onto.cl", cl);
+  const auto reasons = [](const nlohmann::json& report) {
+    std::string all;
+    for (const auto& r : report["unsafe"]) all += r.get<std::string>() + "\n";
+    return all;
+  };
+  const auto onto = check(dir, "onto.cl", "onto");
+  EXPECT_NE(reasons(onto).find("1 links end with a rapid move onto a pass's first posture"),
+            std::string::npos)
+      << onto["unsafe"];
+  EXPECT_FALSE(onto["ok"].get<bool>());
+  const auto retracted = check(dir, "retracted.cl", "retracted");
+  EXPECT_EQ(reasons(retracted).find("rapid move onto"), std::string::npos) << retracted["unsafe"];
+}
+
 // Two runs of postures 20 mm apart with the axis at -60 and +60 deg about y: generate reads two
 // passes (split at the gap) and takes it; check refused the 120 deg turn as within a pass. A
 // flip within one run is still refused, naming its line.
