@@ -167,7 +167,8 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
         {"rhs_evals", r.rhs_evals},
         {"jacobian_evals", r.jacobian_evals},
         {"error_test_failures", r.error_test_failures},
-        {"convergence_failures", r.convergence_failures}}},
+        {"convergence_failures", r.convergence_failures},
+        {"loosened", r.loosened_solver}}},
       {"per_pass", passes},
   };
 }
@@ -390,6 +391,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                    result.balls_under_clearance.size() == 1 ? " runs" : "es run", b.label.c_str(),
                    b.s_mm, b.clearance_mm, b.obstacle + 1);
     }
+    for (const std::string& why : result.loosened_solver)
+      std::fprintf(stderr, "warning: %s (report.json solver.loosened)\n", why.c_str());
     if (!result.settle_failures.empty())
       std::fprintf(stderr,
                    "warning: %zu pass%s (first: pass %d) could not start from the axis settled "

@@ -394,7 +394,7 @@ void readLinks(const Reader& r, const YAML::Node& node, pathgen::LinkParams& lin
     else
       links.safe_z_mm = r.number(
           node["safe_z"], "links.safe_z", [](double v) { return std::abs(v) <= 1e6; },
-          "`auto` or a height in mm");
+          "`auto` or a height in mm within 1e6 of 0");
   }
 }
 

@@ -162,6 +162,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
     }
   std::vector<char> started_settled(result.passes.size(), 0);
   std::vector<std::string> settle_failed(result.passes.size());  // why, where settling failed
+  std::vector<std::string> loosened(result.passes.size());  // why, where the solver was loosened
   struct Steered {
     std::vector<GeneratedPosture> postures;
     dynamics::SolverStats stats;
@@ -174,6 +175,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
     std::vector<Steered> steered_passes(result.passes.size());
     std::fill(started_settled.begin(), started_settled.end(), 0);  // this steering's own
     std::fill(settle_failed.begin(), settle_failed.end(), std::string());
+    std::fill(loosened.begin(), loosened.end(), std::string());
     int passes_done = 0;
     // Each pass's fraction done (its solver's intervals): the bar moves within a pass too (a
     // wide r0 makes one pass take minutes).
@@ -227,8 +229,23 @@ GenerateResult generatePath(const GenerateRequest& request) {
           pass_done[p] = std::clamp(fraction, 0.0, 1.0);
           return request.progress(fractionDone(), "passes");
         };
+      // Tolerances loosened for a pass whose integrator stalls (below).
+      dynamics::SteeringRequest looser = steer;
+      looser.params.rtol = std::max(params.rtol * 100.0, 1e-3);
+      looser.params.atol = std::max(params.atol * 1000.0, 1e-6);
       if (settle[p]) {
-        const dynamics::SettledStart at_rest = dynamics::settleAtStart(dyn_pass, steer);
+        dynamics::SettledStart at_rest = dynamics::settleAtStart(dyn_pass, steer);
+        if (!at_rest.settled) {  // the same stall at rest: settled with the looser tolerances
+          dynamics::SettledStart again = dynamics::settleAtStart(dyn_pass, looser);
+          if (again.settled) {
+            std::ostringstream why;
+            why << pass.label << ": the integrator failed settling at the start (" << at_rest.why
+                << "); settled with dynamics.rtol " << looser.params.rtol << ", atol "
+                << looser.params.atol;
+            loosened[p] = why.str();
+            at_rest = std::move(again);
+          }
+        }
         if (at_rest.settled) {  // else the nominal start: the pass reports what goes wrong
           steer.initial_lead_rad = at_rest.lead_rad;
           steer.initial_tilt_rad = at_rest.tilt_rad;
@@ -237,7 +254,24 @@ GenerateResult generatePath(const GenerateRequest& request) {
           settle_failed[p] = at_rest.why.empty() ? "the settling failed" : at_rest.why;
         }
       }
-      const dynamics::SteeringResult steered = dynamics::steerPass(dyn_pass, steer);
+      dynamics::SteeringResult steered = dynamics::steerPass(dyn_pass, steer);
+      // The integrator stalled (its step to 1e-10 mm where the interpolated field turns sharply:
+      // a start inside a wall on a 1 mm grid, a helper's overhang that --direct and rtol 1e-3
+      // steer clear): once more with the tolerances loosened, said. The path is checked exactly
+      // all the same; a second failure is the job's error.
+      if (steered.status == dynamics::Status::SolverFailed) {
+        looser.initial_lead_rad = steer.initial_lead_rad;
+        looser.initial_tilt_rad = steer.initial_tilt_rad;
+        dynamics::SteeringResult again = dynamics::steerPass(dyn_pass, looser);
+        if (again.status == dynamics::Status::Ok) {
+          std::ostringstream why;
+          why << pass.label << ": the integrator failed (" << steered.message
+              << "); steered again with dynamics.rtol " << looser.params.rtol << ", atol "
+              << looser.params.atol;
+          loosened[p] += (loosened[p].empty() ? "" : "; ") + why.str();
+          steered = std::move(again);
+        }
+      }
       if (steered.status != dynamics::Status::Ok) {
         std::ostringstream msg;
         msg << pass.label << ": " << dynamics::toString(steered.status) << ": " << steered.message;
@@ -422,6 +456,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
     if (started_settled[p]) result.settled_starts.push_back(result.passes[p].index);
     if (!settle_failed[p].empty())
       result.settle_failures.push_back({result.passes[p].index, settle_failed[p]});
+    if (!loosened[p].empty()) result.loosened_solver.push_back(loosened[p]);
   }
   for (Steered& s : steered_passes) {
     for (GeneratedPosture& g : s.postures) {

@@ -140,6 +140,9 @@ struct GenerateResult {
     std::string why;
   };
   std::vector<SettleFailure> settle_failures;
+  /// Passes whose integrator failed and that were steered again with dynamics.rtol and atol
+  /// loosened (to at least 1e-3 and 1e-6): one line each, the pass, CVODE's words, the tolerances.
+  std::vector<std::string> loosened_solver;
   /// Passes whose ball (its centre is held: only the axis turns) comes within `clearance` of an
   /// obstacle without touching it: no axis can clear that, so the job goes on and the path is
   /// marked under the required clearance (it refused the whole job over 0.0001 mm of a mesh's
