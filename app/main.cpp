@@ -19,6 +19,7 @@
 #include "errors.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/limits.h"
+#include "progress.h"
 #include "scene.h"
 
 #ifndef FIELDPATH_VERSION
@@ -70,6 +71,7 @@ bool standardOutputLost() {
   const bool flushed = std::fflush(stdout) == 0;
   const int error = errno;
   if (flushed && !std::ferror(stdout)) return false;
+  fieldpath::app::endProgressLine();
   std::fprintf(stderr, "fieldpath: error: cannot write the standard output%s%s\n",
                error != 0 ? ": " : "", error != 0 ? std::strerror(error) : "");
   return true;
@@ -141,6 +143,7 @@ int main(int argc, char** argv) {
       if (at->get_require_subcommand_min() > 0 && !subs.empty()) {
         std::string known;
         for (const CLI::App* c : subs) known += (known.empty() ? "" : ", ") + c->get_name();
+        fieldpath::app::endProgressLine();
         std::fprintf(stderr,
                      "fieldpath: error: unknown command '%s' (%s takes: %s; see --help)\n",
                      oneLine(arg.c_str()).c_str(), chain.c_str(), known.c_str());
@@ -152,15 +155,18 @@ int main(int argc, char** argv) {
       std::string known;  // `fieldpath` or `fieldpath field` alone
       for (const CLI::App* c : at->get_subcommands({}))
         known += (known.empty() ? "" : ", ") + c->get_name();
+      fieldpath::app::endProgressLine();
       std::fprintf(stderr, "fieldpath: error: %s needs a command: %s (see --help)\n",
                    chain.c_str(), known.c_str());
       return 1;
     }
     // A usage error is bad input: one line, exit 1 (CLI11's own report adds a second line).
+    fieldpath::app::endProgressLine();
     std::fprintf(stderr, "fieldpath: error: %s (see --help)\n", oneLine(e.what()).c_str());
     return 1;
   } catch (const InputError& e) {
     fieldpath::common::removeWrittenOutputs();  // a failed run leaves no partial set of outputs
+    fieldpath::app::endProgressLine();
     std::fprintf(stderr, "fieldpath: error: %s\n",
                  oneLine(placeSceneKey(e.what()).c_str()).c_str());
     return 1;
@@ -168,6 +174,7 @@ int main(int argc, char** argv) {
     // Reading or writing a path the user gave (an --out that is a file, a directory without
     // permission, a full disk): their environment, not our bug.
     fieldpath::common::removeWrittenOutputs();
+    fieldpath::app::endProgressLine();
     std::fprintf(stderr, "fieldpath: error: %s\n", oneLine(e.what()).c_str());
     return 1;
   } catch (const std::bad_alloc&) {
@@ -178,6 +185,7 @@ int main(int argc, char** argv) {
                                   ? std::string()
                                   : ", or the process's ulimit -v / -d (" +
                                         fieldpath::common::formatBytes(double(headroom)) + " left)";
+    fieldpath::app::endProgressLine();
     std::fprintf(stderr,
                  "fieldpath: error: out of memory (the machine's%s; --max-memory refuses large "
                  "work before it starts)\n",
@@ -187,11 +195,13 @@ int main(int argc, char** argv) {
     // A thread or a file the system would not give (`ulimit -u`, `ulimit -v` too small for a
     // thread's stack): the environment again.
     fieldpath::common::removeWrittenOutputs();
+    fieldpath::app::endProgressLine();
     std::fprintf(stderr, "fieldpath: error: the system refused a resource: %s\n",
                  oneLine(e.what()).c_str());
     return 1;
   } catch (const std::exception& e) {
     fieldpath::common::removeWrittenOutputs();
+    fieldpath::app::endProgressLine();
     std::fprintf(stderr, "fieldpath: internal error: %s\n", oneLine(e.what()).c_str());
     return 2;
   }

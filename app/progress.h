@@ -8,6 +8,20 @@
 
 namespace fieldpath::app {
 
+/// Whether a progress line is drawn without its line end: a message now would run on from it
+/// ("passes  30.0%  1.0 sfieldpath: error: ...", a helper's finding).
+inline bool& progressLineOpen() {
+  static bool open = false;
+  return open;
+}
+
+/// Ends a progress line left open, before a message of its own.
+inline void endProgressLine() {
+  if (!progressLineOpen()) return;
+  std::fputc('\n', stderr);
+  progressLineOpen() = false;
+}
+
 /// Makes a Progress hook that redraws one stderr line at most 10 times a second, and only once
 /// the work has run for a second. Quiet → a hook that never prints.
 inline common::Progress makeProgressLine(bool quiet) {
@@ -25,6 +39,7 @@ inline common::Progress makeProgressLine(bool quiet) {
     last = now;
     std::fprintf(stderr, "\r%-24.*s %5.1f%%  %6.1f s%s", static_cast<int>(what.size()), what.data(),
                  100.0 * fraction, elapsed_s, fraction >= 1.0 ? "\n" : "");
+    progressLineOpen() = fraction < 1.0;
     std::fflush(stderr);
     return true;
   };

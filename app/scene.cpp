@@ -494,6 +494,19 @@ Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
   if (root["dynamics"]) readDynamics(r, root["dynamics"], scene.dynamics);
   if (root["path"]) readPath(r, root["path"], scene.path);
   if (root["links"]) readLinks(r, root["links"], scene.links);
+  // A lead past the lead limit is held at it from the first posture (a helper's 50 deg read 20,
+  // unsaid, and the held posture collided).
+  if (std::abs(scene.path.lead_deg) > scene.dynamics.max_lead_deg) {
+    const YAML::Node at = root["path"] && root["path"]["lead_deg"] ? root["path"]["lead_deg"]
+                          : root["dynamics"] && root["dynamics"]["max_lead_deg"]
+                              ? root["dynamics"]["max_lead_deg"]
+                              : root;
+    r.fail(at, "path.lead_deg",
+           "must be within dynamics.max_lead_deg (lead " +
+               common::shortNumber(scene.path.lead_deg) + " deg, limit " +
+               common::shortNumber(scene.dynamics.max_lead_deg) +
+               " deg): the steering holds the lead inside the limit");
+  }
 
   // Meshes last: every key is checked before the slow part.
   std::vector<const MeshLoad*> obstacle_loads;

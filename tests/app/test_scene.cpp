@@ -184,6 +184,9 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
       {"obstacles:\n  - mesh: wall.stl\npath: { nominal: none.cl }\n", "path.nominal", 3},
       {"obstacles:\n  - mesh: wall.stl\ndynamics: { on_limit: stop }\n", "dynamics.on_limit", 3},
       {"obstacles:\n  - mesh: wall.stl\nlinks: { retract: -1 }\n", "links.retract", 3},
+      // A lead past the lead limit was held at it from the first posture, unsaid.
+      {"obstacles:\n  - mesh: wall.stl\npath: { lead_deg: 50 }\n",
+       "path.lead_deg: must be within dynamics.max_lead_deg (lead 50 deg, limit 20 deg)", 3},
       // 0: each link's last rapid move ended on the part, at the pass's first posture.
       {"obstacles:\n  - mesh: wall.stl\nlinks: { retract: 0 }\n",
        "links.retract: must be a distance in (0", 3},
