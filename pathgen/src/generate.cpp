@@ -229,20 +229,31 @@ GenerateResult generatePath(const GenerateRequest& request) {
           pass_done[p] = std::clamp(fraction, 0.0, 1.0);
           return request.progress(fractionDone(), "passes");
         };
-      // Tolerances loosened for a pass whose integrator stalls (below).
-      dynamics::SteeringRequest looser = steer;
-      looser.params.rtol = std::max(params.rtol * 100.0, 1e-3);
-      looser.params.atol = std::max(params.atol * 1000.0, 1e-6);
+      // The integrator stalled (its step to 1e-10 mm where the interpolated field turns sharply:
+      // a start inside a wall on a 1 mm grid, a helper's overhang that --direct and rtol 1e-3
+      // steer clear): once more with the tolerances loosened, said. The path is checked exactly
+      // all the same; a second failure is the job's error.
+      const auto loosen = [&] {  // a copy of the request as it stands, only when needed
+        dynamics::SteeringRequest looser = steer;
+        looser.params.rtol = std::max(params.rtol * 100.0, 1e-3);
+        looser.params.atol = std::max(params.atol * 1000.0, 1e-6);
+        return looser;
+      };
+      const auto sayLoosened = [&](const char* what, const std::string& why,
+                                   const dynamics::SteeringRequest& looser) {
+        std::ostringstream said;
+        said << pass.label << ": the integrator failed" << what << " (" << why << "); "
+             << "done again with dynamics.rtol " << looser.params.rtol << ", atol "
+             << looser.params.atol;
+        loosened[p] += (loosened[p].empty() ? "" : "; ") + said.str();
+      };
       if (settle[p]) {
         dynamics::SettledStart at_rest = dynamics::settleAtStart(dyn_pass, steer);
-        if (!at_rest.settled) {  // the same stall at rest: settled with the looser tolerances
+        if (!at_rest.settled) {  // the same stall at rest
+          const dynamics::SteeringRequest looser = loosen();
           dynamics::SettledStart again = dynamics::settleAtStart(dyn_pass, looser);
           if (again.settled) {
-            std::ostringstream why;
-            why << pass.label << ": the integrator failed settling at the start (" << at_rest.why
-                << "); settled with dynamics.rtol " << looser.params.rtol << ", atol "
-                << looser.params.atol;
-            loosened[p] = why.str();
+            sayLoosened(" settling at the start", at_rest.why, looser);
             at_rest = std::move(again);
           }
         }
@@ -255,20 +266,11 @@ GenerateResult generatePath(const GenerateRequest& request) {
         }
       }
       dynamics::SteeringResult steered = dynamics::steerPass(dyn_pass, steer);
-      // The integrator stalled (its step to 1e-10 mm where the interpolated field turns sharply:
-      // a start inside a wall on a 1 mm grid, a helper's overhang that --direct and rtol 1e-3
-      // steer clear): once more with the tolerances loosened, said. The path is checked exactly
-      // all the same; a second failure is the job's error.
       if (steered.status == dynamics::Status::SolverFailed) {
-        looser.initial_lead_rad = steer.initial_lead_rad;
-        looser.initial_tilt_rad = steer.initial_tilt_rad;
+        const dynamics::SteeringRequest looser = loosen();
         dynamics::SteeringResult again = dynamics::steerPass(dyn_pass, looser);
         if (again.status == dynamics::Status::Ok) {
-          std::ostringstream why;
-          why << pass.label << ": the integrator failed (" << steered.message
-              << "); steered again with dynamics.rtol " << looser.params.rtol << ", atol "
-              << looser.params.atol;
-          loosened[p] += (loosened[p].empty() ? "" : "; ") + why.str();
+          sayLoosened("", steered.message, looser);
           steered = std::move(again);
         }
       }
