@@ -323,6 +323,10 @@ void checkPlyHeader(const std::filesystem::path& file, std::uintmax_t size) {
         refuse(number, "element count does not fit in the file: " + line);
       lines_declared += count;
     } else if (word == "end_header") {
+      // The data starts on the byte after its line end: `end_header` and a vertical tab read as
+      // the header's end here while assimp took the body elsewhere and read past the file
+      // (SEGV, found by CI's smoke fuzz of fuzz_mesh).
+      if (line != "end_header") refuse(number, "`end_header` must be alone on its line");
       if (!format) refuse(number, "no `format` line");
       if (!ascii) return;
       // assimp reads a file with fewer (or more) lines than its elements silently: faces dropped

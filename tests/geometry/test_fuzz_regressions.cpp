@@ -80,6 +80,20 @@ TEST(FuzzRegressions, PlyElementCountBeyondTheFileIsRefused) {
                        "x\nproperty float y\nproperty float z\nend_header\n0 0 0\n");
 }
 
+// CI's smoke fuzz, fuzz_mesh crash-2b0d2aaa: a binary PLY whose `end_header` is followed by a
+// vertical tab, not a line end: read as the header's end here, assimp took the body elsewhere and
+// read past the file (SEGV). `end_header` must be alone on its line.
+TEST(FuzzRegressions, PlyEndHeaderNotAloneOnItsLineIsRefused) {
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float "
+      "y\nproperty float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header";
+  const std::string body(
+      "\x0b\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x80\x3f\x01\x00\x00\x00\x00\x00"
+      "\x00\x07\x00\x00\x00\x00\x00\x00\x80\x3f\x00\x00\x00\x00\x00\x02\x00\x00\x00",
+      42);
+  expectRefusedQuickly("vt.ply", header + body);
+}
+
 // fuzz_tool timeout-93cb5020: a 613 mm holder on a 1 mm ball. Nodes 0.5 mm apart (the target
 // tied the spacing to the ball) are ~10 M: work the user never asks for (generate and study pick
 // the spacing from the area). At a spacing from the area, the count is what the area says, fast.
