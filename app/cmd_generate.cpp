@@ -49,8 +49,15 @@ const char* startPolicyName(dynamics::StartPolicy start) {
   return "?";
 }
 
+/// The notes of a job (said on stdout and kept in report.json), each found once: the part's
+/// nearly-closed shells are a search of its edges.
+struct JobNotes {
+  std::vector<std::string> tool, obstacle, link;
+};
+
 nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& job,
-                          const pathgen::GenerateResult& r, const pathgen::AxisTurn& axis_turn) {
+                          const pathgen::GenerateResult& r, const pathgen::AxisTurn& axis_turn,
+                          const JobNotes& notes) {
   using nlohmann::json;
   json passes = json::array();
   json settled = json::array();  // 1-based, as per_pass
@@ -131,9 +138,9 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"link_part_skipped",
        r.link_part ? json(nullptr) : json("no `part` in the scene, or no links")},
       {"safe", unsafe.empty()},
-      {"tool_notes",
-       scene.nominal ? cutterNotes(scene.tool, *scene.nominal) : std::vector<std::string>{}},
-      {"obstacle_notes", openObstacleNotes(scene)},
+      {"tool_notes", notes.tool},
+      {"obstacle_notes", notes.obstacle},
+      {"link_notes", notes.link},
       {"unsafe", unsafe},
       {"links",
        {{"links", r.path.count(geometry::PathBlock::Kind::Link)},
@@ -350,8 +357,13 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     geometry::writeAptFile(out / "path.apt", result.path, header);
     common::writeTextAtomically(out / "angles.csv", anglesCsv(result));
     const pathgen::AxisTurn axis_turn = pathgen::largestAxisTurn(result.path, job.tool.radius_mm);
+    JobNotes notes;
+    if (scene.nominal) notes.tool = cutterNotes(scene.tool, *scene.nominal);
+    notes.obstacle = openObstacleNotes(scene);
+    if (std::string far = farLinkNote(scene, result.path); !far.empty())
+      notes.link.push_back(std::move(far));
     common::writeTextAtomically(out / "report.json",
-                                jsonText(reportJson(scene, job, result, axis_turn)));
+                                jsonText(reportJson(scene, job, result, axis_turn, notes)));
 
     const auto& c = result.clearance;
     const auto& m = result.motions;
@@ -401,13 +413,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                    result.settle_failures.size(), result.settle_failures.size() == 1 ? "" : "es",
                    result.settle_failures.front().pass + 1,
                    result.settle_failures.front().why.c_str());
-    if (scene.nominal)
-      for (const std::string& note : cutterNotes(scene.tool, *scene.nominal))
-        std::printf("note: %s\n", note.c_str());
-    for (const std::string& note : openObstacleNotes(scene))
-      std::printf("note: %s\n", note.c_str());
-    if (const std::string far = farLinkNote(scene, result.path); !far.empty())
-      std::printf("note: %s\n", far.c_str());
+    for (const auto* list : {&notes.tool, &notes.obstacle, &notes.link})
+      for (const std::string& note : *list) std::printf("note: %s\n", note.c_str());
     // A lead in the file is not kept: n is ⊥ the feed, steered (the field) or written as it is
     // (--nominal: the written axes were up to 5.6 deg off the file's, unsaid: a helper's finding).
     if (scene.nominal) {

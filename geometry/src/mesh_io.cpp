@@ -28,6 +28,7 @@
 #include "fieldpath/common/file_names.h"
 #include "fieldpath/common/input_file.h"
 #include "fieldpath/common/limits.h"
+#include "ply_check.h"
 
 namespace fieldpath::geometry {
 namespace {
@@ -277,80 +278,6 @@ StlFeed checkStl(const std::filesystem::path& file, std::uintmax_t size) {
   return binaryFeed(needed);
 }
 
-/// assimp's PLY loader trusts what a header says and loops forever on some malformed ones (no
-/// `end_header`; a `plyply` first line; found by tests/fuzz fuzz_mesh), and element counts size its
-/// allocations. So whatever assimp would take for PLY (the extension, or `ply` at the start) must
-/// have a header of the standard's grammar, read here first: `ply`, one `format` line of the
-/// three, `element NAME COUNT` with counts that fit in the file (every element takes at least one
-/// byte), `property ...`, `comment ...`, `obj_info ...`, and `end_header` within 64 KiB.
-void checkPlyHeader(const std::filesystem::path& file, std::uintmax_t size) {
-  std::ifstream in(file, std::ios::binary);
-  char magic[3] = {};
-  in.read(magic, 3);
-  const bool looks_ply = in.gcount() == 3 && std::string(magic, 3) == "ply";
-  if (!looks_ply && lowerExtension(file) != ".ply") return;  // assimp decides
-  in.seekg(0);
-  const auto refuse = [&](std::size_t number, const std::string& why) {
-    throw InputError(file.string() + ":" + std::to_string(number) + ": PLY header: " + why);
-  };
-  std::string line;
-  std::size_t read = 0, number = 0;
-  bool format = false, ascii = false;
-  double lines_declared = 0.0;  // an ASCII PLY holds one line per element instance
-  while (std::getline(in, line)) {
-    ++number;
-    read += line.size() + 1;
-    if (read > (std::size_t{64} << 10)) break;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    std::istringstream words(line);
-    std::string word;
-    words >> word;
-    if (number == 1) {
-      if (line != "ply") refuse(number, "the first line must be `ply`");
-    } else if (word == "format") {
-      std::string kind, version;
-      words >> kind >> version;
-      if (format || version != "1.0" ||
-          (kind != "ascii" && kind != "binary_little_endian" && kind != "binary_big_endian"))
-        refuse(number, "expected one `format ascii|binary_little_endian|binary_big_endian 1.0`");
-      format = true;
-      ascii = kind == "ascii";
-    } else if (word == "element") {
-      std::string name;
-      double count = -1;
-      words >> name >> count;
-      if (!words || count < 0 || count != std::floor(count) || count > static_cast<double>(size))
-        refuse(number, "element count does not fit in the file: " + line);
-      lines_declared += count;
-    } else if (word == "end_header") {
-      // The data starts on the byte after its line end: `end_header` and a vertical tab read as
-      // the header's end here while assimp took the body elsewhere and read past the file
-      // (SEGV, found by CI's smoke fuzz of fuzz_mesh).
-      if (line != "end_header") refuse(number, "`end_header` must be alone on its line");
-      if (!format) refuse(number, "no `format` line");
-      if (!ascii) return;
-      // assimp reads a file with fewer (or more) lines than its elements silently: faces dropped
-      // or made up at the end.
-      double lines = 0.0;
-      while (std::getline(in, line))
-        for (const char c : line)
-          if (!std::isspace(static_cast<unsigned char>(c))) {
-            ++lines;
-            break;
-          }
-      if (lines != lines_declared)
-        throw InputError(file.string() + ": ASCII PLY: its header declares " +
-                         std::to_string(static_cast<long long>(lines_declared)) +
-                         " element lines, the file has " + std::to_string(static_cast<long long>(lines)) +
-                         " (truncated, or the header's counts are wrong)");
-      return;
-    } else if (word != "property" && word != "comment" && word != "obj_info") {
-      refuse(number, "unexpected line '" + line.substr(0, 40) + "'");
-    }
-  }
-  throw InputError(file.string() + ": PLY header without `end_header` in its first 64 KiB");
-}
-
 /// A text mesh saved with a UTF-8 byte-order mark (Windows editors write one): assimp and the
 /// checks above read it as binary or as a bad first line ("header says 170926129 triangles",
 /// "vertex index out of range"). Not a binary STL whose 80-byte header happens to start so (its
@@ -435,7 +362,7 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
   // (a binary STL's 50-byte facet becomes 3 aiVector3D, a face, 3 map entries, 1.5 vertices).
   common::requireMemory(file.string(), 16.0 * static_cast<double>(size), "mesh file of " +
                         std::to_string(size >> 20) + " MiB");
-  checkPlyHeader(file, size);
+  detail::checkPly(file, size);
   const StlFeed stl = checkStl(file, size);
 
   Assimp::Importer importer;

@@ -213,3 +213,44 @@ TEST(GenerateEdges, AStalledIntegratorIsLoosenedOnceAndSaid) {
     EXPECT_NE(run.err.find("dynamics.rtol 0.001"), std::string::npos) << run.err;
   }
 }
+
+// Links climb along the tool axis: with an axis 60 deg from vertical and the travel plane 100 mm
+// up, the climb goes ~170 mm sideways, past a 20 x 32 mm part and rib. Said once, on stdout and in
+// report.json `link_notes` (it was on stdout only); none with the axis vertical.
+TEST(GenerateEdges, ALinkFarOutsideTheMeshesIsSaidInTheReport) {
+  const TempDir dir;
+  geometry::TriangleMesh plate, rib;
+  pathgen::test::addBox(plate, -10, 10, -10, 10, -5, 0);
+  pathgen::test::addBox(rib, -10, 10, 20, 22, -5, 5);
+  geometry::saveMesh(plate, dir.path() / "plate.stl");
+  geometry::saveMesh(rib, dir.path() / "rib.stl");
+  for (const bool tilted : {true, false}) {
+    const double s = tilted ? std::sin(M_PI / 3) : 0.0, c = tilted ? std::cos(M_PI / 3) : 1.0;
+    std::ostringstream cl;
+    for (int pass = 0; pass < 2; ++pass) {
+      cl << "# pass " << pass + 1 << "\n";
+      for (int i = -5; i <= 5; ++i)
+        cl << 2.0 * i << ' ' << 4.0 * pass << " 0 0 " << s << ' ' << c << "\n";
+    }
+    dir.write("p.cl", cl.str());
+    dir.write("scene.yaml",
+              "obstacles:\n  - mesh: rib.stl\npart: plate.stl\n"
+              "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n"
+              "links: { safe_z: 100 }\npath: { nominal: p.cl }\n");
+    const std::string out = tilted ? "tilted" : "vertical";
+    const auto r = test::runFieldpath(dir, "generate scene.yaml --nominal --out " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    const auto report = nlohmann::json::parse(test::slurp(dir.path() / out / "report.json"));
+    const std::size_t said = r.out.find("outside the meshes' x-y box") != std::string::npos;
+    EXPECT_EQ(report["link_notes"].size(), tilted ? 1u : 0u) << report["link_notes"];
+    EXPECT_EQ(said, tilted ? 1u : 0u) << r.out;
+    if (tilted) {
+      // The climb along the axis leaning 60 deg across the feed (+y) from z ~ 0 to where the
+      // holder clears z = 100: ~ 100 tan 60 = 173 mm sideways from y = 4, past the box's y = 22.
+      const std::string note = report["link_notes"][0];
+      const double outside = std::stod(note.substr(note.find(" lies ") + 6));
+      EXPECT_GT(outside, 120.0) << note;
+      EXPECT_LT(outside, 200.0) << note;
+    }
+  }
+}

@@ -1,0 +1,248 @@
+#include "ply_check.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/common/file_names.h"
+
+namespace fieldpath::geometry::detail {
+namespace {
+
+using common::InputError;
+
+/// One property of an element as its bytes lie in a binary body: a scalar of `item_bytes`, or a
+/// list: a count of `count_bytes` (signed or not), then that many items.
+struct PlyProperty {
+  int count_bytes = 0;  // 0: a scalar
+  bool count_signed = false;
+  int item_bytes = 0;
+};
+
+struct PlyElement {
+  std::string name;
+  std::uintmax_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+/// Bytes of a PLY scalar type by the names the standard and assimp know; nothing for others
+/// (assimp reads an unknown type as no bytes and the body goes out of step).
+std::optional<int> typeBytes(const std::string& type) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "int" || type == "uint" || type == "int32" || type == "uint32" || type == "float" ||
+      type == "float32")
+    return 4;
+  if (type == "double" || type == "float64") return 8;
+  return std::nullopt;
+}
+
+bool isSignedType(const std::string& type) {
+  return type == "char" || type == "int8" || type == "short" || type == "int16" || type == "int" ||
+         type == "int32";
+}
+
+/// The words of a header line (spaces or tabs between them).
+std::vector<std::string> wordsOf(const std::string& line) {
+  std::istringstream in(line);
+  std::vector<std::string> words;
+  for (std::string word; in >> word;) words.push_back(word);
+  return words;
+}
+
+/// Reads a binary file forward from any byte, a MiB at a time: the list counts of a body.
+class ByteReader {
+ public:
+  explicit ByteReader(const std::filesystem::path& file)
+      : file_(file), in_(file, std::ios::binary), buffer_(std::size_t{1} << 20) {}
+
+  /// The `bytes` bytes at `at` (the caller has checked that they lie in the file).
+  const unsigned char* at(std::uintmax_t at, int bytes) {
+    if (at < start_ || at + static_cast<std::uintmax_t>(bytes) > start_ + length_) {
+      in_.clear();
+      in_.seekg(static_cast<std::streamoff>(at));
+      in_.read(reinterpret_cast<char*>(buffer_.data()),
+               static_cast<std::streamsize>(buffer_.size()));
+      start_ = at;
+      length_ = static_cast<std::uintmax_t>(std::max<std::streamsize>(in_.gcount(), 0));
+      if (length_ < static_cast<std::uintmax_t>(bytes))
+        throw InputError(file_.string() + ": the file changed while it was read");
+    }
+    return buffer_.data() + (at - start_);
+  }
+
+ private:
+  std::filesystem::path file_;
+  std::ifstream in_;
+  std::vector<unsigned char> buffer_;
+  std::uintmax_t start_ = 0, length_ = 0;
+};
+
+/// A list's count as its bytes say, in the body's byte order; negative counts as -1.
+long long listCount(const unsigned char* bytes, const PlyProperty& property, bool big_endian) {
+  unsigned long long value = 0;
+  for (int k = 0; k < property.count_bytes; ++k) {
+    const int from = big_endian ? k : property.count_bytes - 1 - k;
+    value = value << 8 | bytes[from];
+  }
+  if (property.count_signed && (bytes[big_endian ? 0 : property.count_bytes - 1] & 0x80)) return -1;
+  return static_cast<long long>(value);
+}
+
+/// Walks a binary body from `at` element by element as the header declares it: every list count
+/// read (none negative), every byte within the file. Where it does not fit, assimp read past the
+/// file's end (a SEGV found by CI's smoke fuzz) or took counts from float bytes.
+void walkBinaryBody(const std::filesystem::path& file, std::uintmax_t size, std::uintmax_t at,
+                    const std::vector<PlyElement>& elements, bool big_endian) {
+  ByteReader reader(file);
+  // `instance` counted from 0, said from 1.
+  const auto cutShort = [&](const PlyElement& element, std::uintmax_t instance) {
+    throw InputError(file.string() + ": binary PLY: the body ends inside " + element.name + " " +
+                     std::to_string(instance + 1) + " of the " + std::to_string(element.count) +
+                     " its header declares (" + std::to_string(size) +
+                     " bytes: truncated, or the header's counts or types are wrong)");
+  };
+  for (const PlyElement& element : elements) {
+    const bool lists = std::any_of(element.properties.begin(), element.properties.end(),
+                                   [](const PlyProperty& p) { return p.count_bytes > 0; });
+    if (!lists) {
+      // Fixed-size instances: one step (no overflow: count <= size, stride <= 8 * properties).
+      std::uintmax_t stride = 0;
+      for (const PlyProperty& p : element.properties)
+        stride += static_cast<std::uintmax_t>(p.item_bytes);
+      if (stride > 0 && element.count > (size - at) / stride)
+        cutShort(element, (size - at) / stride);
+      at += stride * element.count;
+      continue;
+    }
+    for (std::uintmax_t instance = 0; instance < element.count; ++instance)
+      for (const PlyProperty& p : element.properties) {
+        if (p.count_bytes == 0) {
+          if (static_cast<std::uintmax_t>(p.item_bytes) > size - at) cutShort(element, instance);
+          at += static_cast<std::uintmax_t>(p.item_bytes);
+          continue;
+        }
+        if (static_cast<std::uintmax_t>(p.count_bytes) > size - at) cutShort(element, instance);
+        const long long n = listCount(reader.at(at, p.count_bytes), p, big_endian);
+        at += static_cast<std::uintmax_t>(p.count_bytes);
+        if (n < 0)
+          throw InputError(file.string() + ": binary PLY: " + element.name + " " +
+                           std::to_string(instance + 1) + " has a negative list count");
+        if (static_cast<std::uintmax_t>(n) >
+            (size - at) / static_cast<std::uintmax_t>(p.item_bytes))
+          cutShort(element, instance);
+        at += static_cast<std::uintmax_t>(n) * static_cast<std::uintmax_t>(p.item_bytes);
+      }
+  }
+}
+
+/// An ASCII body holds one line per element instance: assimp reads a file with fewer (or more)
+/// lines silently, faces dropped or made up at the end.
+void countAsciiLines(const std::filesystem::path& file, std::ifstream& in, double declared) {
+  double lines = 0.0;
+  for (std::string line; std::getline(in, line);)
+    for (const char c : line)
+      if (!std::isspace(static_cast<unsigned char>(c))) {
+        ++lines;
+        break;
+      }
+  if (lines != declared)
+    throw InputError(file.string() + ": ASCII PLY: its header declares " +
+                     std::to_string(static_cast<long long>(declared)) +
+                     " element lines, the file has " +
+                     std::to_string(static_cast<long long>(lines)) +
+                     " (truncated, or the header's counts are wrong)");
+}
+
+}  // namespace
+
+/// The header must be of the standard's grammar within 64 KiB: `ply`, one `format` line of the
+/// three, `element NAME COUNT` with counts that fit in the file (every instance of an element
+/// with properties takes at least one byte), `property TYPE NAME` or `property list TYPE TYPE
+/// NAME` of known types after an element, `comment ...`, `obj_info ...`, and `end_header` alone
+/// on its line. Then the body is checked against it.
+void checkPly(const std::filesystem::path& file, std::uintmax_t size) {
+  std::ifstream in(file, std::ios::binary);
+  char magic[3] = {};
+  in.read(magic, 3);
+  const bool looks_ply = in.gcount() == 3 && std::string(magic, 3) == "ply";
+  if (!looks_ply && common::lowerExtension(file) != ".ply") return;  // assimp decides
+  in.seekg(0);
+  const auto refuse = [&](std::size_t number, const std::string& why) {
+    throw InputError(file.string() + ":" + std::to_string(number) + ": PLY header: " + why);
+  };
+  std::string line;
+  std::uintmax_t read = 0;
+  std::size_t number = 0;
+  bool format = false, ascii = false, big_endian = false;
+  double lines_declared = 0.0;  // an ASCII PLY holds one line per element instance
+  std::vector<PlyElement> elements;
+  while (std::getline(in, line)) {
+    ++number;
+    read += line.size() + 1;
+    if (read > (std::uintmax_t{64} << 10)) break;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::vector<std::string> words = wordsOf(line);
+    const std::string word = words.empty() ? std::string() : words[0];
+    if (number == 1) {
+      if (line != "ply") refuse(number, "the first line must be `ply`");
+    } else if (word == "format") {
+      const std::string kind = words.size() > 1 ? words[1] : "";
+      if (format || words.size() != 3 || words[2] != "1.0" ||
+          (kind != "ascii" && kind != "binary_little_endian" && kind != "binary_big_endian"))
+        refuse(number, "expected one `format ascii|binary_little_endian|binary_big_endian 1.0`");
+      format = true;
+      ascii = kind == "ascii";
+      big_endian = kind == "binary_big_endian";
+    } else if (word == "element") {
+      double count = -1;
+      if (words.size() == 3) {
+        std::istringstream(words[2]) >> count;
+        if (words[2].find_first_not_of("0123456789") != std::string::npos) count = -1;
+      }
+      if (count < 0 || count > static_cast<double>(size))
+        refuse(number, "element count does not fit in the file: " + line.substr(0, 60));
+      lines_declared += count;
+      elements.push_back({words[1], static_cast<std::uintmax_t>(count), {}});
+    } else if (word == "property") {
+      if (elements.empty()) refuse(number, "a property before any element");
+      PlyProperty property;
+      const bool list = words.size() == 5 && words[1] == "list";
+      const std::string item = list ? words[3] : words.size() == 3 ? words[1] : "";
+      const auto item_bytes = typeBytes(item);
+      const auto count_bytes = list ? typeBytes(words[2]) : std::optional<int>(0);
+      if (!item_bytes || !count_bytes ||
+          (list && (words[2] == "float" || words[2] == "float32" || words[2] == "double" ||
+                    words[2] == "float64")))
+        refuse(number,
+               "expected `property TYPE NAME` or `property list COUNT-TYPE TYPE NAME` "
+               "(types char uchar short ushort int uint float double, or int8 ... float64; a "
+               "list's count an integer type): " +
+                   line.substr(0, 60));
+      property.item_bytes = *item_bytes;
+      property.count_bytes = *count_bytes;
+      property.count_signed = list && isSignedType(words[2]);
+      elements.back().properties.push_back(property);
+    } else if (word == "end_header") {
+      // The data starts on the byte after its line end: `end_header` and a vertical tab read as
+      // the header's end here while assimp took the body elsewhere and read past the file
+      // (SEGV, found by CI's smoke fuzz of fuzz_mesh).
+      if (line != "end_header") refuse(number, "`end_header` must be alone on its line");
+      if (!format) refuse(number, "no `format` line");
+      if (ascii) return countAsciiLines(file, in, lines_declared);
+      // (No line end after `end_header`: the body starts past the file's end.)
+      return walkBinaryBody(file, size, std::min(read, size), elements, big_endian);
+    } else if (word != "comment" && word != "obj_info") {
+      refuse(number, "unexpected line '" + line.substr(0, 40) + "'");
+    }
+  }
+  throw InputError(file.string() + ": PLY header without `end_header` in its first 64 KiB");
+}
+
+}  // namespace fieldpath::geometry::detail
