@@ -153,6 +153,65 @@ TEST(Law, PlaneIsIndependentOfSamplingDensityAndMatchesClosedForm) {
   }
 }
 
+/// The square [-a, a]² at height z, cut into 2 k² triangles, normal +z or (flipped) -z.
+TriangleMesh finePlane(double a, int k, double z, bool flipped = false) {
+  TriangleMesh m;
+  for (int j = 0; j <= k; ++j)
+    for (int i = 0; i <= k; ++i) m.vertices.emplace_back(-a + 2 * a * i / k, -a + 2 * a * j / k, z);
+  for (int j = 0; j < k; ++j)
+    for (int i = 0; i < k; ++i) {
+      const int v = j * (k + 1) + i;
+      if (flipped) {
+        m.triangles.push_back({v, v + k + 2, v + 1});
+        m.triangles.push_back({v, v + k + 1, v + k + 2});
+      } else {
+        m.triangles.push_back({v, v + 1, v + k + 2});
+        m.triangles.push_back({v, v + k + 2, v + k + 1});
+      }
+    }
+  return m;
+}
+
+// A surface tessellated finer than the sample step (CAD exports: 1 M triangles on 10^4 mm² gave
+// 1 M samples, 100× the density asked, and a 200 s field) is sampled about once per step²: its
+// small triangles merged per cell and normal direction, the area an exact partition still, the
+// field the plane's closed form as from two triangles.
+TEST(Sampling, AFineTessellationIsSampledAtTheStepAsked) {
+  FieldParams p;
+  const TriangleMesh fine = finePlane(8.0, 160, 0.0);  // 51 200 triangles of 0.005 mm²
+  const ObstacleSamples s = sampleObstacles({&fine, 1}, 1.0, Weights::Area);
+  const double area = 256.0;
+  EXPECT_NEAR(s.area_mm2, area, 1e-9 * area);
+  double total = 0.0;
+  for (std::size_t j = 0; j < s.size(); ++j) {
+    total += s.weights[j];
+    EXPECT_NEAR(s.normals[j].z(), 1.0, 1e-12);
+  }
+  EXPECT_NEAR(total, area, 1e-9 * area);
+  EXPECT_LE(s.size(), 2.0 * area);  // 256 cells of 1 mm² (was 51 200 samples)
+  EXPECT_GE(s.size(), area);
+  const DirectField direct(s, p);
+  for (double d : {1.0, 1.5, 2.0, 3.0, 4.0, 4.5}) {
+    const Vec3 x(0.3, -0.2, d);
+    const double exact = planeFieldMagnitude(d, p);
+    EXPECT_NEAR(direct.at(x).z(), exact, 0.02 * exact) << d;  // as the coarse plane above
+  }
+  // A sheet 0.3 mm thick, both faces fine and in the same layer of cells: its faces are not
+  // merged into each other (their normals would cancel): the force points away on each side.
+  std::vector<TriangleMesh> sheet{finePlane(8.0, 160, 0.65), finePlane(8.0, 160, 0.35, true)};
+  const ObstacleSamples both = sampleObstacles(sheet, 1.0, Weights::Area);
+  std::size_t up = 0, down = 0;
+  for (const Vec3& n : both.normals) (n.z() > 0.999 ? up : n.z() < -0.999 ? down : up) += 1;
+  EXPECT_EQ(up + down, both.size());
+  EXPECT_GE(up, std::size_t{256});
+  EXPECT_GE(down, std::size_t{256});
+  const DirectField sheet_field(both, p);
+  for (double d : {0.5, 1.0, 2.0}) {
+    EXPECT_GT(sheet_field.at(Vec3(0.3, -0.2, 0.65 + d)).z(), 0.0) << d;
+    EXPECT_LT(sheet_field.at(Vec3(0.3, -0.2, 0.35 - d)).z(), 0.0) << d;
+  }
+}
+
 TEST(Law, InsideAnObstacleTheForceIsFiniteAndOutward) {
   FieldParams p;
   const TriangleMesh cube = test::box(Vec3(-5, -5, -5), Vec3(5, 5, 5));
