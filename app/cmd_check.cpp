@@ -288,6 +288,11 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     if (motions.colliding == 0 && motions.under_required > 0)
       not_ok.push_back(std::to_string(motions.under_required) +
                        " motions come under the required clearance");
+    // A part given and never reached: the machined surface is unproven, most likely a path in
+    // other units or another frame (a helper's inch file 165 mm from its part read `ok: true`).
+    const bool part_never_reached = scene.part && !surface && !touches_part;
+    if (part_never_reached)
+      not_ok.push_back(std::string("the surface is not checked: ") + surface_skipped);
     if (surface && surface->gouged_lines > 0)
       not_ok.push_back(std::to_string(surface->gouged_lines) + " Z-buffer lines cut below the part "
                        "by more than the gouge tolerance (max " +
@@ -426,10 +431,11 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                    options->spacing_mm, surface->grid.dx_mm);
     if (rapids_onto_passes > 0)
       std::fprintf(stderr, "warning: %s (check.json unsafe)\n", unsafe.back().c_str());
-    if (never_cut && !touches_part)
+    if (part_never_reached)
       std::fprintf(stderr,
-                   "warning: the path never reaches the part (no line of the surface cut): is "
-                   "the part in the path's frame and units?\n");
+                   "warning: the path never reaches the part (%s): is the part in the path's "
+                   "frame and units? (check.json not ok)\n",
+                   never_cut ? "no line of the surface cut" : "no pass over it");
   });
 }
 

@@ -141,6 +141,9 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
     // The steering's frame (f, n, n x f) turns over with the feed: the same tilt would lean the
     // axis to the other side, into the wall it leaned away from.
     constexpr std::size_t kRecent = 3;
+    // A step back followed by one turned more than 30 deg from it is a step-over (a return
+    // leg's steps run alike).
+    const double kStepOverTurnCos = std::cos(30.0 * M_PI / 180.0);
     std::vector<Vec3> recent;
     for (std::size_t i = block.begin + 1; i < block.end; ++i) {
       const Vec3 step = centre(i) - centre(i - 1);
@@ -163,14 +166,30 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
       // An axis turned over (more than 90 deg) throws its centre 2R the other way: that is the
       // axis's fault, named at its line by nominalPasses, not a new leg.
       back = back && path.postures[i].axis.dot(path.postures[i - 1].axis) > 0.0;
-      if (back) {  // the new pass starts where this step does; the step-over before is the link
+      if (back) {
+        // The new pass starts where this step does, the step-over before it the link; but where
+        // this step is the step-over itself (it leans back against the leg, as a raster's does
+        // over a sloped floor where the tips follow the surface normal) and the next step turns
+        // from it, the new pass starts after it: this step is the link. (The leg's last posture
+        // went to the next pass, the step-over and its corner were cut inside it, and the frame
+        // turned over there: 16.8 deg in one step into a wall, a helper's finding.)
+        std::size_t start = i - 1;
+        if (i + 1 < block.end) {
+          const Vec3 next = centre(i + 1) - centre(i);
+          bool next_back = false;
+          for (const Vec3& before : recent) next_back = next_back || next.dot(before) < 0.0;
+          if (next_back && next.norm() > kRepeatMm && !(gap > 0.0 && next.norm() > gap) &&
+              next.normalized().dot(step.normalized()) < kStepOverTurnCos)
+            start = i;
+        }
         // A block that begins with its step-over (where the last one ended) leaves a leg of one
         // posture, the step-over's start: no pass of its own (was "a single posture"). Elsewhere
         // a leg of one posture stays an error of nominalPasses (a jitter back in a pass).
-        const bool step_over_start = begin == block.begin && i - 1 == begin + 1;
-        if (i - 1 > begin && !step_over_start) ranges.emplace_back(begin, i - 1);
-        begin = i - 1;
+        const bool step_over_start = begin == block.begin && start == begin + 1 && start == i - 1;
+        if (start > begin && !step_over_start) ranges.emplace_back(begin, start);
+        begin = start;
         recent.clear();
+        if (start == i) continue;  // the step-over is no feed direction of the new pass
       }
       recent.push_back(step);
       if (recent.size() > kRecent) recent.erase(recent.begin());

@@ -167,7 +167,8 @@ TEST(CheckSurface, ALonePassHasNoScallop) {
 }
 
 // Tips 5 mm over the plate (the stock stands 2 mm over it): nothing is cut, so nothing of the
-// surface is checked (it read 2000 um of 'scallop', ok, and surface_skipped null).
+// surface is checked (it read 2000 um of 'scallop', ok, and surface_skipped null), and the check
+// is not ok.
 TEST(CheckSurface, APathThatNeverCutsThePartIsNotChecked) {
   const TempDir dir;
   writePlateScene(dir);
@@ -181,6 +182,12 @@ TEST(CheckSurface, APathThatNeverCutsThePartIsNotChecked) {
   EXPECT_TRUE(report["surface"].is_null()) << report;
   ASSERT_TRUE(report["surface_skipped"].is_string()) << report;
   EXPECT_NE(report["surface_skipped"].get<std::string>().find("never cuts"), std::string::npos);
+  // Not ok: the part was given and the path never reached it (another frame or units; it read
+  // ok: a helper's inch file 165 mm from its part).
+  EXPECT_FALSE(report["ok"].get<bool>()) << report;
+  ASSERT_EQ(report["not_ok_because"].size(), 1u) << report;
+  EXPECT_NE(report["not_ok_because"][0].get<std::string>().find("the surface is not checked"),
+            std::string::npos);
   for (const char* stale : {"deviation.npy", "deviation.json", "deviation.png"})
     EXPECT_FALSE(fs::exists(dir.path() / "out" / stale)) << stale;
 }

@@ -117,6 +117,23 @@ TEST(Passes, AZigZagInOnePassBlockIsOnePassALeg) {
   ASSERT_EQ(legs.size(), 2u);
   EXPECT_EQ(legs[0], std::make_pair(std::size_t{0}, std::size_t{11}));
   EXPECT_EQ(legs[1], std::make_pair(std::size_t{12}, std::size_t{24}));
+  // Step-overs that lean back against the leg they end (a raster over a sloped floor, its tips
+  // below centres on the surface normal: a helper's pocket): the leg keeps its last posture and
+  // the step-over is the link (the leg's end went to the next pass, its corner cut in it).
+  geometry::PathFile leaning;
+  const auto legFrom = [&](double x0, double y, double dx) {
+    for (int k = 0; k <= 10; ++k)
+      leaning.postures.push_back({Vec3(x0 + dx * k, y, 0), Vec3::UnitZ()});
+  };
+  legFrom(0, 0, 1);     // 0-10, ends at x = 10
+  legFrom(9.8, 1, -1);  // 11-21: the step-over 10 -> 11 leans back 0.2 mm
+  legFrom(0.3, 2, 1);   // 22-32: this one 0.3 mm forward
+  leaning.blocks = {{geometry::PathBlock::Kind::Pass, 0, leaning.postures.size()}};
+  const auto leaning_legs = passRanges(leaning, 0.0, 1.0);
+  ASSERT_EQ(leaning_legs.size(), 3u);
+  EXPECT_EQ(leaning_legs[0], std::make_pair(std::size_t{0}, std::size_t{11}));
+  EXPECT_EQ(leaning_legs[1], std::make_pair(std::size_t{11}, std::size_t{22}));
+  EXPECT_EQ(leaning_legs[2], std::make_pair(std::size_t{22}, std::size_t{33}));
   // A corner of 90 deg (an L) is one pass still.
   geometry::PathFile corner;
   for (int k = 0; k <= 10; ++k) corner.postures.push_back({Vec3(k, 0, 0), Vec3::UnitZ()});
