@@ -62,6 +62,10 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
   json passes = json::array();
   json settled = json::array();  // 1-based, as per_pass
   for (const int p : r.settled_starts) settled.push_back(p + 1);
+  json kept_nominal = json::array();
+  for (const auto& k : r.kept_nominal)
+    kept_nominal.push_back(
+        {{"pass", k.pass + 1}, {"at", k.label}, {"steered_colliding", k.steered_colliding}});
   json balls_under = json::array();
   for (const auto& b : r.balls_under_clearance)
     balls_under.push_back({{"pass", b.pass + 1},
@@ -164,6 +168,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"max_lead_deg", r.max_lead_deg},
       // The balls themselves within `clearance` (no axis clears them): what marks such a path.
       {"balls_under_clearance", balls_under},
+      {"kept_nominal", kept_nominal},
       {"axis_turn", axisTurnJson(axis_turn)},
       {"start",
        {{"policy", startPolicyName(job.dynamics.start)},
@@ -393,6 +398,17 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     // narrower than the holder; unsafe there too, but the turn is its own warning)
     if (const std::string turn = axisTurnWarning(result.path, axis_turn); !turn.empty())
       std::fprintf(stderr, "warning: %s (report.json axis_turn)\n", turn.c_str());
+    if (!result.kept_nominal.empty()) {
+      const auto& k = result.kept_nominal.front();
+      std::fprintf(stderr,
+                   "warning: %zu pass%s collided steered (first: %s, %zu postures and motions: "
+                   "the field of the obstacles turned the tool into them or into the part, which "
+                   "never repels) and %s written with the nominal axes, which clear the obstacles "
+                   "and the part (report.json kept_nominal)\n",
+                   result.kept_nominal.size(), result.kept_nominal.size() == 1 ? "" : "es",
+                   k.label.c_str(), k.steered_colliding,
+                   result.kept_nominal.size() == 1 ? "is" : "are");
+    }
     if (!result.balls_under_clearance.empty()) {
       const auto& b = result.balls_under_clearance.front();
       std::fprintf(stderr,

@@ -21,8 +21,9 @@
 #include "fieldpath/field/voxel_field.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/geometry/units.h"
-#include "open_sheets.h"
 #include "fieldpath/pathgen/reach_box.h"
+#include "nominal_fallback.h"
+#include "open_sheets.h"
 
 namespace fieldpath::pathgen {
 namespace {
@@ -479,49 +480,59 @@ GenerateResult generatePath(const GenerateRequest& request) {
 
   // ---- links, then the exact clearance of every posture and motion ----------------------------
   const auto clearance_start = Clock::now();
-  std::vector<std::vector<geometry::Posture>> pass_postures(result.passes.size());
-  for (const GeneratedPosture& g : result.postures) pass_postures[g.pass].push_back(g.posture);
-  if (request.passes_only) {
-    for (const auto& postures : pass_postures)
-      for (const auto& p : postures) result.path.postures.push_back(p);
-    result.path = geometry::singlePass(std::move(result.path.postures));
-  } else {
-    LinkRequest links;
-    links.params = request.links;
-    links.tool = tool;
-    links.holder = request.holder;
-    links.safe_z_mm = safe_z_mm;
-    result.safe_z_mm = links.safe_z_mm;
-    result.path = linkPasses(pass_postures, links);
-  }
-  // Where each pass posture landed in the output path.
-  {
-    std::size_t next = 0;
-    for (const geometry::PathBlock& block : result.path.blocks) {
-      if (block.kind == geometry::PathBlock::Kind::Link) {
-        result.link_postures += block.size();
-        continue;
+  std::optional<PartContacts::Marks> part_marks;  // of result.path, where the part is touched
+  const auto linkAndCheck = [&] {
+    std::vector<std::vector<geometry::Posture>> pass_postures(result.passes.size());
+    for (const GeneratedPosture& g : result.postures) pass_postures[g.pass].push_back(g.posture);
+    result.link_postures = 0;
+    result.path = {};
+    if (request.passes_only) {
+      for (const auto& postures : pass_postures)
+        for (const auto& p : postures) result.path.postures.push_back(p);
+      result.path = geometry::singlePass(std::move(result.path.postures));
+    } else {
+      LinkRequest links;
+      links.params = request.links;
+      links.tool = tool;
+      links.holder = request.holder;
+      links.safe_z_mm = safe_z_mm;
+      result.safe_z_mm = links.safe_z_mm;
+      result.path = linkPasses(pass_postures, links);
+    }
+    // Where each pass posture landed in the output path.
+    {
+      std::size_t next = 0;
+      for (const geometry::PathBlock& block : result.path.blocks) {
+        if (block.kind == geometry::PathBlock::Kind::Link) {
+          result.link_postures += block.size();
+          continue;
+        }
+        for (std::size_t i = block.begin; i < block.end; ++i) result.postures[next++].output = i;
       }
-      for (std::size_t i = block.begin; i < block.end; ++i) result.postures[next++].output = i;
     }
-  }
-  for (const GeneratedPosture& g : result.postures)
-    if (g.limited) result.path.limited.push_back(g.output);
-  result.clearance =
-      checker.check(result.path.postures, {}, scaled(request.progress, 0.9, 0.93, "clearance"));
-  if (!request.passes_only) {
-    MotionRequest motions;
-    motions.required_mm = request.clearance_mm;
-    motions.posture_clearance_mm = result.clearance.clearance_mm;
-    result.motions = checker.checkMotions(result.path.postures, motions,
-                                          scaled(request.progress, 0.93, 1.0, "motions"));
-    if (request.part) {
-      PartContacts contacts = checkAgainstPart(tool, request.holder, *request.part, result.path);
-      result.link_part = std::move(contacts.links);
-      result.holder_part = std::move(contacts.holder);
-      result.cutter_part = std::move(contacts.cutter);
+    for (const GeneratedPosture& g : result.postures)
+      if (g.limited) result.path.limited.push_back(g.output);
+    result.clearance =
+        checker.check(result.path.postures, {}, scaled(request.progress, 0.9, 0.93, "clearance"));
+    if (!request.passes_only) {
+      MotionRequest motions;
+      motions.required_mm = request.clearance_mm;
+      motions.posture_clearance_mm = result.clearance.clearance_mm;
+      result.motions = checker.checkMotions(result.path.postures, motions,
+                                            scaled(request.progress, 0.93, 1.0, "motions"));
+      if (request.part) {
+        PartContacts contacts = checkAgainstPart(tool, request.holder, *request.part, result.path);
+        part_marks = contacts.marks(result.path.postures.size());
+        result.link_part = std::move(contacts.links);
+        result.holder_part = std::move(contacts.holder);
+        result.cutter_part = std::move(contacts.cutter);
+      }
     }
-  }
+  };
+  linkAndCheck();
+  if (!request.nominal && !request.passes_only &&
+      keepClearNominalPasses(request, checker, result, part_marks))
+    linkAndCheck();
   for (GeneratedPosture& g : result.postures) {
     g.clearance_mm = result.clearance.clearance_mm[g.output];
     result.max_tilt_deg = std::max(result.max_tilt_deg, std::abs(g.tilt_rad) / kDegToRad);

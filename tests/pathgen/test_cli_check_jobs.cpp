@@ -217,12 +217,15 @@ TEST(CheckClearance, ABoxWithExportDefectsIsMendedAndItsInsideCounts) {
 // both marks: a pass started upright beside a wall 0.3 mm from its holder (start: nominal, damped
 // for the spring alone) swings so far (tilt limit 89°) that the holder goes into the part: UNSAFE;
 // the first posture keeps 0.29 mm from the wall: UNDER THE REQUIRED CLEARANCE too (only the first
-// was said: a helper's finding).
+// was said: a helper's finding). A block of the part at the pass's end, on the side away from the
+// wall, meets the upright holder too: the nominal pass is no way out (a pass the steering drives
+// into the part is written nominal where the nominal is clear).
 TEST(CheckClearance, UnsafeAndUnderTheClearanceAreBothMarked) {
   const TempDir dir;
   geometry::TriangleMesh wall, part;
   pathgen::test::addBox(wall, -20, 120, 12.3, 14, -2, 60);  // 0.3 mm from the holder's r 12
   pathgen::test::addBox(part, -30, 130, -40, 40, -5, 0);
+  pathgen::test::addBox(part, 95, 130, -40, -11.5, 0, 60);  // 0.5 mm into the upright holder
   geometry::saveMesh(wall, dir.path() / "wall.stl");
   geometry::saveMesh(part, dir.path() / "part.stl");
   std::string cl = "# pass 1\n";
@@ -238,6 +241,7 @@ TEST(CheckClearance, UnsafeAndUnderTheClearanceAreBothMarked) {
   ASSERT_EQ(r.exit_code, 0) << r.output();
   const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out" / "report.json"));
   ASSERT_FALSE(report["unsafe"].empty()) << report["unsafe"];  // the holder into the part
+  ASSERT_EQ(report["kept_nominal"].size(), 0u);
   ASSERT_EQ(report["clearance"]["colliding_postures"].get<int>(), 0);
   ASSERT_LT(report["clearance"]["min_mm"].get<double>(), 0.5);
   const std::string cl_out = test::slurp(dir.path() / "out" / "path.cl");

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/mesh_io.h"
 #include "fixtures.h"
 #include "run_fieldpath.h"
@@ -251,6 +252,58 @@ TEST(GenerateEdges, ALinkFarOutsideTheMeshesIsSaidInTheReport) {
       const double outside = std::stod(note.substr(note.find(" lies ") + 6));
       EXPECT_GT(outside, 120.0) << note;
       EXPECT_LT(outside, 200.0) << note;
+    }
+  }
+}
+
+// The part never repels: a pass between a post (the obstacle) and a tall wall of the part, the
+// holder 1 mm from the post when vertical, is tilted ~17 deg away from the post by the field and
+// its holder driven into the part's wall (a helper's mould cavity: 458 postures, marked UNSAFE,
+// where the nominal loops were clear). The pass is written with its nominal axes, which clear
+// both, and said; with the post 2 mm nearer the nominal pass collides too and the steered one
+// stays (marked).
+TEST(GenerateEdges, APassTheSteeringDrivesIntoThePartKeepsItsClearNominalAxes) {
+  const TempDir dir;
+  geometry::TriangleMesh part;
+  pathgen::test::addBox(part, -30, 12, -30, 30, -5, 0);  // the floor the ball runs on
+  pathgen::test::addBox(part, 12, 20, -30, 30, -5, 60);  // a wall of the part, 4 mm off the holder
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  for (const double post_x : {-11.0, -9.0}) {
+    geometry::TriangleMesh post;
+    pathgen::test::addBox(post, post_x, post_x + 2, -30, 30, 0, 30);
+    geometry::saveMesh(post, dir.path() / "post.stl");
+    std::ostringstream cl;
+    cl << "# pass 1\n";
+    for (int i = -20; i <= 20; ++i) cl << "0 " << 0.5 * i << " 0 0 0 1\n";
+    dir.write("p.cl", cl.str());
+    dir.write("scene.yaml",
+              "obstacles:\n  - mesh: post.stl\npart: part.stl\n"
+              "tool: { shape: ball, radius: 3, length: 20 }\nholder: [[20, 8], [40, 8]]\n"
+              "clearance: 0.5\npath: { nominal: p.cl }\n");
+    const auto steered = test::runFieldpath(dir, "generate scene.yaml --out steered");
+    ASSERT_EQ(steered.exit_code, 0) << steered.output();
+    const auto report = nlohmann::json::parse(test::slurp(dir.path() / "steered/report.json"));
+    if (post_x == -9.0) {  // the holder's radius 8 reaches into the post at x -9..-7 either way
+      EXPECT_EQ(report["kept_nominal"].size(), 0u) << report["kept_nominal"];
+      EXPECT_FALSE(report["safe"].get<bool>());
+      continue;
+    }
+    ASSERT_EQ(report["kept_nominal"].size(), 1u) << steered.output();
+    EXPECT_EQ(report["kept_nominal"][0]["pass"].get<int>(), 1);
+    EXPECT_GT(report["kept_nominal"][0]["steered_colliding"].get<int>(), 10);
+    EXPECT_NE(steered.err.find("written with the nominal axes"), std::string::npos) << steered.err;
+    EXPECT_TRUE(report["safe"].get<bool>()) << report["unsafe"];
+    EXPECT_EQ(report["holder_part"]["colliding_postures"].get<int>(), 0);
+    // The holder 1 mm from the post, less the clearance mesh's chordal error.
+    EXPECT_NEAR(report["clearance"]["min_mm"].get<double>(), 1.0, 0.03);
+    // The postures are --nominal's, bit for bit.
+    ASSERT_EQ(test::runFieldpath(dir, "generate scene.yaml --nominal --out nominal").exit_code, 0);
+    const geometry::PathFile a = geometry::readPathFile(dir.path() / "steered/path.cl");
+    const geometry::PathFile b = geometry::readPathFile(dir.path() / "nominal/path.cl");
+    ASSERT_EQ(a.postures.size(), b.postures.size());
+    for (std::size_t i = 0; i < a.postures.size(); ++i) {
+      EXPECT_EQ(a.postures[i].tip_mm, b.postures[i].tip_mm) << i;
+      EXPECT_EQ(a.postures[i].axis, b.postures[i].axis) << i;
     }
   }
 }

@@ -154,6 +154,15 @@ struct GenerateResult {
     int obstacle = 0;  ///< 0-based
   };
   std::vector<BallUnderClearance> balls_under_clearance;
+  /// Passes that collided steered (with the obstacles, or the holder or the cutter with the
+  /// part) and are written with their nominal axes, which clear them at every posture and motion
+  /// (the part never repels: steering away from an obstacle can drive the holder into it).
+  struct KeptNominal {
+    int pass = 0;                       ///< Pass::index
+    std::string label;                  ///< the pass and its line
+    std::size_t steered_colliding = 0;  ///< postures and in-pass motions that collided steered
+  };
+  std::vector<KeptNominal> kept_nominal;
   StageTimes times;
   std::size_t obstacle_points = 0;  ///< field samples
   std::size_t tool_nodes = 0;       ///< tool + holder nodes of the moment

@@ -1,0 +1,24 @@
+#pragma once
+/// Passes the steering made collide, written with their nominal axes where those are clear.
+#include <optional>
+
+#include "fieldpath/pathgen/clearance.h"
+#include "fieldpath/pathgen/generate.h"
+#include "fieldpath/pathgen/link_check.h"
+
+namespace fieldpath::pathgen {
+
+/// The passes of `result` whose steered postures or motions collide (`result.clearance` and
+/// `result.motions` of the linked `result.path`, and `part_marks`: the holder or the cutter in
+/// the part) and whose nominal axes (the pass's axis made square to the feed, path.lead_deg, no
+/// tilt) clear the obstacles and the part at every posture and motion: their postures in
+/// `result.postures` replaced by the nominal ones, listed in `result.kept_nominal`. The part never
+/// repels, so the steering can turn a clear pass into a crash (a helper's mould cavity: the axis
+/// tilted 23 deg away from a boss, into the cavity's draft walls); a pass that collides either
+/// way keeps its steering. Returns whether any pass was replaced (the caller links and checks
+/// the path again).
+bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceChecker& checker,
+                            GenerateResult& result,
+                            const std::optional<PartContacts::Marks>& part_marks);
+
+}  // namespace fieldpath::pathgen
