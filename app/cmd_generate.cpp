@@ -400,14 +400,15 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
       std::fprintf(stderr, "warning: %s (report.json axis_turn)\n", turn.c_str());
     if (!result.kept_nominal.empty()) {
       const auto& k = result.kept_nominal.front();
-      std::fprintf(stderr,
-                   "warning: %zu pass%s collided steered (first: %s, %zu postures and motions: "
-                   "the field of the obstacles turned the tool into them or into the part, which "
-                   "never repels) and %s written with the nominal axes, which clear the obstacles "
-                   "and the part (report.json kept_nominal)\n",
-                   result.kept_nominal.size(), result.kept_nominal.size() == 1 ? "" : "es",
-                   k.label.c_str(), k.steered_colliding,
-                   result.kept_nominal.size() == 1 ? "is" : "are");
+      std::fprintf(
+          stderr,
+          "warning: %zu pass%s collided steered (first: %s, %zu postures colliding there or "
+          "on the move to the next: "
+          "the field of the obstacles turned the tool into them or into the part, which "
+          "never repels) and %s written with the nominal axes, which clear the obstacles "
+          "and the part (report.json kept_nominal)\n",
+          result.kept_nominal.size(), result.kept_nominal.size() == 1 ? "" : "es", k.label.c_str(),
+          k.steered_colliding, result.kept_nominal.size() == 1 ? "is" : "are");
     }
     if (!result.balls_under_clearance.empty()) {
       const auto& b = result.balls_under_clearance.front();

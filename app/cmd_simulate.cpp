@@ -219,6 +219,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     std::optional<geometry::TriangleMesh> part;
     double part_top_z = -HUGE_VAL;
     if (!o->part.empty()) {
+      sayReading(o->part);
       part = geometry::loadMesh(o->part);
       for (const auto& v : part->vertices) part_top_z = std::max(part_top_z, double(v.z()));
     }

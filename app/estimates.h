@@ -39,7 +39,8 @@ void checkSampleStep(const Scene& scene, double step_mm, const std::string& key)
 /// `key` names where h came from.
 void checkVoxelSize(const Scene& scene, double voxel_mm, const std::string& key);
 
-/// The obstacle samples at `step_mm` (the count sampleObstacles makes, to the sample).
+/// The obstacle samples at `step_mm`: the count sampleObstacles makes, to the sample, but for a
+/// bound on the merged ones of triangles finer than the step.
 double sampleCount(const Scene& scene, double step_mm);
 
 }  // namespace fieldpath::app

@@ -98,7 +98,8 @@ int main(int argc, char** argv) {
   app.add_option("--max-memory", max_memory,
                  "Refuse work whose estimated memory exceeds this (e.g. 512M, 4G; default: the "
                  "machine's available memory)");
-  app.parse_complete_callback([&max_memory] {
+  app.parse_complete_callback([&max_memory, &global] {
+    fieldpath::app::progressQuiet() = global.quiet;
     if (!max_memory.empty())
       fieldpath::common::setMemoryLimitBytes(
           fieldpath::common::parseMemorySize(max_memory, "--max-memory"));

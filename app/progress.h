@@ -1,7 +1,9 @@
 #pragma once
 /// The CLI's progress line on stderr (for work over a second; silenced by --quiet).
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include "fieldpath/common/progress.h"
@@ -13,6 +15,13 @@ namespace fieldpath::app {
 inline bool& progressLineOpen() {
   static bool open = false;
   return open;
+}
+
+/// --quiet, for the lines drawn outside a command's own Progress hook (set once its options are
+/// parsed).
+inline bool& progressQuiet() {
+  static bool quiet = false;
+  return quiet;
 }
 
 /// Ends a progress line left open, before a message of its own.
@@ -43,6 +52,19 @@ inline common::Progress makeProgressLine(bool quiet) {
     std::fflush(stderr);
     return true;
   };
+}
+
+/// A line before a big mesh file is read (assimp says nothing while it reads: a 300 MB STL took
+/// 133 s before the first progress line, a scale sweep's finding). Files under 32 MiB read in
+/// about a second: nothing.
+inline void sayReading(const std::filesystem::path& file) {
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(file, ec);
+  if (progressQuiet() || ec || size < (std::uintmax_t{32} << 20)) return;
+  endProgressLine();
+  std::fprintf(stderr, "reading %s (%ju MiB) ...\n", file.string().c_str(),
+               static_cast<std::uintmax_t>(size >> 20));
+  std::fflush(stderr);
 }
 
 }  // namespace fieldpath::app

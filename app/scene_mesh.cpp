@@ -8,6 +8,7 @@
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/limits.h"
 #include "fieldpath/geometry/mesh_io.h"
+#include "progress.h"
 
 namespace fieldpath::app {
 namespace {
@@ -39,6 +40,7 @@ void mendExportDefects(geometry::TriangleMesh& mesh, const std::filesystem::path
 }  // namespace
 
 geometry::TriangleMesh loadSceneMesh(const std::filesystem::path& file) {
+  sayReading(file);
   geometry::TriangleMesh mesh = geometry::loadMesh(file);
   // Every triangle degenerate: no surface to sample or to machine (it was read, and the field
   // was zero everywhere without a word: a helper's finding).

@@ -99,8 +99,16 @@ long long listCount(const unsigned char* bytes, const PlyProperty& property, boo
 /// read (none negative), every byte within the file. Where it does not fit, assimp read past the
 /// file's end (a SEGV found by CI's smoke fuzz) or took counts from float bytes.
 void walkBinaryBody(const std::filesystem::path& file, std::uintmax_t size, std::uintmax_t at,
-                    const std::vector<PlyElement>& elements, bool big_endian) {
+                    const std::vector<PlyElement>& elements, bool big_endian, bool crlf_header) {
   ByteReader reader(file);
+  // assimp 5.2 skips a line end after `end_header\n`: a body whose first byte is 0x0A (1 in 256
+  // of binary files: the first float's lowest byte) is read one byte late ("no triangles", or
+  // counts from the wrong bytes: a reviewer's file). After `end_header\r\n` it is read right.
+  if (at < size && !crlf_header && *reader.at(at, 1) == '\n')
+    throw InputError(file.string() +
+                     ": binary PLY: its body starts with the byte 0x0A, which assimp 5.2 reads "
+                     "as part of the header's line end and then misreads the file: save it with "
+                     "CRLF header lines, or as STL");
   // `instance` counted from 0, said from 1.
   const auto cutShort = [&](const PlyElement& element, std::uintmax_t instance) {
     throw InputError(file.string() + ": binary PLY: the body ends inside " + element.name + " " +
@@ -187,7 +195,8 @@ void checkPly(const std::filesystem::path& file, std::uintmax_t size) {
     ++number;
     read += line.size() + 1;
     if (read > (std::uintmax_t{64} << 10)) break;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const bool crlf = !line.empty() && line.back() == '\r';
+    if (crlf) line.pop_back();
     const std::vector<std::string> words = wordsOf(line);
     const std::string word = words.empty() ? std::string() : words[0];
     if (number == 1) {
@@ -237,7 +246,7 @@ void checkPly(const std::filesystem::path& file, std::uintmax_t size) {
       if (!format) refuse(number, "no `format` line");
       if (ascii) return countAsciiLines(file, in, lines_declared);
       // (No line end after `end_header`: the body starts past the file's end.)
-      return walkBinaryBody(file, size, std::min(read, size), elements, big_endian);
+      return walkBinaryBody(file, size, std::min(read, size), elements, big_endian, crlf);
     } else if (word != "comment" && word != "obj_info") {
       refuse(number, "unexpected line '" + line.substr(0, 40) + "'");
     }

@@ -1,11 +1,12 @@
 #include "nominal_fallback.h"
 
+#include <memory>
 #include <string>
 #include <vector>
 
-#include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/geometry/units.h"
+#include "fieldpath/pathgen/cutter_part.h"
 #include "fieldpath/pathgen/passes.h"
 
 namespace fieldpath::pathgen {
@@ -31,8 +32,10 @@ std::vector<std::size_t> collidingByPass(const GenerateResult& result,
   return colliding;
 }
 
-/// Whether `postures` (one pass) clear the obstacles and the part at every posture and motion.
+/// Whether `postures` (one pass) clear the obstacles and the part (`part`: its model, prepared
+/// once for every pass tried: a 1 M-triangle part takes seconds) at every posture and motion.
 bool clearPass(const GenerateRequest& request, const ClearanceChecker& checker,
+               const std::shared_ptr<const ObstacleModel>& part,
                const std::vector<geometry::Posture>& postures) {
   const ClearanceResult at_postures = checker.check(postures);
   if (at_postures.colliding > 0) return false;
@@ -40,10 +43,12 @@ bool clearPass(const GenerateRequest& request, const ClearanceChecker& checker,
   motions.required_mm = request.clearance_mm;
   motions.posture_clearance_mm = at_postures.clearance_mm;
   if (checker.checkMotions(postures, motions).colliding > 0) return false;
-  if (!request.part) return true;
-  const PartContacts part =
-      checkAgainstPart(request.tool, request.holder, *request.part, geometry::singlePass(postures));
-  return !(part.holder && part.holder->collides()) && !(part.cutter && part.cutter->gouges());
+  if (!part) return true;
+  const std::optional<LinkPartResult> holder =
+      checkHolderAgainstPart(request.tool, request.holder, part, postures);
+  if (holder && holder->collides()) return false;
+  return request.tool.shape == geometry::ToolShape::Flat ||
+         !checkCutterAgainstPart(request.tool, part, postures).gouges();
 }
 
 }  // namespace
@@ -53,6 +58,7 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
                             const std::optional<PartContacts::Marks>& part_marks) {
   const std::vector<std::size_t> colliding = collidingByPass(result, part_marks);
   const double lead_rad = request.path.lead_deg * geometry::kDegToRad;
+  std::shared_ptr<const ObstacleModel> part;
   bool replaced = false;
   std::size_t first = 0;  // the pass's first posture in result.postures
   for (std::size_t p = 0; p < result.passes.size(); ++p) {
@@ -66,7 +72,8 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
     for (const PassSample& s : pass.samples)
       nominal.push_back(
           geometry::ballEndPosture(s.centre_mm, nominalAxis(s, lead_rad), request.tool.radius_mm));
-    if (!clearPass(request, checker, nominal)) continue;
+    if (request.part && !part) part = prepareObstacle(*request.part, "part");
+    if (!clearPass(request, checker, part, nominal)) continue;
     for (std::size_t k = begin; k < end; ++k) {
       GeneratedPosture& g = result.postures[k];
       g.posture = nominal[k - begin];
@@ -77,6 +84,21 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
     }
     result.kept_nominal.push_back({pass.index, pass.label, colliding[p]});
     replaced = true;
+  }
+  if (replaced) {
+    // What the steering said of a pass written nominal is not of the path written (a reviewer).
+    const auto kept = [&result](int pass) {
+      for (const auto& k : result.kept_nominal)
+        if (k.pass == pass) return true;
+      return false;
+    };
+    std::erase_if(result.settled_starts, kept);
+    std::erase_if(result.settle_failures, [&](const auto& f) { return kept(f.pass); });
+    std::erase_if(result.loosened_solver, [&](const std::string& line) {
+      for (const auto& k : result.kept_nominal)
+        if (line.rfind(k.label + ": ", 0) == 0) return true;
+      return false;
+    });
   }
   if (replaced) {  // the limits held are the steered postures' that remain
     result.limited_postures = 0;

@@ -141,9 +141,10 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
     // The steering's frame (f, n, n x f) turns over with the feed: the same tilt would lean the
     // axis to the other side, into the wall it leaned away from.
     constexpr std::size_t kRecent = 3;
-    // A step back followed by one turned more than 30 deg from it is a step-over (a return
-    // leg's steps run alike).
-    const double kStepOverTurnCos = std::cos(30.0 * M_PI / 180.0);
+    // A step back that runs within 30 deg of square to the leg, followed by one within 30 deg of
+    // the leg's reverse, is a step-over.
+    const double kStepOverSidewaysCos = std::cos(60.0 * M_PI / 180.0);
+    const double kReturnLegCos = std::cos(30.0 * M_PI / 180.0);
     std::vector<Vec3> recent;
     for (std::size_t i = block.begin + 1; i < block.end; ++i) {
       const Vec3 step = centre(i) - centre(i - 1);
@@ -173,14 +174,19 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
         // from it, the new pass starts after it: this step is the link. (The leg's last posture
         // went to the next pass, the step-over and its corner were cut inside it, and the frame
         // turned over there: 16.8 deg in one step into a wall, a helper's finding.)
+        // Judged against the leg (its recent feed), not the next step: a return leg whose first
+        // step is followed by a kink is no step-over (a reviewer's case).
         std::size_t start = i - 1;
         if (i + 1 < block.end) {
+          Vec3 leg = Vec3::Zero();
+          for (const Vec3& before : recent) leg += before.normalized();
           const Vec3 next = centre(i + 1) - centre(i);
-          bool next_back = false;
-          for (const Vec3& before : recent) next_back = next_back || next.dot(before) < 0.0;
-          if (next_back && next.norm() > kRepeatMm && !(gap > 0.0 && next.norm() > gap) &&
-              next.normalized().dot(step.normalized()) < kStepOverTurnCos)
-            start = i;
+          if (leg.norm() > 0.0 && next.norm() > kRepeatMm && !(gap > 0.0 && next.norm() > gap)) {
+            leg.normalize();
+            const bool sideways = std::abs(step.normalized().dot(leg)) < kStepOverSidewaysCos;
+            const bool reversed = next.normalized().dot(leg) < -kReturnLegCos;
+            if (sideways && reversed) start = i;
+          }
         }
         // A block that begins with its step-over (where the last one ended) leaves a leg of one
         // posture, the step-over's start: no pass of its own (was "a single posture"). Elsewhere

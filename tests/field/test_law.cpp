@@ -212,6 +212,37 @@ TEST(Sampling, AFineTessellationIsSampledAtTheStepAsked) {
   }
 }
 
+// A cylinder R 1.5 tessellated finer than the step (128 x 100 facets): its merged samples keep
+// the field radial and even around it, 1 mm off, against the same mesh sampled every 0.05 mm (no
+// merging there). Merged across 90 deg sectors they swung it 2.7 deg and by 12 % (at 0.3 mm off,
+// 17.8 deg: a reviewer's case).
+TEST(Sampling, AFineCurvedSurfaceKeepsItsFieldRadial) {
+  FieldParams p;
+  TriangleMesh cylinder;
+  const int around = 128, rings = 100;
+  for (int j = 0; j <= rings; ++j)
+    for (int i = 0; i < around; ++i) {
+      const double a = 2.0 * M_PI * i / around;
+      cylinder.vertices.emplace_back(1.5 * std::cos(a), 1.5 * std::sin(a), 20.0 * j / rings);
+    }
+  for (int j = 0; j < rings; ++j)
+    for (int i = 0; i < around; ++i) {
+      const int a = j * around + i, b = j * around + (i + 1) % around;
+      cylinder.triangles.push_back({a, b, b + around});
+      cylinder.triangles.push_back({a, b + around, a + around});
+    }
+  const DirectField merged(sampleObstacles({&cylinder, 1}, 1.0, Weights::Area), p);
+  const DirectField dense(sampleObstacles({&cylinder, 1}, 0.05, Weights::Area), p);
+  for (int k = 0; k < 13; ++k) {
+    const double a = 7.5 * k * M_PI / 180.0;
+    const Vec3 radial(std::cos(a), std::sin(a), 0.0);
+    const Vec3 x = 2.5 * radial + Vec3(0, 0, 10);
+    const Vec3 f = merged.at(x), exact = dense.at(x);
+    EXPECT_NEAR(f.norm(), exact.norm(), 0.05 * exact.norm()) << k;
+    EXPECT_GT(f.normalized().dot(radial), std::cos(2.0 * M_PI / 180.0)) << k;
+  }
+}
+
 TEST(Law, InsideAnObstacleTheForceIsFiniteAndOutward) {
   FieldParams p;
   const TriangleMesh cube = test::box(Vec3(-5, -5, -5), Vec3(5, 5, 5));

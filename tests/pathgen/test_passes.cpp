@@ -134,6 +134,19 @@ TEST(Passes, AZigZagInOnePassBlockIsOnePassALeg) {
   EXPECT_EQ(leaning_legs[0], std::make_pair(std::size_t{0}, std::size_t{11}));
   EXPECT_EQ(leaning_legs[1], std::make_pair(std::size_t{11}, std::size_t{22}));
   EXPECT_EQ(leaning_legs[2], std::make_pair(std::size_t{22}, std::size_t{33}));
+  // A square step-over and a return leg whose first step is followed by a kink (a reviewer's
+  // case: the kink made that first step read as the step-over): the return leg starts after the
+  // step-over, with its first step.
+  geometry::PathFile kinked;
+  for (int k = 0; k <= 9; ++k) kinked.postures.push_back({Vec3(k, 0, 0), Vec3::UnitZ()});
+  kinked.postures.push_back({Vec3(10, 0, 1), Vec3::UnitZ()});  // 10: the leg's end, lifted
+  kinked.postures.push_back({Vec3(10, 1, 1), Vec3::UnitZ()});  // 11: the step-over's end
+  for (int k = 9; k >= 0; --k) kinked.postures.push_back({Vec3(k, 1, 0), Vec3::UnitZ()});
+  kinked.blocks = {{geometry::PathBlock::Kind::Pass, 0, kinked.postures.size()}};
+  const auto kinked_legs = passRanges(kinked, 0.0, 1.0);
+  ASSERT_EQ(kinked_legs.size(), 2u);
+  EXPECT_EQ(kinked_legs[0], std::make_pair(std::size_t{0}, std::size_t{11}));
+  EXPECT_EQ(kinked_legs[1], std::make_pair(std::size_t{11}, std::size_t{22}));
   // A corner of 90 deg (an L) is one pass still.
   geometry::PathFile corner;
   for (int k = 0; k <= 10; ++k) corner.postures.push_back({Vec3(k, 0, 0), Vec3::UnitZ()});

@@ -160,7 +160,8 @@ struct GenerateResult {
   struct KeptNominal {
     int pass = 0;                       ///< Pass::index
     std::string label;                  ///< the pass and its line
-    std::size_t steered_colliding = 0;  ///< postures and in-pass motions that collided steered
+    /// Postures of the steered pass that collided there or on the move to the pass's next.
+    std::size_t steered_colliding = 0;
   };
   std::vector<KeptNominal> kept_nominal;
   StageTimes times;
