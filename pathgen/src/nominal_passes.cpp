@@ -143,6 +143,7 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
     constexpr std::size_t kRecent = 3;
     // A step back that runs within 30 deg of square to the leg, followed by one within 30 deg of
     // the leg's reverse, is a step-over.
+    const double kBackSin = std::sin(5.0 * M_PI / 180.0);
     const double kStepOverSidewaysCos = std::cos(60.0 * M_PI / 180.0);
     const double kReturnLegCos = std::cos(30.0 * M_PI / 180.0);
     std::vector<Vec3> recent;
@@ -162,8 +163,12 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
         continue;
       }
       if (step.norm() <= kRepeatMm) continue;
+      // Back past 95 deg, not 90: at a square corner (a contour's) rounding made the dot of two
+      // perpendicular steps -1e-17 or +1e-17, and loops were cut at random corners (a helper's
+      // contour loops: 23 uneven pieces, the frame turned over at each).
       bool back = false;
-      for (const Vec3& before : recent) back = back || step.dot(before) < 0.0;
+      for (const Vec3& before : recent)
+        back = back || step.dot(before) < -kBackSin * step.norm() * before.norm();
       // An axis turned over (more than 90 deg) throws its centre 2R the other way: that is the
       // axis's fault, named at its line by nominalPasses, not a new leg.
       back = back && path.postures[i].axis.dot(path.postures[i - 1].axis) > 0.0;

@@ -287,6 +287,23 @@ TEST(MeshIo, BinaryPlyBodyIsWalkedAgainstItsHeader) {
       EXPECT_NEAR(area(loadMesh(writeBytes("lf.ply", lf))), 1.0, 1e-6);
     }
   }
+  // Data after the body (the header's face count short of the faces: assimp dropped the rest,
+  // a sphere with 400 faces left out read clear where it collides): refused; a line end after
+  // the body is read past.
+  expectMessage(square + std::string(13, '\x01'), "13 bytes after the body its header declares");
+  EXPECT_EQ(loadMesh(writeBytes("eol.ply", square + "\r\n")).triangles.size(), 2u);
+  std::string short_count = square;
+  short_count.replace(short_count.find("element face 2"), 14, "element face 1");
+  expectMessage(short_count, "13 bytes after the body");
+  // Vertices without z (read as flat), triangle strips (dropped): refused.
+  std::string flat = square;
+  flat.replace(flat.find("property float z\n"), 17, "");
+  expectMessage(flat, "element vertex has no property z");
+  std::string strips = square;
+  strips.insert(strips.find("end_header"),
+                "element tristrips 1\nproperty list int int vertex_indices\n");
+  expectMessage(strips + std::string("\x00\x00\x00\x00", 4),
+                "triangle strips (element tristrips) are not read");
   // Vertices cut short: the fixed-size element's step.
   const std::size_t body = square.find("end_header\n") + 11;
   expectMessage(square.substr(0, body + 30), "the body ends inside vertex 3 of the 4");
