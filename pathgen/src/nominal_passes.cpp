@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "fieldpath/common/errors.h"
@@ -141,12 +142,58 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
     // The steering's frame (f, n, n x f) turns over with the feed: the same tilt would lean the
     // axis to the other side, into the wall it leaned away from.
     constexpr std::size_t kRecent = 3;
-    // A step back that runs within 30 deg of square to the leg, followed by one within 30 deg of
-    // the leg's reverse, is a step-over.
-    const double kBackSin = std::sin(5.0 * M_PI / 180.0);
-    const double kStepOverSidewaysCos = std::cos(60.0 * M_PI / 180.0);
+    // A turn that runs within 60 deg of square to the leg (a step-over leaning back, an arc's
+    // middle), followed by a step within 30 deg of the leg's reverse, is a step-over.
+    const double kBackSin = std::sin(30.0 * M_PI / 180.0);  // -cos 120 deg
+    const double kStepOverSidewaysCos = std::cos(30.0 * M_PI / 180.0);
     const double kReturnLegCos = std::cos(30.0 * M_PI / 180.0);
     std::vector<Vec3> recent;
+    // A turn under way: from the posture where the leg ended (`corner`), steps within 60 deg of
+    // square to the leg (`leg`: its recent feed), up to a ball's diameter in all. A step then
+    // within 30 deg of the leg's reverse makes it a zig-zag's step-over, however many postures
+    // it has: the leg ends at the corner, the return leg starts with that step, the step-over
+    // between them is the link (with 3 postures in the step-over the legs split at random, the
+    // axis turned 43 deg in one step, 30 postures collided: a helper's pocket). Any other step
+    // ends the turn: a corner kept in the pass (an L).
+    struct Turn {
+      std::size_t corner = 0;
+      Vec3 leg = Vec3::Zero();
+      double length_mm = 0.0;
+      std::vector<std::pair<std::size_t, Vec3>> steps;  // (posture at its end, step)
+    };
+    std::optional<Turn> turn;
+    const auto pushRecent = [&recent](const Vec3& step) {
+      recent.push_back(step);
+      if (recent.size() > kRecent) recent.erase(recent.begin());
+    };
+    // A block that begins with its step-over (where the last one ended) leaves a leg of one
+    // posture, the step-over's start: no pass of its own (was "a single posture"). Elsewhere a
+    // leg of one posture stays an error of nominalPasses (a jitter back in a pass).
+    const auto split = [&](std::size_t end, std::size_t next_begin) {
+      const bool step_over_start = begin == block.begin && end == begin + 1;
+      if (end > begin && !step_over_start) ranges.emplace_back(begin, end);
+      begin = next_begin;
+      recent.clear();
+    };
+    // Back past 120 deg, not 90: a square corner in contact is a few degrees more or less in the
+    // ball centres over a sloped floor (and +-1e-17 of rounding at 90): a helper's contour loops
+    // in one block were cut at random corners (23 uneven pieces, the frame turned at each).
+    // Step-overs that turn back less are the turns' above. The new pass starts
+    // where the step back does, the step before it the link.
+    const auto feed = [&](std::size_t i, const Vec3& step) {
+      bool back = false;
+      for (const Vec3& before : recent)
+        back = back || step.dot(before) < -kBackSin * step.norm() * before.norm();
+      // An axis turned over (more than 90 deg) throws its centre 2R the other way: that is the
+      // axis's fault, named at its line by nominalPasses, not a new leg.
+      if (back && path.postures[i].axis.dot(path.postures[i - 1].axis) > 0.0) split(i - 1, i - 1);
+      pushRecent(step);
+    };
+    const auto endTurn = [&] {  // not a step-over: its steps are the pass's feed (a corner)
+      const std::vector<std::pair<std::size_t, Vec3>> steps = std::move(turn->steps);
+      turn.reset();
+      for (const auto& [at, step] : steps) feed(at, step);
+    };
     for (std::size_t i = block.begin + 1; i < block.end; ++i) {
       const Vec3 step = centre(i) - centre(i - 1);
       // DESIGN's gap is the tips'; the centres' too, so that an axis swung about a steady tip
@@ -157,54 +204,42 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
           ranges.emplace_back(begin, i);
           begin = i;
           recent.clear();
+          turn.reset();  // (its steps were no pass's feed but the one ended here)
         }
         // else the axis swung about a steady tip: its centre's jump is no feed direction (a
         // swing along the feed read as a turn back and left a pass of one posture)
         continue;
       }
       if (step.norm() <= kRepeatMm) continue;
-      // Back past 95 deg, not 90: at a square corner (a contour's) rounding made the dot of two
-      // perpendicular steps -1e-17 or +1e-17, and loops were cut at random corners (a helper's
-      // contour loops: 23 uneven pieces, the frame turned over at each).
-      bool back = false;
-      for (const Vec3& before : recent)
-        back = back || step.dot(before) < -kBackSin * step.norm() * before.norm();
-      // An axis turned over (more than 90 deg) throws its centre 2R the other way: that is the
-      // axis's fault, named at its line by nominalPasses, not a new leg.
-      back = back && path.postures[i].axis.dot(path.postures[i - 1].axis) > 0.0;
-      if (back) {
-        // The new pass starts where this step does, the step-over before it the link; but where
-        // this step is the step-over itself (it leans back against the leg, as a raster's does
-        // over a sloped floor where the tips follow the surface normal) and the next step turns
-        // from it, the new pass starts after it: this step is the link. (The leg's last posture
-        // went to the next pass, the step-over and its corner were cut inside it, and the frame
-        // turned over there: 16.8 deg in one step into a wall, a helper's finding.)
-        // Judged against the leg (its recent feed), not the next step: a return leg whose first
-        // step is followed by a kink is no step-over (a reviewer's case).
-        std::size_t start = i - 1;
-        if (i + 1 < block.end) {
-          Vec3 leg = Vec3::Zero();
-          for (const Vec3& before : recent) leg += before.normalized();
-          const Vec3 next = centre(i + 1) - centre(i);
-          if (leg.norm() > 0.0 && next.norm() > kRepeatMm && !(gap > 0.0 && next.norm() > gap)) {
-            leg.normalize();
-            const bool sideways = std::abs(step.normalized().dot(leg)) < kStepOverSidewaysCos;
-            const bool reversed = next.normalized().dot(leg) < -kReturnLegCos;
-            if (sideways && reversed) start = i;
-          }
+      const bool axis_steady = path.postures[i].axis.dot(path.postures[i - 1].axis) > 0.0;
+      const Vec3 along = step.normalized();
+      if (turn) {
+        if (along.dot(turn->leg) < -kReturnLegCos && axis_steady) {
+          split(turn->corner + 1, i - 1);  // the step-over (corner .. i - 1) is the link
+          turn.reset();
+          pushRecent(step);
+          continue;
         }
-        // A block that begins with its step-over (where the last one ended) leaves a leg of one
-        // posture, the step-over's start: no pass of its own (was "a single posture"). Elsewhere
-        // a leg of one posture stays an error of nominalPasses (a jitter back in a pass).
-        const bool step_over_start = begin == block.begin && start == begin + 1 && start == i - 1;
-        if (start > begin && !step_over_start) ranges.emplace_back(begin, start);
-        begin = start;
-        recent.clear();
-        if (start == i) continue;  // the step-over is no feed direction of the new pass
+        if (std::abs(along.dot(turn->leg)) < kStepOverSidewaysCos &&
+            turn->length_mm + step.norm() <= 2.0 * ball_radius_mm) {
+          turn->length_mm += step.norm();
+          turn->steps.emplace_back(i, step);
+          continue;
+        }
+        endTurn();
       }
-      recent.push_back(step);
-      if (recent.size() > kRecent) recent.erase(recent.begin());
+      if (!recent.empty()) {
+        Vec3 leg = Vec3::Zero();
+        for (const Vec3& before : recent) leg += before.normalized();
+        if (leg.norm() > 0.0 && std::abs(along.dot(leg.normalized())) < kStepOverSidewaysCos &&
+            step.norm() <= 2.0 * ball_radius_mm) {
+          turn = Turn{i - 1, leg.normalized(), step.norm(), {{i, step}}};
+          continue;
+        }
+      }
+      feed(i, step);
     }
+    if (turn) endTurn();
     ranges.emplace_back(begin, block.end);
   }
   return ranges;

@@ -147,6 +147,58 @@ TEST(Passes, AZigZagInOnePassBlockIsOnePassALeg) {
   ASSERT_EQ(kinked_legs.size(), 2u);
   EXPECT_EQ(kinked_legs[0], std::make_pair(std::size_t{0}, std::size_t{11}));
   EXPECT_EQ(kinked_legs[1], std::make_pair(std::size_t{11}, std::size_t{22}));
+  // Step-overs of several postures (square, leaning back) and a semicircle turn: the legs split
+  // at the turn's ends, the turn between them the link (legs of 88/84/92 postures, the axis 43 deg
+  // in one step, 30 postures colliding: a helper's pocket).
+  for (const std::string shape : {"square", "leaning", "arc"}) {
+    geometry::PathFile turns;
+    const auto add = [&](double x, double y) {
+      turns.postures.push_back({Vec3(x, y, 0), Vec3::UnitZ()});
+    };
+    std::vector<std::size_t> leg_starts;
+    double x = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double y = 2.0 * k, dir = k % 2 ? -1.0 : 1.0;  // this leg's feed along x
+      if (k > 0) {  // the turn from the last leg's end: 3 postures between, then this leg's first
+        for (int t = 1; t <= 3; ++t) {
+          if (shape == "square") add(x, y - 2.0 + 0.5 * t);
+          if (shape == "leaning") add(x + 0.3 * dir * t, y - 2.0 + 0.5 * t);  // back, 31 deg
+          if (shape == "arc")
+            add(x - dir * std::sin(M_PI * t / 4.0), y - 1.0 - std::cos(M_PI * t / 4.0));
+        }
+        if (shape == "leaning") x += 1.2 * dir;
+      }
+      leg_starts.push_back(turns.postures.size());
+      for (int j = 0; j <= 10; ++j) add(x + dir * j, y);
+      x += 10.0 * dir;
+    }
+    turns.blocks = {{geometry::PathBlock::Kind::Pass, 0, turns.postures.size()}};
+    const auto legs = passRanges(turns, 0.0, 1.5);
+    ASSERT_EQ(legs.size(), 3u) << shape;
+    for (int k = 0; k < 3; ++k) {
+      if (shape != "arc") {
+        EXPECT_EQ(legs[k], std::make_pair(leg_starts[k], leg_starts[k] + 11)) << shape << k;
+        continue;
+      }
+      // The arc's gentle ends (22.5 deg from the legs) go with the legs: each pass holds its
+      // whole leg and at most one arc posture each side.
+      EXPECT_LE(legs[k].first, leg_starts[k]) << k;
+      EXPECT_GE(legs[k].first + 1, leg_starts[k]) << k;
+      EXPECT_GE(legs[k].second, leg_starts[k] + 11) << k;
+      EXPECT_LE(legs[k].second, leg_starts[k] + 12) << k;
+    }
+  }
+  // A square loop whose corners turn 90 +- 10 deg (ball centres over a sloped floor) is one pass
+  // (it was cut at random corners).
+  geometry::PathFile loop;
+  const Vec3 corners[] = {Vec3(0, 0, 0), Vec3(10, 0.9, 0), Vec3(10.9, 10, 0), Vec3(0, 9.1, 0),
+                          Vec3(0, 1, 0)};
+  for (int side = 0; side < 4; ++side)
+    for (int j = 0; j < 10; ++j)
+      loop.postures.push_back(
+          {corners[side] + (corners[side + 1] - corners[side]) * j / 10.0, Vec3::UnitZ()});
+  loop.blocks = {{geometry::PathBlock::Kind::Pass, 0, loop.postures.size()}};
+  EXPECT_EQ(passRanges(loop, 0.0, 1.5).size(), 1u);
   // A corner of 90 deg (an L) is one pass still.
   geometry::PathFile corner;
   for (int k = 0; k <= 10; ++k) corner.postures.push_back({Vec3(k, 0, 0), Vec3::UnitZ()});
