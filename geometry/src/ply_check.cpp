@@ -152,11 +152,16 @@ void walkBinaryBody(const std::filesystem::path& file, std::uintmax_t size, std:
   // More than a line end after the body: the header's counts are short of it (assimp read the
   // declared faces and dropped the rest: a sphere with 400 faces left out read clear where it
   // collides, a helper's file), or the file was joined with something else.
-  while (at < size && (*reader.at(at, 1) == '\n' || *reader.at(at, 1) == '\r')) ++at;
-  if (at < size)
-    throw InputError(file.string() + ": binary PLY: " + std::to_string(size - at) +
-                     " bytes after the body its header declares (the header's counts are short "
-                     "of the data, or the file was joined with another)");
+  // Padding is read past (NUL bytes to a block, white space, a DOS end-of-file 0x1A, a line of
+  // text: exporters write them, a reviewer's files); bytes of data are not.
+  const std::uintmax_t body_end = at;
+  for (; at < size; ++at) {
+    const unsigned char c = *reader.at(at, 1);
+    if (!(c == 0 || c == 0x1A || c == '\n' || c == '\r' || c == '\t' || (c >= 0x20 && c < 0x7F)))
+      throw InputError(file.string() + ": binary PLY: " + std::to_string(size - body_end) +
+                       " byte(s) after the body its header declares, not padding (the header's "
+                       "counts are short of the data, or the file was joined with another)");
+  }
 }
 
 /// What a mesh needs of the elements, and what assimp would drop without a word (a helper's

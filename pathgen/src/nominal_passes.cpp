@@ -148,13 +148,13 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
     const double kStepOverSidewaysCos = std::cos(30.0 * M_PI / 180.0);
     const double kReturnLegCos = std::cos(30.0 * M_PI / 180.0);
     std::vector<Vec3> recent;
-    // A turn under way: from the posture where the leg ended (`corner`), steps within 60 deg of
-    // square to the leg (`leg`: its recent feed), up to a ball's diameter in all. A step then
-    // within 30 deg of the leg's reverse makes it a zig-zag's step-over, however many postures
-    // it has: the leg ends at the corner, the return leg starts with that step, the step-over
-    // between them is the link (with 3 postures in the step-over the legs split at random, the
-    // axis turned 43 deg in one step, 30 postures collided: a helper's pocket). Any other step
-    // ends the turn: a corner kept in the pass (an L).
+    // A turn under way: from the posture where a straight leg ended (`corner`), steps within 60
+    // deg of square to the leg (`leg`: its recent feed), up to a ball's diameter in all. A step
+    // then within 30 deg of the leg's reverse, and the next straight on, makes it a zig-zag's
+    // turn, however many postures it has: the leg ends at the corner, the next pass starts with
+    // the turn's second posture, its first step the link (with 3 postures in the step-over the legs
+    // split at random, the axis turned 43 deg in one step, 30 postures collided: a helper's
+    // pocket). Any other step ends the turn: a corner kept in the pass (an L).
     struct Turn {
       std::size_t corner = 0;
       Vec3 leg = Vec3::Zero();
@@ -194,6 +194,32 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
       turn.reset();
       for (const auto& [at, step] : steps) feed(at, step);
     };
+    // The ball centres' path from posture `from` over up to a ball's diameter, forward (+1) or
+    // back (-1), within the block and short of a gap: its chord (unit) and whether the chord is
+    // at least 0.9 of the length (true where there is no path to tell).
+    struct Run {
+      Vec3 chord = Vec3::Zero();
+      bool straight = true;
+    };
+    const auto run = [&](std::size_t from, int direction) {
+      Run out;
+      double length_mm = 0.0;
+      std::size_t at = from;
+      while (length_mm < 2.0 * ball_radius_mm) {
+        if (direction > 0 ? at + 1 >= block.end : at <= block.begin) break;
+        const std::size_t to = direction > 0 ? at + 1 : at - 1;
+        const double step_mm = (centre(to) - centre(at)).norm();
+        if (gap > 0.0 && step_mm > gap) break;
+        length_mm += step_mm;
+        at = to;
+      }
+      const Vec3 chord = (centre(at) - centre(from)) * static_cast<double>(direction);
+      if (length_mm > kRepeatMm) {
+        out.chord = chord.normalized();
+        out.straight = chord.norm() >= 0.9 * length_mm;
+      }
+      return out;
+    };
     for (std::size_t i = block.begin + 1; i < block.end; ++i) {
       const Vec3 step = centre(i) - centre(i - 1);
       // DESIGN's gap is the tips'; the centres' too, so that an axis swung about a steady tip
@@ -214,9 +240,21 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
       const bool axis_steady = path.postures[i].axis.dot(path.postures[i - 1].axis) > 0.0;
       const Vec3 along = step.normalized();
       if (turn) {
-        if (along.dot(turn->leg) < -kReturnLegCos && axis_steady) {
-          split(turn->corner + 1, i - 1);  // the step-over (corner .. i - 1) is the link
+        // The return leg runs straight on after it: its chord over a ball's diameter within 30
+        // deg of the leg's reverse and at least 0.9 of its length (a circle or a helix turning
+        // 20 deg a step comes within 30 deg of reversed too, half a turn on: a reviewer's small
+        // circles lost their arcs to links; the chord, not each step: ball centres over a
+        // sloped floor wiggle by 15 deg a step).
+        const Run after = run(i, +1);
+        const bool straight_on = after.straight && after.chord.dot(turn->leg) < -kReturnLegCos;
+        if (along.dot(turn->leg) < -kReturnLegCos && axis_steady && straight_on) {
+          // The leg ends at the corner; the next pass starts one posture on and cuts the rest of
+          // the turn (a contour's short side, a step-over's), only its first step the link: a
+          // rectangle 20 x 4 lost its short sides to links (a reviewer's case).
+          const std::vector<std::pair<std::size_t, Vec3>> steps = std::move(turn->steps);
           turn.reset();
+          split(steps.front().first, steps.front().first);
+          for (std::size_t k = 1; k < steps.size(); ++k) pushRecent(steps[k].second);
           pushRecent(step);
           continue;
         }
@@ -228,10 +266,13 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
         }
         endTurn();
       }
-      if (!recent.empty()) {
+      if (recent.size() == kRecent) {
         Vec3 leg = Vec3::Zero();
         for (const Vec3& before : recent) leg += before.normalized();
-        if (leg.norm() > 0.0 && std::abs(along.dot(leg.normalized())) < kStepOverSidewaysCos &&
+        // Only from a straight leg (its chord over a ball's diameter at least 0.9 of its length):
+        // a curve turns a little every step, and its lagging mean read as a corner.
+        const bool straight = leg.norm() > 0.0 && run(i - 1, -1).straight;
+        if (straight && std::abs(along.dot(leg.normalized())) < kStepOverSidewaysCos &&
             step.norm() <= 2.0 * ball_radius_mm) {
           turn = Turn{i - 1, leg.normalized(), step.norm(), {{i, step}}};
           continue;

@@ -290,11 +290,13 @@ TEST(MeshIo, BinaryPlyBodyIsWalkedAgainstItsHeader) {
   // Data after the body (the header's face count short of the faces: assimp dropped the rest,
   // a sphere with 400 faces left out read clear where it collides): refused; a line end after
   // the body is read past.
-  expectMessage(square + std::string(13, '\x01'), "13 bytes after the body its header declares");
-  EXPECT_EQ(loadMesh(writeBytes("eol.ply", square + "\r\n")).triangles.size(), 2u);
+  expectMessage(square + std::string(13, '\x01'), "13 byte(s) after the body its header declares");
+  for (const std::string padding : {std::string("\r\n"), std::string(90, '\0'), std::string("\x1a"),
+                                    std::string("comment end\n")})
+    EXPECT_EQ(loadMesh(writeBytes("padded.ply", square + padding)).triangles.size(), 2u);
   std::string short_count = square;
   short_count.replace(short_count.find("element face 2"), 14, "element face 1");
-  expectMessage(short_count, "13 bytes after the body");
+  expectMessage(short_count, "13 byte(s) after the body");
   // Vertices without z (read as flat), triangle strips (dropped): refused.
   std::string flat = square;
   flat.replace(flat.find("property float z\n"), 17, "");

@@ -175,19 +175,51 @@ TEST(Passes, AZigZagInOnePassBlockIsOnePassALeg) {
     turns.blocks = {{geometry::PathBlock::Kind::Pass, 0, turns.postures.size()}};
     const auto legs = passRanges(turns, 0.0, 1.5);
     ASSERT_EQ(legs.size(), 3u) << shape;
+    // Each pass holds its whole leg; the next starts with the turn's second posture (the turn's
+    // first step is the link, the rest is cut: a contour's short side is not lost).
     for (int k = 0; k < 3; ++k) {
+      const std::size_t first = k == 0 ? 0 : leg_starts[k] - 3;
       if (shape != "arc") {
-        EXPECT_EQ(legs[k], std::make_pair(leg_starts[k], leg_starts[k] + 11)) << shape << k;
+        EXPECT_EQ(legs[k], std::make_pair(first, leg_starts[k] + 11)) << shape << k;
         continue;
       }
-      // The arc's gentle ends (22.5 deg from the legs) go with the legs: each pass holds its
-      // whole leg and at most one arc posture each side.
+      // The arc's first half goes with its leg, its second with the next.
       EXPECT_LE(legs[k].first, leg_starts[k]) << k;
-      EXPECT_GE(legs[k].first + 1, leg_starts[k]) << k;
+      EXPECT_GE(legs[k].first + 3, leg_starts[k]) << k;
       EXPECT_GE(legs[k].second, leg_starts[k] + 11) << k;
-      EXPECT_LE(legs[k].second, leg_starts[k] + 12) << k;
+      EXPECT_LE(legs[k].second, leg_starts[k] + 14) << k;
     }
   }
+  // Small circles and a helix (20 deg a step) stay one pass (their arcs read as step-overs
+  // and became links: a reviewer's case).
+  geometry::PathFile circle;
+  for (int j = 0; j <= 36; ++j) {
+    const double a = 2.0 * M_PI * j / 18.0;
+    circle.postures.push_back(
+        {Vec3(2.5 * std::cos(a), 2.5 * std::sin(a), 0.05 * j), Vec3::UnitZ()});
+  }
+  circle.blocks = {{geometry::PathBlock::Kind::Pass, 0, circle.postures.size()}};
+  EXPECT_EQ(passRanges(circle, 0.0, 3.0).size(), 1u);
+  // A rectangle 20 x 4 followed around twice: its short sides are cut (in the passes), only the
+  // first step of each the link.
+  geometry::PathFile rectangle;
+  const Vec3 rect[] = {Vec3(0, 0, 0), Vec3(20, 0, 0), Vec3(20, 4, 0), Vec3(0, 4, 0)};
+  for (int loop = 0; loop < 2; ++loop)
+    for (int side = 0; side < 4; ++side) {
+      const Vec3 &a = rect[side], &b = rect[(side + 1) % 4];
+      const int n = static_cast<int>((b - a).norm());
+      for (int j = 0; j < n; ++j)
+        rectangle.postures.push_back({a + (b - a) * j / n, Vec3::UnitZ()});
+    }
+  rectangle.postures.push_back({rect[0], Vec3::UnitZ()});
+  rectangle.blocks = {{geometry::PathBlock::Kind::Pass, 0, rectangle.postures.size()}};
+  std::size_t covered = 0, last_end = 0;
+  for (const auto& [begin, end] : passRanges(rectangle, 0.0, 3.0)) {
+    EXPECT_EQ(begin, last_end);  // no posture left out
+    covered += end - begin;
+    last_end = end;
+  }
+  EXPECT_EQ(covered, rectangle.postures.size());
   // A square loop whose corners turn 90 +- 10 deg (ball centres over a sloped floor) is one pass
   // (it was cut at random corners).
   geometry::PathFile loop;
