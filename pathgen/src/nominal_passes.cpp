@@ -248,13 +248,17 @@ std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path
         const Run after = run(i, +1);
         const bool straight_on = after.straight && after.chord.dot(turn->leg) < -kReturnLegCos;
         if (along.dot(turn->leg) < -kReturnLegCos && axis_steady && straight_on) {
-          // The leg ends at the corner; the next pass starts one posture on and cuts the rest of
-          // the turn (a contour's short side, a step-over's), only its first step the link: a
-          // rectangle 20 x 4 lost its short sides to links (a reviewer's case).
-          const std::vector<std::pair<std::size_t, Vec3>> steps = std::move(turn->steps);
+          // The leg ends at the corner, the return leg starts with this step, and the turn's
+          // postures between (two or more: a contour's short side, a step-over of several) are a
+          // pass of their own, each frame along its own feed: cut as links they were lost (a
+          // rectangle 20 x 4 lost its short sides, a reviewer's case), cut as the return leg's
+          // start its frame turned there (43 deg in one step, 38 postures colliding).
+          const std::size_t turn_begin = turn->corner + 1;
           turn.reset();
-          split(steps.front().first, steps.front().first);
-          for (std::size_t k = 1; k < steps.size(); ++k) pushRecent(steps[k].second);
+          split(turn_begin, turn_begin);
+          if (i - 1 >= turn_begin + 2) split(i - 1, i - 1);
+          begin = i - 1;
+          recent.clear();
           pushRecent(step);
           continue;
         }
