@@ -8,6 +8,7 @@
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/limits.h"
+#include "fieldpath/field/sampling.h"
 #include "fieldpath/field/voxel_field.h"
 
 namespace fieldpath::app {
@@ -106,10 +107,8 @@ double sampleCount(const Scene& scene, double step_mm) {
       const Vec3 &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
       const double area = 0.5 * (b - a).cross(c - a).norm();
       if (!(area > 0.0)) continue;
-      const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
-      const double n =
-          std::max({1.0, std::ceil(std::sqrt(area) / step_mm), std::ceil(longest / (1.5 * step_mm))});
-      if (n == 1.0 && area < 0.25 * step_mm * step_mm) {
+      const double n = field::triangleSplits(a, b, c, step_mm);
+      if (n == 1.0 && field::isSmallPiece(area, step_mm)) {
         small_area += area;
         small += 1.0;
         continue;

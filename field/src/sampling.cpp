@@ -23,10 +23,6 @@ class SmallPieces {
  public:
   explicit SmallPieces(double step_mm) : step_mm_(step_mm) {}
 
-  static bool isSmall(double area_mm2, double step_mm) {
-    return area_mm2 < 0.25 * step_mm * step_mm;
-  }
-
   void add(const Vec3& centroid, const Vec3& normal, double area_mm2) {
     // The normal's cell on the cube map: the face of its largest component, then 4 x 4 on that
     // face (cells under ~25 deg wide): the pieces of a fillet or a thin cylinder merged across
@@ -91,7 +87,7 @@ void sampleSliver(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& norma
   const double longest = std::max({ab, bc, ca});
   if (longest <= 1.5 * step_mm || depth >= 40) {
     const double area = 0.5 * (b - a).cross(c - a).norm();
-    if (SmallPieces::isSmall(area, step_mm))
+    if (isSmallPiece(area, step_mm))
       small.add((a + b + c) / 3.0, normal, area);
     else
       out.add((a + b + c) / 3.0, normal, weights == Weights::Area ? area : 1.0);
@@ -114,6 +110,14 @@ void sampleSliver(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& norma
 
 }  // namespace
 
+int triangleSplits(const Vec3& a, const Vec3& b, const Vec3& c, double step_mm) {
+  const double area = 0.5 * (b - a).cross(c - a).norm();
+  const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+  // In double and clamped before the cast: a step of 1e-300 mm would overflow an int.
+  return static_cast<int>(std::clamp(
+      std::ceil(std::max(std::sqrt(area) / step_mm, longest / (1.5 * step_mm))), 1.0, 1e9));
+}
+
 ObstacleSamples sampleObstacles(std::span<const geometry::TriangleMesh> meshes, double step_mm,
                                 Weights weights) {
   if (!(step_mm > 0.0) || !std::isfinite(step_mm))
@@ -134,9 +138,7 @@ ObstacleSamples sampleObstacles(std::span<const geometry::TriangleMesh> meshes, 
       const double area = 0.5 * cross.norm();
       if (!(area > 0.0)) continue;
       const Vec3 normal = cross.normalized();
-      const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
-      const int n = std::max(1, static_cast<int>(std::ceil(std::max(std::sqrt(area) / step_mm,
-                                                                    longest / (1.5 * step_mm)))));
+      const int n = triangleSplits(a, b, c, step_mm);
       if (double(n) * n > 2.0 * std::max(1.0, area / (step_mm * step_mm))) {
         // A sliver (CAD tessellations are full of them): the n×n split would put n² points on
         // little area. Halve it at its longest edge instead, until no edge exceeds 1.5 steps.
@@ -144,7 +146,7 @@ ObstacleSamples sampleObstacles(std::span<const geometry::TriangleMesh> meshes, 
         out.area_mm2 += area;
         continue;
       }
-      if (n == 1 && SmallPieces::isSmall(area, step_mm)) {
+      if (n == 1 && isSmallPiece(area, step_mm)) {
         small.add((a + b + c) / 3.0, normal, area);
         out.area_mm2 += area;
         continue;

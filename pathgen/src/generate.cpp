@@ -190,12 +190,14 @@ GenerateResult generatePath(const GenerateRequest& request) {
       const Pass& pass = result.passes[p];
       Steered& out = steered_passes[p];
       if (request.nominal) {
-        for (const PassSample& s : pass.samples) {
+        const std::vector<geometry::Posture> nominal =
+            nominalPostures(std::span(&pass, 1), lead_rad, r);
+        for (std::size_t k = 0; k < nominal.size(); ++k) {
           GeneratedPosture g;
           g.pass = pass.index;
-          g.s_mm = s.s_mm;
+          g.s_mm = pass.samples[k].s_mm;
           g.lead_rad = lead_rad;
-          g.posture = geometry::ballEndPosture(s.centre_mm, nominalAxis(s, lead_rad), r);
+          g.posture = nominal[k];
           out.postures.push_back(g);
         }
         return;

@@ -68,10 +68,8 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
     const std::size_t begin = first;
     first = end;
     if (colliding[p] == 0 || end - begin != pass.samples.size()) continue;
-    std::vector<geometry::Posture> nominal;
-    for (const PassSample& s : pass.samples)
-      nominal.push_back(
-          geometry::ballEndPosture(s.centre_mm, nominalAxis(s, lead_rad), request.tool.radius_mm));
+    const std::vector<geometry::Posture> nominal =
+        nominalPostures(std::span(&pass, 1), lead_rad, request.tool.radius_mm);
     if (request.part && !part) part = prepareObstacle(*request.part, "part");
     if (!clearPass(request, checker, part, nominal)) continue;
     for (std::size_t k = begin; k < end; ++k) {

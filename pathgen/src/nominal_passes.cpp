@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
-#include <optional>
 #include <sstream>
 
 #include "fieldpath/common/errors.h"
@@ -67,11 +66,6 @@ PassSample polylineSample(const Polyline& line, double s_mm) {
   return sample;
 }
 
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values.empty() ? 0.0 : values[values.size() / 2];
-}
-
 }  // namespace
 
 AxisTurn largestAxisTurn(const PathFile& path, double ball_radius_mm) {
@@ -114,180 +108,6 @@ void requireSteadyAxes(const PathFile& path, double pass_gap_mm, double ball_rad
       geometry::requireSteadyAxis(path, i - 1, i);
     }
   }
-}
-
-std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path,
-                                                            double pass_gap_mm,
-                                                            double ball_radius_mm) {
-  auto centre = [&](std::size_t i) {
-    return geometry::ballCentre(path.postures[i], ball_radius_mm);
-  };
-  auto tipStep = [&](std::size_t i) {
-    return (path.postures[i].tip_mm - path.postures[i - 1].tip_mm).norm();
-  };
-  std::vector<std::pair<std::size_t, std::size_t>> ranges;
-  for (const PathBlock& block : path.blocks) {
-    if (block.kind != PathBlock::Kind::Pass) continue;
-    std::vector<double> steps, tip_steps;
-    for (std::size_t i = block.begin + 1; i < block.end; ++i) {
-      const double d = (centre(i) - centre(i - 1)).norm();
-      if (d > kRepeatMm) steps.push_back(d);
-      if (tipStep(i) > kRepeatMm) tip_steps.push_back(tipStep(i));
-    }
-    const double gap = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(steps);
-    const double tip_gap = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(tip_steps);
-    std::size_t begin = block.begin;
-    // The last few feed directions of the pass (repeats skipped): a feed that turns back past
-    // 90 deg from one of them (a zig-zag's return leg after its step-over) starts a new pass.
-    // The steering's frame (f, n, n x f) turns over with the feed: the same tilt would lean the
-    // axis to the other side, into the wall it leaned away from.
-    constexpr std::size_t kRecent = 3;
-    // A turn that runs within 60 deg of square to the leg (a step-over leaning back, an arc's
-    // middle), followed by a step within 30 deg of the leg's reverse, is a step-over.
-    const double kBackSin = std::sin(30.0 * M_PI / 180.0);  // -cos 120 deg
-    const double kStepOverSidewaysCos = std::cos(30.0 * M_PI / 180.0);
-    const double kReturnLegCos = std::cos(30.0 * M_PI / 180.0);
-    std::vector<Vec3> recent;
-    // A turn under way: from the posture where a straight leg ended (`corner`), steps within 60
-    // deg of square to the leg (`leg`: its recent feed), up to a ball's diameter in all. A step
-    // then within 30 deg of the leg's reverse, and the next straight on, makes it a zig-zag's
-    // turn, however many postures it has: the leg ends at the corner, the next pass starts with
-    // the turn's second posture, its first step the link (with 3 postures in the step-over the legs
-    // split at random, the axis turned 43 deg in one step, 30 postures collided: a helper's
-    // pocket). Any other step ends the turn: a corner kept in the pass (an L).
-    struct Turn {
-      std::size_t corner = 0;
-      Vec3 leg = Vec3::Zero();
-      double length_mm = 0.0;
-      std::vector<std::pair<std::size_t, Vec3>> steps;  // (posture at its end, step)
-    };
-    std::optional<Turn> turn;
-    const auto pushRecent = [&recent](const Vec3& step) {
-      recent.push_back(step);
-      if (recent.size() > kRecent) recent.erase(recent.begin());
-    };
-    // A block that begins with its step-over (where the last one ended) leaves a leg of one
-    // posture, the step-over's start: no pass of its own (was "a single posture"). Elsewhere a
-    // leg of one posture stays an error of nominalPasses (a jitter back in a pass).
-    const auto split = [&](std::size_t end, std::size_t next_begin) {
-      const bool step_over_start = begin == block.begin && end == begin + 1;
-      if (end > begin && !step_over_start) ranges.emplace_back(begin, end);
-      begin = next_begin;
-      recent.clear();
-    };
-    // Back past 120 deg, not 90: a square corner in contact is a few degrees more or less in the
-    // ball centres over a sloped floor (and +-1e-17 of rounding at 90): a helper's contour loops
-    // in one block were cut at random corners (23 uneven pieces, the frame turned at each).
-    // Step-overs that turn back less are the turns' above. The new pass starts
-    // where the step back does, the step before it the link.
-    const auto feed = [&](std::size_t i, const Vec3& step) {
-      bool back = false;
-      for (const Vec3& before : recent)
-        back = back || step.dot(before) < -kBackSin * step.norm() * before.norm();
-      // An axis turned over (more than 90 deg) throws its centre 2R the other way: that is the
-      // axis's fault, named at its line by nominalPasses, not a new leg.
-      if (back && path.postures[i].axis.dot(path.postures[i - 1].axis) > 0.0) split(i - 1, i - 1);
-      pushRecent(step);
-    };
-    const auto endTurn = [&] {  // not a step-over: its steps are the pass's feed (a corner)
-      const std::vector<std::pair<std::size_t, Vec3>> steps = std::move(turn->steps);
-      turn.reset();
-      for (const auto& [at, step] : steps) feed(at, step);
-    };
-    // The ball centres' path from posture `from` over up to a ball's diameter, forward (+1) or
-    // back (-1), within the block and short of a gap: its chord (unit) and whether the chord is
-    // at least 0.9 of the length (true where there is no path to tell).
-    struct Run {
-      Vec3 chord = Vec3::Zero();
-      bool straight = true;
-    };
-    const auto run = [&](std::size_t from, int direction) {
-      Run out;
-      double length_mm = 0.0;
-      std::size_t at = from;
-      while (length_mm < 2.0 * ball_radius_mm) {
-        if (direction > 0 ? at + 1 >= block.end : at <= block.begin) break;
-        const std::size_t to = direction > 0 ? at + 1 : at - 1;
-        const double step_mm = (centre(to) - centre(at)).norm();
-        if (gap > 0.0 && step_mm > gap) break;
-        length_mm += step_mm;
-        at = to;
-      }
-      const Vec3 chord = (centre(at) - centre(from)) * static_cast<double>(direction);
-      if (length_mm > kRepeatMm) {
-        out.chord = chord.normalized();
-        out.straight = chord.norm() >= 0.9 * length_mm;
-      }
-      return out;
-    };
-    for (std::size_t i = block.begin + 1; i < block.end; ++i) {
-      const Vec3 step = centre(i) - centre(i - 1);
-      // DESIGN's gap is the tips'; the centres' too, so that an axis swung about a steady tip
-      // (the centre thrown up to 2R) or about a steady centre (the tip thrown) stays in its
-      // pass: such a turn is the axis's, counted and named at its line, not a link.
-      if (gap > 0.0 && step.norm() > gap) {
-        if (tipStep(i) > tip_gap) {  // the link between the two
-          ranges.emplace_back(begin, i);
-          begin = i;
-          recent.clear();
-          turn.reset();  // (its steps were no pass's feed but the one ended here)
-        }
-        // else the axis swung about a steady tip: its centre's jump is no feed direction (a
-        // swing along the feed read as a turn back and left a pass of one posture)
-        continue;
-      }
-      if (step.norm() <= kRepeatMm) continue;
-      const bool axis_steady = path.postures[i].axis.dot(path.postures[i - 1].axis) > 0.0;
-      const Vec3 along = step.normalized();
-      if (turn) {
-        // The return leg runs straight on after it: its chord over a ball's diameter within 30
-        // deg of the leg's reverse and at least 0.9 of its length (a circle or a helix turning
-        // 20 deg a step comes within 30 deg of reversed too, half a turn on: a reviewer's small
-        // circles lost their arcs to links; the chord, not each step: ball centres over a
-        // sloped floor wiggle by 15 deg a step).
-        const Run after = run(i, +1);
-        const bool straight_on = after.straight && after.chord.dot(turn->leg) < -kReturnLegCos;
-        if (along.dot(turn->leg) < -kReturnLegCos && axis_steady && straight_on) {
-          // The leg ends at the corner, the return leg starts with this step, and the turn's
-          // postures between (two or more: a contour's short side, a step-over of several) are a
-          // pass of their own, each frame along its own feed: cut as links they were lost (a
-          // rectangle 20 x 4 lost its short sides, a reviewer's case), cut as the return leg's
-          // start its frame turned there (43 deg in one step, 38 postures colliding).
-          const std::size_t turn_begin = turn->corner + 1;
-          turn.reset();
-          split(turn_begin, turn_begin);
-          if (i - 1 >= turn_begin + 2) split(i - 1, i - 1);
-          begin = i - 1;
-          recent.clear();
-          pushRecent(step);
-          continue;
-        }
-        if (std::abs(along.dot(turn->leg)) < kStepOverSidewaysCos &&
-            turn->length_mm + step.norm() <= 2.0 * ball_radius_mm) {
-          turn->length_mm += step.norm();
-          turn->steps.emplace_back(i, step);
-          continue;
-        }
-        endTurn();
-      }
-      if (recent.size() == kRecent) {
-        Vec3 leg = Vec3::Zero();
-        for (const Vec3& before : recent) leg += before.normalized();
-        // Only from a straight leg (its chord over a ball's diameter at least 0.9 of its length):
-        // a curve turns a little every step, and its lagging mean read as a corner.
-        const bool straight = leg.norm() > 0.0 && run(i - 1, -1).straight;
-        if (straight && std::abs(along.dot(leg.normalized())) < kStepOverSidewaysCos &&
-            step.norm() <= 2.0 * ball_radius_mm) {
-          turn = Turn{i - 1, leg.normalized(), step.norm(), {{i, step}}};
-          continue;
-        }
-      }
-      feed(i, step);
-    }
-    if (turn) endTurn();
-    ranges.emplace_back(begin, block.end);
-  }
-  return ranges;
 }
 
 std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,

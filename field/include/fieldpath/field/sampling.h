@@ -37,4 +37,14 @@ struct ObstacleSamples {
 ObstacleSamples sampleObstacles(std::span<const geometry::TriangleMesh> meshes, double step_mm,
                                 Weights weights);
 
+/// The n of sampleObstacles' n×n split of triangle (a, b, c): sub-triangles of area <= step² and
+/// edges <= 1.5·step (>= 1). The memory estimates count samples with it.
+int triangleSplits(const Vec3& a, const Vec3& b, const Vec3& c, double step_mm);
+
+/// Whether a piece of surface is under a quarter of a sample's patch (step²): sampleObstacles
+/// merges such pieces per cell of side `step` and direction of normal instead of sampling each.
+inline bool isSmallPiece(double area_mm2, double step_mm) {
+  return area_mm2 < 0.25 * step_mm * step_mm;
+}
+
 }  // namespace fieldpath::field
