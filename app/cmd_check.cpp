@@ -214,7 +214,9 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                        ": check proves ball and torus tools; a flat end's sharp rim, tilted, is "
                        "not bounded by its Z-buffer stamps yet (`simulate --tool flat:R` cuts "
                        "with it)");
-    const std::vector<std::string> tool_notes = cutterNotes(scene.tool, path);
+    std::vector<std::string> tool_notes = cutterNotes(scene.tool, path);
+    if (std::string holder = noHolderNote(scene.tool, scene.holder); !holder.empty())
+      tool_notes.push_back(std::move(holder));
     const std::vector<std::string> obstacle_notes = openObstacleNotes(scene);
     const pathgen::AxisTurn axis_turn = pathgen::largestAxisTurn(path, scene.tool.radius_mm);
 
@@ -413,6 +415,15 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
           surface->simulation_s);
     } else
       std::printf("surface: not checked (%s)\n", surface_skipped);
+    // The verdict last, as a user looks for it (the reasons were only in check.json: a
+    // newcomer's 352 colliding postures ended on a line of statistics).
+    std::string reasons;
+    for (const std::string& reason : not_ok) reasons += (reasons.empty() ? "" : "; ") + reason;
+    if (not_ok.empty())
+      std::printf("check: ok\n");
+    else
+      std::printf("check: NOT OK%s: %s (check.json not_ok_because)\n",
+                  unsafe.empty() ? "" : ", UNSAFE TO RUN", reasons.c_str());
     for (const std::string& note : tool_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
     for (const std::string& note : obstacle_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
     if (const std::string turn = axisTurnWarning(path, axis_turn); !turn.empty())

@@ -141,6 +141,8 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
        r.cutter_part ? json(nullptr) : json("no `part` in the scene, or a flat end")},
       {"link_part_skipped",
        r.link_part ? json(nullptr) : json("no `part` in the scene, or no links")},
+      {"holder_part_skipped",
+       r.holder_part ? json(nullptr) : json("no `part` or no `holder` in the scene")},
       {"safe", unsafe.empty()},
       {"tool_notes", notes.tool},
       {"obstacle_notes", notes.obstacle},
@@ -364,6 +366,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     const pathgen::AxisTurn axis_turn = pathgen::largestAxisTurn(result.path, job.tool.radius_mm);
     JobNotes notes;
     if (scene.nominal) notes.tool = cutterNotes(scene.tool, *scene.nominal);
+    if (std::string holder = noHolderNote(scene.tool, scene.holder); !holder.empty())
+      notes.tool.push_back(std::move(holder));
     notes.obstacle = openObstacleNotes(scene);
     if (std::string far = farLinkNote(scene, result.path); !far.empty())
       notes.link.push_back(std::move(far));

@@ -423,6 +423,16 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
       names += file + ", ";
     }
     std::printf("outputs         %s/{%ssimulate.json}\n", out.string().c_str(), names.c_str());
+    // Nothing cut is most often the stock where the path already is (a newcomer's raster on a
+    // floor read "0 lines touched" without a word, twice).
+    if (res.lines_lowered == 0)
+      std::fprintf(stderr,
+                   "warning: no line was cut: the tool never goes below the initial surface (%s); "
+                   "a finishing path runs on the finished part, so its stock lies above: give "
+                   "--stock Z above the path's lowest tips\n",
+                   part                       ? "the top of --part"
+                   : !std::isnan(o->stock_mm) ? "--stock"
+                                              : "the stock at the highest tip, the default");
   });
 }
 

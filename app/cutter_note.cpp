@@ -59,4 +59,12 @@ std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool,
   return notes;
 }
 
+std::string noHolderNote(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder) {
+  if (!holder.empty()) return {};
+  return "no `holder` in the scene: the tool is proven clear up to its length (" +
+         mm(tool.length_mm) +
+         " mm from the tip), the holder and spindle above it are not (give its stations: "
+         "holder: [[z, radius], ...])";
+}
+
 }  // namespace fieldpath::app

@@ -17,4 +17,8 @@ namespace fieldpath::app {
 std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool,
                                      const geometry::PathFile& path);
 
+/// The line said when a scene has no `holder`: what is then proven clear is the tool up to its
+/// length, not what holds it (a newcomer's job read safe with no word of it). Empty with a holder.
+std::string noHolderNote(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder);
+
 }  // namespace fieldpath::app

@@ -38,15 +38,24 @@ pathgen::GenerateRequest sceneJob(const Scene& scene) {
   job.part = scene.part;
   if (job.tool.shape != geometry::ToolShape::Ball)
     throw InputError(toolShapeWhere(scene) + ": the passes are for a ball-end mill (shape: ball)");
-  std::size_t repeated = 0;
-  job.passes =
-      impeller ? pathgen::impellerPasses(*scene.impeller_model, job.path, job.tool.radius_mm)
-               : pathgen::nominalPasses(*scene.nominal, job.path, job.tool.radius_mm, &repeated);
-  if (repeated > 0)  // DESIGN: a posture kept out of the path is reported (they went unsaid)
+  pathgen::NominalDropped dropped;
+  job.passes = impeller
+                   ? pathgen::impellerPasses(*scene.impeller_model, job.path, job.tool.radius_mm)
+                   : pathgen::nominalPasses(*scene.nominal, job.path, job.tool.radius_mm, &dropped);
+  // DESIGN: a posture kept out of the path is reported (repeats, and a zig-zag's one-posture
+  // step-overs, went unsaid: a newcomer's 1319 postures came out as 1308).
+  if (dropped.repeated > 0)
     std::fprintf(stderr,
                  "note: %s: %zu posture%s at the ball centre of the one before dropped (a repeat "
                  "is no motion)\n",
-                 scene.nominal->file.string().c_str(), repeated, repeated == 1 ? "" : "s");
+                 scene.nominal->file.string().c_str(), dropped.repeated,
+                 dropped.repeated == 1 ? "" : "s");
+  if (dropped.between_legs > 0)
+    std::fprintf(stderr,
+                 "note: %zu posture%s between the legs of a zig-zag (a step-over of one posture; "
+                 "first: %s) made into links: the passes end and start at the legs\n",
+                 dropped.between_legs, dropped.between_legs == 1 ? "" : "s",
+                 scene.nominal->where(dropped.first_between).c_str());
   if (!impeller) {  // link blocks are dropped (links are made anew): said, with their size, as
     // a `# link` with no `# pass` or blank line after its moves takes the cutting that follows
     std::size_t blocks = 0, postures = 0, first = 0;

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <string>
 
+#include <unistd.h>
+
 #include "fieldpath/common/progress.h"
 
 namespace fieldpath::app {
@@ -31,24 +33,29 @@ inline void endProgressLine() {
   progressLineOpen() = false;
 }
 
-/// Makes a Progress hook that redraws one stderr line at most 10 times a second, and only once
-/// the work has run for a second. Quiet → a hook that never prints.
+/// Makes a Progress hook that, on a terminal, redraws one stderr line at most 10 times a second,
+/// and only once the work has run for a second. Into a file or a pipe (a log) the redraws would
+/// pile up on one line (a newcomer's log): there a whole line at most every 10 s, and at 100 %.
+/// Quiet → a hook that never prints.
 inline common::Progress makeProgressLine(bool quiet) {
   if (quiet) return [](double, std::string_view) { return true; };
+  const bool terminal = isatty(fileno(stderr)) != 0;
+  const auto every = terminal ? std::chrono::milliseconds(100) : std::chrono::milliseconds(10000);
   const auto start = std::chrono::steady_clock::now();
   auto last = start;
   std::string finished;  // the work whose 100 % line was printed (a second report of it is not)
-  return [start, last, finished](double fraction, std::string_view what) mutable {
+  return [=](double fraction, std::string_view what) mutable {
     const auto now = std::chrono::steady_clock::now();
     const double elapsed_s = std::chrono::duration<double>(now - start).count();
-    if (elapsed_s < 1.0 || (now - last < std::chrono::milliseconds(100) && fraction < 1.0))
-      return true;
+    if (elapsed_s < 1.0 || (now - last < every && fraction < 1.0)) return true;
     if (fraction >= 1.0 && finished == what) return true;
     finished = fraction >= 1.0 ? std::string(what) : std::string();
     last = now;
-    std::fprintf(stderr, "\r%-24.*s %5.1f%%  %6.1f s%s", static_cast<int>(what.size()), what.data(),
-                 100.0 * fraction, elapsed_s, fraction >= 1.0 ? "\n" : "");
-    progressLineOpen() = fraction < 1.0;
+    const bool ends = fraction >= 1.0 || !terminal;
+    std::fprintf(stderr, "%s%-24.*s %5.1f%%  %6.1f s%s", terminal ? "\r" : "",
+                 static_cast<int>(what.size()), what.data(), 100.0 * fraction, elapsed_s,
+                 ends ? "\n" : "");
+    progressLineOpen() = !ends;
     std::fflush(stderr);
     return true;
   };

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <functional>
 #include <initializer_list>
 #include <map>
@@ -456,8 +457,19 @@ Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
                          ": a second YAML document (after `---` or `...`): a scene file holds "
                          "one scene; remove it or put it in its own file");
   } catch (const YAML::ParserException& e) {
+    // A tab in the indentation reads as "illegal block entry" and the like: say the tab (a
+    // newcomer's scene, pasted from an editor that indents with tabs).
+    std::string hint;
+    {
+      std::ifstream in(file);
+      std::string line;
+      for (int n = 0; n <= e.mark.line && std::getline(in, line);) ++n;
+      const std::size_t text = line.find_first_not_of(" \t");
+      if (line.substr(0, text).find('\t') != std::string::npos)
+        hint = " (the line is indented with a tab: YAML indents with spaces only)";
+    }
     throw InputError(file.string() + ":" + std::to_string(e.mark.line + 1) +
-                     ": YAML syntax: " + e.msg);
+                     ": YAML syntax: " + e.msg + hint);
   } catch (const YAML::Exception& e) {
     throw InputError(file.string() + ": cannot read scene file: " + e.msg);
   }

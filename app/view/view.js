@@ -72,11 +72,15 @@
   var GOUGE_STOPS = [[8, 48, 107], [66, 146, 198], [198, 219, 239]];
   var SCALLOP_STOPS = [[229, 245, 224], [254, 224, 139], [253, 141, 60], [189, 0, 38]];
   var UNCUT = [0.45, 0.45, 0.47];
+  // Above the scale (its top: check's max scallop over the machined band), stock left beside the
+  // band: its own colour (it read as the worst scallop's red, a newcomer's finding).
+  var ABOVE = [0.42, 0.24, 0.6];
   function deviationMap(lo, hi, uncut) {
     return function (v) {
       if (uncut && v >= uncut) return UNCUT;
       if (!isFinite(v)) return null;  // off the part: no triangle
       if (v < 0) return ramp(GOUGE_STOPS, 1 - v / lo);
+      if (v > hi) return ABOVE;
       return ramp(SCALLOP_STOPS, v / hi);
     };
   }
@@ -601,11 +605,17 @@
     }
     if (surface && layers.surface.object.visible) {
       var s = surface;
-      legend(s.kind === 'deviation' ? 'surface: deviation, \u00b5m (gouge < 0 < scallop)'
-                                    : 'surface: height, mm',
-             s.range[0], s.range[1], surfaceMap,
-             s.uncut_um ? 'grey: not cut' + (s.uncut_um < 1e6 ? ' (' + Math.round(s.uncut_um) +
-                                             ' \u00b5m of stock left)' : '') : '', 'fp-legend-surface');
+      legend(
+          s.kind === 'deviation' ? 'surface: deviation, \u00b5m (gouge < 0 < scallop)' :
+                                   'surface: height, mm',
+          s.range[0], s.range[1], surfaceMap,
+          (s.kind === 'deviation' ? 'purple: above the scale (stock left beside the band); ' : '') +
+              (s.uncut_um ? 'grey: not cut' +
+                       (s.uncut_um < 1e6 ?
+                            ' (' + Math.round(s.uncut_um) + ' \u00b5m of stock left)' :
+                            '') :
+                            ''),
+          'fp-legend-surface');
     }
   }
   drawLegends();

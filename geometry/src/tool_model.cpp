@@ -163,7 +163,11 @@ Profile fullProfile(const ToolSpec& tool, const HolderProfile& holder) {
                      " mm, not above the cutting end of the tool (" +
                      std::to_string(cornerRadius(tool)) + " mm)");
   // The shank runs up to the first station, also past L into a holder that starts above the tool.
-  Profile p = toolSide(tool, holder.front().z_mm);
+  // Past L it does not cut: holder surface (checked against the part as the holder is; as tool
+  // surface a shank 1 mm into an overhang above L went unseen, `check` ok: a reviewer's case).
+  Profile p = toolSide(tool, std::min(holder.front().z_mm, len));
+  if (holder.front().z_mm > len)
+    p.push_back(line(p.back().to, Vec2(big_r, holder.front().z_mm), NodePart::Holder));
   // Pieces on the shank cylinder below L are tool surface; the rest is holder.
   const auto add = [&](Vec2 to) {
     const Vec2 from = p.back().to;

@@ -200,14 +200,15 @@ double ClearanceChecker::clearance(const geometry::Posture& posture, int* obstac
 }
 
 double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double radius_mm,
-                                       std::size_t* at, int* obstacle) const {
+                                       std::size_t* at, int* obstacle,
+                                       double exact_below_mm) const {
   // A point-sized sphere model: the distance from the centre to the obstacles, less the radius.
   constexpr double kPointRadiusMm = 1e-4;
   auto ball = std::make_shared<Model>();
   fcl::generateBVHModel(*ball, fcl::Sphered(kPointRadiusMm), fcl::Transform3d::Identity(), 4u, 4u);
   std::vector<double> distance(centres_mm.size());
   std::vector<int> nearest(centres_mm.size());
-  tbb::parallel_for(size_t{0}, centres_mm.size(), [&](size_t i) {
+  const auto measure = [&](size_t i) {
     fcl::Transform3d pose = fcl::Transform3d::Identity();
     pose.translation() = centres_mm[i];
     distance[i] = nearestObstacle(*ball, pose, impl_->obstacles, &nearest[i]);
@@ -217,6 +218,26 @@ double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double 
         distance[i] = 0.0;  // the centre inside an obstacle: the ball is in it
         nearest[i] = static_cast<int>(k);
       }
+  };
+  // Runs of stations, each walked in order from its last measured centre: a centre that cannot
+  // come under the exact range (its lower bound d - |c - c_measured|) keeps that bound. The
+  // runs in parallel; the bounds, the minimum and its first index as every station measured.
+  constexpr size_t kRun = 256;
+  const double skip_from_mm = radius_mm + exact_below_mm;
+  tbb::parallel_for(size_t{0}, (centres_mm.size() + kRun - 1) / kRun, [&](size_t run) {
+    const size_t end = std::min(centres_mm.size(), (run + 1) * kRun);
+    size_t measured = run * kRun;
+    measure(measured);
+    for (size_t i = measured + 1; i < end; ++i) {
+      const double bound = distance[measured] - (centres_mm[i] - centres_mm[measured]).norm();
+      if (std::isfinite(skip_from_mm) && bound >= skip_from_mm) {
+        distance[i] = bound;
+        nearest[i] = nearest[measured];
+        continue;
+      }
+      measure(i);
+      measured = i;
+    }
   });
   double best = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < distance.size(); ++i) {
@@ -237,11 +258,42 @@ ClearanceResult ClearanceChecker::check(std::span<const geometry::Posture> postu
   std::vector<double> distance(postures.size());
   std::vector<int> nearest(postures.size());
   const size_t batch = std::max<size_t>(1, request.batch);
+  constexpr size_t kEvery = 8;  // exact_min_only: the postures measured first
+  const auto measured = [&](size_t i) { return i % kEvery == 0 || i + 1 == postures.size(); };
+  double least_measured = std::numeric_limits<double>::infinity();
+  if (request.exact_min_only) {
+    const size_t firsts = (postures.size() + kEvery - 1) / kEvery;
+    tbb::parallel_for(size_t{0}, firsts, [&](size_t j) {
+      distance[j * kEvery] = clearance(postures[j * kEvery], &nearest[j * kEvery]);
+    });
+    if (!postures.empty()) distance.back() = clearance(postures.back(), &nearest.back());
+    for (size_t i = 0; i < postures.size(); i += kEvery)
+      least_measured = std::min(least_measured, distance[i]);
+    if (!postures.empty()) least_measured = std::min(least_measured, distance.back());
+  }
+  // The lower bound of posture i's clearance from measured posture k's.
+  const auto boundFrom = [&](size_t k, size_t i) {
+    return distance[k] - geometry::motionSweepMm(postures[k], postures[i], impl_->reach_mm);
+  };
   for (size_t begin = 0; begin < postures.size(); begin += batch) {
     const size_t end = std::min(postures.size(), begin + batch);
     tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
-      for (size_t i = range.begin(); i != range.end(); ++i)
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        if (request.exact_min_only) {
+          if (measured(i)) continue;
+          const size_t before = i - i % kEvery;
+          const size_t after = std::min(before + kEvery, postures.size() - 1);
+          const bool from_after = boundFrom(after, i) > boundFrom(before, i);
+          const double bound = std::max(boundFrom(before, i), boundFrom(after, i));
+          // Strictly above the least measured: it can be neither the minimum nor tie with it.
+          if (bound > 0.0 && bound > least_measured) {
+            distance[i] = bound;
+            nearest[i] = nearest[from_after ? after : before];
+            continue;
+          }
+        }
         distance[i] = clearance(postures[i], &nearest[i]);
+      }
     });
     common::report(progress, static_cast<double>(end) / postures.size(), "clearance");
   }

@@ -58,7 +58,7 @@ void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>
     for (const PassSample& s : pass.samples) centres.push_back(s.centre_mm);
     size_t at = 0;
     int obstacle = -1;
-    const double d = checker.ballClearance(centres, ball_radius_mm, &at, &obstacle);
+    const double d = checker.ballClearance(centres, ball_radius_mm, &at, &obstacle, clearance_mm);
     if (d <= 0.0) {
       std::ostringstream msg;
       msg << pass.label << ": at s = " << pass.samples[at].s_mm << " mm the ball touches or "

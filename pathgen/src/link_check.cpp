@@ -131,7 +131,10 @@ std::optional<LinkPartResult> checkHolderAgainstPart(
   if (holder_mesh.triangles.empty() || postures.empty()) return std::nullopt;
   const ClearanceChecker holder_part(holder_mesh, std::span(&part, 1), kClearanceMeshTolMm);
   LinkPartResult out;
-  const ClearanceResult c = holder_part.check(postures, {}, common::scaled(progress, 0, 0.3, ""));
+  ClearanceRequest only_min;  // the holder's minimum and contacts are reported, not each posture's
+  only_min.exact_min_only = true;
+  const ClearanceResult c =
+      holder_part.check(postures, only_min, common::scaled(progress, 0, 0.3, ""));
   out.postures = c.postures;
   out.min_clearance_mm = c.min_clearance_mm;
   out.colliding_postures = c.colliding;

@@ -111,7 +111,7 @@ void requireSteadyAxes(const PathFile& path, double pass_gap_mm, double ball_rad
 }
 
 std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
-                                double ball_radius_mm, std::size_t* repeated) {
+                                double ball_radius_mm, NominalDropped* dropped) {
   if (!std::isfinite(params.pass_gap_mm) || params.pass_gap_mm < 0.0)
     throw InputError("path.pass_gap: must be a finite distance >= 0 mm (0: automatic)");
   if (params.step_given && (!std::isfinite(params.step_mm) || !(params.step_mm >= kMinPathStepMm)))
@@ -121,16 +121,26 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
   if (!std::isfinite(ball_radius_mm) || ball_radius_mm <= 0.0)
     throw InputError("tool.radius: must be > 0");
   const double r = ball_radius_mm;
-  std::size_t dropped = 0;
+  NominalDropped said;
   std::vector<Pass> passes;
-  for (const auto& [begin, end] : passRanges(path, params.pass_gap_mm, r)) {
+  const std::vector<std::pair<std::size_t, std::size_t>> ranges =
+      passRanges(path, params.pass_gap_mm, r);
+  {  // postures of pass blocks that no range holds
+    std::vector<char> held(path.postures.size(), 0);
+    for (const auto& [begin, end] : ranges) std::fill(held.begin() + begin, held.begin() + end, 1);
+    for (const PathBlock& block : path.blocks)
+      if (block.kind == PathBlock::Kind::Pass)
+        for (std::size_t i = block.begin; i < block.end; ++i)
+          if (!held[i] && said.between_legs++ == 0) said.first_between = i;
+  }
+  for (const auto& [begin, end] : ranges) {
     const int number = static_cast<int>(passes.size()) + 1;
     // Distinct postures of the pass (consecutive repeats of a ball centre dropped).
     std::vector<std::size_t> kept;
     for (std::size_t i = begin; i < end; ++i) {
       const Vec3 c = geometry::ballCentre(path.postures[i], r);
       if (!kept.empty() && (c - geometry::ballCentre(path.postures[kept.back()], r)).norm() <= kRepeatMm) {
-        ++dropped;
+        ++said.repeated;
         continue;
       }
       kept.push_back(i);
@@ -203,7 +213,7 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
   }
   if (passes.empty())
     throw InputError(path.file.string() + ": no pass (every block is a `# link` or RAPID move)");
-  if (repeated) *repeated = dropped;
+  if (dropped) *dropped = said;
   return passes;
 }
 

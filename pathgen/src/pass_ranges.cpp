@@ -188,8 +188,11 @@ class BlockSplitter {
     const bool straight_on = after.straight && after.chord.dot(turn_->leg) < -kReverseOfLegCos;
     if (along.dot(turn_->leg) < -kReverseOfLegCos && axisSteady(i) && straight_on) {
       const std::size_t turn_begin = turn_->corner + 1;
+      // Distinct postures between the corner and the return leg's first: one a turn step but the
+      // last (repeats skipped: a step-over written twice made a pass "at one place", refused).
+      const std::size_t between = turn_->steps.size() - 1;
       turn_.reset();
-      if (i - 1 >= turn_begin + 2) {
+      if (between >= 2) {
         split(turn_begin, turn_begin);  // the leg, to its corner
         split(i - 1, i - 1);            // the turn's postures
       } else {

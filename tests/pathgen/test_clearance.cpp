@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/pathgen/clearance.h"
 #include "fieldpath/pathgen/link_check.h"
 #include "fixtures.h"
@@ -152,6 +153,73 @@ TEST(Clearance, BallClearanceIsCentreDistanceLessTheRadius) {
   EXPECT_EQ(obstacle, 0);
   const std::vector<Vec3> touching = {Vec3(4.5, 0, 0)};
   EXPECT_EQ(checker.ballClearance(touching, 1.0), 0.0);
+}
+
+// Only the clearance under `exact_below_mm` is asked for exactly: a dense path (0.01 mm stations)
+// swinging towards the wall x = 5 from 12 mm off and back gives the every-station minimum, value
+// and index, bit for bit where it is under the threshold, and a lower bound of at least the
+// threshold (at most the true minimum) where it is not.
+TEST(Clearance, BallClearanceSkipsStationsThatCannotComeUnderTheThreshold) {
+  const TriangleMesh tool = box(Vec3(-1, -1, 0), Vec3(1, 1, 10));
+  const std::vector<TriangleMesh> obstacles = {wall(5.0), wall(-20.0)};
+  const pathgen::ClearanceChecker checker(tool, obstacles);
+  for (const double nearest_x : {-7.0, 2.5, 3.9}) {  // ball clearance 11, 1.5, 0.1 mm at the apex
+    std::vector<Vec3> centres;
+    for (int k = 0; k <= 6000; ++k) {
+      const double t = k / 6000.0;
+      centres.emplace_back(-7.0 + (nearest_x + 7.0) * std::sin(M_PI * t), 60.0 * t, 1.0);
+    }
+    std::size_t at_all = 0, at = 0;
+    int obstacle_all = -1, obstacle = -1;
+    const double all = checker.ballClearance(centres, 1.0, &at_all, &obstacle_all);
+    for (const double threshold : {0.5, 2.0}) {
+      const double skipped = checker.ballClearance(centres, 1.0, &at, &obstacle, threshold);
+      if (all < threshold) {
+        EXPECT_EQ(skipped, all) << nearest_x << ' ' << threshold;
+        EXPECT_EQ(at, at_all);
+        EXPECT_EQ(obstacle, obstacle_all);
+      } else {
+        EXPECT_GE(skipped, threshold) << nearest_x << ' ' << threshold;
+        EXPECT_LE(skipped, all + 1e-12) << nearest_x << ' ' << threshold;
+      }
+    }
+  }
+}
+
+// exact_min_only (the holder against the part): a dense path of a ball-end tool and holder that
+// tilts towards a wall and into it gives the every-posture minimum (value, posture, obstacle),
+// the colliding postures and the first, bit for bit; every other posture's figure is a lower
+// bound of its measured one (within the tool mesh's chordal tolerance, the two bounds' common
+// ground).
+TEST(Clearance, OnlyTheMinimumExactMeasuresFewerPosturesAndAgrees) {
+  const TriangleMesh tool =
+      geometry::toolMesh(geometry::parseToolSpec("ball:3:20"),
+                         geometry::parseHolderProfile("20:6,40:6,40:12,60:12"), 0.02);
+  const std::vector<TriangleMesh> obstacles = {wall(5.0), wall(-40.0)};
+  const pathgen::ClearanceChecker checker(tool, obstacles, 0.02);
+  for (const double deepest_deg : {5.0, 30.0}) {  // clear all along; the holder into the wall
+    std::vector<Posture> postures;
+    for (int k = 0; k <= 3000; ++k) {
+      const double t = k / 3000.0, tilt = deepest_deg * M_PI / 180.0 * std::sin(M_PI * t);
+      postures.push_back({Vec3(-15.0, 30.0 * t, 0.0), Vec3(std::sin(tilt), 0.0, std::cos(tilt))});
+    }
+    pathgen::ClearanceRequest only_min;
+    only_min.exact_min_only = true;
+    const pathgen::ClearanceResult all = checker.check(postures);
+    const pathgen::ClearanceResult some = checker.check(postures, only_min);
+    EXPECT_EQ(some.min_clearance_mm, all.min_clearance_mm) << deepest_deg;
+    EXPECT_EQ(some.min_index, all.min_index);
+    EXPECT_EQ(some.min_obstacle, all.min_obstacle);
+    EXPECT_EQ(some.colliding, all.colliding);
+    EXPECT_EQ(some.first_colliding, all.first_colliding);
+    std::size_t spared = 0;
+    for (std::size_t i = 0; i < postures.size(); ++i) {
+      EXPECT_LE(some.clearance_mm[i], all.clearance_mm[i] + 0.02) << i;
+      spared += some.clearance_mm[i] != all.clearance_mm[i];
+    }
+    // Clear all along: most spared; colliding in the middle: the clear postures near the ends.
+    EXPECT_GT(spared, postures.size() / (deepest_deg < 10.0 ? 2 : 10)) << deepest_deg;
+  }
 }
 
 // The moves out of and into passes are checked with the tool 0.1 mm smaller all round, its top

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -308,13 +309,24 @@ TEST(CheckSurface, AShankDrivenIntoAWallOfThePartIsAGouge) {
            << " 0 " << c << '\n';
     dir.write(side > 0 ? "towards.cl" : "away.cl", path.str());
   }
+  std::map<std::string, std::string> said;  // stdout of each
   auto checked = [&](const std::string& name) {
     const auto r = test::runFieldpath(
         dir, "check scene.yaml --path " + name + ".cl --spacing 0.1 --out out_" + name);
     EXPECT_EQ(r.exit_code, 0) << r.output();
+    said[name] = r.out;
     return nlohmann::json::parse(test::slurp(dir.path() / ("out_" + name) / "check.json"));
   };
   const auto towards = checked("towards"), away = checked("away");
+  // The verdict is the last line (it was only in check.json), and a scene with no holder says
+  // what is then not proven.
+  EXPECT_NE(said["towards"].find(
+                "check: NOT OK: " + towards["not_ok_because"][0].get<std::string>() + "; "),
+            std::string::npos)
+      << said["towards"];
+  EXPECT_TRUE(said["away"].ends_with("check: ok\n")) << said["away"];
+  EXPECT_NE(away["tool_notes"].dump().find("no `holder` in the scene"), std::string::npos)
+      << away["tool_notes"];
   EXPECT_GT(towards["surface"]["max_gouge_um"].get<double>(), 3000.0);
   EXPECT_GT(towards["surface"]["gouged_lines"].get<int>(), 100);
   EXPECT_FALSE(towards["ok"].get<bool>());
@@ -330,6 +342,44 @@ TEST(CheckSurface, AShankDrivenIntoAWallOfThePartIsAGouge) {
   EXPECT_EQ(away["cutter_part"]["gouging_postures"].get<int>(), 0);
   EXPECT_EQ(away["surface"]["gouged_lines"].get<int>(), 0);
   EXPECT_TRUE(away["ok"].get<bool>()) << away["not_ok_because"];
+}
+
+// The shank above the flutes (L 20) and below a holder that starts at 40 does not cut: driven
+// 1 mm into an overhang of the part at z 25..35 it is a crash, found by `check` and `generate`
+// (it was neither the cutter's, which ends at L, nor the holder's: ok and safe, a reviewer's
+// case). 1 mm clear of the overhang, the same pass is ok.
+TEST(CheckClearance, TheShankAboveTheFlutesIntoAnOverhangIsUnsafe) {
+  const TempDir dir;
+  for (const double edge : {2.0, 4.0}) {
+    // The overhang over the pass's middle only: the links at its ends, straight up, clear it.
+    writeFloorAndWall(dir, {-30, 30, -30, 30, -10, 0}, {-2, 2, edge, 30, 25, 35});
+    dir.write("scene.yaml",
+              "obstacles:\n  - mesh: far.stl\npart: part.stl\n"
+              "tool: { shape: ball, radius: 3, length: 20 }\nholder: [[40, 6], [90, 6]]\n"
+              "clearance: 0.5\npath: { nominal: pass.cl }\n");
+    std::ostringstream path;
+    path << "# pass 1\n";
+    for (int k = 0; k <= 32; ++k) path << -8 + 0.5 * k << " 0 0 0 0 1\n";
+    dir.write("pass.cl", path.str());
+    const std::string out = edge < 3.0 ? "into" : "clear";
+    const auto r = test::runFieldpath(
+        dir, "check scene.yaml --path pass.cl --spacing 0.1 --out " + out + "_check");
+    EXPECT_EQ(r.exit_code, 0) << r.output();
+    const auto check =
+        nlohmann::json::parse(test::slurp(dir.path() / (out + "_check") / "check.json"));
+    const auto g = test::runFieldpath(dir, "generate scene.yaml --nominal --out " + out + "_gen");
+    EXPECT_EQ(g.exit_code, 0) << g.output();
+    const auto report =
+        nlohmann::json::parse(test::slurp(dir.path() / (out + "_gen") / "report.json"));
+    if (edge < 3.0) {
+      EXPECT_FALSE(check["ok"].get<bool>()) << check["holder_part"];
+      EXPECT_FALSE(check["unsafe"].empty()) << check["holder_part"];
+      EXPECT_FALSE(report["safe"].get<bool>()) << report["holder_part"];
+    } else {
+      EXPECT_TRUE(check["ok"].get<bool>()) << check["not_ok_because"];
+      EXPECT_TRUE(report["safe"].get<bool>()) << report["unsafe"];
+    }
+  }
 }
 
 // A shank 0.3 mm into a vertical wall of the part gouges 0.3 mm (along the wall's normal), not

@@ -58,12 +58,19 @@ std::vector<Pass> impellerPasses(const Impeller& impeller, const PathParams& pat
 /// The passes of a nominal path: its pass blocks (link blocks dropped), each split where two
 /// consecutive tips (and ball centres) are farther apart than `path.pass_gap` (0: 4 × the
 /// block's median step; passRanges);
-/// consecutive postures with the same ball centre are dropped (counted in `repeated`). Stations:
+/// consecutive postures with the same ball centre are dropped (counted in `dropped`). Stations:
 /// the postures one for one, or every `path.step` mm when `path.step_given`. Throws
 /// common::InputError naming the file and line for a pass with fewer than two distinct postures
 /// and for a posture whose feed runs along its axis (no frame).
+struct NominalDropped {
+  std::size_t repeated = 0;  ///< postures at the ball centre of the one before
+  /// Postures of pass blocks in no pass: a zig-zag's step-over of one posture between two legs
+  /// (passRanges: its moves are the link's, made anew); `first_between` the first (npos: none).
+  std::size_t between_legs = 0;
+  std::size_t first_between = static_cast<std::size_t>(-1);
+};
 std::vector<Pass> nominalPasses(const geometry::PathFile& path, const PathParams& params,
-                                double ball_radius_mm, std::size_t* repeated = nullptr);
+                                double ball_radius_mm, NominalDropped* dropped = nullptr);
 
 /// Posture ranges [begin, end) of the passes of a path: its pass blocks (link blocks dropped),
 /// each split where two consecutive tips are farther apart than `pass_gap_mm` (0: 4 × the
