@@ -109,7 +109,8 @@ inline nlohmann::json holderPartJson(const std::optional<pathgen::LinkPartResult
   if (!h) return nullptr;
   return partContactsJson(
       *h, "postures", "motions",
-      "the holder (the stations above the tool: it never cuts) against the part mesh at every "
+      "the holder (its stations, and the shank above the tool's length up to them: they never "
+      "cut) against the part mesh at every "
       "posture and motion, passes and links (as `motions`, required 0)");
 }
 

@@ -609,12 +609,17 @@
           s.kind === 'deviation' ? 'surface: deviation, \u00b5m (gouge < 0 < scallop)' :
                                    'surface: height, mm',
           s.range[0], s.range[1], surfaceMap,
-          (s.kind === 'deviation' ? 'purple: above the scale (stock left beside the band); ' : '') +
-              (s.uncut_um ? 'grey: not cut' +
-                       (s.uncut_um < 1e6 ?
-                            ' (' + Math.round(s.uncut_um) + ' \u00b5m of stock left)' :
-                            '') :
-                            ''),
+          [
+            s.kind === 'deviation' ? 'purple: above the scale (stock left beside the band)' : '',
+            s.uncut_um ? 'grey: not cut' +
+                    (s.uncut_um < 1e6 ? ' (' + Math.round(s.uncut_um) + ' \u00b5m of stock left)' :
+                                        '') :
+                         ''
+          ]
+              .filter(function(t) {
+                return t;
+              })
+              .join('; '),
           'fp-legend-surface');
     }
   }

@@ -134,6 +134,19 @@ TEST(PathBlocks, PosturesBetweenTheLegsOfAZigZagAreCounted) {
   EXPECT_EQ(dropped.between_legs, 3u);  // 11, 23 and its repeat
   EXPECT_EQ(dropped.first_between, 11u);
   EXPECT_EQ(dropped.repeated, 0u);  // (the repeat lies between the legs, in no pass)
+  // A repeat changes no pass: the return leg's first posture written twice (its first copy ended
+  // the turn, and the turn of one posture became a pass of two, a reviewer's case) gives the
+  // same three legs, the step-over posture the link's.
+  std::ostringstream twice;
+  twice << "# pass 1\n";
+  for (int k = 0; k <= 10; ++k) twice << k << " 0 0 0 0 1\n";
+  twice << "10 0.5 0 0 0 1\n10 1 0 0 0 1\n";  // between the legs, then the return leg's first
+  for (int k = 10; k >= 0; --k) twice << k << " 1 0 0 0 1\n";
+  const auto legs =
+      nominalPasses(geometry::readPathFile(dir.write("twice.cl", twice.str())), {}, kR);
+  ASSERT_EQ(legs.size(), 2u);
+  EXPECT_EQ(legs[0].samples.size(), 11u);
+  EXPECT_EQ(legs[1].samples.size(), 11u);
 }
 
 TEST(PathBlocks, GapsSplitPassesAtFourMedianSteps) {

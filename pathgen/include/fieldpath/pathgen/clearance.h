@@ -22,8 +22,9 @@ struct ClearanceRequest {
   std::size_t batch = 256;
   /// Only the minimum (value and posture) and the colliding postures exact: every 8th posture is
   /// measured, then a posture whose lower bound from its measured neighbours (their clearance
-  /// less the sweep D = |Δtip| + ρ_max Δθ to it, as MotionRequest's) is above 0 and above the
-  /// least measured keeps that bound (never above the truth) instead of a query. For checks that
+  /// less |Δtip| + ρ_max times the angle between the two placements' rotations, twist included)
+  /// is above 0 and above the least measured keeps that bound (never above what a query would
+  /// give) instead of a query. For checks that
   /// report a minimum and contacts, not each posture's figure: the holder against the part took
   /// half of a 97k-posture job.
   bool exact_min_only = false;
