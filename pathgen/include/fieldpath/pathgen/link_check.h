@@ -58,10 +58,10 @@ GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
 /// first posture against `grazing` (grazingPartChecker): they start or end where the ball cuts
 /// the part, so they may touch it, not enter it by more than kPassGrazeMm (a retract along an
 /// axis leaning over a fin of the part did). Link postures at a pass's first or last posture
-/// (a path written with no retract) are that pass's.
-LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part,
-                                     const GrazingChecker& grazing,
-                                     const geometry::PathFile& path);
+/// (a path written with no retract) are that pass's. `progress` after each link.
+LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const GrazingChecker& grazing,
+                                     const geometry::PathFile& path,
+                                     const common::Progress& progress = {});
 
 /// The holder (geometry::holderMesh) against the part at every posture and every motion of the
 /// path, passes and links. The holder never cuts: touching the part anywhere is a crash, also
