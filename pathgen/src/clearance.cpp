@@ -222,7 +222,7 @@ double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double 
   // Runs of stations, each walked in order from its last measured centre: a centre that cannot
   // come under the exact range (its lower bound d - |c - c_measured|) keeps that bound. The
   // runs in parallel; the bounds, the minimum and its first index as every station measured.
-  constexpr size_t kRun = 256;
+  constexpr size_t kRun = 64;  // (256 left a pass of fewer stations on one core)
   const double skip_from_mm = radius_mm + exact_below_mm;
   tbb::parallel_for(size_t{0}, (centres_mm.size() + kRun - 1) / kRun, [&](size_t run) {
     const size_t end = std::min(centres_mm.size(), (run + 1) * kRun);
@@ -293,12 +293,12 @@ ClearanceResult ClearanceChecker::check(std::span<const geometry::Posture> postu
           if (measured(i)) continue;
           const size_t before = i - i % kEvery;
           const size_t after = std::min(before + kEvery, postures.size() - 1);
-          const bool from_after = boundFrom(after, i) > boundFrom(before, i);
-          const double bound = std::max(boundFrom(before, i), boundFrom(after, i));
+          const double from_before = boundFrom(before, i), from_after = boundFrom(after, i);
+          const double bound = std::max(from_before, from_after);
           // Strictly above the least measured: it can be neither the minimum nor tie with it.
           if (bound > 0.0 && bound > least_measured) {
             distance[i] = bound;
-            nearest[i] = nearest[from_after ? after : before];
+            nearest[i] = nearest[from_after > from_before ? after : before];
             continue;
           }
         }
