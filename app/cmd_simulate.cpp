@@ -429,10 +429,11 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
       std::fprintf(stderr,
                    "warning: no line was cut: the tool never goes below the initial surface (%s); "
                    "a finishing path runs on the finished part, so its stock lies above: give "
-                   "--stock Z above the path's lowest tips\n",
+                   "--stock Z above the path's lowest tips%s\n",
                    part                       ? "the top of --part"
                    : !std::isnan(o->stock_mm) ? "--stock"
-                                              : "the stock at the highest tip, the default");
+                                              : "the stock at the highest tip, the default",
+                   part ? " instead of --part" : "");
   });
 }
 

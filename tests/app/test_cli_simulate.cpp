@@ -59,6 +59,33 @@ TEST(CliSimulate, BallDimpleIsTheExactSphere) {
     EXPECT_TRUE(std::filesystem::exists(dir.path() / "out" / file)) << file;
 }
 
+// A path that cuts nothing says why and what to give (a newcomer's raster on a floor read "0
+// lines touched" without a word): with the default stock (the highest tip) and with --part, whose
+// advice names --stock instead of --part (the two exclude each other); a cut says nothing.
+TEST(CliSimulate, APathThatCutsNothingSaysWhy) {
+  const TempDir dir;
+  dir.write("flat.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n2 0 0 0 0 1\n");
+  geometry::TriangleMesh floor;
+  floor.vertices = {{-10, -10, 0}, {10, -10, 0}, {10, 10, 0}, {-10, 10, 0}};
+  floor.triangles = {{0, 1, 2}, {0, 2, 3}};
+  geometry::saveMesh(floor, dir.path() / "floor.stl");
+  const Outcome stock =
+      runFieldpath(dir, "simulate --tool ball:2 --path flat.cl --grid 20x20 --out a");
+  ASSERT_EQ(stock.exit_code, 0) << stock.err;
+  EXPECT_NE(stock.err.find("warning: no line was cut"), std::string::npos) << stock.err;
+  EXPECT_NE(stock.err.find("the stock at the highest tip"), std::string::npos) << stock.err;
+  const Outcome part = runFieldpath(
+      dir, "simulate --tool ball:2 --path flat.cl --grid 20x20 --part floor.stl --out b");
+  ASSERT_EQ(part.exit_code, 0) << part.err;
+  EXPECT_NE(part.err.find("--stock Z above the path's lowest tips instead of --part"),
+            std::string::npos)
+      << part.err;
+  const Outcome cut =
+      runFieldpath(dir, "simulate --tool ball:2 --path flat.cl --grid 20x20 --stock 1 --out c");
+  ASSERT_EQ(cut.exit_code, 0) << cut.err;
+  EXPECT_EQ(cut.err.find("no line was cut"), std::string::npos) << cut.err;
+}
+
 // A tool mesh wound inward (each triangle the other way round) cut nothing with a vertical axis
 // (its downward faces were its top); turned outward with a note, it cuts as the same mesh wound
 // outward, bit for bit.
