@@ -19,7 +19,6 @@
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/input_file.h"
 #include "fieldpath/common/short_number.h"
-#include "fieldpath/geometry/closed_shells.h"
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "scene_mesh.h"
@@ -554,37 +553,6 @@ Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
   if (scene.impeller || scene.guide_impeller) resolveImpeller(scene);
   checkSceneSize(scene);  // before any command's heavy work
   return scene;
-}
-
-std::vector<std::string> openObstacleNotes(const Scene& scene) {
-  std::vector<std::string> notes;
-  if (scene.part && scene.part_file) {
-    // An open box wound inward is a pocket by its winding (a tool in it clear); wound outward, a
-    // solid missing a face. Geometry cannot tell them: said, so that a mesh exported with a face
-    // missing and its normals flipped is not taken on trust (a helper's buried tool read ok).
-    // Sheets (a machined surface exported open, as the mesh example's hub) are no such doubt.
-    const std::size_t closing = geometry::nearlyClosedOpenShells(*scene.part).size();
-    if (closing > 0)
-      notes.push_back(
-          scene.part_file->string() + ": " + std::to_string(closing) +
-          (closing == 1 ? " open shell nearly encloses" : " open shells nearly enclose") +
-          " a volume (a solid with facets missing?): an open shell has no inside, so "
-          "the cutter test does not see a tool wholly within it, and the surface "
-          "check reads its sides by its winding (wound inward, a box with a face "
-          "missing is a pocket): close the mesh to have its inside checked");
-  }
-  for (std::size_t i = 0; i < scene.obstacle_files.size() && i < scene.obstacles.size(); ++i) {
-    const std::size_t open = geometry::openShells(scene.obstacles[i]).size();
-    if (open == 0) continue;
-    const std::size_t edges = geometry::validateMesh(scene.obstacles[i]).open_edges;
-    notes.push_back(scene.obstacle_files[i].string() + ": " + std::to_string(open) +
-                    (open == 1 ? " shell is" : " shells are") + " open (" + std::to_string(edges) +
-                    " edge" + (edges == 1 ? "" : "s") +
-                    " with one triangle): its surface repels and is checked, but an open shell "
-                    "has no inside, so a tool or holder wholly inside the solid it bounds reads as "
-                    "clear (close the mesh to have its inside checked)");
-  }
-  return notes;
 }
 
 std::filesystem::path nominalPathOf(const std::filesystem::path& file) {
