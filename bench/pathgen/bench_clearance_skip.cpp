@@ -26,21 +26,7 @@
 
 using namespace fieldpath;
 
-namespace {
-
-template <class Run>
-double medianSeconds(int repeats, Run&& run) {
-  std::vector<double> seconds;
-  for (int r = 0; r < repeats; ++r) {
-    const auto start = std::chrono::steady_clock::now();
-    run();
-    seconds.push_back(
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  }
-  return common::median(seconds);
-}
-
-}  // namespace
+using common::medianSeconds;
 
 int main(int argc, char** argv) {
   std::string scene_file = std::string(FIELDPATH_SOURCE_DIR) + "/examples/impeller/scene.yaml";

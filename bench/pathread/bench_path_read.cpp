@@ -16,6 +16,7 @@
 #include <fstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "fieldpath/common/stats.h"
@@ -62,14 +63,7 @@ std::vector<Posture> serialRead(const fs::path& file) {
 
 template <class F>
 double medianMs(int reps, F&& f) {
-  std::vector<double> ms;
-  for (int r = 0; r < reps; ++r) {
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  return fieldpath::common::median(std::move(ms));
+  return 1e3 * fieldpath::common::medianSeconds(reps, std::forward<F>(f));
 }
 
 std::vector<CompactPosture> scanAll(const fs::path& file) {

@@ -1,9 +1,8 @@
 /// Passes from a nominal path file: pass breaks (markers, blank lines, gaps, APT RAPID), frames at
-/// degenerate postures, marked path files read back bit for bit, links, and motions checked
-/// between clear postures.
+/// degenerate postures, links, and motions checked between clear postures (marked path files
+/// read back: test_path_files.cpp).
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <sstream>
 #include <string>
 
@@ -49,8 +48,6 @@ std::string errorOf(F&& f) {
   }
   return {};
 }
-
-bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 }  // namespace
 
@@ -251,72 +248,6 @@ TEST(NominalPasses, DegeneratePosturesAreClearErrorsNamingTheLine) {
   EXPECT_NE(m4.find("flip.cl:3: the tool axis turns 180 deg"), std::string::npos) << m4;
   const auto turned = dir.write("turn.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n2 0 0 0 0.866 0.5\n");
   EXPECT_EQ(nominalPasses(geometry::readPathFile(turned), {}, kR).size(), 1u);
-}
-
-TEST(PathFiles, MarkedClAndNpyReadBackBitForBit) {
-  PathFile path;
-  for (int i = 0; i < 9; ++i) {
-    Posture p;
-    p.tip_mm = {0.1 * i + 1.0 / 3.0, -7.25 + i * 1e-7, 12.0 / 7.0};
-    p.axis = Eigen::Vector3d(0.1, -0.2 * i, 1.0).normalized();
-    path.postures.push_back(p);
-  }
-  path.blocks = {{PathBlock::Kind::Link, 0, 2}, {PathBlock::Kind::Pass, 2, 5},
-                 {PathBlock::Kind::Link, 5, 6}, {PathBlock::Kind::Pass, 6, 9}};
-  path.limited = {3, 7};
-  TempDir dir;
-  geometry::writeClFile(dir.path() / "m.cl", path, "a test\nof markers");
-  const PathFile back = geometry::readPathFile(dir.path() / "m.cl");
-  EXPECT_EQ(back.blocks, path.blocks);
-  EXPECT_EQ(back.limited, path.limited);
-  geometry::writeNpyFile(dir.path() / "m.npy", path.postures);
-  const PathFile npy = geometry::readPathFile(dir.path() / "m.npy");
-  geometry::AptHeader header;
-  geometry::writeAptFile(dir.path() / "m.apt", path, header);
-  const PathFile apt = geometry::readPathFile(dir.path() / "m.apt");
-  EXPECT_EQ(apt.blocks, path.blocks);
-  for (const PathFile* read : {&back, &npy, &apt}) {
-    ASSERT_EQ(read->postures.size(), path.postures.size());
-    for (std::size_t i = 0; i < path.postures.size(); ++i)
-      for (int c = 0; c < 3; ++c) {
-        EXPECT_TRUE(sameBits(read->postures[i].tip_mm[c], path.postures[i].tip_mm[c]));
-        EXPECT_TRUE(sameBits(read->postures[i].axis[c], path.postures[i].axis[c]));
-      }
-  }
-  // Written again, the .cl file is the same text.
-  geometry::writeClFile(dir.path() / "m2.cl", back, "a test\nof markers");
-  EXPECT_EQ(fieldpath::test::slurp(dir.path() / "m.cl"), fieldpath::test::slurp(dir.path() / "m2.cl"));
-}
-
-TEST(PathFiles, BadNpyFilesAreOneLineErrors) {
-  TempDir dir;
-  std::vector<Posture> postures(3);
-  geometry::writeNpyFile(dir.path() / "good.npy", postures);
-  const std::string good = fieldpath::test::slurp(dir.path() / "good.npy");
-  auto variant = [&](const std::string& name, std::string bytes) {
-    const auto file = dir.path() / name;
-    std::ofstream(file, std::ios::binary) << bytes;
-    return errorOf([&] { geometry::readPathFile(file); });
-  };
-  auto replaced = [&](const std::string& from, const std::string& to) {
-    std::string s = good;
-    s.replace(s.find(from), from.size(), to);
-    return s;
-  };
-  EXPECT_NE(variant("trunc.npy", good.substr(0, good.size() - 8)).find("truncated"), std::string::npos);
-  EXPECT_NE(variant("dtype.npy", replaced("<f8", "<i8")).find("dtype"), std::string::npos);
-  // (Fortran order is read, as numpy reads it: test_cli_path_formats.cpp.)
-  EXPECT_NE(variant("order.npy", replaced("False", "Maybe")).find("fortran_order"),
-            std::string::npos);
-  EXPECT_NE(variant("shape.npy", replaced("(3, 6)", "(6, 3)")).find("shape"), std::string::npos);
-  EXPECT_NE(variant("magic.npy", "hello").find("magic"), std::string::npos);
-  std::string nan = good;
-  const double q = std::nan("");
-  std::memcpy(nan.data() + nan.size() - 8, &q, 8);
-  EXPECT_NE(variant("nan.npy", nan).find("row 2"), std::string::npos);
-  std::string zero = good;  // row 0 has the axis (0, 0, 1): zero it
-  std::memset(zero.data() + (good.size() - 3 * 48) + 40, 0, 8);
-  EXPECT_NE(variant("zero.npy", zero).find("row 0: zero tool axis"), std::string::npos);
 }
 
 TEST(Links, LeaveAlongTheAxisTravelAboveSafeZAndTurnInSmallSteps) {

@@ -1,0 +1,106 @@
+/// Path files as generate writes them (.cl with `# pass` / `# link` / limit marks, .npy, APT)
+/// read back bit for bit, and broken .npy files refused with one line.
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "fieldpath/common/errors.h"
+#include "fieldpath/geometry/cl_file.h"
+#include "run_fieldpath.h"
+
+using namespace fieldpath;
+using fieldpath::test::TempDir;
+using geometry::PathBlock;
+using geometry::PathFile;
+using geometry::Posture;
+
+namespace {
+
+/// The InputError message of `f`, or "" if it did not throw one.
+template <class F>
+std::string errorOf(F&& f) {
+  try {
+    f();
+  } catch (const common::InputError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+}  // namespace
+
+TEST(PathFiles, MarkedClAndNpyReadBackBitForBit) {
+  PathFile path;
+  for (int i = 0; i < 9; ++i) {
+    Posture p;
+    p.tip_mm = {0.1 * i + 1.0 / 3.0, -7.25 + i * 1e-7, 12.0 / 7.0};
+    p.axis = Eigen::Vector3d(0.1, -0.2 * i, 1.0).normalized();
+    path.postures.push_back(p);
+  }
+  path.blocks = {{PathBlock::Kind::Link, 0, 2},
+                 {PathBlock::Kind::Pass, 2, 5},
+                 {PathBlock::Kind::Link, 5, 6},
+                 {PathBlock::Kind::Pass, 6, 9}};
+  path.limited = {3, 7};
+  TempDir dir;
+  geometry::writeClFile(dir.path() / "m.cl", path, "a test\nof markers");
+  const PathFile back = geometry::readPathFile(dir.path() / "m.cl");
+  EXPECT_EQ(back.blocks, path.blocks);
+  EXPECT_EQ(back.limited, path.limited);
+  geometry::writeNpyFile(dir.path() / "m.npy", path.postures);
+  const PathFile npy = geometry::readPathFile(dir.path() / "m.npy");
+  geometry::AptHeader header;
+  geometry::writeAptFile(dir.path() / "m.apt", path, header);
+  const PathFile apt = geometry::readPathFile(dir.path() / "m.apt");
+  EXPECT_EQ(apt.blocks, path.blocks);
+  for (const PathFile* read : {&back, &npy, &apt}) {
+    ASSERT_EQ(read->postures.size(), path.postures.size());
+    for (std::size_t i = 0; i < path.postures.size(); ++i)
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_TRUE(sameBits(read->postures[i].tip_mm[c], path.postures[i].tip_mm[c]));
+        EXPECT_TRUE(sameBits(read->postures[i].axis[c], path.postures[i].axis[c]));
+      }
+  }
+  // Written again, the .cl file is the same text.
+  geometry::writeClFile(dir.path() / "m2.cl", back, "a test\nof markers");
+  EXPECT_EQ(fieldpath::test::slurp(dir.path() / "m.cl"),
+            fieldpath::test::slurp(dir.path() / "m2.cl"));
+}
+
+TEST(PathFiles, BadNpyFilesAreOneLineErrors) {
+  TempDir dir;
+  std::vector<Posture> postures(3);
+  geometry::writeNpyFile(dir.path() / "good.npy", postures);
+  const std::string good = fieldpath::test::slurp(dir.path() / "good.npy");
+  auto variant = [&](const std::string& name, std::string bytes) {
+    const auto file = dir.path() / name;
+    std::ofstream(file, std::ios::binary) << bytes;
+    return errorOf([&] { geometry::readPathFile(file); });
+  };
+  auto replaced = [&](const std::string& from, const std::string& to) {
+    std::string s = good;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  EXPECT_NE(variant("trunc.npy", good.substr(0, good.size() - 8)).find("truncated"),
+            std::string::npos);
+  EXPECT_NE(variant("dtype.npy", replaced("<f8", "<i8")).find("dtype"), std::string::npos);
+  // (Fortran order is read, as numpy reads it: test_cli_path_formats.cpp.)
+  EXPECT_NE(variant("order.npy", replaced("False", "Maybe")).find("fortran_order"),
+            std::string::npos);
+  EXPECT_NE(variant("shape.npy", replaced("(3, 6)", "(6, 3)")).find("shape"), std::string::npos);
+  EXPECT_NE(variant("magic.npy", "hello").find("magic"), std::string::npos);
+  std::string nan = good;
+  const double q = std::nan("");
+  std::memcpy(nan.data() + nan.size() - 8, &q, 8);
+  EXPECT_NE(variant("nan.npy", nan).find("row 2"), std::string::npos);
+  std::string zero = good;  // row 0 has the axis (0, 0, 1): zero it
+  std::memset(zero.data() + (good.size() - 3 * 48) + 40, 0, 8);
+  EXPECT_NE(variant("zero.npy", zero).find("row 0: zero tool axis"), std::string::npos);
+}
