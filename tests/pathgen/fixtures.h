@@ -1,9 +1,23 @@
 #pragma once
 /// Shared test scenes for pathgen.
+#include <string>
+
+#include "fieldpath/common/errors.h"
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/pathgen/impeller.h"
 
 namespace fieldpath::pathgen::test {
+
+/// The InputError message of `f`, or "" if it did not throw one.
+template <class F>
+std::string errorOf(F&& f) {
+  try {
+    f();
+  } catch (const common::InputError& e) {
+    return e.what();
+  }
+  return {};
+}
 
 /// A straight, flat, parallel channel 72 × 20 mm with vertical 34 mm walls: closed forms apply.
 inline ImpellerParams flatChannel() {

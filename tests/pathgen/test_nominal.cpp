@@ -20,11 +20,12 @@
 
 using namespace fieldpath;
 using namespace fieldpath::pathgen;
+using fieldpath::test::TempDir;
 using geometry::PathBlock;
 using geometry::PathFile;
 using geometry::Posture;
 using pathgen::test::boxMesh;
-using fieldpath::test::TempDir;
+using pathgen::test::errorOf;
 
 namespace {
 
@@ -36,17 +37,6 @@ std::string straightLines(double x0, double x1, double step, double y, double z 
   for (double x = x0; x <= x1 + 1e-9; x += step)
     text += std::to_string(x) + " " + std::to_string(y) + " " + std::to_string(z) + " 0 0 1\n";
   return text;
-}
-
-/// The InputError message of `f`, or "" if it did not throw one.
-template <class F>
-std::string errorOf(F&& f) {
-  try {
-    f();
-  } catch (const common::InputError& e) {
-    return e.what();
-  }
-  return {};
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/geometry/cl_file.h"
+#include "fixtures.h"
 #include "run_fieldpath.h"
 
 using namespace fieldpath;
@@ -17,19 +18,9 @@ using fieldpath::test::TempDir;
 using geometry::PathBlock;
 using geometry::PathFile;
 using geometry::Posture;
+using pathgen::test::errorOf;
 
 namespace {
-
-/// The InputError message of `f`, or "" if it did not throw one.
-template <class F>
-std::string errorOf(F&& f) {
-  try {
-    f();
-  } catch (const common::InputError& e) {
-    return e.what();
-  }
-  return {};
-}
 
 bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
