@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <future>
 #include <sstream>
 #include <string>
@@ -17,15 +18,16 @@
 
 #include "commands.h"
 #include "cutter_note.h"
-#include "json_text.h"
 #include "errors.h"
 #include "estimates.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/csv.h"
+#include "fieldpath/common/file_digest.h"
 #include "fieldpath/field/voxel_field.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/units.h"
 #include "job.h"
+#include "json_text.h"
 #include "progress.h"
 #include "scene.h"
 
@@ -33,6 +35,29 @@ namespace fieldpath::app {
 namespace {
 
 using geometry::kRadToDeg;
+
+/// Removes `check --out`'s files from `out` where they checked the path.cl this run replaces
+/// (check.json's path_digest is the file's): check.json's `"ok": true`, deviation.png and
+/// clearance.csv stayed beside a new path nobody had checked (a helper's finding). A check of
+/// another path (its digest differs) stays.
+void forgetCheckOfReplacedPath(const std::filesystem::path& out) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path check = out / "check.json", path = out / "path.cl";
+  if (!fs::is_regular_file(check, ec) || !fs::is_regular_file(path, ec)) return;
+  std::string digest;
+  try {
+    std::ifstream in(check);
+    digest = nlohmann::json::parse(in).value("path_digest", std::string());
+  } catch (const std::exception&) {
+    return;  // not check's: left as it is
+  }
+  if (digest.empty() || digest != common::fileDigest(path)) return;
+  common::removeStaleOutputs(
+      out, {"check.json", "clearance.csv", "deviation.npy", "deviation.json", "deviation.png"});
+  std::fprintf(stderr, "note: %s: the check of the path.cl this run replaces is removed with it\n",
+               out.string().c_str());
+}
 
 /// A nominal path whose axes lean along the feed by more than this (deg) gets a note: the
 /// steering starts from path.lead_deg, not from the file's lead.
@@ -274,6 +299,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     // never the scene's own files (a nominal path.cl in --out).
     common::claimOutputs(options->out, {"path.cl", "path.apt", "angles.csv", "report.json"},
                          {options->scene, nominalPathOf(options->scene)});
+    forgetCheckOfReplacedPath(options->out);
     // Reading (the scene, its meshes, the nominal path, the passes) is counted apart: the job's
     // total left out 9 s of a 70 MB STL (a helper's).
     const auto read_start = std::chrono::steady_clock::now();
@@ -379,6 +405,10 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
       notes.link.push_back(std::move(far));
     nlohmann::json report = reportJson(scene, job, result, axis_turn, notes);
     report["times_s"]["read"] = read_s;  // before `total`, which counts from the passes on
+    // The files this report is of (written before it, renamed one by one): a folder holding
+    // another run's path beside this report can be told (as check.json's path_digest).
+    report["path_digest"] = {{"path.cl", common::fileDigest(out / "path.cl")},
+                             {"path.apt", common::fileDigest(out / "path.apt")}};
     common::writeTextAtomically(out / "report.json", jsonText(report));
 
     const auto& c = result.clearance;

@@ -14,6 +14,7 @@
 #include "fieldpath/common/errors.h"
 #include "fieldpath/pathgen/passes.h"
 #include "fieldpath/zbuffer/outputs.h"
+#include "machined_band.h"
 #include "to_zbuffer.h"
 
 namespace fieldpath::app {
@@ -21,117 +22,6 @@ namespace {
 
 using geometry::Vec3;
 using Vec2 = Eigen::Vector2d;
-
-/// Marks the lines inside triangle (a, b, c) (plan view, mm).
-void markTriangle(const zbuffer::Grid& grid, const Vec2& a, const Vec2& b, const Vec2& c,
-                  std::vector<char>& mask) {
-  const double area = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-  if (std::abs(area) < 1e-12) return;
-  const Vec2 lo = a.cwiseMin(b).cwiseMin(c), hi = a.cwiseMax(b).cwiseMax(c);
-  const int ix0 = std::max(0, static_cast<int>(std::floor((lo.x() - grid.x0_mm) / grid.dx_mm - 0.5)));
-  const int ix1 = std::min(grid.nx - 1, static_cast<int>(std::ceil((hi.x() - grid.x0_mm) / grid.dx_mm - 0.5)));
-  const int iy0 = std::max(0, static_cast<int>(std::floor((lo.y() - grid.y0_mm) / grid.dy_mm - 0.5)));
-  const int iy1 = std::min(grid.ny - 1, static_cast<int>(std::ceil((hi.y() - grid.y0_mm) / grid.dy_mm - 0.5)));
-  auto edge = [](const Vec2& p, const Vec2& q, const Vec2& x) {
-    return (q - p).x() * (x - p).y() - (q - p).y() * (x - p).x();
-  };
-  for (int iy = iy0; iy <= iy1; ++iy)
-    for (int ix = ix0; ix <= ix1; ++ix) {
-      const Vec2 x(grid.x0_mm + (ix + 0.5) * grid.dx_mm, grid.y0_mm + (iy + 0.5) * grid.dy_mm);
-      const double e0 = edge(a, b, x), e1 = edge(b, c, x), e2 = edge(c, a, x);
-      if ((e0 >= 0 && e1 >= 0 && e2 >= 0) || (e0 <= 0 && e1 <= 0 && e2 <= 0))
-        mask[static_cast<std::size_t>(iy) * grid.nx + ix] = 1;
-    }
-}
-
-/// A pass's ball centres in plan, resampled at `count` points evenly in arc length.
-std::vector<Vec2> resampled(const std::vector<Vec2>& line, std::size_t count) {
-  std::vector<double> s(line.size(), 0.0);
-  for (std::size_t i = 1; i < line.size(); ++i) s[i] = s[i - 1] + (line[i] - line[i - 1]).norm();
-  std::vector<Vec2> out;
-  std::size_t j = 1;
-  for (std::size_t k = 0; k < count; ++k) {
-    const double target = s.back() * k / std::max<std::size_t>(1, count - 1);
-    while (j + 1 < s.size() && s[j] < target) ++j;
-    const double span = s[j] - s[j - 1];
-    const double w = span > 0 ? std::clamp((target - s[j - 1]) / span, 0.0, 1.0) : 0.0;
-    out.push_back((1 - w) * line[j - 1] + w * line[j]);
-  }
-  return out;
-}
-
-/// The part's upward unit normal at plan point p, from its top heights on the grid (central
-/// differences of the lines either side of the nearest one; a facet's own slope on a mesh); +z
-/// where the part or a neighbour line is missing.
-Vec3 partNormal(const zbuffer::Grid& grid, const std::vector<float>& top, const Vec2& p) {
-  if (grid.nx < 3 || grid.ny < 3) return Vec3::UnitZ();
-  const double fx = (p.x() - grid.x0_mm) / grid.dx_mm - 0.5,
-               fy = (p.y() - grid.y0_mm) / grid.dy_mm - 0.5;
-  if (!std::isfinite(fx) || !std::isfinite(fy)) return Vec3::UnitZ();
-  const int ix = static_cast<int>(std::clamp(std::round(fx), 1.0, grid.nx - 2.0));
-  const int iy = static_cast<int>(std::clamp(std::round(fy), 1.0, grid.ny - 2.0));
-  auto h = [&](int i, int j) { return double(top[static_cast<std::size_t>(j) * grid.nx + i]); };
-  const double gx = (h(ix + 1, iy) - h(ix - 1, iy)) / (2.0 * grid.dx_mm);
-  const double gy = (h(ix, iy + 1) - h(ix, iy - 1)) / (2.0 * grid.dy_mm);
-  if (!std::isfinite(gx) || !std::isfinite(gy)) return Vec3::UnitZ();
-  return Vec3(-gx, -gy, 1.0).normalized();
-}
-
-/// Where a posture's tool touches the part, in plan: the support point, in the direction -n of
-/// the part's normal n there, of its cutting end (a ring of radius R - r, r above the tip, swept
-/// by a ball of radius r; a ball: r = R, its centre less R n). A fixed point from under the tip:
-/// the contact moves with the normal where it lands (a few rounds; a plane's in one).
-Vec2 contactInPlan(const geometry::Posture& p, double radius_mm, double corner_mm,
-                   const zbuffer::Grid& grid, const std::vector<float>& top) {
-  const Vec3& a = p.axis;
-  const Vec3 ring_centre = p.tip_mm + corner_mm * a;
-  Vec2 q(p.tip_mm.x(), p.tip_mm.y());
-  for (int round = 0; round < 4; ++round) {
-    const Vec3 n = partNormal(grid, top, q);
-    const Vec3 u = n - n.dot(a) * a;  // -n's direction in the ring's plane is -u
-    Vec3 point = ring_centre - corner_mm * n;
-    if (u.norm() > 1e-9) point -= (radius_mm - corner_mm) / u.norm() * u;
-    q = Vec2(point.x(), point.y());
-  }
-  return q;
-}
-
-/// The machined band: strips between consecutive passes that are neighbours (their facing points
-/// at most `neighbour_mm` apart on average). A pass with no neighbour has no scallop (the band
-/// of ±R/2 it once had read the ball's own profile as one: 389 µm for a single clean pass).
-/// The passes as their contact points with the part in plan (contactInPlan), not their ball
-/// centres: on a slope those lie R sin(slope) off the contact, and a band of centres took in the
-/// tool's flank beyond the first pass (a tilted plane's 76 um scallop read as 233 um).
-std::vector<char> machinedBand(const zbuffer::Grid& grid, const geometry::PathFile& path,
-                               double radius_mm, double corner_mm, const std::vector<float>& top) {
-  std::vector<std::vector<Vec2>> passes;
-  for (const auto& [begin, end] : pathgen::passRanges(path, 0.0, radius_mm)) {
-    std::vector<Vec2> line;
-    for (std::size_t i = begin; i < end; ++i) {
-      const Vec2 c = contactInPlan(path.postures[i], radius_mm, corner_mm, grid, top);
-      if (line.empty() || (c - line.back()).norm() > 1e-9) line.push_back(c);
-    }
-    if (line.size() >= 2) passes.push_back(std::move(line));
-  }
-  std::vector<char> mask(grid.lineCount(), 0);
-  const double neighbour_mm = 4.0 * radius_mm;
-  for (std::size_t k = 0; k + 1 < passes.size(); ++k) {
-    const std::size_t n = std::max(passes[k].size(), passes[k + 1].size());
-    std::vector<Vec2> a = resampled(passes[k], n), b = resampled(passes[k + 1], n);
-    double forward = 0, backward = 0;
-    for (std::size_t j = 0; j < n; ++j) {
-      forward += (a[j] - b[j]).norm();
-      backward += (a[j] - b[n - 1 - j]).norm();
-    }
-    if (backward < forward) std::reverse(b.begin(), b.end());  // a zig-zag path
-    if (std::min(forward, backward) / n > neighbour_mm) continue;
-    for (std::size_t j = 0; j + 1 < n; ++j) {
-      markTriangle(grid, a[j], a[j + 1], b[j + 1], mask);
-      markTriangle(grid, a[j], b[j + 1], b[j], mask);
-    }
-  }
-  return mask;
-}
 
 /// How far a line's deviation `scallop_um` may lie under a cusp's within spacing/√2 of it
 /// (µm), for lines `spacing_mm` apart, a cutting edge of curvature radius `edge_mm` and the
@@ -161,9 +51,12 @@ double scallopGridErrorUm(double scallop_um, double spacing_mm, double edge_mm, 
 /// The path's postures with the motions between them swept: where a motion can reach below
 /// `stock_top_mm` (its lower tip less the tool's reach), postures along it as `check`'s motions
 /// are (geometry::alongMotion) so that no point of the tool moves more than `step_mm` between two
-/// of them (geometry::forEachPoseBetween, as cutter_part's stamps).
+/// of them (geometry::forEachPoseBetween, as cutter_part's stamps), up to `extent_mm` from the
+/// tip (zbuffer::toolExtent: the shank's top turns L / R times faster than the ball; stepped by
+/// the ball's reach, a 10° swing of a 40 mm tool cut 68 of a 100 um gouge between its stamps).
 std::vector<geometry::Posture> sweptPostures(const std::vector<geometry::Posture>& postures,
-                                             double reach_mm, double step_mm, double stock_top_mm) {
+                                             double reach_mm, double extent_mm, double step_mm,
+                                             double stock_top_mm) {
   std::vector<geometry::Posture> out;
   out.reserve(postures.size());
   for (std::size_t i = 0; i < postures.size(); ++i) {
@@ -172,7 +65,7 @@ std::vector<geometry::Posture> sweptPostures(const std::vector<geometry::Posture
     const geometry::Posture& a = postures[i];
     const geometry::Posture& b = postures[i + 1];
     if (std::min(a.tip_mm.z(), b.tip_mm.z()) - reach_mm > stock_top_mm) continue;  // above it all
-    geometry::forEachPoseBetween(a, b, reach_mm, step_mm,
+    geometry::forEachPoseBetween(a, b, extent_mm, step_mm,
                                  [&out](const geometry::Posture& p) { out.push_back(p); });
   }
   return out;
@@ -425,15 +318,20 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
                  ? zbuffer::Tool::torus(radius, request.tool.corner_radius_mm, request.tool.length_mm)
                  : zbuffer::Tool::flat(radius, request.tool.length_mm);
   sim.backend = request.backend;
-  // Heights relative to the part's lowest point: the Z-buffer's heights are floats, which 1e5 mm
-  // up in z hold to 8 µm only (a clean job read 7.8 µm of gouge there, 62 µm at 9e5 mm); the
-  // deviation is a difference, the same in either frame. (The plan is local already: the grid.)
-  double z0 = std::numeric_limits<double>::infinity();
-  for (const Vec3& v : part.vertices) z0 = std::min(z0, v.z());
+  // The Z-buffer in a frame at the grid's corner and the part's lowest point: its coordinates
+  // are floats, which 1e5 mm from the origin hold to 8 µm only (a clean job read 7.8 µm of
+  // gouge 1e5 mm up, 62 µm at 9e5 mm; a reviewer's at x = 5e5 mm, 20.6 µm); the deviation is a
+  // difference, the same in either frame. What is reported is in the part's frame (world_grid).
+  const zbuffer::Grid world_grid = sim.grid;
+  const Vec3 origin(world_grid.x0_mm, world_grid.y0_mm,
+                    std::min_element(part.vertices.begin(), part.vertices.end(),
+                                     [](const Vec3& a, const Vec3& b) { return a.z() < b.z(); })
+                        ->z());
+  sim.grid.x0_mm = sim.grid.y0_mm = 0.0;
   geometry::TriangleMesh part_local = part;
-  for (Vec3& v : part_local.vertices) v.z() -= z0;
+  for (Vec3& v : part_local.vertices) v -= origin;
   std::vector<geometry::Posture> postures_local = path.postures;
-  for (geometry::Posture& p : postures_local) p.tip_mm.z() -= z0;
+  for (geometry::Posture& p : postures_local) p.tip_mm -= origin;
   const zbuffer::ToolMesh part_mesh = toZbuffer(part_local);
   // Each line's facet slope: deviations are told along the part's normal, as a profile
   // tolerance is; vertical ones read 1/cos(slope) deeper (a 3 um overcut of a 60 deg wall: 6 um).
@@ -456,24 +354,25 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
       request.tool.shape == geometry::ToolShape::Torus ? request.tool.corner_radius_mm : radius;
   result.sweep_step_mm = std::max(0.5 * spacing, std::sqrt(2.0 * edge_mm * tol_mm));
   result.sweep_error_um = 1e3 * result.sweep_step_mm * result.sweep_step_mm / (8.0 * edge_mm);
-  const std::vector<geometry::Posture> swept = sweptPostures(
-      postures_local, zbuffer::toolReach(sim.tool), result.sweep_step_mm, top + kStockAllowanceMm);
+  const std::vector<geometry::Posture> swept =
+      sweptPostures(postures_local, zbuffer::toolReach(sim.tool), zbuffer::toolExtent(sim.tool),
+                    result.sweep_step_mm, top + kStockAllowanceMm);
   result.simulated_postures = swept.size();
   sim.expected_postures = swept.size();
   const zbuffer::SimulationResult simulated = zbuffer::simulate(sim, toZbuffer(swept));
-  result.grid = sim.grid;
+  result.grid = world_grid;
   result.gouge_tolerance_um = request.gouge_tolerance_um;
   result.backend = simulated.backend;
   result.simulation_s = simulated.seconds;
   result.cut_lines = simulated.lines_lowered;
-  result.in_band = machinedBand(sim.grid, path, radius, edge_mm, nominal);
+  result.in_band = machinedBand(world_grid, path, radius, edge_mm, nominal);
   result.deviation_um.assign(sim.grid.lineCount(), std::numeric_limits<float>::quiet_NaN());
   result.lowered.assign(sim.grid.lineCount(), 0);
   for (std::size_t i = 0; i < result.lowered.size(); ++i)
     result.lowered[i] = simulated.heights_mm[i] < sim.initial_heights_mm[i];
   const auto lineAt = [&](std::size_t i) {
-    return Vec2(sim.grid.x0_mm + (i % sim.grid.nx + 0.5) * sim.grid.dx_mm,
-                sim.grid.y0_mm + (i / sim.grid.nx + 0.5) * sim.grid.dy_mm);
+    return Vec2(world_grid.x0_mm + (i % world_grid.nx + 0.5) * world_grid.dx_mm,
+                world_grid.y0_mm + (i / world_grid.nx + 0.5) * world_grid.dy_mm);
   };
   // The surface each line is measured against: the part's top, or, where the tool passed
   // beneath the top's layer (under an overhang), the top of what lies under it (the Z-buffer
@@ -527,7 +426,7 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
     max_dev = std::max(max_dev, d);
     const Vec2 at = lineAt(i);
     const double bound_um =
-        scallopGridErrorUm(vertical_um, spacing_mm, edge_mm, partNormal(sim.grid, reference, at));
+        scallopGridErrorUm(vertical_um, spacing_mm, edge_mm, partNormal(world_grid, reference, at));
     highest_cusp = std::max(highest_cusp, (vertical_um + bound_um) * cos_slope);
   }
   if (result.band_lines > 0) {

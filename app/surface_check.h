@@ -41,7 +41,7 @@ struct SurfaceResult {
   /// Per line: (machined height − part height) · |n_z| of the part's facet there, µm: the
   /// deviation along the part's normal; NaN where the line misses the part.
   std::vector<float> deviation_um;
-  /// Per line: in the machined band (between consecutive neighbouring passes), where scallops
+  /// Per line: in the machined band (between passes side by side: machinedBand), where scallops
   /// count; a lone pass has none (band_lines 0: no scallop figures).
   std::vector<char> in_band;
   /// Per line: 1 where the tool lowered it (0: the stock allowance stands; deviation.png shows

@@ -399,6 +399,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   parts.reserve(chunks.size());
   for (AptChunk& c : chunks) parts.push_back(std::move(c.postures));
   concatenate(parts, options.threads, path);
+  checkDeclaredCount(text, kAptCountPrefix, path.postures.size(), file);
   return path;
 }
 
@@ -412,6 +413,9 @@ void writeAptFile(const std::filesystem::path& file, const PathFile& path,
   std::string text =
       "PARTNO/" + header.part_name.substr(0, std::min(header.part_name.size(), kAptTextColumns)) +
       "\n";
+  // The count first: a safety mark's text runs on into the PPRINT cards after it.
+  text += std::string(kAptCountPrefix) + std::to_string(path.postures.size()) +
+          " (A FILE HOLDING FEWER WAS CUT SHORT)\n";
   for (const std::string& remark : header.remarks) {
     std::string line = upperCase(remark);
     for (char& c : line)

@@ -258,6 +258,7 @@ PathFile readClPath(const std::filesystem::path& file, const PathReadOptions& op
   path.blocks = clBlocks(chunks, total);
   concatenate(chunks, options.threads, path);
   if (path.postures.empty()) throw InputError(file.string() + ": no postures (empty path file)");
+  checkDeclaredCount(text, kClCountPrefix, path.postures.size(), file);
   return path;
 }
 
@@ -333,6 +334,8 @@ void writeClFile(const std::filesystem::path& file, const PathFile& path,
     for (std::string line; std::getline(lines, line);) text += "# " + line + "\n";
   }
   const auto& postures = path.postures;
+  text += std::string(kClCountPrefix) + std::to_string(postures.size()) +
+          " (a file holding fewer was cut short)\n";
   text += "# x y z i j k" +
           std::string(!postures.empty() && postures[0].has_spindle ? " spindle_rad" : "") +
           "  (tool tip, mm; unit tool axis)\n";

@@ -1,6 +1,7 @@
 #pragma once
 /// Helpers shared by the path readers and writers (.cl, APT, .npy): errors naming the file and
 /// line, strict number parsing, the axis check, shortest round-trip numbers.
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -215,6 +216,36 @@ inline void addToBlocks(std::vector<PathBlock>& blocks, PathBlock::Kind kind, bo
     blocks.push_back({kind, i, i + 1});
   else
     blocks.back().end = i + 1;
+}
+
+/// The header lines that declare a path's posture count (checkDeclaredCount).
+inline constexpr std::string_view kClCountPrefix = "# postures: ";
+inline constexpr std::string_view kAptCountPrefix = "PPRINT/POSTURES ";
+
+/// The posture count a path's writer declares in its header (`.cl`: `# postures: N ...`, APT:
+/// `PPRINT/POSTURES N ...`, in its first 64 lines), checked against the `read` count: a path
+/// file cut short (a DNC or USB transfer) ends at a line boundary and reads as a shorter, valid
+/// path that stops in the cut (a helper's 500 lines of a 1089-posture path.cl read `check: ok`).
+/// Files that declare nothing are taken as they are.
+inline void checkDeclaredCount(std::string_view text, std::string_view prefix, std::size_t read,
+                               const std::filesystem::path& file) {
+  std::size_t line = 1;
+  for (std::size_t at = 0; at < text.size() && line <= 64; ++line) {
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    const std::string_view l = text.substr(at, end - at);
+    at = end + 1;
+    if (l.substr(0, prefix.size()) != prefix) continue;
+    std::size_t declared = 0;
+    const char* first = l.data() + prefix.size();
+    const auto [next, error] = std::from_chars(first, l.data() + l.size(), declared);
+    if (error != std::errc() || next == first) continue;
+    if (declared != read)
+      fail(file, line,
+           "declares " + std::to_string(declared) + " postures and the file holds " +
+               std::to_string(read) + ": it was cut short (a transfer?) or edited; write it " +
+               "again, or delete this line to take the file as it is");
+    return;
+  }
 }
 
 }  // namespace fieldpath::geometry::detail

@@ -2,9 +2,10 @@
 /// file under a final name, nor a temporary; the same inputs give the same files, bit for bit,
 /// whatever the number of threads (generate, simulate, check, tool, field build and probe, view,
 /// study, convert; the run's own timings aside).
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -23,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fieldpath/common/atomic_file.h"
+#include "fieldpath/common/file_digest.h"
 #include "files.h"
 #include "run_fieldpath.h"
 
@@ -145,6 +147,62 @@ TEST(AtomicOutput, AFailedRunLeavesNoEarlierRunsOutputs) {
   dir.write("job/scene.yaml", "obstacles:\n  - mesh: missing.stl\npath: { nominal: path.cl }\n");
   EXPECT_EQ(test::runFieldpath(dir, "generate job/scene.yaml --out job").exit_code, 1);
   EXPECT_EQ(filesUnder(dir.path() / "job"), (std::vector<std::string>{"path.cl", "scene.yaml"}));
+}
+
+// A check of the path.cl a generate replaces goes with it: check.json's `"ok": true` stayed
+// beside a new path nobody had checked (a helper's finding); a check of another path stays.
+TEST(AtomicOutput, GenerateTakesAwayTheCheckOfThePathItReplaces) {
+  const TempDir dir;
+  dir.write("scene.yaml", "obstacles:\n  - mesh: missing.stl\n");
+  for (const char* folder : {"same", "other"}) {
+    const std::string f(folder);
+    dir.write(f + "/path.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
+    const std::string digest = f == "same" ? common::fileDigest(dir.path() / f / "path.cl")
+                                           : std::string("fnv1a64:0000000000000000");
+    dir.write(f + "/check.json", "{\"ok\": true, \"path_digest\": \"" + digest + "\"}\n");
+    dir.write(f + "/deviation.png", "png\n");
+    dir.write(f + "/mine.txt", "mine\n");
+    const auto run = test::runFieldpath(dir, "generate scene.yaml --out " + f);
+    EXPECT_EQ(run.exit_code, 1) << run.output();  // the scene is refused: path.cl goes too
+  }
+  EXPECT_EQ(filesUnder(dir.path() / "same"), std::vector<std::string>{"mine.txt"});
+  EXPECT_EQ(filesUnder(dir.path() / "other"),
+            (std::vector<std::string>{"check.json", "deviation.png", "mine.txt"}));
+}
+
+// A folder another run is writing (here: held as that run holds it) is refused before any work,
+// and nothing in it is taken away: two runs at once left one job's path.cl beside the other's
+// path.apt and report.json, both exiting 0, and a failed one took the other's path.cl (a
+// helper's finding). A folder the refused run made for itself is not left behind either.
+TEST(AtomicOutput, AFolderAnotherRunIsWritingIsRefused) {
+  const TempDir dir;
+  for (const char* name : {"path.cl", "report.json", "check.json"})
+    dir.write(std::string("out/") + name, "the other run's\n");
+  dir.write("p.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
+  const int held = ::open((dir.path() / "out").c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  ASSERT_GE(held, 0);
+  ASSERT_EQ(::flock(held, LOCK_EX | LOCK_NB), 0);
+  const std::vector<std::string> commands = {
+      "generate " + kImpeller.string() + " --out out",
+      "check " + kImpeller.string() + " --path p.cl --out out",
+      "simulate --tool ball:3 --path p.cl --out out"};
+  for (const std::string& command : commands) {
+    SCOPED_TRACE(command);
+    const auto run = test::runFieldpath(dir, command);
+    EXPECT_EQ(run.exit_code, 1) << run.output();
+    EXPECT_NE(run.err.find("out: another fieldpath run is writing this folder"), std::string::npos)
+        << run.err;
+    EXPECT_EQ(filesUnder(dir.path() / "out"),
+              (std::vector<std::string>{"check.json", "path.cl", "report.json"}));
+  }
+  ::close(held);
+  // Released: the next run writes there; and a run refused for its input into a folder of its
+  // own making leaves no folder.
+  EXPECT_EQ(test::runFieldpath(dir, "simulate --tool ball:3 --path p.cl --out out").exit_code, 0);
+  EXPECT_EQ(
+      test::runFieldpath(dir, "simulate --tool ball:3 --path missing.cl --out new/deep").exit_code,
+      1);
+  EXPECT_FALSE(fs::exists(dir.path() / "new/deep"));
 }
 
 // An interrupted run (Ctrl-C, `timeout`'s SIGTERM) leaves no earlier run's outputs either, as a

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -200,6 +201,18 @@ TEST(View, TiltLeadAndArcLengthAgreeWithGenerate) {
   EXPECT_GT(max_tilt, 1.0);  // the wall did tilt the tool
 }
 
+/// A page's surface: its blocks' values and the value from which a block reads as not cut.
+std::pair<std::vector<float>, double> surfaceValues(const std::string& html) {
+  const json meta = pageMeta(html);
+  const std::string blob = base64Decode(
+      between(html, "<script type=\"application/octet-stream\" id=\"fp-blob\">", "</script>"));
+  const std::size_t offset = meta["surface"]["value"]["offset"],
+                    count = meta["surface"]["value"]["count"];
+  std::vector<float> out(count);
+  std::memcpy(out.data(), blob.data() + offset, 4 * count);
+  return std::make_pair(out, meta["surface"]["uncut_um"].get<double>());
+}
+
 // A simulated surface's lines that no pass cut are greyed (the page's uncut marker) from the
 // stock simulate.json records, not from the highest height: in a zoom that every pass reaches
 // (11 passes 1 mm apart under a ball R 3, every line lowered), the highest lines are the cusps
@@ -228,15 +241,7 @@ TEST(View, ASimulatedZoomCutEverywhereHasNoUncutLines) {
     const Outcome v = runFieldpath(
         dir, "--quiet view scene.yaml --path flat.cl --surface " + sim + " --out " + sim + ".html");
     EXPECT_EQ(v.exit_code, 0) << v.output();
-    const std::string html = slurp(dir.path() / (sim + ".html"));
-    const json meta = pageMeta(html);
-    const std::string blob = base64Decode(
-        between(html, "<script type=\"application/octet-stream\" id=\"fp-blob\">", "</script>"));
-    const std::size_t offset = meta["surface"]["value"]["offset"],
-                      count = meta["surface"]["value"]["count"];
-    std::vector<float> out(count);
-    std::memcpy(out.data(), blob.data() + offset, 4 * count);
-    return std::make_pair(out, meta["surface"]["uncut_um"].get<double>());
+    return surfaceValues(slurp(dir.path() / (sim + ".html")));
   };
   const auto [zoom, marker] = values("0,0,20,10");
   ASSERT_EQ(zoom.size(), 20000u);
@@ -249,6 +254,43 @@ TEST(View, ASimulatedZoomCutEverywhereHasNoUncutLines) {
   const auto [wide, wide_marker] = values("-10,-10,30,20");
   EXPECT_GT(std::count_if(wide.begin(), wide.end(), [&](float v) { return v >= wide_marker; }), 0);
   EXPECT_GE(wide.front(), wide_marker);  // the corner (-10, -10): 7 mm from the nearest tip
+}
+
+// A check's lines no pass cut keep the stock allowance, told along the part's normal: on a 45°
+// sheet 2000 cos 45° = 1414 um, which the page showed as stock beside the band (purple), not as
+// not cut (grey: a reviewer's finding). One pass along the slope: the rest of it is not cut.
+TEST(View, ACheckedSlopesUncutLinesAreGreyed) {
+  const TempDir dir;
+  std::ostringstream stl;
+  stl << "solid slope\n";
+  const auto facet = [&stl](std::array<double, 9> v) {
+    stl << " facet normal 0 -0.7071 0.7071\n  outer loop\n";
+    for (int k = 0; k < 9; k += 3)
+      stl << "   vertex " << v[k] << ' ' << v[k + 1] << ' ' << v[k + 2] << '\n';
+    stl << "  endloop\n endfacet\n";
+  };
+  facet({-10, -10, -10, 10, -10, -10, 10, 10, 10});  // z = y
+  facet({-10, -10, -10, 10, 10, 10, -10, 10, 10});
+  stl << "endsolid slope\n";
+  dir.write("slope.stl", stl.str());
+  dir.write("block.stl", boxStl(60, 60, 0, 70, 70, 10));
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: block.stl\npart: slope.stl\n"
+            "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n");
+  std::ostringstream cl;  // the ball's centre R along the normal from the contact (x, 0, 0)
+  cl << "# pass 1\n";
+  const double off = 3.0 / std::sqrt(2.0);
+  for (int i = 0; i <= 20; ++i) cl << -5 + 0.5 * i << ' ' << -off << ' ' << off - 3 << " 0 0 1\n";
+  dir.write("pass.cl", cl.str());
+  ASSERT_EQ(runFieldpath(dir, "--quiet check scene.yaml --path pass.cl --out chk").exit_code, 0);
+  const Outcome v = runFieldpath(dir, "--quiet view scene.yaml --check chk --out v.html");
+  ASSERT_EQ(v.exit_code, 0) << v.output();
+  const auto [values, marker] = surfaceValues(slurp(dir.path() / "v.html"));
+  EXPECT_GT(std::count_if(values.begin(), values.end(), [&](float x) { return x >= marker; }), 0);
+  const double stock_um = 2000.0 / std::sqrt(2.0);
+  EXPECT_EQ(std::count_if(values.begin(), values.end(),
+                          [&](float x) { return std::abs(x - stock_um) < 1.0; }),
+            0);
 }
 
 TEST(View, MeshesAreDecimatedToTheBudget) {

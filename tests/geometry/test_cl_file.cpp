@@ -225,10 +225,12 @@ TEST(AptFile, WritesHeaderAndParsesBackExactly) {
   const fs::path p = tempPath("path.apt");
   writeAptFile(p, postures, header);
   std::ifstream in(p);
-  std::string l1, l2, l3, l4, l5, l6;
-  std::getline(in, l1), std::getline(in, l2), std::getline(in, l3), std::getline(in, l4),
-      std::getline(in, l5), std::getline(in, l6);
+  std::string l1, count, l2, l3, l4, l5, l6;
+  std::getline(in, l1), std::getline(in, count), std::getline(in, l2), std::getline(in, l3),
+      std::getline(in, l4), std::getline(in, l5), std::getline(in, l6);
   EXPECT_EQ(l1, "PARTNO/IMPELLER");
+  EXPECT_EQ(count, "PPRINT/POSTURES " + std::to_string(postures.size()) +
+                       " (A FILE HOLDING FEWER WAS CUT SHORT)");
   EXPECT_EQ(l2, "UNITS/MM");
   EXPECT_EQ(l3, "MULTAX/ON");
   EXPECT_EQ(l4, "CUTTER/10,1,4,1,0,0,30");
@@ -308,8 +310,8 @@ TEST(AptFile, UnitsFiniAndRemarks) {
   const fs::path w = tempPath("remarks.apt");
   writeAptFile(w, p, header);
   std::ifstream in(w);
-  std::string l1, l2;
-  std::getline(in, l1), std::getline(in, l2);
+  std::string l1, l2;  // PARTNO, the posture count, then the remark
+  std::getline(in, l1), std::getline(in, l1), std::getline(in, l2);
   EXPECT_EQ(l2, "PPRINT/UNSAFE TO RUN: A   AND A NEWLINE");
   EXPECT_EQ(readAptFile(w).size(), 3u);
   // A remark past a PPRINT card's 65 characters of text goes on in PPRINT cards of its own,
@@ -319,9 +321,9 @@ TEST(AptFile, UnitsFiniAndRemarks) {
       "next) and 47 postures"};
   writeAptFile(w, p, header);
   std::ifstream cards(w);
-  std::string c1, c2, c3, c4;
-  std::getline(cards, c1), std::getline(cards, c2), std::getline(cards, c3),
-      std::getline(cards, c4);
+  std::string c1, c2, c3, c4;  // PARTNO, the posture count, then the remark
+  std::getline(cards, c1), std::getline(cards, c1), std::getline(cards, c2),
+      std::getline(cards, c3), std::getline(cards, c4);
   EXPECT_EQ(c2, "PPRINT/UNSAFE TO RUN: 49 MOTIONS TOUCH AN OBSTACLE (FIRST: POSTURE 114");
   EXPECT_EQ(c3, "PPRINT/TO THE NEXT) AND 47 POSTURES");
   EXPECT_EQ(c4, "UNITS/MM");

@@ -490,26 +490,34 @@ TEST(CheckSurface, PassesBesideThePartAreStillCheckedForClearance) {
   EXPECT_EQ(snapped["axis_turn"]["posture"].get<int>(), 5);
 }
 
-TEST(CheckSurface, TheSameJobHighUpInZReadsTheSame) {
-  // A pass along a plate, and the whole job lifted 1e5 mm in z: the same surface figures
-  // (float heights held there read a clean pass as 7.8 um of gouge on 498 lines).
+TEST(CheckSurface, TheSameJobFarFromTheOriginReadsTheSame) {
+  // A pass along a plate, and the whole job lifted 1e5 mm in z, or moved 5e5 mm in x and y: the
+  // same surface figures (float heights held there read a clean pass as 7.8 um of gouge on 498
+  // lines; float plan coordinates, 1/32 mm apart at 5e5 mm, a reviewer's clean slope as 20 um).
   const TempDir dir;
-  for (const double lift : {0.0, 1e5}) {
+  struct Place {
+    std::string tag;
+    double shift, lift;  // mm, in x and y; in z
+  };
+  const std::vector<Place> places = {{"low", 0.0, 0.0}, {"high", 0.0, 1e5}, {"far", 5e5, 0.0}};
+  for (const auto& [tag, shift, lift] : places) {
     geometry::TriangleMesh part, wall;
-    pathgen::test::addBox(part, 0, 50, 0, 50, lift - 10, lift);
-    pathgen::test::addBox(wall, 0, 50, 30, 35, lift - 5, lift + 20);
-    const std::string tag = lift == 0.0 ? "low" : "high";
+    pathgen::test::addBox(part, shift, shift + 50, shift, shift + 50, lift - 10, lift);
+    pathgen::test::addBox(wall, shift, shift + 50, shift + 30, shift + 35, lift - 5, lift + 20);
     geometry::saveMesh(part, dir.path() / ("part_" + tag + ".stl"));
     geometry::saveMesh(wall, dir.path() / ("wall_" + tag + ".stl"));
     dir.write(tag + ".yaml", "obstacles:\n  - mesh: wall_" + tag + ".stl\npart: part_" + tag +
                                  ".stl\ntool: { shape: ball, radius: 3, length: 40 }\n");
     std::ostringstream path;
     path.precision(17);
-    for (const double y : {20.0, 24.0}) {  // two passes: a scallop between them
+    for (const double y : {20.3, 24.3}) {  // two passes: a scallop between them, off 1/32 mm
       if (y > 20.0)
-        path << "# link\n45 20 " << lift + 8 << " 0 0 1\n5 24 " << lift + 8 << " 0 0 1\n";
+        path << "# link\n"
+             << shift + 45 << ' ' << shift + y - 4 << ' ' << lift + 8 << " 0 0 1\n"
+             << shift + 5 << ' ' << shift + y << ' ' << lift + 8 << " 0 0 1\n";
       path << "# pass\n";
-      for (int k = 0; k <= 80; ++k) path << 5.0 + 0.5 * k << ' ' << y << ' ' << lift << " 0 0 1\n";
+      for (int k = 0; k <= 80; ++k)
+        path << shift + 5.0 + 0.5 * k << ' ' << shift + y << ' ' << lift << " 0 0 1\n";
     }
     dir.write(tag + ".cl", path.str());
   }
@@ -520,10 +528,15 @@ TEST(CheckSurface, TheSameJobHighUpInZReadsTheSame) {
     return nlohmann::json::parse(
         test::slurp(dir.path() / ("out_" + tag) / "check.json"))["surface"];
   };
-  const auto low = surface("low"), high = surface("high");
+  const auto low = surface("low");
   EXPECT_EQ(low["gouged_lines"].get<int>(), 0);
-  EXPECT_EQ(high["gouged_lines"].get<int>(), 0);
-  EXPECT_NEAR(high["max_gouge_um"].get<double>(), low["max_gouge_um"].get<double>(), 1.0);
-  EXPECT_NEAR(high["max_scallop_um"].get<double>(), low["max_scallop_um"].get<double>(), 1.0);
+  for (const char* tag : {"high", "far"}) {
+    const auto moved = surface(tag);
+    EXPECT_EQ(moved["gouged_lines"].get<int>(), 0) << tag;
+    EXPECT_NEAR(moved["max_gouge_um"].get<double>(), low["max_gouge_um"].get<double>(), 1.0) << tag;
+    EXPECT_NEAR(moved["max_scallop_um"].get<double>(), low["max_scallop_um"].get<double>(), 1.0)
+        << tag;
+    EXPECT_EQ(moved["band_lines"].get<int>(), low["band_lines"].get<int>()) << tag;
+  }
   EXPECT_GT(low["max_scallop_um"].get<double>(), 600.0);  // R - sqrt(R² - 4) = 764 um
 }

@@ -3,6 +3,7 @@
 /// scallop along its normal, a lone pass (no scallop), a path that never cuts (not checked), and a
 /// tool axis turned far across a gap between two passes (taken, as generate takes it).
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -164,6 +165,88 @@ TEST(CheckSurface, ALonePassHasNoScallop) {
   EXPECT_EQ(s["band_lines"].get<int>(), 0) << s;
   EXPECT_TRUE(s["scallop_skipped"].is_string()) << s;
   EXPECT_LT(s["max_gouge_um"].get<double>(), 0.5) << s;
+}
+
+// The band is where the cuts are, not how the file writes them: six passes 2 mm apart in order,
+// and the same cuts as pieces of three postures, shuffled, every other one reversed, give the
+// same band and scallop (it paired consecutive passes only: pieces read no band at all, or a
+// reviewer's two rows of two pieces each read 0 or 64 000 band lines by their order).
+TEST(CheckSurface, TheBandDoesNotDependOnHowThePassesAreWritten) {
+  const TempDir dir;
+  writePlateScene(dir);
+  dir.write("order.cl", passes(6, -5.0, 2.0, 0.0));
+  struct Piece {  // postures first..first+2 of a pass, x = 0.5 i: each ends where the next starts
+    double y;
+    int first;
+  };
+  std::vector<Piece> pieces;
+  for (int k = 0; k < 6; ++k)
+    for (int i = 0; i < 40; i += 2) pieces.push_back({-5.0 + 2.0 * k, i});
+  std::ostringstream cl;
+  std::size_t at = 0;
+  ASSERT_NE(pieces.size() % 37, 0u);
+  for (std::size_t n = 0; n < pieces.size(); ++n) {
+    at = (at + 37) % pieces.size();  // 37 is prime to the count: every piece once
+    const Piece& p = pieces[at];
+    const bool reversed = n % 2 == 1;
+    const int from = reversed ? p.first + 2 : p.first, dir_i = reversed ? -1 : 1;
+    cl << "# link\n" << 0.5 * from << ' ' << p.y << " 8 0 0 1\n# pass\n";
+    for (int j = 0; j < 3; ++j) cl << 0.5 * (from + dir_i * j) << ' ' << p.y << " 0 0 0 1\n";
+  }
+  dir.write("pieces.cl", cl.str());
+  const auto order = check(dir, "order.cl", "order")["surface"];
+  const auto shuffled = check(dir, "pieces.cl", "pieces")["surface"];
+  const double band = order["band_lines"].get<double>();
+  EXPECT_GT(band, 0.9 * 10 * 20 / (0.05 * 0.05)) << order;  // 10 mm between the outer passes
+  EXPECT_NEAR(shuffled["band_lines"].get<double>(), band, 0.03 * band) << shuffled;
+  EXPECT_NEAR(shuffled["max_scallop_um"].get<double>(), order["max_scallop_um"].get<double>(), 1.0)
+      << shuffled;
+}
+
+/// deviation.npy of a check folder: float32 lines, row-major from the grid's origin (y rows).
+std::vector<float> deviationLines(const fs::path& dir) {
+  const std::string bytes = test::slurp(dir / "deviation.npy");
+  const std::size_t header =
+      10 + (static_cast<unsigned char>(bytes[8]) | static_cast<unsigned char>(bytes[9]) << 8);
+  std::vector<float> lines((bytes.size() - header) / sizeof(float));
+  std::memcpy(lines.data(), bytes.data() + header, lines.size() * sizeof(float));
+  return lines;
+}
+
+// A ball R 3 on a 20 mm tool lying flat, its shank 0.1 mm into the plate, swung 10° about the
+// ball's centre: every line under the swept shank is cut 100 um deep. Stamps stepped by the
+// ball's reach were 0.7 mm apart 16 mm up the shank, and the cylinder's imprints left 79 um
+// between them (a reviewer's 40 mm tool: 68 of 100 um); stepped by the tool's extent, they are
+// within the sweep's stated error.
+TEST(CheckSurface, AShankSweptByATurnCutsEveryLineUnderIt) {
+  const TempDir dir;
+  writePlateScene(dir);
+  const double turn = 10.0 * M_PI / 180.0, cx = -5.0, cy = 0.0, cz = 2.9;
+  std::ostringstream cl;
+  cl.precision(12);
+  cl << "# pass 1\n";
+  for (const double a : {0.0, turn})  // the tip: the centre less R along the axis
+    cl << cx - 3 * std::cos(a) << ' ' << cy - 3 * std::sin(a) << ' ' << cz << ' ' << std::cos(a)
+       << ' ' << std::sin(a) << " 0\n";
+  dir.write("turn.cl", cl.str());
+  const auto s = check(dir, "turn.cl", "out")["surface"];
+  const std::vector<float> dev = deviationLines(dir.path() / "out");
+  const double x0 = s["grid"]["origin"][0], y0 = s["grid"]["origin"][1];
+  const double d = s["grid"]["spacing"][0];
+  const int rows = s["grid"]["shape"][0], cols = s["grid"]["shape"][1];
+  ASSERT_EQ(dev.size(), std::size_t(rows) * cols);
+  double shallowest_um = 1e9;
+  int inside = 0;
+  for (int iy = 0; iy < rows; ++iy)
+    for (int ix = 0; ix < cols; ++ix) {
+      const double x = x0 + (ix + 0.5) * d - cx, y = y0 + (iy + 0.5) * d - cy;
+      const double r = std::hypot(x, y), a = std::atan2(y, x);
+      if (r < 4 || r > 16 || a < 0.1 * turn || a > 0.9 * turn) continue;
+      ++inside;
+      shallowest_um = std::min(shallowest_um, -double(dev[std::size_t(iy) * cols + ix]));
+    }
+  EXPECT_GT(inside, 5000);
+  EXPECT_GE(shallowest_um, 100.0 - s["sweep_error_um"].get<double>() - 0.5) << s;
 }
 
 // Tips 5 mm over the plate (the stock stands 2 mm over it): nothing is cut, so nothing of the

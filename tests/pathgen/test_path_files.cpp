@@ -64,6 +64,39 @@ TEST(PathFiles, MarkedClAndNpyReadBackBitForBit) {
             fieldpath::test::slurp(dir.path() / "m2.cl"));
 }
 
+// A path file cut short at a line (a DNC or USB transfer) reads as a shorter path that stops in
+// the cut: a helper's first 500 lines of a path.cl, and an APT file cut before FINI, read
+// `check: ok`. The writers declare the count; a file holding fewer is refused at that line.
+TEST(PathFiles, AFileCutShortIsRefusedAtItsDeclaredCount) {
+  PathFile path;
+  for (int i = 0; i < 40; ++i) {
+    Posture p;
+    p.tip_mm = {0.5 * i, 1.0, 2.0};
+    path.postures.push_back(p);
+  }
+  path.blocks = {{PathBlock::Kind::Pass, 0, 40}};
+  TempDir dir;
+  geometry::writeClFile(dir.path() / "p.cl", path, "a path");
+  geometry::writeAptFile(dir.path() / "p.apt", path, geometry::AptHeader{});
+  for (const char* name : {"p.cl", "p.apt"}) {
+    SCOPED_TRACE(name);
+    ASSERT_EQ(geometry::readPathFile(dir.path() / name).postures.size(), 40u);
+    const std::string text = fieldpath::test::slurp(dir.path() / name);
+    std::size_t cut = text.size() - 1;  // 10 lines before the end
+    for (int k = 0; k < 10; ++k) cut = text.rfind('\n', cut - 1);
+    const std::string short_name = std::string("short_") + name;
+    dir.write(short_name, text.substr(0, cut + 1));
+    const std::string error = errorOf([&] { geometry::readPathFile(dir.path() / short_name); });
+    EXPECT_NE(error.find(short_name + ":2: declares 40 postures and the file holds"),
+              std::string::npos)
+        << error;
+    EXPECT_NE(error.find("cut short"), std::string::npos) << error;
+  }
+  // A file that declares nothing (any other writer's) is taken as it is.
+  dir.write("plain.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
+  EXPECT_EQ(geometry::readPathFile(dir.path() / "plain.cl").postures.size(), 2u);
+}
+
 TEST(PathFiles, BadNpyFilesAreOneLineErrors) {
   TempDir dir;
   std::vector<Posture> postures(3);

@@ -468,6 +468,14 @@ TEST(BadInput, RegionGridAndToolAreChecked) {
   req.tool = Tool::ball(1, 4);
   req.engine = Engine::Coarse;
   EXPECT_THROW(simulate(req, std::span<const Posture>{}), common::InputError);
+  // A NaN starting line: the CPU never lowered it, the GPU did (a reviewer's reading).
+  req.engine = Engine::Fast;
+  req.backend = Backend::Cpu;
+  req.initial_heights_mm.assign(req.grid.lineCount(), 1.0f);
+  req.initial_heights_mm[5] = std::nanf("");
+  EXPECT_THROW(simulate(req, std::span<const Posture>{}), common::InputError);
+  req.initial_heights_mm[5] = INFINITY;
+  EXPECT_THROW(simulate(req, std::span<const Posture>{}), common::InputError);
 }
 
 }  // namespace

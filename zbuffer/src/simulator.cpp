@@ -341,6 +341,10 @@ SimulationResult run(const SimulationRequest& request, std::size_t expected_post
   checkGridFits(grid);
   if (!request.initial_heights_mm.empty() && request.initial_heights_mm.size() != grid.lineCount())
     throw InputError("initial heights: size does not match the grid");
+  // A NaN line would differ by backend: never lowered on the CPU (x < NaN is false), lowered on
+  // the GPU (NaN's ordered key is the largest); an infinite one has no stock to cut.
+  for (const float h : request.initial_heights_mm)
+    if (!std::isfinite(h)) throw InputError("initial heights: a line is not a finite number");
   if (request.engine == Engine::Coarse && request.tool.kind != ToolKind::Mesh)
     throw InputError("the coarse engine needs a mesh tool");
   Backend backend = request.backend;
@@ -495,6 +499,15 @@ double toolReach(const Tool& tool) {
   for (const auto& p : tool.mesh.vertices)
     reach = std::max(reach, std::sqrt(double(p.x) * p.x + double(p.y) * p.y));
   return reach;
+}
+
+double toolExtent(const Tool& tool) {
+  if (tool.kind != ToolKind::Mesh)
+    return std::hypot(double(tool.length_mm), double(tool.radius_mm));
+  double extent = 0;
+  for (const auto& p : tool.mesh.vertices)
+    extent = std::max(extent, std::sqrt(double(p.x) * p.x + double(p.y) * p.y + double(p.z) * p.z));
+  return extent;
 }
 
 }  // namespace fieldpath::zbuffer

@@ -3,7 +3,9 @@
 /// interrupted run never leaves a truncated file under the final name (DESIGN.md). The temporaries
 /// being written are listed where a SIGINT/SIGTERM handler can remove them
 /// (removeTemporariesNow(), installed by the CLI's main()).
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <time.h>
@@ -142,9 +144,24 @@ inline void removeClaimedOutputsNow() noexcept {
 }
 
 namespace detail {
+/// The output folders this process holds (lockOutputDirectory): locked once each.
+inline std::vector<std::filesystem::path> locked_directories;
+/// The folder this run made for its outputs: removed again if a failed or interrupted run leaves
+/// it empty (a refused run leaves no files).
+inline TemporarySlot created_directory;
+}  // namespace detail
+
+/// Removes the output folder this run made (lockOutputDirectory) if it is empty: rmdir only,
+/// async-signal-safe.
+inline void removeCreatedDirectoryNow() noexcept {
+  if (detail::created_directory.state.load() == 2) ::rmdir(detail::created_directory.path);
+}
+
+namespace detail {
 extern "C" inline void removeTemporariesAndDie(int signal_number) {
   removeTemporariesNow();
   removeClaimedOutputsNow();
+  removeCreatedDirectoryNow();
   ::raise(signal_number);  // SA_RESETHAND restored the default action: die of the signal
 }
 }  // namespace detail
@@ -333,6 +350,37 @@ inline void removeWrittenOutputs() {
   }
   detail::claimed_outputs.clear();
   for (auto& slot : detail::claimed_slots) slot.state.store(0);
+  removeCreatedDirectoryNow();
+}
+
+/// Holds `dir` (made now if missing) for this run's outputs until the process ends: a second run
+/// writing the same folder meanwhile is refused before its work, with nothing of either taken
+/// away (two runs at once left one job's path.cl beside the other's report.json and path.apt,
+/// both exiting 0; a failed one took the other's new path.cl away: a helper's finding). An
+/// advisory lock (flock) on the folder itself: no lock file, released by the kernel when the
+/// process ends however it ends. Where the file system has no locks, runs are not kept apart.
+inline void lockOutputDirectory(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path key = fs::weakly_canonical(fs::absolute(dir, ec), ec);
+  for (const fs::path& held : detail::locked_directories)
+    if (held == key) return;
+  if (!fs::exists(dir, ec)) {
+    createOutputDirectory(dir);
+    detail::listInSlots(&detail::created_directory, 1, fs::absolute(dir, ec).string());
+  }
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const int error = errno;
+    ::close(fd);
+    if (error == EWOULDBLOCK)
+      throw InputError(dir.string() +
+                       ": another fieldpath run is writing this folder; wait for it to end, "
+                       "or choose another folder");
+    return;
+  }
+  detail::locked_directories.push_back(key);  // the descriptor stays open: the lock with it
 }
 
 /// The files `names` in `dir` are this command's outputs: a run that fails (exit 1 or 2) removes
@@ -342,6 +390,7 @@ inline void removeWrittenOutputs() {
 /// Files in `inputs` are never claimed: a scene whose nominal path is `--out`'s path.cl keeps it.
 inline void claimOutputs(const std::filesystem::path& dir, std::initializer_list<const char*> names,
                          std::initializer_list<std::filesystem::path> inputs = {}) {
+  lockOutputDirectory(dir);  // before claiming: a refused second run takes nothing away
   const std::lock_guard<std::mutex> lock(detail::written_mutex);
   for (const char* name : names) {
     bool input = false;
@@ -372,6 +421,7 @@ inline void refuseOutputsOverInputs(const std::filesystem::path& dir,
 inline void releaseClaimedOutputs() {
   const std::lock_guard<std::mutex> lock(detail::written_mutex);
   for (auto& slot : detail::claimed_slots) slot.state.store(0);
+  detail::created_directory.state.store(0);
   detail::claimed_outputs.clear();
 }
 

@@ -54,6 +54,10 @@ struct Tool {
 /// The radius (mm, about the tool's axis) that contains the whole tool: how far from a posture's
 /// tip its cut can reach on the grid. Cheap: no BVH is built.
 double toolReach(const Tool& tool);
+/// How far the tool's farthest point lies from its tip (mm): how far a point of it moves, at
+/// most, for a turn of its axis about the tip of one radian (an analytic tool's hypot(length, R);
+/// a mesh's farthest vertex).
+double toolExtent(const Tool& tool);
 
 enum class Backend { Auto, Cpu, Cuda };
 /// Fast: per posture, only the lines under the tool (analytic envelope, or the line in the tool
