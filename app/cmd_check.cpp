@@ -129,6 +129,10 @@ json surfaceJson(const SurfaceResult& s) {
        "test's (cutter_part, exact)"},
       {"part_lines", s.part_lines},
       {"band_lines", s.band_lines},
+      {"uncut_band_lines", s.uncut_band_lines},
+      {"uncut_band",
+       "lines between two passes that no pass cut (passes farther apart than the tool reaches): "
+       "the stock allowance stands there; not in band_lines nor the scallop figures"},
       {"gouged_lines", s.gouged_lines},
       {"gouge_tolerance_um", s.gouge_tolerance_um},
       {"max_gouge_um", s.max_gouge_um},
@@ -261,11 +265,18 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     // The cutter entering the part is no path in another frame (a side cut under the stock's
     // lines asked 'is the part in the path's frame?' while cutter_part read its 9.9 um).
     const bool touches_part = contacts.cutter && contacts.cutter->gouges();
+    // The ball reaching the part where no line falls: a wall finished with the axis tilted (a
+    // helper's walls at 30-85 deg read "is the part in the path's frame?" and never ok).
+    const bool reaches_part =
+        contacts.ball_part_mm && *contacts.ball_part_mm <= pathgen::kReachesPartMm;
     const char* surface_skipped =
         !scene.part ? "the scene has no `part`"
         : never_cut && touches_part
             ? "the tool lowers no line of the stock over the part (it enters the part where no "
               "line falls: cutter_part)"
+        : !surface && reaches_part
+            ? "the ball reaches the part where the Z-buffer, looking down, lowers no line (a wall "
+              "or an undercut): its gouges are cutter_part's, its scallop is not measured"
         : never_cut ? "the tool never cuts the stock over the part (no line lowered): is the part "
                       "in the path's frame and units?"
         : !surface  ? "the passes do not pass over the part (`part` mesh)"
@@ -292,7 +303,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                        " motions come under the required clearance");
     // A part given and never reached: the machined surface is unproven, most likely a path in
     // other units or another frame (a helper's inch file 165 mm from its part read `ok: true`).
-    const bool part_never_reached = scene.part && !surface && !touches_part;
+    const bool part_never_reached = scene.part && !surface && !touches_part && !reaches_part;
     if (part_never_reached)
       not_ok.push_back(std::string("the surface is not checked: ") + surface_skipped);
     if (surface && surface->gouged_lines > 0)
@@ -413,6 +424,12 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
           surface->band_lines, surface->max_gouge_um, surface->gouged_lines,
           -surface->gouge_tolerance_um, scallop, zbuffer::backendName(surface->backend),
           surface->simulation_s);
+      if (surface->uncut_band_lines > 0)
+        std::fprintf(stderr,
+                     "warning: %zu lines between passes were not cut: passes there lie farther "
+                     "apart than the tool reaches, and the stock stands between them "
+                     "(check.json surface.uncut_band_lines; sand on deviation.png)\n",
+                     surface->uncut_band_lines);
     } else
       std::printf("surface: not checked (%s)\n", surface_skipped);
     // The verdict last, as a user looks for it (the reasons were only in check.json: a

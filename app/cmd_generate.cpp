@@ -36,26 +36,29 @@ namespace {
 
 using geometry::kRadToDeg;
 
-/// Removes `check --out`'s files from `out` where they checked the path.cl this run replaces
-/// (check.json's path_digest is the file's): check.json's `"ok": true`, deviation.png and
-/// clearance.csv stayed beside a new path nobody had checked (a helper's finding). A check of
-/// another path (its digest differs) stays.
+/// Removes `check --out`'s files from `out` where they checked the path.cl or path.apt this run
+/// replaces (check.json's path_digest is the file's): check.json's `"ok": true`, deviation.png
+/// and clearance.csv stayed beside a new path nobody had checked (a helper's finding). A check
+/// of another path (its digest differs), or one that cannot be read, stays.
 void forgetCheckOfReplacedPath(const std::filesystem::path& out) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  const fs::path check = out / "check.json", path = out / "path.cl";
-  if (!fs::is_regular_file(check, ec) || !fs::is_regular_file(path, ec)) return;
-  std::string digest;
+  const fs::path check = out / "check.json";
+  if (!fs::is_regular_file(check, ec)) return;
+  bool replaced = false;
   try {
     std::ifstream in(check);
-    digest = nlohmann::json::parse(in).value("path_digest", std::string());
+    const std::string digest = nlohmann::json::parse(in).value("path_digest", std::string());
+    for (const char* name : {"path.cl", "path.apt"})
+      replaced = replaced || (!digest.empty() && fs::is_regular_file(out / name, ec) &&
+                              digest == common::fileDigest(out / name));
   } catch (const std::exception&) {
-    return;  // not check's: left as it is
+    return;  // not check's, or a path that cannot be read: left as it is
   }
-  if (digest.empty() || digest != common::fileDigest(path)) return;
+  if (!replaced) return;
   common::removeStaleOutputs(
       out, {"check.json", "clearance.csv", "deviation.npy", "deviation.json", "deviation.png"});
-  std::fprintf(stderr, "note: %s: the check of the path.cl this run replaces is removed with it\n",
+  std::fprintf(stderr, "note: %s: the check of the path this run replaces is removed with it\n",
                out.string().c_str());
 }
 

@@ -100,7 +100,8 @@ inline nlohmann::json linkPartJson(const std::optional<pathgen::LinkPartResult>&
       "every link posture and every motion between two link postures against the part mesh "
       "(as `motions`, required 0: rapid moves must not touch it), and the moves out of and "
       "into a pass with the tool and holder 0.1 mm smaller all round (they start or end where "
-      "the ball cuts and may slide along a wall it finishes; counted, not in min_mm)");
+      "the ball cuts and may slide along a wall it finishes; counted, not in min_mm); min_mm "
+      "a lower bound within 10 % of the links' least clearance to the part");
 }
 
 /// The `holder_part` block of report.json and check.json: the holder against the part at every

@@ -81,11 +81,17 @@ LineEnd endOf(const std::vector<Line>& lines, std::size_t k, bool at_start) {
   return {k, at_start, e, (e - inner).normalized(), (e - inner).norm()};
 }
 
-/// Integer cell of a plan point for a hash of cells `cell_mm` wide.
+/// The hash of cell (ix, iy): keys may collide, which only costs a few more candidates.
+std::int64_t cellHash(std::int64_t ix, std::int64_t iy) { return ix * 73856093 ^ iy * 19349663; }
+
+/// The integer cell index of coordinate `x` (mm) in cells `cell_mm` wide.
+std::int64_t cellIndex(double x, double cell_mm) {
+  return static_cast<std::int64_t>(std::floor(x / cell_mm));
+}
+
+/// The hash of the cell `dx`, `dy` cells from the one holding plan point p.
 std::int64_t cellKey(const Vec2& p, double cell_mm, int dx = 0, int dy = 0) {
-  const auto ix = static_cast<std::int64_t>(std::floor(p.x() / cell_mm)) + dx;
-  const auto iy = static_cast<std::int64_t>(std::floor(p.y() / cell_mm)) + dy;
-  return ix * 73856093 ^ iy * 19349663;  // collisions only cost a few more candidates
+  return cellHash(cellIndex(p.x(), cell_mm) + dx, cellIndex(p.y(), cell_mm) + dy);
 }
 
 /// The contact lines with pieces that continue one another joined into one line: an end of one
@@ -155,14 +161,20 @@ std::vector<Line> joined(std::vector<Line> lines, double radius_mm) {
   return out;
 }
 
-/// The line with points inserted so that none is more than `step_mm` from the next.
-Line densified(const Line& line, double step_mm) {
+/// The line resampled every `step_mm` along it, its ends kept: a path's own postures may be far
+/// denser than the band needs (the casts cost by points), or far apart (a long straight pass of
+/// two postures, whose neighbour covers only its middle).
+Line resampledEvery(const Line& line, double step_mm) {
   Line out{line.front()};
+  double next_mm = step_mm;  // along the current segment, to the next point
   for (std::size_t i = 1; i < line.size(); ++i) {
     const Vec2 d = line[i] - line[i - 1];
-    const auto pieces = static_cast<int>(std::ceil(d.norm() / step_mm));
-    for (int k = 1; k <= pieces; ++k) out.push_back(line[i - 1] + (double(k) / pieces) * d);
+    const double length_mm = d.norm();
+    for (; next_mm <= length_mm; next_mm += step_mm)
+      out.push_back(line[i - 1] + (next_mm / length_mm) * d);
+    next_mm -= length_mm;
   }
+  if ((out.back() - line.back()).norm() > 1e-9) out.push_back(line.back());
   return out;
 }
 
@@ -195,9 +207,19 @@ class SegmentIndex {
     const Vec2& p = lines_[k][i];
     const double min_t = 1e-6 * reach_mm;
     Hit best;
-    const Vec2 far = p + reach_mm * dir;
-    forCells(p.cwiseMin(far), p.cwiseMax(far), [&](std::int64_t key) {
-      const auto [first, last] = cells_.equal_range(key);
+    // The cells the cast crosses, in its order (Amanatides and Woo), until one ends beyond the
+    // nearest meeting: a segment met at t lies in the cell holding that point.
+    std::int64_t ix = cellIndex(p.x(), cell_), iy = cellIndex(p.y(), cell_);
+    const int step_x = dir.x() > 0 ? 1 : -1, step_y = dir.y() > 0 ? 1 : -1;
+    const auto exitAt = [this](std::int64_t cell, int step, double from, double along) {
+      if (along == 0.0) return std::numeric_limits<double>::infinity();
+      return (double(cell + (step > 0 ? 1 : 0)) * cell_ - from) / along;
+    };
+    double exit_x = exitAt(ix, step_x, p.x(), dir.x());
+    double exit_y = exitAt(iy, step_y, p.y(), dir.y());
+    const double across_x = cell_ / std::abs(dir.x()), across_y = cell_ / std::abs(dir.y());
+    for (;;) {
+      const auto [first, last] = cells_.equal_range(cellHash(ix, iy));
       for (auto it = first; it != last; ++it) {
         const auto [m, j] = it->second;
         const Vec2 &a = lines_[m][j - 1], &b = lines_[m][j];
@@ -211,19 +233,25 @@ class SegmentIndex {
         }
         best = {t, m};
       }
-    });
-    return best;
+      const double exit = std::min(exit_x, exit_y);
+      if (!(exit <= reach_mm) || exit >= best.distance_mm) return best;
+      if (exit_x < exit_y) {
+        ix += step_x;
+        exit_x += across_x;
+      } else {
+        iy += step_y;
+        exit_y += across_y;
+      }
+    }
   }
 
  private:
   template <class F>
   void forCells(const Vec2& lo, const Vec2& hi, F&& f) const {
-    const auto x0 = static_cast<std::int64_t>(std::floor(lo.x() / cell_));
-    const auto x1 = static_cast<std::int64_t>(std::floor(hi.x() / cell_));
-    const auto y0 = static_cast<std::int64_t>(std::floor(lo.y() / cell_));
-    const auto y1 = static_cast<std::int64_t>(std::floor(hi.y() / cell_));
+    const std::int64_t x0 = cellIndex(lo.x(), cell_), x1 = cellIndex(hi.x(), cell_);
+    const std::int64_t y0 = cellIndex(lo.y(), cell_), y1 = cellIndex(hi.y(), cell_);
     for (auto iy = y0; iy <= y1; ++iy)
-      for (auto ix = x0; ix <= x1; ++ix) f(ix * 73856093 ^ iy * 19349663);
+      for (auto ix = x0; ix <= x1; ++ix) f(cellHash(ix, iy));
   }
 
   const std::vector<Line>& lines_;
@@ -262,14 +290,17 @@ std::vector<char> machinedBand(const zbuffer::Grid& grid, const geometry::PathFi
     for (std::size_t i = 1; i < line.size(); ++i) length_mm += (line[i] - line[i - 1]).norm();
     if (line.size() >= 2) pieces.push_back(std::move(line));
   }
-  // Points a quarter of R apart along the lines (at most 4 million in all): a neighbour's side
-  // is followed to within (R/4)² / 8ρ of its curvature radius ρ.
+  // Points a quarter of R apart along the lines (about 4 million at most in all): a neighbour's
+  // side is followed to within (R/4)² / 8ρ of its curvature radius ρ.
   const double step_mm =
       std::max({0.25 * radius_mm, std::max(grid.dx_mm, grid.dy_mm), length_mm / 4e6});
   std::vector<Line> lines;
-  for (const Line& l : joined(std::move(pieces), radius_mm)) lines.push_back(densified(l, step_mm));
+  for (const Line& l : joined(std::move(pieces), radius_mm))
+    lines.push_back(resampledEvery(l, step_mm));
   const double reach_mm = 4.0 * radius_mm;  // passes farther apart leave no scallop between them
-  const SegmentIndex index(lines, reach_mm);
+  // Cells a few points wide: a cast stops at the cell past its nearest meeting (the passes'
+  // step-over), not after all of its reach.
+  const SegmentIndex index(lines, std::max(step_mm, reach_mm / 8));
   // Per point of every line: the distance to the nearest line on its left and on its right.
   std::vector<std::size_t> first(lines.size() + 1, 0);
   for (std::size_t k = 0; k < lines.size(); ++k) first[k + 1] = first[k] + lines[k].size();

@@ -341,6 +341,7 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   float top = -std::numeric_limits<float>::infinity();
   for (float h : nominal)
     if (!std::isnan(h)) top = std::max(top, h);
+  if (!std::isfinite(top)) return std::nullopt;  // no line of the region falls on the part
   sim.initial_heights_mm = nominal;
   for (float& h : sim.initial_heights_mm) h = (std::isnan(h) ? top : h) + kStockAllowanceMm;
   sim.progress = request.progress;
@@ -420,6 +421,11 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
     min_dev = std::min(min_dev, d);
     result.gouged_lines += d < -request.gouge_tolerance_um;
     if (!result.in_band[i]) continue;
+    if (!result.lowered[i]) {
+      ++result.uncut_band_lines;
+      result.in_band[i] = 0;
+      continue;
+    }
     ++result.band_lines;
     sum += d;
     sum2 += d * d;

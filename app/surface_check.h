@@ -48,6 +48,10 @@ struct SurfaceResult {
   /// such lines in the stock's colour, not as the largest scallop).
   std::vector<char> lowered;
   std::size_t part_lines = 0, band_lines = 0;
+  /// Lines between two passes (in the band) that no pass lowered: the stock allowance stands
+  /// there, passes too far apart to meet (not in band_lines nor the scallop figures: they read
+  /// the allowance, 2000 um, as a scallop).
+  std::size_t uncut_band_lines = 0;
   std::size_t gouged_lines = 0;  ///< anywhere on the part, deeper than the tolerance
   double gouge_tolerance_um = kGougeToleranceUm;
   double max_gouge_um = 0, max_scallop_um = 0, mean_um = 0, rms_um = 0;  ///< scallop stats: band

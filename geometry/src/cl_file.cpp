@@ -315,6 +315,9 @@ std::size_t scanPathFile(const std::filesystem::path& file, const PathReadOption
   std::size_t total = 0;
   for (std::size_t n : counts) total += n;
   if (total == 0) throw InputError(file.string() + ": no postures (empty path file)");
+  // After the chunks were handed on: the caller's work on them fails with this (`simulate`
+  // stamped a path cut short, a reviewer's finding).
+  checkDeclaredCount(text, kClCountPrefix, total, file);
   return total;
 }
 

@@ -223,17 +223,20 @@ inline constexpr std::string_view kClCountPrefix = "# postures: ";
 inline constexpr std::string_view kAptCountPrefix = "PPRINT/POSTURES ";
 
 /// The posture count a path's writer declares in its header (`.cl`: `# postures: N ...`, APT:
-/// `PPRINT/POSTURES N ...`, in its first 64 lines), checked against the `read` count: a path
-/// file cut short (a DNC or USB transfer) ends at a line boundary and reads as a shorter, valid
-/// path that stops in the cut (a helper's 500 lines of a 1089-posture path.cl read `check: ok`).
-/// Files that declare nothing are taken as they are.
+/// `PPRINT/POSTURES N ...`, anywhere before the first posture), checked against the `read`
+/// count: a path file cut short (a DNC or USB transfer) ends at a line boundary and reads as a
+/// shorter, valid path that stops in the cut (a helper's 500 lines of a 1089-posture path.cl read
+/// `check: ok`). Files that declare nothing are taken as they are.
 inline void checkDeclaredCount(std::string_view text, std::string_view prefix, std::size_t read,
                                const std::filesystem::path& file) {
+  const bool apt = prefix == kAptCountPrefix;
   std::size_t line = 1;
-  for (std::size_t at = 0; at < text.size() && line <= 64; ++line) {
+  for (std::size_t at = 0; at < text.size(); ++line) {
     const std::size_t end = std::min(text.find('\n', at), text.size());
-    const std::string_view l = text.substr(at, end - at);
+    std::string_view l = text.substr(at, end - at);
     at = end + 1;
+    while (!l.empty() && std::isspace(static_cast<unsigned char>(l.front()))) l.remove_prefix(1);
+    if (apt ? l.substr(0, 4) == "GOTO" : !l.empty() && l.front() != '#') return;  // a posture
     if (l.substr(0, prefix.size()) != prefix) continue;
     std::size_t declared = 0;
     const char* first = l.data() + prefix.size();

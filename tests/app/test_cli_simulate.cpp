@@ -16,16 +16,7 @@
 namespace fieldpath::app::test {
 namespace {
 
-/// The float32 data of a version-1 .npy file (the header is checked by the zbuffer tests).
-std::vector<float> npyFloats(const std::string& bytes) {
-  if (bytes.size() < 10) return {};
-  const std::size_t header =
-      static_cast<unsigned char>(bytes[8]) | (static_cast<unsigned char>(bytes[9]) << 8);
-  const std::size_t start = 10 + header;
-  std::vector<float> data((bytes.size() - start) / sizeof(float));
-  std::memcpy(data.data(), bytes.data() + start, data.size() * sizeof(float));
-  return data;
-}
+using fieldpath::test::npyFloats;
 
 TEST(CliSimulate, BallDimpleIsTheExactSphere) {
   const TempDir dir;

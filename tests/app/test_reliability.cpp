@@ -154,11 +154,13 @@ TEST(AtomicOutput, AFailedRunLeavesNoEarlierRunsOutputs) {
 TEST(AtomicOutput, GenerateTakesAwayTheCheckOfThePathItReplaces) {
   const TempDir dir;
   dir.write("scene.yaml", "obstacles:\n  - mesh: missing.stl\n");
-  for (const char* folder : {"same", "other"}) {
+  for (const char* folder : {"same", "apt", "other"}) {
     const std::string f(folder);
     dir.write(f + "/path.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
-    const std::string digest = f == "same" ? common::fileDigest(dir.path() / f / "path.cl")
-                                           : std::string("fnv1a64:0000000000000000");
+    dir.write(f + "/path.apt", "GOTO/0,0,0,0,0,1\nFINI\n");
+    const std::string digest = f == "same"  ? common::fileDigest(dir.path() / f / "path.cl")
+                               : f == "apt" ? common::fileDigest(dir.path() / f / "path.apt")
+                                            : std::string("fnv1a64:0000000000000000");
     dir.write(f + "/check.json", "{\"ok\": true, \"path_digest\": \"" + digest + "\"}\n");
     dir.write(f + "/deviation.png", "png\n");
     dir.write(f + "/mine.txt", "mine\n");
@@ -166,6 +168,7 @@ TEST(AtomicOutput, GenerateTakesAwayTheCheckOfThePathItReplaces) {
     EXPECT_EQ(run.exit_code, 1) << run.output();  // the scene is refused: path.cl goes too
   }
   EXPECT_EQ(filesUnder(dir.path() / "same"), std::vector<std::string>{"mine.txt"});
+  EXPECT_EQ(filesUnder(dir.path() / "apt"), std::vector<std::string>{"mine.txt"});
   EXPECT_EQ(filesUnder(dir.path() / "other"),
             (std::vector<std::string>{"check.json", "deviation.png", "mine.txt"}));
 }
@@ -202,7 +205,7 @@ TEST(AtomicOutput, AFolderAnotherRunIsWritingIsRefused) {
   EXPECT_EQ(
       test::runFieldpath(dir, "simulate --tool ball:3 --path missing.cl --out new/deep").exit_code,
       1);
-  EXPECT_FALSE(fs::exists(dir.path() / "new/deep"));
+  EXPECT_FALSE(fs::exists(dir.path() / "new"));
 }
 
 // An interrupted run (Ctrl-C, `timeout`'s SIGTERM) leaves no earlier run's outputs either, as a

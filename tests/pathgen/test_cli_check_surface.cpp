@@ -203,14 +203,55 @@ TEST(CheckSurface, TheBandDoesNotDependOnHowThePassesAreWritten) {
       << shuffled;
 }
 
-/// deviation.npy of a check folder: float32 lines, row-major from the grid's origin (y rows).
-std::vector<float> deviationLines(const fs::path& dir) {
-  const std::string bytes = test::slurp(dir / "deviation.npy");
-  const std::size_t header =
-      10 + (static_cast<unsigned char>(bytes[8]) | static_cast<unsigned char>(bytes[9]) << 8);
-  std::vector<float> lines((bytes.size() - header) / sizeof(float));
-  std::memcpy(lines.data(), bytes.data() + header, lines.size() * sizeof(float));
-  return lines;
+// A wall finished with the ball's axis tilted 60° away from it (the plate's side at y = 15, the
+// ball touching it midway down): the Z-buffer, looking down, lowers no line, yet the tool
+// reaches the part. Not "is the part in the path's frame?" and never ok (a helper's walls at
+// 30-85°): the surface is said not measured, and the check is ok; the same pass 1 mm off the
+// wall is the path that never reaches the part.
+TEST(CheckSurface, AWallFinishedWithATiltedBallIsReachedNotLost) {
+  const TempDir dir;
+  writePlateScene(dir);
+  const double tilt = M_PI / 3, ay = std::sin(tilt), az = std::cos(tilt);
+  const auto pass = [&](double gap_mm) {
+    std::ostringstream cl;
+    cl << "# pass 1\n";
+    for (int i = 0; i <= 20; ++i)  // the tip: the centre (x, 18 + gap, -2.5) less R along the axis
+      cl << 0.5 * i << ' ' << 18.0 + gap_mm - 3 * ay << ' ' << -2.5 - 3 * az << " 0 " << ay << ' '
+         << az << '\n';
+    return cl.str();
+  };
+  dir.write("wall.cl", pass(0.0));
+  dir.write("off.cl", pass(1.0));
+  const auto wall = test::runFieldpath(dir, "check scene.yaml --path wall.cl --out wall");
+  ASSERT_EQ(wall.exit_code, 0) << wall.output();
+  EXPECT_NE(wall.out.find("check: ok"), std::string::npos) << wall.out;
+  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "wall/check.json"));
+  EXPECT_NE(report["surface_skipped"].get<std::string>().find("a wall or an undercut"),
+            std::string::npos)
+      << report["surface_skipped"];
+  const auto off = test::runFieldpath(dir, "check scene.yaml --path off.cl --out off");
+  ASSERT_EQ(off.exit_code, 0) << off.output();
+  EXPECT_NE(off.out.find("check: NOT OK"), std::string::npos) << off.out;
+}
+
+// Two passes 7 mm apart under a ball R 3: the strip between them farther than 2.83 mm from both
+// (where the ball stands under the 2 mm of stock) is never cut. Those lines are counted apart
+// and warned of, not read as a 2000 um scallop and `check: ok` in silence (a helper's finding);
+// the lines the ball's flank only grazed stay in the band (up to 3 - sqrt(9 - 2.83²) mm).
+TEST(CheckSurface, LinesBetweenPassesThatNoPassCutAreSaidApart) {
+  const TempDir dir;
+  writePlateScene(dir);
+  dir.write("far.cl", passes(2, -3.5, 7.0, 0.0));
+  const auto r = test::runFieldpath(dir, "check scene.yaml --path far.cl --backend cpu --out out");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const auto s = nlohmann::json::parse(test::slurp(dir.path() / "out/check.json"))["surface"];
+  const double reach = std::sqrt(9.0 - 1.0), uncut = 20.0 * (7.0 - 2 * reach) / (0.05 * 0.05);
+  EXPECT_NEAR(s["uncut_band_lines"].get<double>(), uncut, 0.1 * uncut) << s;
+  EXPECT_NEAR(s["band_lines"].get<double>() + s["uncut_band_lines"].get<double>(),
+              20.0 * 7.0 / (0.05 * 0.05), 0.03 * 20.0 * 7.0 / (0.05 * 0.05))
+      << s;
+  EXPECT_NE(r.err.find("lines between passes were not cut"), std::string::npos) << r.err;
+  EXPECT_LT(s["max_scallop_um"].get<double>(), 1999.0) << s;  // the stock's 2000 um left out
 }
 
 // A ball R 3 on a 20 mm tool lying flat, its shank 0.1 mm into the plate, swung 10° about the
@@ -230,7 +271,8 @@ TEST(CheckSurface, AShankSweptByATurnCutsEveryLineUnderIt) {
        << ' ' << std::sin(a) << " 0\n";
   dir.write("turn.cl", cl.str());
   const auto s = check(dir, "turn.cl", "out")["surface"];
-  const std::vector<float> dev = deviationLines(dir.path() / "out");
+  // deviation.npy: float32 lines, row-major from the grid's origin (y rows).
+  const std::vector<float> dev = test::npyFloats(test::slurp(dir.path() / "out/deviation.npy"));
   const double x0 = s["grid"]["origin"][0], y0 = s["grid"]["origin"][1];
   const double d = s["grid"]["spacing"][0];
   const int rows = s["grid"]["shape"][0], cols = s["grid"]["shape"][1];

@@ -92,6 +92,11 @@ TEST(PathFiles, AFileCutShortIsRefusedAtItsDeclaredCount) {
         << error;
     EXPECT_NE(error.find("cut short"), std::string::npos) << error;
   }
+  // simulate streams the file (its chunks stamped as they are read): refused all the same.
+  const auto sim =
+      fieldpath::test::runFieldpath(dir, "simulate --tool ball:3 --path short_p.cl --out sim");
+  EXPECT_EQ(sim.exit_code, 1) << sim.output();
+  EXPECT_NE(sim.err.find("short_p.cl:2: declares 40 postures"), std::string::npos) << sim.err;
   // A file that declares nothing (any other writer's) is taken as it is.
   dir.write("plain.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
   EXPECT_EQ(geometry::readPathFile(dir.path() / "plain.cl").postures.size(), 2u);

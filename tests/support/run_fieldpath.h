@@ -4,11 +4,13 @@
 #include <sys/wait.h>
 
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace fieldpath::test {
 
@@ -73,6 +75,19 @@ inline Outcome runFieldpath(const TempDir& dir, const std::string& args) {
 inline Outcome runFieldpath(const std::string& args) {
   const TempDir scratch;
   return runFieldpath(scratch, args);
+}
+
+/// The float32 data of a version-1 .npy file's bytes, past its header (the header itself is
+/// checked by the zbuffer tests): heights.npy, deviation.npy.
+inline std::vector<float> npyFloats(const std::string& bytes) {
+  if (bytes.size() < 10) return {};
+  const std::size_t header =
+      static_cast<unsigned char>(bytes[8]) | (static_cast<unsigned char>(bytes[9]) << 8);
+  const std::size_t start = 10 + header;
+  if (bytes.size() < start) return {};
+  std::vector<float> data((bytes.size() - start) / sizeof(float));
+  std::memcpy(data.data(), bytes.data() + start, data.size() * sizeof(float));
+  return data;
 }
 
 }  // namespace fieldpath::test

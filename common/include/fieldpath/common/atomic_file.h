@@ -146,15 +146,18 @@ inline void removeClaimedOutputsNow() noexcept {
 namespace detail {
 /// The output folders this process holds (lockOutputDirectory): locked once each.
 inline std::vector<std::filesystem::path> locked_directories;
-/// The folder this run made for its outputs: removed again if a failed or interrupted run leaves
-/// it empty (a refused run leaves no files).
-inline TemporarySlot created_directory;
+/// The folders this run made for its outputs, outermost first: removed again, innermost first,
+/// where a failed or interrupted run leaves them empty (a refused run leaves no files).
+inline constexpr int kCreatedSlots = 8;
+inline TemporarySlot created_directories[kCreatedSlots];
 }  // namespace detail
 
 /// Removes the output folder this run made (lockOutputDirectory) if it is empty: rmdir only,
 /// async-signal-safe.
 inline void removeCreatedDirectoryNow() noexcept {
-  if (detail::created_directory.state.load() == 2) ::rmdir(detail::created_directory.path);
+  for (int i = detail::kCreatedSlots - 1; i >= 0; --i)
+    if (detail::created_directories[i].state.load() == 2)
+      ::rmdir(detail::created_directories[i].path);
 }
 
 namespace detail {
@@ -358,29 +361,47 @@ inline void removeWrittenOutputs() {
 /// away (two runs at once left one job's path.cl beside the other's report.json and path.apt,
 /// both exiting 0; a failed one took the other's new path.cl away: a helper's finding). An
 /// advisory lock (flock) on the folder itself: no lock file, released by the kernel when the
-/// process ends however it ends. Where the file system has no locks, runs are not kept apart.
+/// process ends however it ends. Where the folder cannot be locked (NFS takes no exclusive flock
+/// on a directory) a note says runs are not kept apart there.
 inline void lockOutputDirectory(const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path key = fs::weakly_canonical(fs::absolute(dir, ec), ec);
   for (const fs::path& held : detail::locked_directories)
     if (held == key) return;
-  if (!fs::exists(dir, ec)) {
-    createOutputDirectory(dir);
-    detail::listInSlots(&detail::created_directory, 1, fs::absolute(dir, ec).string());
+  // Made here only by the run that makes it (two runs starting together both saw it missing: the
+  // one whose lock then failed removed the other's folder).
+  std::vector<fs::path> made;  // outermost first
+  const fs::path full = fs::absolute(dir, ec);
+  std::vector<fs::path> missing;
+  for (fs::path at = full; !at.empty() && !fs::exists(at, ec) && at != at.parent_path();
+       at = at.parent_path())
+    missing.insert(missing.begin(), at);
+  for (const fs::path& at : missing) {
+    if (fs::create_directory(at, ec)) made.push_back(at);
+    if (ec) throw InputError(dir.string() + ": cannot create the directory: " + ec.message());
   }
   const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) return;
-  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
-    const int error = errno;
+  const int error = fd < 0 ? errno : ::flock(fd, LOCK_EX | LOCK_NB) != 0 ? errno : 0;
+  if (error == EWOULDBLOCK) {
     ::close(fd);
-    if (error == EWOULDBLOCK)
-      throw InputError(dir.string() +
-                       ": another fieldpath run is writing this folder; wait for it to end, "
-                       "or choose another folder");
-    return;
+    throw InputError(dir.string() +
+                     ": another fieldpath run is writing this folder; wait for it to end, or "
+                     "choose another folder");
   }
-  detail::locked_directories.push_back(key);  // the descriptor stays open: the lock with it
+  if (error != 0) {
+    if (fd >= 0) ::close(fd);
+    std::fprintf(stderr,
+                 "note: %s: the folder cannot be locked here (%s): runs writing it at the same "
+                 "time are not kept apart\n",
+                 dir.c_str(), detail::systemReason(error).c_str());
+  } else {
+    detail::locked_directories.push_back(key);  // the descriptor stays open: the lock with it
+  }
+  // Removed again on failure only by the run that made them and held the folder.
+  if (error == 0)
+    for (const fs::path& at : made)
+      detail::listInSlots(detail::created_directories, detail::kCreatedSlots, at.string());
 }
 
 /// The files `names` in `dir` are this command's outputs: a run that fails (exit 1 or 2) removes
@@ -421,7 +442,7 @@ inline void refuseOutputsOverInputs(const std::filesystem::path& dir,
 inline void releaseClaimedOutputs() {
   const std::lock_guard<std::mutex> lock(detail::written_mutex);
   for (auto& slot : detail::claimed_slots) slot.state.store(0);
-  detail::created_directory.state.store(0);
+  for (auto& slot : detail::created_directories) slot.state.store(0);
   detail::claimed_outputs.clear();
 }
 

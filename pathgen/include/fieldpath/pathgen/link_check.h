@@ -85,6 +85,10 @@ std::optional<LinkPartResult> checkHolderAgainstPart(
 struct PartContacts {
   std::optional<LinkPartResult> links, holder;
   std::optional<CutterPartResult> cutter;
+  /// A ball end mill: the least distance (mm) from its ball at the passes' postures to the part,
+  /// exact under kReachesPartMm (a lower bound above it): whether the tool reaches the part
+  /// where the Z-buffer, looking down, may see no line (a wall finished with a tilted ball).
+  std::optional<double> ball_part_mm;
   /// Per posture of a path of n: 1 where the links, the holder or the cutter touch the part there
   /// (posture) or on the motion to the next (motion), from the results' contact lists.
   struct Marks {
@@ -92,6 +96,8 @@ struct PartContacts {
   };
   Marks marks(std::size_t n) const;
 };
+/// The ball within this of the part (mm) reaches it: the mesh's chord on a fine part.
+inline constexpr double kReachesPartMm = 0.05;
 PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
                               const geometry::TriangleMesh& part, const geometry::PathFile& path,
                               double gouge_tolerance_mm = kGougeToleranceMm,
