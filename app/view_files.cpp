@@ -193,10 +193,23 @@ ViewSurface readSurface(const fs::path& dir, const Scene& scene, std::size_t max
   const std::size_t lines = s.grid.lineCount();
   s.height_mm.assign(lines, NAN);
   s.value.assign(lines, NAN);
-  std::vector<float> top, top_nz;  // the part's top per block, and its facet's normal's z there
+  std::vector<float> top;  // the part's top per block
+  // A check's line no pass cut keeps the stock allowance, told along its facet's normal: 2000
+  // cos(slope) um (on a 45° slope 1414: the page showed such lines as stock beside the band, a
+  // reviewer's finding). Each line by its own facet (a block's centre misread a curved part).
+  std::vector<char> line_uncut;
   if (scene.part) {
     const zbuffer::ToolMesh part = toZbuffer(*scene.part);
-    top = zbuffer::partTop(s.grid, part.vertices, part.triangles, &top_nz);
+    top = zbuffer::partTop(s.grid, part.vertices, part.triangles);
+    if (deviation) {
+      std::vector<float> nz;
+      const std::vector<float> source_top =
+          zbuffer::partTop(source, part.vertices, part.triangles, &nz);
+      line_uncut.assign(values.size(), 0);
+      for (std::size_t i = 0; i < values.size(); ++i)
+        line_uncut[i] =
+            std::isfinite(source_top[i]) && values[i] >= 0.99f * kStockAllowanceMm * 1e3f * nz[i];
+    }
   }
   // Lines no pass cut keep simulate's stock: its plane (simulate.json `stock.plane_mm`, stored
   // as the heights are, in float: a line at it was never lowered), or the part's top (`--part`:
@@ -230,10 +243,16 @@ ViewSurface readSurface(const fs::path& dir, const Scene& scene, std::size_t max
   for (int by = 0; by < s.grid.ny; ++by)
     for (int bx = 0; bx < s.grid.nx; ++bx) {
       float lo = INFINITY, hi = -INFINITY;
+      bool cut = false;  // a check's block: some line of it cut (its figures are those lines')
       for (int iy = by * k; iy < std::min(source.ny, (by + 1) * k); ++iy)
         for (int ix = bx * k; ix < std::min(source.nx, (bx + 1) * k); ++ix) {
-          const float v = values[std::size_t(iy) * source.nx + ix];
+          const std::size_t i = std::size_t(iy) * source.nx + ix;
+          const float v = values[i];
           if (std::isnan(v)) continue;
+          const bool uncut_line = !line_uncut.empty() && line_uncut[i];
+          if (cut && uncut_line) continue;
+          if (!cut && !uncut_line && !line_uncut.empty()) lo = INFINITY, hi = -INFINITY;
+          cut = cut || !uncut_line;
           lo = std::min(lo, v);
           hi = std::max(hi, v);
         }
@@ -241,12 +260,8 @@ ViewSurface readSurface(const fs::path& dir, const Scene& scene, std::size_t max
       const std::size_t b = std::size_t(by) * s.grid.nx + bx;
       if (deviation) {
         const float dev = lo < -gouge_tolerance_um ? lo : hi;
-        s.value[b] = dev;
+        s.value[b] = cut ? dev : kUncut;
         s.height_mm[b] = top[b] + dev * 1e-3f;  // NaN where the block centre misses the part
-        // Not cut: the stock allowance, told along the normal (on a 45° slope 1414 um: the
-        // page showed such blocks as stock beside the band, a reviewer's finding).
-        if (std::isfinite(top[b]) && lo >= 0.99f * kStockAllowanceMm * 1e3f * top_nz[b])
-          s.value[b] = kUncut;
       } else {
         s.height_mm[b] = lo;
         s.value[b] = uncut(lo, b) ? kUncut : scene.part ? (lo - top[b]) * 1e3f : lo;

@@ -21,6 +21,10 @@ constexpr double kRepeatMm = 1e-9;
 /// over a sloped floor (and +-1e-17 of rounding at 90): a helper's contour loops in one block
 /// were cut at random corners (23 uneven pieces, the frame turned at each).
 constexpr double kTurnBackCos = -0.5;
+/// A centre step under this fraction of the block's median is no feed direction: an axis swivelled
+/// about a steady ball centre, written to 6 decimals, moves the centre a few nm in any direction
+/// (a helper's swivel read as the feed turning back, and left "a pass of a single posture").
+constexpr double kFeedNoise = 1e-3;
 /// How many feed directions the turn-back test remembers (repeats skipped).
 constexpr std::size_t kRecentSteps = 3;
 /// A step-over step runs within 60 deg of square to the leg: |cos| under cos 30 deg.
@@ -62,6 +66,7 @@ class BlockSplitter {
       if (const double d = tipStep(i); d > kRepeatMm) tip_steps.push_back(d);
     }
     gap_mm_ = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(steps);
+    feed_min_mm_ = std::max(kRepeatMm, kFeedNoise * median(steps));
     tip_gap_mm_ = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(tip_steps);
   }
 
@@ -82,7 +87,7 @@ class BlockSplitter {
         // swing along the feed read as a turn back and left a pass of one posture)
         continue;
       }
-      if (step.norm() <= kRepeatMm) continue;
+      if (step.norm() <= feed_min_mm_) continue;
       if (turn_ && continueTurn(i, step)) continue;
       if (startsTurn(i, step)) continue;
       feed(i, step);
@@ -230,6 +235,7 @@ class BlockSplitter {
   double radius_mm_;
   Ranges& out_;
   double gap_mm_ = 0.0, tip_gap_mm_ = 0.0;
+  double feed_min_mm_ = kRepeatMm;  // shorter centre steps give no feed direction (kFeedNoise)
   std::size_t begin_;         ///< first posture of the pass under way
   std::vector<Vec3> recent_;  ///< the last kRecentSteps feed steps of the pass under way
   std::optional<Turn> turn_;

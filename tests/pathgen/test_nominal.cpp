@@ -169,6 +169,18 @@ TEST(PathBlocks, GapsSplitPassesAtFourMedianSteps) {
   const std::string m =
       errorOf([&] { nominalPasses(geometry::readPathFile(dir.write("flip6.cl", flip)), {}, kR); });
   EXPECT_NE(m.find("flip6.cl:7: the tool axis turns 180 deg"), std::string::npos) << m;
+  // A swivel about a steady ball centre in mid-pass (15°, 30°, 45°), written to 6 decimals: the
+  // centre moves a few nm up, then down, which read as the feed turning back and left "pass 2
+  // has a single posture" (a helper's lines). One pass.
+  std::string swivel;
+  for (int k = 0; k <= 6; ++k) swivel += std::to_string(-3.0 + 0.5 * k) + " 0 0 0 0 1\n";
+  swivel +=
+      "0.000000 0.776457 0.102223 0.000000 -0.258819 0.965926\n"
+      "0.000000 1.500000 0.401924 0.000000 -0.500000 0.866025\n"
+      "0.000000 2.121320 0.878680 0.000000 -0.707107 0.707107\n";
+  for (int k = 1; k <= 6; ++k)
+    swivel += std::to_string(0.5 * k) + " 2.121320 0.878680 0.000000 -0.707107 0.707107\n";
+  EXPECT_EQ(passRanges(geometry::readPathFile(dir.write("swivel.cl", swivel)), 0.0, kR).size(), 1u);
 }
 
 TEST(NominalPasses, FramesFollowThePolylineAndKeepPosturesOneForOne) {
