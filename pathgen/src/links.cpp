@@ -31,18 +31,26 @@ Posture at(const Vec3& tip, const Vec3& axis) {
   return p;
 }
 
-/// Distance along `axis` from `tip` to where the tip reaches `z_mm` (never less than `retract`).
-double climb(const Posture& p, double z_mm, double retract_mm, const char* which, int pass) {
-  if (p.axis.z() < kMinAxisRise) {
+/// Where a link leaving posture p (or entering it) meets the travel plane, the tip at `z_mm`:
+/// along its axis (DESIGN), never nearer than `retract`; an axis within 5° of horizontal (side
+/// milling, a wall finished with the ball: the climb along it ran hundreds of mm sideways, or
+/// never rose, and the job was refused), `retract` along it, then straight up. An axis below
+/// horizontal is left from beneath (an undercut): no link from above reaches it.
+Vec3 travelPoint(const Posture& p, double z_mm, double retract_mm, const char* which, int pass) {
+  if (p.axis.z() >= kMinAxisRise)
+    return p.tip_mm + std::max(retract_mm, (z_mm - p.tip_mm.z()) / p.axis.z()) * p.axis;
+  if (p.axis.z() < -kMinAxisRise) {
     std::ostringstream msg;
     msg.precision(3);
     msg << "links: pass " << pass << " " << which << " with the tool axis "
         << std::acos(std::clamp(p.axis.z(), -1.0, 1.0)) * 180.0 / M_PI
-        << " deg from vertical: it cannot be " << (which[0] == 'e' ? "left" : "entered")
-        << " along its axis from the travel plane (links.safe_z)";
+        << " deg from vertical, pointing down: no link from the travel plane above reaches it "
+           "(write its links in the nominal path and run `check` on it)";
     throw InputError(msg.str());
   }
-  return std::max(retract_mm, (z_mm - p.tip_mm.z()) / p.axis.z());
+  Vec3 up = p.tip_mm + retract_mm * p.axis;
+  up.z() = std::max(up.z(), z_mm);
+  return up;
 }
 
 }  // namespace
@@ -122,14 +130,12 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
     const Vec3 from_axis = k == 0 ? first.axis : passes[k - 1].back().axis;
     const double z = travelTipZ(from_axis, first.axis);
     if (k == 0) {
-      const double down = climb(first, z, params.retract_mm, "starts", number);
-      add(link, at(first.tip_mm + down * first.axis, first.axis));
+      add(link, at(travelPoint(first, z, params.retract_mm, "starts", number), first.axis));
     } else {
       const Posture& last = passes[k - 1].back();
-      const double up = climb(last, z, params.retract_mm, "ends", number - 1);
-      const double down = climb(first, z, params.retract_mm, "starts", number);
       add(link, at(last.tip_mm + params.retract_mm * last.axis, last.axis));
-      const Vec3 a = last.tip_mm + up * last.axis, b = first.tip_mm + down * first.axis;
+      const Vec3 a = travelPoint(last, z, params.retract_mm, "ends", number - 1);
+      const Vec3 b = travelPoint(first, z, params.retract_mm, "starts", number);
       const double turn_deg =
           std::acos(std::clamp(last.axis.dot(first.axis), -1.0, 1.0)) * 180.0 / M_PI;
       const int steps = std::max(1, static_cast<int>(std::ceil(turn_deg / kMaxLinkTurnDeg)));
@@ -143,12 +149,11 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
   }
   // Departure: back along the last axis to the travel plane.
   if (!out.postures.empty()) {
-    const Posture& last = out.postures.back();
-    const Posture final_posture = last;
-    const double up = climb(final_posture, travelTipZ(final_posture.axis, final_posture.axis),
-                            params.retract_mm, "ends", static_cast<int>(passes.size()));
+    const Posture final_posture = out.postures.back();
+    const Vec3 up = travelPoint(final_posture, travelTipZ(final_posture.axis, final_posture.axis),
+                                params.retract_mm, "ends", static_cast<int>(passes.size()));
     add(link, at(final_posture.tip_mm + params.retract_mm * final_posture.axis, final_posture.axis));
-    add(link, at(final_posture.tip_mm + up * final_posture.axis, final_posture.axis));
+    add(link, at(up, final_posture.axis));
   }
   return out;
 }

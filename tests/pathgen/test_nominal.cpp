@@ -294,6 +294,49 @@ TEST(Links, LeaveAlongTheAxisTravelAboveSafeZAndTurnInSmallSteps) {
   EXPECT_NEAR((out.postures[middle.begin].tip_mm - (passes[0].back().tip_mm + 10 * tilted)).norm(), 0, 1e-12);
 }
 
+// An axis within 5° of horizontal (a wall finished with the ball's side): no climb along it
+// reaches the travel plane (the job was refused; at 84.9° the climb ran 446 mm sideways). The
+// link leaves `retract` along the axis, then straight up, and comes down the same way; an axis
+// pointing down is refused, saying how to proceed.
+TEST(Links, AHorizontalAxisIsLeftStraightUpAfterItsRetract) {
+  geometry::ToolSpec tool{geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
+  const geometry::HolderProfile holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
+  const Eigen::Vector3d side = Eigen::Vector3d(1, 0, 0.02).normalized();  // 88.9° from vertical
+  std::vector<std::vector<Posture>> passes(2);
+  for (int i = 0; i <= 4; ++i) {
+    passes[0].push_back({Eigen::Vector3d(0, i, 0), side, 0.0, false});
+    passes[1].push_back({Eigen::Vector3d(0, 4 - i, -5), side, 0.0, false});
+  }
+  LinkRequest request;
+  request.safe_z_mm = 60.0;
+  request.tool = tool;
+  request.holder = holder;
+  request.params.retract_mm = 10.0;
+  const PathFile out = linkPasses(passes, request);
+  ASSERT_EQ(out.blocks.size(), 5u);
+  const PathBlock& middle = out.blocks[2];
+  const Posture& retracted = out.postures[middle.begin];
+  EXPECT_NEAR((retracted.tip_mm - (passes[0].back().tip_mm + 10 * side)).norm(), 0, 1e-12);
+  const Posture& risen = out.postures[middle.begin + 1];  // straight up from the retract
+  EXPECT_NEAR(risen.tip_mm.x(), retracted.tip_mm.x(), 1e-12);
+  EXPECT_NEAR(risen.tip_mm.y(), retracted.tip_mm.y(), 1e-12);
+  EXPECT_GE(risen.tip_mm.z() + lowestPointBelowTip(tool, holder, side), 60.0 - 1e-9);
+  const Posture& above = out.postures[middle.end - 2];  // over the next pass's retract point
+  const Posture& entry = out.postures[middle.end - 1];
+  EXPECT_NEAR((entry.tip_mm - (passes[1].front().tip_mm + 10 * side)).norm(), 0, 1e-12);
+  EXPECT_NEAR((above.tip_mm - entry.tip_mm).head<2>().norm(), 0, 1e-12);
+  for (std::size_t i = 1; i < out.postures.size(); ++i)  // nothing runs hundreds of mm aside
+    EXPECT_LT((out.postures[i].tip_mm - out.postures[i - 1].tip_mm).head<2>().norm(), 20.0) << i;
+  // Pointing down (an undercut): refused, saying how to proceed.
+  for (Posture& p : passes[1]) p.axis = Eigen::Vector3d(1, 0, -0.3).normalized();
+  const std::string error = errorOf([&] { linkPasses(passes, request); });
+  EXPECT_NE(error.find("links: pass 2 starts with the tool axis 107 deg from vertical, pointing "
+                       "down: no link from the travel plane above reaches it (write its links in "
+                       "the nominal path and run `check` on it)"),
+            std::string::npos)
+      << error;
+}
+
 TEST(Motions, AThinWallBetweenTwoClearPosturesIsACollidingMotion) {
   // A wall 0.2 mm thick (x in [4.9, 5.1]), 10 mm high; the tool jumps over it from x = 0 to 10 at
   // a height where the ball goes through it, both ends 4.9 - 3 = 1.9 mm clear.
