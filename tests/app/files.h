@@ -1,5 +1,7 @@
 #pragma once
 /// Scratch folders, files and runs of `fieldpath` for the app tests.
+#include <array>
+#include <sstream>
 #include <string>
 
 #include "run_fieldpath.h"
@@ -22,6 +24,31 @@ inline std::string squareStl(double a, double z = 0.0) {
   };
   return "solid square\n" + facet(v(-a, -a), v(a, -a), v(a, a)) +
          facet(v(-a, -a), v(a, a), v(-a, a)) + "endsolid square\n";
+}
+
+/// ASCII STL of the closed box [x0, x1] × [y0, y1] × [z0, z1], outward normals.
+inline std::string boxStl(double x0, double y0, double z0, double x1, double y1, double z1) {
+  const double x[2] = {x0, x1}, y[2] = {y0, y1}, z[2] = {z0, z1};
+  auto v = [&](int i, int j, int k) {
+    std::ostringstream s;
+    s << "   vertex " << x[i] << ' ' << y[j] << ' ' << z[k] << '\n';
+    return s.str();
+  };
+  // Each face as four corners, counter-clockwise seen from outside.
+  const int faces[6][4][3] = {{{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}},   // z0
+                              {{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}},   // z1
+                              {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}},   // y0
+                              {{0, 1, 0}, {0, 1, 1}, {1, 1, 1}, {1, 1, 0}},   // y1
+                              {{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}},   // x0
+                              {{1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1}}};  // x1
+  std::string text = "solid box\n";
+  for (const auto& f : faces)
+    for (const auto& t : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
+      text += " facet normal 0 0 0\n  outer loop\n";
+      for (int c : t) text += v(f[c][0], f[c][1], f[c][2]);
+      text += "  endloop\n endfacet\n";
+    }
+  return text + "endsolid box\n";
 }
 
 /// A small impeller job (part of one channel, three passes, a coarse solver): generate, study

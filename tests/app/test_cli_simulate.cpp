@@ -187,6 +187,38 @@ TEST(CliSimulate, ASurfaceStlFarFromTheOriginIsSaidToBeCoarse) {
   EXPECT_NE(stl.err.find("surface.stl needs 2 lines each way"), std::string::npos) << stl.err;
 }
 
+// A tool under a shelf of --part (a plate, and a shelf 8 mm over it): the Z-buffer keeps each
+// line's lowest cut, so the surface shows the shelf cut through there; said (a helper's
+// mushroom: its cap read cut from 30 to 12.6 mm, silently). A pass clear of the shelf: no word.
+TEST(CliSimulate, ACutBeneathAnOverhangOfThePartIsSaid) {
+  const TempDir dir;
+  const std::string plate = boxStl(-10, -15, -5, 30, 15, 0), shelf = boxStl(-10, 5, 8, 30, 15, 10);
+  const auto body = [](const std::string& solid) {  // between `solid box` and `endsolid`
+    const std::size_t from = solid.find('\n') + 1;
+    return solid.substr(from, solid.rfind("endsolid") - from);
+  };
+  dir.write("part.stl", "solid part\n" + body(plate) + body(shelf) + "endsolid part\n");
+  const double tilt = 60.0 * M_PI / 180.0, ay = -std::sin(tilt), az = std::cos(tilt);
+  const auto pass = [&](double centre_y) {  // the ball's centre at z 3 (on the plate), tilted 60°
+    std::string cl = "# pass 1\n";
+    for (int i = 0; i <= 40; ++i)
+      cl += std::to_string(0.5 * i) + ' ' + std::to_string(centre_y - 3.0 * ay) + ' ' +
+            std::to_string(3.0 - 3.0 * az) + " 0 " + std::to_string(ay) + ' ' + std::to_string(az) +
+            '\n';
+    return cl;
+  };
+  dir.write("under.cl", pass(6.0));
+  dir.write("open.cl", pass(-8.0));
+  const std::string args = "simulate --tool ball:3:40 --grid 200x200 --part part.stl --out ";
+  const Outcome under = runFieldpath(dir, args + "u --path under.cl");
+  ASSERT_EQ(under.exit_code, 0) << under.output();
+  EXPECT_NE(under.err.find("lines were cut beneath the top layer of --part"), std::string::npos)
+      << under.err;
+  const Outcome clear = runFieldpath(dir, args + "o --path open.cl");
+  ASSERT_EQ(clear.exit_code, 0) << clear.output();
+  EXPECT_EQ(clear.err.find("beneath the top layer"), std::string::npos) << clear.err;
+}
+
 TEST(CliSimulate, BadInputIsExitOneWithOneLineAndNoOutputs) {
   const TempDir dir;
   dir.write("path.cl", "0 0 0 0 0 1\n");

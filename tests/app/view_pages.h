@@ -18,6 +18,7 @@ namespace fieldpath::app::test::view {
 namespace fs = std::filesystem;
 using nlohmann::json;
 // What the tests call from files.h, brought in with this namespace.
+using fieldpath::app::test::boxStl;
 using fieldpath::app::test::Outcome;
 using fieldpath::app::test::runFieldpath;
 using fieldpath::app::test::slurp;
@@ -26,31 +27,6 @@ using fieldpath::app::test::TempDir;
 
 inline const fs::path kImpellerScene =
     fs::path(FIELDPATH_SOURCE_DIR) / "examples/impeller/scene.yaml";
-
-/// ASCII STL of the closed box [x0, x1] × [y0, y1] × [z0, z1], outward normals.
-inline std::string boxStl(double x0, double y0, double z0, double x1, double y1, double z1) {
-  const double x[2] = {x0, x1}, y[2] = {y0, y1}, z[2] = {z0, z1};
-  auto v = [&](int i, int j, int k) {
-    std::ostringstream s;
-    s << "   vertex " << x[i] << ' ' << y[j] << ' ' << z[k] << '\n';
-    return s.str();
-  };
-  // Each face as four corners, counter-clockwise seen from outside.
-  const int faces[6][4][3] = {{{0, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}},   // z0
-                              {{0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}},   // z1
-                              {{0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}},   // y0
-                              {{0, 1, 0}, {0, 1, 1}, {1, 1, 1}, {1, 1, 0}},   // y1
-                              {{0, 0, 0}, {0, 0, 1}, {0, 1, 1}, {0, 1, 0}},   // x0
-                              {{1, 0, 0}, {1, 1, 0}, {1, 1, 1}, {1, 0, 1}}};  // x1
-  std::string text = "solid box\n";
-  for (const auto& f : faces)
-    for (const auto& t : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
-      text += " facet normal 0 0 0\n  outer loop\n";
-      for (int c : t) text += v(f[c][0], f[c][1], f[c][2]);
-      text += "  endloop\n endfacet\n";
-    }
-  return text + "endsolid box\n";
-}
 
 /// Two passes along x (y = 0 through the block, y = 8 beside it) joined by a link; one `# limit`.
 inline std::string pathCl(double shift_mm = 0) {
