@@ -13,6 +13,9 @@ using common::InputError;
 using geometry::PathBlock;
 using geometry::Posture;
 
+/// An axis lower than this (its z component) points down: sin 0.06°, past a horizontal axis's
+/// rounding (one a little below horizontal was taken, and a link's turn hung the tool upside down).
+constexpr double kHorizontalZ = 1e-3;
 /// An axis must rise at least this much (its z component) to be left along: sin 5°.
 constexpr double kMinAxisRise = 0.0872;
 
@@ -23,6 +26,35 @@ Vec3 slerp(const Vec3& a, const Vec3& b, double t) {
   const double sa = std::sin(angle);
   return (std::sin((1 - t) * angle) / sa * a + std::sin(t * angle) / sa * b).normalized();
 }
+
+/// A link's turn of the axis from a to b: the great-circle arc, or, where that arc is undefined
+/// or dips below both ends (opposite axes: both sides of a rib milled with the ball's side; a
+/// reviewer's link wrote axes of 0 0 0, or hung the tool upside down), the two arcs through +z.
+class AxisTurn {
+ public:
+  AxisTurn(const Vec3& a, const Vec3& b) : a_(a), b_(b) {
+    via_up_ = a.dot(b) < -0.9999 || slerp(a, b, 0.5).z() < std::min(a.z(), b.z()) - 1e-12;
+    first_rad_ = via_up_ ? angle(a, Vec3::UnitZ()) : angle(a, b);
+    total_rad_ = first_rad_ + (via_up_ ? angle(Vec3::UnitZ(), b) : 0.0);
+  }
+  double degrees() const { return total_rad_ * 180.0 / M_PI; }
+  /// The axis at fraction t of the turn (by angle).
+  Vec3 at(double t) const {
+    if (!via_up_) return slerp(a_, b_, t);
+    const double s = t * total_rad_;
+    if (s <= first_rad_) return first_rad_ > 0.0 ? slerp(a_, Vec3::UnitZ(), s / first_rad_) : a_;
+    const double second = total_rad_ - first_rad_;
+    return second > 0.0 ? slerp(Vec3::UnitZ(), b_, (s - first_rad_) / second) : b_;
+  }
+
+ private:
+  static double angle(const Vec3& u, const Vec3& v) {
+    return std::acos(std::clamp(u.dot(v), -1.0, 1.0));
+  }
+  Vec3 a_, b_;
+  bool via_up_ = false;
+  double first_rad_ = 0.0, total_rad_ = 0.0;
+};
 
 Posture at(const Vec3& tip, const Vec3& axis) {
   Posture p;
@@ -39,7 +71,7 @@ Posture at(const Vec3& tip, const Vec3& axis) {
 Vec3 travelPoint(const Posture& p, double z_mm, double retract_mm, const char* which, int pass) {
   if (p.axis.z() >= kMinAxisRise)
     return p.tip_mm + std::max(retract_mm, (z_mm - p.tip_mm.z()) / p.axis.z()) * p.axis;
-  if (p.axis.z() < -kMinAxisRise) {
+  if (p.axis.z() < -kHorizontalZ) {
     std::ostringstream msg;
     msg.precision(3);
     msg << "links: pass " << pass << " " << which << " with the tool axis "
@@ -115,8 +147,10 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
   // holder stay above safe_z at every axis on the way.
   auto travelTipZ = [&](const Vec3& a, const Vec3& b) {
     double lowest = 0.0;
+    const AxisTurn turn(a, b);
     for (int k = 0; k <= 32; ++k)
-      lowest = std::min(lowest, lowestPointBelowTip(request.tool, request.holder, slerp(a, b, k / 32.0)));
+      lowest =
+          std::min(lowest, lowestPointBelowTip(request.tool, request.holder, turn.at(k / 32.0)));
     return request.safe_z_mm - lowest;
   };
   const auto link = PathBlock::Kind::Link;
@@ -136,12 +170,11 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
       add(link, at(last.tip_mm + params.retract_mm * last.axis, last.axis));
       const Vec3 a = travelPoint(last, z, params.retract_mm, "ends", number - 1);
       const Vec3 b = travelPoint(first, z, params.retract_mm, "starts", number);
-      const double turn_deg =
-          std::acos(std::clamp(last.axis.dot(first.axis), -1.0, 1.0)) * 180.0 / M_PI;
-      const int steps = std::max(1, static_cast<int>(std::ceil(turn_deg / kMaxLinkTurnDeg)));
+      const AxisTurn turn(last.axis, first.axis);
+      const int steps = std::max(1, static_cast<int>(std::ceil(turn.degrees() / kMaxLinkTurnDeg)));
       for (int j = 0; j <= steps; ++j) {
         const double t = static_cast<double>(j) / steps;
-        add(link, at((1 - t) * a + t * b, slerp(last.axis, first.axis, t)));
+        add(link, at((1 - t) * a + t * b, turn.at(t)));
       }
     }
     add(link, at(first.tip_mm + params.retract_mm * first.axis, first.axis));

@@ -136,10 +136,22 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
   for (const auto& [begin, end] : ranges) {
     const int number = static_cast<int>(passes.size()) + 1;
     // Distinct postures of the pass (consecutive repeats of a ball centre dropped).
+    // A swivel about a steady centre, written to a few decimals, moves it by its rounding only:
+    // the same place (its steps' directions are noise, and turned the frames 90°).
+    std::vector<double> steps;
+    for (std::size_t i = begin + 1; i < end; ++i)
+      if (const double d = (geometry::ballCentre(path.postures[i], r) -
+                            geometry::ballCentre(path.postures[i - 1], r))
+                               .norm();
+          d > kRepeatMm)
+        steps.push_back(d);
+    std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+    const double repeat_mm = centreNoiseMm(steps.empty() ? 0.0 : steps[steps.size() / 2]);
     std::vector<std::size_t> kept;
     for (std::size_t i = begin; i < end; ++i) {
       const Vec3 c = geometry::ballCentre(path.postures[i], r);
-      if (!kept.empty() && (c - geometry::ballCentre(path.postures[kept.back()], r)).norm() <= kRepeatMm) {
+      if (!kept.empty() &&
+          (c - geometry::ballCentre(path.postures[kept.back()], r)).norm() <= repeat_mm) {
         ++said.repeated;
         continue;
       }

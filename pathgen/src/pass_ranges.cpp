@@ -21,10 +21,6 @@ constexpr double kRepeatMm = 1e-9;
 /// over a sloped floor (and +-1e-17 of rounding at 90): a helper's contour loops in one block
 /// were cut at random corners (23 uneven pieces, the frame turned at each).
 constexpr double kTurnBackCos = -0.5;
-/// A centre step under this fraction of the block's median is no feed direction: an axis swivelled
-/// about a steady ball centre, written to 6 decimals, moves the centre a few nm in any direction
-/// (a helper's swivel read as the feed turning back, and left "a pass of a single posture").
-constexpr double kFeedNoise = 1e-3;
 /// How many feed directions the turn-back test remembers (repeats skipped).
 constexpr std::size_t kRecentSteps = 3;
 /// A step-over step runs within 60 deg of square to the leg: |cos| under cos 30 deg.
@@ -38,6 +34,14 @@ double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   return values.empty() ? 0.0 : values[values.size() / 2];
 }
+
+}  // namespace
+
+double centreNoiseMm(double median_step_mm) {
+  return std::max(kRepeatMm, std::min(1e-3 * median_step_mm, 1e-3));
+}
+
+namespace {
 
 /// Cuts one pass block into posture ranges [begin, end):
 /// - at a gap: two consecutive tips (and ball centres) farther apart than the gap;
@@ -66,7 +70,7 @@ class BlockSplitter {
       if (const double d = tipStep(i); d > kRepeatMm) tip_steps.push_back(d);
     }
     gap_mm_ = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(steps);
-    feed_min_mm_ = std::max(kRepeatMm, kFeedNoise * median(steps));
+    feed_min_mm_ = centreNoiseMm(median(steps));
     tip_gap_mm_ = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(tip_steps);
   }
 
@@ -235,7 +239,7 @@ class BlockSplitter {
   double radius_mm_;
   Ranges& out_;
   double gap_mm_ = 0.0, tip_gap_mm_ = 0.0;
-  double feed_min_mm_ = kRepeatMm;  // shorter centre steps give no feed direction (kFeedNoise)
+  double feed_min_mm_ = kRepeatMm;  // shorter centre steps give no feed direction (centreNoiseMm)
   std::size_t begin_;         ///< first posture of the pass under way
   std::vector<Vec3> recent_;  ///< the last kRecentSteps feed steps of the pass under way
   std::optional<Turn> turn_;

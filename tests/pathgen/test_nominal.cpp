@@ -180,7 +180,16 @@ TEST(PathBlocks, GapsSplitPassesAtFourMedianSteps) {
       "0.000000 2.121320 0.878680 0.000000 -0.707107 0.707107\n";
   for (int k = 1; k <= 6; ++k)
     swivel += std::to_string(0.5 * k) + " 2.121320 0.878680 0.000000 -0.707107 0.707107\n";
-  EXPECT_EQ(passRanges(geometry::readPathFile(dir.write("swivel.cl", swivel)), 0.0, kR).size(), 1u);
+  const PathFile swivelled = geometry::readPathFile(dir.write("swivel.cl", swivel));
+  EXPECT_EQ(passRanges(swivelled, 0.0, kR).size(), 1u);
+  // ... and its frames run along the feed (+x) throughout: the swivel's postures are one place
+  // (the centre's nm steps turned the frames 90°, a reviewer's finding).
+  NominalDropped dropped;
+  const auto swivel_passes = nominalPasses(swivelled, {}, kR, &dropped);
+  ASSERT_EQ(swivel_passes.size(), 1u);
+  EXPECT_EQ(dropped.repeated, 3u);
+  for (const PassSample& sample : swivel_passes[0].samples)
+    EXPECT_GT(sample.feed.x(), 0.999) << sample.s_mm;
 }
 
 TEST(NominalPasses, FramesFollowThePolylineAndKeepPosturesOneForOne) {
@@ -327,7 +336,23 @@ TEST(Links, AHorizontalAxisIsLeftStraightUpAfterItsRetract) {
   EXPECT_NEAR((above.tip_mm - entry.tip_mm).head<2>().norm(), 0, 1e-12);
   for (std::size_t i = 1; i < out.postures.size(); ++i)  // nothing runs hundreds of mm aside
     EXPECT_LT((out.postures[i].tip_mm - out.postures[i - 1].tip_mm).head<2>().norm(), 20.0) << i;
-  // Pointing down (an undercut): refused, saying how to proceed.
+  // Both sides of a rib: the axis turns over from +x to -x through +z (the great circle between
+  // opposite axes is no arc: a reviewer's link wrote axes of 0 0 0), 5° a step at most.
+  std::vector<std::vector<Posture>> sides = passes;
+  for (Posture& p : sides[1]) p.axis = Eigen::Vector3d(-1, 0, 0);
+  for (Posture& p : sides[0]) p.axis = Eigen::Vector3d(1, 0, 0);
+  const PathFile over = linkPasses(sides, request);
+  for (std::size_t i = 1; i < over.postures.size(); ++i) {
+    const Eigen::Vector3d& axis = over.postures[i].axis;
+    EXPECT_NEAR(axis.norm(), 1.0, 1e-12) << i;
+    EXPECT_GE(axis.z(), -1e-12) << i;
+    EXPECT_LE(std::acos(std::min(1.0, axis.dot(over.postures[i - 1].axis))),
+              kMaxLinkTurnDeg * M_PI / 180 + 1e-9)
+        << i;
+  }
+  // Pointing down (an undercut), even a little: refused, saying how to proceed.
+  for (Posture& p : sides[1]) p.axis = Eigen::Vector3d(-1, 0, -0.05).normalized();
+  EXPECT_NE(errorOf([&] { linkPasses(sides, request); }).find("pointing down"), std::string::npos);
   for (Posture& p : passes[1]) p.axis = Eigen::Vector3d(1, 0, -0.3).normalized();
   const std::string error = errorOf([&] { linkPasses(passes, request); });
   EXPECT_NE(error.find("links: pass 2 starts with the tool axis 107 deg from vertical, pointing "

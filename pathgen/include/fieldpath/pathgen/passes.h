@@ -72,6 +72,14 @@ struct NominalDropped {
 std::vector<Pass> nominalPasses(const geometry::PathFile& path, const PathParams& params,
                                 double ball_radius_mm, NominalDropped* dropped = nullptr);
 
+/// Ball-centre steps no longer than this are no move of the feed, for a pass block whose median
+/// centre step is `median_step_mm`: 1e-3 of it, at most 1 µm. An axis swivelled about a steady
+/// centre, written to 4-6 decimals, moves the centre by nm-µm in any direction: read as the
+/// feed turning back it split the pass ("a single posture", a helper's), and as the feed's
+/// direction it turned the frames 90° (a reviewer's). At most 1 µm: a zig-zag's step-over of
+/// 50 µm between legs of 60 mm steps stays a move.
+double centreNoiseMm(double median_step_mm);
+
 /// Posture ranges [begin, end) of the passes of a path: its pass blocks (link blocks dropped),
 /// each split where two consecutive tips are farther apart than `pass_gap_mm` (0: 4 × the
 /// block's median tip step), as DESIGN reads a gap, and their ball centres (R = `ball_radius_mm`
