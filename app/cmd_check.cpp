@@ -96,6 +96,31 @@ std::string clearanceCsv(const geometry::PathFile& path, const pathgen::Clearanc
   return csv.str();
 }
 
+/// What `check` learned of the surface and the part, for surfaceSkipped.
+struct SurfaceFacts {
+  bool part = false;          ///< the scene has a part
+  bool surface = false;       ///< a surface was measured
+  bool never_cut = false;     ///< the Z-buffer lowered no line over the part
+  bool touches_part = false;  ///< the cutter enters the part (cutter_part)
+  bool reaches_part = false;  ///< the ball comes within kReachesPartMm of it
+};
+
+/// Why the surface was not checked (nullptr: it was), as check.json's surface_skipped says it.
+const char* surfaceSkipped(const SurfaceFacts& f) {
+  if (!f.part) return "the scene has no `part`";
+  if (f.never_cut && f.touches_part)
+    return "the tool lowers no line of the stock over the part (it enters the part where no "
+           "line falls: cutter_part)";
+  if (!f.surface && f.reaches_part)
+    return "the ball reaches the part where the Z-buffer, looking down, lowers no line (a wall "
+           "or an undercut): its gouges are cutter_part's, its scallop is not measured";
+  if (f.never_cut)
+    return "the tool never cuts the stock over the part (no line lowered): is the part in the "
+           "path's frame and units?";
+  if (!f.surface) return "the passes do not pass over the part (`part` mesh)";
+  return nullptr;
+}
+
 json surfaceJson(const SurfaceResult& s) {
   auto scallop = [&s](double um) { return s.band_lines > 0 ? json(um) : json(nullptr); };
   return {
@@ -269,18 +294,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     // helper's walls at 30-85 deg read "is the part in the path's frame?" and never ok).
     const bool reaches_part =
         contacts.ball_part_mm && *contacts.ball_part_mm <= pathgen::kReachesPartMm;
-    const char* surface_skipped =
-        !scene.part ? "the scene has no `part`"
-        : never_cut && touches_part
-            ? "the tool lowers no line of the stock over the part (it enters the part where no "
-              "line falls: cutter_part)"
-        : !surface && reaches_part
-            ? "the ball reaches the part where the Z-buffer, looking down, lowers no line (a wall "
-              "or an undercut): its gouges are cutter_part's, its scallop is not measured"
-        : never_cut ? "the tool never cuts the stock over the part (no line lowered): is the part "
-                      "in the path's frame and units?"
-        : !surface  ? "the passes do not pass over the part (`part` mesh)"
-                    : nullptr;
+    const char* surface_skipped = surfaceSkipped(
+        {scene.part.has_value(), surface.has_value(), never_cut, touches_part, reaches_part});
 
     // Why the check fails, one line each (empty: ok): the collisions of `unsafe`, a clearance
     // under the required one, and the gouges (a flank driven into a wall of the part is one).
