@@ -300,7 +300,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     // Why the check fails, one line each (empty: ok): the collisions of `unsafe`, a clearance
     // under the required one, and the gouges (a flank driven into a wall of the part is one).
     const std::optional<pathgen::CutterPartResult>& cutter_part = contacts.cutter;
-    std::vector<std::string> unsafe = unsafeReasons(clearance, motions, link_part, holder_part);
+    std::vector<std::string> unsafe =
+        unsafeReasons(path, clearance, motions, link_part, holder_part);
     const auto [rapids_onto_passes, first_rapid_onto_pass] = rapidsOntoPasses(path);
     if (rapids_onto_passes > 0)
       unsafe.push_back(std::to_string(rapids_onto_passes) +

@@ -36,6 +36,12 @@ namespace {
 
 using geometry::kRadToDeg;
 
+/// Said after an unsafe reason whose first posture or motion is a link's: generate made it, and
+/// these keys place it (the move along the axis, the travel plane).
+const std::string kLinkHint =
+    "generate's link: `links.retract` (along the axis) and `links.safe_z` (the travel plane) "
+    "place it";
+
 /// Removes `check --out`'s files from `out` where they checked the path.cl or path.apt this run
 /// replaces (check.json's path_digest is the file's): check.json's `"ok": true`, deviation.png
 /// and clearance.csv stayed beside a new path nobody had checked (a helper's finding). A check
@@ -130,7 +136,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
   }
   const auto& box = r.reach_box_mm;
   const std::vector<std::string> unsafe =
-      unsafeReasons(r.clearance, r.motions, r.link_part, r.holder_part);
+      unsafeReasons(r.path, r.clearance, r.motions, r.link_part, r.holder_part, kLinkHint);
   return {
       {"scene", scene.file.string()},
       {"field_mode", job.nominal ? "nominal" : pathgen::fieldModeNames(job.mode).id},
@@ -358,7 +364,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     const std::string what = job.nominal ? "nominal path" : "field path";
     // A path that collides is still written (to look at, and `check`), marked in both files.
     const std::vector<std::string> unsafe =
-        unsafeReasons(result.clearance, result.motions, result.link_part, result.holder_part);
+        unsafeReasons(result.path, result.clearance, result.motions, result.link_part,
+                      result.holder_part, kLinkHint);
     std::string unsafe_text;
     for (const std::string& reason : unsafe)
       unsafe_text += (unsafe_text.empty() ? "" : "; ") + reason;

@@ -183,38 +183,83 @@ inline std::string axisTurnWarning(const geometry::PathFile& path, const pathgen
          " deg between two postures of a pass)";
 }
 
+/// Where posture i lies, for a reason a user acts on: "posture i (pass K, FILE:LINE)", its block
+/// the pass (numbered from 1, as `# pass K`), the link into pass K or the link after the last
+/// pass, and its file line where the path was read from a file (a reviewer: "posture 5123" alone
+/// sent users counting through a 40 000-line file, and did not say the fault was a link's).
+inline std::string postureWhere(const geometry::PathFile& path, std::size_t i) {
+  std::string block;
+  std::size_t passes_before = 0;
+  for (const geometry::PathBlock& b : path.blocks) {
+    const bool pass = b.kind == geometry::PathBlock::Kind::Pass;
+    if (i >= b.begin && i < b.end) {
+      block = pass ? "pass " + std::to_string(passes_before + 1)
+              : passes_before == path.count(geometry::PathBlock::Kind::Pass)
+                  ? std::string("the link after the last pass")
+                  : "the link into pass " + std::to_string(passes_before + 1);
+      break;
+    }
+    passes_before += pass;
+  }
+  const std::string line = i < path.lines.size() ? path.where(i) : std::string();
+  const std::string sep = !block.empty() && !line.empty() ? ", " : "";
+  return "posture " + std::to_string(i) +
+         (block.empty() && line.empty() ? "" : " (" + block + sep + line + ")");
+}
+
+/// Whether posture i lies in a link block.
+inline bool inLink(const geometry::PathFile& path, std::size_t i) {
+  for (const geometry::PathBlock& b : path.blocks)
+    if (i >= b.begin && i < b.end) return b.kind == geometry::PathBlock::Kind::Link;
+  return false;
+}
+
 /// Why a path is not safe to run as it stands (empty: it is): postures or motions that touch an
 /// obstacle, links that touch the part, the holder touching the part. Postures numbered from 0,
-/// as in the JSON and clearance.csv; motion i from posture i to i + 1.
-inline std::vector<std::string> unsafeReasons(
-    const pathgen::ClearanceResult& c, const pathgen::MotionResult& m,
-    const std::optional<pathgen::LinkPartResult>& l,
-    const std::optional<pathgen::LinkPartResult>& h,
-    const std::optional<pathgen::CutterPartResult>& cut = std::nullopt) {
+/// as in the JSON and clearance.csv, with their block and line (postureWhere); motion i from
+/// posture i to i + 1, a link's when either end is (the retract and the plunge are). A reason
+/// whose first posture or motion is a link's ends with `link_hint` where one is given (`generate`
+/// made the links: it says which keys move them; `check` reads the user's).
+inline std::vector<std::string> unsafeReasons(const geometry::PathFile& path,
+                                              const pathgen::ClearanceResult& c,
+                                              const pathgen::MotionResult& m,
+                                              const std::optional<pathgen::LinkPartResult>& l,
+                                              const std::optional<pathgen::LinkPartResult>& h,
+                                              const std::string& link_hint = {}) {
   std::vector<std::string> out;
-  auto first = [](std::size_t i) { return std::to_string(i); };
+  auto posture = [&](std::size_t i) {
+    return postureWhere(path, i) + (inLink(path, i) && !link_hint.empty() ? ": " + link_hint : "");
+  };
+  auto motion = [&](std::size_t i) {
+    const bool link = inLink(path, i) || inLink(path, i + 1);
+    const std::size_t named = inLink(path, i + 1) || !link ? i + 1 : i;
+    std::string where = postureWhere(path, named);
+    // "posture i to the next (its block, line)": the block of the end that makes it a link's.
+    const std::size_t open = where.find(" (");
+    const std::string place = open == std::string::npos ? "" : where.substr(open);
+    return "posture " + std::to_string(i) + " to the next" + place +
+           (link && !link_hint.empty() ? ": " + link_hint : "");
+  };
   if (c.colliding)
-    out.push_back(std::to_string(c.colliding) + " postures touch an obstacle (first: posture " +
-                  first(c.first_colliding) + ")");
+    out.push_back(std::to_string(c.colliding) +
+                  " postures touch an obstacle (first: " + posture(c.first_colliding) + ")");
   if (m.colliding)
-    out.push_back(std::to_string(m.colliding) + " motions touch an obstacle (first: posture " +
-                  first(m.first_colliding) + " to the next)");
+    out.push_back(std::to_string(m.colliding) +
+                  " motions touch an obstacle (first: " + motion(m.first_colliding) + ")");
   if (l && l->colliding_postures)
-    out.push_back(std::to_string(l->colliding_postures) +
-                  " link postures touch the part (first: posture " +
-                  first(l->first_colliding_posture) + ")");
+    out.push_back(std::to_string(l->colliding_postures) + " link postures touch the part (first: " +
+                  posture(l->first_colliding_posture) + ")");
   if (l && l->colliding_motions)
-    out.push_back(std::to_string(l->colliding_motions) +
-                  " link motions touch the part (first: posture " +
-                  first(l->first_colliding_motion) + " to the next)");
+    out.push_back(std::to_string(l->colliding_motions) + " link motions touch the part (first: " +
+                  motion(l->first_colliding_motion) + ")");
   if (h && h->colliding_postures)
     out.push_back(std::to_string(h->colliding_postures) +
-                  " postures put the holder into the part (first: posture " +
-                  first(h->first_colliding_posture) + ")");
+                  " postures put the holder into the part (first: " +
+                  posture(h->first_colliding_posture) + ")");
   if (h && h->colliding_motions)
-    out.push_back(std::to_string(h->colliding_motions) +
-                  " motions put the holder into the part (first: posture " +
-                  first(h->first_colliding_motion) + " to the next)");
+    out.push_back(
+        std::to_string(h->colliding_motions) +
+        " motions put the holder into the part (first: " + motion(h->first_colliding_motion) + ")");
   return out;
 }
 

@@ -417,7 +417,8 @@ ViewData gatherView(const ViewRequest& request) {
       p.clearance_known = true;
     }
     if (check)
-      for (const std::string& reason : unsafeReasons({}, {}, check->link_part, check->holder_part))
+      for (const std::string& reason :
+           unsafeReasons(p.file, {}, {}, check->link_part, check->holder_part))
         d.warnings.push_back("UNSAFE TO RUN: " + reason);
     if (check)
       if (const std::string gouge = cutterGougeReason(check->cutter_part); !gouge.empty())

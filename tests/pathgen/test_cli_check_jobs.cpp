@@ -256,6 +256,50 @@ TEST(CheckClearance, UnsafeAndUnderTheClearanceAreBothMarked) {
   EXPECT_EQ(geometry::readPathFile(dir.path() / "out" / "path.cl").warnings.size(), 2u);
 }
 
+// An unsafe reason says where its first posture lies: its block (the link into pass K) and, for a
+// path read from a file, its line; generate adds which keys place its links. Two passes finishing
+// a wall with the axis horizontal under a bar: the approach comes straight down through the bar
+// (the reason said "posture 0 to the next", a user counted through path.cl to learn it was a
+// link's, and not what moves one).
+TEST(CheckClearance, AnUnsafeLinkIsNamedWithItsBlockAndTheKeysThatPlaceIt) {
+  const TempDir dir;
+  geometry::TriangleMesh bar, part;
+  pathgen::test::addBox(bar, 30, 200, -50, 50, 25, 30);
+  pathgen::test::addBox(part, -60, -3, -50, 50, -20, 20);
+  geometry::saveMesh(bar, dir.path() / "bar.stl");
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  std::string cl = "# pass 1\n";
+  for (int i = 0; i <= 10; ++i) cl += "-3 " + std::to_string(i) + " 0 1 0 0\n";
+  cl += "# pass 2\n";
+  for (int i = 10; i >= 0; --i) cl += "-3 " + std::to_string(i) + " 5 1 0 0\n";
+  dir.write("nominal.cl", cl);
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: bar.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 40 }\n"
+            "holder: [[40, 6], [55, 6], [55, 12], [90, 12]]\nclearance: 0.5\n"
+            "path: { nominal: nominal.cl }\nlinks: { retract: 10 }\n");
+  const auto r = test::runFieldpath(dir, "generate scene.yaml --out out");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out" / "report.json"));
+  ASSERT_EQ(report["unsafe"].size(), 1u) << report["unsafe"];
+  const std::string reason = report["unsafe"][0].get<std::string>();
+  EXPECT_NE(reason.find("(first: posture 0 to the next (the link into pass 1): generate's link: "
+                        "`links.retract`"),
+            std::string::npos)
+      << reason;
+  // check reads the user's links: the block and the line, no keys of generate's.
+  const auto c = test::runFieldpath(dir, "check scene.yaml --path out/path.cl --out chk");
+  ASSERT_EQ(c.exit_code, 0) << c.output();
+  const auto checked = nlohmann::json::parse(test::slurp(dir.path() / "chk" / "check.json"));
+  const std::string line =
+      std::to_string(geometry::readPathFile(dir.path() / "out/path.cl").lines[1]);
+  EXPECT_NE(checked["unsafe"][0].get<std::string>().find(
+                "(first: posture 0 to the next (the link into pass 1, out/path.cl:" + line + "))"),
+            std::string::npos)
+      << checked["unsafe"];
+  EXPECT_EQ(checked["unsafe"][0].get<std::string>().find("links.retract"), std::string::npos);
+}
+
 // `check` cuts along the motions, not only at the postures: two postures on a floor either side
 // of a ridge 1 mm high, each clear of it, and the straight move between them through the ridge.
 // The gouge is the ridge's height (1000 um; 2 mm wide, no line is deeper from its sides, less the
