@@ -1,0 +1,159 @@
+/// `check`'s verdict on what is not a collision, through the built `fieldpath`: postures and
+/// motions under the scene's clearance, the gouge tolerance of `--gouge-tol`, a spacing coarsened
+/// to the largest grid; and `generate`'s travel plane over a part taller than the obstacles. (A
+/// test audit: none of these had a test; deleting the under-the-clearance lines of `check` left it
+/// saying `ok` of a path 0.3 mm from a blade with the scene asking 0.5.)
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "fieldpath/geometry/mesh_io.h"
+#include "fixtures.h"
+#include "run_fieldpath.h"
+
+namespace fs = std::filesystem;
+using namespace fieldpath;
+using test::TempDir;
+
+namespace {
+
+nlohmann::json checkJson(const TempDir& dir, const std::string& out) {
+  return nlohmann::json::parse(test::slurp(dir.path() / out / "check.json"));
+}
+
+bool says(const nlohmann::json& reasons, const std::string& text) {
+  for (const auto& r : reasons)
+    if (r.get<std::string>().find(text) != std::string::npos) return true;
+  return false;
+}
+
+}  // namespace
+
+// A ridge 0.2 mm thick standing to z = 10. Postures 0.3 mm beside its face, and a move 0.3 mm over
+// its top between postures 2.9 mm clear: with `clearance: 0.5` both are not ok (not unsafe: nothing
+// is touched); with 0.2 both are ok.
+TEST(CheckVerdict, PosturesAndMotionsUnderTheClearanceAreNotOk) {
+  const TempDir dir;
+  geometry::saveMesh(pathgen::test::boxMesh(4.9, 5.1, -20, 20, -10, 10), dir.path() / "ridge.stl");
+  dir.write("beside.cl", "# pass 1\n1.6 0 0 0 0 1\n1.6 1 0 0 0 1\n1.6 2 0 0 0 1\n");
+  dir.write("over.cl", "# pass 1\n0 0 10.3 0 0 1\n10 0 10.3 0 0 1\n");
+  for (const double clearance : {0.5, 0.2}) {
+    dir.write("scene.yaml",
+              "obstacles:\n  - mesh: ridge.stl\n"
+              "tool: { shape: ball, radius: 3, length: 20 }\nclearance: " +
+                  std::to_string(clearance) + "\n");
+    for (const std::string path : {"beside", "over"}) {
+      const std::string out = path + "_" + std::to_string(clearance);
+      const auto r =
+          test::runFieldpath(dir, "check scene.yaml --path " + path + ".cl --out " + out);
+      ASSERT_EQ(r.exit_code, 0) << r.output();
+      const nlohmann::json check = checkJson(dir, out);
+      EXPECT_TRUE(check["unsafe"].empty()) << check["unsafe"];
+      const std::string reason = path == "beside" ? "postures come within 0.2"
+                                                  : "1 motions come under the required clearance";
+      EXPECT_EQ(says(check["not_ok_because"], reason), clearance == 0.5)
+          << path << " " << clearance << ": " << check["not_ok_because"];
+      EXPECT_EQ(check["ok"].get<bool>(), clearance != 0.5) << path << " " << clearance;
+      EXPECT_NE(r.out.find(clearance == 0.5 ? "check: NOT OK" : "check: ok"), std::string::npos)
+          << r.out;
+    }
+  }
+}
+
+// A pass dipped 8 um into a flat part: a gouge under the default 5 um tolerance, none under
+// `--gouge-tol 10`, in the cutter's exact check and in the Z-buffer's; a tolerance of half the
+// ball's radius or more is refused before any output.
+TEST(CheckVerdict, TheGougeToleranceIsTheOptions) {
+  const TempDir dir;
+  geometry::TriangleMesh part, far;
+  pathgen::test::addBox(part, -20, 20, -20, 20, -10, 0);
+  pathgen::test::addBox(far, -100, -90, -100, -90, -50, -40);
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(far, dir.path() / "far.stl");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: far.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 40 }\n");
+  std::string cl = "# pass 1\n";
+  for (int i = -10; i <= 10; ++i) cl += std::to_string(i) + " 0 -0.008 0 0 1\n";
+  dir.write("dip.cl", cl);
+  const auto strict = test::runFieldpath(dir, "check scene.yaml --path dip.cl --out strict");
+  ASSERT_EQ(strict.exit_code, 0) << strict.output();
+  const nlohmann::json s = checkJson(dir, "strict");
+  EXPECT_TRUE(says(s["not_ok_because"], "deeper than the gouge tolerance (5 um)"))
+      << s["not_ok_because"];
+  EXPECT_NEAR(s["cutter_part"]["max_depth_um"].get<double>(), 8.0, 0.5) << s["cutter_part"];
+  EXPECT_NEAR(s["surface"]["max_gouge_um"].get<double>(), 8.0, 0.5) << s["surface"];
+  EXPECT_GT(s["surface"]["gouged_lines"].get<int>(), 0) << s["surface"];
+
+  const auto loose =
+      test::runFieldpath(dir, "check scene.yaml --path dip.cl --gouge-tol 10 --out loose");
+  ASSERT_EQ(loose.exit_code, 0) << loose.output();
+  const nlohmann::json l = checkJson(dir, "loose");
+  EXPECT_FALSE(says(l["not_ok_because"], "gouge")) << l["not_ok_because"];
+  EXPECT_EQ(l["cutter_part"]["gouging_postures"].get<int>(), 0) << l["cutter_part"];
+  EXPECT_EQ(l["surface"]["gouged_lines"].get<int>(), 0) << l["surface"];
+  EXPECT_DOUBLE_EQ(l["surface"]["gouge_tolerance_um"].get<double>(), 10.0);
+
+  dir.write("small.yaml",
+            "obstacles:\n  - mesh: far.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 1, length: 40 }\n");
+  const auto wide =
+      test::runFieldpath(dir, "check small.yaml --path dip.cl --gouge-tol 600 --out wide");
+  EXPECT_EQ(wide.exit_code, 1) << wide.output();
+  EXPECT_NE(wide.err.find("--gouge-tol 600"), std::string::npos) << wide.err;
+  EXPECT_FALSE(fs::exists(dir.path() / "wide"));
+}
+
+// A 400 mm square part at a 0.02 mm spacing is 4 · 10^8 lines: the grid is coarsened to the
+// largest the check makes, and says so (check.json and stdout).
+TEST(CheckVerdict, AFineSpacingOverALargePartIsCoarsenedAndSaid) {
+  const TempDir dir;
+  geometry::TriangleMesh part, far;
+  pathgen::test::addBox(part, -200, 200, -200, 200, -10, 0);
+  pathgen::test::addBox(far, -300, -290, -300, -290, -50, -40);
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(far, dir.path() / "far.stl");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: far.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 40 }\n");
+  dir.write("diag.cl", "# pass 1\n-190 -190 0 0 0 1\n190 190 0 0 0 1\n");
+  const auto r = test::runFieldpath(dir, "check scene.yaml --path diag.cl --spacing 0.02 --out c");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const nlohmann::json surface = checkJson(dir, "c")["surface"];
+  EXPECT_TRUE(surface["spacing_coarsened"].get<bool>()) << surface;
+  // The passes' reach, 386 mm square, in 6e6 lines: sqrt(386² / 6e6) ≈ 0.158 mm.
+  EXPECT_NEAR(surface["grid"]["spacing"][0].get<double>(), 386 / std::sqrt(6e6), 0.002)
+      << surface["grid"];
+  EXPECT_NE(r.err.find("note: --spacing 0.02 mm would make more Z-buffer lines than a check "
+                       "takes"),
+            std::string::npos)
+      << r.err;
+}
+
+// The links' travel plane clears the highest mesh, the part's too: a part 30 mm high beside
+// obstacles 10 mm high puts it at 30 + clearance + 2 mm, and the links touch nothing.
+TEST(GenerateLinks, TheTravelPlaneClearsAPartTallerThanTheObstacles) {
+  const TempDir dir;
+  geometry::TriangleMesh part, low;
+  pathgen::test::addBox(part, -20, 20, -20, 20, 0, 30);
+  pathgen::test::addBox(low, 40, 50, -5, 5, 0, 10);
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(low, dir.path() / "low.stl");
+  std::string cl = "# pass 1\n";
+  for (int i = -10; i <= 10; ++i) cl += std::to_string(i) + " -5 30 0 0 1\n";
+  cl += "# pass 2\n";
+  for (int i = 10; i >= -10; --i) cl += std::to_string(i) + " 5 30 0 0 1\n";
+  dir.write("top.cl", cl);
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: low.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 40 }\nclearance: 0.5\n"
+            "path: { nominal: top.cl }\nlinks: { retract: 5 }\n");
+  const auto r = test::runFieldpath(dir, "generate scene.yaml --nominal --out out");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out" / "report.json"));
+  EXPECT_DOUBLE_EQ(report["links"]["safe_z_mm"].get<double>(), 30 + 0.5 + 2) << report["links"];
+  EXPECT_TRUE(report["safe"].get<bool>()) << report["unsafe"];
+}
