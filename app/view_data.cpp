@@ -369,7 +369,7 @@ ViewData gatherView(const ViewRequest& request) {
                        p.part_contact, p.part_contact_to_next);
       if (scene.part && p.part_contact.empty())
         d.warnings.push_back(
-            "The part's contacts (links, holder) are not shown: " +
+            "The part's contacts (links, holder, cutter) are not shown: " +
             (request.check_dir / "clearance.csv").string() +
             " does not mark them (a check written before it did, or without the part): run "
             "`fieldpath check` again, or view without --check");
@@ -435,6 +435,37 @@ ViewData gatherView(const ViewRequest& request) {
                            std::to_string(p.colliding_motions) +
                            (p.colliding_motions == 1 ? " motion" : " motions") +
                            " touch an obstacle (red on the path)");
+    // Clear of the obstacles but under the scene's clearance: said as path.cl's mark says it
+    // (the page had no word of it, its side panel read "colliding: 0": a helper's finding).
+    std::size_t postures_under = 0, closest = ViewPath::npos;
+    for (std::size_t i = 0; i < n; ++i)
+      if (p.clearance_mm[i] < scene.clearance_mm) {
+        ++postures_under;
+        if (closest == ViewPath::npos || p.clearance_mm[i] < p.clearance_mm[closest]) closest = i;
+      }
+    p.postures_under_required = postures_under;
+    if (p.colliding_postures == 0 && p.colliding_motions == 0 &&
+        (postures_under > 0 || p.motions_under_required > 0)) {
+      char text[160];
+      std::snprintf(text, sizeof text, "UNDER THE REQUIRED CLEARANCE (%.3f mm): %zu postures",
+                    scene.clearance_mm, postures_under);
+      std::string line = text;
+      if (closest != ViewPath::npos) {
+        std::snprintf(text, sizeof text, " (closest %.3f mm, ", p.clearance_mm[closest]);
+        line += text + postureWhere(p.file, closest) + ")";
+      }
+      line += " and " + std::to_string(p.motions_under_required) +
+              " motions under it (orange on the path coloured by clearance)";
+      d.warnings.push_back(line);
+    }
+    if (check) {  // whose the part's contacts are (the page called a cutter's gouge the holder's)
+      if (check->holder_part)
+        p.holder_part_contacts =
+            check->holder_part->colliding_postures + check->holder_part->colliding_motions;
+      if (check->cutter_part)
+        p.cutter_part_contacts =
+            check->cutter_part->gouging_postures + check->cutter_part->gouging_motions;
+    }
     for (std::size_t i : p.file.limited) p.limited_colliding += p.clearance_mm[i] <= 0.0;
     if (check && (check->colliding_postures != p.colliding_postures ||
                   check->colliding_motions != p.colliding_motions))

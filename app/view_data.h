@@ -35,7 +35,8 @@ struct ViewPath {
   std::string what;  ///< where it came from, for the page ("path.cl", "the scene's path.nominal")
   std::vector<double> clearance_mm;  ///< tool + holder ↔ obstacles, as `check` (0: colliding)
   std::vector<double> motion_mm;     ///< lower bound along the motion to the next posture
-  /// 1 where the links or the holder touch the part (check's link_part, holder_part) at the
+  /// 1 where the links, the holder or the cutter (beyond the gouge tolerance) touch the part
+  /// (check's link_part, holder_part, cutter_part) at the
   /// posture / on the motion to the next; empty when not known (no part, an older check folder).
   std::vector<std::uint8_t> part_contact, part_contact_to_next;
   std::vector<double> s_mm;          ///< ball-centre arc length from the start of its pass block
@@ -46,6 +47,10 @@ struct ViewPath {
   std::size_t colliding_postures = 0;  ///< clearance_mm <= 0
   std::size_t colliding_motions = 0;   ///< motion_mm <= 0
   std::size_t motions_under_required = 0;
+  std::size_t postures_under_required = 0;  ///< clearance_mm under the scene's `clearance`
+  /// The part's contacts by whose they are (postures + motions): the holder's, the cutter's
+  /// beyond the gouge tolerance (a pass posture's mark is either; a link's is the link's).
+  std::size_t holder_part_contacts = 0, cutter_part_contacts = 0;
   std::size_t limited_colliding = 0;
   /// Postures whose tip lies far outside the scene's meshes (see gatherView).
   std::size_t outside = 0, first_outside = npos;

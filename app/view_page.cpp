@@ -247,6 +247,9 @@ json pathJson(const ViewData& d, std::size_t max_postures, Blob& blob, std::size
         {"colliding_postures", p.colliding_postures},
         {"colliding_motions", p.colliding_motions},
         {"motions_under_required", p.motions_under_required},
+        {"postures_under_required", p.postures_under_required},
+        {"part_contact_holder", p.holder_part_contacts},
+        {"part_contact_cutter", p.cutter_part_contacts},
         {"limited", p.file.limited.size()},
         {"limited_colliding", p.limited_colliding},
         // null: not known (no part, or a check folder written before clearance.csv had them)

@@ -550,8 +550,15 @@
       ['colliding postures', P.count(F_COLLIDING)], ['colliding motions', P.count(F_MOTION_COLLIDING)],
       ['angle limit held', P.count(F_LIMITED)]];
     if (c.part_contact_postures !== null && c.part_contact_postures !== undefined)
-      rows.push(['touching the part (links, holder)', P.count(F_PART) + ' postures, ' +
-                 P.count(F_MOTION_PART) + ' motions']);
+      rows.push([
+        'touching the part (links, holder, cutter)',
+        P.count(F_PART) + ' postures, ' + P.count(F_MOTION_PART) + ' motions'
+      ]);
+    if (c.postures_under_required || c.motions_under_required)
+      rows.push([
+        'under the required clearance',
+        c.postures_under_required + ' postures, ' + c.motions_under_required + ' motions'
+      ]);
     rows.forEach(function (r) { el('div', {}, side, r[0] + ': ' + r[1]); });
     el('div', { class: 'sub' }, side, 'clearance: ' + path.clearance_source);
     el('div', { class: 'sub' }, side, 'tilt, lead: ' + path.angles_source);
@@ -596,7 +603,7 @@
       var kinds = [['#ff2a1a', 'colliding posture / motion'], ['#ff9f1c', 'angle limit held'],
                    ['#b8c0cc', 'link (dashed)']];
       if (P.count(F_PART) + P.count(F_MOTION_PART) > 0)
-        kinds.splice(1, 0, ['#e040fb', 'link / holder touching the part']);
+        kinds.splice(1, 0, ['#e040fb', 'touching the part: link, holder, or cutter (gouge)']);
       kinds.forEach(function (m) {
         var row = el('div', {}, marks);
         el('span', { style: 'background:' + m[0] }, row);
@@ -710,10 +717,19 @@
        o.motion_colliding || o.motion_part_contact ? 'bad' : ''],
       ['tip', o.tip_mm.map(function (v) { return fmt(v, 2); }).join(' ') + ' mm'],
       ['axis', o.axis.map(function (v) { return fmt(v, 3); }).join(' ')]];
+    // Whose the contact is: a link's posture is the link's; a pass posture's the holder's or the
+    // cutter's (a gouge past the tolerance), told by check's counts where only one has any.
+    function partContactWhose(o) {
+      if (o.block === 'link') return 'link';
+      var c = path.counts, holder = c.part_contact_holder > 0, cutter = c.part_contact_cutter > 0;
+      return holder && cutter ? 'holder or cutter' : cutter ? 'cutter: gouge' : 'holder';
+    }
     // One status row always: the panel keeps its size from posture to posture.
-    rows.push(o.colliding ? ['', o.limited ? 'COLLIDING, limit held' : 'COLLIDING', 'bad']
-              : o.part_contact ? ['', 'PART CONTACT (' + (o.block === 'link' ? 'link' : 'holder') + ')', 'bad']
-              : o.limited ? ['', 'angle limit held', 'warn'] : ['', '\u00a0']);
+    rows.push(
+        o.colliding        ? ['', o.limited ? 'COLLIDING, limit held' : 'COLLIDING', 'bad'] :
+            o.part_contact ? ['', 'PART CONTACT (' + partContactWhose(o) + ')', 'bad'] :
+            o.limited      ? ['', 'angle limit held', 'warn'] :
+                             ['', '\u00a0']);
     info.textContent = '';
     var table = el('table', { id: 'fp-posture' }, info);
     rows.forEach(function (r) {

@@ -201,18 +201,6 @@ TEST(View, TiltLeadAndArcLengthAgreeWithGenerate) {
   EXPECT_GT(max_tilt, 1.0);  // the wall did tilt the tool
 }
 
-/// A page's surface: its blocks' values and the value from which a block reads as not cut.
-std::pair<std::vector<float>, double> surfaceValues(const std::string& html) {
-  const json meta = pageMeta(html);
-  const std::string blob = base64Decode(
-      between(html, "<script type=\"application/octet-stream\" id=\"fp-blob\">", "</script>"));
-  const std::size_t offset = meta["surface"]["value"]["offset"],
-                    count = meta["surface"]["value"]["count"];
-  std::vector<float> out(count);
-  std::memcpy(out.data(), blob.data() + offset, 4 * count);
-  return std::make_pair(out, meta["surface"]["uncut_um"].get<double>());
-}
-
 // A simulated surface's lines that no pass cut are greyed (the page's uncut marker) from the
 // stock simulate.json records, not from the highest height: in a zoom that every pass reaches
 // (11 passes 1 mm apart under a ball R 3, every line lowered), the highest lines are the cusps
@@ -261,18 +249,8 @@ TEST(View, ASimulatedZoomCutEverywhereHasNoUncutLines) {
 // not cut (grey: a reviewer's finding). One pass along the slope: the rest of it is not cut.
 TEST(View, ACheckedSlopesUncutLinesAreGreyed) {
   const TempDir dir;
-  std::ostringstream stl;
-  stl << "solid slope\n";
-  const auto facet = [&stl](std::array<double, 9> v) {
-    stl << " facet normal 0 -0.7071 0.7071\n  outer loop\n";
-    for (int k = 0; k < 9; k += 3)
-      stl << "   vertex " << v[k] << ' ' << v[k + 1] << ' ' << v[k + 2] << '\n';
-    stl << "  endloop\n endfacet\n";
-  };
-  facet({-10, -10, -10, 10, -10, -10, 10, 10, 10});  // z = y
-  facet({-10, -10, -10, 10, 10, 10, -10, 10, 10});
-  stl << "endsolid slope\n";
-  dir.write("slope.stl", stl.str());
+  dir.write("slope.stl", facetsStl({{-10, -10, -10, 10, -10, -10, 10, 10, 10},  // z = y
+                                    {-10, -10, -10, 10, 10, 10, -10, 10, 10}}));
   dir.write("block.stl", boxStl(60, 60, 0, 70, 70, 10));
   dir.write("scene.yaml",
             "obstacles:\n  - mesh: block.stl\npart: slope.stl\n"

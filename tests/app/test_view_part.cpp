@@ -1,5 +1,8 @@
-/// `view` and the part's contacts (links, holder): marked on the page as `check` finds them,
-/// from its clearance.csv or computed; older or edited check folders said or refused.
+/// `view` and the part: its contacts (links, holder, cutter) marked on the page as `check` finds
+/// them, from its clearance.csv or computed; older or edited check folders said or refused; a
+/// simulated surface measured from the part line by line; a path under the clearance said.
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <sstream>
@@ -90,8 +93,9 @@ TEST(View, PartContactsAreMarkedAsCheckFindsThem) {
   EXPECT_TRUE(meta["path"]["counts"]["part_contact_postures"].is_null());
   EXPECT_EQ(countBit(pageFlags(html, meta), 32), 0u);
   // ... and the page says so: the scene has a part, the check marks nothing of it.
-  EXPECT_NE(meta["warnings"].dump().find("The part's contacts (links, holder) are not shown"),
-            std::string::npos)
+  EXPECT_NE(
+      meta["warnings"].dump().find("The part's contacts (links, holder, cutter) are not shown"),
+      std::string::npos)
       << meta["warnings"];
   // Saved again with CR LF line ends: the same page.
   std::string crlf;
@@ -129,4 +133,83 @@ TEST(View, PartContactsAreMarkedAsCheckFindsThem) {
   EXPECT_NE(stale.err.find("or its meshes have changed since the check"), std::string::npos)
       << stale.err;
   EXPECT_FALSE(fs::exists(dir.path() / "bad.html"));
+}
+
+// simulate's heights over a sloped part, shown in blocks of 3 x 3 lines: each line is measured
+// from the part under it. A block's lowest line less the part at the block's centre read the
+// downhill line of every block as a gouge (12 um on this 0.6 slope, a line 0.02 mm downhill: a
+// helper's clean ramp showed 29 000 gouged blocks of 73 000).
+TEST(View, ASimulatedSlopeReadsNoGougeInItsBlocks) {
+  const TempDir dir;
+  dir.write("ramp.stl", facetsStl({{-12, -12, -7.2, 12, -12, 7.2, 12, 12, 7.2},  // z = 0.6 x
+                                   {-12, -12, -7.2, 12, 12, 7.2, -12, 12, -7.2}}));
+  dir.write("far.stl", boxStl(60, 60, 0, 70, 70, 10));
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: far.stl\npart: ramp.stl\n"
+            "tool: { shape: ball, radius: 1, length: 10 }\n");
+  std::ostringstream cl;  // the ball on the slope: centre R along the normal from the contact
+  const double n = std::sqrt(1.36), R = 1.0;
+  for (int j = 0; j <= 32; ++j) {
+    cl << "# pass " << j + 1 << '\n';
+    for (int i = 0; i <= 80; ++i) {
+      const double x = -8 + 0.2 * i, y = -8 + 0.5 * j;
+      cl << x - 0.6 * R / n << ' ' << y << ' ' << 0.6 * x + R / n - R << " 0 0 1\n";
+    }
+  }
+  dir.write("ramp.cl", cl.str());
+  ASSERT_EQ(runFieldpath(dir, "--quiet simulate --tool ball:1 --path ramp.cl --stock 8 --out sim")
+                .exit_code,
+            0);
+  const Outcome v =
+      runFieldpath(dir, "--quiet view scene.yaml --path ramp.cl --surface sim --out v.html");
+  ASSERT_EQ(v.exit_code, 0) << v.output();
+  const std::string html = slurp(dir.path() / "v.html");
+  ASSERT_GT(pageMeta(html)["surface"]["stride"].get<int>(), 1);
+  const auto [values, marker] = surfaceValues(html);
+  std::size_t cut = 0, gouged = 0;
+  for (float x : values)
+    if (std::isfinite(x) && x < marker) ++cut, gouged += x < -5.0f;
+  EXPECT_GT(cut, 10000u);
+  EXPECT_EQ(gouged, 0u);
+}
+
+// A pass dipped 50 um into the floor: the page's marks are the cutter's (the page called them
+// the holder's), and its banner states the tolerance check counted them against (it said 0 um).
+TEST(View, ACuttersGougeIsTheCuttersAtCheckTolerance) {
+  const TempDir dir;
+  writeBlockScene(dir, /*nominal=*/false);
+  std::ostringstream path;
+  path << "# pass 1\n";
+  for (int k = 0; k < 20; ++k) path << -9.75 + 0.5 * k << " 8 -0.05 0 0 1\n";
+  dir.write("dip.cl", path.str());
+  ASSERT_EQ(runFieldpath(dir, "--quiet check scene.yaml --path dip.cl --out chk").exit_code, 0);
+  const Outcome r = runFieldpath(dir, "--quiet view scene.yaml --check chk --out v.html");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const json meta = pageMeta(slurp(dir.path() / "v.html"));
+  EXPECT_GT(meta["path"]["counts"]["part_contact_cutter"].get<int>(), 0) << meta["path"]["counts"];
+  EXPECT_EQ(meta["path"]["counts"]["part_contact_holder"].get<int>(), 0);
+  EXPECT_NE(meta["warnings"].dump().find("the gouge tolerance (5 um)"), std::string::npos)
+      << meta["warnings"];
+}
+
+// A pass 0.3 mm beside the block, the scene asking 0.5: nothing collides, and the page says the
+// path is under the required clearance, with the closest posture (it said nothing; its panel
+// read "colliding postures: 0").
+TEST(View, APathUnderTheRequiredClearanceIsSaid) {
+  const TempDir dir;
+  writeBlockScene(dir, /*nominal=*/false);
+  std::ostringstream path;
+  path << "# pass 1\n";
+  for (int k = 0; k <= 8; ++k) path << "1.7 " << -2 + 0.5 * k << " 0 0 0 1\n";
+  dir.write("under.cl", path.str());
+  const Outcome r = runFieldpath(dir, "--quiet view scene.yaml --path under.cl --out v.html");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const json meta = pageMeta(slurp(dir.path() / "v.html"));
+  EXPECT_EQ(meta["path"]["counts"]["colliding_postures"].get<int>(), 0);
+  EXPECT_EQ(meta["path"]["counts"]["postures_under_required"].get<int>(), 9);
+  const std::string warnings = meta["warnings"].dump();
+  EXPECT_NE(warnings.find("UNDER THE REQUIRED CLEARANCE (0.500 mm): 9 postures (closest 0.2"),
+            std::string::npos)
+      << warnings;
+  EXPECT_NE(warnings.find("(pass 1, under.cl:"), std::string::npos) << warnings;
 }

@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -90,6 +92,36 @@ inline std::string base64Decode(const std::string& text) {
 }
 
 /// The page's per-posture flags (1 link, 2 limit held, 4 colliding, 8 colliding motion).
+/// An ASCII STL of the given triangles (x y z of each corner, counter-clockwise seen from above),
+/// normals from their winding.
+inline std::string facetsStl(const std::vector<std::array<double, 9>>& facets) {
+  std::ostringstream stl;
+  stl << "solid sheet\n";
+  for (const auto& v : facets) {
+    const double u[3] = {v[3] - v[0], v[4] - v[1], v[5] - v[2]};
+    const double w[3] = {v[6] - v[0], v[7] - v[1], v[8] - v[2]};
+    stl << " facet normal " << u[1] * w[2] - u[2] * w[1] << ' ' << u[2] * w[0] - u[0] * w[2] << ' '
+        << u[0] * w[1] - u[1] * w[0] << "\n  outer loop\n";
+    for (int k = 0; k < 9; k += 3)
+      stl << "   vertex " << v[k] << ' ' << v[k + 1] << ' ' << v[k + 2] << '\n';
+    stl << "  endloop\n endfacet\n";
+  }
+  stl << "endsolid sheet\n";
+  return stl.str();
+}
+
+/// A page's surface: its blocks' values and the value from which a block reads as not cut.
+inline std::pair<std::vector<float>, double> surfaceValues(const std::string& html) {
+  const json meta = pageMeta(html);
+  const std::string blob = base64Decode(
+      between(html, "<script type=\"application/octet-stream\" id=\"fp-blob\">", "</script>"));
+  const std::size_t offset = meta["surface"]["value"]["offset"],
+                    count = meta["surface"]["value"]["count"];
+  std::vector<float> out(count);
+  std::memcpy(out.data(), blob.data() + offset, 4 * count);
+  return std::make_pair(out, meta["surface"]["uncut_um"].get<double>());
+}
+
 inline std::vector<std::uint8_t> pageFlags(const std::string& html, const json& meta) {
   const std::string blob = base64Decode(
       between(html, "<script type=\"application/octet-stream\" id=\"fp-blob\">", "</script>"));
