@@ -72,6 +72,9 @@ std::set<std::string> parseOutputs(const std::string& text) {
       throw InputError("--outputs '" + text + "': '" + item + "' named twice");
     pos = comma + 1;
   }
+  // heights.npy comes with its grid (DESIGN: heights.json beside it; `view --surface` reads
+  // both): `--outputs npy` wrote the array alone, a helper's finding.
+  if (out.count("npy")) out.insert("json");
   return out;
 }
 
@@ -193,8 +196,9 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
                   "GPU) | cpu | cuda")
       ->capture_default_str();
   cmd->add_option("--outputs", o->outputs,
-                  "Which of npy (heights.npy), json (heights.json), stl (surface.stl), png "
-                  "(heights.png) to write; simulate.json is always written (those left out that an "
+                  "Which of npy (heights.npy, with heights.json: its grid), json (heights.json), "
+                  "stl (surface.stl), png (heights.png) to write; simulate.json is always written "
+                  "(those left out that an "
                   "earlier run wrote in --out are removed)")
       ->capture_default_str();
   cmd->add_option("--block", o->block_postures,

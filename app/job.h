@@ -183,28 +183,36 @@ inline std::string axisTurnWarning(const geometry::PathFile& path, const pathgen
          " deg between two postures of a pass)";
 }
 
-/// Where posture i lies, for a reason a user acts on: "posture i (pass K, FILE:LINE)", its block
-/// the pass (numbered from 1, as `# pass K`), the link into pass K or the link after the last
-/// pass, and its file line where the path was read from a file (a reviewer: "posture 5123" alone
-/// sent users counting through a 40 000-line file, and did not say the fault was a link's).
-inline std::string postureWhere(const geometry::PathFile& path, std::size_t i) {
-  std::string block;
+/// The block posture i lies in, as a user reads it: "pass K" (numbered from 1, as `# pass K`),
+/// "the link into pass K", "the link after the last pass"; empty past the blocks.
+inline std::string blockOf(const geometry::PathFile& path, std::size_t i) {
   std::size_t passes_before = 0;
   for (const geometry::PathBlock& b : path.blocks) {
     const bool pass = b.kind == geometry::PathBlock::Kind::Pass;
-    if (i >= b.begin && i < b.end) {
-      block = pass ? "pass " + std::to_string(passes_before + 1)
-              : passes_before == path.count(geometry::PathBlock::Kind::Pass)
-                  ? std::string("the link after the last pass")
-                  : "the link into pass " + std::to_string(passes_before + 1);
-      break;
-    }
+    if (i >= b.begin && i < b.end)
+      return pass ? "pass " + std::to_string(passes_before + 1)
+             : passes_before == path.count(geometry::PathBlock::Kind::Pass)
+                 ? std::string("the link after the last pass")
+                 : "the link into pass " + std::to_string(passes_before + 1);
     passes_before += pass;
   }
+  return {};
+}
+
+/// "posture i (BLOCK, FILE:LINE)": the posture a reason names, with the block `block_of` lies in
+/// (i's own, or for a motion the end that makes it a link's) and i's file line where the path was
+/// read from a file (a reviewer: "posture 5123" alone sent users counting through a 40 000-line
+/// file, and did not say the fault was a link's).
+inline std::string postureWhere(const geometry::PathFile& path, std::size_t i,
+                                std::size_t block_of) {
+  const std::string block = blockOf(path, block_of);
   const std::string line = i < path.lines.size() ? path.where(i) : std::string();
   const std::string sep = !block.empty() && !line.empty() ? ", " : "";
   return "posture " + std::to_string(i) +
          (block.empty() && line.empty() ? "" : " (" + block + sep + line + ")");
+}
+inline std::string postureWhere(const geometry::PathFile& path, std::size_t i) {
+  return postureWhere(path, i, i);
 }
 
 /// Whether posture i lies in a link block.
@@ -231,13 +239,12 @@ inline std::vector<std::string> unsafeReasons(const geometry::PathFile& path,
     return postureWhere(path, i) + (inLink(path, i) && !link_hint.empty() ? ": " + link_hint : "");
   };
   auto motion = [&](std::size_t i) {
+    // "posture i to the next (BLOCK, i's line)": the block of the end that makes it a link's.
     const bool link = inLink(path, i) || inLink(path, i + 1);
-    const std::size_t named = inLink(path, i + 1) || !link ? i + 1 : i;
-    std::string where = postureWhere(path, named);
-    // "posture i to the next (its block, line)": the block of the end that makes it a link's.
+    const std::string where = postureWhere(path, i, !inLink(path, i) && link ? i + 1 : i);
     const std::size_t open = where.find(" (");
-    const std::string place = open == std::string::npos ? "" : where.substr(open);
-    return "posture " + std::to_string(i) + " to the next" + place +
+    return "posture " + std::to_string(i) + " to the next" +
+           (open == std::string::npos ? "" : where.substr(open)) +
            (link && !link_hint.empty() ? ": " + link_hint : "");
   };
   if (c.colliding)

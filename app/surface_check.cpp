@@ -138,6 +138,9 @@ std::array<std::uint8_t, 3> deviationColour(double dev_um, double gouge_scale_um
                     : std::array<std::uint8_t, 3>{255, fade, fade};
 }
 
+/// Deviation above the colour bar's top (the band's largest scallop): the page's purple.
+constexpr std::array<std::uint8_t, 3> kAboveScale = {107, 61, 153};
+
 std::string microns(double um) {
   char text[32];
   std::snprintf(text, sizeof text, "%.0fum", um);
@@ -153,11 +156,23 @@ void writeDeviationPng(const std::filesystem::path& file, const SurfaceResult& s
   const int k =
       std::max(1, static_cast<int>(std::ceil(std::max(grid.nx, grid.ny) / double(max_side))));
   const int map_w = grid.nx / k, map_h = grid.ny / k;
-  const int scale = std::max(2, map_h / 120), bar_w = 12 * scale, legend_w = bar_w + 28 * scale;
+  // Gouges scaled to the tolerance at least: a mesh's chordal error of -1 um read full blue, as
+  // a gouge, where the page shows it pale (a helper's finding). Above the band's largest scallop
+  // (stock left on the outer passes' flanks) a colour of its own, as the page's: it read as the
+  // worst scallop.
+  const double gouge_scale = std::max({1.0, stats.gouge_tolerance_um, stats.max_gouge_um});
+  double scallop_scale = std::max(1.0, stats.max_scallop_um);
+  if (stats.band_lines == 0)  // no band (one pass): the scale is the cut lines' largest
+    for (std::size_t i = 0; i < dev_um.size(); ++i)
+      if (std::isfinite(dev_um[i]) && (stats.lowered.empty() || stats.lowered[i]))
+        scallop_scale = std::max(scallop_scale, double(dev_um[i]));
+  const std::array<std::string, 3> labels = {microns(scallop_scale), "0um", microns(-gouge_scale)};
+  std::size_t label_chars = 0;
+  for (const std::string& l : labels) label_chars = std::max(label_chars, l.size());
+  const int scale = std::max(2, map_h / 120), bar_w = 12 * scale;
+  const int legend_w = bar_w + 8 * scale + 4 * scale * static_cast<int>(label_chars);
   Image img{map_w + legend_w, std::max(map_h, 60 * scale), {}};
   img.rgb.assign(static_cast<std::size_t>(img.width) * img.height * 3, 255);
-  const double gouge_scale = std::max(1.0, stats.max_gouge_um);
-  const double scallop_scale = std::max(1.0, stats.max_scallop_um);
   for (int py = 0; py < map_h; ++py) {
     for (int px = 0; px < map_w; ++px) {
       const int ix = px * k, iy = (map_h - 1 - py) * k;
@@ -167,7 +182,8 @@ void writeDeviationPng(const std::filesystem::path& file, const SurfaceResult& s
       img.set(px, py,
               std::isnan(d) ? std::array<std::uint8_t, 3>{200, 200, 200}
               : stock       ? std::array<std::uint8_t, 3>{235, 222, 179}  // never cut: the stock
-                            : deviationColour(d, gouge_scale, scallop_scale));
+              : d > scallop_scale + 0.5 ? kAboveScale
+                                        : deviationColour(d, gouge_scale, scallop_scale));
     }
   }
   // Colour bar: top = max scallop, middle = 0, bottom = max gouge.
@@ -178,10 +194,12 @@ void writeDeviationPng(const std::filesystem::path& file, const SurfaceResult& s
     for (int x = 0; x < bar_w; ++x)
       img.set(bar_x + x, bar_top + y, deviationColour(dev, gouge_scale, scallop_scale));
   }
+  for (int y = 0; y < 3 * scale; ++y)  // above the bar: what lies above its top
+    for (int x = 0; x < bar_w; ++x) img.set(bar_x + x, y, kAboveScale);
   const int label_x = bar_x + bar_w + 2 * scale;
-  img.text(label_x, bar_top, microns(scallop_scale), scale);
-  img.text(label_x, bar_top + bar_h / 2 - 3 * scale, "0um", scale);
-  img.text(label_x, bar_top + bar_h - 5 * scale, microns(-gouge_scale), scale);
+  img.text(label_x, bar_top, labels[0], scale);
+  img.text(label_x, bar_top + bar_h / 2 - 3 * scale, labels[1], scale);
+  img.text(label_x, bar_top + bar_h - 5 * scale, labels[2], scale);
   const std::string png = zbuffer::encodePng(img.width, img.height, img.rgb);
   common::writeTextAtomically(file, png);
 }

@@ -399,7 +399,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   parts.reserve(chunks.size());
   for (AptChunk& c : chunks) parts.push_back(std::move(c.postures));
   concatenate(parts, options.threads, path);
-  checkDeclaredCount(text, kAptCountPrefix, path.postures.size(), file);
+  checkDeclaredCount(text, kAptCountPrefix, path.postures.size(), file, ended);
   return path;
 }
 

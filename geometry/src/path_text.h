@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -218,17 +219,63 @@ inline void addToBlocks(std::vector<PathBlock>& blocks, PathBlock::Kind kind, bo
     blocks.back().end = i + 1;
 }
 
-/// The header lines that declare a path's posture count (checkDeclaredCount).
+/// The header lines that declare a path's posture count (checkDeclaredCount), as written.
 inline constexpr std::string_view kClCountPrefix = "# postures: ";
 inline constexpr std::string_view kAptCountPrefix = "PPRINT/POSTURES ";
+
+/// Whether `s` starts with `prefix`, ASCII letters compared without case.
+inline bool startsWithNoCase(std::string_view s, std::string_view prefix) {
+  if (s.size() < prefix.size()) return false;
+  for (std::size_t i = 0; i < prefix.size(); ++i)
+    if (std::tolower(static_cast<unsigned char>(s[i])) !=
+        std::tolower(static_cast<unsigned char>(prefix[i])))
+      return false;
+  return true;
+}
+
+/// What follows a header line's count keyword, or nullopt where the line declares no count:
+/// `.cl` `# postures: N` in any case and spacing (`#Postures:N`), APT `PPRINT/POSTURES N` in any
+/// case (a PPRINT is free text: only a number after POSTURES declares; see checkDeclaredCount).
+inline std::optional<std::string_view> declaredCountText(std::string_view l, bool apt) {
+  const auto skip = [](std::string_view& t) {
+    while (!t.empty() && std::isspace(static_cast<unsigned char>(t.front()))) t.remove_prefix(1);
+  };
+  if (apt) {
+    if (!startsWithNoCase(l, "PPRINT/")) return std::nullopt;
+    l.remove_prefix(7);
+    skip(l);
+    if (!startsWithNoCase(l, "POSTURES") || l.size() == 8 ||
+        !std::isspace(static_cast<unsigned char>(l[8])))
+      return std::nullopt;
+    l.remove_prefix(8);
+    skip(l);
+    if (l.empty() || !std::isdigit(static_cast<unsigned char>(l.front()))) return std::nullopt;
+    return l;
+  }
+  if (l.empty() || l.front() != '#') return std::nullopt;
+  l.remove_prefix(1);
+  skip(l);
+  if (!startsWithNoCase(l, "postures")) return std::nullopt;
+  l.remove_prefix(8);
+  skip(l);
+  if (l.empty() || l.front() != ':') return std::nullopt;
+  l.remove_prefix(1);
+  skip(l);
+  return l;
+}
 
 /// The posture count a path's writer declares in its header (`.cl`: `# postures: N ...`, APT:
 /// `PPRINT/POSTURES N ...`, anywhere before the first posture), checked against the `read`
 /// count: a path file cut short (a DNC or USB transfer) ends at a line boundary and reads as a
 /// shorter, valid path that stops in the cut (a helper's 500 lines of a 1089-posture path.cl read
-/// `check: ok`). Files that declare nothing are taken as they are.
+/// `check: ok`). A file that declares its count must also be whole (`complete`: `.cl` ends with a
+/// line end, APT with FINI, as their writers end them): one cut inside its last record read the
+/// fragment as a posture (`GOTO/0.37,15.03,1`: a 3-number GOTO at z = 1 where 17.8 was written,
+/// `check: ok`; a `.cl` cut in its last axis, normalised). A `.cl` declaration whose number is
+/// unreadable is refused (it switched the check off). Files that declare nothing are taken as
+/// they are.
 inline void checkDeclaredCount(std::string_view text, std::string_view prefix, std::size_t read,
-                               const std::filesystem::path& file) {
+                               const std::filesystem::path& file, bool complete) {
   const bool apt = prefix == kAptCountPrefix;
   std::size_t line = 1;
   for (std::size_t at = 0; at < text.size(); ++line) {
@@ -236,17 +283,30 @@ inline void checkDeclaredCount(std::string_view text, std::string_view prefix, s
     std::string_view l = text.substr(at, end - at);
     at = end + 1;
     while (!l.empty() && std::isspace(static_cast<unsigned char>(l.front()))) l.remove_prefix(1);
-    if (apt ? l.substr(0, 4) == "GOTO" : !l.empty() && l.front() != '#') return;  // a posture
-    if (l.substr(0, prefix.size()) != prefix) continue;
+    if (apt ? startsWithNoCase(l, "GOTO") : !l.empty() && l.front() != '#') return;  // a posture
+    const std::optional<std::string_view> rest = declaredCountText(l, apt);
+    if (!rest) continue;
     std::size_t declared = 0;
-    const char* first = l.data() + prefix.size();
-    const auto [next, error] = std::from_chars(first, l.data() + l.size(), declared);
-    if (error != std::errc() || next == first) continue;
+    const char* first = rest->data();
+    const char* last = rest->data() + rest->size();
+    const auto [next, error] = std::from_chars(first, last, declared);
+    if (error != std::errc() || next == first ||
+        (next != last && !std::isspace(static_cast<unsigned char>(*next)) && *next != '\r'))
+      fail(file, line,
+           "'" + std::string(l.substr(0, std::min<std::size_t>(l.size(), 40))) +
+               "': a posture count is a whole number (`" + std::string(prefix) +
+               "N`, the number of postures the file holds)");
     if (declared != read)
       fail(file, line,
            "declares " + std::to_string(declared) + " postures and the file holds " +
                std::to_string(read) + ": it was cut short (a transfer?) or edited; write it " +
                "again, or delete this line to take the file as it is");
+    if (!complete)
+      fail(file, line,
+           "declares " + std::to_string(declared) + " postures and the file ends " +
+               (apt ? std::string("without FINI") : std::string("inside its last line")) +
+               ": it was cut short (a transfer?) in its last record; write it again, or delete "
+               "this line to take the file as it is");
     return;
   }
 }

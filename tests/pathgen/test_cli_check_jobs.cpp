@@ -292,7 +292,7 @@ TEST(CheckClearance, AnUnsafeLinkIsNamedWithItsBlockAndTheKeysThatPlaceIt) {
   ASSERT_EQ(c.exit_code, 0) << c.output();
   const auto checked = nlohmann::json::parse(test::slurp(dir.path() / "chk" / "check.json"));
   const std::string line =
-      std::to_string(geometry::readPathFile(dir.path() / "out/path.cl").lines[1]);
+      std::to_string(geometry::readPathFile(dir.path() / "out/path.cl").lines[0]);
   EXPECT_NE(checked["unsafe"][0].get<std::string>().find(
                 "(first: posture 0 to the next (the link into pass 1, out/path.cl:" + line + "))"),
             std::string::npos)

@@ -102,6 +102,77 @@ TEST(PathFiles, AFileCutShortIsRefusedAtItsDeclaredCount) {
   EXPECT_EQ(geometry::readPathFile(dir.path() / "plain.cl").postures.size(), 2u);
 }
 
+// Cut inside its last record, a file still holds its declared count: the fragment reads as a
+// posture (an APT GOTO cut before its `$` is a 3-number GOTO at z = 1 where 17.8 was written; a
+// `.cl` line cut in its axis is normalised). A file that declares its count must end as its
+// writer ends it (APT: FINI; `.cl`: a line end). The declaration is read in any case and
+// spacing, and one whose number is unreadable is refused (both switched the check off: a helper).
+TEST(PathFiles, AFileCutInsideItsLastRecordIsRefused) {
+  PathFile path;
+  for (int i = 0; i < 12; ++i) {
+    Posture p;
+    p.tip_mm = {0.37 + i, 15.03, 17.83};
+    p.axis = Eigen::Vector3d(0.1, 0.2, 1.0).normalized();
+    path.postures.push_back(p);
+  }
+  path.blocks = {{PathBlock::Kind::Pass, 0, 12}};
+  TempDir dir;
+  geometry::writeClFile(dir.path() / "p.cl", path, "a path");
+  geometry::writeAptFile(dir.path() / "p.apt", path, geometry::AptHeader{});
+  const std::string cl = fieldpath::test::slurp(dir.path() / "p.cl");
+  const std::string apt = fieldpath::test::slurp(dir.path() / "p.apt");
+  // The last GOTO cut after its second comma and one digit, and the last .cl line after 3 bytes
+  // of its last axis component.
+  const std::size_t last_goto = apt.rfind("GOTO/");
+  const std::size_t second_comma = apt.find(',', apt.find(',', last_goto) + 1);
+  dir.write("cut.apt", apt.substr(0, second_comma + 2));
+  dir.write("nofini.apt", apt.substr(0, apt.rfind("FINI")));
+  dir.write("cut.cl", cl.substr(0, cl.size() - 4));
+  for (const char* name : {"cut.apt", "nofini.apt", "cut.cl"}) {
+    const std::string error = errorOf([&] { geometry::readPathFile(dir.path() / name); });
+    EXPECT_NE(error.find(std::string(name) + ":"), std::string::npos) << error;
+    EXPECT_NE(error.find("declares 12 postures and the file ends"), std::string::npos) << error;
+  }
+  // Deleting the declaration takes the file as it is (as the message says).
+  std::string undeclared = cl.substr(0, cl.size() - 4);
+  undeclared.erase(
+      undeclared.find("# postures: "),
+      undeclared.find('\n', undeclared.find("# postures: ")) + 1 - undeclared.find("# postures: "));
+  dir.write("undeclared.cl", undeclared);
+  EXPECT_EQ(geometry::readPathFile(dir.path() / "undeclared.cl").postures.size(), 12u);
+  // The declaration in other spellings is still one; a number that is none is refused.
+  const std::string body = "0 0 0 0 0 1\n1 0 0 0 0 1\n";
+  for (const std::string header : {"#postures:3\n", "# Postures : 3\n", "#\tPOSTURES: 3 (x)\n"}) {
+    dir.write("h.cl", header + body);
+    EXPECT_NE(errorOf([&] {
+                geometry::readPathFile(dir.path() / "h.cl");
+              }).find("declares 3 postures and the file holds 2"),
+              std::string::npos)
+        << header;
+  }
+  for (const std::string header : {"# postures: abc\n", "# postures: -1\n",
+                                   "# postures: 99999999999999999999999\n", "# postures: 2x\n"}) {
+    dir.write("h.cl", header + body);
+    EXPECT_NE(
+        errorOf([&] { geometry::readPathFile(dir.path() / "h.cl"); }).find("h.cl:1: '# postures: "),
+        std::string::npos)
+        << header;
+  }
+  dir.write("h.apt", "pprint/postures 3\ngoto/0,0,0,0,0,1\ngoto/1,0,0,0,0,1\nfini\n");
+  EXPECT_NE(errorOf([&] {
+              geometry::readPathFile(dir.path() / "h.apt");
+            }).find("declares 3 postures and the file holds 2"),
+            std::string::npos);
+  // A PPRINT is free text: POSTURES followed by words declares nothing.
+  dir.write("words.apt", "PPRINT/POSTURES ARE CHECKED\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0,0,0,1\n");
+  EXPECT_EQ(geometry::readPathFile(dir.path() / "words.apt").postures.size(), 2u);
+  // Whole, with CR LF line ends: read.
+  std::string crlf;
+  for (char c : cl) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  dir.write("crlf.cl", crlf);
+  EXPECT_EQ(geometry::readPathFile(dir.path() / "crlf.cl").postures.size(), 12u);
+}
+
 TEST(PathFiles, BadNpyFilesAreOneLineErrors) {
   TempDir dir;
   std::vector<Posture> postures(3);
