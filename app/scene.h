@@ -88,7 +88,8 @@ inline std::string toolShapeWhere(const Scene& scene) {
 /// inside, so a tool wholly inside the solid it was meant to bound (a fixture exported with a
 /// facet missing) reads as clear. Empty when every shell is closed; the impeller's blades, sheets
 /// by design, are not files and get none. The part's file gets one too, first (its open shells
-/// have no inside for the cutter test, and their winding says which side is the part's).
+/// have no inside for the cutter test, and their winding says which side is the part's). A part
+/// file named as an obstacle too gets one (it repels the tool from the surface it cuts).
 std::vector<std::string> openObstacleNotes(const Scene& scene);
 
 /// Turns scene.impeller / scene.guide_impeller into meshes (obstacles, part) and

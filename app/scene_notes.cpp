@@ -1,6 +1,9 @@
 /// What a scene's meshes leave unproven, said as notes by `generate` and `check`: open shells
-/// (no inside) of the obstacles and of the part (scene.h openObstacleNotes).
+/// (no inside) of the obstacles and of the part, and a part named as an obstacle too (scene.h
+/// openObstacleNotes).
+#include <filesystem>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "fieldpath/geometry/closed_shells.h"
@@ -26,6 +29,19 @@ std::vector<std::string> openObstacleNotes(const Scene& scene) {
           "check reads its sides by its winding (wound inward, a box with a face "
           "missing is a pocket): close the mesh to have its inside checked");
   }
+  // The part named as an obstacle too (DESIGN: obstacles are never the machined surface): it
+  // repels the tool from the surface it cuts, and a ball on it reads as colliding at every posture
+  // (accepted without a word: a helper's finding). Said, not refused: a mesh of the whole part,
+  // hub and blades, may be both where the hub is machined another way.
+  if (scene.part_file)
+    for (const std::filesystem::path& f : scene.obstacle_files) {
+      std::error_code ec;
+      if (!std::filesystem::equivalent(f, *scene.part_file, ec)) continue;
+      notes.push_back(f.string() +
+                      ": the part is also an obstacle: the surface being machined "
+                      "repels the tool and a ball on it reads as colliding; obstacles are the "
+                      "surfaces to keep clear of (give the machined surface as `part` only)");
+    }
   for (std::size_t i = 0; i < scene.obstacle_files.size() && i < scene.obstacles.size(); ++i) {
     const std::size_t open = geometry::openShells(scene.obstacles[i]).size();
     if (open == 0) continue;

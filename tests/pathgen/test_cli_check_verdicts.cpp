@@ -1,8 +1,9 @@
 /// `check`'s verdict on what is not a collision, through the built `fieldpath`: postures and
 /// motions under the scene's clearance, the gouge tolerance of `--gouge-tol`, a spacing coarsened
-/// to the largest grid; and `generate`'s travel plane over a part taller than the obstacles. (A
-/// test audit: none of these had a test; deleting the under-the-clearance lines of `check` left it
-/// saying `ok` of a path 0.3 mm from a blade with the scene asking 0.5.)
+/// to the largest grid, a part named as an obstacle too; and `generate`'s travel plane over a
+/// part taller than the obstacles. (A test audit: none of these had a test; deleting the
+/// under-the-clearance lines of `check` left it saying `ok` of a path 0.3 mm from a blade with the
+/// scene asking 0.5.)
 #include <cmath>
 #include <filesystem>
 #include <string>
@@ -156,4 +157,29 @@ TEST(GenerateLinks, TheTravelPlaneClearsAPartTallerThanTheObstacles) {
   const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out" / "report.json"));
   EXPECT_DOUBLE_EQ(report["links"]["safe_z_mm"].get<double>(), 30 + 0.5 + 2) << report["links"];
   EXPECT_TRUE(report["safe"].get<bool>()) << report["unsafe"];
+}
+
+// The part named as an obstacle too (DESIGN: obstacles are never the machined surface): the ball
+// on it reads as colliding at every posture; said, naming the file, on stderr and in check.json.
+TEST(CheckVerdict, APartThatIsAlsoAnObstacleIsSaid) {
+  const TempDir dir;
+  geometry::saveMesh(pathgen::test::boxMesh(-20, 20, -20, 20, -10, 0), dir.path() / "part.stl");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: part.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 40 }\n");
+  dir.write("top.cl", "# pass 1\n0 0 0 0 0 1\n1 0 0 0 0 1\n");
+  const auto r = test::runFieldpath(dir, "check scene.yaml --path top.cl --out c");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  EXPECT_NE(r.err.find("part.stl: the part is also an obstacle"), std::string::npos) << r.err;
+  const nlohmann::json check = checkJson(dir, "c");
+  EXPECT_TRUE(says(check["obstacle_notes"], "the part is also an obstacle")) << check;
+  EXPECT_GT(check["clearance"]["colliding_postures"].get<int>(), 0);
+  // Apart, no such note.
+  geometry::saveMesh(pathgen::test::boxMesh(40, 50, -5, 5, 0, 10), dir.path() / "far.stl");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: far.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 40 }\n");
+  const auto apart = test::runFieldpath(dir, "check scene.yaml --path top.cl --out d");
+  ASSERT_EQ(apart.exit_code, 0) << apart.output();
+  EXPECT_EQ(apart.err.find("also an obstacle"), std::string::npos) << apart.err;
 }
