@@ -307,3 +307,37 @@ TEST(GenerateEdges, APassTheSteeringDrivesIntoThePartKeepsItsClearNominalAxes) {
     }
   }
 }
+
+// The nominal axes are kept only where they clear the motions too: the same pass with postures
+// 2 mm apart and a grain 0.01 mm across beside the ball's equator, halfway between two postures
+// (0.11 mm from the ball at each, inside the ball's sweep between them: 2.95 mm from its centre
+// line). The nominal pass clears every posture and not that motion: it is not written (a test
+// audit: the kept pass's motion, holder and cutter checks were never what decided).
+TEST(GenerateEdges, NominalAxesThatClearThePosturesButNotAMotionAreNotKept) {
+  const TempDir dir;
+  geometry::TriangleMesh part, post;
+  pathgen::test::addBox(part, -30, 12, -30, 30, -5, 0);
+  pathgen::test::addBox(part, 12, 20, -30, 30, -5, 60);
+  pathgen::test::addBox(post, -11, -9, -30, 30, 0, 30);
+  pathgen::test::addBox(post, 2.95, 2.96, 0.995, 1.005, 2.995, 3.005);  // the grain
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(post, dir.path() / "post.stl");
+  std::ostringstream cl;
+  cl << "# pass 1\n";
+  for (int i = -5; i <= 5; ++i) cl << "0 " << 2 * i << " 0 0 0 1\n";
+  dir.write("p.cl", cl.str());
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: post.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 20 }\nholder: [[20, 8], [40, 8]]\n"
+            "clearance: 0.05\npath: { nominal: p.cl }\n");
+  // The nominal path itself: clear at every posture, colliding on the motion across the grain.
+  ASSERT_EQ(test::runFieldpath(dir, "generate scene.yaml --nominal --out nominal").exit_code, 0);
+  const auto nominal = nlohmann::json::parse(test::slurp(dir.path() / "nominal/report.json"));
+  ASSERT_EQ(nominal["clearance"]["colliding_postures"].get<int>(), 0) << nominal["clearance"];
+  ASSERT_GT(nominal["motions"]["colliding_motions"].get<int>(), 0) << nominal["motions"];
+  const auto steered = test::runFieldpath(dir, "generate scene.yaml --out steered");
+  ASSERT_EQ(steered.exit_code, 0) << steered.output();
+  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "steered/report.json"));
+  EXPECT_EQ(report["kept_nominal"].size(), 0u) << report["kept_nominal"];
+  EXPECT_FALSE(report["safe"].get<bool>());
+}
