@@ -42,6 +42,12 @@ inline std::shared_ptr<SumField> channel(double y_left_mm, double y_right_mm) {
   return sum;
 }
 
+/// The tool dwelling at the start of the straight pass (the centre does not move; s still runs).
+inline Pass dwell(double length_mm) {
+  const PassFrame at_start = straightPass(1.0).frameAt(0.0);
+  return Pass{length_mm, [at_start](double) { return at_start; }};
+}
+
 inline SteeringRequest requestFor(const field::ForceField* field) {
   SteeringRequest r;
   r.field = field;

@@ -52,13 +52,16 @@ TEST_P(FreeResponse, MatchesTheAnalyticDampedOscillator) {
   ASSERT_EQ(result.status, Status::Ok) << result.message;
   const DynamicsParams& p = request.params;
   const double v = p.feed_mm_per_min / 60.0;
+  // Critical damping written here, c = 2 sqrt(k J) (the reference took the program's own value,
+  // and followed a wrong one into the overdamped branch: a test audit).
+  const double c = GetParam().damping >= 0.0 ? GetParam().damping : 2.0 * std::sqrt(2.0 * 0.5);
   double worst = 0.0;
   for (const PostureSample& s : result.samples) {
     const double t = s.s_mm / v;
-    worst = std::max(worst, std::abs(s.lead_rad - analyticAngle(p.inertia, p.effectiveDamping(),
-                                                                p.stiffness, 0.1, t)));
-    worst = std::max(worst, std::abs(s.tilt_rad - analyticAngle(p.inertia, p.effectiveDamping(),
-                                                                p.stiffness, 0.2, t)));
+    worst =
+        std::max(worst, std::abs(s.lead_rad - analyticAngle(p.inertia, c, p.stiffness, 0.1, t)));
+    worst =
+        std::max(worst, std::abs(s.tilt_rad - analyticAngle(p.inertia, c, p.stiffness, 0.2, t)));
     EXPECT_EQ(s.moment, Vec3::Zero());
   }
   EXPECT_LT(worst, 1e-4 * 0.2) << GetParam().name;
@@ -72,6 +75,45 @@ INSTANTIATE_TEST_SUITE_P(Dynamics, FreeResponse,
                                            OscillatorCase{"critical", -1.0},
                                            OscillatorCase{"over", 5.0}),
                          [](const auto& info) { return std::string(info.param.name); });
+
+// The spring pulls to the pass's nominal angles θ0(s) (DESIGN: k (θ - θ0(s))), not to 0: with
+// θ0 = (0.05, -0.08) rad the free response is θ0 + (θi - θ0) times the oscillator's from 1, and a
+// pass started without initial angles starts at θ0 and stays there (every test had θ0 = 0: a
+// spring pulling to 0 passed them all, a test audit).
+TEST(FreeResponse, TheSpringPullsToTheNominalAngles) {
+  const double lead0 = 0.05, tilt0 = -0.08;
+  const Pass straight = straightPass(200.0);
+  const Pass pass{200.0, [&](double s_mm) {
+                    PassFrame f = straight.frameAt(s_mm);
+                    f.lead0_rad = lead0;
+                    f.tilt0_rad = tilt0;
+                    return f;
+                  }};
+  SteeringRequest request = requestFor(nullptr);
+  request.params.inertia = 0.5;
+  request.params.stiffness = 2.0;
+  request.params.damping = 0.4;  // under-damped: the nominal is crossed and returned to
+  request.initial_lead_rad = 0.1;
+  request.initial_tilt_rad = 0.2;
+  const SteeringResult result = runToleranceStable(pass, request);
+  ASSERT_EQ(result.status, Status::Ok) << result.message;
+  const double v = request.params.feed_mm_per_min / 60.0;
+  double worst = 0.0;
+  for (const PostureSample& s : result.samples) {
+    const double unit = analyticAngle(0.5, 0.4, 2.0, 1.0, s.s_mm / v);
+    worst = std::max(worst, std::abs(s.lead_rad - (lead0 + (0.1 - lead0) * unit)));
+    worst = std::max(worst, std::abs(s.tilt_rad - (tilt0 + (0.2 - tilt0) * unit)));
+  }
+  EXPECT_LT(worst, 1e-4 * 0.28);
+  EXPECT_NEAR(result.samples.back().tilt_rad, tilt0, 1e-3);
+  SteeringRequest still = requestFor(nullptr);
+  const SteeringResult at_rest = steerPass(pass, still);
+  ASSERT_EQ(at_rest.status, Status::Ok) << at_rest.message;
+  for (const PostureSample& s : at_rest.samples) {
+    EXPECT_NEAR(s.lead_rad, lead0, 1e-12) << s.s_mm;
+    EXPECT_NEAR(s.tilt_rad, tilt0, 1e-12) << s.s_mm;
+  }
+}
 
 TEST(FreeResponse, DefaultsAreCriticalAndDoNotOvershoot) {
   SteeringRequest request = requestFor(nullptr);
@@ -299,12 +341,6 @@ TEST_P(CoarseLattice, VoxelBoundaryCrossingsDoNotDiverge) {
 
 INSTANTIATE_TEST_SUITE_P(Dynamics, CoarseLattice, ::testing::Values(false, true),
                          [](const auto& info) { return info.param ? "nearest" : "trilinear"; });
-
-/// The tool dwelling at the start of the straight pass (the centre does not move; s still runs).
-Pass dwell(double length_mm) {
-  const PassFrame at_start = straightPass(1.0).frameAt(0.0);
-  return Pass{length_mm, [at_start](double) { return at_start; }};
-}
 
 TEST(PlaneWall, WallAheadLeansTheAxisBack) {
   auto ahead =

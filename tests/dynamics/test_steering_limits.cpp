@@ -48,6 +48,68 @@ TEST(Limits, ClampHoldsTheAxisAtTheLimit) {
   EXPECT_TRUE(result.samples.back().limited);
 }
 
+// Clamped either way and on either angle: a wall on the -y side tilts the axis negative, held at
+// -3°; a wall ahead leans it back, held at the lead limit -1°; at a held sample the stop has
+// absorbed the motion (rate 0). (Only a positive tilt was ever clamped: a clamp to +limit, or
+// to the tilt's limit for the lead, or one leaving the rate, passed: a test audit.)
+TEST(Limits, ClampHoldsEitherSignAndEitherAngleAtRest) {
+  const auto below = wallAt(-4.0);
+  SteeringRequest request = requestFor(below.get());
+  request.params.max_tilt_deg = 3.0;
+  request.params.on_limit = LimitPolicy::Clamp;
+  const SteeringResult tilt = runToleranceStable(straightPass(300.0), request);
+  ASSERT_EQ(tilt.status, Status::Ok) << tilt.message;
+  EXPECT_NEAR(tilt.samples.back().tilt_rad, -3.0 * kDeg, 1e-12);
+  auto ahead = std::make_shared<PlaneField>(Vec3(4.0, 0, 0), -Vec3::UnitX(), kGain);
+  SteeringRequest lean = requestFor(ahead.get());
+  lean.params.max_lead_deg = 1.0;  // the wall wants more than 1° (PlaneWall.WallAhead...)
+  lean.params.on_limit = LimitPolicy::Clamp;
+  const SteeringResult lead = runToleranceStable(dwell(300.0), lean);
+  ASSERT_EQ(lead.status, Status::Ok) << lead.message;
+  EXPECT_NEAR(lead.samples.back().lead_rad, -1.0 * kDeg, 1e-12);
+  EXPECT_NEAR(lead.samples.back().tilt_rad, 0.0, 1e-12);
+  for (const SteeringResult* r : {&tilt, &lead}) {
+    EXPECT_GT(r->clamped_samples, 0);
+    for (const PostureSample& s : r->samples) {
+      EXPECT_LE(std::abs(s.tilt_rad), 3.0 * kDeg * (1 + 1e-12));
+      EXPECT_LE(std::abs(s.lead_rad), 20.0 * kDeg);
+      if (!s.limited) continue;
+      EXPECT_EQ(r == &tilt ? s.tilt_rate_rad_per_s : s.lead_rate_rad_per_s, 0.0) << s.s_mm;
+    }
+  }
+}
+
+// The rate limit is per mm of path whatever the step: stations every 0.5 mm turn half as much a
+// step; and it reads the lead too. Clamp goes on and marks the samples.
+TEST(Limits, AngleChangePerMmIsPerMmOnEitherAngle) {
+  for (const bool on_lead : {false, true}) {
+    SteeringRequest request = requestFor(nullptr);
+    request.step_mm = 0.5;
+    request.params.on_limit = LimitPolicy::Fail;
+    (on_lead ? request.initial_lead_rad : request.initial_tilt_rad) = 0.2;
+    // The free return's fastest turn, degrees per mm, from its samples (no limit set).
+    const SteeringResult free = steerPass(straightPass(100.0), request);
+    double fastest = 0.0;
+    for (std::size_t i = 1; i < free.samples.size(); ++i)
+      fastest = std::max(
+          fastest, std::abs(on_lead ? free.samples[i].lead_rad - free.samples[i - 1].lead_rad
+                                    : free.samples[i].tilt_rad - free.samples[i - 1].tilt_rad) /
+                       (free.samples[i].s_mm - free.samples[i - 1].s_mm) / kDeg);
+    ASSERT_GT(fastest, 0.1);
+    request.max_angle_change_deg_per_mm = 0.9 * fastest;
+    EXPECT_EQ(steerPass(straightPass(100.0), request).status, Status::RateLimit) << on_lead;
+    request.max_angle_change_deg_per_mm = 1.1 * fastest;
+    EXPECT_EQ(steerPass(straightPass(100.0), request).status, Status::Ok) << on_lead;
+    request.max_angle_change_deg_per_mm = 0.9 * fastest;
+    request.params.on_limit = LimitPolicy::Clamp;
+    const SteeringResult marked = steerPass(straightPass(100.0), request);
+    ASSERT_EQ(marked.status, Status::Ok) << marked.message;
+    int limited = 0;
+    for (const PostureSample& s : marked.samples) limited += s.limited;
+    EXPECT_GT(limited, 0) << on_lead;
+  }
+}
+
 TEST(Limits, AngleChangePerMmIsReported) {
   SteeringRequest request = requestFor(nullptr);
   request.params.on_limit = LimitPolicy::Fail;
