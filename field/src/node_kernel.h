@@ -91,6 +91,7 @@ struct Rules {
 
 constexpr double kOverCos = 0.7;  ///< |cos| of the field's angle to n* over the surface
 constexpr double kPlaneFit = 0.1;  ///< voxel_field.h kPlaneFitTolerance (a device constant)
+constexpr double kPlaneRescale = 2.0;  ///< voxel_field.h kPlaneRescaleLimit
 
 /// A running sum of eq. 1 and the nearest sample (by squared distance, then lowest id).
 struct Accum {
@@ -308,14 +309,19 @@ FP_HD NodeValue nodeValue(Hood& hood, const Law& L, const Rules& R, D3 x) {
     double plane = L.planeAt(e);
     s_mm = e - lift_mm;
     // The continuation at the node itself, against the node's exact force: where it gives more
-    // than kPlaneFit above it, the node's own force (voxel_build.cpp planeRatio).
-    if (lift_mm > 0.0 && plane > 0.0 &&
-        L.planeAt(s_mm) * norm(f) > (1.0 + kPlaneFit) * plane * norm(p.force)) {
+    // than kPlaneFit above it, G scaled to the node's own force at the continuation's height, or
+    // past kPlaneRescale × the node's own force (voxel_build.cpp planeRatio).
+    const double continued = L.planeAt(s_mm) * norm(f), own = plane * norm(p.force);
+    if (lift_mm > 0.0 && plane > 0.0 && continued > (1.0 + kPlaneFit) * own) {
       f = p.force;
-      s_mm = L.planeHeight(norm(f));
-      if (eta < 0.0) s_mm = dmax(-s_mm, eta);  // under, no deeper than the node (voxel_refine)
-      plane = L.planeAt(s_mm);
-      over = false;
+      if (continued <= kPlaneRescale * own) {
+        plane = L.planeAt(s_mm);
+      } else {
+        s_mm = L.planeHeight(norm(f));
+        if (eta < 0.0) s_mm = dmax(-s_mm, eta);  // under, no deeper than the node (voxel_refine)
+        plane = L.planeAt(s_mm);
+        over = false;
+      }
     }
     g = plane > 0.0 ? D3{f.x / plane, f.y / plane, f.z / plane} : D3{0, 0, 0};
   }

@@ -43,7 +43,8 @@ bool overSurface(const detail::Probe& p, double over_mm) {
 }
 
 constexpr double kOverCos = 0.7;  ///< |cos| of the field's angle to n* over the surface
-static_assert(kernel::kPlaneFit == kPlaneFitTolerance && kernel::kOverCos == kOverCos,
+static_assert(kernel::kPlaneFit == kPlaneFitTolerance &&
+                  kernel::kPlaneRescale == kPlaneRescaleLimit && kernel::kOverCos == kOverCos,
               "the block and CUDA builds' rules are the reference's");
 
 /// One node of the plane ratio: s (mm), G, and whether it lies over/under the surface.
@@ -92,12 +93,18 @@ RatioNode planeRatio(const detail::Probe& p, const Vec3& x, const Vec3& q, const
   const double lift_mm = near_mm - eta;
   const Vec3 lifted = field_at(Vec3(x + lift_mm * n));
   // The continuation at the node itself, against the node's exact force (kPlaneFitTolerance):
-  // where it overstates it, the node's own force, s = P⁻¹(|F|); under the surface s < 0 and
+  // where it overstates it up to kPlaneRescaleLimit ×, its height kept and G scaled to the
+  // node's own force; beyond, the node's own force, s = P⁻¹(|F|); under the surface s < 0 and
   // no deeper than the node (η <= s: the refinement's inside test reads s as a height).
   const double e = law.height(lifted.norm());
   const double plane = law.at(e);
-  if (plane > 0.0 &&
-      law.at(e - lift_mm) * lifted.norm() > (1.0 + kPlaneFitTolerance) * plane * p.force->norm()) {
+  const double continued = law.at(e - lift_mm) * lifted.norm(), own = plane * p.force->norm();
+  if (plane > 0.0 && continued > (1.0 + kPlaneFitTolerance) * own &&
+      continued <= kPlaneRescaleLimit * own) {
+    const double at_node = law.at(e - lift_mm);
+    return {e - lift_mm, at_node > 0.0 ? Vec3(*p.force / at_node) : Vec3::Zero(), over};
+  }
+  if (plane > 0.0 && continued > (1.0 + kPlaneFitTolerance) * own) {
     double s_mm = law.height(p.force->norm());
     if (eta < 0.0) s_mm = std::max(-s_mm, eta);
     const double own = law.at(s_mm);

@@ -141,7 +141,7 @@ struct Accessors {
 /// s jumps there, and P(s~) would read the wall's r_min value in mid-air; the corner forces are
 /// blended instead. A cell wholly under the surface holds it too (s~ < 0 throughout), also with
 /// corners not over it: nodes under a surface that is no plane's hold their own force with
-/// s = -P⁻¹(|F|) (kPlaneFitTolerance), whose decay the blend follows where forces blended
+/// s = -P⁻¹(|F|) (past kPlaneRescaleLimit), whose decay the blend follows where forces blended
 /// trilinearly overshoot (+27 % 1 mm under a lone triangle at h = 0.5).
 /// (`whole_under_holds` false: not so for quadratic interpolation, whose 27 nodes reach past
 /// the cell's 8 corners this tests.)
