@@ -324,5 +324,24 @@ TEST(StudyCommand, BadInputIsExitOneWithNoOutputs) {
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "study"));
 }
 
+// Near the blades' open edges the plane ratio's continuation overstates the nodes' own force by
+// tens of percent; such nodes keep the continuation's height and scale G (field
+// kPlaneRescaleLimit), so their cells interpolate a plane's s. Holding their own force instead
+// (the rule as first written, 2026-11-28) made those cells blend the forces of a 1/r³ field:
+// on this small job 2 mm line a 0.2 -> 46 %, line b 10.7 -> 121 %, 1 mm line b 9.5 -> 17.6 %
+// (the study of record: 2 mm nodes 91 -> 252 %, a researcher's re-run). Blades sampled every
+// 0.5 mm, as the study's record.
+TEST(StudyRefinement, TheBladesOpenEdgesKeepThePlaneRatio) {
+  StudyRequest request = planeRatioStudy({2.0, 1.0});
+  request.job.field.sample_step_mm = 0.5;
+  const StudyResult result = runStudy(request);
+  const StudyRow& two = rowNamed(result, "voxel 2 mm trilinear plane_ratio");
+  const StudyRow& one = rowNamed(result, "voxel 1 mm trilinear plane_ratio");
+  EXPECT_LT(two.line_a.relative.max_relative, 0.05);
+  EXPECT_LT(two.line_b.relative.max_relative, 0.3);
+  EXPECT_LT(one.line_b.relative.max_relative, 0.13);
+  EXPECT_LT(one.nodes.relative.max_relative, two.nodes.relative.max_relative);
+}
+
 }  // namespace
 }  // namespace fieldpath::app
