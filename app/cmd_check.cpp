@@ -306,8 +306,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     if (rapids_onto_passes > 0)
       unsafe.push_back(std::to_string(rapids_onto_passes) +
                        " links end with a rapid move onto a pass's first posture, where the ball "
-                       "cuts (first: posture " +
-                       std::to_string(first_rapid_onto_pass) + "): no retract before the pass");
+                       "cuts (first: " +
+                       postureWhere(path, first_rapid_onto_pass) + "): no retract before the pass");
     std::vector<std::string> not_ok = unsafe;
     if (const std::string gouge = cutterGougeReason(cutter_part); !gouge.empty())
       not_ok.push_back(gouge);

@@ -23,6 +23,7 @@
 #include "commands.h"
 #include "errors.h"
 #include "fieldpath/common/atomic_file.h"
+#include "fieldpath/common/file_digest.h"
 #include "fieldpath/common/limits.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/mesh.h"
@@ -400,8 +401,11 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
         {"heights_mm", {{"min", finiteOrNull(*lo)}, {"max", finiteOrNull(*hi)}}},
         // What the lines no pass cut still hold (`view` greys them): the stock plane, exactly
         // as the heights store it (float), or the part's top (--part).
-        {"stock", part ? nlohmann::json{{"part", o->part}}
-                       : nlohmann::json{{"plane_mm", double(req.stock_mm)}}},
+        // The part's digest: `view` tells whether it is its scene's part (the name is relative to
+        // where simulate ran).
+        {"stock",
+         part ? nlohmann::json{{"part", o->part}, {"part_digest", common::fileDigest(o->part)}}
+              : nlohmann::json{{"plane_mm", double(req.stock_mm)}}},
         {"backend", zb::backendName(res.backend)},
         {"backend_asked", choice},
         {"streamed", streamed},

@@ -184,13 +184,15 @@ inline std::string axisTurnWarning(const geometry::PathFile& path, const pathgen
 }
 
 /// The block posture i lies in, as a user reads it: "pass K" (numbered from 1, as `# pass K`),
-/// "the link into pass K", "the link after the last pass"; empty past the blocks.
+/// "the link into pass K", "the link after the last pass" ("a link" in a path of links only);
+/// empty past the blocks.
 inline std::string blockOf(const geometry::PathFile& path, std::size_t i) {
   std::size_t passes_before = 0;
   for (const geometry::PathBlock& b : path.blocks) {
     const bool pass = b.kind == geometry::PathBlock::Kind::Pass;
     if (i >= b.begin && i < b.end)
       return pass ? "pass " + std::to_string(passes_before + 1)
+             : path.count(geometry::PathBlock::Kind::Pass) == 0 ? std::string("a link")
              : passes_before == path.count(geometry::PathBlock::Kind::Pass)
                  ? std::string("the link after the last pass")
                  : "the link into pass " + std::to_string(passes_before + 1);

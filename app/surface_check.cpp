@@ -96,6 +96,8 @@ const char* glyph(char c) {
       return "111101111001111";
     case '-':
       return "000000111000000";
+    case '>':
+      return "100010001010100";
     case '.':
       return "000000000000010";
     case 'u':
@@ -173,30 +175,37 @@ void writeDeviationPng(const std::filesystem::path& file, const SurfaceResult& s
   const int legend_w = bar_w + 8 * scale + 4 * scale * static_cast<int>(label_chars);
   Image img{map_w + legend_w, std::max(map_h, 60 * scale), {}};
   img.rgb.assign(static_cast<std::size_t>(img.width) * img.height * 3, 255);
+  bool above = false;  // some line shown above the bar's top (its swatch and '>' then drawn)
   for (int py = 0; py < map_h; ++py) {
     for (int px = 0; px < map_w; ++px) {
       const int ix = px * k, iy = (map_h - 1 - py) * k;
       const std::size_t line = static_cast<std::size_t>(iy) * grid.nx + ix;
       const float d = dev_um[line];
       const bool stock = !stats.lowered.empty() && !stats.lowered[line];
+      const bool over = !std::isnan(d) && !stock && d > scallop_scale + 0.5;
+      above = above || over;
       img.set(px, py,
               std::isnan(d) ? std::array<std::uint8_t, 3>{200, 200, 200}
               : stock       ? std::array<std::uint8_t, 3>{235, 222, 179}  // never cut: the stock
-              : d > scallop_scale + 0.5 ? kAboveScale
-                                        : deviationColour(d, gouge_scale, scallop_scale));
+              : over        ? kAboveScale
+                            : deviationColour(d, gouge_scale, scallop_scale));
     }
   }
-  // Colour bar: top = max scallop, middle = 0, bottom = max gouge.
-  const int bar_x = map_w + 4 * scale, bar_top = 4 * scale, bar_h = img.height - 8 * scale;
+  // Colour bar: top = max scallop, middle = 0, bottom = max gouge; above it, the swatch of what
+  // lies above its top, labelled '>'.
+  const int bar_x = map_w + 4 * scale, bar_top = 7 * scale, bar_h = img.height - 11 * scale;
   for (int y = 0; y < bar_h; ++y) {
     const double t = 1.0 - 2.0 * y / (bar_h - 1);  // +1 top, -1 bottom
     const double dev = t >= 0 ? t * scallop_scale : t * gouge_scale;
     for (int x = 0; x < bar_w; ++x)
       img.set(bar_x + x, bar_top + y, deviationColour(dev, gouge_scale, scallop_scale));
   }
-  for (int y = 0; y < 3 * scale; ++y)  // above the bar: what lies above its top
-    for (int x = 0; x < bar_w; ++x) img.set(bar_x + x, y, kAboveScale);
   const int label_x = bar_x + bar_w + 2 * scale;
+  if (above) {
+    for (int y = 0; y < 5 * scale; ++y)
+      for (int x = 0; x < bar_w; ++x) img.set(bar_x + x, y, kAboveScale);
+    img.text(label_x, 0, ">", scale);
+  }
   img.text(label_x, bar_top, labels[0], scale);
   img.text(label_x, bar_top + bar_h / 2 - 3 * scale, labels[1], scale);
   img.text(label_x, bar_top + bar_h - 5 * scale, labels[2], scale);

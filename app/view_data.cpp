@@ -446,16 +446,21 @@ ViewData gatherView(const ViewRequest& request) {
     p.postures_under_required = postures_under;
     if (p.colliding_postures == 0 && p.colliding_motions == 0 &&
         (postures_under > 0 || p.motions_under_required > 0)) {
+      const auto count = [](std::size_t n, const char* what) {
+        return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
+      };
       char text[160];
-      std::snprintf(text, sizeof text, "UNDER THE REQUIRED CLEARANCE (%.3f mm): %zu postures",
-                    scene.clearance_mm, postures_under);
+      std::snprintf(text, sizeof text,
+                    "UNDER THE REQUIRED CLEARANCE (%.3f mm): ", scene.clearance_mm);
       std::string line = text;
-      if (closest != ViewPath::npos) {
+      if (postures_under > 0) {
         std::snprintf(text, sizeof text, " (closest %.3f mm, ", p.clearance_mm[closest]);
-        line += text + postureWhere(p.file, closest) + ")";
+        line += count(postures_under, "posture") + text + postureWhere(p.file, closest) + ")";
       }
-      line += " and " + std::to_string(p.motions_under_required) +
-              " motions under it (orange on the path coloured by clearance)";
+      if (p.motions_under_required > 0)
+        line += std::string(postures_under > 0 ? " and " : "") +
+                count(p.motions_under_required, "motion");
+      line += " under it (orange on the path coloured by clearance)";
       d.warnings.push_back(line);
     }
     if (check) {  // whose the part's contacts are (the page called a cutter's gouge the holder's)

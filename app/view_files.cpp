@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "errors.h"
+#include "fieldpath/common/file_digest.h"
 #include "fieldpath/common/limits.h"
 #include "scene.h"
 #include "surface_check.h"
@@ -196,33 +197,21 @@ ViewSurface readSurface(const fs::path& dir, const Scene& scene, std::size_t max
   const std::size_t lines = s.grid.lineCount();
   s.height_mm.assign(lines, NAN);
   s.value.assign(lines, NAN);
-  std::vector<float> top;  // the part's top per block
-  // A check's line no pass cut keeps the stock allowance, told along its facet's normal: 2000
-  // cos(slope) um (on a 45° slope 1414: the page showed such lines as stock beside the band, a
-  // reviewer's finding). Each line by its own facet (a block's centre misread a curved part).
-  std::vector<char> line_uncut;
+  // The part's top and facet normal under each source line, once: a check's uncut lines and
+  // simulate's per-line deviation both read them; the blocks' top places a check's surface.
+  std::vector<float> top, source_top, source_nz;
   if (scene.part) {
     const zbuffer::ToolMesh part = toZbuffer(*scene.part);
-    top = zbuffer::partTop(s.grid, part.vertices, part.triangles);
-    if (deviation) {
-      std::vector<float> nz;
-      const std::vector<float> source_top =
-          zbuffer::partTop(source, part.vertices, part.triangles, &nz);
-      line_uncut.assign(values.size(), 0);
-      // The allowance itself, to 0.5 % (a cut line under an overhang, measured against the part
-      // beneath, may stand above it: a reviewer's 990-3999 um lines under a 60° cap).
-      for (std::size_t i = 0; i < values.size(); ++i) {
-        const float stock_um = kStockAllowanceMm * 1e3f * nz[i];
-        line_uncut[i] = std::isfinite(source_top[i]) &&
-                        std::abs(values[i] - stock_um) <= 0.005f * stock_um + 0.5f;
-      }
-    }
+    if (deviation) top = zbuffer::partTop(s.grid, part.vertices, part.triangles);
+    source_top = zbuffer::partTop(source, part.vertices, part.triangles, &source_nz);
   }
   // Lines no pass cut keep simulate's stock: its plane (simulate.json `stock.plane_mm`, stored
-  // as the heights are, in float: a line at it was never lowered), or the part's top (`--part`:
-  // the scene's part at the block). Without simulate.json (older folders, --outputs without
-  // json), lines at the highest height: wrong where every line was cut (the highest cusps then
-  // read as uncut), so simulate.json's `lines_lowered` equal to the line count overrides it.
+  // as the heights are, in float: a line at it was never lowered), or the part's top (`--part`
+  // of the scene's part, by its digest: another mesh's top is not known here, and a cast stock
+  // 1 mm over the part read every cut line as uncut, a reviewer's finding). Without
+  // simulate.json (older folders, --outputs without json), lines at the highest height: wrong
+  // where every line was cut (the highest cusps then read as uncut), so simulate.json's
+  // `lines_lowered` equal to the line count overrides it.
   float stock = -INFINITY;
   bool part_stock = false, all_cut = false;
   if (!deviation) {
@@ -235,60 +224,73 @@ ViewSurface readSurface(const fs::path& dir, const Scene& scene, std::size_t max
         const json& st = j["stock"];
         if (st.contains("plane_mm") && st["plane_mm"].is_number())
           stock = static_cast<float>(st["plane_mm"].get<double>());
-        part_stock = st.contains("part") && scene.part.has_value();
+        if (st.contains("part")) {
+          const std::string digest = st.value("part_digest", std::string());
+          part_stock =
+              scene.part_file && !digest.empty() && digest == common::fileDigest(*scene.part_file);
+          if (!part_stock && !all_cut) {
+            all_cut = true;  // nothing greyed: every line shown as it stands
+            warnings.push_back(where + ": simulate started from " + st["part"].get<std::string>() +
+                               ", not this scene's part (or a folder written before simulate "
+                               "said which): the lines no pass cut are not told apart");
+          }
+        }
       }
     }
   }
-  // simulate's heights over a part: each line's deviation from the part under it, as a check's
-  // (a block's lowest line less the part at the block's centre read the downhill line of every
-  // block on a slope as a gouge: 29 000 of 73 000 blocks of a clean ramp, a helper's finding).
-  std::vector<float> line_dev;
-  if (!deviation && scene.part) {
-    const zbuffer::ToolMesh part = toZbuffer(*scene.part);
-    const std::vector<float> source_top = zbuffer::partTop(source, part.vertices, part.triangles);
-    line_dev.assign(values.size(), NAN);
-    line_uncut.assign(values.size(), 0);
-    for (std::size_t i = 0; i < values.size(); ++i) {
-      if (!std::isfinite(source_top[i]) || std::isnan(values[i])) continue;
-      line_dev[i] = (values[i] - source_top[i]) * 1e3f;
-      line_uncut[i] = !all_cut && (part_stock ? values[i] >= source_top[i] - 1e-4f
-                                              : values[i] >= stock - 1e-4f);
+  // A line's deviation from the part along its facet's normal, um, as a check's (simulate's
+  // heights: a block's lowest line less the part at the block's centre read the downhill line
+  // of every block on a slope as a gouge, a helper's finding; the vertical gap read 1/n_z too
+  // much on a steep one, a reviewer's); NaN off the part. Without a part: the height.
+  const bool measured = deviation || scene.part.has_value();
+  auto lineValue = [&](std::size_t i) -> float {
+    if (deviation || !measured) return values[i];
+    if (!std::isfinite(source_top[i])) return NAN;
+    return (values[i] - source_top[i]) * 1e3f * source_nz[i];
+  };
+  // Whether no pass cut line i. A check's line keeps the stock allowance, told along its facet's
+  // normal (2000 cos(slope) um: on a 45° slope 1414, which the page showed as stock beside the
+  // band), to 0.5 % (a cut line under an overhang, measured against the part beneath, may stand
+  // above it: a reviewer's 990-3999 um lines under a 60° cap).
+  auto lineUncut = [&](std::size_t i) -> bool {
+    if (deviation) {
+      const float stock_um = kStockAllowanceMm * 1e3f * source_nz[i];
+      return std::isfinite(source_top[i]) &&
+             std::abs(values[i] - stock_um) <= 0.005f * stock_um + 0.5f;
     }
-  }
-  const std::vector<float>& dev_of = deviation ? values : line_dev;  // per line, um
-  auto uncut = [&](float lowest) { return !all_cut && lowest >= stock - 1e-4f; };
+    if (all_cut) return false;
+    return part_stock ? values[i] >= source_top[i] - 1e-4f : values[i] >= stock - 1e-4f;
+  };
   constexpr float kUncut = 1e30f;  // value of a block never cut (grey on the page)
-  // Block representative: deviation: its deepest gouge if it has one, else its largest scallop
-  // (a gouge is never averaged away); heights: the lowest (deepest cut).
+  // Block representative: a deviation's deepest gouge if it has one, else its largest scallop (a
+  // gouge is never averaged away); a height (no part): the lowest (deepest cut). Only the cut
+  // lines of a block that has some.
   for (int by = 0; by < s.grid.ny; ++by)
     for (int bx = 0; bx < s.grid.nx; ++bx) {
-      float lo = INFINITY, hi = -INFINITY;  // of the deviations (of the heights without a part)
-      float lowest = INFINITY;              // the block's lowest height (simulate's)
-      bool cut = false;  // some line of the block cut (its figures are those lines')
+      float lo = INFINITY, hi = -INFINITY;
+      float lowest = INFINITY;  // the block's lowest height (simulate's)
+      bool cut = false;
       for (int iy = by * k; iy < std::min(source.ny, (by + 1) * k); ++iy)
         for (int ix = bx * k; ix < std::min(source.nx, (bx + 1) * k); ++ix) {
           const std::size_t i = std::size_t(iy) * source.nx + ix;
           if (std::isnan(values[i])) continue;
           lowest = std::min(lowest, values[i]);
-          const float v = dev_of.empty() ? values[i] : dev_of[i];
+          const float v = lineValue(i);
           if (std::isnan(v)) continue;  // a line off the part
-          const bool uncut_line = !line_uncut.empty() && line_uncut[i];
+          const bool uncut_line = lineUncut(i);
           if (cut && uncut_line) continue;
-          if (!cut && !uncut_line && !line_uncut.empty()) lo = INFINITY, hi = -INFINITY;
+          if (!cut && !uncut_line) lo = INFINITY, hi = -INFINITY;
           cut = cut || !uncut_line;
           lo = std::min(lo, v);
           hi = std::max(hi, v);
         }
       const std::size_t b = std::size_t(by) * s.grid.nx + bx;
       if (!deviation && std::isfinite(lowest)) s.height_mm[b] = lowest;
-      if (lo > hi) continue;                                 // every line of the block off the part
-      const float dev = lo < -gouge_tolerance_um ? lo : hi;  // a gouge is never averaged away
+      if (lo > hi) continue;  // every line of the block off the part
+      const float dev = !measured ? lo : lo < -gouge_tolerance_um ? lo : hi;
       if (deviation)
         s.height_mm[b] = top[b] + dev * 1e-3f;  // NaN where the block centre misses the part
-      if (!dev_of.empty())
-        s.value[b] = cut ? dev : kUncut;
-      else
-        s.value[b] = uncut(lo) ? kUncut : lo;
+      s.value[b] = cut ? dev : kUncut;
     }
   s.deviation = deviation || scene.part.has_value();
   s.uncut_um = kUncut;

@@ -722,7 +722,7 @@
     function partContactWhose(o) {
       if (o.block === 'link') return 'link';
       var c = path.counts, holder = c.part_contact_holder > 0, cutter = c.part_contact_cutter > 0;
-      return holder && cutter ? 'holder or cutter' : cutter ? 'cutter: gouge' : 'holder';
+      return holder === cutter ? 'holder or cutter' : cutter ? 'cutter: gouge' : 'holder';
     }
     // One status row always: the panel keeps its size from posture to posture.
     rows.push(

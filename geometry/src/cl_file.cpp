@@ -258,7 +258,7 @@ PathFile readClPath(const std::filesystem::path& file, const PathReadOptions& op
   path.blocks = clBlocks(chunks, total);
   concatenate(chunks, options.threads, path);
   if (path.postures.empty()) throw InputError(file.string() + ": no postures (empty path file)");
-  checkDeclaredCount(text, kClCountPrefix, path.postures.size(), file, text.ends_with('\n'));
+  checkDeclaredCount(text, kClCountPrefix, path.postures.size(), file, clEndsWhole(text));
   return path;
 }
 
@@ -317,7 +317,7 @@ std::size_t scanPathFile(const std::filesystem::path& file, const PathReadOption
   if (total == 0) throw InputError(file.string() + ": no postures (empty path file)");
   // After the chunks were handed on: the caller's work on them fails with this (`simulate`
   // stamped a path cut short, a reviewer's finding).
-  checkDeclaredCount(text, kClCountPrefix, total, file, text.ends_with('\n'));
+  checkDeclaredCount(text, kClCountPrefix, total, file, clEndsWhole(text));
   return total;
 }
 

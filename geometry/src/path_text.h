@@ -233,23 +233,34 @@ inline bool startsWithNoCase(std::string_view s, std::string_view prefix) {
   return true;
 }
 
-/// What follows a header line's count keyword, or nullopt where the line declares no count:
-/// `.cl` `# postures: N` in any case and spacing (`#Postures:N`), APT `PPRINT/POSTURES N` in any
-/// case (a PPRINT is free text: only a number after POSTURES declares; see checkDeclaredCount).
+/// What follows a header line's count keyword, from its number on, or nullopt where the line
+/// declares no count: `.cl` `# postures: N` in any case and spacing (`#Postures:N`), APT
+/// `PPRINT/POSTURES N` in any case and spacing (`pprint / postures N`). A number declares: `.cl`
+/// a comment `# postures: x y z i j k` is a comment, `# postures: 2x` or `-1` a count misread
+/// (refused by checkDeclaredCount); an APT PPRINT is free text, so only a number standing alone
+/// declares (`PPRINT/POSTURES 3-AXIS FINISH` is a remark).
 inline std::optional<std::string_view> declaredCountText(std::string_view l, bool apt) {
   const auto skip = [](std::string_view& t) {
     while (!t.empty() && std::isspace(static_cast<unsigned char>(t.front()))) t.remove_prefix(1);
   };
+  const auto digit = [](char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; };
   if (apt) {
-    if (!startsWithNoCase(l, "PPRINT/")) return std::nullopt;
-    l.remove_prefix(7);
+    if (!startsWithNoCase(l, "PPRINT")) return std::nullopt;
+    l.remove_prefix(6);
+    skip(l);
+    if (l.empty() || l.front() != '/') return std::nullopt;
+    l.remove_prefix(1);
     skip(l);
     if (!startsWithNoCase(l, "POSTURES") || l.size() == 8 ||
         !std::isspace(static_cast<unsigned char>(l[8])))
       return std::nullopt;
     l.remove_prefix(8);
     skip(l);
-    if (l.empty() || !std::isdigit(static_cast<unsigned char>(l.front()))) return std::nullopt;
+    std::size_t n = 0;
+    while (n < l.size() && digit(l[n])) ++n;
+    const bool alone =
+        n < l.size() ? std::isspace(static_cast<unsigned char>(l[n])) || l[n] == '(' : true;
+    if (n == 0 || !alone) return std::nullopt;
     return l;
   }
   if (l.empty() || l.front() != '#') return std::nullopt;
@@ -261,7 +272,20 @@ inline std::optional<std::string_view> declaredCountText(std::string_view l, boo
   if (l.empty() || l.front() != ':') return std::nullopt;
   l.remove_prefix(1);
   skip(l);
+  const bool signed_number = l.size() > 1 && (l[0] == '-' || l[0] == '+') && digit(l[1]);
+  if (l.empty() || !(digit(l.front()) || signed_number)) return std::nullopt;
   return l;
+}
+
+/// Whether a `.cl` text ends whole: its last line ended, or what follows its last line end is
+/// blank or a comment (a cut there loses no posture; a whole file saved without its last line
+/// end, ending in `# end`, was refused: a reviewer's finding).
+inline bool clEndsWhole(std::string_view text) {
+  const std::size_t last = text.rfind('\n');
+  std::string_view tail = last == std::string_view::npos ? text : text.substr(last + 1);
+  while (!tail.empty() && std::isspace(static_cast<unsigned char>(tail.front())))
+    tail.remove_prefix(1);
+  return tail.empty() || tail.front() == '#';
 }
 
 /// The posture count a path's writer declares in its header (`.cl`: `# postures: N ...`, APT:
@@ -271,9 +295,9 @@ inline std::optional<std::string_view> declaredCountText(std::string_view l, boo
 /// `check: ok`). A file that declares its count must also be whole (`complete`: `.cl` ends with a
 /// line end, APT with FINI, as their writers end them): one cut inside its last record read the
 /// fragment as a posture (`GOTO/0.37,15.03,1`: a 3-number GOTO at z = 1 where 17.8 was written,
-/// `check: ok`; a `.cl` cut in its last axis, normalised). A `.cl` declaration whose number is
-/// unreadable is refused (it switched the check off). Files that declare nothing are taken as
-/// they are.
+/// `check: ok`; a `.cl` cut in its last axis, normalised). A declared number that is not a whole
+/// number of postures (`2x`, `-1`, past 2^64) is refused (it switched the check off). Files that
+/// declare nothing are taken as they are.
 inline void checkDeclaredCount(std::string_view text, std::string_view prefix, std::size_t read,
                                const std::filesystem::path& file, bool complete) {
   const bool apt = prefix == kAptCountPrefix;

@@ -136,44 +136,58 @@ TEST(View, PartContactsAreMarkedAsCheckFindsThem) {
 }
 
 // simulate's heights over a sloped part, shown in blocks of 3 x 3 lines: each line is measured
-// from the part under it. A block's lowest line less the part at the block's centre read the
-// downhill line of every block as a gouge (12 um on this 0.6 slope, a line 0.02 mm downhill: a
-// helper's clean ramp showed 29 000 gouged blocks of 73 000).
-TEST(View, ASimulatedSlopeReadsNoGougeInItsBlocks) {
+// from the part under it, along the facet's normal, as check measures. A block's lowest line less
+// the part at the block's centre read the downhill line of every block as a gouge (12 um on a 0.6
+// slope, a line 0.02 mm downhill: a helper's clean ramp showed 29 000 gouged blocks of 73 000);
+// the vertical gap read 1/n_z too much (a 4.5 um dip on a slope of 2 read 10 um, a gouge, where
+// check reads 4.5: a reviewer's). A pass dipped 20 um along the normal reads as the gouge it is.
+TEST(View, ASimulatedSlopeReadsItsGougesAlongTheNormal) {
   const TempDir dir;
-  dir.write("ramp.stl", facetsStl({{-12, -12, -7.2, 12, -12, 7.2, 12, 12, 7.2},  // z = 0.6 x
-                                   {-12, -12, -7.2, 12, 12, 7.2, -12, 12, -7.2}}));
   dir.write("far.stl", boxStl(60, 60, 0, 70, 70, 10));
-  dir.write("scene.yaml",
-            "obstacles:\n  - mesh: far.stl\npart: ramp.stl\n"
-            "tool: { shape: ball, radius: 1, length: 10 }\n");
-  std::ostringstream cl;  // the ball on the slope: centre R along the normal from the contact
-  const double n = std::sqrt(1.36), R = 1.0;
-  for (int j = 0; j <= 32; ++j) {
-    cl << "# pass " << j + 1 << '\n';
-    for (int i = 0; i <= 80; ++i) {
-      const double x = -8 + 0.2 * i, y = -8 + 0.5 * j;
-      cl << x - 0.6 * R / n << ' ' << y << ' ' << 0.6 * x + R / n - R << " 0 0 1\n";
+  // The blocks' values of the page of simulate's heights: a 33-pass raster on z = slope x with a
+  // ball R 1, the middle pass dipped `dip_um` along the normal.
+  const auto page = [&](double slope, double dip_um) {
+    const double z = 12 * slope;
+    dir.write("ramp.stl", facetsStl({{-12, -12, -z, 12, -12, z, 12, 12, z},
+                                     {-12, -12, -z, 12, 12, z, -12, 12, -z}}));
+    dir.write("scene.yaml",
+              "obstacles:\n  - mesh: far.stl\npart: ramp.stl\n"
+              "tool: { shape: ball, radius: 1, length: 10 }\n");
+    std::ostringstream cl;  // the ball on the slope: centre R along the normal from the contact
+    const double n = std::sqrt(1 + slope * slope), R = 1.0;
+    for (int j = 0; j <= 32; ++j) {
+      cl << "# pass " << j + 1 << '\n';
+      const double off = R - (j == 16 ? 1e-3 * dip_um : 0.0);  // centre off the surface
+      for (int i = 0; i <= 80; ++i) {
+        const double x = (-8 + 0.2 * i) / std::max(1.0, slope), y = -8 + 0.5 * j;
+        cl << x - slope * off / n << ' ' << y << ' ' << slope * x + off / n - R << " 0 0 1\n";
+      }
     }
-  }
-  dir.write("ramp.cl", cl.str());
-  ASSERT_EQ(runFieldpath(dir, "--quiet simulate --tool ball:1 --path ramp.cl --stock 8 --out sim")
-                .exit_code,
-            0);
-  const Outcome v =
-      runFieldpath(dir, "--quiet view scene.yaml --path ramp.cl --surface sim --out v.html");
-  ASSERT_EQ(v.exit_code, 0) << v.output();
-  const std::string html = slurp(dir.path() / "v.html");
-  ASSERT_GT(pageMeta(html)["surface"]["stride"].get<int>(), 1);
-  const auto [values, marker] = surfaceValues(html);
-  std::size_t cut = 0, gouged = 0;
-  for (float x : values)
-    if (std::isfinite(x) && x < marker) ++cut, gouged += x < -5.0f;
-  EXPECT_GT(cut, 10000u);
-  EXPECT_EQ(gouged, 0u);
+    dir.write("ramp.cl", cl.str());
+    EXPECT_EQ(runFieldpath(dir, "--quiet simulate --tool ball:1 --path ramp.cl --stock " +
+                                    std::to_string(10 * slope + 2) + " --out sim")
+                  .exit_code,
+              0);
+    const Outcome v =
+        runFieldpath(dir, "--quiet view scene.yaml --path ramp.cl --surface sim --out v.html");
+    EXPECT_EQ(v.exit_code, 0) << v.output();
+    const std::string html = slurp(dir.path() / "v.html");
+    EXPECT_GT(pageMeta(html)["surface"]["stride"].get<int>(), 1);
+    const auto [values, marker] = surfaceValues(html);
+    std::size_t cut = 0, gouged = 0;
+    float lowest = 0.0f;
+    for (float x : values)
+      if (std::isfinite(x) && x < marker) ++cut, gouged += x < -5.0f, lowest = std::min(lowest, x);
+    EXPECT_GT(cut, 5000u) << slope;
+    return std::make_pair(gouged, lowest);
+  };
+  EXPECT_EQ(page(0.6, 0.0).first, 0u);
+  EXPECT_EQ(page(2.0, 4.5).first, 0u);  // under the 5 um tolerance along the normal
+  const auto [gouged, lowest] = page(0.6, 20.0);
+  EXPECT_GT(gouged, 0u);
+  EXPECT_NEAR(lowest, -20.0f, 2.0f);
 }
 
-// A pass dipped 50 um into the floor: the page's marks are the cutter's (the page called them
 // the holder's), and its banner states the tolerance check counted them against (it said 0 um).
 TEST(View, ACuttersGougeIsTheCuttersAtCheckTolerance) {
   const TempDir dir;

@@ -91,7 +91,6 @@ inline std::string base64Decode(const std::string& text) {
   return out;
 }
 
-/// The page's per-posture flags (1 link, 2 limit held, 4 colliding, 8 colliding motion).
 /// An ASCII STL of the given triangles (x y z of each corner, counter-clockwise seen from above),
 /// normals from their winding.
 inline std::string facetsStl(const std::vector<std::array<double, 9>>& facets) {
@@ -122,6 +121,7 @@ inline std::pair<std::vector<float>, double> surfaceValues(const std::string& ht
   return std::make_pair(out, meta["surface"]["uncut_um"].get<double>());
 }
 
+/// The page's per-posture flags (1 link, 2 limit held, 4 colliding, 8 colliding motion).
 inline std::vector<std::uint8_t> pageFlags(const std::string& html, const json& meta) {
   const std::string blob = base64Decode(
       between(html, "<script type=\"application/octet-stream\" id=\"fp-blob\">", "</script>"));

@@ -150,22 +150,33 @@ TEST(PathFiles, AFileCutInsideItsLastRecordIsRefused) {
               std::string::npos)
         << header;
   }
-  for (const std::string header : {"# postures: abc\n", "# postures: -1\n",
-                                   "# postures: 99999999999999999999999\n", "# postures: 2x\n"}) {
+  for (const std::string header :
+       {"# postures: -1\n", "# postures: 99999999999999999999999\n", "# postures: 2x\n"}) {
     dir.write("h.cl", header + body);
     EXPECT_NE(
         errorOf([&] { geometry::readPathFile(dir.path() / "h.cl"); }).find("h.cl:1: '# postures: "),
         std::string::npos)
         << header;
   }
-  dir.write("h.apt", "pprint/postures 3\ngoto/0,0,0,0,0,1\ngoto/1,0,0,0,0,1\nfini\n");
+  // Words after the colon are a comment (`# Postures: x y z i j k`), not a count.
+  for (const std::string header : {"# postures: abc\n", "# Postures: x y z i j k\n"}) {
+    dir.write("h.cl", header + body);
+    EXPECT_EQ(geometry::readPathFile(dir.path() / "h.cl").postures.size(), 2u) << header;
+  }
+  // Whole but for its last line end, after a comment or blanks: read.
+  dir.write("tail.cl", "# postures: 2\n" + body + "# end");
+  EXPECT_EQ(geometry::readPathFile(dir.path() / "tail.cl").postures.size(), 2u);
+  dir.write("h.apt", "pprint / postures 3\ngoto/0,0,0,0,0,1\ngoto/1,0,0,0,0,1\nfini\n");
   EXPECT_NE(errorOf([&] {
               geometry::readPathFile(dir.path() / "h.apt");
             }).find("declares 3 postures and the file holds 2"),
             std::string::npos);
   // A PPRINT is free text: POSTURES followed by words declares nothing.
-  dir.write("words.apt", "PPRINT/POSTURES ARE CHECKED\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0,0,0,1\n");
-  EXPECT_EQ(geometry::readPathFile(dir.path() / "words.apt").postures.size(), 2u);
+  for (const std::string remark :
+       {"PPRINT/POSTURES ARE CHECKED", "PPRINT/POSTURES 3-AXIS FINISH"}) {
+    dir.write("words.apt", remark + "\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0,0,0,1\n");
+    EXPECT_EQ(geometry::readPathFile(dir.path() / "words.apt").postures.size(), 2u) << remark;
+  }
   // Whole, with CR LF line ends: read.
   std::string crlf;
   for (char c : cl) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);

@@ -129,6 +129,51 @@ TEST(Outputs, PngDecodesToTheSamePixels) {
         << "row " << y;
   }
 }
+
+/// The RGB pixels of a PNG the encoder wrote (one IDAT stream, filter 0 rows), read with zlib.
+std::vector<std::uint8_t> decodeRgb(const std::string& png, int& w, int& h) {
+  std::string idat;
+  for (std::size_t at = 8; at < png.size();) {
+    const std::uint32_t len = be32(png, at);
+    const std::string type = png.substr(at + 4, 4);
+    if (type == "IHDR") w = int(be32(png, at + 8)), h = int(be32(png, at + 12));
+    if (type == "IDAT") idat += png.substr(at + 8, len);
+    at += 12 + len;
+  }
+  std::string raw(std::size_t(h) * (3 * w + 1), '\0');
+  uLongf size = raw.size();
+  EXPECT_EQ(uncompress(reinterpret_cast<Bytef*>(raw.data()), &size,
+                       reinterpret_cast<const Bytef*>(idat.data()), idat.size()),
+            Z_OK);
+  std::vector<std::uint8_t> rgb;
+  for (int y = 0; y < h; ++y)
+    rgb.insert(rgb.end(), raw.begin() + y * (3 * w + 1) + 1, raw.begin() + (y + 1) * (3 * w + 1));
+  return rgb;
+}
+
+// heights.png: a pixel of k × k lines shows their lowest (a pit one line wide stays in the
+// picture), tinted blue where low and red where high, and row 0 is the largest y (README). A flat
+// 8 × 8 grid at 5 mm with one line at 0 (x 3, y 6), drawn 4 × 4: the pit is the pixel of column 1,
+// top row; the bottom row is flat. (Only the PNG's wellformedness was read: a pixel taking its
+// last line, or the image upside down, passed.)
+TEST(Outputs, ReliefShowsEachPixelsLowestLineWithYUp) {
+  const auto dir = std::filesystem::temp_directory_path() / "fieldpath_zbuffer_relief";
+  std::filesystem::create_directories(dir);
+  const Grid g = Grid::fromRegion(0, 0, 8, 8, 8, 8);
+  std::vector<float> heights(64, 5.0f);
+  heights[6 * 8 + 3] = 0.0f;
+  writeReliefPng(dir / "r.png", g, heights, 4);
+  std::ifstream in(dir / "r.png", std::ios::binary);
+  const std::string png((std::istreambuf_iterator<char>(in)), {});
+  int w = 0, h = 0;
+  const std::vector<std::uint8_t> rgb = decodeRgb(png, w, h);
+  ASSERT_EQ(w, 4);
+  ASSERT_EQ(h, 4);
+  const auto px = [&](int x, int y) { return &rgb[(std::size_t(y) * w + x) * 3]; };
+  EXPECT_GT(px(1, 0)[2], px(1, 0)[0]);  // the pit: low, blue over red
+  for (int x = 0; x < 4; ++x) EXPECT_GT(px(x, 3)[0], px(x, 3)[2]) << x;  // flat and high
+  std::filesystem::remove_all(dir);
+}
 #endif
 
 }  // namespace
