@@ -130,8 +130,17 @@ void probe(const FieldOptions& o, const GlobalOptions& global) {
       voxel ? static_cast<const field::ForceField&>(*voxel) : *obstacles.direct;
   std::vector<Vec3> forces(points.size());
   f.evaluate(points, forces);
-  std::string out =
-      "# x y z Fx Fy Fz (mm; " + std::string(voxel ? "voxel" : "direct") + " field)\n";
+  // What was probed, in the header: the voxel size and the interpolation (a --voxel or
+  // --interpolation not taken read as the scene's, unseen).
+  std::string what = "direct field";
+  if (voxel) {
+    char text[96];
+    std::snprintf(
+        text, sizeof text, "voxel field, h %g mm, %s", voxel->voxelSizeMm(),
+        voxel->interpolation() == field::Interpolation::Quadratic ? "quadratic" : "trilinear");
+    what = text;
+  }
+  std::string out = "# x y z Fx Fy Fz (mm; " + what + ")\n";
   char line[256];
   for (std::size_t i = 0; i < points.size(); ++i) {
     // + 0.0: a component the interpolation left at -0 prints 0.

@@ -1,17 +1,20 @@
 /// `fieldpath field probe|build`, run as a program: output against the closed form of a plane, and
 /// bad input → exit 1 with one line on stderr and nothing on stdout.
+#include <array>
 #include <cmath>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "fieldpath/field/law.h"
 #include "files.h"
 
 using fieldpath::app::test::Outcome;
 using fieldpath::app::test::runFieldpath;
+using fieldpath::app::test::slurp;
 using fieldpath::app::test::TempDir;
 
 namespace {
@@ -57,6 +60,51 @@ TEST(CliField, ProbeMatchesThePlaneClosedForm) {
       // 2 %: the sampling's quadrature; 10 % off the nodes for the voxels (0.25, 0.5 mm)
       const bool off_node = mode != "--direct" && z[i] == 3.75;
       EXPECT_NEAR(fz[i], exact, (off_node ? 0.1 : 0.02) * exact) << mode << " z " << z[i];
+    }
+  }
+}
+
+// Every column is its own component: a plane through the origin with normal n = (1, 2, 2) / 3
+// (16 × 16 mm, infinite for r0 at its middle) gives P(d) n at a point d along n, Fx : Fy : Fz =
+// 1 : 2 : 2 (the plane z = 0 gave Fx = Fy = 0: a column printed twice passed). The header says
+// the voxel size and interpolation probed, and --save-field writes the VDB. (A test audit.)
+TEST(CliField, ProbeWritesEachComponentAndSaysWhatItProbed) {
+  TempDir dir;
+  const Eigen::Vector3d n = Eigen::Vector3d(1, 2, 2) / 3.0;
+  const Eigen::Vector3d u = n.unitOrthogonal(), v = n.cross(u);
+  std::ostringstream stl;
+  stl << "solid tilted\n";
+  const Eigen::Vector3d c[4] = {-8 * u - 8 * v, 8 * u - 8 * v, 8 * u + 8 * v, -8 * u + 8 * v};
+  for (const auto& tri : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
+    stl << "facet normal " << n.x() << ' ' << n.y() << ' ' << n.z() << "\nouter loop\n";
+    for (int k : tri) stl << "vertex " << c[k].x() << ' ' << c[k].y() << ' ' << c[k].z() << '\n';
+    stl << "endloop\nendfacet\n";
+  }
+  stl << "endsolid tilted\n";
+  dir.write("tilted.stl", stl.str());
+  dir.write("scene.yaml", "obstacles:\n  - mesh: tilted.stl\nfield:\n  sample_step: 0.5\n");
+  const Eigen::Vector3d at = 1.5 * n;
+  std::ostringstream point;
+  point << at.x() << ' ' << at.y() << ' ' << at.z() << '\n';
+  dir.write("point.txt", point.str());
+  const double exact = fieldpath::field::planeFieldMagnitude(1.5, fieldpath::field::FieldParams{});
+  for (const std::string mode :
+       {"--direct", "--voxel 0.25 --interpolation quadratic --save-field f.vdb"}) {
+    const Outcome run = runFieldpath(dir, "field probe scene.yaml --points point.txt " + mode);
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    std::istringstream out(run.out);
+    std::string header, line;
+    std::getline(out, header);
+    std::getline(out, line);
+    std::istringstream fields(line);
+    double x, y, z, f[3];
+    ASSERT_TRUE(fields >> x >> y >> z >> f[0] >> f[1] >> f[2]) << line;
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(f[k], exact * n[k], 0.03 * exact) << mode << " " << k;
+    if (mode == "--direct") {
+      EXPECT_EQ(header, "# x y z Fx Fy Fz (mm; direct field)");
+    } else {
+      EXPECT_EQ(header, "# x y z Fx Fy Fz (mm; voxel field, h 0.25 mm, quadratic)");
+      EXPECT_EQ(slurp(dir.path() / "f.vdb").substr(0, 4), std::string(" BDV"));
     }
   }
 }
