@@ -242,5 +242,37 @@ TEST(CliSimulate, BadInputIsExitOneWithOneLineAndNoOutputs) {
       << bare.err;
 }
 
+// The spindle angle (a .cl's 7th column) turns a mesh tool about its own axis before it is placed
+// (README): a flat blade 3 mm along +x turned by pi/2 cuts what the blade along +y cuts, 6
+// columns (the heights to float rounding), and not what the unturned blade cuts. (A test audit:
+// the 7th column never reached a simulation in any test.)
+TEST(CliSimulate, TheSpindleAngleTurnsAMeshToolAboutItsAxis) {
+  const TempDir dir;
+  dir.write("blade_x.stl", boxStl(0, -0.3, 0, 3, 0.3, 5));
+  dir.write("blade_y.stl", boxStl(-0.3, 0, 0, 0.3, 3, 5));
+  dir.write("turned.cl", "0 0 0 0 0 1 1.5707963267948966\n0.01 0 0 0 0 1 1.5707963267948966\n");
+  dir.write("plain.cl", "0 0 0 0 0 1\n0.01 0 0 0 0 1\n");
+  const std::string common = " --region -4,-4,4,4 --grid 64x64 --stock 1 --outputs npy";
+  const auto heights = [&](const std::string& tool, const std::string& path) {
+    const Outcome run =
+        runFieldpath(dir, "simulate --tool " + tool + " --path " + path + common + " --out o");
+    EXPECT_EQ(run.exit_code, 0) << run.output();
+    return npyFloats(slurp(dir.path() / "o" / "heights.npy"));
+  };
+  const std::vector<float> turned = heights("blade_x.stl", "turned.cl");
+  const std::vector<float> along_y = heights("blade_y.stl", "plain.cl");
+  const std::vector<float> along_x = heights("blade_x.stl", "plain.cl");
+  ASSERT_EQ(turned.size(), 64u * 64u);
+  ASSERT_EQ(along_y.size(), turned.size());
+  std::size_t cut = 0, differs = 0;
+  for (std::size_t i = 0; i < turned.size(); ++i) {
+    EXPECT_NEAR(turned[i], along_y[i], 1e-4) << i;
+    cut += turned[i] < 0.5f;
+    differs += std::abs(turned[i] - along_x[i]) > 0.5f;
+  }
+  EXPECT_GT(cut, 20u);
+  EXPECT_GT(differs, 20u);
+}
+
 }  // namespace
 }  // namespace fieldpath::app::test
