@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_scenes.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/mesh_io.h"
 #include "fixtures.h"
@@ -137,19 +138,10 @@ std::pair<test::Outcome, nlohmann::json> checkInsideBox(const TempDir& dir,
   return {r, fs::exists(file) ? nlohmann::json::parse(test::slurp(file)) : nlohmann::json()};
 }
 
-/// A part of a floor and a wall (boxes x0 x1 y0 y1 z0 z1, mm) and an obstacle far away (a scene
-/// needs one); a ball-end mill R 3 up to 40.
+/// A part of a floor and a wall (boxes x0 x1 y0 y1 z0 z1, mm) and an obstacle far away.
 void writeFloorAndWall(const TempDir& dir, const std::array<double, 6>& floor,
                        const std::array<double, 6>& wall) {
-  geometry::TriangleMesh part, far;
-  for (const auto& b : {floor, wall})
-    pathgen::test::addBox(part, b[0], b[1], b[2], b[3], b[4], b[5]);
-  pathgen::test::addBox(far, -100, -90, -100, -90, -50, -40);
-  geometry::saveMesh(part, dir.path() / "part.stl");
-  geometry::saveMesh(far, dir.path() / "far.stl");
-  dir.write("scene.yaml",
-            "obstacles:\n  - mesh: far.stl\npart: part.stl\n"
-            "tool: { shape: ball, radius: 3, length: 40 }\n");
+  pathgen::test::writeBoxPartScene(dir, {floor, wall});
 }
 
 }  // namespace

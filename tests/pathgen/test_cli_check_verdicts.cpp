@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_scenes.h"
 #include "fieldpath/geometry/mesh_io.h"
 #include "fixtures.h"
 #include "run_fieldpath.h"
@@ -69,14 +70,7 @@ TEST(CheckVerdict, PosturesAndMotionsUnderTheClearanceAreNotOk) {
 // ball's radius or more is refused before any output.
 TEST(CheckVerdict, TheGougeToleranceIsTheOptions) {
   const TempDir dir;
-  geometry::TriangleMesh part, far;
-  pathgen::test::addBox(part, -20, 20, -20, 20, -10, 0);
-  pathgen::test::addBox(far, -100, -90, -100, -90, -50, -40);
-  geometry::saveMesh(part, dir.path() / "part.stl");
-  geometry::saveMesh(far, dir.path() / "far.stl");
-  dir.write("scene.yaml",
-            "obstacles:\n  - mesh: far.stl\npart: part.stl\n"
-            "tool: { shape: ball, radius: 3, length: 40 }\n");
+  pathgen::test::writeBoxPartScene(dir, {{-20, 20, -20, 20, -10, 0}});
   std::string cl = "# pass 1\n";
   for (int i = -10; i <= 10; ++i) cl += std::to_string(i) + " 0 -0.008 0 0 1\n";
   dir.write("dip.cl", cl);
@@ -112,14 +106,8 @@ TEST(CheckVerdict, TheGougeToleranceIsTheOptions) {
 // largest the check makes, and says so (check.json and stdout).
 TEST(CheckVerdict, AFineSpacingOverALargePartIsCoarsenedAndSaid) {
   const TempDir dir;
-  geometry::TriangleMesh part, far;
-  pathgen::test::addBox(part, -200, 200, -200, 200, -10, 0);
-  pathgen::test::addBox(far, -300, -290, -300, -290, -50, -40);
-  geometry::saveMesh(part, dir.path() / "part.stl");
-  geometry::saveMesh(far, dir.path() / "far.stl");
-  dir.write("scene.yaml",
-            "obstacles:\n  - mesh: far.stl\npart: part.stl\n"
-            "tool: { shape: ball, radius: 3, length: 40 }\n");
+  pathgen::test::writeBoxPartScene(dir, {{-200, 200, -200, 200, -10, 0}},
+                                   {-300, -290, -300, -290, -50, -40});
   dir.write("diag.cl", "# pass 1\n-190 -190 0 0 0 1\n190 190 0 0 0 1\n");
   const auto r = test::runFieldpath(dir, "check scene.yaml --path diag.cl --spacing 0.02 --out c");
   ASSERT_EQ(r.exit_code, 0) << r.output();

@@ -1,8 +1,10 @@
 /// `generate` at the edges of what a scene allows, through the built `fieldpath`: a nominal pass
 /// whose ball itself comes within `clearance` of a wall (no axis can clear it); a voxel grid
 /// coarse against r0.
+#include <array>
 #include <cmath>
 #include <filesystem>
+#include <initializer_list>
 #include <sstream>
 #include <string>
 
@@ -256,6 +258,33 @@ TEST(GenerateEdges, ALinkFarOutsideTheMeshesIsSaidInTheReport) {
   }
 }
 
+namespace {
+
+/// The part of a floor (z <= 0 up to x = 12) and a wall (x 12..20: 4 mm off the holder of radius 8
+/// at x = 0), the obstacle boxes `posts` (x0 x1 y0 y1 z0 z1, mm), and one pass along y at x = 0,
+/// postures every `step_mm` out to +-`half_mm`, as the nominal path; ball R 3 up to 20, holder r 8.
+void writeWallAndPosts(const TempDir& dir, std::initializer_list<std::array<double, 6>> posts,
+                       double step_mm, double half_mm, double clearance_mm) {
+  geometry::TriangleMesh part, post;
+  pathgen::test::addBox(part, -30, 12, -30, 30, -5, 0);  // the floor the ball runs on
+  pathgen::test::addBox(part, 12, 20, -30, 30, -5, 60);  // a wall of the part, 4 mm off the holder
+  for (const auto& b : posts) pathgen::test::addBox(post, b[0], b[1], b[2], b[3], b[4], b[5]);
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(post, dir.path() / "post.stl");
+  std::ostringstream cl;
+  cl << "# pass 1\n";
+  const int n = static_cast<int>(std::lround(half_mm / step_mm));
+  for (int i = -n; i <= n; ++i) cl << "0 " << step_mm * i << " 0 0 0 1\n";
+  dir.write("p.cl", cl.str());
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: post.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 20 }\n"
+            "holder: [[20, 8], [40, 8]]\nclearance: " +
+                std::to_string(clearance_mm) + "\npath: { nominal: p.cl }\n");
+}
+
+}  // namespace
+
 // The part never repels: a pass between a post (the obstacle) and a tall wall of the part, the
 // holder 1 mm from the post when vertical, is tilted ~17 deg away from the post by the field and
 // its holder driven into the part's wall (a helper's mould cavity: 458 postures, marked UNSAFE,
@@ -264,22 +293,8 @@ TEST(GenerateEdges, ALinkFarOutsideTheMeshesIsSaidInTheReport) {
 // stays (marked).
 TEST(GenerateEdges, APassTheSteeringDrivesIntoThePartKeepsItsClearNominalAxes) {
   const TempDir dir;
-  geometry::TriangleMesh part;
-  pathgen::test::addBox(part, -30, 12, -30, 30, -5, 0);  // the floor the ball runs on
-  pathgen::test::addBox(part, 12, 20, -30, 30, -5, 60);  // a wall of the part, 4 mm off the holder
-  geometry::saveMesh(part, dir.path() / "part.stl");
   for (const double post_x : {-11.0, -9.0}) {
-    geometry::TriangleMesh post;
-    pathgen::test::addBox(post, post_x, post_x + 2, -30, 30, 0, 30);
-    geometry::saveMesh(post, dir.path() / "post.stl");
-    std::ostringstream cl;
-    cl << "# pass 1\n";
-    for (int i = -20; i <= 20; ++i) cl << "0 " << 0.5 * i << " 0 0 0 1\n";
-    dir.write("p.cl", cl.str());
-    dir.write("scene.yaml",
-              "obstacles:\n  - mesh: post.stl\npart: part.stl\n"
-              "tool: { shape: ball, radius: 3, length: 20 }\nholder: [[20, 8], [40, 8]]\n"
-              "clearance: 0.5\npath: { nominal: p.cl }\n");
+    writeWallAndPosts(dir, {{post_x, post_x + 2, -30, 30, 0, 30}}, 0.5, 10.0, 0.5);
     const auto steered = test::runFieldpath(dir, "generate scene.yaml --out steered");
     ASSERT_EQ(steered.exit_code, 0) << steered.output();
     const auto report = nlohmann::json::parse(test::slurp(dir.path() / "steered/report.json"));
@@ -315,21 +330,8 @@ TEST(GenerateEdges, APassTheSteeringDrivesIntoThePartKeepsItsClearNominalAxes) {
 // audit: the kept pass's motion, holder and cutter checks were never what decided).
 TEST(GenerateEdges, NominalAxesThatClearThePosturesButNotAMotionAreNotKept) {
   const TempDir dir;
-  geometry::TriangleMesh part, post;
-  pathgen::test::addBox(part, -30, 12, -30, 30, -5, 0);
-  pathgen::test::addBox(part, 12, 20, -30, 30, -5, 60);
-  pathgen::test::addBox(post, -11, -9, -30, 30, 0, 30);
-  pathgen::test::addBox(post, 2.95, 2.96, 0.995, 1.005, 2.995, 3.005);  // the grain
-  geometry::saveMesh(part, dir.path() / "part.stl");
-  geometry::saveMesh(post, dir.path() / "post.stl");
-  std::ostringstream cl;
-  cl << "# pass 1\n";
-  for (int i = -5; i <= 5; ++i) cl << "0 " << 2 * i << " 0 0 0 1\n";
-  dir.write("p.cl", cl.str());
-  dir.write("scene.yaml",
-            "obstacles:\n  - mesh: post.stl\npart: part.stl\n"
-            "tool: { shape: ball, radius: 3, length: 20 }\nholder: [[20, 8], [40, 8]]\n"
-            "clearance: 0.05\npath: { nominal: p.cl }\n");
+  writeWallAndPosts(dir, {{-11, -9, -30, 30, 0, 30}, {2.95, 2.96, 0.995, 1.005, 2.995, 3.005}}, 2.0,
+                    10.0, 0.05);  // the post, and the grain
   // The nominal path itself: clear at every posture, colliding on the motion across the grain.
   ASSERT_EQ(test::runFieldpath(dir, "generate scene.yaml --nominal --out nominal").exit_code, 0);
   const auto nominal = nlohmann::json::parse(test::slurp(dir.path() / "nominal/report.json"));
