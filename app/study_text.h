@@ -8,7 +8,7 @@ namespace fieldpath::app::study_detail {
 
 std::string interpolationName(field::Interpolation interpolation);
 std::string storedName(field::StoredQuantity stored);
-/// A number in at most `precision` significant digits.
+/// A number in at most `precision` significant digits; empty when it is not finite (CSV cells).
 std::string number(double value, int precision = 4);
 /// "CPU model, N cores" of this machine, for the tables.
 std::string machineDescription();

@@ -153,7 +153,9 @@ std::string storedName(field::StoredQuantity stored) {
 }
 
 std::string number(double value, int precision) {
-  if (!std::isfinite(value)) return "nan";
+  // Empty for inf / nan, as common/csv.h's cells: the CSVs are its main reader (a `nan` cell,
+  // e.g. the brute-force speed-up under --no-brute-force, breaks some CSV readers).
+  if (!std::isfinite(value)) return "";
   std::ostringstream s;
   s << std::setprecision(precision) << value;
   return s.str();

@@ -25,6 +25,7 @@ namespace fs = std::filesystem;
 using geometry::PathBlock;
 using geometry::PathFile;
 using geometry::Posture;
+using geometry::Vec3;
 
 /// A value as float32 carries it: the .npy float32 file then holds the same numbers as the others.
 double asFloat(double v) { return double(float(v)); }
@@ -318,8 +319,17 @@ TEST(Convert, RoundTripsKeepThePosturesBitForBit) {
       ASSERT_EQ(back.postures[i].axis, marked.postures[i].axis) << file << " " << i;
     }
   }
-  // APT keeps the link (RAPID) and .cl the blocks; the limit mark APT cannot hold is said.
+  // APT keeps the link (RAPID) and .cl the blocks and the limit marks (a test audit: convert
+  // writing one pass to .cl, links read back as cutting moves, passed); the limit mark APT
+  // cannot hold is said.
   EXPECT_EQ(geometry::readPathFile(f.dir.path() / "d.cls").blocks, marked.blocks);
+  ASSERT_EQ(marked.limited, std::vector<std::size_t>{17});
+  const PathFile e = geometry::readPathFile(f.dir.path() / "E.CL");
+  EXPECT_EQ(e.blocks, marked.blocks);
+  EXPECT_EQ(e.limited, marked.limited);
+  // An APT link comes back a link block in .cl.
+  ASSERT_EQ(runFieldpath(f.dir, "convert d.cls h.cl").exit_code, 0);
+  EXPECT_EQ(geometry::readPathFile(f.dir.path() / "h.cl").blocks, marked.blocks);
   const Outcome to_apt = runFieldpath(f.dir, "convert marked.cl g.apt --tool ball:1");
   ASSERT_EQ(to_apt.exit_code, 0) << to_apt.err;
   EXPECT_NE(to_apt.err.find("note: APT has no `# limit` marks: 1 dropped"), std::string::npos)
@@ -353,6 +363,43 @@ TEST(Convert, PassesWithNoLinkBetweenThemAreSaidToJoinInApt) {
   const Outcome to_cl = runFieldpath(f.dir, "convert path.cl same.cl");
   ASSERT_EQ(to_cl.exit_code, 0) << to_cl.err;
   EXPECT_EQ(to_cl.err.find("note:"), std::string::npos) << to_cl.err;
+}
+
+// The 7th column (spindle angle, rad) through .npy (N×7) and back, bit for bit; a hand-written
+// float32 N×7 array read as spindle angles (a test audit: no test wrote or read the 7th column
+// of an .npy: dropping it would have been silent, a mesh tool simulated unturned).
+TEST(Convert, TheSpindleColumnGoesThroughNpy) {
+  const TempDir dir;
+  dir.write("s.cl", "0 0 0 0 0 1 0.5\n1 0 0 0 0 1 -0.25\n2 0 0 0 0 1 3.125\n");
+  ASSERT_EQ(runFieldpath(dir, "convert s.cl s.npy").exit_code, 0);
+  const PathFile npy = geometry::readPathFile(dir.path() / "s.npy");
+  ASSERT_EQ(npy.postures.size(), 3u);
+  const double spindle[] = {0.5, -0.25, 3.125};
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_TRUE(npy.postures[i].has_spindle) << i;
+    EXPECT_EQ(npy.postures[i].spindle_rad, spindle[i]) << i;
+  }
+  ASSERT_EQ(runFieldpath(dir, "convert s.npy back.cl").exit_code, 0);
+  const PathFile back = geometry::readPathFile(dir.path() / "back.cl");
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(back.postures[i].spindle_rad, spindle[i]) << i;
+  // float32, shape (2, 7), written by hand as numpy writes it (version 1.0, header to 128 bytes).
+  std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 7), }";
+  header.append(128 - 10 - header.size() - 1, ' ');
+  header += '\n';
+  std::string bytes = std::string("\x93NUMPY\x01\x00", 8);
+  bytes += char(header.size() & 0xff);
+  bytes += char(header.size() >> 8);
+  bytes += header;
+  const float rows[2][7] = {{1, 2, 3, 0, 0, 1, 0.75f}, {4, 5, 6, 0, 1, 0, -1.5f}};
+  bytes.append(reinterpret_cast<const char*>(rows), sizeof rows);
+  dir.write("hand.npy", bytes);
+  const PathFile hand = geometry::readPathFile(dir.path() / "hand.npy");
+  ASSERT_EQ(hand.postures.size(), 2u);
+  EXPECT_EQ(hand.postures[1].tip_mm, Vec3(4, 5, 6));
+  EXPECT_EQ(hand.postures[1].axis, Vec3(0, 1, 0));
+  EXPECT_TRUE(hand.postures[0].has_spindle);
+  EXPECT_EQ(hand.postures[0].spindle_rad, 0.75);
+  EXPECT_EQ(hand.postures[1].spindle_rad, -1.5);
 }
 
 TEST(Convert, ASpindleColumnDroppedInAptIsSaid) {

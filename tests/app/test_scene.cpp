@@ -35,6 +35,11 @@ field:
   weights: unit
   voxel_size: 0.4
   interpolation: quadratic
+  stored: force
+  refine_tolerance: 0.02
+  refine_levels: 3
+  refine_region: reach
+  backend: cpu
 dynamics:
   inertia: 2.0
   damping: 3.0
@@ -45,10 +50,14 @@ dynamics:
   max_tilt_deg: 30
   max_lead_deg: 15
   integrator: erk
+  on_limit: fail
+  start: settled
 path:
   passes: 5
   step: 0.25
   lead_deg: 3
+  pass_gap: 2.5
+links: { retract: 7, safe_z: 80 }
 )");
   const app::Scene s = app::loadScene(file);
   ASSERT_EQ(s.obstacles.size(), 2u);
@@ -85,6 +94,18 @@ path:
   EXPECT_EQ(s.path.passes, 5);
   EXPECT_EQ(s.path.step_mm, 0.25);
   EXPECT_EQ(s.path.lead_deg, 3.0);
+  // (a test audit: these keys were read by no test, a user's setting could fall to its default)
+  EXPECT_EQ(s.field.voxel.stored, field::StoredQuantity::Force);
+  EXPECT_EQ(s.field.voxel.refine_tolerance, 0.02);
+  EXPECT_EQ(s.field.voxel.refine_levels, 3);
+  EXPECT_EQ(s.field.voxel.refine_region, field::RefineRegion::Reach);
+  EXPECT_EQ(s.field.voxel.backend, field::FieldBackend::Cpu);
+  EXPECT_EQ(s.dynamics.on_limit, dynamics::LimitPolicy::Fail);
+  EXPECT_EQ(s.dynamics.start, dynamics::StartPolicy::Settled);
+  EXPECT_EQ(s.path.pass_gap_mm, 2.5);
+  EXPECT_EQ(s.links.retract_mm, 7.0);
+  ASSERT_TRUE(s.links.safe_z_mm.has_value());
+  EXPECT_EQ(*s.links.safe_z_mm, 80.0);
 }
 
 TEST(Scene, DefaultsComeFromTheParamsStructs) {

@@ -2,6 +2,7 @@
 // methods agree, errors shrink as the voxels do.
 #include <gtest/gtest.h>
 #include <unistd.h>
+#include <algorithm>
 
 #include <cmath>
 #include <cstdlib>
@@ -285,7 +286,41 @@ TEST(StudyCommand, WritesTablesAndPicturesOrSaysWhyNot) {
   for (const char* file : {"study.csv", "study.md", "lines.csv", "tilt.csv"})
     EXPECT_TRUE(std::filesystem::exists(dir.path() / "study" / file)) << file;
   const Csv csv = readCsv(dir.path() / "study" / "study.csv");
-  EXPECT_EQ(csv.rows.size(), 5u);  // direct, 2 voxel sizes × 2 stored quantities
+  ASSERT_EQ(csv.rows.size(), 5u);  // direct, 2 voxel sizes × 2 stored quantities
+  // The cells against one another (a test audit: a speed-up inverted, the max force error not
+  // the largest of its parts, would have passed): the direct row first, the ratios its total over
+  // the row's, the brute force's speed-up an empty cell (no `nan` text: common/csv.h) when it
+  // was not run.
+  const auto column = [&](const std::string& name) {
+    const auto it = std::find(csv.header.begin(), csv.header.end(), name);
+    EXPECT_NE(it, csv.header.end()) << name;
+    return static_cast<std::size_t>(it - csv.header.begin());
+  };
+  const auto value = [&](const std::vector<std::string>& cells, const std::string& name) {
+    return std::stod(cells.at(column(name)));
+  };
+  ASSERT_EQ(csv.rows[0][column("variant")], "direct");
+  const double direct_total = value(csv.rows[0], "total_s");
+  const double direct_path = value(csv.rows[0], "path_s");
+  for (const auto& cells : csv.rows) {
+    ASSERT_EQ(cells.size(), csv.header.size()) << cells[0];
+    EXPECT_EQ(cells[column("speedup_vs_brute")], "") << cells[0];
+    EXPECT_NEAR(value(cells, "speedup_vs_direct"), direct_total / value(cells, "total_s"),
+                2e-3 * value(cells, "speedup_vs_direct"))
+        << cells[0];
+    EXPECT_NEAR(value(cells, "path_speedup_vs_direct"), direct_path / value(cells, "path_s"),
+                2e-3 * value(cells, "path_speedup_vs_direct"))
+        << cells[0];
+    EXPECT_DOUBLE_EQ(value(cells, "max_force_error_pct"),
+                     std::max({value(cells, "line_a_max_pct"), value(cells, "line_b_max_pct"),
+                               value(cells, "nodes_max_pct")}))
+        << cells[0];
+    EXPECT_LE(value(cells, "line_a_rms_pct"), value(cells, "line_a_max_pct")) << cells[0];
+    EXPECT_LE(value(cells, "nodes_rms_pct"), value(cells, "nodes_max_pct")) << cells[0];
+    for (std::size_t c = 0; c < cells.size(); ++c)
+      EXPECT_EQ(cells[c].find("nan"), std::string::npos) << csv.header[c];
+  }
+  EXPECT_EQ(value(csv.rows[0], "speedup_vs_direct"), 1.0);
   // Pictures, unless python3/matplotlib is missing, which the command says on stderr.
   if (run.err.find("pictures not made") == std::string::npos)
     for (const char* file : {"speed_vs_error.png", "tilt_along_path.png", "force_error_lines.png"})

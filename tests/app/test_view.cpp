@@ -72,6 +72,60 @@ TEST(View, PageAgreesWithCheckJson) {
   }
 }
 
+// A path longer than --max-postures: the slider shows every k-th posture and still every
+// colliding one, both ends of each colliding motion and each block's ends (a test audit: every
+// other page test showed all its postures; dropping the clause that keeps flagged postures lost
+// the red marks on long paths).
+TEST(View, ALongPathShownEveryKthKeepsEveryCollisionAndBlockEnd) {
+  const TempDir dir;
+  writeBlockScene(dir, /*nominal=*/false);
+  std::ostringstream path;
+  path << "# pass 1\n";
+  for (int k = 0; k < 400; ++k) path << -9.975 + 0.05 * k << " 0 0 0 0 1\n";
+  path << "# link\n9.975 0 15 0 0 1\n-9.975 8 15 0 0 1\n# pass 2\n";
+  for (int k = 0; k < 400; ++k) path << -9.975 + 0.05 * k << " 8 0 0 0 1\n";
+  dir.write("long.cl", path.str());
+  const Outcome r =
+      runFieldpath(dir, "view scene.yaml --path long.cl --max-postures 100 --out v.html");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const std::string html = slurp(dir.path() / "v.html");
+  const json meta = pageMeta(html);
+  const json& counts = meta["path"]["counts"];
+  ASSERT_EQ(counts["postures"], 802);
+  const std::size_t colliding = counts["colliding_postures"], motions = counts["colliding_motions"];
+  ASSERT_GT(colliding, 10u);  // the block stands in pass 1's way
+  const auto flags = pageFlags(html, meta);
+  const auto index = pageArray<std::uint32_t>(html, meta, "index");
+  ASSERT_EQ(index.size(), flags.size());
+  EXPECT_LT(flags.size(), 802u - colliding);  // every k-th: fewer than all
+  EXPECT_GT(flags.size(), 100u);              // the flagged ones on top of the 100
+  EXPECT_EQ(countBit(flags, 4), colliding);
+  EXPECT_EQ(countBit(flags, 8), motions);
+  for (std::size_t j = 0; j + 1 < index.size(); ++j) {
+    EXPECT_LT(index[j], index[j + 1]);
+    if (flags[j] & 8) EXPECT_EQ(index[j + 1], index[j] + 1) << "colliding motion at " << index[j];
+  }
+  // Each block's first and last posture (pass 1: 0, 399; the link: 400, 401; pass 2: 402, 801).
+  for (std::uint32_t end : {0u, 399u, 400u, 401u, 402u, 801u})
+    EXPECT_NE(std::find(index.begin(), index.end(), end), index.end()) << end;
+}
+
+// A path with a few postures far outside the scene (a home position, a tool change) is shown
+// with a warning; most of them outside is refused (another scene's path).
+TEST(View, AFewPosturesOutsideTheSceneAreShownWithAWarning) {
+  const TempDir dir;
+  writeBlockScene(dir, /*nominal=*/false);
+  dir.write("home.cl", pathCl() + "# link\n0 0 10000 0 0 1\n");
+  const Outcome r = runFieldpath(dir, "view scene.yaml --path home.cl --out v.html");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const json meta = pageMeta(slurp(dir.path() / "v.html"));
+  EXPECT_EQ(meta["path"]["counts"]["postures"], 83);
+  bool said = false;
+  for (const auto& w : meta["warnings"])
+    said = said || w.get<std::string>().find("1 of 83 postures lie more than") != std::string::npos;
+  EXPECT_TRUE(said) << meta["warnings"];
+}
+
 TEST(View, BadInputIsExitOneWithOneLineOrAPageThatSaysWhatIsMissing) {
   const TempDir dir;
   writeBlockScene(dir, /*nominal=*/false);

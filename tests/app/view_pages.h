@@ -122,12 +122,21 @@ inline std::pair<std::vector<float>, double> surfaceValues(const std::string& ht
 }
 
 /// The page's per-posture flags (1 link, 2 limit held, 4 colliding, 8 colliding motion).
-inline std::vector<std::uint8_t> pageFlags(const std::string& html, const json& meta) {
+/// The page's path array `name` (meta.path[name]: its offset in bytes and count in the blob).
+template <class T>
+std::vector<T> pageArray(const std::string& html, const json& meta, const std::string& name) {
   const std::string blob = base64Decode(
       between(html, "<script type=\"application/octet-stream\" id=\"fp-blob\">", "</script>"));
-  const json ref = meta["path"]["flags"];
+  const json ref = meta["path"][name];
   const std::size_t offset = ref["offset"], count = ref["count"];
-  return {blob.begin() + offset, blob.begin() + offset + count};
+  std::vector<T> values(count);
+  if (offset + count * sizeof(T) <= blob.size())
+    std::memcpy(values.data(), blob.data() + offset, count * sizeof(T));
+  return values;
+}
+
+inline std::vector<std::uint8_t> pageFlags(const std::string& html, const json& meta) {
+  return pageArray<std::uint8_t>(html, meta, "flags");
 }
 
 inline std::size_t countBit(const std::vector<std::uint8_t>& flags, int bit) {

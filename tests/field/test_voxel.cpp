@@ -14,6 +14,7 @@
 #include "fieldpath/field/metrics.h"
 #include "fieldpath/field/voxel_field.h"
 #include "meshes.h"
+#include "temporaries.h"
 
 using namespace fieldpath::field;
 using fieldpath::geometry::TriangleMesh;
@@ -244,7 +245,7 @@ TEST(Voxel, SavesAVdbFile) {
   in.read(magic, 4);  // OPENVDB_MAGIC 0x56444220, little-endian: " BDV"
   EXPECT_EQ(std::string(magic, 4), std::string(" BDV"));
   EXPECT_GT(std::filesystem::file_size(file), voxel.stats().active_nodes * 12 / 2);
-  EXPECT_FALSE(std::filesystem::exists(file.string() + ".tmp"));
+  EXPECT_TRUE(fieldpath::test::temporariesOf(file).empty());
   std::filesystem::remove(file);
 }
 

@@ -12,6 +12,7 @@
 #include "fieldpath/common/errors.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "temp_files.h"
+#include "temporaries.h"
 
 using namespace fieldpath::geometry;
 using fieldpath::common::InputError;
@@ -109,8 +110,14 @@ TEST(ClFile, RoundTripsExactly) {
     writeClFile(p, postures, "fieldpath test\nsecond line");
     expectSame(readClFile(p), writtenAs(postures));
     expectNoExponent(p);
-    EXPECT_FALSE(fs::exists(p.string() + ".tmp"));
+    EXPECT_TRUE(fieldpath::test::temporariesOf(p).empty());
   }
+  // The check sees a temporary where one is left.
+  const fs::path p = tempPath("rt.cl");
+  const fs::path left = p.parent_path() / ("." + p.filename().string() + ".tmp-1");
+  std::ofstream(left) << "1 2 3";
+  EXPECT_EQ(fieldpath::test::temporariesOf(p).size(), 1u);
+  fs::remove(left);
 }
 
 // Numbers as post-processors read them: no exponent ("4.8e-05" was written for an axis component

@@ -13,6 +13,7 @@
 #include "fieldpath/geometry/mesh_io.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "temp_files.h"
+#include "temporaries.h"
 
 using namespace fieldpath::geometry;
 using fieldpath::common::InputError;
@@ -167,7 +168,7 @@ TEST(MeshIo, RoundTripsStlObjPly) {
     SCOPED_TRACE(ext);
     const fs::path p = tempPath(std::string("tool") + ext);
     saveMesh(tool, p);
-    EXPECT_FALSE(fs::exists(p.string() + ".tmp"));
+    EXPECT_TRUE(fieldpath::test::temporariesOf(p).empty());
     const TriangleMesh back = loadMesh(p);
     EXPECT_EQ(back.vertices.size(), tool.vertices.size());
     ASSERT_EQ(back.triangles.size(), tool.triangles.size());
