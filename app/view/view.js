@@ -367,6 +367,9 @@
     g.computeVertexNormals();
     tool = new THREE.Mesh(g, shaded({ vertexColors: THREE.VertexColors }, 60, 0x444444));
     tool.visible = !!P;
+    tool.userData.top =
+        0;  // the top of tool + holder on its axis (mm): where the page's state says it is
+    for (var k = 2; k < p.length; k += 3) tool.userData.top = Math.max(tool.userData.top, p[k]);
     scene.add(tool);
     layers.tool = { object: tool, label: 'tool + holder', count: t.triangles + ' triangles' };
   })();
@@ -816,7 +819,14 @@
         [['start', shownIndexOf(+(hash.posture || 0))], ['probe', shownIndexOf(+hash.probe)]]
             .forEach(function (p) {
               placeTool(p[1]);
-              state[p[0]] = { index: P.index[p[1]], tool_box: screenBox(tool) };
+              // Where the tool stands in the world (mm): its tip and the top of its axis, for a
+              // test against the path file (the screen box alone moves with a misplaced tool).
+              state[p[0]] = {
+                index: P.index[p[1]],
+                tool_box: screenBox(tool),
+                tip_mm: tool.localToWorld(new THREE.Vector3(0, 0, 0)).toArray(),
+                top_mm: tool.localToWorld(new THREE.Vector3(0, 0, tool.userData.top)).toArray()
+              };
             });
         placeTool(keep);
       }

@@ -20,6 +20,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "fieldpath/geometry/cl_file.h"
 #include "files.h"
 #include "png_read.h"
 #include "view_data.h"
@@ -298,6 +299,41 @@ TEST(View, ASimulatedZoomCutEverywhereHasNoUncutLines) {
   EXPECT_GE(wide.front(), wide_marker);  // the corner (-10, -10): 7 mm from the nearest tip
 }
 
+// The surface stands where simulate cut it: a plunge at (5, -3) on a grid whose origin is not
+// on its diagonal (x0 != y0, dx != dy), its deepest line at x0 + (ix + 0.5) dx, y0 + (iy + 0.5) dy
+// (DESIGN's height map) on the page (a test audit: x0 and y0 swapped, or the half line dropped,
+// passed every test: their grids had x0 == y0).
+TEST(View, TheSurfaceStandsWhereSimulateCutIt) {
+  const TempDir dir;
+  dir.write("floor.stl", squareStl(30, 0));
+  dir.write("block.stl", boxStl(60, 60, 0, 70, 70, 10));
+  dir.write("plunge.cl", "5 -3 -0.5 0 0 1\n");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: block.stl\npart: floor.stl\n"
+            "tool: { shape: ball, radius: 2, length: 20 }\nclearance: 0.5\n");
+  ASSERT_EQ(runFieldpath(dir,
+                         "--quiet simulate --tool ball:2 --path plunge.cl --stock 0 "
+                         "--grid 120x32 --region -10,-8,20,4 --out sim")
+                .exit_code,
+            0);
+  const Outcome v =
+      runFieldpath(dir, "--quiet view scene.yaml --path plunge.cl --surface sim --out v.html");
+  ASSERT_EQ(v.exit_code, 0) << v.output();
+  const std::string html = slurp(dir.path() / "v.html");
+  const json surface = pageMeta(html)["surface"];
+  const auto height = pageBlob<float>(html, surface["height"]);
+  const int nx = surface["nx"], ny = surface["ny"];
+  ASSERT_EQ(height.size(), std::size_t(nx) * ny);
+  const auto lowest = std::min_element(height.begin(), height.end(), [](float a, float b) {
+    return std::isnan(b) || (!std::isnan(a) && a < b);
+  });
+  const int at = int(lowest - height.begin()), ix = at % nx, iy = at / nx;
+  const double dx = surface["dx"], dy = surface["dy"];
+  EXPECT_NEAR(surface["x0"].get<double>() + (ix + 0.5) * dx, 5.0, dx) << ix;
+  EXPECT_NEAR(surface["y0"].get<double>() + (iy + 0.5) * dy, -3.0, dy) << iy;
+  EXPECT_NEAR(*lowest, -0.5, 0.01);
+}
+
 // A check's lines no pass cut keep the stock allowance, told along the part's normal: on a 45°
 // sheet 2000 cos 45° = 1414 um, which the page showed as stock beside the band (purple), not as
 // not cut (grey: a reviewer's finding). One pass along the slope: the rest of it is not cut.
@@ -467,6 +503,19 @@ TEST(ViewBrowser, ImpellerPageRendersAndTheSliderMovesTheTool) {
   EXPECT_EQ(state["limited_postures"], 0);
   EXPECT_EQ(state["start"]["index"], a);
   EXPECT_EQ(state["probe"]["index"], b);
+  // The tool stands on the path file's tip with its axis up the file's axis (a test audit: a
+  // tool turned the other way, or placed at the ball's centre, kept a screen box that moves).
+  const auto path = fieldpath::geometry::readPathFile(dir.path() / "nominal/path.cl");
+  for (const char* which : {"start", "probe"}) {
+    const std::size_t i = state[which]["index"];
+    ASSERT_LT(i, path.postures.size());
+    const json tip = state[which]["tip_mm"], top = state[which]["top_mm"];
+    ASSERT_TRUE(tip.is_array() && top.is_array()) << state[which];
+    const Eigen::Vector3d tip_mm(tip[0], tip[1], tip[2]), top_mm(top[0], top[1], top[2]);
+    EXPECT_LT((tip_mm - path.postures[i].tip_mm).norm(), 1e-3) << which;
+    EXPECT_GT((top_mm - tip_mm).norm(), 10.0) << which;
+    EXPECT_LT(((top_mm - tip_mm).normalized() - path.postures[i].axis).norm(), 1e-4) << which;
+  }
   EXPECT_GT(state["posture"]["index"].get<std::size_t>(), a + 10) << "play did not move on";
   EXPECT_GT(state["triangles"].get<int>(), 10000);
   const double first_frame_ms = state["first_frame_ms"];

@@ -109,25 +109,11 @@ inline std::string facetsStl(const std::vector<std::array<double, 9>>& facets) {
   return stl.str();
 }
 
-/// A page's surface: its blocks' values and the value from which a block reads as not cut.
-inline std::pair<std::vector<float>, double> surfaceValues(const std::string& html) {
-  const json meta = pageMeta(html);
-  const std::string blob = base64Decode(
-      between(html, "<script type=\"application/octet-stream\" id=\"fp-blob\">", "</script>"));
-  const std::size_t offset = meta["surface"]["value"]["offset"],
-                    count = meta["surface"]["value"]["count"];
-  std::vector<float> out(count);
-  std::memcpy(out.data(), blob.data() + offset, 4 * count);
-  return std::make_pair(out, meta["surface"]["uncut_um"].get<double>());
-}
-
-/// The page's per-posture flags (1 link, 2 limit held, 4 colliding, 8 colliding motion).
-/// The page's path array `name` (meta.path[name]: its offset in bytes and count in the blob).
+/// The page's array that `ref` names ({offset: bytes into the blob, count: values}).
 template <class T>
-std::vector<T> pageArray(const std::string& html, const json& meta, const std::string& name) {
+std::vector<T> pageBlob(const std::string& html, const json& ref) {
   const std::string blob = base64Decode(
       between(html, "<script type=\"application/octet-stream\" id=\"fp-blob\">", "</script>"));
-  const json ref = meta["path"][name];
   const std::size_t offset = ref["offset"], count = ref["count"];
   std::vector<T> values(count);
   if (offset + count * sizeof(T) <= blob.size())
@@ -135,6 +121,20 @@ std::vector<T> pageArray(const std::string& html, const json& meta, const std::s
   return values;
 }
 
+/// The surface's values (µm from the part, or heights) and its "not cut" marker (uncut_um).
+inline std::pair<std::vector<float>, double> surfaceValues(const std::string& html) {
+  const json meta = pageMeta(html);
+  return std::make_pair(pageBlob<float>(html, meta["surface"]["value"]),
+                        meta["surface"]["uncut_um"].get<double>());
+}
+
+/// The page's path array `name` (meta.path[name]).
+template <class T>
+std::vector<T> pageArray(const std::string& html, const json& meta, const std::string& name) {
+  return pageBlob<T>(html, meta["path"][name]);
+}
+
+/// The page's per-posture flags (1 link, 2 limit held, 4 colliding, 8 colliding motion).
 inline std::vector<std::uint8_t> pageFlags(const std::string& html, const json& meta) {
   return pageArray<std::uint8_t>(html, meta, "flags");
 }
