@@ -28,10 +28,6 @@
 #include "fieldpath/pathgen/impeller.h"
 #include "fieldpath/pathgen/reach_box.h"
 
-#ifndef FIELDPATH_PLOT_STUDY_SCRIPT
-#define FIELDPATH_PLOT_STUDY_SCRIPT "scripts/plot_study.py"
-#endif
-
 namespace fieldpath::app {
 using namespace study_detail;
 namespace {

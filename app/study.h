@@ -148,8 +148,9 @@ void writeStudy(const StudyResult& result, const std::filesystem::path& dir,
                 const std::string& command_line, const std::string& machine);
 
 /// Renders speed_vs_error.png, tilt_along_path.png and force_error_lines.png from the CSVs with
-/// scripts/plot_study.py (/usr/bin/python3 + matplotlib). Returns false with `message` set if
-/// python3 or matplotlib is missing or the script fails.
+/// scripts/plot_study.py, compiled in and run by python3 (/usr/bin's, else PATH's) + matplotlib,
+/// without a shell. Returns false with `message` set if python3 or matplotlib is missing or the
+/// script fails (the last line it wrote).
 bool plotStudy(const std::filesystem::path& dir, std::string* message);
 
 /// "2,1,0.5" → {2, 1, 0.5}; "trilinear,quadratic" → interpolations. Throw InputError naming `key`.

@@ -1,20 +1,29 @@
 /// The study's outputs: study.csv, study.md, lines.csv, tilt.csv and their plots (split from
 /// study.cpp, which runs the variants).
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <fstream>
 #include <iomanip>
 #include <limits>
 #include <sstream>
+#include <string_view>
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/errors.h"
 #include "fieldpath/field/law.h"
 #include "fieldpath/geometry/units.h"
 #include "study.h"
+#include "study_assets.h"
 #include "study_text.h"
 
 namespace fieldpath::app {
@@ -398,21 +407,68 @@ void writeStudy(const StudyResult& result, const std::filesystem::path& dir,
 }
 
 bool plotStudy(const std::filesystem::path& dir, std::string* message) {
-  const std::filesystem::path python = "/usr/bin/python3";
-  const std::filesystem::path script = FIELDPATH_PLOT_STUDY_SCRIPT;
   auto fail = [&](const std::string& why) {
     if (message) *message = why;
     return false;
   };
-  if (!std::filesystem::exists(python)) return fail("no /usr/bin/python3: pictures not made");
-  if (!std::filesystem::exists(script))
-    return fail("no " + script.string() + ": pictures not made");
-  const std::string command = python.string() + " '" + script.string() + "' '" + dir.string() + "'";
-  const int status = std::system(command.c_str());
-  if (status != 0)
-    return fail(script.string() + " failed (status " + std::to_string(status) +
-                "; python3-matplotlib missing?): pictures not made");
-  return true;
+  // Debian's python3 (where python3-matplotlib goes), else the one on PATH; the script on its
+  // standard input and the folder as an argument of its own:
+  // no shell (a folder named with a quote ran what followed it) and no script file to find (the
+  // program looked for a developer's checkout). Its stderr is kept for the message: a traceback
+  // is not printed under --quiet.
+  int to_python[2], from_python[2];
+  if (::pipe2(to_python, O_CLOEXEC) != 0) return fail("no pipe to python3: pictures not made");
+  if (::pipe2(from_python, O_CLOEXEC) != 0) {
+    ::close(to_python[0]), ::close(to_python[1]);
+    return fail("no pipe from python3: pictures not made");
+  }
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, to_python[0], STDIN_FILENO);
+  posix_spawn_file_actions_adddup2(&actions, from_python[1], STDOUT_FILENO);
+  posix_spawn_file_actions_adddup2(&actions, from_python[1], STDERR_FILENO);
+  const std::string folder = dir.string();
+  char* argv[] = {const_cast<char*>("python3"), const_cast<char*>("-"),
+                  const_cast<char*>(folder.c_str()), nullptr};
+  pid_t pid = 0;
+  const char* const debian = "/usr/bin/python3";
+  const int spawned = ::access(debian, X_OK) == 0
+                          ? ::posix_spawn(&pid, debian, &actions, nullptr, argv, environ)
+                          : ::posix_spawnp(&pid, "python3", &actions, nullptr, argv, environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(to_python[0]);
+  ::close(from_python[1]);
+  if (spawned != 0) {
+    ::close(to_python[1]), ::close(from_python[0]);
+    return fail("no python3 (" + std::string(std::strerror(spawned)) + "): pictures not made");
+  }
+  // The script (a few kB) fits in the pipe's buffer: written whole before its output is read.
+  const std::string_view script = study_assets::kPlotStudyPy;
+  const ::sighandler_t old_pipe = ::signal(SIGPIPE, SIG_IGN);  // python3 gone early: EPIPE
+  for (std::size_t done = 0; done < script.size();) {
+    const ssize_t n = ::write(to_python[1], script.data() + done, script.size() - done);
+    if (n <= 0 && errno != EINTR) break;
+    if (n > 0) done += static_cast<std::size_t>(n);
+  }
+  ::close(to_python[1]);
+  ::signal(SIGPIPE, old_pipe);
+  std::string output;
+  char buffer[4096];
+  for (ssize_t n; (n = ::read(from_python[0], buffer, sizeof buffer)) != 0;) {
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) break;
+    if (output.size() < (1u << 20)) output.append(buffer, static_cast<std::size_t>(n));
+  }
+  ::close(from_python[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return true;
+  // The last line python3 wrote says why (an ImportError for a missing matplotlib).
+  while (!output.empty() && (output.back() == '\n' || output.back() == '\r')) output.pop_back();
+  const std::string last = output.substr(output.find_last_of('\n') + 1);
+  return fail("pictures not made: " +
+              (last.empty() ? "python3 ended with status " + std::to_string(status) : last));
 }
 
 }  // namespace fieldpath::app

@@ -1,6 +1,6 @@
 #pragma once
 /// The page template, style and script of `fieldpath view` (app/view/), compiled in by
-/// app/view/embed.cmake so that the installed program needs no data folder of its own.
+/// app/embed_text.cmake so that the installed program needs no data folder of its own.
 namespace fieldpath::app::view_assets {
 extern const char* const kPageHtml;  ///< app/view/page.html
 extern const char* const kViewCss;   ///< app/view/view.css
