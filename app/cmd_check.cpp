@@ -222,7 +222,9 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
           {options->scene, options->path});
     }
     const Scene scene = loadScene(options->scene, /*read_nominal=*/false);
+    const common::FileStamp path_stamp = common::fileStamp(options->path);
     const geometry::PathFile path = geometry::readPathFile(options->path);
+    const std::string path_digest = common::fileDigest(options->path);
     const common::Progress progress = makeProgressLine(global.quiet);
     if (!scene.tool_given)
       throw InputError(scene.file.string() + ": tool: missing: check needs the cutter (`tool: { "
@@ -327,10 +329,12 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                        "by more than the gouge tolerance (max " +
                        std::to_string(static_cast<long long>(std::lround(surface->max_gouge_um))) +
                        " um)");
+    // The verdict is on the bytes read: a path rewritten meanwhile gets none (it was "ok").
+    common::requireUnchanged(options->path, path_stamp, "checked");
     const json report = {
         {"scene", scene.file.string()},
         {"path", options->path},
-        {"path_digest", common::fileDigest(options->path)},
+        {"path_digest", path_digest},
         {"scene_digest", sceneDigest(scene)},
         {"postures", path.postures.size()},
         // As generate reads them: pass blocks split at gaps (a file without markers), links out.

@@ -85,6 +85,33 @@ int run(const TempDir& dir, const std::vector<std::string>& args, const std::str
 // ---- the mechanism ---------------------------------------------------------------------------
 
 // A signal in the middle of a write: the handler removes the temporary, the target never appears.
+// check's verdict is on the bytes it read: a path rewritten in place (same size), replaced by a
+// rename or removed while it ran is told by its stamp (a helper replaced a path during `check`:
+// "ok" for the old bytes, and the digest taken of the new).
+TEST(FileStamp, TellsAFileRewrittenReplacedOrRemoved) {
+  const TempDir dir;
+  const fs::path file = dir.write("p.cl", "0 0 0 0 0 1\n");
+  const common::FileStamp before = common::fileStamp(file);
+  EXPECT_NO_THROW(common::requireUnchanged(file, before, "checked"));
+  dir.write("p.cl", "1 0 0 0 0 1\n");  // same size, in place
+  fs::last_write_time(file, fs::last_write_time(file) + std::chrono::seconds(1));
+  try {
+    common::requireUnchanged(file, before, "checked");
+    ADD_FAILURE() << "a rewritten file passed";
+  } catch (const common::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("p.cl: changed while it was checked"), std::string::npos)
+        << e.what();
+  }
+  const common::FileStamp rewritten = common::fileStamp(file);
+  dir.write("q.cl", "1 0 0 0 0 1\n");
+  fs::last_write_time(dir.path() / "q.cl", fs::last_write_time(file));
+  fs::rename(dir.path() / "q.cl", file);  // same bytes and time, another file
+  EXPECT_THROW(common::requireUnchanged(file, rewritten, "checked"), common::InputError);
+  const common::FileStamp replaced = common::fileStamp(file);
+  fs::remove(file);
+  EXPECT_THROW(common::requireUnchanged(file, replaced, "checked"), common::InputError);
+}
+
 TEST(AtomicOutput, SignalDuringAWriteLeavesNothing) {
   const TempDir dir;
   const fs::path target = dir.path() / "out" / "big.bin";
