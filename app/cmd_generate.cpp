@@ -299,8 +299,13 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                   "field.backend)")
       ->check(CLI::IsMember({"auto", "cpu", "cuda", "reference"}))
       ->excludes(direct);
+  // The field's options mean nothing without a field: refused, not ignored (a --voxel 1e9 beside
+  // --nominal ran and wrote a reach box of 2e9 mm in report.json).
   cmd->add_flag("--nominal", options->nominal,
-                "The nominal path: axis on the hub normal (+ lead), no field, no dynamics");
+                "The nominal path: axis on the hub normal (+ lead), no field, no dynamics")
+      ->excludes(direct)
+      ->excludes(voxel)
+      ->excludes("--backend");
   cmd->add_option("--out", options->out, "Output folder")->required();
   cmd->callback([options, &global] {
     common::checkOutputDirectory(options->out, "--out");  // before the work, not after

@@ -23,6 +23,7 @@
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/phase_trace.h"
+#include "fieldpath/common/short_number.h"
 #include "node_block.h"
 #include "voxel_grid.h"
 
@@ -402,7 +403,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
   // A node spacing past r0 cannot hold a field that lives within r0 of the surfaces: at 10 and
   // 20 mm (r0 5) the paths collided more than the nominal one, from 50 mm the field was zero.
   if (h > params.r0_mm)
-    throw common::InputError("field.voxel_size (or --voxel): " + std::to_string(h) +
+    throw common::InputError("field.voxel_size (or --voxel): " + common::shortNumber(h) +
                              " mm is coarser than field.r0 (" + std::to_string(params.r0_mm) +
                              " mm): the grid cannot hold a field that ends within r0 of the "
                              "surfaces; use at most r0 (r0 / 10 for an accurate one)");
@@ -434,10 +435,11 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
                     const std::string& advice = "use a coarser voxel size") {
     const double bytes = nodes * bytes_per_node;
     if (bytes <= static_cast<double>(request.max_memory_bytes)) return;
-    throw common::InputError("voxel field at h = " + std::to_string(h) + " mm: " + what + " " +
+    throw common::InputError("voxel field at h = " + common::shortNumber(h) + " mm: " + what + " " +
                              std::to_string(static_cast<long long>(nodes)) + " nodes (" +
                              mib(bytes) + "), over the limit of " +
-                             mib(static_cast<double>(request.max_memory_bytes)) + "; " + advice);
+                             mib(static_cast<double>(request.max_memory_bytes)) +
+                             " (--max-memory, else the memory available); " + advice);
   };
   const std::string refine_advice =
       "raise field.refine_tolerance or lower field.refine_levels (or a coarser voxel size)";

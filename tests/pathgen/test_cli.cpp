@@ -217,6 +217,26 @@ TEST(BadOptions, VoxelSizeMustBeAPositiveLength) {
     EXPECT_NE(r.output.find("--voxel"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(out));
   }
+  // The field's options beside --nominal (no field): refused, not ignored.
+  for (const char* field : {"--direct", "--voxel 1e9", "--backend cpu"}) {
+    const Outcome r = run("generate '" + kScene.string() + "' --nominal " + field + " --out '" +
+                          out.string() + "'");
+    EXPECT_EQ(r.exit_code, 1) << field << ": " << r.output;
+    EXPECT_NE(r.output.find("excludes --nominal"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+// --max-memory bounds generate's voxel grid as it bounds `field build`'s (a helper's 10M built a
+// 35 MB grid: the grid's request kept a fixed 4 GiB).
+TEST(BadOptions, TheVoxelGridKeepsToMaxMemory) {
+  const fs::path out = fs::temp_directory_path() / ("fieldpath_mem_" + std::to_string(getpid()));
+  const Outcome r = run("--max-memory 10M generate '" + kScene.string() + "' --voxel 0.5 --out '" +
+                        out.string() + "'");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("voxel field at h = 0.5 mm: estimated"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("over the limit of 10 MiB (--max-memory"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include "fieldpath/common/limits.h"
 #include "fieldpath/common/progress.h"
 #include "fieldpath/field/cell_mask.h"
 #include "fieldpath/field/direct_field.h"
@@ -55,7 +56,9 @@ struct VoxelRequest : VoxelSettings {
   /// wherever the error asks, in the region.
   std::shared_ptr<const CellMask> refine_mask;
   /// A build whose estimated memory (estimateVoxelNodes) exceeds this is refused (InputError).
-  std::size_t max_memory_bytes = std::size_t{4} << 30;
+  /// The process's limit (`--max-memory`, else the memory available) unless set: generate's grid
+  /// was built past --max-memory (a fixed 4 GiB here; a helper's 10M gave a 35 MB grid).
+  std::size_t max_memory_bytes = common::memoryLimitBytes();
   common::Progress progress;  ///< "field" fraction of leaves built
 };
 
