@@ -220,6 +220,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
           options->out,
           {"check.json", "clearance.csv", "deviation.npy", "deviation.json", "deviation.png"},
           {options->scene, options->path});
+      common::removeEarlierOutputs();
     }
     const Scene scene = loadScene(options->scene, /*read_nominal=*/false);
     const common::FileStamp path_stamp = common::fileStamp(options->path);

@@ -314,6 +314,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     common::claimOutputs(options->out, {"path.cl", "path.apt", "angles.csv", "report.json"},
                          {options->scene, nominalPathOf(options->scene)});
     forgetCheckOfReplacedPath(options->out);
+    common::removeEarlierOutputs();
     // Reading (the scene, its meshes, the nominal path, the passes) is counted apart: the job's
     // total left out 9 s of a 70 MB STL (a helper's).
     const auto read_start = std::chrono::steady_clock::now();

@@ -44,6 +44,7 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
   common::claimOutputs(o.out,
                        {"study.csv", "lines.csv", "tilt.csv", "study.md", "speed_vs_error.png",
                         "force_error_lines.png", "tilt_along_path.png"});
+  common::removeEarlierOutputs();
   StudyRequest request;
   request.voxel_sizes_mm = parseVoxelSizes(o.voxels, "--voxels");
   request.interpolations = parseInterpolations(o.interpolations, "--interp");

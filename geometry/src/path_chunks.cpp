@@ -17,6 +17,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/errors.h"
 #include "path_text.h"
 
@@ -32,6 +33,7 @@ MappedFile::MappedFile(const std::filesystem::path& file) {
     if (map != MAP_FAILED) {
       map_ = map;
       mapped_bytes_ = static_cast<std::size_t>(st.st_size);
+      listed_ = common::listMappedInput(file.string());
       // Read ahead: the chunks are parsed in parallel from the first to the last.
       ::madvise(map_, mapped_bytes_, MADV_SEQUENTIAL | MADV_WILLNEED);
       text_ = std::string_view(static_cast<const char*>(map_), mapped_bytes_);
@@ -48,6 +50,7 @@ MappedFile::MappedFile(const std::filesystem::path& file) {
 }
 
 MappedFile::~MappedFile() {
+  common::unlistMappedInput(listed_);
   if (map_) ::munmap(map_, mapped_bytes_);
 }
 

@@ -27,6 +27,7 @@ class MappedFile {
  private:
   void* map_ = nullptr;
   std::size_t mapped_bytes_ = 0;
+  int listed_ = -1;   ///< common::listMappedInput's slot (a SIGBUS names the file)
   std::string copy_;  ///< the contents where mapping failed
   std::string_view text_;
 };

@@ -112,6 +112,19 @@ TEST(FileStamp, TellsAFileRewrittenReplacedOrRemoved) {
   EXPECT_THROW(common::requireUnchanged(file, replaced, "checked"), common::InputError);
 }
 
+// A link planted under the writer's temporary name (`.NAME.tmp-PID`, in a shared folder) is not
+// written through: the victim keeps its bytes, the output is a file of its own (a helper's).
+TEST(AtomicOutput, ALinkUnderTheTemporaryNameIsNotWrittenThrough) {
+  const TempDir dir;
+  const fs::path victim = dir.write("victim.txt", "keep me\n");
+  const fs::path out = dir.path() / "out.txt";
+  fs::create_symlink(victim, dir.path() / (".out.txt.tmp-" + std::to_string(::getpid())));
+  common::writeTextAtomically(out, "the output\n");
+  EXPECT_EQ(slurp(victim), "keep me\n");
+  EXPECT_FALSE(fs::is_symlink(out));
+  EXPECT_EQ(slurp(out), "the output\n");
+}
+
 TEST(AtomicOutput, SignalDuringAWriteLeavesNothing) {
   const TempDir dir;
   const fs::path target = dir.path() / "out" / "big.bin";
@@ -379,6 +392,32 @@ void interruptMidway(const std::vector<std::string>& args, std::chrono::millisec
 TEST(Interrupted, GenerateLeavesNoPartialFile) {
   interruptMidway({"generate", kImpeller.string(), "--out", "out"}, std::chrono::milliseconds(600),
                   SIGINT);
+}
+
+// A run killed where no handler runs (SIGKILL, the out-of-memory killer) between its renames
+// left its new path.cl beside the earlier run's path.apt and report.json, a set that reads
+// complete (a helper's): the earlier files go when the work starts. Looked at the moment the new
+// path.cl appears (the first rename): the earlier report.json is gone already.
+TEST(Killed, AGenerateKilledBetweenItsRenamesLeavesNoEarlierFile) {
+  const TempDir dir;
+  for (const char* name : {"path.cl", "path.apt", "angles.csv", "report.json"})
+    dir.write(std::string("out/") + name, "earlier\n");
+  const pid_t pid = start(dir, {"generate", kImpeller.string(), "--out", "out"});
+  const fs::path path_cl = dir.path() / "out" / "path.cl";
+  std::string report_then = "(path.cl never appeared)";
+  for (int ms = 0; ms < 60000; ++ms) {
+    std::error_code ec;
+    if (fs::exists(path_cl, ec) && slurp(path_cl).rfind("earlier", 0) != 0) {
+      report_then = slurp(dir.path() / "out" / "report.json");
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  kill(pid, SIGKILL);
+  finish(pid);
+  EXPECT_EQ(report_then.find("earlier"), std::string::npos) << report_then;
+  for (const auto& name : filesUnder(dir.path() / "out"))
+    if (!isTemporary(name)) EXPECT_NE(slurp(dir.path() / "out" / name), "earlier\n") << name;
 }
 
 TEST(Interrupted, SimulateLeavesNoPartialFile) {

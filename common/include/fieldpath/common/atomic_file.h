@@ -169,12 +169,56 @@ extern "C" inline void removeTemporariesAndDie(int signal_number) {
 }
 }  // namespace detail
 
+namespace detail {
+/// The input files mapped into memory now (listMappedInput): one cut short while it is mapped
+/// (another program rewrote it) ends the process with SIGBUS at the next read of a lost page.
+inline constexpr int kMappedSlots = 8;
+inline TemporarySlot mapped_slots[kMappedSlots];
+
+inline void writeAll(int fd, const char* text) noexcept {
+  for (std::size_t n = std::strlen(text); n > 0;) {
+    const ssize_t w = ::write(fd, text, n);
+    if (w <= 0) return;
+    text += w, n -= static_cast<std::size_t>(w);
+  }
+}
+
+/// SIGBUS: one line naming the mapped input (it crashed with "Bus error", leaving an empty output
+/// folder), the run's files removed as for a failed run, exit 1. Async-signal-safe.
+extern "C" inline void inputCutShortAndExit(int) {
+  const char* name = "an input file";
+  for (auto& slot : mapped_slots)
+    if (slot.state.load() == 2) {
+      name = slot.path;
+      break;
+    }
+  writeAll(STDERR_FILENO, "fieldpath: error: ");
+  writeAll(STDERR_FILENO, name);
+  writeAll(STDERR_FILENO,
+           ": cut short while it was read (another program wrote it): run again on the file as it "
+           "is\n");
+  removeTemporariesNow();
+  removeClaimedOutputsNow();
+  removeCreatedDirectoryNow();
+  ::_exit(1);
+}
+}  // namespace detail
+
+/// Lists an input file mapped into memory (for the SIGBUS message); -1 when no slot is free.
+inline int listMappedInput(const std::string& path) {
+  return detail::listInSlots(detail::mapped_slots, detail::kMappedSlots, path);
+}
+inline void unlistMappedInput(int slot) {
+  if (slot >= 0) detail::mapped_slots[slot].state.store(0);
+}
+
 /// SIGINT, SIGTERM, SIGHUP (the terminal closed), SIGQUIT and SIGPIPE (`| head` done reading)
 /// remove the temporaries being written (no partial file under any name) and the outputs the run
 /// claimed (no earlier run's file beside an interrupted one), then end the process by the signal
 /// as usual. SIGXFSZ (`ulimit -f`) is ignored: the write fails, the run reports it as any
-/// failed write and removes its files (killed by it, its temporaries stayed). The CLI's main()
-/// installs it first thing.
+/// failed write and removes its files (killed by it, its temporaries stayed). SIGBUS (a mapped
+/// input cut short) is one line and exit 1, the files removed as for a failed run. The CLI's
+/// main() installs it first thing.
 inline void installTemporaryCleanupOnSignals() {
   struct sigaction action {};
   action.sa_handler = detail::removeTemporariesAndDie;
@@ -188,6 +232,10 @@ inline void installTemporaryCleanupOnSignals() {
     sigaction(signal_number, &action, nullptr);
   }
   ::signal(SIGXFSZ, SIG_IGN);
+  struct sigaction bus {};
+  bus.sa_handler = detail::inputCutShortAndExit;
+  sigemptyset(&bus.sa_mask);
+  sigaction(SIGBUS, &bus, nullptr);
 }
 
 /// Makes `dir` (and its parents) a directory for outputs. Throws InputError (one line naming the
@@ -300,6 +348,10 @@ inline void writeFileAtomically(const std::filesystem::path& given,
   const detail::TemporaryListing listing{detail::listTemporary(tmp.string())};
   try {
     {
+      // The name is this process's (its PID): whatever holds it was left by a dead process or
+      // planted, a link to another file that the open would write through (a helper's, in a
+      // shared folder). Unlinked (a link, not its target), then created afresh.
+      ::unlink(tmp.c_str());
       errno = 0;
       detail::beginCreating(listing.slot);
       std::ofstream out(tmp, mode | std::ios::trunc);
@@ -424,6 +476,12 @@ inline void claimOutputs(const std::filesystem::path& dir, std::initializer_list
     detail::listInSlots(detail::claimed_slots, detail::kClaimedSlots, (dir / name).string());
   }
 }
+
+/// Removes, before the work, the earlier run's files of the outputs claimed (regular files, not
+/// inputs): a run killed where no handler runs (SIGKILL, the out-of-memory killer) between two
+/// of its renames left its new path.cl beside the earlier run's path.apt and report.json, a set
+/// that reads complete (a helper's); now the folder holds this run's files or none.
+inline void removeEarlierOutputs() { removeClaimedOutputsNow(); }
 
 /// Refuses, before the work, outputs `names` in `dir` that are inputs this run has read (a scene
 /// whose nominal path is --out's path.cl: generate wrote over it, and the next run steered its
