@@ -207,7 +207,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                   "Depth under the part, along its normal, that counts as a gouge, um (the part "
                   "mesh's own chordal "
                   "error reads as a gouge where it is concave; 0.1 to 1000)")
-      ->check(CLI::Range(0.1, 1000.0))
+      ->check(numberFromTo(0.1, 1000.0, "um"))  // (CLI::Range let nan through)
       ->capture_default_str();
   cmd->add_option("--backend", options->backend, "Z-buffer backend: auto | cpu | cuda")
       ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
@@ -240,7 +240,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     if (!(1e-3 * options->gouge_tol_um < 0.5 * scene.tool.radius_mm))
       throw InputError("--gouge-tol " + common::shortNumber(options->gouge_tol_um) +
                        " um: must be under half the tool radius (" +
-                       common::shortNumber(1e3 * scene.tool.radius_mm) + " um)");
+                       common::shortNumber(0.5e3 * scene.tool.radius_mm) + " um)");
     if (scene.tool.shape == geometry::ToolShape::Flat)
       throw InputError(toolShapeWhere(scene) +
                        ": check proves ball and torus tools; a flat end's sharp rim, tilted, is "

@@ -134,9 +134,15 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
       ->check(positiveFinite("mm"));
   cmd->add_flag("--no-brute-force", options->no_brute_force,
                 "Skip the every-point direct sum (slow on large scenes)");
-  cmd->add_option("--line-step", options->line_step_mm, "Sampling of the study lines, mm")
+  // Bounded: 1e-8 sampled each line with 2 points unsaid, 1e-5 ran for minutes unestimated, and
+  // a billion repeats ran until killed (a helper's).
+  cmd->add_option("--line-step", options->line_step_mm,
+                  "Sampling of the study lines, mm (0.001 to 10)")
+      ->check(numberFromTo(0.001, 10.0, "mm"))
       ->capture_default_str();
-  cmd->add_option("--repeat", options->repeats, "Runs per variant; times are their medians")
+  cmd->add_option("--repeat", options->repeats,
+                  "Runs per variant (1 to 100); times are their medians")
+      ->check(numberFromTo(1, 100, ""))
       ->capture_default_str();
   cmd->add_option("--out", options->out, "Output folder")->required();
   cmd->callback([options, &global] {

@@ -10,6 +10,7 @@
 #include "commands.h"
 #include "errors.h"
 #include "fieldpath/common/atomic_file.h"
+#include "fieldpath/common/short_number.h"
 #include "progress.h"
 #include "view_data.h"
 #include "view_page.h"
@@ -96,8 +97,11 @@ void addViewCommand(CLI::App& app, const GlobalOptions& global) {
       page = viewPage(data, three, budget, generator, &stats);
       if (stats.bytes <= max_bytes) break;
       if (attempt == 6 || (budget.max_triangles <= 2000 && budget.max_postures <= 1000))
-        throw InputError("--max-mb " + std::to_string(o->max_mb) + ": the smallest page is " +
-                         std::to_string(stats.bytes / 1e6) + " MB");
+        throw InputError("--max-mb " + common::shortNumber(o->max_mb) +
+                         ": the smallest page at these budgets is " +
+                         common::shortNumber(stats.bytes / 1e6) +
+                         " MB (its meshes, postures and surface: lower --surface-lines, or "
+                         "--max-triangles and --max-postures further)");
       budget.max_triangles = std::max<std::size_t>(2000, budget.max_triangles / 2);
       budget.max_postures = std::max<std::size_t>(1000, budget.max_postures / 2);
     }

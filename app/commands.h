@@ -8,6 +8,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "fieldpath/common/short_number.h"
+
 namespace fieldpath::app {
 
 /// CLI11 check for a size option: a finite number > 0 (or >= 0 with `zero_ok`), in `unit`, with
@@ -31,6 +33,23 @@ inline CLI::Validator finiteNumber(const std::string& unit, bool zero_ok) {
       (unit.empty() ? "" : unit + " ") + bound);
 }
 inline CLI::Validator positiveFinite(const std::string& unit) { return finiteNumber(unit, false); }
+
+/// CLI11 check for a number in [lo, hi] (`unit` may be empty), with the short message of
+/// finiteNumber (CLI::Range printed "not in range 0.001000 to 10.000000").
+inline CLI::Validator numberFromTo(double lo, double hi, const std::string& unit) {
+  const std::string range =
+      common::shortNumber(lo) + " to " + common::shortNumber(hi) + (unit.empty() ? "" : " " + unit);
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (text.empty() || end == text.c_str()) return "'" + text + "' is not a number";
+        if (end != text.c_str() + text.size() || !(value >= lo && value <= hi))
+          return "must be a number from " + range + ", got '" + text + "'";
+        return {};
+      },
+      range);
+}
 
 struct GlobalOptions {
   bool quiet = false;  ///< silence progress lines on stderr

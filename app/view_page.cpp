@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <numeric>
 #include <sstream>
 #include <type_traits>
 
@@ -341,14 +342,24 @@ std::string viewPage(const ViewData& d, const ThreeJs& three, const PageBudget& 
   Blob blob;
   json meshes = json::array();
   for (const ViewMesh& m : d.meshes) st.source_triangles += m.mesh.triangles.size();
-  for (const ViewMesh& m : d.meshes) {
-    // Each mesh gets the budget in proportion to its triangles.
-    const double share =
-        double(m.mesh.triangles.size()) / double(std::max<std::size_t>(1, st.source_triangles));
-    const std::size_t max =
-        std::max<std::size_t>(2000, std::size_t(share * double(budget.max_triangles)));
+  // The budget shared out from the smallest mesh up: each takes its own triangles or an equal
+  // share of what is left, so a small mesh stays whole, the large ones share alike, and the page
+  // holds max_triangles at most (a floor of 2000 a mesh showed 3444 for --max-triangles 1000).
+  std::vector<std::size_t> order(d.meshes.size()), allowed(d.meshes.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return d.meshes[a].mesh.triangles.size() < d.meshes[b].mesh.triangles.size();
+  });
+  std::size_t left = budget.max_triangles;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const std::size_t i = order[k];
+    allowed[i] = std::max<std::size_t>(
+        1, std::min(d.meshes[i].mesh.triangles.size(), left / (order.size() - k)));
+    left -= std::min(left, allowed[i]);
+  }
+  for (std::size_t i = 0; i < d.meshes.size(); ++i) {
     std::size_t shown = 0;
-    meshes.push_back(meshJson(m, max, blob, &shown));
+    meshes.push_back(meshJson(d.meshes[i], allowed[i], blob, &shown));
     st.triangles += shown;
   }
   json meta = {

@@ -353,6 +353,14 @@ TEST(StudyCommand, BadInputIsExitOneWithNoOutputs) {
       << zero_step.err;
   EXPECT_EQ(test::runFieldpath(dir, "study missing.yaml --out study").exit_code, 1);
   EXPECT_EQ(test::runFieldpath(dir, "study scene.yaml --backend gpu --out study").exit_code, 1);
+  // Bounded (1e-8 sampled each line with 2 points unsaid; a billion repeats ran until killed).
+  for (const char* args : {"--line-step 1e-8", "--line-step 11", "--repeat 1000000000"}) {
+    const test::Outcome run =
+        test::runFieldpath(dir, std::string("study scene.yaml ") + args + " --out study");
+    EXPECT_EQ(run.exit_code, 1) << args;
+    EXPECT_NE(run.err.find("must be a number from"), std::string::npos) << args << ": " << run.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / "study")) << args;
+  }
   // Sizes the options drive are estimated before any work (the brute-force variant, first, ran
   // for minutes before the voxel size was looked at).
   for (const char* args : {"--voxels 2,1e-6", "--voxels 2 --sample-step 1e-5"}) {

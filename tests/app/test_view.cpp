@@ -361,6 +361,26 @@ TEST(View, ACheckedSlopesUncutLinesAreGreyed) {
             0);
 }
 
+// --max-triangles is the page's whole budget (a floor of 2000 a mesh showed 3444 for 1000 on a
+// scene of several meshes): shared out, at most the budget in all.
+TEST(View, MaxTrianglesIsThePagesWholeBudget) {
+  const TempDir dir;
+  const Outcome r =
+      runFieldpath(dir, "view '" + kImpellerScene.string() + "' --max-triangles 1000 --out v.html");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const json meta = pageMeta(slurp(dir.path() / "v.html"));
+  ASSERT_GE(meta["meshes"].size(), 2u);
+  std::size_t shown = 0, source = 0;
+  for (const auto& m : meta["meshes"]) {
+    shown += m["triangles"].get<std::size_t>();
+    source += m["source_triangles"].get<std::size_t>();
+    EXPECT_GT(m["triangles"].get<std::size_t>(), 0u) << m["name"];
+  }
+  EXPECT_GT(source, 5000u);
+  EXPECT_LE(shown, 1000u);
+  EXPECT_GT(shown, 500u);
+}
+
 TEST(View, MeshesAreDecimatedToTheBudget) {
   // A finely triangulated sphere-like mesh: a subdivided box.
   fieldpath::geometry::TriangleMesh mesh;

@@ -98,8 +98,16 @@ TEST(CheckVerdict, TheGougeToleranceIsTheOptions) {
   const auto wide =
       test::runFieldpath(dir, "check small.yaml --path dip.cl --gouge-tol 600 --out wide");
   EXPECT_EQ(wide.exit_code, 1) << wide.output();
-  EXPECT_NE(wide.err.find("--gouge-tol 600"), std::string::npos) << wide.err;
+  EXPECT_NE(wide.err.find("--gouge-tol 600 um: must be under half the tool radius (500 um)"),
+            std::string::npos)
+      << wide.err;
   EXPECT_FALSE(fs::exists(dir.path() / "wide"));
+  // Not a number: said so (nan passed the range check and was told it was over half the radius).
+  const auto nan = test::runFieldpath(dir, "check small.yaml --path dip.cl --gouge-tol nan");
+  EXPECT_EQ(nan.exit_code, 1) << nan.output();
+  EXPECT_NE(nan.err.find("--gouge-tol: must be a number from 0.1 to 1000 um, got 'nan'"),
+            std::string::npos)
+      << nan.err;
 }
 
 // A 400 mm square part at a 0.02 mm spacing is 4 · 10^8 lines: the grid is coarsened to the
