@@ -19,6 +19,7 @@
 #include "commands.h"
 #include "cutter_note.h"
 #include "errors.h"
+#include "estimates.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/csv.h"
 #include "fieldpath/common/file_digest.h"
@@ -223,6 +224,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       common::removeEarlierOutputs();
     }
     const Scene scene = loadScene(options->scene, /*read_nominal=*/false);
+    checkPathFileSize(options->path, "--path " + options->path);
     const common::FileStamp path_stamp = common::fileStamp(options->path);
     const geometry::PathFile path = geometry::readPathFile(options->path);
     const std::string path_digest = common::fileDigest(options->path);

@@ -10,6 +10,7 @@
 
 #include "commands.h"
 #include "errors.h"
+#include "estimates.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/file_names.h"
 #include "fieldpath/common/limits.h"
@@ -63,13 +64,7 @@ void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
       header.tool = geometry::parseToolSpec(o->tool);
     }
     common::checkOutputFile(out, "OUT");  // before the reading, not after
-    // A PathFile keeps ~80 bytes a posture (a Posture, its line, its block): the input's size
-    // bounds the posture count (a .cl line is at least 12 bytes, an .npy row 24).
-    std::error_code size_ec;
-    const double in_bytes = double(fs::file_size(in, size_ec));
-    if (!size_ec)
-      common::requireMemory(in.string(), in_bytes / 12.0 * 80.0,
-                            "the postures of the input, whole");
+    checkPathFileSize(in, in.string());
 
     const geometry::PathFile path = geometry::readPathFile(in);
     // The safety marks go with the path (`# ...` at the top of a .cl, PPRINT/ in APT): a path

@@ -118,6 +118,14 @@ std::string mib(std::size_t bytes) {
 }
 
 void probe(const FieldOptions& o, const GlobalOptions& global) {
+  // Before reading: the points, their forces and the output text are held whole, ~150 bytes a
+  // point, and a point's line is 6 bytes at least (a helper's 3 GB file ran to 12.6 GB under
+  // --max-memory 256M).
+  std::error_code size_ec;
+  const double point_bytes = double(std::filesystem::file_size(o.points, size_ec));
+  if (!size_ec)
+    common::requireMemory("--points " + o.points, point_bytes / 6.0 * 150.0,
+                          "its points, their forces and the output text, whole");
   const std::vector<Vec3> points = readPoints(o.points);
   const Obstacles obstacles = loadObstacles(o);
   std::unique_ptr<field::VoxelField> voxel;

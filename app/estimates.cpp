@@ -186,6 +186,12 @@ void checkSceneSize(const Scene& scene) {
   }
 }
 
+void checkPathFileSize(const std::filesystem::path& file, const std::string& what) {
+  std::error_code ec;
+  const double bytes = double(std::filesystem::file_size(file, ec));
+  if (!ec) common::requireMemory(what, bytes / 12.0 * 80.0, "its postures, whole");
+}
+
 void checkVoxelSize(const Scene& scene, double voxel_mm, const std::string& key) {
   const double r0 = scene.field.r0_mm;
   // The field build refuses it too, but only when it comes (study: after its direct variants).

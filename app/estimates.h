@@ -4,6 +4,7 @@
 /// throws common::InputError "SCENE: KEY: needs about E of memory (...), limit L (--max-memory)"
 /// naming the key that drives the size, against common::memoryLimitBytes().
 #include <cstddef>
+#include <filesystem>
 #include <string>
 
 #include "fieldpath/pathgen/impeller.h"
@@ -38,6 +39,12 @@ void checkSampleStep(const Scene& scene, double step_mm, const std::string& key)
 /// of the obstacles, at most their box padded by r0 (the field module estimates refinement).
 /// `key` names where h came from.
 void checkVoxelSize(const Scene& scene, double voxel_mm, const std::string& key);
+
+/// A path file read whole (geometry::readPathFile): ~80 bytes a posture held (a Posture, its
+/// line, its block), and a .cl line is 12 bytes at least (an .npy row 24). Refused before the
+/// read above --max-memory, `what` naming where the file came from (a helper's 10 GB
+/// path.nominal was mapped whole, 16 GiB reserved, before its first line was refused).
+void checkPathFileSize(const std::filesystem::path& file, const std::string& what);
 
 /// The obstacle samples at `step_mm`: the count sampleObstacles makes, to the sample, but for a
 /// bound on the merged ones of triangles finer than the step.

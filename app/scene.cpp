@@ -18,6 +18,7 @@
 #include "estimates.h"
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/input_file.h"
+#include "fieldpath/common/limits.h"
 #include "fieldpath/common/short_number.h"
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/geometry/tool_model.h"
@@ -441,9 +442,30 @@ std::string placeSceneKey(const std::string& message) {
   return keys.file.string() + ":" + std::to_string(at->second) + ": " + message;
 }
 
+namespace {
+/// A scene file is a few kB of text (its meshes and paths are files it names); past this it is
+/// not one, and reading it whole took minutes and gigabytes (a helper's 3 GB sparse file:
+/// 4.2 GB of memory, then "unknown escape character").
+constexpr std::uintmax_t kMaxSceneBytes = std::uintmax_t{16} << 20;
+
+/// False (nothing to read) for a file over kMaxSceneBytes; throws InputError saying so when
+/// `refuse`.
+bool sceneSizeOk(const std::filesystem::path& file, bool refuse) {
+  std::error_code ec;
+  const std::uintmax_t bytes = std::filesystem::file_size(file, ec);
+  if (ec || bytes <= kMaxSceneBytes) return true;
+  if (refuse)
+    throw InputError(file.string() + ": " + common::formatBytes(double(bytes)) +
+                     ": not a scene file (a scene is YAML text of a few kB that names its mesh "
+                     "and path files; at most 16 MiB)");
+  return false;
+}
+}  // namespace
+
 Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
   sceneKeyLines() = SceneKeyLines{};  // none of another scene's
   common::requireRegularFile(file, "scene file (YAML)");
+  sceneSizeOk(file, /*refuse=*/true);
   YAML::Node root;
   try {
     // Every document read, so that one past the scene (after `---`, or text after `...`) is
@@ -544,6 +566,7 @@ Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
     const YAML::Node node = root["path"]["nominal"];
     const auto file = r.path(node, "path.nominal");
     try {
+      checkPathFileSize(file, file.string());
       scene.nominal = geometry::readPathFile(file);
     } catch (const InputError& e) {
       // The path file's own message names its line; say which key led there.
@@ -557,7 +580,8 @@ Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
 
 std::filesystem::path nominalPathOf(const std::filesystem::path& file) {
   std::error_code ec;  // a FIFO would block the read before loadScene refuses it
-  if (!std::filesystem::is_regular_file(file, ec)) return {};
+  if (!std::filesystem::is_regular_file(file, ec) || !sceneSizeOk(file, /*refuse=*/false))
+    return {};
   try {
     const YAML::Node root = YAML::LoadFile(file.string());
     const YAML::Node node = root["path"] ? root["path"]["nominal"] : YAML::Node();

@@ -5,6 +5,7 @@
 /// with no output directory, also when the bad line comes after blocks already cut.
 #include <algorithm>
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -287,6 +288,43 @@ TEST(SimulateFormats, BadClLineAfterManyBlocksIsOneLineAndNoOutputs) {
   EXPECT_EQ(big.exit_code, 1) << big.err;
   EXPECT_NE(big.err.find("--path many.cl: needs about 1.83 MiB"), std::string::npos) << big.err;
   EXPECT_FALSE(fs::exists(dir.path() / "out"));
+}
+
+// Inputs read whole are sized before they are read (a helper's sparse files: a 3 GB scene took
+// 4.2 GB of memory, a 10 GB path.nominal was mapped and 16 GiB reserved before its first line
+// was refused, a 3 GB points file ran to 12.6 GB under --max-memory 256M): one line, at once.
+TEST(InputSizes, FilesReadWholeAreSizedBeforeTheRead) {
+  const TempDir dir;
+  dir.write("wall.stl", squareStl(10));
+  dir.write("s.yaml",
+            "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 1, length: 20 }\n"
+            "path: { nominal: huge.cl }\n");
+  const auto sparse = [&](const char* name, std::uintmax_t bytes) {
+    std::ofstream(dir.path() / name).put('\n');
+    fs::resize_file(dir.path() / name, bytes);
+  };
+  sparse("huge.cl", std::uintmax_t{4} << 30);
+  sparse("huge.yaml", std::uintmax_t{1} << 30);
+  sparse("points.txt", std::uintmax_t{1} << 30);
+  struct Case {
+    std::string args, message;
+  };
+  const Case cases[] = {
+      {"--max-memory 1G generate s.yaml --out g", "s.yaml:4: path.nominal: "},
+      {"--max-memory 1G check s.yaml --path huge.cl", "--path huge.cl: needs about"},
+      {"--max-memory 1G convert huge.cl h.npy", "huge.cl: needs about"},
+      {"generate huge.yaml --out g", "huge.yaml: 1 GiB: not a scene file"},
+      {"--max-memory 1G field probe s.yaml --points points.txt", "--points points.txt: needs"}};
+  for (const Case& c : cases) {
+    const auto start = std::chrono::steady_clock::now();
+    const Outcome run = runFieldpath(dir, c.args);
+    EXPECT_EQ(run.exit_code, 1) << c.args << ": " << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << c.args << ": " << run.err;
+    EXPECT_NE(run.err.find(c.message), std::string::npos) << c.args << ": " << run.err;
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5)) << c.args;
+    EXPECT_FALSE(fs::exists(dir.path() / "g")) << c.args;
+    EXPECT_FALSE(fs::exists(dir.path() / "h.npy")) << c.args;
+  }
 }
 
 /// convert: .cl (passes, a link, a limit mark) → .npy → APT → .cl gives the same postures bit for
