@@ -104,7 +104,6 @@ field::VoxelRequest voxelRequest(const FieldOptions& o, const Scene& scene, bool
   if (!o.interpolation.empty())
     request.interpolation = o.interpolation == "quadratic" ? field::Interpolation::Quadratic
                                                            : field::Interpolation::Trilinear;
-  request.max_memory_bytes = common::memoryLimitBytes();  // loadObstacles set --max-memory
   if (!o.backend.empty()) request.backend = *field::fieldBackendNamed(o.backend);
   if (o.refine_tolerance >= 0.0) request.refine_tolerance = o.refine_tolerance;
   request.progress = makeProgressLine(quiet);

@@ -22,6 +22,7 @@
 #include "cli_parse.h"
 #include "commands.h"
 #include "errors.h"
+#include "estimates.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/file_digest.h"
 #include "fieldpath/common/limits.h"
@@ -114,39 +115,6 @@ std::size_t linesBeneathTheTopLayer(const geometry::TriangleMesh& part, const zb
   const zb::PartUnderCut under =
       zb::partUnderCut(grid, m.vertices, m.triangles, top, heights_mm, open, kLayerMm);
   return static_cast<std::size_t>(std::count(under.beneath.begin(), under.beneath.end(), 1));
-}
-
-/// About how many postures a path file holds, from its size: `.npy` rows of 24 bytes (float32
-/// N×6; float64 counts double), text by the line length of its first 64 KiB (5-axis lines of
-/// 32-bit values run ~60 bytes, 3-axis ones ~35). 0 where the file cannot be read (the reader
-/// then says why).
-double estimatePostures(const fs::path& file) {
-  std::error_code ec;
-  const double bytes = double(fs::file_size(file, ec));
-  if (ec) return 0.0;
-  std::ifstream in(file, std::ios::binary);
-  std::string head(std::size_t{1} << 16, '\0');
-  in.read(head.data(), std::streamsize(head.size()));
-  const std::size_t got = std::size_t(in.gcount());
-  head.resize(got);
-  const geometry::PathFormat format = geometry::pathFormatOf(file);
-  if (format == geometry::PathFormat::Npy) {  // the rows its header says (float32 or 64)
-    const auto shape = head.find("'shape': (");
-    if (shape != std::string::npos) {
-      const double rows = std::strtod(head.c_str() + shape + 10, nullptr);
-      if (rows > 0) return rows;
-    }
-    return bytes / 24.0;
-  }
-  // A posture a line in .cl, a GOTO in APT (a GOTO may take two lines: cards of 72 columns).
-  std::size_t count = 0;
-  if (format == geometry::PathFormat::Apt)
-    for (std::size_t at = head.find("GOTO"); at != std::string::npos;
-         at = head.find("GOTO", at + 4))
-      ++count;
-  else
-    count = std::count(head.begin(), head.end(), '\n');
-  return count > 0 ? bytes * double(count) / double(std::max<std::size_t>(got, 1)) : bytes / 30.0;
 }
 
 }  // namespace

@@ -43,7 +43,8 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
   // script that did not look at the exit code as this run's), as generate, check and simulate do.
   common::claimOutputs(o.out,
                        {"study.csv", "lines.csv", "tilt.csv", "study.md", "speed_vs_error.png",
-                        "force_error_lines.png", "tilt_along_path.png"});
+                        "force_error_lines.png", "tilt_along_path.png"},
+                       {o.scene});  // never the scene (`study out/study.md --out out` removed it)
   common::removeEarlierOutputs();
   StudyRequest request;
   request.voxel_sizes_mm = parseVoxelSizes(o.voxels, "--voxels");
@@ -136,12 +137,10 @@ void addStudyCommand(CLI::App& app, const GlobalOptions& global) {
                 "Skip the every-point direct sum (slow on large scenes)");
   // Bounded: 1e-8 sampled each line with 2 points unsaid, 1e-5 ran for minutes unestimated, and
   // a billion repeats ran until killed (a helper's).
-  cmd->add_option("--line-step", options->line_step_mm,
-                  "Sampling of the study lines, mm (0.001 to 10)")
+  cmd->add_option("--line-step", options->line_step_mm, "Sampling of the study lines, mm")
       ->check(numberFromTo(0.001, 10.0, "mm"))
       ->capture_default_str();
-  cmd->add_option("--repeat", options->repeats,
-                  "Runs per variant (1 to 100); times are their medians")
+  cmd->add_option("--repeat", options->repeats, "Runs per variant; times are their medians")
       ->check(numberFromTo(1, 100, ""))
       ->capture_default_str();
   cmd->add_option("--out", options->out, "Output folder")->required();

@@ -3,6 +3,7 @@
 /// lead or clearance, links, colliding postures and motions and clamped-limit postures marked, the
 /// tool + holder at the posture of a slider, the simulated surface coloured by deviation, axes in
 /// millimetres. Exit 1 on bad input (one line); a page that lacks a path says so.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -96,14 +97,19 @@ void addViewCommand(CLI::App& app, const GlobalOptions& global) {
     for (int attempt = 0;; ++attempt) {
       page = viewPage(data, three, budget, generator, &stats);
       if (stats.bytes <= max_bytes) break;
-      if (attempt == 6 || (budget.max_triangles <= 2000 && budget.max_postures <= 1000))
+      // Halved down to a floor that is never above the user's own budget (the floor of 2000
+      // raised --max-triangles 1000 to 1653 shown, a reviewer's).
+      const std::size_t triangle_floor = std::min<std::size_t>(2000, o->max_triangles),
+                        posture_floor = std::min<std::size_t>(1000, o->max_postures);
+      if (attempt == 6 ||
+          (budget.max_triangles <= triangle_floor && budget.max_postures <= posture_floor))
         throw InputError("--max-mb " + common::shortNumber(o->max_mb) +
                          ": the smallest page at these budgets is " +
                          common::shortNumber(stats.bytes / 1e6) +
                          " MB (its meshes, postures and surface: lower --surface-lines, or "
                          "--max-triangles and --max-postures further)");
-      budget.max_triangles = std::max<std::size_t>(2000, budget.max_triangles / 2);
-      budget.max_postures = std::max<std::size_t>(1000, budget.max_postures / 2);
+      budget.max_triangles = std::max(triangle_floor, budget.max_triangles / 2);
+      budget.max_postures = std::max(posture_floor, budget.max_postures / 2);
     }
     common::writeTextAtomically(o->out, page);
 

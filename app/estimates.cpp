@@ -1,10 +1,15 @@
 #include "estimates.h"
 
+#include "fieldpath/geometry/cl_file.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <sstream>
+#include <string>
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/limits.h"
@@ -186,10 +191,44 @@ void checkSceneSize(const Scene& scene) {
   }
 }
 
-void checkPathFileSize(const std::filesystem::path& file, const std::string& what) {
+double estimatePostures(const std::filesystem::path& file) {
+  namespace fs = std::filesystem;
   std::error_code ec;
-  const double bytes = double(std::filesystem::file_size(file, ec));
-  if (!ec) common::requireMemory(what, bytes / 12.0 * 80.0, "its postures, whole");
+  const double bytes = double(fs::file_size(file, ec));
+  if (ec) return 0.0;
+  std::ifstream in(file, std::ios::binary);
+  std::string head(std::size_t{1} << 16, '\0');
+  in.read(head.data(), std::streamsize(head.size()));
+  const std::size_t got = std::size_t(in.gcount());
+  head.resize(got);
+  const geometry::PathFormat format = geometry::pathFormatOf(file);
+  // Text with NUL bytes is no path file (a sparse or binary file: its 10 GB of zero pages were
+  // read in parallel for 15-48 s before line 1 was refused).
+  if (format != geometry::PathFormat::Npy && head.find('\0') != std::string::npos)
+    throw common::InputError(file.string() +
+                             ": NUL bytes near its start: binary data, not a text path file "
+                             "(.cl, APT)");
+  if (format == geometry::PathFormat::Npy) {  // the rows its header says (float32 or 64)
+    const auto shape = head.find("'shape': (");
+    if (shape != std::string::npos) {
+      const double rows = std::strtod(head.c_str() + shape + 10, nullptr);
+      if (rows > 0) return rows;
+    }
+    return bytes / 24.0;
+  }
+  // A posture a line in .cl, a GOTO in APT (a GOTO may take two lines: cards of 72 columns).
+  std::size_t count = 0;
+  if (format == geometry::PathFormat::Apt)
+    for (std::size_t at = head.find("GOTO"); at != std::string::npos;
+         at = head.find("GOTO", at + 4))
+      ++count;
+  else
+    count = std::count(head.begin(), head.end(), '\n');
+  return count > 0 ? bytes * double(count) / double(std::max<std::size_t>(got, 1)) : bytes / 30.0;
+}
+
+void checkPathFileSize(const std::filesystem::path& file, const std::string& what) {
+  common::requireMemory(what, estimatePostures(file) * 80.0, "its postures, whole");
 }
 
 void checkVoxelSize(const Scene& scene, double voxel_mm, const std::string& key) {

@@ -40,10 +40,16 @@ void checkSampleStep(const Scene& scene, double step_mm, const std::string& key)
 /// `key` names where h came from.
 void checkVoxelSize(const Scene& scene, double voxel_mm, const std::string& key);
 
+/// About how many postures a path file holds, from its size: `.npy` rows of 24 bytes (float32
+/// N×6; float64 counts double), text by the line length of its first 64 KiB (5-axis lines of
+/// 32-bit values run ~60 bytes, 3-axis ones ~35). 0 where the file cannot be read (the reader
+/// then says why). InputError for text (.cl, APT) with NUL bytes in its first 64 KiB.
+double estimatePostures(const std::filesystem::path& file);
+
 /// A path file read whole (geometry::readPathFile): ~80 bytes a posture held (a Posture, its
-/// line, its block), and a .cl line is 12 bytes at least (an .npy row 24). Refused before the
-/// read above --max-memory, `what` naming where the file came from (a helper's 10 GB
-/// path.nominal was mapped whole, 16 GiB reserved, before its first line was refused).
+/// line, its block). Refused before the read above --max-memory, `what` naming where the file
+/// came from, and a text file of NUL bytes at once (a helper's sparse 10 GB path.nominal was
+/// mapped whole, 16 GiB reserved, 15-48 s before its first line was refused).
 void checkPathFileSize(const std::filesystem::path& file, const std::string& what);
 
 /// The obstacle samples at `step_mm`: the count sampleObstacles makes, to the sample, but for a

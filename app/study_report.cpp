@@ -417,10 +417,10 @@ bool plotStudy(const std::filesystem::path& dir, std::string* message) {
   // program looked for a developer's checkout). Its stderr is kept for the message: a traceback
   // is not printed under --quiet.
   int to_python[2], from_python[2];
-  if (::pipe2(to_python, O_CLOEXEC) != 0) return fail("no pipe to python3: pictures not made");
+  if (::pipe2(to_python, O_CLOEXEC) != 0) return fail("pictures not made: no pipe to python3");
   if (::pipe2(from_python, O_CLOEXEC) != 0) {
     ::close(to_python[0]), ::close(to_python[1]);
-    return fail("no pipe from python3: pictures not made");
+    return fail("pictures not made: no pipe from python3");
   }
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
@@ -440,18 +440,24 @@ bool plotStudy(const std::filesystem::path& dir, std::string* message) {
   ::close(from_python[1]);
   if (spawned != 0) {
     ::close(to_python[1]), ::close(from_python[0]);
-    return fail("no python3 (" + std::string(std::strerror(spawned)) + "): pictures not made");
+    return fail("pictures not made: no python3 (" + std::string(std::strerror(spawned)) + ")");
   }
   // The script (a few kB) fits in the pipe's buffer: written whole before its output is read.
   const std::string_view script = study_assets::kPlotStudyPy;
-  const ::sighandler_t old_pipe = ::signal(SIGPIPE, SIG_IGN);  // python3 gone early: EPIPE
+  // python3 gone early: EPIPE, not SIGPIPE. The whole sigaction is put back (signal() dropped
+  // the cleanup handler's SA_RESETHAND: a later SIGPIPE re-raised itself for ever, a reviewer's).
+  struct sigaction ignore {
+  }, old_pipe{};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  ::sigaction(SIGPIPE, &ignore, &old_pipe);
   for (std::size_t done = 0; done < script.size();) {
     const ssize_t n = ::write(to_python[1], script.data() + done, script.size() - done);
     if (n <= 0 && errno != EINTR) break;
     if (n > 0) done += static_cast<std::size_t>(n);
   }
   ::close(to_python[1]);
-  ::signal(SIGPIPE, old_pipe);
+  ::sigaction(SIGPIPE, &old_pipe, nullptr);
   std::string output;
   char buffer[4096];
   for (ssize_t n; (n = ::read(from_python[0], buffer, sizeof buffer)) != 0;) {
@@ -460,10 +466,10 @@ bool plotStudy(const std::filesystem::path& dir, std::string* message) {
     if (output.size() < (1u << 20)) output.append(buffer, static_cast<std::size_t>(n));
   }
   ::close(from_python[0]);
-  int status = 0;
+  int status = -1;  // a failed waitpid (SIGCHLD ignored: ECHILD) is no success
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return true;
+  if (status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 0) return true;
   // The last line python3 wrote says why (an ImportError for a missing matplotlib).
   while (!output.empty() && (output.back() == '\n' || output.back() == '\r')) output.pop_back();
   const std::string last = output.substr(output.find_last_of('\n') + 1);

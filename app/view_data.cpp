@@ -277,7 +277,7 @@ ViewData gatherView(const ViewRequest& request) {
   }
   if (!path_file.empty()) {
     ViewPath p;
-    checkPathFileSize(path_file, "path " + path_file.string());
+    checkPathFileSize(path_file, (request.path.empty() ? "path " : "--path ") + path_file.string());
     p.file = geometry::readPathFile(path_file);
     pathgen::requireSteadyAxes(p.file, scene.path.pass_gap_mm,
                                scene.tool.radius_mm);  // a flipped axis in a pass

@@ -22,6 +22,7 @@
 #include <tbb/parallel_scan.h>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/limits.h"
 #include "fieldpath/common/phase_trace.h"
 #include "fieldpath/common/short_number.h"
 #include "node_block.h"
@@ -431,14 +432,15 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
   trace.lap("cell list");
   const double reach_mm = builder.reach_mm;
 
+  const double limit_bytes = static_cast<double>(
+      request.max_memory_bytes ? request.max_memory_bytes : common::memoryLimitBytes());
   auto refuse = [&](const std::string& what, double nodes, double bytes_per_node,
                     const std::string& advice = "use a coarser voxel size") {
     const double bytes = nodes * bytes_per_node;
-    if (bytes <= static_cast<double>(request.max_memory_bytes)) return;
+    if (bytes <= limit_bytes) return;
     throw common::InputError("voxel field at h = " + common::shortNumber(h) + " mm: " + what + " " +
                              std::to_string(static_cast<long long>(nodes)) + " nodes (" +
-                             mib(bytes) + "), over the limit of " +
-                             mib(static_cast<double>(request.max_memory_bytes)) +
+                             mib(bytes) + "), over the limit of " + mib(limit_bytes) +
                              " (--max-memory, else the memory available); " + advice);
   };
   const std::string refine_advice =

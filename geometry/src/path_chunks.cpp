@@ -17,8 +17,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
-#include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/input_file.h"
 #include "path_text.h"
 
 namespace fieldpath::geometry::detail {
@@ -33,7 +33,7 @@ MappedFile::MappedFile(const std::filesystem::path& file) {
     if (map != MAP_FAILED) {
       map_ = map;
       mapped_bytes_ = static_cast<std::size_t>(st.st_size);
-      listed_ = common::listMappedInput(file.string());
+      listed_ = common::listMappedInput(file.string(), map_, mapped_bytes_);
       // Read ahead: the chunks are parsed in parallel from the first to the last.
       ::madvise(map_, mapped_bytes_, MADV_SEQUENTIAL | MADV_WILLNEED);
       text_ = std::string_view(static_cast<const char*>(map_), mapped_bytes_);

@@ -84,7 +84,6 @@ int run(const TempDir& dir, const std::vector<std::string>& args, const std::str
 
 // ---- the mechanism ---------------------------------------------------------------------------
 
-// A signal in the middle of a write: the handler removes the temporary, the target never appears.
 // check's verdict is on the bytes it read: a path rewritten in place (same size), replaced by a
 // rename or removed while it ran is told by its stamp (a helper replaced a path during `check`:
 // "ok" for the old bytes, and the digest taken of the new).
@@ -125,6 +124,7 @@ TEST(AtomicOutput, ALinkUnderTheTemporaryNameIsNotWrittenThrough) {
   EXPECT_EQ(slurp(out), "the output\n");
 }
 
+// A signal in the middle of a write: the handler removes the temporary, the target never appears.
 TEST(AtomicOutput, SignalDuringAWriteLeavesNothing) {
   const TempDir dir;
   const fs::path target = dir.path() / "out" / "big.bin";
@@ -415,6 +415,7 @@ TEST(Killed, AGenerateKilledBetweenItsRenamesLeavesNoEarlierFile) {
   }
   kill(pid, SIGKILL);
   finish(pid);
+  ASSERT_NE(report_then, "(path.cl never appeared)") << slurp(dir.path() / "stderr.txt");
   EXPECT_EQ(report_then.find("earlier"), std::string::npos) << report_then;
   for (const auto& name : filesUnder(dir.path() / "out"))
     if (!isTemporary(name)) EXPECT_NE(slurp(dir.path() / "out" / name), "earlier\n") << name;

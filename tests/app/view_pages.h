@@ -118,6 +118,9 @@ std::vector<T> pageBlob(const std::string& html, const json& ref) {
   std::vector<T> values(count);
   if (offset + count * sizeof(T) <= blob.size())
     std::memcpy(values.data(), blob.data() + offset, count * sizeof(T));
+  else
+    ADD_FAILURE() << "the page's array " << ref << " runs past its blob of " << blob.size()
+                  << " bytes";
   return values;
 }
 

@@ -170,11 +170,6 @@ extern "C" inline void removeTemporariesAndDie(int signal_number) {
 }  // namespace detail
 
 namespace detail {
-/// The input files mapped into memory now (listMappedInput): one cut short while it is mapped
-/// (another program rewrote it) ends the process with SIGBUS at the next read of a lost page.
-inline constexpr int kMappedSlots = 8;
-inline TemporarySlot mapped_slots[kMappedSlots];
-
 inline void writeAll(int fd, const char* text) noexcept {
   for (std::size_t n = std::strlen(text); n > 0;) {
     const ssize_t w = ::write(fd, text, n);
@@ -183,15 +178,21 @@ inline void writeAll(int fd, const char* text) noexcept {
   }
 }
 
-/// SIGBUS: one line naming the mapped input (it crashed with "Bus error", leaving an empty output
-/// folder), the run's files removed as for a failed run, exit 1. Async-signal-safe.
-extern "C" inline void inputCutShortAndExit(int) {
-  const char* name = "an input file";
-  for (auto& slot : mapped_slots)
-    if (slot.state.load() == 2) {
-      name = slot.path;
-      break;
-    }
+/// SIGBUS at an address of a mapped input (listMappedInput: the file was cut short while it was
+/// read, and it crashed with "Bus error", an empty output folder left): one line naming it, the
+/// run's files removed as for a failed run, exit 1; the first thread in says it (the readers
+/// run in parallel). Any other SIGBUS (a fault elsewhere, `kill -BUS`) keeps its default action:
+/// the handler steps aside and the fault, or the signal, recurs. Async-signal-safe.
+inline std::atomic<int> bus_reported{0};
+extern "C" inline void inputCutShortAndExit(int signal_number, siginfo_t* info, void*) {
+  const char* name = info && info->si_code > 0 ? mappedInputAt(info->si_addr) : nullptr;
+  if (!name) {
+    ::signal(signal_number, SIG_DFL);
+    if (!info || info->si_code <= 0) ::raise(signal_number);  // sent, not a fault: re-sent
+    return;
+  }
+  if (bus_reported.exchange(1) != 0)
+    while (true) ::pause();  // another thread is saying it and ending the process
   writeAll(STDERR_FILENO, "fieldpath: error: ");
   writeAll(STDERR_FILENO, name);
   writeAll(STDERR_FILENO,
@@ -203,14 +204,6 @@ extern "C" inline void inputCutShortAndExit(int) {
   ::_exit(1);
 }
 }  // namespace detail
-
-/// Lists an input file mapped into memory (for the SIGBUS message); -1 when no slot is free.
-inline int listMappedInput(const std::string& path) {
-  return detail::listInSlots(detail::mapped_slots, detail::kMappedSlots, path);
-}
-inline void unlistMappedInput(int slot) {
-  if (slot >= 0) detail::mapped_slots[slot].state.store(0);
-}
 
 /// SIGINT, SIGTERM, SIGHUP (the terminal closed), SIGQUIT and SIGPIPE (`| head` done reading)
 /// remove the temporaries being written (no partial file under any name) and the outputs the run
@@ -233,7 +226,8 @@ inline void installTemporaryCleanupOnSignals() {
   }
   ::signal(SIGXFSZ, SIG_IGN);
   struct sigaction bus {};
-  bus.sa_handler = detail::inputCutShortAndExit;
+  bus.sa_sigaction = detail::inputCutShortAndExit;
+  bus.sa_flags = SA_SIGINFO;
   sigemptyset(&bus.sa_mask);
   sigaction(SIGBUS, &bus, nullptr);
 }
@@ -349,13 +343,24 @@ inline void writeFileAtomically(const std::filesystem::path& given,
   try {
     {
       // The name is this process's (its PID): whatever holds it was left by a dead process or
-      // planted, a link to another file that the open would write through (a helper's, in a
-      // shared folder). Unlinked (a link, not its target), then created afresh.
-      ::unlink(tmp.c_str());
+      // planted, a link to another file that an open would write through (a helper's, in a
+      // shared folder). Unlinked (a link, not its target), then created new by this process
+      // (O_EXCL | O_NOFOLLOW: a link planted again in between is refused, not followed); the
+      // stream then opens the file this process owns.
       errno = 0;
       detail::beginCreating(listing.slot);
-      std::ofstream out(tmp, mode | std::ios::trunc);
+      int created = -1;
+      for (int attempt = 0; created < 0 && attempt < 3; ++attempt) {
+        ::unlink(tmp.c_str());
+        created = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+        if (created < 0 && errno != EEXIST) break;
+      }
+      const int create_error = errno;
+      if (created >= 0) ::close(created);
+      std::ofstream out;
+      if (created >= 0) out.open(tmp, mode | std::ios::trunc);
       detail::endCreating(listing.slot);
+      if (created < 0) errno = create_error;
       if (!out)
         throw InputError(path.string() + ": cannot open for writing: " +
                          detail::systemReason(errno));

@@ -37,7 +37,7 @@ inline std::string fileDigest(const std::filesystem::path& file) {
 
 /// What tells a file rewritten or replaced since it was read: its device, inode, size and
 /// modification time (ns). Cheap where fileDigest reads every byte: taken before a long job reads
-/// the file and compared after (fileUnchanged).
+/// the file and compared after (requireUnchanged).
 struct FileStamp {
   std::uint64_t device = 0, inode = 0, size = 0;
   std::int64_t mtime_s = 0, mtime_ns = 0;

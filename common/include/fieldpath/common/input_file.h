@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <mutex>
@@ -92,6 +94,51 @@ inline void requireRegularFile(const std::filesystem::path& file, const std::str
     throw InputError(file.string() + ": not a regular file (a FIFO, socket or device), expected a " +
                      what);
   throw InputError(file.string() + ": no such " + what);
+}
+
+namespace detail {
+/// An input mapped into memory (listMappedInput): its bytes' addresses, and its name for the
+/// SIGBUS a read of a page lost to a cut (another program rewrote the file) raises.
+struct MappedInput {
+  std::atomic<int> state{0};  ///< 0 free, 1 being claimed, 2 live
+  std::atomic<std::uintptr_t> base{0};
+  std::atomic<std::size_t> bytes{0};
+  char path[4096];
+};
+inline constexpr int kMappedInputs = 8;
+inline MappedInput mapped_inputs[kMappedInputs];
+}  // namespace detail
+
+/// Lists the mapping [base, base + bytes) of input `path`; returns its slot, -1 when none is
+/// free or the name is too long (a SIGBUS there is then not told from another).
+inline int listMappedInput(const std::string& path, const void* base, std::size_t bytes) {
+  if (path.size() >= sizeof(detail::MappedInput::path)) return -1;
+  for (int i = 0; i < detail::kMappedInputs; ++i) {
+    int expected = 0;
+    auto& slot = detail::mapped_inputs[i];
+    if (slot.state.compare_exchange_strong(expected, 1)) {
+      std::memcpy(slot.path, path.c_str(), path.size() + 1);
+      slot.base.store(reinterpret_cast<std::uintptr_t>(base));
+      slot.bytes.store(bytes);
+      slot.state.store(2);
+      return i;
+    }
+  }
+  return -1;
+}
+inline void unlistMappedInput(int slot) {
+  if (slot >= 0) detail::mapped_inputs[slot].state.store(0);
+}
+
+/// The name of the listed input whose mapping holds `address`, or nullptr (lock-free atomics:
+/// async-signal-safe).
+inline const char* mappedInputAt(const void* address) noexcept {
+  const auto at = reinterpret_cast<std::uintptr_t>(address);
+  for (auto& slot : detail::mapped_inputs)
+    if (slot.state.load() == 2 && at >= slot.base.load() &&
+        at - slot.base.load() < slot.bytes.load())
+      return slot.path;
+  return nullptr;
 }
 
 }  // namespace fieldpath::common

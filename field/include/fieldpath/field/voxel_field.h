@@ -10,7 +10,6 @@
 
 #include <Eigen/Geometry>
 
-#include "fieldpath/common/limits.h"
 #include "fieldpath/common/progress.h"
 #include "fieldpath/field/cell_mask.h"
 #include "fieldpath/field/direct_field.h"
@@ -56,9 +55,10 @@ struct VoxelRequest : VoxelSettings {
   /// wherever the error asks, in the region.
   std::shared_ptr<const CellMask> refine_mask;
   /// A build whose estimated memory (estimateVoxelNodes) exceeds this is refused (InputError).
-  /// The process's limit (`--max-memory`, else the memory available) unless set: generate's grid
-  /// was built past --max-memory (a fixed 4 GiB here; a helper's 10M gave a 35 MB grid).
-  std::size_t max_memory_bytes = common::memoryLimitBytes();
+  /// 0: the process's limit when the build starts (common::memoryLimitBytes: `--max-memory`, else
+  /// the memory available): generate's grid was built past --max-memory (a fixed 4 GiB here; a
+  /// helper's 10M gave a 35 MB grid).
+  std::size_t max_memory_bytes = 0;
   common::Progress progress;  ///< "field" fraction of leaves built
 };
 
