@@ -64,9 +64,8 @@ void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
       header.tool = geometry::parseToolSpec(o->tool);
     }
     common::checkOutputFile(out, "OUT");  // before the reading, not after
-    checkPathFileSize(in, in.string());
 
-    const geometry::PathFile path = geometry::readPathFile(in);
+    const geometry::PathFile path = readPathFileWhole(in, in.string());
     // The safety marks go with the path (`# ...` at the top of a .cl, PPRINT/ in APT): a path
     // that collides must not read as a clean program once converted. .npy has no room for them.
     std::string marks;

@@ -206,6 +206,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     common::requireMemory("--path " + o->path, postures_estimate * double(kPostureBytes),
                           "about " + std::to_string(std::llround(postures_estimate)) +
                               " postures of " + std::to_string(kPostureBytes) + " bytes");
+    const common::FileStamp path_stamp = common::fileStamp(o->path);
     PostureStream stream(o->path, read_options);
     // The part (--part) read beside the path: its top bounds the default region.
     std::optional<geometry::TriangleMesh> part;
@@ -301,6 +302,9 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     const zb::SimulationResult res = zb::simulateBlocks(req, [&stream] { return stream.next(); });
     stream.waitAll();  // an error after the last chunk (e.g. no postures at all)
     if (res.postures == 0) throw InputError(o->path + ": no postures");
+    // Heights from the bytes read: a path rewritten in place meanwhile (not cut short: that is
+    // SIGBUS's) mixed both files' postures, exit 0 (a helper's).
+    common::requireUnchanged(o->path, path_stamp, "simulated");
 
     // The outputs, concurrently; each lands atomically under its name.
     const auto write_start = Clock::now();

@@ -91,12 +91,12 @@ void addViewCommand(CLI::App& app, const GlobalOptions& global) {
     PageBudget budget;
     budget.max_triangles = o->max_triangles;
     budget.max_postures = o->max_postures;
-    const std::size_t max_bytes = static_cast<std::size_t>(o->max_mb * 1e6);
+    const double max_bytes = o->max_mb * 1e6;  // a double: 2e13 MB overflowed a size_t
     PageStats stats;
     std::string page;
     for (int attempt = 0;; ++attempt) {
       page = viewPage(data, three, budget, generator, &stats);
-      if (stats.bytes <= max_bytes) break;
+      if (double(stats.bytes) <= max_bytes) break;
       // Halved down to a floor that is never above the user's own budget (the floor of 2000
       // raised --max-triangles 1000 to 1653 shown, a reviewer's).
       const std::size_t triangle_floor = std::min<std::size_t>(2000, o->max_triangles),

@@ -1,5 +1,6 @@
 #include "estimates.h"
 
+#include "fieldpath/common/file_digest.h"
 #include "fieldpath/geometry/cl_file.h"
 
 #include <algorithm>
@@ -229,6 +230,14 @@ double estimatePostures(const std::filesystem::path& file) {
 
 void checkPathFileSize(const std::filesystem::path& file, const std::string& what) {
   common::requireMemory(what, estimatePostures(file) * 80.0, "its postures, whole");
+}
+
+geometry::PathFile readPathFileWhole(const std::filesystem::path& file, const std::string& what) {
+  checkPathFileSize(file, what);
+  const common::FileStamp stamp = common::fileStamp(file);
+  geometry::PathFile path = geometry::readPathFile(file);
+  common::requireUnchanged(file, stamp, "read");
+  return path;
 }
 
 void checkVoxelSize(const Scene& scene, double voxel_mm, const std::string& key) {

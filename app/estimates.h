@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string>
 
+#include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/pathgen/impeller.h"
 #include "scene.h"
 
@@ -51,6 +52,10 @@ double estimatePostures(const std::filesystem::path& file);
 /// came from, and a text file of NUL bytes at once (a helper's sparse 10 GB path.nominal was
 /// mapped whole, 16 GiB reserved, 15-48 s before its first line was refused).
 void checkPathFileSize(const std::filesystem::path& file, const std::string& what);
+
+/// geometry::readPathFile after checkPathFileSize, refused when the file changed while it was
+/// read (a path rewritten in place meanwhile gave a mix of both files' postures, exit 0).
+geometry::PathFile readPathFileWhole(const std::filesystem::path& file, const std::string& what);
 
 /// The obstacle samples at `step_mm`: the count sampleObstacles makes, to the sample, but for a
 /// bound on the merged ones of triangles finer than the step.

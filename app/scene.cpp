@@ -566,8 +566,7 @@ Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
     const YAML::Node node = root["path"]["nominal"];
     const auto file = r.path(node, "path.nominal");
     try {
-      checkPathFileSize(file, file.string());
-      scene.nominal = geometry::readPathFile(file);
+      scene.nominal = readPathFileWhole(file, file.string());
     } catch (const InputError& e) {
       // The path file's own message names its line; say which key led there.
       r.fail(node, "path.nominal", e.what());

@@ -277,8 +277,8 @@ ViewData gatherView(const ViewRequest& request) {
   }
   if (!path_file.empty()) {
     ViewPath p;
-    checkPathFileSize(path_file, (request.path.empty() ? "path " : "--path ") + path_file.string());
-    p.file = geometry::readPathFile(path_file);
+    p.file = readPathFileWhole(path_file,
+                               (request.path.empty() ? "path " : "--path ") + path_file.string());
     pathgen::requireSteadyAxes(p.file, scene.path.pass_gap_mm,
                                scene.tool.radius_mm);  // a flipped axis in a pass
     p.what = path_file.string();

@@ -28,7 +28,16 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+/// A sidecar JSON of check or simulate is a few kB: past this it is no such file (a helper's
+/// check.json padded to 10 GB was read whole, 96 s, and parsed up to its first NUL).
+constexpr std::uintmax_t kMaxJsonBytes = std::uintmax_t{64} << 20;
+
 std::string readBytes(const fs::path& file) {
+  std::error_code size_ec;
+  const std::uintmax_t bytes = fs::file_size(file, size_ec);
+  if (!size_ec && bytes > kMaxJsonBytes)
+    throw InputError(file.string() + ": " + common::formatBytes(double(bytes)) +
+                     ": not one of check's or simulate's JSON files (a few kB; at most 64 MiB)");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string() + ": cannot be read");
   std::ostringstream s;
@@ -345,6 +354,13 @@ void readClearanceCsv(const fs::path& file, std::size_t postures, std::vector<do
                       std::vector<std::uint8_t>& part_contact_to_next) {
   if (!fs::exists(file))
     throw InputError(file.string() + ": missing (the check folder has check.json without it)");
+  // A row is ~60 bytes: far past that, no check's file of this path (a helper's padded to 10 GB
+  // was read for 50 s).
+  std::error_code size_ec;
+  const std::uintmax_t bytes = fs::file_size(file, size_ec);
+  if (!size_ec && double(bytes) > 512.0 * double(postures) + 65536.0)
+    throw InputError(file.string() + ": " + common::formatBytes(double(bytes)) + " for a path of " +
+                     std::to_string(postures) + " postures: not the clearance.csv of its check");
   std::ifstream in(file);
   if (!in) throw InputError(file.string() + ": cannot be read");
   std::string line;

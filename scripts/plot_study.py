@@ -10,6 +10,7 @@ import csv
 import math
 import os
 import sys
+import tempfile
 from collections import OrderedDict
 
 try:
@@ -35,10 +36,23 @@ def num(text):
 
 
 def save(fig, path):
-    tmp = path + ".tmp.png"
-    fig.savefig(tmp, dpi=120, bbox_inches="tight")
-    plt.close(fig)
-    os.replace(tmp, path)
+    # A temporary of this process's own making (mkstemp: O_EXCL, a fresh name), renamed into
+    # place: a fixed NAME.tmp.png was written through a link planted under that name.
+    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".",
+                               suffix=".tmp.png", dir=os.path.dirname(path) or ".")
+    try:
+        with os.fdopen(fd, "wb") as out:
+            fig.savefig(out, format="png", dpi=120, bbox_inches="tight")
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)  # as a file the user makes (mkstemp's is 0600)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    finally:
+        plt.close(fig)
 
 
 def colours(names):

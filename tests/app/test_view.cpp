@@ -175,6 +175,19 @@ TEST(View, BadInputIsExitOneWithOneLineOrAPageThatSaysWhatIsMissing) {
   EXPECT_EQ(r.exit_code, 1) << r.output();
   EXPECT_NE(r.err.find("truncated or padded"), std::string::npos) << r.err;
 
+  // check's files padded far past their size (NUL bytes: a helper's 10 GB check.json was read
+  // whole for 96 s and parsed up to its first NUL): refused by their size, at once.
+  ASSERT_EQ(runFieldpath(dir, "check scene.yaml --path path.cl --out padded").exit_code, 0);
+  for (const char* name : {"check.json", "clearance.csv"}) {
+    fs::remove_all(dir.path() / "sized");
+    fs::copy(dir.path() / "padded", dir.path() / "sized");
+    fs::resize_file(dir.path() / "sized" / name, std::uintmax_t{1} << 30);
+    r = runFieldpath(dir, "view scene.yaml --check sized --out bad.html");
+    EXPECT_EQ(r.exit_code, 1) << name << ": " << r.output();
+    EXPECT_NE(r.err.find(std::string(name) + ": 1 GiB"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir.path() / "bad.html"));
+  }
+
   // A simulated surface whose .json was edited to lie beyond any machine (1e300 mm).
   ASSERT_EQ(runFieldpath(dir, "simulate --tool ball:1 --path short.cl --grid 32x32 --out sim")
                 .exit_code,
