@@ -114,6 +114,23 @@ int main(int argc, char** argv) {
   addViewCommand(app, global);
   addConvertCommand(app, global);
 
+  // An empty argument is no value: `--part ""` or `--region ""` read as the option not given
+  // (the default silently taken: a helper's); `--opt=` the same.
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const bool empty_after_equals = arg.size() > 2 && arg.rfind("--", 0) == 0 && arg.back() == '=';
+    if (!arg.empty() && !empty_after_equals) continue;
+    const std::string before = i > 1 ? argv[i - 1] : "";
+    const std::string where =
+        empty_after_equals ? arg.substr(0, arg.size() - 1) + ": an empty value"
+        : before.rfind("-", 0) == 0
+            ? before + ": an empty value"
+            : "an empty argument after '" + (i > 1 ? before : "fieldpath") + "'";
+    std::fprintf(stderr, "fieldpath: error: %s: give one, or leave it out (see --help)\n",
+                 oneLine(where.c_str()).c_str());
+    return 1;
+  }
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

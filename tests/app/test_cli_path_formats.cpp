@@ -290,6 +290,25 @@ TEST(SimulateFormats, BadClLineAfterManyBlocksIsOneLineAndNoOutputs) {
   EXPECT_FALSE(fs::exists(dir.path() / "out"));
 }
 
+// An empty value is refused, not read as the option left out (`--part ""` took the default
+// stock, `--region ""` the default region: a helper's).
+TEST(EmptyValues, AreRefusedWithTheOptionNamed) {
+  const TempDir dir;
+  dir.write("p.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
+  const std::pair<std::string, std::string> cases[] = {
+      {"simulate --tool ball:1 --path p.cl --part '' --out s", "--part: an empty value"},
+      {"simulate --tool ball:1 --path p.cl --region= --out s", "--region: an empty value"},
+      {"simulate --tool ball:1 --path p.cl --out ''", "--out: an empty value"},
+      {"check '' --path p.cl", "an empty argument after 'check'"}};
+  for (const auto& [args, message] : cases) {
+    const Outcome run = runFieldpath(dir, args);
+    EXPECT_EQ(run.exit_code, 1) << args << ": " << run.err;
+    EXPECT_NE(run.err.find(message), std::string::npos) << args << ": " << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+    EXPECT_FALSE(fs::exists(dir.path() / "s")) << args;
+  }
+}
+
 // Inputs read whole are sized before they are read (a helper's sparse files: a 3 GB scene took
 // 4.2 GB of memory, a 10 GB path.nominal was mapped and 16 GiB reserved before its first line
 // was refused, a 3 GB points file ran to 12.6 GB under --max-memory 256M): one line, at once; a
