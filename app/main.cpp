@@ -8,6 +8,7 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <iterator>
 #include <new>
 #include <string>
 #include <system_error>
@@ -116,6 +117,22 @@ int main(int argc, char** argv) {
 
   // An empty argument is no value: `--part ""` or `--region ""` read as the option not given
   // (the default silently taken: a helper's); `--opt=` the same.
+  // A name option followed by an option (`--out --quiet`) made a folder named `--quiet`.
+  for (int i = 2; i < argc; ++i) {
+    const std::string arg = argv[i], before = argv[i - 1];
+    static const char* const kNameOptions[] = {"--out",   "--path",   "--check",      "--surface",
+                                               "--part",  "--points", "--save-field", "--tool",
+                                               "--shape", "--holder"};
+    if (arg.rfind("--", 0) != 0 || std::none_of(std::begin(kNameOptions), std::end(kNameOptions),
+                                                [&before](const char* o) { return before == o; }))
+      continue;
+    std::fprintf(stderr,
+                 "fieldpath: error: %s: '%s' is an option, not a name (a file of that name: "
+                 "%s=./%s)\n",
+                 before.c_str(), oneLine(arg.c_str()).c_str(), before.c_str(),
+                 oneLine(arg.c_str()).c_str());
+    return 1;
+  }
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     const bool empty_after_equals = arg.size() > 2 && arg.rfind("--", 0) == 0 && arg.back() == '=';

@@ -291,7 +291,7 @@ TEST(SimulateFormats, BadClLineAfterManyBlocksIsOneLineAndNoOutputs) {
 }
 
 // An empty value is refused, not read as the option left out (`--part ""` took the default
-// stock, `--region ""` the default region: a helper's).
+// stock, `--region ""` the default region: a helper's); so is an option where a name goes.
 TEST(EmptyValues, AreRefusedWithTheOptionNamed) {
   const TempDir dir;
   dir.write("p.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
@@ -299,7 +299,9 @@ TEST(EmptyValues, AreRefusedWithTheOptionNamed) {
       {"simulate --tool ball:1 --path p.cl --part '' --out s", "--part: an empty value"},
       {"simulate --tool ball:1 --path p.cl --region= --out s", "--region: an empty value"},
       {"simulate --tool ball:1 --path p.cl --out ''", "--out: an empty value"},
-      {"check '' --path p.cl", "an empty argument after 'check'"}};
+      {"check '' --path p.cl", "an empty argument after 'check'"},
+      // an option where a name goes: it made a folder named `--quiet`
+      {"simulate --tool ball:1 --path p.cl --out --quiet", "--out: '--quiet' is an option"}};
   for (const auto& [args, message] : cases) {
     const Outcome run = runFieldpath(dir, args);
     EXPECT_EQ(run.exit_code, 1) << args << ": " << run.err;
