@@ -2,8 +2,11 @@
 /// each by its extension. The postures travel as doubles in every direction (`.cl` numbers in
 /// shortest round-trip form, `.npy` float64), so a path converted and read back gives the same
 /// postures bit for bit and `simulate` the same heights. `.npy` has no place for pass and link
-/// blocks or `# limit` marks: converting to it says what was dropped.
+/// blocks or `# limit` marks: converting to it says what was dropped. An APT output keeps the
+/// feeds of an APT input (`FEDRAT/`) or takes `--feed`: never a feed of its own (1000 mm/min
+/// was written over a FEDRAT/MMPM,150, a machine-side helper's finding).
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -14,6 +17,7 @@
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/file_names.h"
 #include "fieldpath/common/limits.h"
+#include "fieldpath/common/short_number.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/tool_model.h"
 
@@ -38,6 +42,30 @@ const char* formatName(PathFormat format) {
   return format == PathFormat::Npy ? ".npy" : format == PathFormat::Apt ? "APT" : ".cl";
 }
 
+/// The feeds of an APT output: `--feed` over all (`feed_mm_per_min` > 0), else the input's own
+/// FEDRATs, each a feed per minute within a machine's (the input's line named otherwise).
+void takeFeeds(geometry::PathFile& path, double feed_mm_per_min, const fs::path& in,
+               const fs::path& out, geometry::AptHeader& header) {
+  if (feed_mm_per_min > 0.0) {
+    path.feeds.clear();
+    header.feed_mm_per_min = feed_mm_per_min;
+    return;
+  }
+  if (path.feeds.empty())
+    throw InputError(out.string() + ": APT output needs --feed (mm/min): " + in.string() +
+                     " has no FEDRAT of its own");
+  for (const geometry::PathFile::Feed& f : path.feeds) {
+    const std::string where = in.string() + ":" + std::to_string(f.line) + ": FEDRAT: ";
+    if (!std::isfinite(f.mm_per_min))
+      throw InputError(where +
+                       "a feed per revolution, inverse time or without a number has no "
+                       "mm/min to write: give --feed");
+    if (f.mm_per_min < common::kMinFeedMmPerMin || f.mm_per_min > common::kMaxFeedMmPerMin)
+      throw InputError(where + common::shortNumber(f.mm_per_min) +
+                       " mm/min is no machine's feed (0.001 to 1e6): give --feed");
+  }
+}
+
 }  // namespace
 
 void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
@@ -45,6 +73,7 @@ void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
       "convert", "A path file from one format to another (.cl, APT .apt/.cls, .npy) by extension");
   struct Options {
     std::string in, out, tool;
+    double feed_mm_per_min = 0.0;  ///< 0: not given
   };
   auto o = std::make_shared<Options>();
   cmd->add_option("IN", o->in, "Path file to read: .cl, APT (.apt/.cls) or .npy")->required();
@@ -53,6 +82,10 @@ void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
   cmd->add_option("--tool", o->tool,
                   "ball:R[:L] | torus:R:r[:L] | flat:R[:L]: the CUTTER record of an APT output "
                   "(required for APT)");
+  cmd->add_option("--feed", o->feed_mm_per_min,
+                  "mm/min: the FEDRAT of an APT output, over any feed of the input (required "
+                  "for APT when the input has no FEDRAT of its own in mm/min)")
+      ->check(numberFromTo(common::kMinFeedMmPerMin, common::kMaxFeedMmPerMin, "mm/min"));
 
   cmd->callback([o] {
     const fs::path in = o->in, out = o->out;
@@ -65,7 +98,9 @@ void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
     }
     common::checkOutputFile(out, "OUT");  // before the reading, not after
 
-    const geometry::PathFile path = readPathFileWhole(in, in.string());
+    geometry::PathFile path = readPathFileWhole(in, in.string());
+    const std::size_t feeds_read = path.feeds.size();
+    if (to == PathFormat::Apt) takeFeeds(path, o->feed_mm_per_min, in, out, header);
     // The safety marks go with the path (`# ...` at the top of a .cl, PPRINT/ in APT): a path
     // that collides must not read as a clean program once converted. .npy has no room for them.
     std::string marks;
@@ -90,7 +125,16 @@ void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
       std::fprintf(stderr,
                    "note: .npy keeps postures only: %zu pass and %zu link blocks%s dropped\n",
                    passes, links, path.limited.empty() ? "" : " and the # limit marks");
+    if (to != PathFormat::Apt && feeds_read > 0)
+      std::fprintf(stderr,
+                   "note: %s has no feed: the %zu FEDRAT records dropped (converted back "
+                   "to APT, give --feed)\n",
+                   formatName(to), feeds_read);
     if (to == PathFormat::Apt) {
+      if (o->feed_mm_per_min > 0.0 && feeds_read > 0)
+        std::fprintf(stderr, "note: --feed %s mm/min written over the %zu FEDRAT records of %s\n",
+                     common::shortNumber(o->feed_mm_per_min).c_str(), feeds_read,
+                     in.string().c_str());
       // APT breaks a pass only with RAPID (a link's moves): passes that follow one another with
       // no link between them read back as one.
       std::size_t joined = 0, first = 0;

@@ -328,7 +328,11 @@ void readDynamics(const Reader& r, const YAML::Node& node, dynamics::DynamicsPar
           ">= 0 or `critical`");
   }
   if (node["stiffness"]) d.stiffness = r.positive(node["stiffness"], "dynamics.stiffness");
-  if (node["feed"]) d.feed_mm_per_min = r.positive(node["feed"], "dynamics.feed");
+  if (node["feed"])
+    d.feed_mm_per_min = r.number(
+        node["feed"], "dynamics.feed",
+        [](double v) { return v >= common::kMinFeedMmPerMin && v <= common::kMaxFeedMmPerMin; },
+        "a feed from 0.001 to 1e6 mm/min");
   // Tolerances of 1 or more accept any step (rtol 1e6 moved the lead by 1.6 deg without a word).
   const auto tolerance = [](double v) { return v > 0.0 && v < 1.0; };
   if (node["rtol"])

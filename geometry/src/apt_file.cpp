@@ -2,7 +2,7 @@
 /// (spaces allowed, 3 values keep the last axis), `$` at a line's end continues the record, `$$`
 /// starts a comment, `RAPID` makes the next motion a rapid (a link) unless a `FEDRAT` comes
 /// between them, `UNITS/INCHES` scales the coordinates that follow to mm, `TLAXIS/i,j,k` sets the
-/// axis of the 3-value GOTOs that follow,
+/// axis of the 3-value GOTOs that follow, `FEDRAT/` records give the feeds (kept for `convert`),
 /// `FINI` ends the program (nothing after it is read); motions it does not take (arcs, cycles,
 /// relative and drive-surface moves) are refused; every other record is read past.
 #include <algorithm>
@@ -12,6 +12,7 @@
 #include <exception>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string_view>
@@ -34,6 +35,12 @@ std::string upperCase(std::string_view text) {
   for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   return s;
 }
+
+/// The PPRINT of every APT output: how its motions were checked (README, "Path files").
+constexpr std::string_view kAptMotionNote =
+    "MOTIONS CHECKED WITH THE TIP ON A LINE AND THE TOOL AXIS ON THE GREAT CIRCLE BETWEEN "
+    "GOTOS, RAPIDS TOO: POST THE TOOL VECTOR (NOT INTERPOLATED ROTARY ANGLES) AND RAPIDS AS "
+    "LINEAR MOVES";
 
 /// The columns of an APT card: a record is continued on the next line with `$` past them.
 constexpr std::size_t kAptColumns = 72;
@@ -139,6 +146,15 @@ struct AptChunk {
   bool fini = false;  ///< FINI seen: the program ends there; later records are not read
   /// CUTTER records in file units, each with the count of this chunk's UNITS records before it.
   std::vector<std::pair<std::size_t, PathFile::Cutter>> cutters;
+  /// FEDRAT records: the feed (`from`: this chunk's posture after it) as written, in mm per
+  /// minute times `unit` (0: the file's unit in force, the count of this chunk's UNITS records
+  /// before it in `units_before`).
+  struct Feed {
+    PathFile::Feed feed;
+    double unit = 1.0;
+    std::size_t units_before = 0;
+  };
+  std::vector<Feed> feeds;
 };
 
 /// The leading finite numbers of comma-separated `values` (at most `max`, into v): how many.
@@ -162,6 +178,36 @@ std::optional<PathFile::Cutter> cutterOf(std::string_view values, std::size_t li
   const std::size_t count = leadingNumbers(values, v, 2);
   if (count == 0 || !(v[0] > 0.0)) return std::nullopt;
   return PathFile::Cutter{v[0], count == 2 && v[1] >= 0.0 ? v[1] : -1.0, line};
+}
+
+/// A FEDRAT record's feed: its number in `feed.mm_per_min` and, in `unit`, mm per unit of it:
+/// 1 with MMPM, 25.4 with IPM, 0 (the file's unit) with none or PERMIN; NaN where it is per
+/// revolution (IPR, MMPR, PERREV), inverse time (INVERS) or has no number.
+AptChunk::Feed feedOf(std::string_view values, std::size_t line, std::size_t posture) {
+  AptChunk::Feed out;
+  out.feed = {posture, std::numeric_limits<double>::quiet_NaN(), line};
+  out.unit = 0.0;
+  bool number = false, per_minute = true;
+  for (std::size_t start = 0; start <= values.size();) {
+    const auto comma = std::min(values.find(',', start), values.size());
+    const std::string_view token = trimmed(values.substr(start, comma - start));
+    start = comma + 1;
+    double v = 0.0;
+    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
+    if (ec == std::errc() && end == token.data() + token.size()) {
+      if (!number && std::isfinite(v) && v > 0.0) out.feed.mm_per_min = v;
+      number = true;
+    } else if (token == "MMPM") {
+      out.unit = 1.0;
+    } else if (token == "IPM") {
+      out.unit = 25.4;
+    } else if (token == "IPR" || token == "MMPR" || token == "PERREV" || token == "REV" ||
+               token == "INVERS") {
+      per_minute = false;
+    }
+  }
+  if (!per_minute) out.feed.mm_per_min = std::numeric_limits<double>::quiet_NaN();
+  return out;
 }
 
 /// mm per unit of a UNITS record's value (MM, INCHES), 0 if unknown.
@@ -227,6 +273,11 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
     if (major == "FEDRAT") {  // a feed rate set after RAPID: the next motion is a feed move
       rapid = false;
       if (chunk.postures.empty()) out.cancels_rapid = true;
+      if (slash != std::string::npos) {
+        out.feeds.push_back(feedOf(std::string_view(statement).substr(slash + 1), record_line,
+                                   chunk.postures.size()));
+        out.feeds.back().units_before = out.units.size();
+      }
       continue;
     }
     if (major == "FINI") {
@@ -339,6 +390,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   // And the unit: a UNITS record holds until the next; inches are read as mm x 25.4.
   std::vector<std::size_t> link_postures;
   std::vector<PathFile::Cutter> cutters;
+  std::vector<PathFile::Feed> feeds;
   bool pending = false, ended = false;
   double scale = 1.0;
   std::size_t offset = 0;
@@ -359,6 +411,15 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
       cutter.diameter_mm *= unit;
       if (cutter.corner_mm > 0.0) cutter.corner_mm *= unit;
       cutters.push_back(cutter);
+    }
+    for (const AptChunk::Feed& f : c.feeds) {  // in the unit in force at the record
+      PathFile::Feed feed = f.feed;
+      const double unit = f.unit > 0.0     ? f.unit
+                          : f.units_before ? c.units[f.units_before - 1].second
+                                           : scale;
+      feed.mm_per_min *= unit;
+      feed.from += offset;
+      feeds.push_back(feed);
     }
     std::size_t next_unit = 0;
     for (std::size_t k = 0; k < postures.size(); ++k) {
@@ -386,6 +447,8 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   PathFile path;
   path.file = file;
   path.cutters = std::move(cutters);
+  for (const PathFile::Feed& f : feeds)
+    if (f.from < offset) path.feeds.push_back(f);  // a FEDRAT after the last GOTO feeds nothing
   if (offset == 0) throw InputError(file.string() + ": no GOTO records");
   // Blocks: runs of link postures between pass runs.
   std::size_t next = 0;
@@ -426,19 +489,38 @@ void writeAptFile(const std::filesystem::path& file, const PathFile& path,
   const double cutter[] = {2 * t.radius_mm, corner_mm, t.radius_mm - corner_mm, corner_mm, 0.0, 0.0,
                            t.length_mm};
   appendRecord(text, "CUTTER", cutter);
+  // What check proves of a motion, for whoever writes the post: a controller that runs rotary
+  // angles (A/B/C) interpolated, or a rapid axis by axis, sweeps other space (a machine-side
+  // helper's finding: a dog-leg rapid crossed a wall that the straight retract cleared). After
+  // CUTTER, not beside the safety marks: a mark's text runs on in the PPRINT cards after it.
+  appendTextCards(text, "PPRINT", kAptMotionNote);
   // A path marked unsafe halts before its first motion (STOP: M00 on post-processors): a PPRINT
   // is only read, and the program ran on (a machine-safety helper's finding).
   if (std::any_of(header.remarks.begin(), header.remarks.end(), [](const std::string& remark) {
         return upperCase(detail::safetyMark(remark)).rfind("UNSAFE TO RUN", 0) == 0;
       }))
     text += "STOP\n";
-  std::string feed = "FEDRAT/MMPM,";
-  appendNumber(feed, header.feed_mm_per_min);
-  feed += '\n';
+  // The feed in force: the path's own from the first of its FEDRATs (none before it, as read),
+  // else the header's. Written before a pass and where it changes within one; a change at a link
+  // waits for the next pass (a FEDRAT after RAPID would make the link's motion a feed move).
+  double in_force =
+      path.feeds.empty() ? header.feed_mm_per_min : std::numeric_limits<double>::quiet_NaN();
+  std::size_t next_feed = 0;
+  bool changed = true;
   for (const PathBlock& block : path.blocks) {
-    if (block.kind == PathBlock::Kind::Pass) text += feed;
     for (std::size_t i = block.begin; i < block.end; ++i) {
-      if (block.kind == PathBlock::Kind::Link) text += "RAPID\n";
+      for (; next_feed < path.feeds.size() && path.feeds[next_feed].from <= i; ++next_feed) {
+        changed = changed || !(path.feeds[next_feed].mm_per_min == in_force);
+        in_force = path.feeds[next_feed].mm_per_min;
+      }
+      if (block.kind == PathBlock::Kind::Link) {
+        text += "RAPID\n";
+      } else if ((i == block.begin || changed) && std::isfinite(in_force)) {
+        text += "FEDRAT/MMPM,";
+        appendNumber(text, in_force);
+        text += '\n';
+        changed = false;
+      }
       appendGoto(text, path.postures[i]);
     }
   }

@@ -368,9 +368,10 @@ TEST(Convert, RoundTripsKeepThePosturesBitForBit) {
   ASSERT_EQ(to_npy.exit_code, 0) << to_npy.err;
   EXPECT_NE(to_npy.err.find("dropped"), std::string::npos) << to_npy.err;
   EXPECT_NE(to_npy.out.find("1200 postures"), std::string::npos) << to_npy.out;
-  ASSERT_EQ(runFieldpath(f.dir, "convert a.npy b.apt --tool ball:1").exit_code, 0);
+  ASSERT_EQ(runFieldpath(f.dir, "convert a.npy b.apt --tool ball:1 --feed 1000").exit_code, 0);
   ASSERT_EQ(runFieldpath(f.dir, "convert b.apt c.cl").exit_code, 0);
-  ASSERT_EQ(runFieldpath(f.dir, "convert marked.cl d.cls --tool torus:2:0.5").exit_code, 0);
+  ASSERT_EQ(runFieldpath(f.dir, "convert marked.cl d.cls --tool torus:2:0.5 --feed 1000").exit_code,
+            0);
   // Output names in capitals, as the readers take them (they were refused).
   ASSERT_EQ(runFieldpath(f.dir, "convert marked.cl E.CL").exit_code, 0);
   ASSERT_EQ(runFieldpath(f.dir, "convert marked.cl F.NPY").exit_code, 0);
@@ -396,7 +397,7 @@ TEST(Convert, RoundTripsKeepThePosturesBitForBit) {
   // An APT link comes back a link block in .cl.
   ASSERT_EQ(runFieldpath(f.dir, "convert d.cls h.cl").exit_code, 0);
   EXPECT_EQ(geometry::readPathFile(f.dir.path() / "h.cl").blocks, marked.blocks);
-  const Outcome to_apt = runFieldpath(f.dir, "convert marked.cl g.apt --tool ball:1");
+  const Outcome to_apt = runFieldpath(f.dir, "convert marked.cl g.apt --tool ball:1 --feed 1000");
   ASSERT_EQ(to_apt.exit_code, 0) << to_apt.err;
   EXPECT_NE(to_apt.err.find("note: APT has no `# limit` marks: 1 dropped"), std::string::npos)
       << to_apt.err;
@@ -416,7 +417,7 @@ TEST(Convert, RoundTripsKeepThePosturesBitForBit) {
 // breaks a pass only with RAPID: said, not silent (a helper found it silent).
 TEST(Convert, PassesWithNoLinkBetweenThemAreSaidToJoinInApt) {
   const Formats f;
-  const Outcome run = runFieldpath(f.dir, "convert path.cl joined.apt --tool ball:1");
+  const Outcome run = runFieldpath(f.dir, "convert path.cl joined.apt --tool ball:1 --feed 1000");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.err.find("note: 2 pass breaks with no link between the passes (first: passes 1 "
                          "and 2): APT breaks a pass only with RAPID"),
@@ -472,14 +473,14 @@ TEST(Convert, ASpindleColumnDroppedInAptIsSaid) {
   // GOTO has six values: the 7th column of a .cl goes, and the note counts it; none, no note.
   const TempDir dir;
   dir.write("s.cl", "0 0 0 0 0 1 0.5\n1 0 0 0 0 1 0.25\n2 0 0 0 0 1\n");
-  const Outcome run = runFieldpath(dir, "convert s.cl s.apt --tool ball:1");
+  const Outcome run = runFieldpath(dir, "convert s.cl s.apt --tool ball:1 --feed 1000");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.err.find("note: APT's GOTO has no spindle angle: the 7th column of 2 postures "
                          "dropped"),
             std::string::npos)
       << run.err;
   dir.write("n.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
-  const Outcome none = runFieldpath(dir, "convert n.cl n.apt --tool ball:1");
+  const Outcome none = runFieldpath(dir, "convert n.cl n.apt --tool ball:1 --feed 1000");
   ASSERT_EQ(none.exit_code, 0) << none.err;
   EXPECT_EQ(none.err.find("spindle"), std::string::npos) << none.err;
 }
@@ -498,7 +499,7 @@ TEST(Convert, SafetyMarksGoWithThePathOrTheirLossIsSaid) {
       "UNSAFE TO RUN: 2 postures touch an obstacle (first: posture 1) (report.json)",
       "under the required clearance: postures min 0.3 mm"};
   EXPECT_EQ(geometry::readPathFile(dir.path() / "u.cl").warnings, marks);
-  const Outcome to_apt = runFieldpath(dir, "convert u.cl u.apt --tool ball:1");
+  const Outcome to_apt = runFieldpath(dir, "convert u.cl u.apt --tool ball:1 --feed 1000");
   ASSERT_EQ(to_apt.exit_code, 0) << to_apt.err;
   EXPECT_NE(to_apt.err.find("warning: u.cl is marked \"UNSAFE TO RUN"), std::string::npos)
       << to_apt.err;
@@ -520,7 +521,7 @@ TEST(Convert, SafetyMarksGoWithThePathOrTheirLossIsSaid) {
   // An unmarked path: no warning; a comment that only mentions the words is not a mark.
   dir.write("c.cl", "# the tool is not UNSAFE TO RUN here\n0 0 0 0 0 1\n1 0 0 0 0 1\n");
   EXPECT_TRUE(geometry::readPathFile(dir.path() / "c.cl").warnings.empty());
-  const Outcome clean = runFieldpath(dir, "convert c.cl c.apt --tool ball:1");
+  const Outcome clean = runFieldpath(dir, "convert c.cl c.apt --tool ball:1 --feed 1000");
   EXPECT_EQ(clean.err.find("warning"), std::string::npos) << clean.err;
 }
 

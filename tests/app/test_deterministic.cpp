@@ -230,10 +230,11 @@ TEST(Deterministic, ConvertOnOneAndOnAllCores) {
   dir.write("in.cl", cl);
   for (const std::string out : {"one", "all"}) {
     const std::string cpus = out == "one" ? "0" : "";
-    for (const std::vector<std::string>& args : {std::vector<std::string>{"in.cl", out + "/a.npy"},
-                                                 {"in.cl", out + "/b.apt", "--tool", "ball:3"},
-                                                 {out + "/a.npy", out + "/c.cl"},
-                                                 {out + "/b.apt", out + "/d.cl"}}) {
+    for (const std::vector<std::string>& args :
+         {std::vector<std::string>{"in.cl", out + "/a.npy"},
+          {"in.cl", out + "/b.apt", "--tool", "ball:3", "--feed", "800"},
+          {out + "/a.npy", out + "/c.cl"},
+          {out + "/b.apt", out + "/d.cl"}}) {
       std::vector<std::string> command{"convert"};
       command.insert(command.end(), args.begin(), args.end());
       ASSERT_EQ(run(dir, command, cpus), 0) << slurp(dir.path() / "stderr.txt");

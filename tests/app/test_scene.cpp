@@ -169,6 +169,9 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
        4},
       {"obstacles:\n  - mesh: wall.stl\ndynamics:\n  atol: 1\n", "dynamics.atol: must be in (0, 1)",
        4},
+      // A feed past any machine's was written into path.apt as FEDRAT/MMPM,1e+300.
+      {"obstacles:\n  - mesh: wall.stl\ndynamics:\n  feed: 1e300\n",
+       "dynamics.feed: must be a feed from 0.001 to 1e6 mm/min", 4},
       // A module's refusal names the line of the key it names, not its map's first line.
       {"obstacles:\n  - mesh: wall.stl\ntool:\n  shape: ball\n  radius: 3\n  length: 1\n",
        "tool length", 6},

@@ -232,9 +232,16 @@ TEST(AptFile, WritesHeaderAndParsesBackExactly) {
   const fs::path p = tempPath("path.apt");
   writeAptFile(p, postures, header);
   std::ifstream in(p);
-  std::string l1, count, l2, l3, l4, l5, l6;
+  std::string l1, count, l2, l3, l4, note, l5, l6;
   std::getline(in, l1), std::getline(in, count), std::getline(in, l2), std::getline(in, l3),
-      std::getline(in, l4), std::getline(in, l5), std::getline(in, l6);
+      std::getline(in, l4);
+  // How the motions were checked, for the post-processor's author: cards of their own.
+  std::string notes;
+  while (std::getline(in, note) && note.rfind("PPRINT/", 0) == 0) notes += note.substr(7) + " ";
+  l5 = note;
+  std::getline(in, l6);
+  EXPECT_NE(notes.find("TOOL AXIS ON THE GREAT CIRCLE"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("RAPIDS AS LINEAR MOVES"), std::string::npos) << notes;
   EXPECT_EQ(l1, "PARTNO/IMPELLER");
   EXPECT_EQ(count, "PPRINT/POSTURES " + std::to_string(postures.size()) +
                        " (A FILE HOLDING FEWER WAS CUT SHORT)");
@@ -258,6 +265,7 @@ TEST(AptFile, WritesHeaderAndParsesBackExactly) {
   for (auto& b : back) b.has_spindle = false;
   expectSame(back, writtenAs(postures));
   expectNoExponent(p);
+  EXPECT_TRUE(readPathFile(p).warnings.empty());  // the note is no safety mark
 }
 
 TEST(AptFile, ReadsContinuationAndRejectsBadGoto) {

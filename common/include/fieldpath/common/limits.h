@@ -23,6 +23,11 @@ namespace fieldpath::common {
 /// |x| above this (mm) is outside any machine tool: refused as a typo or a corrupt file.
 inline constexpr double kMaxCoordinateMm = 1e6;
 
+/// A machine's feed (mm/min): the scene's `dynamics.feed`, and the FEDRAT an APT output is given.
+/// The fastest linear-motor machines reach ~1.2e5; 1e300 was written as `FEDRAT/MMPM,1e+300`.
+inline constexpr double kMinFeedMmPerMin = 1e-3;
+inline constexpr double kMaxFeedMmPerMin = 1e6;
+
 /// Beyond this distance from the origin (mm) a float's step passes 1 um (2^13 mm: 0.98 um): where
 /// single-precision files (meshes read, STL written) stop carrying micron figures.
 inline constexpr double kFloatExactMm = 8192.0;

@@ -53,6 +53,15 @@ struct PathFile {
   /// and `# UNDER THE REQUIRED CLEARANCE: ...` comment lines (`.cl`), the same after `PPRINT/`
   /// (APT), as their text (from UNSAFE / UNDER on), in file order. `convert` carries them over.
   std::vector<std::string> warnings;
+  /// APT: the feed of each `FEDRAT/` record in mm/min (NaN where it is per revolution, inverse
+  /// time or no number), from posture `from` on, in file order (one after the last GOTO is not
+  /// kept). `convert` writes them back; the other formats have no feed.
+  struct Feed {
+    std::size_t from = 0;
+    double mm_per_min = 0.0;
+    std::size_t line = 0;  ///< 1-based
+  };
+  std::vector<Feed> feeds;
 
   /// "FILE:LINE" or "FILE: row R" of posture i, for messages.
   std::string where(std::size_t i) const;
@@ -135,13 +144,16 @@ void writeClFile(const std::filesystem::path& file, std::span<const Posture> pos
 struct AptHeader {
   std::string part_name = "FIELDPATH";
   ToolSpec tool;
+  /// The feed of every pass when the path has no `feeds` of its own (mm/min).
   double feed_mm_per_min = 1000;
   /// Operator messages written as `PPRINT/...` records after PARTNO (upper case, one a line).
   std::vector<std::string> remarks;
 };
 
-/// Writes APT CLDATA atomically: PARTNO, PPRINT remarks, UNITS/MM, MULTAX/ON, CUTTER/d,r,e,f,a,b,h, then per
-/// block `FEDRAT/MMPM,f` before a pass's GOTOs and `RAPID` before each link GOTO, FINI.
+/// Writes APT CLDATA atomically: PARTNO, PPRINT remarks, UNITS/MM, MULTAX/ON, CUTTER/d,r,e,f,a,b,h,
+/// then per block `FEDRAT/MMPM,f` before a pass's GOTOs and `RAPID` before each link GOTO, FINI.
+/// The feed is the path's own (`path.feeds`: FEDRAT again where it changes within a pass, none
+/// before a pass that no feed reaches) or, where it has none, the header's.
 void writeAptFile(const std::filesystem::path& file, const PathFile& path,
                   const AptHeader& header);
 /// One pass of `postures`.

@@ -1,0 +1,126 @@
+/// `fieldpath convert` and the feed of an APT output: an APT input's FEDRAT records are read in
+/// mm/min (MMPM, IPM, the file's unit) and written back where they were; a path with no feed of
+/// its own (.cl, .npy, an APT without FEDRAT) needs `--feed`; a feed per revolution or past a
+/// machine's is refused naming its line (convert wrote FEDRAT/MMPM,1000 over a FEDRAT/MMPM,150
+/// without a word, and generate's 1e300 as FEDRAT/MMPM,1e+300: a machine-side helper's findings).
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "fieldpath/geometry/cl_file.h"
+#include "files.h"
+
+namespace fieldpath::app::test {
+namespace {
+
+namespace fs = std::filesystem;
+using geometry::PathFile;
+
+/// The FEDRAT records of an APT text, in order, each with the number of GOTOs before it.
+std::vector<std::pair<int, std::string>> fedrats(const std::string& apt) {
+  std::vector<std::pair<int, std::string>> out;
+  int gotos = 0;
+  for (std::size_t at = 0; at < apt.size();) {
+    const std::size_t end = std::min(apt.find('\n', at), apt.size());
+    const std::string line = apt.substr(at, end - at);
+    if (line.rfind("GOTO/", 0) == 0) ++gotos;
+    if (line.rfind("FEDRAT/", 0) == 0) out.emplace_back(gotos, line);
+    at = end + 1;
+  }
+  return out;
+}
+
+TEST(ConvertFeeds, AnAptInputsFeedsAreWrittenBackWhereTheyWere) {
+  const TempDir dir;
+  // Pass 1 at 150 mm/min, a change within it to 10 in/min; a link; pass 2 in inches at 5 in/min
+  // (the file's unit), then 300 mm/min set during the next link, which the next pass takes.
+  dir.write("in.apt",
+            "PARTNO/X\nUNITS/MM\nFEDRAT/MMPM,150\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0\n"
+            "FEDRAT/IPM,10\nGOTO/2,0,0\nRAPID\nGOTO/2,0,10\nUNITS/INCHES\nFEDRAT/5\n"
+            "GOTO/0.1,0,0\nGOTO/0.2,0,0\nFEDRAT/ 300 , MMPM\nRAPID\nGOTO/0.2,0,1\n"
+            "UNITS/MM\nGOTO/5,0,0\nFINI\n");
+  const PathFile read = geometry::readPathFile(dir.path() / "in.apt");
+  ASSERT_EQ(read.feeds.size(), 4u);
+  const double mm_per_min[] = {150, 254, 127, 300};
+  const std::size_t from[] = {0, 2, 4, 6}, line[] = {3, 6, 11, 14};
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_DOUBLE_EQ(read.feeds[k].mm_per_min, mm_per_min[k]) << k;
+    EXPECT_EQ(read.feeds[k].from, from[k]) << k;
+    EXPECT_EQ(read.feeds[k].line, line[k]) << k;
+  }
+  // The same whatever the chunks the file is read in (a chunk may hold a FEDRAT and no GOTO).
+  geometry::PathReadOptions small;
+  small.chunk_bytes = 16;
+  const PathFile chunked = geometry::readPathFile(dir.path() / "in.apt", small);
+  ASSERT_EQ(chunked.feeds.size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(chunked.feeds[k].mm_per_min, read.feeds[k].mm_per_min) << k;
+    EXPECT_EQ(chunked.feeds[k].from, read.feeds[k].from) << k;
+  }
+
+  // The feed set during the last link is written before the pass after it (a FEDRAT between
+  // RAPID and its GOTO would make the link a feed move).
+  const Outcome run = runFieldpath(dir, "convert in.apt out.apt --tool ball:3");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto written = fedrats(slurp(dir.path() / "out.apt"));
+  const std::vector<std::pair<int, std::string>> expected = {{0, "FEDRAT/MMPM,150"},
+                                                             {2, "FEDRAT/MMPM,254"},
+                                                             {4, "FEDRAT/MMPM,127"},
+                                                             {7, "FEDRAT/MMPM,300"}};
+  EXPECT_EQ(written, expected);
+  const PathFile back = geometry::readPathFile(dir.path() / "out.apt");
+  ASSERT_EQ(back.feeds.size(), 4u);
+  for (std::size_t k = 0; k < 4; ++k) EXPECT_DOUBLE_EQ(back.feeds[k].mm_per_min, mm_per_min[k]);
+  EXPECT_EQ(back.blocks, read.blocks);
+
+  // --feed over all of them, said; a .cl keeps no feed, said.
+  const Outcome over = runFieldpath(dir, "convert in.apt over.apt --tool ball:3 --feed 2000");
+  ASSERT_EQ(over.exit_code, 0) << over.err;
+  EXPECT_NE(over.err.find("--feed 2000 mm/min written over the 4 FEDRAT records"),
+            std::string::npos)
+      << over.err;
+  for (const auto& [gotos, record] : fedrats(slurp(dir.path() / "over.apt")))
+    EXPECT_EQ(record, "FEDRAT/MMPM,2000") << gotos;
+  const Outcome to_cl = runFieldpath(dir, "convert in.apt out.cl");
+  ASSERT_EQ(to_cl.exit_code, 0) << to_cl.err;
+  EXPECT_NE(to_cl.err.find("the 4 FEDRAT records dropped"), std::string::npos) << to_cl.err;
+}
+
+TEST(ConvertFeeds, APathWithoutAFeedPerMinuteNeedsFeed) {
+  const TempDir dir;
+  dir.write("p.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
+  dir.write("none.apt", "GOTO/0,0,0,0,0,1\nGOTO/1,0,0\n");
+  dir.write("rev.apt", "UNITS/MM\nFEDRAT/0.1,IPR\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0\n");
+  dir.write("far.apt", "FEDRAT/MMPM,1e300\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0\n");
+  const std::pair<const char*, const char*> refused[] = {
+      {"convert p.cl o.apt --tool ball:1", "o.apt: APT output needs --feed (mm/min): p.cl"},
+      {"convert none.apt o.apt --tool ball:1", "needs --feed (mm/min): none.apt has no FEDRAT"},
+      {"convert rev.apt o.apt --tool ball:1", "rev.apt:2: FEDRAT: a feed per revolution"},
+      {"convert far.apt o.apt --tool ball:1", "far.apt:1: FEDRAT: 1e+300 mm/min is no machine's"},
+      {"convert p.cl o.apt --tool ball:1 --feed 0", "--feed"},
+      {"convert p.cl o.apt --tool ball:1 --feed 2e6", "--feed"},
+  };
+  for (const auto& [args, said] : refused) {
+    const Outcome run = runFieldpath(dir, args);
+    EXPECT_EQ(run.exit_code, 1) << args << ": " << run.err;
+    EXPECT_NE(run.err.find(said), std::string::npos) << args << ": " << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << args << ": " << run.err;
+    EXPECT_FALSE(fs::exists(dir.path() / "o.apt")) << args;
+  }
+  // With --feed, each: the feed before the pass.
+  for (const char* in : {"p.cl", "none.apt", "rev.apt", "far.apt"}) {
+    const Outcome run =
+        runFieldpath(dir, std::string("convert ") + in + " o.apt --tool ball:1 --feed 450");
+    ASSERT_EQ(run.exit_code, 0) << in << ": " << run.err;
+    const auto written = fedrats(slurp(dir.path() / "o.apt"));
+    ASSERT_EQ(written.size(), 1u) << in;
+    EXPECT_EQ(written[0], (std::pair<int, std::string>{0, "FEDRAT/MMPM,450"})) << in;
+  }
+}
+
+}  // namespace
+}  // namespace fieldpath::app::test
