@@ -265,6 +265,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     motion_request.posture_clearance_mm = clearance.clearance_mm;
     const pathgen::MotionResult motions =
         checker.checkMotions(path.postures, motion_request, progress);
+    const pathgen::RotaryStray rotary =
+        pathgen::rotaryStray(path.postures, motions, scene.clearance_mm);
     // The links (rapid moves) and the holder (it never cuts) must not touch the part.
     pathgen::PartContacts contacts;
     if (scene.part)
@@ -358,6 +360,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"tool_notes", tool_notes},
         {"obstacle_notes", obstacle_notes},
         {"axis_turn", axisTurnJson(axis_turn)},
+        {"rotary_angles", rotaryJson(rotary, motions.tool_reach_mm)},
         {"limits",
          {{"limited_postures", path.limited.size()},
           {"limited_colliding", limited_colliding},
@@ -468,6 +471,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     for (const std::string& note : obstacle_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
     if (const std::string turn = axisTurnWarning(path, axis_turn); !turn.empty())
       std::fprintf(stderr, "warning: %s (check.json axis_turn)\n", turn.c_str());
+    if (const std::string stray = rotaryWarning(path, rotary, motions); !stray.empty())
+      std::fprintf(stderr, "warning: %s (check.json rotary_angles)\n", stray.c_str());
     if (surface && surface->beneath_lines > 0)
       std::fprintf(stderr,
                    "note: the tool passed beneath the part's top layer on %zu Z-buffer lines "

@@ -420,6 +420,9 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (std::string far = farLinkNote(scene, result.path); !far.empty())
       notes.link.push_back(std::move(far));
     nlohmann::json report = reportJson(scene, job, result, axis_turn, notes);
+    const pathgen::RotaryStray rotary =
+        pathgen::rotaryStray(result.path.postures, result.motions, job.clearance_mm);
+    report["rotary_angles"] = rotaryJson(rotary, result.motions.tool_reach_mm);
     report["times_s"]["read"] = read_s;  // before `total`, which counts from the passes on
     // The files this report is of (written before it, renamed one by one): a folder holding
     // another run's path beside this report can be told (as check.json's path_digest).
@@ -456,6 +459,9 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     // narrower than the holder; unsafe there too, but the turn is its own warning)
     if (const std::string turn = axisTurnWarning(result.path, axis_turn); !turn.empty())
       std::fprintf(stderr, "warning: %s (report.json axis_turn)\n", turn.c_str());
+    if (const std::string stray = rotaryWarning(result.path, rotary, result.motions);
+        !stray.empty())
+      std::fprintf(stderr, "warning: %s (report.json rotary_angles)\n", stray.c_str());
     if (!result.kept_nominal.empty()) {
       const auto& k = result.kept_nominal.front();
       std::fprintf(

@@ -11,6 +11,7 @@
 
 #include "fieldpath/common/file_digest.h"
 #include "fieldpath/pathgen/generate.h"
+#include "fieldpath/pathgen/rotary_angles.h"
 #include "scene.h"
 
 namespace fieldpath::app {
@@ -292,6 +293,43 @@ inline std::string cutterGougeReason(const std::optional<pathgen::CutterPartResu
          " um) at " + std::to_string(cut->gouging_postures) + " postures and " +
          std::to_string(cut->gouging_motions) + " motions (max " + depth + " um; first: " + first +
          ")";
+}
+
+/// What a post-processor writing rotary angles would do to the path's motions
+/// (pathgen::rotaryStray), for report.json and check.json.
+inline nlohmann::json rotaryJson(const pathgen::RotaryStray& s, double reach_mm) {
+  return {{"assumes",
+           "a post that writes (tilt >= 0 from z, C about z) angles, each interpolated linearly "
+           "(A/C, B/C machines); the motions are checked with the tool vector on the great "
+           "circle (Fanuc G43.5, Siemens ORIVECT, Heidenhain LN)"},
+          {"reach_mm", reach_mm},
+          {"max_stray_mm", s.max_offset_mm},
+          {"max_stray_motion", jsonIndex(s.max_at)},
+          {"motions_stray_past_clearance", s.beyond_clearance},
+          {"first_stray_past_clearance", jsonIndex(s.first_beyond)},
+          {"motions_stray_under_required", s.under_required},
+          {"c_turn_deg", s.c_deg},
+          {"axis_turn_deg", s.turn_deg}};
+}
+
+/// The warning where interpolated rotary angles stray past a motion's clearance (empty
+/// otherwise): not part of `unsafe` (the checked motion is the tool vector's), said so that
+/// whoever posts the path knows which output the proof holds for.
+inline std::string rotaryWarning(const geometry::PathFile& path, const pathgen::RotaryStray& s,
+                                 const pathgen::MotionResult& m) {
+  if (s.beyond_clearance == 0) return {};
+  const std::size_t i = s.first_beyond;
+  char numbers[160];
+  std::snprintf(numbers, sizeof numbers,
+                "C turns %.1f deg for %.2f deg of the axis, the tool strays %.2f mm where the "
+                "motion is %.3f mm clear",
+                s.c_deg, s.turn_deg, s.offset_mm[i], m.clearance_mm[i]);
+  const bool many = s.beyond_clearance > 1;
+  return std::to_string(s.beyond_clearance) + (many ? " motions" : " motion") +
+         " near the vertical would stray past the clearance " + (many ? "they have" : "it has") +
+         " if posted as rotary angles (first: " + postureWhere(path, i, i + 1) +
+         " to the next: " + numbers +
+         "): post the tool vector (G43.5 / ORIVECT / LN), not interpolated A/B/C";
 }
 
 }  // namespace fieldpath::app

@@ -331,6 +331,7 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
                                             const common::Progress& progress) const {
   MotionResult result;
   result.motions = postures.empty() ? 0 : postures.size() - 1;
+  result.tool_reach_mm = impl_->reach_mm;
   std::vector<double> ends(postures.size());
   std::vector<double> bound(result.motions);
   std::vector<char> touched(result.motions, 0);

@@ -68,6 +68,7 @@ struct MotionResult {
   std::size_t first_under_required = npos;
   std::size_t samples = 0;           ///< distance queries between the postures
   std::vector<double> clearance_mm;  ///< per motion: its lower bound, mm
+  double tool_reach_mm = 0.0;        ///< the farthest point of tool + holder from the tip, mm
 };
 
 struct ClearanceResult {
