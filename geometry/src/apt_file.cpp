@@ -41,6 +41,10 @@ constexpr std::string_view kAptMotionNote =
     "MOTIONS CHECKED WITH THE TIP ON A LINE AND THE TOOL AXIS ON THE GREAT CIRCLE BETWEEN "
     "GOTOS, RAPIDS TOO: POST THE TOOL VECTOR (NOT INTERPOLATED ROTARY ANGLES) AND RAPIDS AS "
     "LINEAR MOVES";
+/// ... and what it leaves to the post or the operator (a post reading no SPINDL writes no M03).
+constexpr std::string_view kAptSetupNote =
+    "NO LOADTL, SPINDL OR COOLNT RECORDS: TOOL, SPINDLE SPEED AND COOLANT ARE SET IN THE POST OR "
+    "AT THE MACHINE";
 
 /// The columns of an APT card: a record is continued on the next line with `$` past them.
 constexpr std::size_t kAptColumns = 72;
@@ -494,6 +498,7 @@ void writeAptFile(const std::filesystem::path& file, const PathFile& path,
   // helper's finding: a dog-leg rapid crossed a wall that the straight retract cleared). After
   // CUTTER, not beside the safety marks: a mark's text runs on in the PPRINT cards after it.
   appendTextCards(text, "PPRINT", kAptMotionNote);
+  appendTextCards(text, "PPRINT", kAptSetupNote);
   // A path marked unsafe halts before its first motion (STOP: M00 on post-processors): a PPRINT
   // is only read, and the program ran on (a machine-safety helper's finding).
   if (std::any_of(header.remarks.begin(), header.remarks.end(), [](const std::string& remark) {

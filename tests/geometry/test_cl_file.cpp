@@ -242,6 +242,7 @@ TEST(AptFile, WritesHeaderAndParsesBackExactly) {
   std::getline(in, l6);
   EXPECT_NE(notes.find("TOOL AXIS ON THE GREAT CIRCLE"), std::string::npos) << notes;
   EXPECT_NE(notes.find("RAPIDS AS LINEAR MOVES"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("NO LOADTL, SPINDL OR COOLNT"), std::string::npos) << notes;
   EXPECT_EQ(l1, "PARTNO/IMPELLER");
   EXPECT_EQ(count, "PPRINT/POSTURES " + std::to_string(postures.size()) +
                        " (A FILE HOLDING FEWER WAS CUT SHORT)");
