@@ -55,15 +55,25 @@ void takeFeeds(geometry::PathFile& path, double feed_mm_per_min, const fs::path&
     throw InputError(out.string() + ": APT output needs --feed (mm/min): " + in.string() +
                      " has no FEDRAT of its own");
   for (const geometry::PathFile::Feed& f : path.feeds) {
-    const std::string where = in.string() + ":" + std::to_string(f.line) + ": FEDRAT: ";
+    const std::string where = in.string() + ":" + std::to_string(f.line) + ": FEDRAT";
     if (!std::isfinite(f.mm_per_min))
-      throw InputError(where +
-                       "a feed per revolution, inverse time or without a number has no "
-                       "mm/min to write: give --feed");
+      throw InputError(where + "/" + f.text +
+                       ": no feed per minute to write (one number > 0 with MMPM, IPM or the "
+                       "file's unit; not per revolution or inverse time): give --feed");
     if (f.mm_per_min < common::kMinFeedMmPerMin || f.mm_per_min > common::kMaxFeedMmPerMin)
-      throw InputError(where + common::shortNumber(f.mm_per_min) +
+      throw InputError(where + ": " + common::shortNumber(f.mm_per_min) +
                        " mm/min is no machine's feed (0.001 to 1e6): give --feed");
   }
+  // Passes before the first FEDRAT run at whatever feed the machine holds: written so, as read.
+  const std::size_t first = path.feeds.front().from;
+  for (const geometry::PathBlock& b : path.blocks)
+    if (b.kind == geometry::PathBlock::Kind::Pass && b.begin < first) {
+      std::fprintf(stderr,
+                   "note: %s sets no feed before its line %zu: the GOTOs before it are written "
+                   "with no FEDRAT, as read (--feed gives them one)\n",
+                   in.string().c_str(), path.feeds.front().line);
+      break;
+    }
 }
 
 }  // namespace
@@ -90,6 +100,9 @@ void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
   cmd->callback([o] {
     const fs::path in = o->in, out = o->out;
     const PathFormat to = outputFormat(out);
+    if (to != PathFormat::Apt && o->feed_mm_per_min > 0.0)
+      throw InputError(out.string() + ": --feed is the FEDRAT of an APT output; " + formatName(to) +
+                       " has no feed");
     geometry::AptHeader header;
     if (to == PathFormat::Apt) {
       if (o->tool.empty())

@@ -23,6 +23,7 @@
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/csv.h"
 #include "fieldpath/common/file_digest.h"
+#include "fieldpath/common/short_number.h"
 #include "fieldpath/field/voxel_field.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/units.h"
@@ -459,6 +460,21 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     // narrower than the holder; unsafe there too, but the turn is its own warning)
     if (const std::string turn = axisTurnWarning(result.path, axis_turn); !turn.empty())
       std::fprintf(stderr, "warning: %s (report.json axis_turn)\n", turn.c_str());
+    // The nominal's own feeds are not carried: path.apt is fed at dynamics.feed (a reviewer's
+    // nominal at FEDRAT/MMPM,150 came out at 1000 without a word).
+    if (scene.nominal)
+      for (const geometry::PathFile::Feed& f : scene.nominal->feeds)
+        if (!(f.mm_per_min == job.dynamics.feed_mm_per_min)) {
+          std::fprintf(stderr,
+                       "note: %s's FEDRAT records (line %zu: %s) are not carried: path.apt is "
+                       "fed at dynamics.feed, %s mm/min\n",
+                       scene.nominal->file.string().c_str(), f.line,
+                       std::isfinite(f.mm_per_min)
+                           ? (common::shortNumber(f.mm_per_min) + " mm/min").c_str()
+                           : f.text.c_str(),
+                       common::shortNumber(job.dynamics.feed_mm_per_min).c_str());
+          break;
+        }
     if (const std::string stray = rotaryWarning(result.path, rotary, result.motions);
         !stray.empty())
       std::fprintf(stderr, "warning: %s (report.json rotary_angles)\n", stray.c_str());

@@ -300,8 +300,8 @@ inline std::string cutterGougeReason(const std::optional<pathgen::CutterPartResu
 inline nlohmann::json rotaryJson(const pathgen::RotaryStray& s, double reach_mm) {
   return {{"assumes",
            "a post that writes (tilt >= 0 from z, C about z) angles, each interpolated linearly "
-           "(A/C, B/C machines); the motions are checked with the tool vector on the great "
-           "circle (Fanuc G43.5, Siemens ORIVECT, Heidenhain LN)"},
+           "(A/C, B/C machines), against the tool vector on the great circle at an even pace "
+           "(Fanuc G43.5, Siemens ORIVECT, Heidenhain LN), the same instant, at the tool's reach"},
           {"reach_mm", reach_mm},
           {"max_stray_mm", s.max_offset_mm},
           {"max_stray_motion", jsonIndex(s.max_at)},
@@ -326,7 +326,7 @@ inline std::string rotaryWarning(const geometry::PathFile& path, const pathgen::
                 s.c_deg, s.turn_deg, s.offset_mm[i], m.clearance_mm[i]);
   const bool many = s.beyond_clearance > 1;
   return std::to_string(s.beyond_clearance) + (many ? " motions" : " motion") +
-         " near the vertical would stray past the clearance " + (many ? "they have" : "it has") +
+         " would stray past the clearance " + (many ? "they have" : "it has") +
          " if posted as rotary angles (first: " + postureWhere(path, i, i + 1) +
          " to the next: " + numbers +
          "): post the tool vector (G43.5 / ORIVECT / LN), not interpolated A/B/C";

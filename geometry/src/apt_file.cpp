@@ -185,32 +185,40 @@ std::optional<PathFile::Cutter> cutterOf(std::string_view values, std::size_t li
 }
 
 /// A FEDRAT record's feed: its number in `feed.mm_per_min` and, in `unit`, mm per unit of it:
-/// 1 with MMPM, 25.4 with IPM, 0 (the file's unit) with none or PERMIN; NaN where it is per
-/// revolution (IPR, MMPR, PERREV), inverse time (INVERS) or has no number.
+/// 1 with MMPM, 25.4 with IPM, 0 (the file's unit) with none or PERMIN. NaN, with the record's
+/// text in `feed.text`, where it is per revolution (IPR, MMPR, PERREV, REV), inverse time
+/// (INVERS), or not read whole: no number or one <= 0, a second number, a word of no feed
+/// (`FEDRAT/IMP,10`, a typo, was read as 10 mm/min) or two units.
 AptChunk::Feed feedOf(std::string_view values, std::size_t line, std::size_t posture) {
   AptChunk::Feed out;
-  out.feed = {posture, std::numeric_limits<double>::quiet_NaN(), line};
+  out.feed = {posture, std::numeric_limits<double>::quiet_NaN(), line, {}};
   out.unit = 0.0;
-  bool number = false, per_minute = true;
+  int numbers = 0, units = 0;
+  bool understood = true;
+  double value = 0.0;
   for (std::size_t start = 0; start <= values.size();) {
     const auto comma = std::min(values.find(',', start), values.size());
-    const std::string_view token = trimmed(values.substr(start, comma - start));
+    std::string_view token = trimmed(values.substr(start, comma - start));
     start = comma + 1;
+    if (!token.empty() && token.front() == '+') token.remove_prefix(1);  // as GOTO reads `+1`
     double v = 0.0;
     const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
-    if (ec == std::errc() && end == token.data() + token.size()) {
-      if (!number && std::isfinite(v) && v > 0.0) out.feed.mm_per_min = v;
-      number = true;
-    } else if (token == "MMPM") {
-      out.unit = 1.0;
-    } else if (token == "IPM") {
-      out.unit = 25.4;
-    } else if (token == "IPR" || token == "MMPR" || token == "PERREV" || token == "REV" ||
-               token == "INVERS") {
-      per_minute = false;
+    if (!token.empty() && ec == std::errc() && end == token.data() + token.size()) {
+      value = v;
+      understood = understood && ++numbers == 1 && std::isfinite(v) && v > 0.0;
+    } else if (token == "MMPM" || token == "IPM" || token == "PERMIN") {
+      out.unit = token == "MMPM" ? 1.0 : token == "IPM" ? 25.4 : 0.0;
+      understood = understood && ++units == 1;
+    } else {  // per revolution, inverse time, or a word of no feed
+      understood = false;
     }
   }
-  if (!per_minute) out.feed.mm_per_min = std::numeric_limits<double>::quiet_NaN();
+  if (understood && numbers == 1) {
+    out.feed.mm_per_min = value;
+  } else {
+    out.feed.text =
+        std::string(trimmed(values.substr(0, std::min<std::size_t>(values.size(), 60))));
+  }
   return out;
 }
 
@@ -421,7 +429,8 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
       const double unit = f.unit > 0.0     ? f.unit
                           : f.units_before ? c.units[f.units_before - 1].second
                                            : scale;
-      feed.mm_per_min *= unit;
+      // To the micrometre a minute: 3 in/min is 76.2, not 76.19999999999999.
+      feed.mm_per_min = std::round(feed.mm_per_min * unit * 1e6) / 1e6;
       feed.from += offset;
       feeds.push_back(feed);
     }

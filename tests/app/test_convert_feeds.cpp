@@ -36,19 +36,19 @@ std::vector<std::pair<int, std::string>> fedrats(const std::string& apt) {
 
 TEST(ConvertFeeds, AnAptInputsFeedsAreWrittenBackWhereTheyWere) {
   const TempDir dir;
-  // Pass 1 at 150 mm/min, a change within it to 10 in/min; a link; pass 2 in inches at 5 in/min
+  // Pass 1 at 150 mm/min, a change within it to 3 in/min; a link; pass 2 in inches at 5 in/min
   // (the file's unit), then 300 mm/min set during the next link, which the next pass takes.
   dir.write("in.apt",
             "PARTNO/X\nUNITS/MM\nFEDRAT/MMPM,150\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0\n"
-            "FEDRAT/IPM,10\nGOTO/2,0,0\nRAPID\nGOTO/2,0,10\nUNITS/INCHES\nFEDRAT/5\n"
+            "FEDRAT/IPM,3\nGOTO/2,0,0\nRAPID\nGOTO/2,0,10\nUNITS/INCHES\nFEDRAT/5\n"
             "GOTO/0.1,0,0\nGOTO/0.2,0,0\nFEDRAT/ 300 , MMPM\nRAPID\nGOTO/0.2,0,1\n"
             "UNITS/MM\nGOTO/5,0,0\nFINI\n");
   const PathFile read = geometry::readPathFile(dir.path() / "in.apt");
   ASSERT_EQ(read.feeds.size(), 4u);
-  const double mm_per_min[] = {150, 254, 127, 300};
+  const double mm_per_min[] = {150, 76.2, 127, 300};  // 3 in/min: 76.2, not 76.19999999999999
   const std::size_t from[] = {0, 2, 4, 6}, line[] = {3, 6, 11, 14};
   for (std::size_t k = 0; k < 4; ++k) {
-    EXPECT_DOUBLE_EQ(read.feeds[k].mm_per_min, mm_per_min[k]) << k;
+    EXPECT_EQ(read.feeds[k].mm_per_min, mm_per_min[k]) << k;
     EXPECT_EQ(read.feeds[k].from, from[k]) << k;
     EXPECT_EQ(read.feeds[k].line, line[k]) << k;
   }
@@ -68,7 +68,7 @@ TEST(ConvertFeeds, AnAptInputsFeedsAreWrittenBackWhereTheyWere) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto written = fedrats(slurp(dir.path() / "out.apt"));
   const std::vector<std::pair<int, std::string>> expected = {{0, "FEDRAT/MMPM,150"},
-                                                             {2, "FEDRAT/MMPM,254"},
+                                                             {2, "FEDRAT/MMPM,76.2"},
                                                              {4, "FEDRAT/MMPM,127"},
                                                              {7, "FEDRAT/MMPM,300"}};
   EXPECT_EQ(written, expected);
@@ -96,13 +96,18 @@ TEST(ConvertFeeds, APathWithoutAFeedPerMinuteNeedsFeed) {
   dir.write("none.apt", "GOTO/0,0,0,0,0,1\nGOTO/1,0,0\n");
   dir.write("rev.apt", "UNITS/MM\nFEDRAT/0.1,IPR\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0\n");
   dir.write("far.apt", "FEDRAT/MMPM,1e300\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0\n");
+  dir.write("typo.apt", "FEDRAT/IMP,10\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0\n");  // 10 mm/min once
+  dir.write("two.apt", "FEDRAT/MMPM,10,IPM\nGOTO/0,0,0,0,0,1\nGOTO/1,0,0\n");
   const std::pair<const char*, const char*> refused[] = {
       {"convert p.cl o.apt --tool ball:1", "o.apt: APT output needs --feed (mm/min): p.cl"},
       {"convert none.apt o.apt --tool ball:1", "needs --feed (mm/min): none.apt has no FEDRAT"},
-      {"convert rev.apt o.apt --tool ball:1", "rev.apt:2: FEDRAT: a feed per revolution"},
+      {"convert rev.apt o.apt --tool ball:1", "rev.apt:2: FEDRAT/0.1,IPR: no feed per minute"},
       {"convert far.apt o.apt --tool ball:1", "far.apt:1: FEDRAT: 1e+300 mm/min is no machine's"},
-      {"convert p.cl o.apt --tool ball:1 --feed 0", "--feed"},
-      {"convert p.cl o.apt --tool ball:1 --feed 2e6", "--feed"},
+      {"convert typo.apt o.apt --tool ball:1", "typo.apt:1: FEDRAT/IMP,10: no feed per minute"},
+      {"convert two.apt o.apt --tool ball:1", "two.apt:1: FEDRAT/MMPM,10,IPM: no feed per minute"},
+      {"convert p.cl o.apt --tool ball:1 --feed 0", "--feed: must be a number from 0.001"},
+      {"convert p.cl o.apt --tool ball:1 --feed 2e6", "--feed: must be a number from 0.001"},
+      {"convert p.cl o.cl --feed 100", "o.cl: --feed is the FEDRAT of an APT output"},
   };
   for (const auto& [args, said] : refused) {
     const Outcome run = runFieldpath(dir, args);
@@ -110,9 +115,10 @@ TEST(ConvertFeeds, APathWithoutAFeedPerMinuteNeedsFeed) {
     EXPECT_NE(run.err.find(said), std::string::npos) << args << ": " << run.err;
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << args << ": " << run.err;
     EXPECT_FALSE(fs::exists(dir.path() / "o.apt")) << args;
+    EXPECT_FALSE(fs::exists(dir.path() / "o.cl")) << args;
   }
   // With --feed, each: the feed before the pass.
-  for (const char* in : {"p.cl", "none.apt", "rev.apt", "far.apt"}) {
+  for (const char* in : {"p.cl", "none.apt", "rev.apt", "far.apt", "typo.apt", "two.apt"}) {
     const Outcome run =
         runFieldpath(dir, std::string("convert ") + in + " o.apt --tool ball:1 --feed 450");
     ASSERT_EQ(run.exit_code, 0) << in << ": " << run.err;

@@ -54,12 +54,13 @@ struct PathFile {
   /// (APT), as their text (from UNSAFE / UNDER on), in file order. `convert` carries them over.
   std::vector<std::string> warnings;
   /// APT: the feed of each `FEDRAT/` record in mm/min (NaN where it is per revolution, inverse
-  /// time or no number), from posture `from` on, in file order (one after the last GOTO is not
-  /// kept). `convert` writes them back; the other formats have no feed.
+  /// time, or not read whole: apt_file.cpp feedOf), from posture `from` on, in file order (one
+  /// after the last GOTO is not kept). `convert` writes them back; the other formats have no feed.
   struct Feed {
     std::size_t from = 0;
     double mm_per_min = 0.0;
     std::size_t line = 0;  ///< 1-based
+    std::string text;      ///< where mm_per_min is NaN: the record's values, for messages
   };
   std::vector<Feed> feeds;
 

@@ -22,8 +22,10 @@ namespace fieldpath::pathgen {
 Vec3 axisByAngles(const Vec3& a, const Vec3& b, double t);
 
 /// The stray of every motion: the largest distance, over the motion, between the tool placed by
-/// interpolated angles and the checked one at the same instant (same tip), at `reach_mm` from
-/// the tip (every point of an axisymmetric tool within reach moves no more).
+/// interpolated angles and the one on the great circle at an even pace at the same instant (same
+/// tip), at the tool's reach from the tip (every point of an axisymmetric tool within reach moves
+/// no more). A turn with C still strays 0: the same arc (check's own pace, the normalised chord,
+/// differs from an even one by 0.0085 mm at 100 mm for 10 deg of turn: the axis_turn warning's).
 struct RotaryStray {
   static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
   std::vector<double> offset_mm;  ///< per motion (posture i to i + 1)
