@@ -9,6 +9,7 @@
 #include "fieldpath/common/errors.h"
 #include "files.h"
 #include "job.h"
+#include "progress.h"
 #include "scene.h"
 
 using namespace fieldpath;
@@ -369,3 +370,26 @@ TEST(Scene, RepeatedPosturesDroppedAreSaid) {
             std::string::npos)
       << err;
 }
+
+namespace fieldpath::app {
+namespace {
+
+// The progress line's time left: the stage's pace so far, said once it says something.
+TEST(ProgressLine, TheTimeLeftIsTheStagesPaceSoFar) {
+  EXPECT_EQ(timeLeftText(94.4, 0.444), "  ~2 min left");  // 118 s at 44.4 % in 94.4 s
+  EXPECT_EQ(timeLeftText(10.0, 0.5), "  ~10 s left");
+  EXPECT_EQ(timeLeftText(60.0, 0.01 * 2.5), "  ~39 min left");
+  EXPECT_EQ(timeLeftText(300.0, 0.02), "  ~4.1 h left");
+  // Not before 5 s and 2 % of the stage, nor at its end.
+  EXPECT_EQ(timeLeftText(4.9, 0.5), "");
+  EXPECT_EQ(timeLeftText(100.0, 0.019), "");
+  EXPECT_EQ(timeLeftText(100.0, 1.0), "");
+  EXPECT_EQ(timeLeftText(100.0, std::nan("")), "");
+  // A stage that began at 35 % of the work: 1.2 % of it in 11 s is the stage's 1.8 %, not yet
+  // said (it read "~20 s left" of a stage that had 200 s to go); at 40 % in 20 s, 7.7 % of it.
+  EXPECT_EQ(timeLeftText(11.2, 0.362, 0.35), "");
+  EXPECT_EQ(timeLeftText(20.0, 0.40, 0.35), "  ~4 min left");
+}
+
+}  // namespace
+}  // namespace fieldpath::app
