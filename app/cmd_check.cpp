@@ -252,6 +252,13 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     if (std::string holder = noHolderNote(scene.tool, scene.holder); !holder.empty())
       tool_notes.push_back(std::move(holder));
     const std::vector<std::string> obstacle_notes = openObstacleNotes(scene);
+    // What the path file holds that check does not prove: an APT start point (FROM/).
+    std::vector<std::string> path_notes;
+    if (path.from_line > 0)
+      path_notes.push_back(path.file.string() + ":" + std::to_string(path.from_line) +
+                           ": FROM/ (the start point) is read past: the machine's move from it to "
+                           "the first GOTO is not checked (write it as a GOTO after RAPID to have "
+                           "it checked)");
     const pathgen::AxisTurn axis_turn = pathgen::largestAxisTurn(path, scene.tool.radius_mm);
 
     // (a) exact clearance of postures and motions
@@ -359,6 +366,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"unsafe", unsafe},
         {"tool_notes", tool_notes},
         {"obstacle_notes", obstacle_notes},
+        {"path_notes", path_notes},
         {"axis_turn", axisTurnJson(axis_turn)},
         {"rotary_angles", rotaryJson(rotary, motions.tool_reach_mm)},
         {"limits",
@@ -469,6 +477,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                   unsafe.empty() ? "" : ", UNSAFE TO RUN", reasons.c_str());
     for (const std::string& note : tool_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
     for (const std::string& note : obstacle_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
+    for (const std::string& note : path_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
     if (const std::string turn = axisTurnWarning(path, axis_turn); !turn.empty())
       std::fprintf(stderr, "warning: %s (check.json axis_turn)\n", turn.c_str());
     if (const std::string stray = rotaryWarning(path, rotary, motions); !stray.empty())

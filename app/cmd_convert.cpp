@@ -138,6 +138,9 @@ void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
       std::fprintf(stderr,
                    "note: .npy keeps postures only: %zu pass and %zu link blocks%s dropped\n",
                    passes, links, path.limited.empty() ? "" : " and the # limit marks");
+    if (path.from_line > 0)
+      std::fprintf(stderr, "note: %s:%zu: FROM/ (the start point) is not carried: no path motion\n",
+                   in.string().c_str(), path.from_line);
     if (to != PathFormat::Apt && feeds_read > 0)
       std::fprintf(stderr,
                    "note: %s has no feed: the %zu FEDRAT records dropped (converted back "

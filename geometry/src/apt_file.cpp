@@ -3,6 +3,7 @@
 /// starts a comment, `RAPID` makes the next motion a rapid (a link) unless a `FEDRAT` comes
 /// between them, `UNITS/INCHES` scales the coordinates that follow to mm, `TLAXIS/i,j,k` sets the
 /// axis of the 3-value GOTOs that follow, `FEDRAT/` records give the feeds (kept for `convert`),
+/// `FROM/` is read past (its line kept: the move from the start point is not the path's),
 /// `FINI` ends the program (nothing after it is read); motions it does not take (arcs, cycles,
 /// relative and drive-surface moves) are refused; every other record is read past.
 #include <algorithm>
@@ -159,6 +160,7 @@ struct AptChunk {
     std::size_t units_before = 0;
   };
   std::vector<Feed> feeds;
+  std::size_t from_line = 0;  ///< its first FROM record's line (0: none)
 };
 
 /// The leading finite numbers of comma-separated `values` (at most `max`, into v): how many.
@@ -296,6 +298,10 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
       out.fini = true;
       break;
     }
+    if (major == "FROM") {
+      if (out.from_line == 0) out.from_line = record_line;
+      continue;
+    }
     if (major == "CUTTER") {
       if (slash != std::string::npos)
         if (auto cutter = cutterOf(std::string_view(statement).substr(slash + 1), record_line))
@@ -403,6 +409,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   std::vector<std::size_t> link_postures;
   std::vector<PathFile::Cutter> cutters;
   std::vector<PathFile::Feed> feeds;
+  std::size_t from_line = 0;
   bool pending = false, ended = false;
   double scale = 1.0;
   std::size_t offset = 0;
@@ -418,6 +425,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
       continue;
     }
     ended = c.fini;
+    if (from_line == 0) from_line = c.from_line;
     for (auto& [units_before, cutter] : c.cutters) {  // in the unit of the record before it
       const double unit = units_before ? c.units[units_before - 1].second : scale;
       cutter.diameter_mm *= unit;
@@ -460,6 +468,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   PathFile path;
   path.file = file;
   path.cutters = std::move(cutters);
+  path.from_line = from_line;
   for (const PathFile::Feed& f : feeds)
     if (f.from < offset) path.feeds.push_back(f);  // a FEDRAT after the last GOTO feeds nothing
   if (offset == 0) throw InputError(file.string() + ": no GOTO records");

@@ -2,7 +2,8 @@
 /// mm/min (MMPM, IPM, the file's unit) and written back where they were; a path with no feed of
 /// its own (.cl, .npy, an APT without FEDRAT) needs `--feed`; a feed per revolution or past a
 /// machine's is refused naming its line (convert wrote FEDRAT/MMPM,1000 over a FEDRAT/MMPM,150
-/// without a word, and generate's 1e300 as FEDRAT/MMPM,1e+300: a machine-side helper's findings).
+/// without a word, and generate's 1e300 as FEDRAT/MMPM,1e+300: a machine-side helper's findings);
+/// and FROM/, read past, said.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "fieldpath/geometry/cl_file.h"
 #include "files.h"
@@ -126,6 +128,42 @@ TEST(ConvertFeeds, APathWithoutAFeedPerMinuteNeedsFeed) {
     ASSERT_EQ(written.size(), 1u) << in;
     EXPECT_EQ(written[0], (std::pair<int, std::string>{0, "FEDRAT/MMPM,450"})) << in;
   }
+}
+
+// FROM/ (the start point) is no motion of the path: read past, its line kept whatever the chunks,
+// and said by check (the move from it is not checked) and convert (not carried).
+TEST(ConvertFeeds, FromIsReadPastAndSaid) {
+  const TempDir dir;
+  dir.write("from.apt",
+            "PARTNO/X\nFROM/0,0,100\nFEDRAT/MMPM,200\nGOTO/0,0,5,0,0,1\n"
+            "GOTO/5,0,5\nFROM/1,1,1\nGOTO/10,0,5\n");
+  for (const std::size_t chunk : {std::size_t{16}, std::size_t{1} << 20}) {
+    geometry::PathReadOptions options;
+    options.chunk_bytes = chunk;
+    const PathFile read = geometry::readPathFile(dir.path() / "from.apt", options);
+    EXPECT_EQ(read.from_line, 2u) << chunk;
+    EXPECT_EQ(read.postures.size(), 3u) << chunk;
+  }
+  const Outcome run = runFieldpath(dir, "convert from.apt to.apt --tool ball:3");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("from.apt:2: FROM/ (the start point) is not carried"), std::string::npos)
+      << run.err;
+  dir.write("wall.stl", squareStl(20.0, -30.0));
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, length: 40 }\n");
+  const Outcome check = runFieldpath(dir, "check scene.yaml --path from.apt --out out");
+  EXPECT_NE(check.err.find("note: from.apt:2: FROM/ (the start point) is read past: the machine's "
+                           "move from it to the first GOTO is not checked"),
+            std::string::npos)
+      << check.err;
+  const auto report = nlohmann::json::parse(slurp(dir.path() / "out" / "check.json"));
+  ASSERT_EQ(report["path_notes"].size(), 1u);
+  // A path with no FROM: no note.
+  dir.write("plain.apt", "GOTO/0,0,5,0,0,1\nGOTO/5,0,5\n");
+  const Outcome plain = runFieldpath(dir, "check scene.yaml --path plain.apt --out out2");
+  EXPECT_EQ(plain.err.find("FROM/"), std::string::npos) << plain.err;
+  EXPECT_TRUE(
+      nlohmann::json::parse(slurp(dir.path() / "out2" / "check.json"))["path_notes"].empty());
 }
 
 }  // namespace

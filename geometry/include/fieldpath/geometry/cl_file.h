@@ -63,6 +63,9 @@ struct PathFile {
     std::string text;      ///< where mm_per_min is NaN: the record's values, for messages
   };
   std::vector<Feed> feeds;
+  /// APT: the line of the first `FROM/` record (0: none). Read past: the machine's move from
+  /// that start point to the first GOTO is no motion of the path, and not checked.
+  std::size_t from_line = 0;
 
   /// "FILE:LINE" or "FILE: row R" of posture i, for messages.
   std::string where(std::size_t i) const;
