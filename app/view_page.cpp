@@ -381,7 +381,8 @@ std::string viewPage(const ViewData& d, const ThreeJs& three, const PageBudget& 
   if (d.path) title += ", " + d.path->file.file.filename().string();
   const std::string meta_text = scriptJson(meta), blob_text = base64(blob.bytes());
   const std::string title_text = htmlEscape(title), generator_text = htmlEscape(generator);
-  const std::string css = view_assets::kViewCss, js = view_assets::kViewJs;
+  const std::string css = view_assets::kViewCss, colours = view_assets::kColoursJs,
+                    js = view_assets::kViewJs;
   const std::string page = fill(view_assets::kPageHtml, {{"GENERATOR", &generator_text},
                                                          {"TITLE", &title_text},
                                                          {"CSS", &css},
@@ -389,6 +390,7 @@ std::string viewPage(const ViewData& d, const ThreeJs& three, const PageBudget& 
                                                          {"BLOB", &blob_text},
                                                          {"THREE", &three.three},
                                                          {"ORBIT", &three.orbit_controls},
+                                                         {"COLOURSJS", &colours},
                                                          {"VIEWJS", &js}});
   st.bytes = page.size();
   if (stats) *stats = st;
