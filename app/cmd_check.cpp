@@ -274,6 +274,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         checker.checkMotions(path.postures, motion_request, progress);
     const pathgen::RotaryStray rotary =
         pathgen::rotaryStray(path.postures, motions, scene.clearance_mm);
+    const pathgen::DogLegRapids dog_leg = pathgen::dogLegRapids(path, motions, scene.clearance_mm);
     // The links (rapid moves) and the holder (it never cuts) must not touch the part.
     pathgen::PartContacts contacts;
     if (scene.part)
@@ -369,6 +370,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"path_notes", path_notes},
         {"axis_turn", axisTurnJson(axis_turn)},
         {"rotary_angles", rotaryJson(rotary, motions.tool_reach_mm)},
+        {"dog_leg_rapids", dogLegJson(dog_leg)},
         {"limits",
          {{"limited_postures", path.limited.size()},
           {"limited_colliding", limited_colliding},
@@ -482,6 +484,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       std::fprintf(stderr, "warning: %s (check.json axis_turn)\n", turn.c_str());
     if (const std::string stray = rotaryWarning(path, rotary, motions); !stray.empty())
       std::fprintf(stderr, "warning: %s (check.json rotary_angles)\n", stray.c_str());
+    if (const std::string rapids = dogLegNote(path, dog_leg, motions); !rapids.empty())
+      std::fprintf(stderr, "note: %s (check.json dog_leg_rapids)\n", rapids.c_str());
     if (surface && surface->beneath_lines > 0)
       std::fprintf(stderr,
                    "note: the tool passed beneath the part's top layer on %zu Z-buffer lines "

@@ -424,6 +424,9 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     const pathgen::RotaryStray rotary =
         pathgen::rotaryStray(result.path.postures, result.motions, job.clearance_mm);
     report["rotary_angles"] = rotaryJson(rotary, result.motions.tool_reach_mm);
+    const pathgen::DogLegRapids dog_leg =
+        pathgen::dogLegRapids(result.path, result.motions, job.clearance_mm);
+    report["dog_leg_rapids"] = dogLegJson(dog_leg);
     report["times_s"]["read"] = read_s;  // before `total`, which counts from the passes on
     // The files this report is of (written before it, renamed one by one): a folder holding
     // another run's path beside this report can be told (as check.json's path_digest).
@@ -478,6 +481,9 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (const std::string stray = rotaryWarning(result.path, rotary, result.motions);
         !stray.empty())
       std::fprintf(stderr, "warning: %s (report.json rotary_angles)\n", stray.c_str());
+    if (const std::string rapids = dogLegNote(result.path, dog_leg, result.motions);
+        !rapids.empty())
+      std::fprintf(stderr, "note: %s (report.json dog_leg_rapids)\n", rapids.c_str());
     if (!result.kept_nominal.empty()) {
       const auto& k = result.kept_nominal.front();
       std::fprintf(

@@ -11,7 +11,7 @@
 
 #include "fieldpath/common/file_digest.h"
 #include "fieldpath/pathgen/generate.h"
-#include "fieldpath/pathgen/rotary_angles.h"
+#include "fieldpath/pathgen/machine_moves.h"
 #include "scene.h"
 
 namespace fieldpath::app {
@@ -330,6 +330,36 @@ inline std::string rotaryWarning(const geometry::PathFile& path, const pathgen::
          " if posted as rotary angles (first: " + postureWhere(path, i, i + 1) +
          " to the next: " + numbers +
          "): post the tool vector (G43.5 / ORIVECT / LN), not interpolated A/B/C";
+}
+
+/// The rapids a controller running them axis by axis is proven to run clear
+/// (pathgen::dogLegRapids), for report.json and check.json.
+inline nlohmann::json dogLegJson(const pathgen::DogLegRapids& d) {
+  return {{"assumes",
+           "rapids (the motions into link postures, RAPID in APT) run axis by axis, in any order "
+           "and pace: the tip in the box its ends span, the axis between theirs; proven where "
+           "the motion's clearance less that box's reach (corner off the segment + tool reach x "
+           "turn) keeps the required clearance"},
+          {"rapids", d.rapids},
+          {"unproven", d.unproven},
+          {"lowest_motion", jsonIndex(d.lowest)},
+          {"lowest_bound_mm", d.unproven ? nlohmann::json(d.lowest_bound_mm) : nlohmann::json()},
+          {"lowest_box_mm", d.unproven ? nlohmann::json(d.lowest_box_mm) : nlohmann::json()}};
+}
+
+/// The note where some rapids are proven clear only as straight moves (empty otherwise): a
+/// controller whose rapids are not linear may leave them (a machine-side helper's dog-leg of the
+/// impeller's retract came 0.245 mm from a blade, under the 0.5 required).
+inline std::string dogLegNote(const geometry::PathFile& path, const pathgen::DogLegRapids& d,
+                              const pathgen::MotionResult& m) {
+  if (d.unproven == 0) return {};
+  char numbers[96];
+  std::snprintf(numbers, sizeof numbers, "%.3f mm clear as checked, up to %.2f mm off it",
+                m.clearance_mm[d.lowest], d.lowest_box_mm);
+  return std::to_string(d.unproven) + " of " + std::to_string(d.rapids) +
+         " rapid moves are proven clear only when run straight (lowest: " +
+         postureWhere(path, d.lowest, d.lowest + 1) + " to the next, " + numbers +
+         " run axis by axis): run rapids as linear moves, or post them as feed moves";
 }
 
 }  // namespace fieldpath::app

@@ -1,5 +1,8 @@
 #pragma once
-/// Where a post-processor that writes rotary angles leaves the checked motions. `check` and
+/// Where a machine's own interpolation leaves the checked motions: rotary angles interpolated
+/// (below) and rapids run axis by axis (dogLegRapids).
+///
+/// A post-processor that writes rotary angles leaves the checked motions. `check` and
 /// `generate` prove a motion with the tip on a line and the tool axis on the great circle between
 /// two postures (what a controller given the tool vector runs). A machine whose C axis turns
 /// about z and whose tilt is measured from z (A/C and B/C heads and tables), given angles, turns
@@ -11,6 +14,7 @@
 #include <span>
 #include <vector>
 
+#include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/posture.h"
 #include "fieldpath/pathgen/clearance.h"
 
@@ -41,5 +45,24 @@ struct RotaryStray {
 
 RotaryStray rotaryStray(std::span<const geometry::Posture> postures, const MotionResult& motions,
                         double required_mm);
+
+/// The rapids (the motions into link postures: APT's RAPID before each link GOTO) that a
+/// controller running rapids axis by axis (a dog-leg: each linear axis on its own, at its own
+/// rate) is proven to run clear. Such a tip stays in the box its two ends span, within `dev` of
+/// the straight segment (the farthest corner: distance to a segment is convex), and the axis
+/// between the two ends': every point of the tool within dev + reach × turn of the checked tool
+/// at some instant, so the motion's certified clearance less that bound holds for any order and
+/// pace of the axes. A bound, not a simulation: a motion not proven is not shown to collide.
+struct DogLegRapids {
+  static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
+  std::size_t rapids = 0;
+  std::size_t unproven = 0;      ///< rapids whose bound falls under the required clearance
+  std::size_t lowest = npos;     ///< the unproven rapid of the lowest bound
+  double lowest_bound_mm = 0.0;  ///< the bound there (may be negative)
+  double lowest_box_mm = 0.0;    ///< its dev + reach × turn
+};
+
+DogLegRapids dogLegRapids(const geometry::PathFile& path, const MotionResult& motions,
+                          double required_mm);
 
 }  // namespace fieldpath::pathgen

@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "fieldpath/pathgen/rotary_angles.h"
+#include "fieldpath/pathgen/machine_moves.h"
 
 namespace fieldpath::pathgen {
 namespace {
@@ -76,6 +76,47 @@ TEST(RotaryAngles, TheStrayOfAMotionNearTheVerticalAgainstItsClearance) {
   EXPECT_EQ(plane.beyond_clearance, 0u);
   EXPECT_EQ(plane.under_required, 0u);
   EXPECT_NEAR(plane.c_deg, 0.0, 1e-9);
+}
+
+// A retract along an axis 30 deg off the vertical, 20 mm: run axis by axis its tip may pass the
+// box's corner, 20 sin 30 cos 30 = 8.66 mm off the segment; a vertical one stays on it. Only the
+// motions into link postures are rapids.
+TEST(DogLegRapids, TheBoxOfARetractAgainstItsClearance) {
+  geometry::PathFile path;
+  const Vec3 axis = tilted(30, 0);
+  path.postures.resize(4);
+  path.postures[0].tip_mm = Vec3(0, 0, 0);                 // the pass's end
+  path.postures[1].tip_mm = 20.0 * axis;                   // the retract
+  path.postures[2].tip_mm = 20.0 * axis + Vec3(0, 0, 15);  // straight up
+  path.postures[3].tip_mm = Vec3(50, 0, 0);                // the next pass (a feed move into it)
+  for (Posture& p : path.postures) p.axis = axis;
+  path.postures[3].axis = Vec3::UnitZ();
+  path.blocks = {{geometry::PathBlock::Kind::Pass, 0, 1},
+                 {geometry::PathBlock::Kind::Link, 1, 3},
+                 {geometry::PathBlock::Kind::Pass, 3, 4}};
+  MotionResult motions;
+  motions.tool_reach_mm = 100.0;
+  const double corner = 20.0 * std::sin(M_PI / 6) * std::cos(M_PI / 6);
+  motions.clearance_mm = {corner + 0.6, 0.6, 0.6};  // the vertical climb: on its segment
+  DogLegRapids d = dogLegRapids(path, motions, 0.5);
+  EXPECT_EQ(d.rapids, 2u);  // 0 -> 1 and 1 -> 2; 2 -> 3 runs at the feed
+  EXPECT_EQ(d.unproven, 0u);
+  motions.clearance_mm = {corner + 0.4, 0.6, 0.0};  // under 0.5 once the corner is off it
+  d = dogLegRapids(path, motions, 0.5);
+  EXPECT_EQ(d.unproven, 1u);
+  EXPECT_EQ(d.lowest, 0u);
+  EXPECT_NEAR(d.lowest_box_mm, corner, 1e-9);
+  EXPECT_NEAR(d.lowest_bound_mm, 0.4, 1e-9);
+  // A turn of the axis adds the tool's reach times its angle; a motion already under the
+  // required clearance as checked is the check's to say.
+  path.postures[2].axis = tilted(25, 0);
+  motions.clearance_mm = {corner + 0.6, 0.6 + 100.0 * 5 * M_PI / 180 - 0.2, 0.6};
+  d = dogLegRapids(path, motions, 0.5);
+  EXPECT_EQ(d.unproven, 1u);
+  EXPECT_EQ(d.lowest, 1u);
+  EXPECT_NEAR(d.lowest_box_mm, 100.0 * 5 * M_PI / 180, 1e-9);
+  motions.clearance_mm = {corner + 0.6, 0.3, 0.6};
+  EXPECT_EQ(dogLegRapids(path, motions, 0.5).unproven, 0u);
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
-/// The stray of interpolated rotary angles from the checked motions (rotary_angles.h).
-#include "fieldpath/pathgen/rotary_angles.h"
+/// Where a machine's interpolation leaves the checked motions (machine_moves.h).
+#include "fieldpath/pathgen/machine_moves.h"
 
 #include <algorithm>
 #include <cmath>
@@ -86,6 +86,49 @@ RotaryStray rotaryStray(std::span<const geometry::Posture> postures, const Motio
     const Vec3 &a = postures[said].axis, &b = postures[said + 1].axis;
     out.c_deg = cTurn(anglesOf(a.normalized()), anglesOf(b.normalized())) * 180.0 / M_PI;
     out.turn_deg = geometry::axisAngle(a, b) * 180.0 / M_PI;
+  }
+  return out;
+}
+
+namespace {
+
+/// The farthest point of the box spanned by a and b from the segment ab (mm): one of its corners.
+double boxFromSegment(const Vec3& a, const Vec3& b) {
+  const Vec3 d = b - a;
+  const double length_sq = d.squaredNorm();
+  double farthest = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Vec3 c((corner & 1) ? b.x() : a.x(), (corner & 2) ? b.y() : a.y(),
+                 (corner & 4) ? b.z() : a.z());
+    const double t = length_sq > 0.0 ? std::clamp((c - a).dot(d) / length_sq, 0.0, 1.0) : 0.0;
+    farthest = std::max(farthest, (c - (a + t * d)).norm());
+  }
+  return farthest;
+}
+
+}  // namespace
+
+DogLegRapids dogLegRapids(const geometry::PathFile& path, const MotionResult& motions,
+                          double required_mm) {
+  DogLegRapids out;
+  std::vector<char> link(path.postures.size(), 0);
+  for (const geometry::PathBlock& b : path.blocks)
+    if (b.kind == geometry::PathBlock::Kind::Link)
+      std::fill(link.begin() + std::ptrdiff_t(b.begin), link.begin() + std::ptrdiff_t(b.end), 1);
+  for (std::size_t i = 0; i + 1 < path.postures.size(); ++i) {
+    if (!link[i + 1] || i >= motions.clearance_mm.size()) continue;
+    ++out.rapids;
+    const geometry::Posture &a = path.postures[i], &b = path.postures[i + 1];
+    const double box_mm = boxFromSegment(a.tip_mm, b.tip_mm) +
+                          motions.tool_reach_mm * geometry::axisAngle(a.axis, b.axis);
+    const double bound = motions.clearance_mm[i] - box_mm;
+    // A motion under the required clearance as checked is said by the check itself.
+    if (motions.clearance_mm[i] < required_mm || bound >= required_mm) continue;
+    if (out.unproven++ == 0 || bound < out.lowest_bound_mm) {
+      out.lowest = i;
+      out.lowest_bound_mm = bound;
+      out.lowest_box_mm = box_mm;
+    }
   }
   return out;
 }
