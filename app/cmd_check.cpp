@@ -484,7 +484,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       std::fprintf(stderr, "warning: %s (check.json axis_turn)\n", turn.c_str());
     if (const std::string stray = rotaryWarning(path, rotary, motions); !stray.empty())
       std::fprintf(stderr, "warning: %s (check.json rotary_angles)\n", stray.c_str());
-    if (const std::string rapids = dogLegNote(path, dog_leg, motions); !rapids.empty())
+    if (const std::string rapids = dogLegNote(path, dog_leg, motions, scene.part.has_value());
+        !rapids.empty())
       std::fprintf(stderr, "note: %s (check.json dog_leg_rapids)\n", rapids.c_str());
     if (surface && surface->beneath_lines > 0)
       std::fprintf(stderr,

@@ -481,7 +481,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (const std::string stray = rotaryWarning(result.path, rotary, result.motions);
         !stray.empty())
       std::fprintf(stderr, "warning: %s (report.json rotary_angles)\n", stray.c_str());
-    if (const std::string rapids = dogLegNote(result.path, dog_leg, result.motions);
+    if (const std::string rapids =
+            dogLegNote(result.path, dog_leg, result.motions, scene.part.has_value());
         !rapids.empty())
       std::fprintf(stderr, "note: %s (report.json dog_leg_rapids)\n", rapids.c_str());
     if (!result.kept_nominal.empty()) {

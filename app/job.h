@@ -300,7 +300,8 @@ inline std::string cutterGougeReason(const std::optional<pathgen::CutterPartResu
 inline nlohmann::json rotaryJson(const pathgen::RotaryStray& s, double reach_mm) {
   return {{"assumes",
            "a post that writes (tilt >= 0 from z, C about z) angles, each interpolated linearly "
-           "(A/C, B/C machines), against the tool vector on the great circle at an even pace "
+           "(A/C, B/C machines), against the tool vector on the great circle at an even pace; an "
+           "upper bound of how far the tool may move from the checked one "
            "(Fanuc G43.5, Siemens ORIVECT, Heidenhain LN), the same instant, at the tool's reach"},
           {"reach_mm", reach_mm},
           {"max_stray_mm", s.max_offset_mm},
@@ -326,7 +327,7 @@ inline std::string rotaryWarning(const geometry::PathFile& path, const pathgen::
                 s.c_deg, s.turn_deg, s.offset_mm[i], m.clearance_mm[i]);
   const bool many = s.beyond_clearance > 1;
   return std::to_string(s.beyond_clearance) + (many ? " motions" : " motion") +
-         " would stray past the clearance " + (many ? "they have" : "it has") +
+         " may stray past the clearance " + (many ? "they have" : "it has") +
          " if posted as rotary angles (first: " + postureWhere(path, i, i + 1) +
          " to the next: " + numbers +
          "): post the tool vector (G43.5 / ORIVECT / LN), not interpolated A/B/C";
@@ -337,9 +338,11 @@ inline std::string rotaryWarning(const geometry::PathFile& path, const pathgen::
 inline nlohmann::json dogLegJson(const pathgen::DogLegRapids& d) {
   return {{"assumes",
            "rapids (the motions into link postures, RAPID in APT) run axis by axis, in any order "
-           "and pace: the tip in the box its ends span, the axis between theirs; proven where "
-           "the motion's clearance less that box's reach (corner off the segment + tool reach x "
-           "turn) keeps the required clearance"},
+           "and pace: the tip in the box its ends span, the axis between theirs; proven clear of "
+           "the obstacles (not of the part) where the motion's clearance less that box's reach "
+           "(corner off the segment + tool reach x turn) keeps the required clearance; a bound: "
+           "an unproven rapid is not shown to collide; rapids under the required clearance as "
+           "checked are the check's findings, not counted here"},
           {"rapids", d.rapids},
           {"unproven", d.unproven},
           {"lowest_motion", jsonIndex(d.lowest)},
@@ -347,19 +350,33 @@ inline nlohmann::json dogLegJson(const pathgen::DogLegRapids& d) {
           {"lowest_box_mm", d.unproven ? nlohmann::json(d.lowest_box_mm) : nlohmann::json()}};
 }
 
-/// The note where some rapids are proven clear only as straight moves (empty otherwise): a
-/// controller whose rapids are not linear may leave them (a machine-side helper's dog-leg of the
-/// impeller's retract came 0.245 mm from a blade, under the 0.5 required).
+/// The note where some rapids are proven clear of the obstacles only as straight moves, or where
+/// the scene has a part, which the bound leaves out (empty otherwise): a controller whose rapids
+/// are not linear may leave them (a machine-side helper's dog-leg of the impeller's retract came
+/// 0.245 mm from a blade, under the 0.5 required; a verifier's X-first retract out of a pass on a
+/// sloped plate cut 1.17 mm into the part).
 inline std::string dogLegNote(const geometry::PathFile& path, const pathgen::DogLegRapids& d,
-                              const pathgen::MotionResult& m) {
-  if (d.unproven == 0) return {};
-  char numbers[96];
-  std::snprintf(numbers, sizeof numbers, "%.3f mm clear as checked, up to %.2f mm off it",
-                m.clearance_mm[d.lowest], d.lowest_box_mm);
-  return std::to_string(d.unproven) + " of " + std::to_string(d.rapids) +
-         " rapid moves are proven clear only when run straight (lowest: " +
-         postureWhere(path, d.lowest, d.lowest + 1) + " to the next, " + numbers +
-         " run axis by axis): run rapids as linear moves, or post them as feed moves";
+                              const pathgen::MotionResult& m, bool has_part) {
+  if (d.unproven == 0 && !(has_part && d.rapids > 0)) return {};
+  std::string note;
+  if (d.unproven > 0) {
+    char numbers[96];
+    std::snprintf(numbers, sizeof numbers, "%.3f mm clear as checked, up to %.2f mm off it",
+                  m.clearance_mm[d.lowest], d.lowest_box_mm);
+    note = std::to_string(d.unproven) + " of " + std::to_string(d.rapids) +
+           " rapid moves are proven clear of the obstacles only when run straight (lowest: " +
+           postureWhere(path, d.lowest, d.lowest + 1) + " to the next, " + numbers +
+           " run axis by axis)";
+  } else {
+    note = "the " + std::to_string(d.rapids) +
+           " rapid moves are proven clear of the obstacles run axis by axis";
+  }
+  if (has_part)
+    note += (d.unproven > 0 ? "; " : ", ") +
+            std::string(
+                "the part is not in that proof: a retract out of a pass run axis by axis "
+                "can cut into the finished surface");
+  return note + ": run rapids as linear moves, or post them as feed moves";
 }
 
 }  // namespace fieldpath::app
