@@ -62,7 +62,8 @@ RotaryStray rotaryStray(std::span<const geometry::Posture> postures, const Motio
   for (std::size_t i = 0; i < n; ++i) {
     const geometry::Posture &a = postures[i], &b = postures[i + 1];
     double gap = 0.0;  // the largest chord between the two axes at one instant
-    for (int k = 1; k < kStraySamples; ++k) {
+    // An axis held (a 3-axis pass, a straight retract) strays nothing: no trigonometry for it.
+    for (int k = 1; k < kStraySamples && a.axis != b.axis; ++k) {
       const double t = double(k) / kStraySamples;
       gap =
           std::max(gap, (axisByAngles(a.axis, b.axis, t) - greatCircle(a.axis, b.axis, t)).norm());

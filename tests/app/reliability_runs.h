@@ -16,6 +16,9 @@
 namespace fieldpath::test::reliability {
 
 namespace fs = std::filesystem;
+// With the helpers, for the tests that take them with `using namespace`.
+using test::slurp;
+using test::TempDir;
 
 inline const fs::path kImpeller = fs::path(FIELDPATH_SOURCE_DIR) / "examples/impeller/scene.yaml";
 

@@ -1,39 +1,25 @@
 /// Reliability of the outputs (issue 14): the same inputs give the same files, bit for bit,
 /// whatever the number of threads (generate, simulate, check, tool, field build and probe, view,
 /// study, convert; the run's own timings aside).
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/file.h>
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "fieldpath/common/atomic_file.h"
-#include "fieldpath/common/file_digest.h"
 #include "files.h"
 #include "reliability_runs.h"
-#include "run_fieldpath.h"
 
 namespace fieldpath {
 namespace {
 
 namespace fs = std::filesystem;
-using test::slurp;
-using test::TempDir;
 using namespace test::reliability;
 
 // ---- determinism ------------------------------------------------------------------------------

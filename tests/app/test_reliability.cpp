@@ -33,8 +33,6 @@ namespace fieldpath {
 namespace {
 
 namespace fs = std::filesystem;
-using test::slurp;
-using test::TempDir;
 using namespace test::reliability;
 
 // ---- the mechanism ---------------------------------------------------------------------------
