@@ -324,7 +324,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                        "cuts (first: " +
                        postureWhere(path, first_rapid_onto_pass) + "): no retract before the pass");
     std::vector<std::string> not_ok = unsafe;
-    if (const std::string gouge = cutterGougeReason(cutter_part); !gouge.empty())
+    if (const std::string gouge = cutterGougeReason(path, cutter_part); !gouge.empty())
       not_ok.push_back(gouge);
     if (clearance.colliding == 0 && clearance.min_clearance_mm < scene.clearance_mm)
       not_ok.push_back("postures come within " + std::to_string(clearance.min_clearance_mm) +
@@ -350,8 +350,12 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"path_digest", path_digest},
         {"scene_digest", sceneDigest(scene)},
         {"postures", path.postures.size()},
-        // As generate reads them: pass blocks split at gaps (a file without markers), links out.
-        {"passes", pathgen::passRanges(path, scene.path.pass_gap_mm, scene.tool.radius_mm).size()},
+        // The file's pass blocks, as clearance.csv's `pass`, the reasons and view number them (a
+        // file without markers is one; a helper read 50 here and 1 in every other output), and
+        // beside them the passes generate would take from it as a nominal path.
+        {"passes", path.count(geometry::PathBlock::Kind::Pass)},
+        {"passes_split_at_gaps",
+         pathgen::passRanges(path, scene.path.pass_gap_mm, scene.tool.radius_mm).size()},
         {"links", path.count(geometry::PathBlock::Kind::Link)},
         {"clearance", clearanceJson(clearance, scene.clearance_mm, pathgen::kClearanceMeshTolMm)},
         {"motions", motionsJson(motions, scene.clearance_mm, motion_request.resolution_mm)},

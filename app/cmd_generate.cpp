@@ -100,8 +100,10 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
   for (const int p : r.settled_starts) settled.push_back(p + 1);
   json kept_nominal = json::array();
   for (const auto& k : r.kept_nominal)
-    kept_nominal.push_back(
-        {{"pass", k.pass + 1}, {"at", k.label}, {"steered_colliding", k.steered_colliding}});
+    kept_nominal.push_back({{"pass", k.pass + 1},
+                            {"at", k.label},
+                            {"steered_colliding", k.steered_colliding},
+                            {"steered_under_required", k.steered_under}});
   json balls_under = json::array();
   for (const auto& b : r.balls_under_clearance)
     balls_under.push_back({{"pass", b.pass + 1},
@@ -355,7 +357,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
         (wanted == field::FieldBackend::Auto || wanted == field::FieldBackend::Cuda))
       cuda_start = std::async(std::launch::async, field::cudaFieldBackendAvailable);
     // The job's errors name a scene key or a pass; the scene file says where to look.
-    const pathgen::GenerateResult result = [&] {
+    pathgen::GenerateResult result = [&] {
       try {
         return pathgen::generatePath(job);
       } catch (const InputError& e) {
@@ -370,13 +372,9 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     const std::filesystem::path out = options->out;
     const std::string what = job.nominal ? "nominal path" : "field path";
     // A path that collides is still written (to look at, and `check`), marked in both files.
-    const std::vector<std::string> unsafe =
-        unsafeReasons(result.path, result.clearance, result.motions, result.link_part,
-                      result.holder_part, kLinkHint);
-    std::string unsafe_text;
-    for (const std::string& reason : unsafe)
-      unsafe_text += (unsafe_text.empty() ? "" : "; ") + reason;
-    if (!unsafe.empty()) unsafe_text = "UNSAFE TO RUN: " + unsafe_text + " (report.json)";
+    const bool unsafe_any = !unsafeReasons(result.path, result.clearance, result.motions,
+                                           result.link_part, result.holder_part)
+                                 .empty();
     // Clear of the obstacles but closer than the scene's `clearance`: said where the machine
     // reads it too (report.json's "safe" stays true: nothing is touched), beside the UNSAFE mark
     // when the path is unsafe for another reason (the holder into the part: fixing that alone
@@ -394,14 +392,27 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                     job.clearance_mm);
       under_text = text;
     }
-    const std::string mark =
-        unsafe_text + (!unsafe_text.empty() && !under_text.empty() ? "\n" : "") + under_text;
-    geometry::writeClFile(out / "path.cl", result.path,
-                          (mark.empty() ? "" : mark + "\n") + "fieldpath generate " +
-                              scene.file.string() + " (" + what +
+    const std::string about = "fieldpath generate " + scene.file.string() + " (" + what +
                               "): x y z i j k, tool tip and axis, mm\n"
                               "`# pass K` blocks are cut at the feed, `# link` blocks are rapid "
-                              "moves between them; `# limit`: an angle limit held there");
+                              "moves between them; `# limit`: an angle limit held there";
+    // Every message names a posture's line in path.cl, as check's do of the file it reads (a
+    // user of generate's "posture 5123" counted through the file): the lines the writer gives
+    // them, the marks one line each whatever their text.
+    result.path.file = "path.cl";
+    result.path.rows = false;
+    result.path.lines = geometry::clFileLines(
+        result.path, unsafe_any + under_required + geometry::clCommentLines(about));
+    const std::vector<std::string> unsafe =
+        unsafeReasons(result.path, result.clearance, result.motions, result.link_part,
+                      result.holder_part, kLinkHint);
+    std::string unsafe_text;
+    for (const std::string& reason : unsafe)
+      unsafe_text += (unsafe_text.empty() ? "" : "; ") + reason;
+    if (!unsafe.empty()) unsafe_text = "UNSAFE TO RUN: " + unsafe_text + " (report.json)";
+    const std::string mark =
+        unsafe_text + (!unsafe_text.empty() && !under_text.empty() ? "\n" : "") + under_text;
+    geometry::writeClFile(out / "path.cl", result.path, (mark.empty() ? "" : mark + "\n") + about);
     geometry::AptHeader header;
     for (const std::string& reason : unsafe) header.remarks.push_back("UNSAFE TO RUN: " + reason);
     if (!under_text.empty()) header.remarks.push_back(under_text);
@@ -447,7 +458,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
         job.clearance_mm, c.colliding, m.colliding, m.motions, m.min_clearance_mm,
         read_s + result.times.total_s, read_s, out.string().c_str());
     if (!unsafe.empty()) std::fprintf(stderr, "warning: %s\n", unsafe_text.c_str());
-    if (const std::string gouge = cutterGougeReason(result.cutter_part); !gouge.empty())
+    if (const std::string gouge = cutterGougeReason(result.path, result.cutter_part);
+        !gouge.empty())
       std::fprintf(stderr,
                    "warning: %s: a gouge, or the part's chordal error where it is concave "
                    "(report.json cutter_part; `check --gouge-tol` sets the tolerance)\n",
@@ -485,17 +497,28 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
             dogLegNote(result.path, dog_leg, result.motions, scene.part.has_value());
         !rapids.empty())
       std::fprintf(stderr, "note: %s (report.json dog_leg_rapids)\n", rapids.c_str());
-    if (!result.kept_nominal.empty()) {
-      const auto& k = result.kept_nominal.front();
-      std::fprintf(
-          stderr,
-          "warning: %zu pass%s collided steered (first: %s, %zu postures colliding there or "
-          "on the move to the next: "
-          "the field of the obstacles turned the tool into them or into the part, which "
-          "never repels) and %s written with the nominal axes, which clear the obstacles "
-          "and the part (report.json kept_nominal)\n",
-          result.kept_nominal.size(), result.kept_nominal.size() == 1 ? "" : "es", k.label.c_str(),
-          k.steered_colliding, result.kept_nominal.size() == 1 ? "is" : "are");
+    // Passes kept nominal: those that collided steered (a warning), and those that only came
+    // under the required clearance steered (a note: the path written keeps it).
+    for (const bool collided : {true, false}) {
+      std::size_t n = 0;
+      const pathgen::GenerateResult::KeptNominal* first = nullptr;
+      for (const auto& k : result.kept_nominal)
+        if ((k.steered_colliding > 0) == collided) n += 1, first = first ? first : &k;
+      if (n == 0) continue;
+      std::fprintf(stderr,
+                   collided ? "warning: %zu pass%s collided steered (first: %s, %zu postures "
+                              "colliding there or on the move to the next: the field of the "
+                              "obstacles turned the tool into them or into the part, which never "
+                              "repels) and %s written with the nominal axes, which clear the "
+                              "obstacles and the part (report.json kept_nominal)\n"
+                            : "note: %zu pass%s came under the required clearance steered "
+                              "(first: %s, %zu postures under it there or on the move to the "
+                              "next: the tilt away from one obstacle brought the tool nearer "
+                              "another) and %s written with the nominal axes, which keep it "
+                              "(report.json kept_nominal)\n",
+                   n, n == 1 ? "" : "es", first->label.c_str(),
+                   collided ? first->steered_colliding : first->steered_under,
+                   n == 1 ? "is" : "are");
     }
     if (!result.balls_under_clearance.empty()) {
       const auto& b = result.balls_under_clearance.front();

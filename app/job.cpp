@@ -56,6 +56,13 @@ pathgen::GenerateRequest sceneJob(const Scene& scene) {
                  "first: %s) made into links: the passes end and start at the legs\n",
                  dropped.between_legs, dropped.between_legs == 1 ? "" : "s",
                  scene.nominal->where(dropped.first_between).c_str());
+  if (dropped.axial > 0)
+    std::fprintf(stderr,
+                 "note: %zu posture%s of approaches and retracts at feed at the ends of passes "
+                 "(moves along the tool axis, or a lone posture a gap parts from the cut; first: "
+                 "%s) made into links: the passes start and end where the cut does\n",
+                 dropped.axial, dropped.axial == 1 ? "" : "s",
+                 scene.nominal->where(dropped.first_axial).c_str());
   if (!impeller) {  // link blocks are dropped (links are made anew): said, with their size, as
     // a `# link` with no `# pass` or blank line after its moves takes the cutting that follows
     std::size_t blocks = 0, postures = 0, first = 0;

@@ -225,6 +225,18 @@ inline bool inLink(const geometry::PathFile& path, std::size_t i) {
   return false;
 }
 
+/// "posture i to the next (BLOCK, FILE:LINE)": motion i, from posture i to i + 1, in the block of
+/// the end that makes it a link's (the retract and the plunge are), else i's own: a move from one
+/// pass straight into the next is named with the pass it leaves, at the line it leaves from (a
+/// helper read "pass 5" beside the last line of pass 4).
+inline std::string motionWhere(const geometry::PathFile& path, std::size_t i) {
+  const bool into_link = !inLink(path, i) && i + 1 < path.postures.size() && inLink(path, i + 1);
+  const std::string where = postureWhere(path, i, into_link ? i + 1 : i);
+  const std::size_t open = where.find(" (");
+  return "posture " + std::to_string(i) + " to the next" +
+         (open == std::string::npos ? "" : where.substr(open));
+}
+
 /// Why a path is not safe to run as it stands (empty: it is): postures or motions that touch an
 /// obstacle, links that touch the part, the holder touching the part. Postures numbered from 0,
 /// as in the JSON and clearance.csv, with their block and line (postureWhere); motion i from
@@ -242,13 +254,8 @@ inline std::vector<std::string> unsafeReasons(const geometry::PathFile& path,
     return postureWhere(path, i) + (inLink(path, i) && !link_hint.empty() ? ": " + link_hint : "");
   };
   auto motion = [&](std::size_t i) {
-    // "posture i to the next (BLOCK, i's line)": the block of the end that makes it a link's.
     const bool link = inLink(path, i) || inLink(path, i + 1);
-    const std::string where = postureWhere(path, i, !inLink(path, i) && link ? i + 1 : i);
-    const std::size_t open = where.find(" (");
-    return "posture " + std::to_string(i) + " to the next" +
-           (open == std::string::npos ? "" : where.substr(open)) +
-           (link && !link_hint.empty() ? ": " + link_hint : "");
+    return motionWhere(path, i) + (link && !link_hint.empty() ? ": " + link_hint : "");
   };
   if (c.colliding)
     out.push_back(std::to_string(c.colliding) +
@@ -276,19 +283,18 @@ inline std::vector<std::string> unsafeReasons(const geometry::PathFile& path,
 /// What the cutter does to the part, beyond the gouge tolerance (empty: nothing): not a crash and
 /// not in `unsafe` (a part meshed with a 20 um chordal error reads a path on its true surface as
 /// entering it by up to that, where it is concave: a reviewer's case), but `check`'s not-ok and
-/// `generate`'s warning. Postures numbered from 0; motion i from posture i to i + 1.
-inline std::string cutterGougeReason(const std::optional<pathgen::CutterPartResult>& cut) {
+/// `generate`'s warning. Postures numbered from 0, with their block and line (postureWhere);
+/// motion i from posture i to i + 1.
+inline std::string cutterGougeReason(const geometry::PathFile& path,
+                                     const std::optional<pathgen::CutterPartResult>& cut) {
   if (!cut || !cut->gouges()) return {};
   char depth[32], tolerance[32];
   std::snprintf(depth, sizeof depth, "%.1f", 1e3 * cut->max_depth_mm);
   std::snprintf(tolerance, sizeof tolerance, "%g", 1e3 * cut->tolerance_mm);
-  const auto index = [](std::size_t i) {
-    return i == pathgen::CutterPartResult::npos ? std::string("-") : std::to_string(i);
-  };
-  const std::string first =
-      cut->first_gouging_posture <= cut->first_gouging_motion
-          ? "posture " + index(cut->first_gouging_posture)
-          : "the motion from posture " + index(cut->first_gouging_motion) + " to the next";
+  // (the first of the two is always one: gouges() holds)
+  const std::string first = cut->first_gouging_posture <= cut->first_gouging_motion
+                                ? postureWhere(path, cut->first_gouging_posture)
+                                : "the motion from " + motionWhere(path, cut->first_gouging_motion);
   return "the cutter enters the part deeper than the gouge tolerance (" + std::string(tolerance) +
          " um) at " + std::to_string(cut->gouging_postures) + " postures and " +
          std::to_string(cut->gouging_motions) + " motions (max " + depth + " um; first: " + first +
@@ -328,8 +334,7 @@ inline std::string rotaryWarning(const geometry::PathFile& path, const pathgen::
   const bool many = s.beyond_clearance > 1;
   return std::to_string(s.beyond_clearance) + (many ? " motions" : " motion") +
          " may stray past the clearance " + (many ? "they have" : "it has") +
-         " if posted as rotary angles (first: " + postureWhere(path, i, i + 1) +
-         " to the next: " + numbers +
+         " if posted as rotary angles (first: " + motionWhere(path, i) + ": " + numbers +
          "): post the tool vector (G43.5 / ORIVECT / LN), not interpolated A/B/C";
 }
 
@@ -365,8 +370,7 @@ inline std::string dogLegNote(const geometry::PathFile& path, const pathgen::Dog
                   m.clearance_mm[d.lowest], d.lowest_box_mm);
     note = std::to_string(d.unproven) + " of " + std::to_string(d.rapids) +
            " rapid moves are proven clear of the obstacles only when run straight (lowest: " +
-           postureWhere(path, d.lowest, d.lowest + 1) + " to the next, " + numbers +
-           " run axis by axis)";
+           motionWhere(path, d.lowest) + ", " + numbers + " run axis by axis)";
   } else {
     note = "the " + std::to_string(d.rapids) +
            " rapid moves are proven clear of the obstacles run axis by axis";

@@ -273,8 +273,8 @@ void readField(const Reader& r, const YAML::Node& node, field::FieldParams& f) {
         "in [0, 1e30] (>= 0: the field pushes the tool away from the obstacles; past 1e30 the "
         "voxels' single-precision forces overflow)");
   if (node["sample_step"]) f.sample_step_mm = r.positive(node["sample_step"], "field.sample_step");
-  if (node["weights"])
-    f.weights = r.word(node["weights"], "field.weights", {"area", "unit"}) == "area"
+  if (node["weights"])  // `1`: DESIGN's "w_j = 1, the paper's choice", as a third party writes it
+    f.weights = r.word(node["weights"], "field.weights", {"area", "unit", "1"}) == "area"
                     ? field::Weights::Area
                     : field::Weights::Unit;
   if (node["voxel_size"])

@@ -404,7 +404,7 @@ ViewData gatherView(const ViewRequest& request) {
       p.motion_mm.resize(n, kNaN);
       p.clearance_source =
           "computed here, as `fieldpath check` computes it (FCL, postures and motions)";
-      check = CheckJson{n, c.colliding, m.colliding, p.what};
+      check = CheckJson{n, c.colliding, m.colliding, c.min_index, p.what};
       // The part's contacts (the links', the holder's), as `check` finds them: marked on the
       // page apart from the obstacles' and said above it.
       if (scene.part) {
@@ -424,7 +424,7 @@ ViewData gatherView(const ViewRequest& request) {
            unsafeReasons(p.file, {}, {}, check->link_part, check->holder_part))
         d.warnings.push_back("UNSAFE TO RUN: " + reason);
     if (check)
-      if (const std::string gouge = cutterGougeReason(check->cutter_part); !gouge.empty())
+      if (const std::string gouge = cutterGougeReason(p.file, check->cutter_part); !gouge.empty())
         d.warnings.push_back("GOUGE: " + gouge);
     for (std::size_t i = 0; i < n; ++i) {
       p.colliding_postures += p.clearance_mm[i] <= 0.0;
@@ -446,6 +446,11 @@ ViewData gatherView(const ViewRequest& request) {
         ++postures_under;
         if (closest == ViewPath::npos || p.clearance_mm[i] < p.clearance_mm[closest]) closest = i;
       }
+    // The posture check named (its exact distances; the file's rounded ones tie, and the page
+    // named another posture of the same clearance than check and generate: a helper's finding).
+    if (check && check->min_posture < n && closest != ViewPath::npos &&
+        p.clearance_mm[check->min_posture] <= p.clearance_mm[closest])
+      closest = check->min_posture;
     p.postures_under_required = postures_under;
     if (p.colliding_postures == 0 && p.colliding_motions == 0 &&
         (postures_under > 0 || p.motions_under_required > 0)) {

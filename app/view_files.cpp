@@ -128,6 +128,8 @@ CheckJson readCheckJson(const fs::path& dir) {
       count(clearance.value("colliding_postures", json()), file, "clearance.colliding_postures");
   c.colliding_motions =
       count(motions.value("colliding_motions", json()), file, "motions.colliding_motions");
+  if (clearance.value("min_posture", json()).is_number_unsigned())
+    c.min_posture = clearance["min_posture"].get<std::size_t>();
   if (j.contains("path") && j["path"].is_string()) c.path = j["path"].get<std::string>();
   if (j.contains("path_digest") && j["path_digest"].is_string())
     c.path_digest = j["path_digest"].get<std::string>();

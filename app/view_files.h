@@ -24,6 +24,9 @@ nlohmann::json readJson(const std::filesystem::path& file);
 /// The counts of check.json (the page must agree with them) and the path it checked.
 struct CheckJson {
   std::size_t postures = 0, colliding_postures = 0, colliding_motions = 0;
+  /// check.json `clearance.min_posture`: the closest posture as check named it from its exact
+  /// distances (clearance.csv's rounded ones tie; npos: not given).
+  std::size_t min_posture = static_cast<std::size_t>(-1);
   std::string path;
   std::string path_digest;  ///< common::fileDigest of the path checked (empty in older check.json)
   std::string scene;        ///< the scene file checked against, as `check` was given it

@@ -121,6 +121,13 @@ std::string at(double s_mm) {
 /// give the direct field's stiffness, not their own.
 constexpr double kStiffnessDeltaRad = 5e-3;
 
+/// Arc length between two updates of the damping that follows the field (`critical`), mm: a grid
+/// of its own from the pass's start, not the output stations, so that the angles do not depend on
+/// `path.step` (a helper's ribs: 0.79° of lead between steps 0.5 and 0.25 mm, halving with the
+/// step, as the damping was held from station to station). The impeller's default step: its
+/// stations fall on the grid.
+constexpr double kDampingSpacingMm = 0.5;
+
 /// J θ'' + c θ' + k (θ - θ0(s)) = τ(θ), first-order form, time in s, s = v t.
 class SteeringSystem final : public detail::OdeSystem {
  public:
@@ -354,25 +361,42 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
   const double max_change_rad_per_mm = request.max_angle_change_deg_per_mm / kDegPerRad;
   const long report_every = std::max(1L, intervals / 100);
 
+  // The damping's grid (kDampingSpacingMm): point `update` is the next it takes; a point within
+  // 1e-9 mm of a station is taken there.
+  long update = 0;
+  const auto gridAt = [](long j) { return static_cast<double>(j) * kDampingSpacingMm; };
+  const auto advanceTo = [&](double to_mm) {
+    double t_reached_s = 0.0;
+    const int flag = integrator->advance(to_mm / v, y.data(), t_reached_s);
+    if (flag >= 0) return true;
+    result.status = Status::SolverFailed;
+    result.message = at(system.arcLength(t_reached_s)) +
+                     (request.params.integrator == Integrator::Erk ? "ARKODE ERK" : "CVODE BDF") +
+                     " failed (" + integrator->flagName(flag) + "): " + integrator->lastError();
+    return false;
+  };
+  const double end_mm = stations.back();
   for (long k = 0; k <= intervals; ++k) {
     const double s_mm = stations[static_cast<std::size_t>(k)];
     if (k > 0) {
-      double t_reached_s = 0.0;
-      const int flag = integrator->advance(s_mm / v, y.data(), t_reached_s);
-      if (flag < 0) {
-        result.status = Status::SolverFailed;
-        result.message =
-            at(system.arcLength(t_reached_s)) +
-            (request.params.integrator == Integrator::Erk ? "ARKODE ERK" : "CVODE BDF") +
-            " failed (" + integrator->flagName(flag) + "): " + integrator->lastError();
-        break;
+      // The damping follows the field from each grid point on: the solver restarts there with
+      // it (its steps stand anywhere up to one interval past; taking it from there made the
+      // angles depend on the tolerances, 0.05° on an oblique wall's approach against DESIGN's
+      // 0.01°).
+      // (the points up to the last station were taken: gridAt(update) lies past it)
+      for (; gridAt(update) < s_mm - 1e-9; ++update) {
+        if (!advanceTo(gridAt(update))) break;
+        if (system.updateDamping(gridAt(update), y))
+          integrator->restart(gridAt(update) / v, y.data());
       }
+      if (result.status == Status::SolverFailed || !advanceTo(s_mm)) break;
     }
     LimitCheck check = checkAngles(request.params, request.params.on_limit, y);
-    // The damping follows the field from this station on: the solver restarts here with it (its
-    // steps stand anywhere up to one interval past; taking it from there made the angles depend
-    // on the tolerances, 0.05° on an oblique wall's approach against DESIGN's 0.01°).
-    const bool damping_follows = k < intervals && system.updateDamping(s_mm, y);
+    bool damping_follows = false;
+    if (std::abs(gridAt(update) - s_mm) <= 1e-9) {
+      damping_follows = s_mm < end_mm && system.updateDamping(s_mm, y);
+      ++update;
+    }
     if (check.clamped || damping_follows) integrator->restart(s_mm / v, y.data());
     PostureSample sample = system.sample(s_mm, y);
     sample.limited = check.clamped;

@@ -369,6 +369,26 @@ void writeClFile(const std::filesystem::path& file, const PathFile& path,
   common::writeTextAtomically(file, text);
 }
 
+std::size_t clCommentLines(std::string_view comment) {
+  std::size_t n = 0;
+  std::istringstream lines{std::string(comment)};
+  for (std::string line; std::getline(lines, line);) ++n;
+  return n;
+}
+
+std::vector<std::size_t> clFileLines(const PathFile& path, std::size_t comment_lines) {
+  // As writeClFile: the comment, the count and column lines, a marker before each block where
+  // the path is not one pass block, one line a posture.
+  const bool marked = !(path.blocks.size() == 1 && path.blocks[0].kind == PathBlock::Kind::Pass);
+  std::vector<std::size_t> lines(path.postures.size());
+  std::size_t line = comment_lines + 2;
+  for (const PathBlock& block : path.blocks) {
+    line += marked;
+    for (std::size_t i = block.begin; i < block.end; ++i) lines[i] = ++line;
+  }
+  return lines;
+}
+
 void writeClFile(const std::filesystem::path& file, std::span<const Posture> postures,
                  std::string_view comment) {
   writeClFile(file, singlePass({postures.begin(), postures.end()}), comment);

@@ -12,37 +12,50 @@
 namespace fieldpath::pathgen {
 namespace {
 
-/// Postures and in-pass motions of each pass that collide in the checked path (0: none).
-std::vector<std::size_t> collidingByPass(const GenerateResult& result,
-                                         const std::optional<PartContacts::Marks>& part_marks) {
-  std::vector<std::size_t> colliding(result.passes.size(), 0);
+/// Per pass, the postures of the checked path that collide there or on the move to the pass's
+/// next posture, and those that come under the required clearance there without colliding.
+struct PassFaults {
+  std::vector<std::size_t> colliding, under;
+};
+PassFaults faultsByPass(const GenerateResult& result, double required_mm,
+                        const std::optional<PartContacts::Marks>& part_marks) {
+  PassFaults out{std::vector<std::size_t>(result.passes.size(), 0),
+                 std::vector<std::size_t>(result.passes.size(), 0)};
   const auto& postures = result.postures;
+  const auto& at = result.clearance.clearance_mm;
+  const auto& moving = result.motions.clearance_mm;
   for (std::size_t k = 0; k < postures.size(); ++k) {
     const std::size_t i = postures[k].output;
-    bool hit = i < result.clearance.clearance_mm.size() && result.clearance.clearance_mm[i] <= 0.0;
+    bool hit = i < at.size() && at[i] <= 0.0;
+    bool under = i < at.size() && at[i] < required_mm;
     hit = hit || (part_marks && i < part_marks->posture.size() && part_marks->posture[i]);
     // The motion to the pass's next posture (a link's motions are the links').
     if (k + 1 < postures.size() && postures[k + 1].pass == postures[k].pass) {
-      hit =
-          hit || (i < result.motions.clearance_mm.size() && result.motions.clearance_mm[i] <= 0.0);
+      hit = hit || (i < moving.size() && moving[i] <= 0.0);
+      under = under || (i < moving.size() && moving[i] < required_mm);
       hit = hit || (part_marks && i < part_marks->motion.size() && part_marks->motion[i]);
     }
-    colliding[static_cast<std::size_t>(postures[k].pass)] += hit;
+    const auto p = static_cast<std::size_t>(postures[k].pass);
+    out.colliding[p] += hit;
+    out.under[p] += !hit && under;
   }
-  return colliding;
+  return out;
 }
 
 /// Whether `postures` (one pass) clear the obstacles and the part (`part`: its model, prepared
-/// once for every pass tried: a 1 M-triangle part takes seconds) at every posture and motion.
+/// once for every pass tried: a 1 M-triangle part takes seconds) at every posture and motion,
+/// and with `keep_required` the obstacles by the required clearance too.
 bool clearPass(const GenerateRequest& request, const ClearanceChecker& checker,
                const std::shared_ptr<const ObstacleModel>& part,
-               const std::vector<geometry::Posture>& postures) {
+               const std::vector<geometry::Posture>& postures, bool keep_required) {
   const ClearanceResult at_postures = checker.check(postures);
   if (at_postures.colliding > 0) return false;
+  if (keep_required && at_postures.min_clearance_mm < request.clearance_mm) return false;
   MotionRequest motions;
   motions.required_mm = request.clearance_mm;
   motions.posture_clearance_mm = at_postures.clearance_mm;
-  if (checker.checkMotions(postures, motions).colliding > 0) return false;
+  const MotionResult moved = checker.checkMotions(postures, motions);
+  if (moved.colliding > 0 || (keep_required && moved.under_required > 0)) return false;
   if (!part) return true;
   const std::optional<LinkPartResult> holder =
       checkHolderAgainstPart(request.tool, request.holder, part, postures);
@@ -56,7 +69,7 @@ bool clearPass(const GenerateRequest& request, const ClearanceChecker& checker,
 bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceChecker& checker,
                             GenerateResult& result,
                             const std::optional<PartContacts::Marks>& part_marks) {
-  const std::vector<std::size_t> colliding = collidingByPass(result, part_marks);
+  const PassFaults faults = faultsByPass(result, request.clearance_mm, part_marks);
   const double lead_rad = request.path.lead_deg * geometry::kDegToRad;
   std::shared_ptr<const ObstacleModel> part;
   bool replaced = false;
@@ -67,11 +80,15 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
     while (end < result.postures.size() && result.postures[end].pass == pass.index) ++end;
     const std::size_t begin = first;
     first = end;
-    if (colliding[p] == 0 || end - begin != pass.samples.size()) continue;
+    const std::size_t colliding = faults.colliding[p], under = faults.under[p];
+    if ((colliding == 0 && under == 0) || end - begin != pass.samples.size()) continue;
     const std::vector<geometry::Posture> nominal =
         nominalPostures(std::span(&pass, 1), lead_rad, request.tool.radius_mm);
     if (request.part && !part) part = prepareObstacle(*request.part, "part");
-    if (!clearPass(request, checker, part, nominal)) continue;
+    // A pass that collided steered takes axes that clear; one that only came under the required
+    // clearance, axes that keep it (a helper's channel: the tilt away from one fin brought the
+    // shank 0.45 mm from the other, leaning over it, where the nominal axes kept 0.64 of 0.5).
+    if (!clearPass(request, checker, part, nominal, colliding == 0)) continue;
     for (std::size_t k = begin; k < end; ++k) {
       GeneratedPosture& g = result.postures[k];
       g.posture = nominal[k - begin];
@@ -80,7 +97,7 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
       g.moment = 0.0;
       g.limited = false;
     }
-    result.kept_nominal.push_back({pass.index, pass.label, colliding[p]});
+    result.kept_nominal.push_back({pass.index, pass.label, colliding, under});
     replaced = true;
   }
   if (replaced) {

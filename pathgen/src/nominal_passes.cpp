@@ -157,6 +157,16 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
       }
       kept.push_back(i);
     }
+    // A lone posture that a gap parts from the cut of its block (an approach's start above the
+    // part, written after FEDRAT: a verifier's "pass 1 has a single posture") is the link's too.
+    const bool whole_block =
+        std::any_of(path.blocks.begin(), path.blocks.end(),
+                    [&](const PathBlock& b) { return b.begin == begin && b.end == end; });
+    if (kept.size() < 2 && !whole_block) {
+      if (said.axial == 0) said.first_axial = begin;
+      said.axial += kept.size();
+      continue;
+    }
     if (kept.size() < 2) {
       std::ostringstream msg;
       msg << path.where(begin) << ": pass " << number << " has "
@@ -166,6 +176,27 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
              "RAPID moves, gaps over path.pass_gap and where the feed turns back: a zig-zag's "
              "return leg)";
       throw InputError(msg.str());
+    }
+    // An approach down the tool axis at feed before the cut, and a retract up it after (CAM
+    // systems write them as feed moves: FEDRAT, GOTO down the axis), are the link's: links are
+    // made anew, and a step along the axis has no frame (a verifier's APT was refused at its
+    // approach). Only at the ends of a pass that cuts (a pass all along its axis, or a step
+    // along it within a pass, is refused below, naming its line).
+    const auto axial = [&](std::size_t from, std::size_t to) {
+      const Vec3 step = geometry::ballCentre(path.postures[kept[to]], r) -
+                        geometry::ballCentre(path.postures[kept[from]], r);
+      const Vec3& axis = path.postures[kept[from]].axis;
+      return (step - axis.dot(step) * axis).norm() < kMinAxisToFeedSin * step.norm();
+    };
+    std::size_t head = 0, tail = kept.size();
+    bool cuts = false;
+    for (std::size_t k = 1; k < kept.size() && !cuts; ++k) cuts = !axial(k - 1, k);
+    while (cuts && axial(head, head + 1)) ++head;
+    while (cuts && axial(tail - 2, tail - 1)) --tail;
+    if (head > 0 || tail < kept.size()) {
+      if (said.axial == 0) said.first_axial = kept[head > 0 ? 0 : tail];
+      said.axial += head + (kept.size() - tail);
+      kept = std::vector<std::size_t>(kept.begin() + head, kept.begin() + tail);
     }
     // A cutting move does not turn the axis over (repeats dropped: between the kept postures).
     for (std::size_t k = 1; k < kept.size(); ++k) geometry::requireSteadyAxis(path, kept[k - 1], kept[k]);

@@ -109,6 +109,16 @@ links: { retract: 7, safe_z: 80 }
   EXPECT_EQ(*s.links.safe_z_mm, 80.0);
 }
 
+// DESIGN writes unit weights as "w_j = 1": `weights: 1` is `unit` (a third party's scene, written
+// from DESIGN alone, was refused).
+TEST(Scene, WeightsOfOneAreUnitWeights) {
+  TempDir dir;
+  dir.write("wall.stl", app::test::squareStl(5));
+  const app::Scene s = app::loadScene(
+      dir.write("s.yaml", "obstacles:\n  - mesh: wall.stl\nfield: { weights: 1 }\n"));
+  EXPECT_EQ(s.field.weights, field::Weights::Unit);
+}
+
 TEST(Scene, DefaultsComeFromTheParamsStructs) {
   TempDir dir;
   dir.write("wall.stl", app::test::squareStl(5));

@@ -120,6 +120,27 @@ TEST(ClFile, RoundTripsExactly) {
   fs::remove(left);
 }
 
+// The lines generate names in its messages before path.cl is written (clFileLines) are those the
+// reader gives the written file's postures: blocks marked or not, comments of any length, an
+// empty comment line, a limit mark.
+TEST(ClFile, LinesNamedBeforeWritingAreTheFilesLines) {
+  PathFile path;
+  path.postures = randomPostures(9, false);
+  const std::vector<std::vector<PathBlock>> layouts = {
+      {{PathBlock::Kind::Pass, 0, 9}},
+      {{PathBlock::Kind::Link, 0, 2}, {PathBlock::Kind::Pass, 2, 6}, {PathBlock::Kind::Link, 6, 9}},
+      {{PathBlock::Kind::Pass, 0, 1}, {PathBlock::Kind::Pass, 1, 9}}};
+  path.limited = {3};
+  for (const auto& blocks : layouts)
+    for (const std::string comment : {"", "one", "UNSAFE TO RUN: x\n\nthird\nfourth"}) {
+      path.blocks = blocks;
+      const fs::path p = tempPath("lines.cl");
+      writeClFile(p, path, comment);
+      const std::vector<std::size_t> named = clFileLines(path, clCommentLines(comment));
+      EXPECT_EQ(named, readClPath(p).lines) << blocks.size() << " blocks, comment: " << comment;
+    }
+}
+
 // Numbers as post-processors read them: no exponent ("4.8e-05" was written for an axis component
 // of the impeller's path), the shortest fixed form that reads back the same; under 1e-12, 0.
 TEST(ClFile, WritesNumbersWithoutAnExponent) {

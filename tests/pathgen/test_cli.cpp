@@ -131,6 +131,31 @@ TEST_F(ImpellerRun, MatchesTheGoldenSummary) {
   EXPECT_EQ(field["links"]["links"].get<int>(), field["passes"].get<int>() + 1);
 }
 
+// generate's reasons name the line of path.cl a posture is written on, as check's name the lines
+// of the file it reads: the line the reader gives the first colliding posture of the nominal path.
+TEST_F(ImpellerRun, GeneratesReasonsNamePathClLines) {
+  ASSERT_EQ(nominal_.exit_code, 0) << nominal_.output;
+  const auto report = readJson(dir_ / "nominal/report.json");
+  const std::size_t first = report["clearance"]["first_colliding_posture"].get<std::size_t>();
+  const fieldpath::geometry::PathFile written =
+      fieldpath::geometry::readClPath(dir_ / "nominal/path.cl");
+  ASSERT_LT(first, written.lines.size());
+  const std::string named =
+      "touch an obstacle (first: posture " + std::to_string(first) + " (pass ";
+  const std::size_t at = nominal_.output.find(named);
+  ASSERT_NE(at, std::string::npos) << nominal_.output;
+  const std::string line = ", path.cl:" + std::to_string(written.lines[first]) + "))";
+  const std::size_t end = nominal_.output.find("))", at);
+  ASSERT_NE(end, std::string::npos) << nominal_.output;
+  EXPECT_TRUE(nominal_.output.substr(at, end + 2 - at).ends_with(line)) << nominal_.output;
+  // The same words at the top of the file.
+  std::ifstream in(dir_ / "nominal/path.cl");
+  std::string top;
+  std::getline(in, top);
+  EXPECT_NE(top.find(named), std::string::npos) << top;
+  EXPECT_NE(top.find(line), std::string::npos) << top;
+}
+
 TEST_F(ImpellerRun, GenerateClCheckRoundTrip) {
   ASSERT_EQ(field_.exit_code, 0) << field_.output;
   const Outcome check =

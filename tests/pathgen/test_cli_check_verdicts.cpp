@@ -79,6 +79,9 @@ TEST(CheckVerdict, TheGougeToleranceIsTheOptions) {
   const nlohmann::json s = checkJson(dir, "strict");
   EXPECT_TRUE(says(s["not_ok_because"], "deeper than the gouge tolerance (5 um)"))
       << s["not_ok_because"];
+  // The first gouge named as the obstacles' are: its block and its line in the file.
+  EXPECT_TRUE(says(s["not_ok_because"], "first: posture 0 (pass 1, ")) << s["not_ok_because"];
+  EXPECT_TRUE(says(s["not_ok_because"], "dip.cl:2))")) << s["not_ok_because"];
   EXPECT_NEAR(s["cutter_part"]["max_depth_um"].get<double>(), 8.0, 0.5) << s["cutter_part"];
   EXPECT_NEAR(s["surface"]["max_gouge_um"].get<double>(), 8.0, 0.5) << s["surface"];
   EXPECT_GT(s["surface"]["gouged_lines"].get<int>(), 0) << s["surface"];

@@ -261,6 +261,45 @@ TEST(NominalPasses, DegeneratePosturesAreClearErrorsNamingTheLine) {
   EXPECT_EQ(nominalPasses(geometry::readPathFile(turned), {}, kR).size(), 1u);
 }
 
+// Approaches and retracts that CAM systems write as feed moves are the links' (made anew): a move
+// down the axis before the cut and up it after, and a lone posture a gap parts from the cut (an
+// approach's start after FEDRAT: "pass 1 has a single posture"). The pass is the cut's, a step
+// along the axis within it included.
+TEST(NominalPasses, ApproachesAndRetractsAtFeedAreTheLinks) {
+  TempDir dir;
+  std::string cut;
+  for (int x = 0; x <= 10; ++x) cut += std::to_string(x) + " 0 0 0 0 1\n";
+  // Lines 1-2 the approach (z 10, 2), 3-13 the cut, 14 the retract up the axis.
+  const auto ends = dir.write("ends.cl", "0 0 10 0 0 1\n0 0 2 0 0 1\n" + cut + "10 0 3 0 0 1\n");
+  NominalDropped dropped;
+  const auto passes = nominalPasses(geometry::readPathFile(ends), {}, kR, &dropped);
+  ASSERT_EQ(passes.size(), 1u);
+  EXPECT_DOUBLE_EQ(passes[0].length_mm, 10.0);
+  EXPECT_EQ(passes[0].samples.size(), 11u);
+  EXPECT_DOUBLE_EQ(passes[0].samples.front().centre_mm.x(), 0.0);
+  EXPECT_DOUBLE_EQ(passes[0].samples.front().centre_mm.z(), kR);
+  EXPECT_EQ(dropped.axial, 3u);
+  EXPECT_EQ(dropped.first_axial, 0u);
+  // The approach's start 20 mm above, a gap from the cut: alone, dropped.
+  const auto lone = dir.write("lone.cl", "0 0 20 0 0 1\n" + cut);
+  NominalDropped alone;
+  const auto after_gap = nominalPasses(geometry::readPathFile(lone), {}, kR, &alone);
+  ASSERT_EQ(after_gap.size(), 1u);
+  EXPECT_DOUBLE_EQ(after_gap[0].length_mm, 10.0);
+  EXPECT_EQ(alone.axial, 1u);
+  // Down the axis in the middle of the cut (a step down a floor): the cut's, kept.
+  std::string dip;
+  for (int x = 0; x <= 5; ++x) dip += std::to_string(x) + " 0 0 0 0 1\n";
+  dip += "5 0 -1 0 0 1\n";
+  for (int x = 6; x <= 10; ++x) dip += std::to_string(x) + " 0 -1 0 0 1\n";
+  NominalDropped within;
+  const auto stepped =
+      nominalPasses(geometry::readPathFile(dir.write("dip.cl", dip)), {}, kR, &within);
+  ASSERT_EQ(stepped.size(), 1u);
+  EXPECT_EQ(stepped[0].samples.size(), 12u);
+  EXPECT_EQ(within.axial, 0u);
+}
+
 TEST(NominalPasses, LargestAxisTurnIsOfThePassesAndItsClosedForm) {
   // Pass 1: the axis tilts 12 deg then 30 deg about y between postures 1 mm apart; a link whose
   // axis swings 80 deg is not a pass (rapid moves turn as they like); pass 2 turns 20 deg.

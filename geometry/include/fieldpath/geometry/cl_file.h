@@ -144,6 +144,12 @@ void writeClFile(const std::filesystem::path& file, const PathFile& path,
 /// One pass of `postures`.
 void writeClFile(const std::filesystem::path& file, std::span<const Posture> postures,
                  std::string_view comment = {});
+/// The 1-based line of each posture in the file writeClFile(file, path, comment) writes, for a
+/// comment of `comment_lines` lines (clCommentLines): messages computed before the file is
+/// written name its lines, as those of a path read from a file do.
+std::vector<std::size_t> clFileLines(const PathFile& path, std::size_t comment_lines);
+/// The number of `#` lines writeClFile writes for `comment`.
+std::size_t clCommentLines(std::string_view comment);
 
 struct AptHeader {
   std::string part_name = "FIELDPATH";

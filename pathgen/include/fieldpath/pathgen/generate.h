@@ -156,12 +156,17 @@ struct GenerateResult {
   std::vector<BallUnderClearance> balls_under_clearance;
   /// Passes that collided steered (with the obstacles, or the holder or the cutter with the
   /// part) and are written with their nominal axes, which clear them at every posture and motion
-  /// (the part never repels: steering away from an obstacle can drive the holder into it).
+  /// (the part never repels: steering away from an obstacle can drive the holder into it); and
+  /// passes that came under the required clearance steered, written with nominal axes that keep
+  /// it at every posture and motion.
   struct KeptNominal {
     int pass = 0;                       ///< Pass::index
     std::string label;                  ///< the pass and its line
     /// Postures of the steered pass that collided there or on the move to the pass's next.
     std::size_t steered_colliding = 0;
+    /// Postures of the steered pass that came under the required clearance there or on the move
+    /// to the pass's next, without colliding.
+    std::size_t steered_under = 0;
   };
   std::vector<KeptNominal> kept_nominal;
   StageTimes times;

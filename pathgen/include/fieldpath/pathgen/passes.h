@@ -68,6 +68,12 @@ struct NominalDropped {
   /// (passRanges: its moves are the link's, made anew); `first_between` the first (npos: none).
   std::size_t between_legs = 0;
   std::size_t first_between = static_cast<std::size_t>(-1);
+  /// Postures of approaches and retracts written as feed moves at a pass's ends: reached by a
+  /// move along the tool axis (down it before the cut, up it after), or alone between a gap and
+  /// the cut of their block (an approach's start above the part): the link's, made anew;
+  /// `first_axial` the first (npos: none).
+  std::size_t axial = 0;
+  std::size_t first_axial = static_cast<std::size_t>(-1);
 };
 std::vector<Pass> nominalPasses(const geometry::PathFile& path, const PathParams& params,
                                 double ball_radius_mm, NominalDropped* dropped = nullptr);
