@@ -495,6 +495,7 @@ ViewData gatherView(const ViewRequest& request) {
     if (fs::exists(surface_dir / "check.json") && fs::exists(surface_dir / "deviation.npy")) {
       const json j = readJson(surface_dir / "check.json");
       const json surface = j.is_object() ? j.value("surface", json()) : json();
+      figures.from_check = surface.is_object();
       auto number = [&](const char* key, double& out) {
         if (surface.is_object() && surface.value(key, json()).is_number())
           out = surface[key].get<double>();

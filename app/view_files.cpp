@@ -326,6 +326,8 @@ ViewSurface readSurface(const fs::path& dir, const Scene& scene, std::size_t max
     // check's own figures (over the machined band) where it wrote them: the legend agrees.
     if (std::isfinite(figures.max_scallop_um) && figures.max_scallop_um > 0)
       s.range[1] = figures.max_scallop_um;
+    else if (figures.from_check)  // no scallop over the band: what stands higher is stock left
+      s.range[1] = 10;            // beside it (a single pass's 1861 um topped the scale: a helper)
     if (std::isfinite(figures.max_gouge_um))
       s.range[0] = std::min(-gouge_tolerance_um, -std::abs(figures.max_gouge_um));
   } else if (!finite.empty()) {

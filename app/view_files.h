@@ -44,6 +44,7 @@ CheckJson readCheckJson(const std::filesystem::path& dir);
 struct SurfaceFigures {
   double gouge_tolerance_um = kGougeToleranceUm;
   double max_scallop_um = NAN, max_gouge_um = NAN;
+  bool from_check = false;  ///< read from check.json: a null scallop there is "none measured"
 };
 /// The surface of a `check` (deviation.npy) or `simulate` (heights.npy) folder with its grid,
 /// decimated to at most `max_lines` lines; warnings for the page.

@@ -206,6 +206,24 @@ TEST(View, ACuttersGougeIsTheCuttersAtCheckTolerance) {
       << meta["warnings"];
 }
 
+// One pass over the floor: check measures no scallop over its band (null), and the page's scale
+// tops at 10 um, the stock left beside the pass above it in its own colour (the scale ran to the
+// 1861 um left beside a helper's pass under "gouge < 0 < scallop").
+TEST(View, WithNoScallopMeasuredTheScaleIsNotTheStockLeft) {
+  const TempDir dir;
+  writeBlockScene(dir, /*nominal=*/false);
+  std::ostringstream path;
+  path << "# pass 1\n";
+  for (int k = 0; k < 20; ++k) path << -9.75 + 0.5 * k << " 8 0 0 0 1\n";
+  dir.write("one.cl", path.str());
+  ASSERT_EQ(runFieldpath(dir, "--quiet check scene.yaml --path one.cl --out c").exit_code, 0);
+  const json check = json::parse(slurp(dir.path() / "c" / "check.json"));
+  ASSERT_TRUE(check["surface"]["max_scallop_um"].is_null()) << check["surface"];
+  ASSERT_EQ(runFieldpath(dir, "--quiet view scene.yaml --check c --out v.html").exit_code, 0);
+  const json surface = pageMeta(slurp(dir.path() / "v.html"))["surface"];
+  EXPECT_EQ(surface["range"][1].get<double>(), 10.0) << surface["range"];
+}
+
 // A pass 0.3 mm beside the block, the scene asking 0.5: nothing collides, and the page says the
 // path is under the required clearance, with the closest posture (it said nothing; its panel
 // read "colliding postures: 0").
