@@ -59,9 +59,30 @@ std::pair<std::size_t, std::size_t> rapidsOntoPasses(const geometry::PathFile& p
     if (!geometry::samePose(path.postures[end], path.postures[pass.begin]) || end == 0 ||
         geometry::samePose(path.postures[end - 1], path.postures[end]))
       continue;
+    // The pass written from the rapid's end, down the tool axis at feed (an engage: RAPID to a
+    // point above the part, FEDRAT, the same point again, down): the ball does not cut there (a
+    // CAM engineer's file read UNSAFE). Within 30 deg of the axis, as generate reads approaches.
+    std::size_t next = pass.begin + 1;
+    while (next < pass.end && geometry::samePose(path.postures[next], path.postures[pass.begin]))
+      ++next;
+    if (next < pass.end) {
+      const geometry::Vec3 step = path.postures[next].tip_mm - path.postures[pass.begin].tip_mm;
+      if (path.postures[pass.begin].axis.dot(step) <= -std::cos(M_PI / 6.0) * step.norm()) continue;
+    }
     if (count++ == 0) first = end;
   }
   return {count, first};
+}
+
+/// The passes generate would take from the path as a nominal one: its pass blocks split at gaps
+/// and turns (passRanges), a lone posture a gap parts from the rest of its block not counted (a
+/// link's: a reviewer counted 5 for generate's 1).
+std::size_t passesSplitAtGaps(const geometry::PathFile& path, const Scene& scene) {
+  std::size_t n = 0;
+  for (const auto& [begin, end] :
+       pathgen::passRanges(path, scene.path.pass_gap_mm, scene.tool.radius_mm))
+    n += end - begin >= 2;
+  return n;
 }
 
 /// Per posture: block, clearance and the lower bound of the motion to the next one.
@@ -259,6 +280,10 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                            ": FROM/ (the start point) is read past: the machine's move from it to "
                            "the first GOTO is not checked (write it as a GOTO after RAPID to have "
                            "it checked)");
+    if (path.msys_line > 0)
+      path_notes.push_back(path.file.string() + ":" + std::to_string(path.msys_line) +
+                           ": MSYS/ (a frame shifted or turned) is read past: the path is checked "
+                           "in the file's coordinates, where the scene's meshes are");
     const pathgen::AxisTurn axis_turn = pathgen::largestAxisTurn(path, scene.tool.radius_mm);
 
     // (a) exact clearance of postures and motions
@@ -354,8 +379,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         // file without markers is one; a helper read 50 here and 1 in every other output), and
         // beside them the passes generate would take from it as a nominal path.
         {"passes", path.count(geometry::PathBlock::Kind::Pass)},
-        {"passes_split_at_gaps",
-         pathgen::passRanges(path, scene.path.pass_gap_mm, scene.tool.radius_mm).size()},
+        {"passes_split_at_gaps", passesSplitAtGaps(path, scene)},
         {"links", path.count(geometry::PathBlock::Kind::Link)},
         {"clearance", clearanceJson(clearance, scene.clearance_mm, pathgen::kClearanceMeshTolMm)},
         {"motions", motionsJson(motions, scene.clearance_mm, motion_request.resolution_mm)},

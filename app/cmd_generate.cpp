@@ -209,6 +209,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       // The balls themselves within `clearance` (no axis clears them): what marks such a path.
       {"balls_under_clearance", balls_under},
       {"kept_nominal", kept_nominal},
+      {"kept_nominal_undone", r.kept_nominal_undone},
       {"axis_turn", axisTurnJson(axis_turn)},
       {"start",
        {{"policy", startPolicyName(job.dynamics.start)},
@@ -467,9 +468,10 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (under_required)
       std::fprintf(stderr,
                    "warning: the path comes closer to the obstacles than `clearance` (%.3f mm): "
-                   "postures min %.3f mm (posture %zu), motions min >= %.3f mm (%zu under it; "
+                   "postures min %.3f mm (%s), motions min >= %.3f mm (%zu under it; "
                    "report.json)\n",
-                   job.clearance_mm, c.min_clearance_mm, c.min_index, m.min_clearance_mm,
+                   job.clearance_mm, c.min_clearance_mm,
+                   postureWhere(result.path, c.min_index).c_str(), m.min_clearance_mm,
                    m.under_required);
     // (the jumps of a field pushing a tool that has no room: 30 deg in 0.5 mm in a pocket
     // narrower than the holder; unsafe there too, but the turn is its own warning)
@@ -520,6 +522,12 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                    collided ? first->steered_colliding : first->steered_under,
                    n == 1 ? "is" : "are");
     }
+    if (result.kept_nominal_undone > 0)
+      std::fprintf(stderr,
+                   "note: %zu pass%s cleared with the nominal axes, but the path linked to them "
+                   "(the links come down the new axes) was checked worse than the steered one: "
+                   "the steering is written (report.json kept_nominal_undone)\n",
+                   result.kept_nominal_undone, result.kept_nominal_undone == 1 ? "" : "es");
     if (!result.balls_under_clearance.empty()) {
       const auto& b = result.balls_under_clearance.front();
       std::fprintf(stderr,

@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/short_number.h"
 
 namespace fieldpath::app {
 
@@ -56,6 +57,25 @@ pathgen::GenerateRequest sceneJob(const Scene& scene) {
                  "first: %s) made into links: the passes end and start at the legs\n",
                  dropped.between_legs, dropped.between_legs == 1 ? "" : "s",
                  scene.nominal->where(dropped.first_between).c_str());
+  if (!impeller && scene.nominal->msys_line > 0)  // (a CAM engineer's MSYS/0,-5,0 went unsaid)
+    std::fprintf(stderr,
+                 "note: %s:%zu: MSYS/ (a frame shifted or turned) is read past: the path is "
+                 "taken in the file's coordinates, where the scene's meshes are\n",
+                 scene.nominal->file.string().c_str(), scene.nominal->msys_line);
+  if (!dropped.gaps.empty()) {
+    // Which moves of the file are not cut: a long cutting move split off as a link (a line
+    // written as one GOTO between arcs written fine: a CAM engineer's floor cut went unsaid).
+    const pathgen::GapSplit& g = dropped.gaps.front();
+    std::fprintf(stderr,
+                 "note: %zu move%s farther than path.pass_gap (%s: %s mm) made into link%s "
+                 "between passes, not cut (first: %s to %s, %s mm): set path.pass_gap above a "
+                 "cutting move that long\n",
+                 dropped.gaps.size(), dropped.gaps.size() == 1 ? "" : "s",
+                 job.path.pass_gap_mm > 0.0 ? "given" : "4 x the pass's median step",
+                 common::shortNumber(g.gap_mm).c_str(), dropped.gaps.size() == 1 ? "" : "s",
+                 scene.nominal->where(g.at - 1).c_str(), scene.nominal->where(g.at).c_str(),
+                 common::shortNumber(g.move_mm).c_str());
+  }
   if (dropped.axial > 0)
     std::fprintf(stderr,
                  "note: %zu posture%s of approaches and retracts at feed at the ends of passes "

@@ -161,6 +161,7 @@ struct AptChunk {
   };
   std::vector<Feed> feeds;
   std::size_t from_line = 0;  ///< its first FROM record's line (0: none)
+  std::size_t msys_line = 0;  ///< its first MSYS record that is not the identity (0: none)
 };
 
 /// The leading finite numbers of comma-separated `values` (at most `max`, into v): how many.
@@ -302,6 +303,16 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
       if (out.from_line == 0) out.from_line = record_line;
       continue;
     }
+    if (major == "MSYS") {  // origin, x axis, y axis: read past, a shifted or turned frame said
+      double v[9] = {};
+      const bool identity =
+          slash != std::string::npos &&
+          leadingNumbers(std::string_view(statement).substr(slash + 1), v, 9) == 9 && v[0] == 0 &&
+          v[1] == 0 && v[2] == 0 && v[3] == 1 && v[4] == 0 && v[5] == 0 && v[6] == 0 && v[7] == 1 &&
+          v[8] == 0;
+      if (!identity && out.msys_line == 0) out.msys_line = record_line;
+      continue;
+    }
     if (major == "CUTTER") {
       if (slash != std::string::npos)
         if (auto cutter = cutterOf(std::string_view(statement).substr(slash + 1), record_line))
@@ -409,7 +420,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   std::vector<std::size_t> link_postures;
   std::vector<PathFile::Cutter> cutters;
   std::vector<PathFile::Feed> feeds;
-  std::size_t from_line = 0;
+  std::size_t from_line = 0, msys_line = 0;
   bool pending = false, ended = false;
   double scale = 1.0;
   std::size_t offset = 0;
@@ -426,6 +437,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
     }
     ended = c.fini;
     if (from_line == 0) from_line = c.from_line;
+    if (msys_line == 0) msys_line = c.msys_line;
     for (auto& [units_before, cutter] : c.cutters) {  // in the unit of the record before it
       const double unit = units_before ? c.units[units_before - 1].second : scale;
       cutter.diameter_mm *= unit;
@@ -469,6 +481,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   path.file = file;
   path.cutters = std::move(cutters);
   path.from_line = from_line;
+  path.msys_line = msys_line;
   for (const PathFile::Feed& f : feeds)
     if (f.from < offset) path.feeds.push_back(f);  // a FEDRAT after the last GOTO feeds nothing
   if (offset == 0) throw InputError(file.string() + ": no GOTO records");

@@ -295,7 +295,10 @@ GenerateResult generatePath(const GenerateRequest& request) {
       }
       if (steered.status != dynamics::Status::Ok) {
         std::ostringstream msg;
-        msg << pass.label << ": " << dynamics::toString(steered.status) << ": " << steered.message;
+        msg << pass.label;
+        if (pass.whereAt && !steered.samples.empty())  // the input line where it stopped
+          msg << ", at " << pass.whereAt(steered.samples.back().s_mm);
+        msg << ": " << dynamics::toString(steered.status) << ": " << steered.message;
         if (steered.status == dynamics::Status::SolverFailed)  // what to change, not CVODE's words
           msg << " (the spring-damper is too stiff for the integrator here: raise "
                  "dynamics.inertia or dynamics.damping, lower field.gain or dynamics.stiffness, "
@@ -553,10 +556,20 @@ GenerateResult generatePath(const GenerateRequest& request) {
     }
   };
   linkAndCheck();
-  if (!request.nominal && !request.passes_only &&
-      keepClearNominalPasses(request, checker, result, part_marks)) {
-    common::report(request.progress, steer_end, "passes kept nominal: checked again");
-    linkAndCheck();
+  if (!request.nominal && !request.passes_only && hasFaultyPasses(request, result, part_marks)) {
+    // The steered path, kept until the one with nominal passes is checked no worse (its links
+    // come down the new axes): a copy only where a pass is faulty.
+    GenerateResult steered = result;
+    const std::optional<PartContacts::Marks> steered_marks = part_marks;
+    if (keepClearNominalPasses(request, checker, result, part_marks)) {
+      common::report(request.progress, steer_end, "passes kept nominal: checked again");
+      linkAndCheck();
+      if (pathFaults(request, result) > pathFaults(request, steered)) {
+        steered.kept_nominal_undone = result.kept_nominal.size();
+        result = std::move(steered);
+        part_marks = steered_marks;
+      }
+    }
   }
   for (GeneratedPosture& g : result.postures) {
     g.clearance_mm = result.clearance.clearance_mm[g.output];

@@ -66,6 +66,24 @@ bool clearPass(const GenerateRequest& request, const ClearanceChecker& checker,
 
 }  // namespace
 
+bool hasFaultyPasses(const GenerateRequest& request, const GenerateResult& result,
+                     const std::optional<PartContacts::Marks>& part_marks) {
+  const PassFaults faults = faultsByPass(result, request.clearance_mm, part_marks);
+  for (std::size_t p = 0; p < faults.colliding.size(); ++p)
+    if (faults.colliding[p] + faults.under[p] > 0) return true;
+  return false;
+}
+
+std::pair<std::size_t, std::size_t> pathFaults(const GenerateRequest& request,
+                                               const GenerateResult& result) {
+  std::size_t collisions = result.clearance.colliding + result.motions.colliding;
+  for (const auto* part : {&result.link_part, &result.holder_part})
+    if (*part) collisions += (*part)->colliding_postures + (*part)->colliding_motions;
+  std::size_t under = result.motions.under_required;
+  for (const double c : result.clearance.clearance_mm) under += c > 0.0 && c < request.clearance_mm;
+  return {collisions, under};
+}
+
 bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceChecker& checker,
                             GenerateResult& result,
                             const std::optional<PartContacts::Marks>& part_marks) {

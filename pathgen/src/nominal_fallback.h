@@ -1,6 +1,7 @@
 #pragma once
 /// Passes the steering made collide, written with their nominal axes where those are clear.
 #include <optional>
+#include <utility>
 
 #include "fieldpath/pathgen/clearance.h"
 #include "fieldpath/pathgen/generate.h"
@@ -20,5 +21,18 @@ namespace fieldpath::pathgen {
 bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceChecker& checker,
                             GenerateResult& result,
                             const std::optional<PartContacts::Marks>& part_marks);
+
+/// Whether a pass of `result` collides or comes under the required clearance (what
+/// keepClearNominalPasses may mend): the caller keeps a copy of the steered result only then.
+bool hasFaultyPasses(const GenerateRequest& request, const GenerateResult& result,
+                     const std::optional<PartContacts::Marks>& part_marks);
+
+/// How bad a checked path is, compared lexicographically: its collisions (postures and motions
+/// with the obstacles, the links and the holder in the part), then the postures and motions under
+/// the required clearance. A path written with nominal passes is kept only where it is no worse
+/// than the steered one by this: the links to a pass come down its new axes, and can meet what
+/// the steered ones missed (a reviewer's cube 400 mm up a nominal axis).
+std::pair<std::size_t, std::size_t> pathFaults(const GenerateRequest& request,
+                                               const GenerateResult& result);
 
 }  // namespace fieldpath::pathgen

@@ -24,6 +24,11 @@ constexpr double kRepeatMm = 1e-9;
 /// The nominal axis must be at least this far from the feed direction (sin of 0.5°): closer, the
 /// frame's normal is the rounding noise of a projection.
 constexpr double kMinAxisToFeedSin = 0.0087;
+/// A step at a pass's end within this of the tool axis (deg), down it before the cut or up it
+/// after, is an approach or a retract (a link's): a ball-end mill does not finish along its axis,
+/// and a frame with the feed that near the axis lays the nominal axis over (an approach
+/// straight down z with the tool tilted 11 deg was turned 66 deg within its pass: a reviewer's).
+constexpr double kApproachDeg = 30.0;
 
 /// The vertices of one pass: ball centres, arc lengths, tangents, normals.
 struct Polyline {
@@ -124,7 +129,7 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
   NominalDropped said;
   std::vector<Pass> passes;
   const std::vector<std::pair<std::size_t, std::size_t>> ranges =
-      passRanges(path, params.pass_gap_mm, r);
+      passRanges(path, params.pass_gap_mm, r, &said.gaps);
   {  // postures of pass blocks that no range holds
     std::vector<char> held(path.postures.size(), 0);
     for (const auto& [begin, end] : ranges) std::fill(held.begin() + begin, held.begin() + end, 1);
@@ -178,21 +183,23 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
       throw InputError(msg.str());
     }
     // An approach down the tool axis at feed before the cut, and a retract up it after (CAM
-    // systems write them as feed moves: FEDRAT, GOTO down the axis), are the link's: links are
-    // made anew, and a step along the axis has no frame (a verifier's APT was refused at its
-    // approach). Only at the ends of a pass that cuts (a pass all along its axis, or a step
-    // along it within a pass, is refused below, naming its line).
-    const auto axial = [&](std::size_t from, std::size_t to) {
+    // systems write them as feed moves: FEDRAT, GOTO down the axis; or straight down z with the
+    // tool tilted), are the link's: links are made anew, and a step along the axis has no frame
+    // (a verifier's APT was refused at its approach). A step within kApproachDeg of the axis,
+    // down it at the start, up it at the end, of a pass that cuts (a pass all along its axis is
+    // refused below, naming its line; a plunge down the axis at the end is the cut's).
+    const auto alongAxis = [&](std::size_t from, std::size_t to) {  // cos(step, axis)
       const Vec3 step = geometry::ballCentre(path.postures[kept[to]], r) -
                         geometry::ballCentre(path.postures[kept[from]], r);
-      const Vec3& axis = path.postures[kept[from]].axis;
-      return (step - axis.dot(step) * axis).norm() < kMinAxisToFeedSin * step.norm();
+      return path.postures[kept[from]].axis.dot(step) / step.norm();
     };
+    const double steep = std::cos(kApproachDeg * M_PI / 180.0);
     std::size_t head = 0, tail = kept.size();
     bool cuts = false;
-    for (std::size_t k = 1; k < kept.size() && !cuts; ++k) cuts = !axial(k - 1, k);
-    while (cuts && axial(head, head + 1)) ++head;
-    while (cuts && axial(tail - 2, tail - 1)) --tail;
+    for (std::size_t k = 1; k < kept.size() && !cuts; ++k)
+      cuts = std::abs(alongAxis(k - 1, k)) < steep;
+    while (cuts && alongAxis(head, head + 1) <= -steep) ++head;
+    while (cuts && alongAxis(tail - 2, tail - 1) >= steep) --tail;
     if (head > 0 || tail < kept.size()) {
       if (said.axial == 0) said.first_axial = kept[head > 0 ? 0 : tail];
       said.axial += head + (kept.size() - tail);
@@ -240,10 +247,23 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
     pass.nominal_lean_deg = lean_max_deg;
     pass.nominal_lean_at = path.where(lean_at);
     pass.index = number - 1;
-    pass.label = "pass " + std::to_string(number) + " (" + path.where(begin) + ")";
+    pass.label = "pass " + std::to_string(number) + " (" + path.where(kept.front()) + ")";
     pass.ball_radius_mm = r;
     pass.length_mm = line->s_mm.back();
     pass.at = [line](double s_mm) { return polylineSample(*line, s_mm); };
+    {  // the lines of the kept postures, not their texts (a million-posture path)
+      geometry::PathFile lines;
+      lines.file = path.file;
+      lines.rows = path.rows;
+      for (const std::size_t i : kept)
+        if (i < path.lines.size()) lines.lines.push_back(path.lines[i]);
+      pass.whereAt = [line, lines = std::move(lines)](double s_mm) {
+        const auto after = std::upper_bound(line->s_mm.begin(), line->s_mm.end(), s_mm);
+        const auto k = static_cast<std::size_t>(
+            std::max<std::ptrdiff_t>(0, std::distance(line->s_mm.begin(), after) - 1));
+        return lines.where(k);
+      };
+    }
     if (params.step_given) {
       const int intervals =
           std::max(1, static_cast<int>(std::ceil(pass.length_mm / params.step_mm - 1e-9)));

@@ -62,8 +62,13 @@ class BlockSplitter {
   using Ranges = std::vector<std::pair<std::size_t, std::size_t>>;
 
   BlockSplitter(const PathFile& path, const PathBlock& block, double pass_gap_mm,
-                double ball_radius_mm, Ranges& out)
-      : path_(path), block_(block), radius_mm_(ball_radius_mm), out_(out), begin_(block.begin) {
+                double ball_radius_mm, Ranges& out, std::vector<GapSplit>* gaps)
+      : path_(path),
+        block_(block),
+        radius_mm_(ball_radius_mm),
+        out_(out),
+        gaps_(gaps),
+        begin_(block.begin) {
     std::vector<double> steps, tip_steps;
     for (std::size_t i = block.begin + 1; i < block.end; ++i) {
       if (const double d = (centre(i) - centre(i - 1)).norm(); d > kRepeatMm) steps.push_back(d);
@@ -83,6 +88,7 @@ class BlockSplitter {
       if (gap_mm_ > 0.0 && step.norm() > gap_mm_) {
         if (tipStep(i) > tip_gap_mm_) {  // the link between two passes
           out_.emplace_back(begin_, i);  // (one posture alone: nominalPasses names it)
+          if (gaps_) gaps_->push_back({i, tipStep(i), tip_gap_mm_});
           begin_ = i;
           recent_.clear();
           turn_.reset();  // (its steps were no pass's feed but the one ended here)
@@ -238,6 +244,7 @@ class BlockSplitter {
   const PathBlock& block_;
   double radius_mm_;
   Ranges& out_;
+  std::vector<GapSplit>* gaps_;
   double gap_mm_ = 0.0, tip_gap_mm_ = 0.0;
   double feed_min_mm_ = kRepeatMm;  // shorter centre steps give no feed direction (centreNoiseMm)
   std::size_t begin_;         ///< first posture of the pass under way
@@ -249,11 +256,12 @@ class BlockSplitter {
 
 std::vector<std::pair<std::size_t, std::size_t>> passRanges(const PathFile& path,
                                                             double pass_gap_mm,
-                                                            double ball_radius_mm) {
+                                                            double ball_radius_mm,
+                                                            std::vector<GapSplit>* gaps) {
   std::vector<std::pair<std::size_t, std::size_t>> ranges;
   for (const PathBlock& block : path.blocks)
     if (block.kind == PathBlock::Kind::Pass)
-      BlockSplitter(path, block, pass_gap_mm, ball_radius_mm, ranges).run();
+      BlockSplitter(path, block, pass_gap_mm, ball_radius_mm, ranges, gaps).run();
   return ranges;
 }
 

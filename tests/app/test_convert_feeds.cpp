@@ -166,5 +166,30 @@ TEST(ConvertFeeds, FromIsReadPastAndSaid) {
       nlohmann::json::parse(slurp(dir.path() / "out2" / "check.json"))["path_notes"].empty());
 }
 
+// A non-identity MSYS (a frame shifted or turned) is read past, and said: the path is taken in the
+// file's coordinates (a CAM engineer's MSYS/0,-5,0 put the ball 1 mm into a wall the check read
+// 3.98 mm clear, unsaid); the identity is no note. Whatever the chunks.
+TEST(ConvertFeeds, AShiftedMsysIsSaid) {
+  const TempDir dir;
+  const std::string motions = "GOTO/0,0,5,0,0,1\nGOTO/5,0,5\n";
+  dir.write("shifted.apt", "PARTNO/X\nMSYS/0,0,0,1,0,0,0,1,0\nMSYS/0,-5,0,1,0,0,0,1,0\n" + motions);
+  dir.write("identity.apt", "PARTNO/X\nMSYS/0,0,0,1,0,0,0,1,0\n" + motions);
+  for (const std::size_t chunk : {std::size_t{16}, std::size_t{1} << 20}) {
+    geometry::PathReadOptions options;
+    options.chunk_bytes = chunk;
+    EXPECT_EQ(geometry::readPathFile(dir.path() / "shifted.apt", options).msys_line, 3u) << chunk;
+    EXPECT_EQ(geometry::readPathFile(dir.path() / "identity.apt", options).msys_line, 0u) << chunk;
+  }
+  dir.write("wall.stl", squareStl(20.0, -30.0));
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, length: 40 }\n");
+  const Outcome check = runFieldpath(dir, "check scene.yaml --path shifted.apt --out out");
+  EXPECT_NE(check.err.find("note: shifted.apt:3: MSYS/ (a frame shifted or turned) is read past"),
+            std::string::npos)
+      << check.err;
+  const Outcome same = runFieldpath(dir, "check scene.yaml --path identity.apt --out same");
+  EXPECT_EQ(same.err.find("MSYS"), std::string::npos) << same.err;
+}
+
 }  // namespace
 }  // namespace fieldpath::app::test

@@ -402,7 +402,7 @@ TEST(CheckSurface, AToolBuriedInABoxWithAFacetMissingIsAGouge) {
 // A link whose last posture is the next pass's first (a path written with no retract): its rapid
 // move ends where the ball cuts. The links' part check takes that posture for the pass's and said
 // nothing (a machine-safety helper's finding); now `unsafe`. The same path with the link ending
-// 8 mm above the pass start is not.
+// 8 mm above the pass start is not, nor one whose pass starts there with an engage down its axis.
 TEST(CheckLinks, ARapidMoveOntoAPassStartIsUnsafe) {
   const TempDir dir;
   writePlateScene(dir);
@@ -423,6 +423,18 @@ TEST(CheckLinks, ARapidMoveOntoAPassStartIsUnsafe) {
   EXPECT_FALSE(onto["ok"].get<bool>());
   const auto retracted = check(dir, "retracted.cl", "retracted");
   EXPECT_EQ(reasons(retracted).find("rapid move onto"), std::string::npos) << retracted["unsafe"];
+  // The link ending 3 mm above the pass start, and the pass written from there down its axis at
+  // feed (an engage, as CAM systems write it): the ball does not cut where the rapid ends (a CAM
+  // engineer's file read UNSAFE).
+  std::string engage = passes(2, 0.0, 1.0, 0.0);
+  const std::string into = "0 1 8 0 0 1\n# pass 2\n";
+  ASSERT_NE(engage.find(into), std::string::npos);
+  engage.replace(engage.find(into), into.size(),
+                 "0 1 8 0 0 1\n0 1 3 0 0 1\n# pass 2\n0 1 3 0 0 1\n");
+  dir.write("engage.cl", engage);
+  const auto engaged = check(dir, "engage.cl", "engage");
+  EXPECT_EQ(reasons(engaged).find("rapid move onto"), std::string::npos) << engaged["unsafe"];
+  EXPECT_TRUE(engaged["ok"].get<bool>()) << engaged["not_ok_because"];
 }
 
 // Two runs of postures 20 mm apart with the axis at -60 and +60 deg about y: generate reads two

@@ -324,24 +324,61 @@ TEST(GenerateEdges, APassTheSteeringDrivesIntoThePartKeepsItsClearNominalAxes) {
   }
 }
 
+namespace {
+
+/// Two fins 1.5 mm thick along x, their feet at |y| 9-10.5, leaning 10 deg over the channel
+/// between them (fins.stl), and one pass along x 4 mm from the feet of one, a posture every
+/// 0.5 mm from line 2 on, the axis leaning 11 deg away from that fin (one.cl).
+/// With `cube`, a 2 mm cube 400 mm up the nominal axis of the pass's last posture too: far from
+/// the steering, in the way of a link coming down that axis.
+void writeLeaningFins(const TempDir& dir, bool cube = false) {
+  const double lean = std::tan(10.0 * std::numbers::pi / 180.0);
+  const Eigen::Vector3d axis = Eigen::Vector3d(0, 0.2, 1).normalized();
+  geometry::TriangleMesh fins;
+  pathgen::test::addBox(fins, -5, 55, 9, 10.5, -2, 25, -lean);
+  pathgen::test::addBox(fins, -5, 55, -10.5, -9, -2, 25, lean);
+  if (cube) {
+    const Eigen::Vector3d c = Eigen::Vector3d(50, -5, 0.5) + 400 * axis;
+    pathgen::test::addBox(fins, c.x() - 1, c.x() + 1, c.y() - 1, c.y() + 1, c.z() - 1, c.z() + 1);
+  }
+  geometry::saveMesh(fins, dir.path() / "fins.stl");
+  std::ostringstream cl;
+  cl.precision(17);
+  cl << "# pass 1\n";
+  for (int i = 0; i <= 100; ++i)
+    cl << 0.5 * i << " -5 0.5 " << axis.x() << " " << axis.y() << " " << axis.z() << "\n";
+  dir.write("one.cl", cl.str());
+}
+
+}  // namespace
+
+// `on_limit: fail` names the line of the input posture where the limit held, beside the pass's
+// first line and s (a verifier: "nominal.npy: row 0" and s only).
+TEST(GenerateEdges, AnAngleLimitThatFailsNamesTheInputLine) {
+  const TempDir dir;
+  writeLeaningFins(dir);
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: fins.stl\ntool: { shape: ball, radius: 3, length: 40 }\n"
+            "holder: [[40, 6], [55, 6], [55, 12], [90, 12]]\npath: { nominal: one.cl }\n"
+            "dynamics: { max_tilt_deg: 0.5, on_limit: fail }\n");
+  const auto r = test::runFieldpath(dir, "generate scene.yaml --out out");
+  ASSERT_EQ(r.exit_code, 1) << r.output();
+  const std::string err = r.err;
+  const std::size_t s_at = err.find("s = ");
+  ASSERT_NE(s_at, std::string::npos) << err;
+  const double s_mm = std::stod(err.substr(s_at + 4));
+  // The postures' ball centres are 0.5 mm apart: the one at or before s is on line 2 + s / 0.5.
+  const std::string line = "one.cl:" + std::to_string(2 + static_cast<int>(s_mm / 0.5 + 1e-9));
+  EXPECT_NE(err.find("pass 1 (one.cl:2), at " + line + ": "), std::string::npos) << err;
+}
+
 // A pass that only comes under the required clearance steered keeps nominal axes that keep it (a
 // helper's channel of two fins leaning 10 deg over it: the tilt away from the nearer fin's foot
 // brought the shank within 0.45 mm of the other's top, where the nominal axes kept 0.64 of 0.5;
 // the path was written marked UNDER THE REQUIRED CLEARANCE).
 TEST(GenerateEdges, APassTheSteeringBringsUnderTheClearanceKeepsNominalAxesThatKeepIt) {
   const TempDir dir;
-  const double lean = std::tan(10.0 * std::numbers::pi / 180.0);
-  geometry::TriangleMesh fins;
-  pathgen::test::addBox(fins, -5, 55, 9, 10.5, -2, 25, -lean);
-  pathgen::test::addBox(fins, -5, 55, -10.5, -9, -2, 25, lean);
-  geometry::saveMesh(fins, dir.path() / "fins.stl");
-  std::ostringstream cl;
-  cl.precision(17);
-  cl << "# pass 1\n";
-  const Eigen::Vector3d axis = Eigen::Vector3d(0, 0.2, 1).normalized();
-  for (int i = 0; i <= 100; ++i)
-    cl << 0.5 * i << " -5 0.5 " << axis.x() << " " << axis.y() << " " << axis.z() << "\n";
-  dir.write("one.cl", cl.str());
+  writeLeaningFins(dir);
   const auto writeScene = [&](const char* clearance_mm) {
     dir.write("scene.yaml", std::string("obstacles:\n  - mesh: fins.stl\n"
                                         "tool: { shape: ball, radius: 3, length: 40 }\n"
@@ -375,6 +412,20 @@ TEST(GenerateEdges, APassTheSteeringBringsUnderTheClearanceKeepsNominalAxesThatK
   EXPECT_EQ(strict["kept_nominal"].size(), 0u) << strict["kept_nominal"];
   EXPECT_NE(test::slurp(dir.path() / "strict/path.cl").find("UNDER THE REQUIRED"),
             std::string::npos);
+  // A cube up the nominal axis of the last posture: the link after the nominal pass comes down
+  // that axis into it (the steered one missed it). The path linked to the nominal pass is worse
+  // (a collision against 0 under the clearance): the steering is written, marked, and said (a
+  // reviewer's: the fallback had turned a safe path UNSAFE).
+  writeLeaningFins(dir, /*cube=*/true);
+  writeScene("0.5");
+  const auto cubed = test::runFieldpath(dir, "generate scene.yaml --out cube");
+  ASSERT_EQ(cubed.exit_code, 0) << cubed.output();
+  const auto with_cube = nlohmann::json::parse(test::slurp(dir.path() / "cube/report.json"));
+  EXPECT_EQ(with_cube["kept_nominal"].size(), 0u) << with_cube["kept_nominal"];
+  EXPECT_EQ(with_cube["kept_nominal_undone"].get<int>(), 1);
+  EXPECT_TRUE(with_cube["safe"].get<bool>()) << with_cube["unsafe"];
+  EXPECT_NE(cubed.err.find("was checked worse than the steered one"), std::string::npos)
+      << cubed.err;
 }
 
 // The nominal axes are kept only where they clear the motions too: the same pass with postures

@@ -142,13 +142,21 @@ TEST(PathBlocks, GapsSplitPassesAtFourMedianSteps) {
   TempDir dir;
   const PathFile path = geometry::readPathFile(dir.write("g.cl", text));
   ASSERT_EQ(path.blocks.size(), 1u);
-  const auto passes = nominalPasses(path, PathParams{}, kR);
+  NominalDropped split;
+  const auto passes = nominalPasses(path, PathParams{}, kR, &split);
   ASSERT_EQ(passes.size(), 2u);
   EXPECT_EQ(passes[0].samples.size(), 11u);
   EXPECT_NEAR(passes[0].length_mm, 5.0, 1e-9);
+  // The move between them, said (generate's note): after line 11, 2.1 mm, over 4 x 0.5.
+  ASSERT_EQ(split.gaps.size(), 1u);
+  EXPECT_EQ(split.gaps[0].at, 11u);
+  EXPECT_NEAR(split.gaps[0].move_mm, 2.1, 1e-9);
+  EXPECT_NEAR(split.gaps[0].gap_mm, 2.0, 1e-9);
   PathParams wide;
   wide.pass_gap_mm = 3.0;
-  EXPECT_EQ(nominalPasses(path, wide, kR).size(), 1u);
+  NominalDropped none;
+  EXPECT_EQ(nominalPasses(path, wide, kR, &none).size(), 1u);
+  EXPECT_TRUE(none.gaps.empty());
 
   // DESIGN's gap is the tips': tips 0.5 mm apart whose axis swings 60 deg once throw the ball
   // centre 3 mm (> 4 × 0.5), one pass still (it read as two, with a link generate made in it,
@@ -287,6 +295,27 @@ TEST(NominalPasses, ApproachesAndRetractsAtFeedAreTheLinks) {
   ASSERT_EQ(after_gap.size(), 1u);
   EXPECT_DOUBLE_EQ(after_gap[0].length_mm, 10.0);
   EXPECT_EQ(alone.axial, 1u);
+  // Straight down z with the tool tilted 11.3 deg (within 30 deg of its axis), in steps no gap
+  // parts from the cut: an approach too, and the pass is named by its first cut line.
+  std::string tilted_cut;
+  for (int x = 0; x <= 10; ++x)
+    tilted_cut += std::to_string(x) + " 0 0 0 0.19611613513818402 0.98058067569092010\n";
+  const auto tilted = dir.write("tilted.cl",
+                                "0 0 3 0 0.19611613513818402 0.98058067569092010\n0 0 1.5 0 "
+                                "0.19611613513818402 0.98058067569092010\n" +
+                                    tilted_cut);
+  NominalDropped down_z;
+  const auto tilted_passes = nominalPasses(geometry::readPathFile(tilted), {}, kR, &down_z);
+  ASSERT_EQ(tilted_passes.size(), 1u);
+  EXPECT_EQ(down_z.axial, 2u);
+  EXPECT_NE(tilted_passes[0].label.find("tilted.cl:3"), std::string::npos)
+      << tilted_passes[0].label;
+  // A plunge down the axis at the end is no retract: the cut's, refused at its line (it was
+  // dropped as a retract, its cut lost: a reviewer's).
+  const auto plunge_end = dir.write("plunge_end.cl", cut + "10 0 -1 0 0 1\n");
+  const std::string end_error =
+      errorOf([&] { nominalPasses(geometry::readPathFile(plunge_end), {}, kR); });
+  EXPECT_NE(end_error.find("along the tool axis"), std::string::npos) << end_error;
   // Down the axis in the middle of the cut (a step down a floor): the cut's, kept.
   std::string dip;
   for (int x = 0; x <= 5; ++x) dip += std::to_string(x) + " 0 0 0 0 1\n";

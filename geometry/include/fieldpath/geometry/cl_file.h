@@ -66,6 +66,9 @@ struct PathFile {
   /// APT: the line of the first `FROM/` record (0: none). Read past: the machine's move from
   /// that start point to the first GOTO is no motion of the path, and not checked.
   std::size_t from_line = 0;
+  /// APT: the line of the first `MSYS/` record that is not the identity (0: none). Read past:
+  /// the path is taken in the file's coordinates, not shifted nor turned into the frame it names.
+  std::size_t msys_line = 0;
 
   /// "FILE:LINE" or "FILE: row R" of posture i, for messages.
   std::string where(std::size_t i) const;

@@ -169,6 +169,9 @@ struct GenerateResult {
     std::size_t steered_under = 0;
   };
   std::vector<KeptNominal> kept_nominal;
+  /// Passes whose nominal axes cleared them but were not kept: the path linked to them was
+  /// checked worse than the steered one (pathFaults), and is not written.
+  std::size_t kept_nominal_undone = 0;
   StageTimes times;
   std::size_t obstacle_points = 0;  ///< field samples
   std::size_t tool_nodes = 0;       ///< tool + holder nodes of the moment

@@ -46,6 +46,9 @@ struct Pass {
   /// The station at any s in [0, length_mm] (clamped): cheap, deterministic, thread-safe, so the
   /// dynamics can call it at every solver stage.
   std::function<PassSample(double s_mm)> at;
+  /// A nominal pass's: "FILE:LINE" of the input posture at or before arc length s, for messages
+  /// that stop at a station (`on_limit: fail` named the pass's first line only); empty: none.
+  std::function<std::string(double s_mm)> whereAt;
 };
 
 /// The `passes` passes at v evenly spread over impeller.passes_v, covering u_range, for a ball
@@ -54,6 +57,13 @@ struct Pass {
 /// pass shorter than one step.
 std::vector<Pass> impellerPasses(const Impeller& impeller, const PathParams& path,
                                  double ball_radius_mm);
+
+/// Where a gap split a pass block (`gaps` of passRanges): the posture after the gap, the move's
+/// tip length and the gap it exceeded (mm).
+struct GapSplit {
+  std::size_t at = 0;
+  double move_mm = 0.0, gap_mm = 0.0;
+};
 
 /// The passes of a nominal path: its pass blocks (link blocks dropped), each split where two
 /// consecutive tips (and ball centres) are farther apart than `path.pass_gap` (0: 4 × the
@@ -74,6 +84,9 @@ struct NominalDropped {
   /// `first_axial` the first (npos: none).
   std::size_t axial = 0;
   std::size_t first_axial = static_cast<std::size_t>(-1);
+  /// The moves between two passes of one block that a gap split (passRanges): made into links,
+  /// not cut (a line written as one GOTO between arcs written fine is such a move: said).
+  std::vector<GapSplit> gaps;
 };
 std::vector<Pass> nominalPasses(const geometry::PathFile& path, const PathParams& params,
                                 double ball_radius_mm, NominalDropped* dropped = nullptr);
@@ -98,7 +111,8 @@ double centreNoiseMm(double median_step_mm);
 /// a new pass, and its turn went uncounted).
 std::vector<std::pair<std::size_t, std::size_t>> passRanges(const geometry::PathFile& path,
                                                             double pass_gap_mm,
-                                                            double ball_radius_mm);
+                                                            double ball_radius_mm,
+                                                            std::vector<GapSplit>* gaps = nullptr);
 
 /// geometry::requireSteadyAxis for every two consecutive postures of every pass block but
 /// those that passRanges (`pass_gap_mm`: the scene's path.pass_gap, 0 automatic, as generate
