@@ -284,6 +284,10 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       path_notes.push_back(path.file.string() + ":" + std::to_string(path.msys_line) +
                            ": MSYS/ (a frame shifted or turned) is read past: the path is checked "
                            "in the file's coordinates, where the scene's meshes are");
+    if (path.cutcom_line > 0)
+      path_notes.push_back(path.file.string() + ":" + std::to_string(path.cutcom_line) +
+                           ": CUTCOM/ (the control's cutter offset) is read past: the path is "
+                           "checked where it is written, not where the offset puts the tool");
     const pathgen::AxisTurn axis_turn = pathgen::largestAxisTurn(path, scene.tool.radius_mm);
 
     // (a) exact clearance of postures and motions

@@ -45,16 +45,15 @@ std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool,
       file_tool += " with a " + mm(c.corner_mm) + " mm corner";
     else
       file_tool += " with no corner radius given (in APT, a flat end mill)";
-    notes.push_back(path.file.string() + ":" + std::to_string(c.line) +
-                    ": CUTTER says the path was written for " + file_tool +
-                    "; the scene's tool is " + toolWords(tool) +
-                    ": what follows is for the scene's tool, not the file's");
+    notes.push_back(path.file.string() + ":" + std::to_string(c.line) + ": " + c.record +
+                    " says the path was written for " + file_tool + "; the scene's tool is " +
+                    toolWords(tool) + ": what follows is for the scene's tool, not the file's");
   }
   if (notes.size() > kMaxLines) {
     const std::size_t more = notes.size() - (kMaxLines - 1);
     notes.resize(kMaxLines - 1);
     notes.push_back(path.file.string() + ": " + std::to_string(more) +
-                    " more CUTTER records differ from the scene's tool");
+                    " more CUTTER / TLDATA records differ from the scene's tool");
   }
   return notes;
 }

@@ -62,6 +62,11 @@ pathgen::GenerateRequest sceneJob(const Scene& scene) {
                  "note: %s:%zu: MSYS/ (a frame shifted or turned) is read past: the path is "
                  "taken in the file's coordinates, where the scene's meshes are\n",
                  scene.nominal->file.string().c_str(), scene.nominal->msys_line);
+  if (!impeller && scene.nominal->cutcom_line > 0)
+    std::fprintf(stderr,
+                 "note: %s:%zu: CUTCOM/ (the control's cutter offset) is read past: the path is "
+                 "taken where it is written\n",
+                 scene.nominal->file.string().c_str(), scene.nominal->cutcom_line);
   if (!dropped.gaps.empty()) {
     // Which moves of the file are not cut: a long cutting move split off as a link (a line
     // written as one GOTO between arcs written fine: a CAM engineer's floor cut went unsaid).

@@ -386,7 +386,12 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
       // (the points up to the last station were taken: gridAt(update) lies past it)
       for (; gridAt(update) < s_mm - 1e-9; ++update) {
         if (!advanceTo(gridAt(update))) break;
-        if (system.updateDamping(gridAt(update), y))
+        // From the angles held at the limits, as at a station (the limits are held there: a
+        // station 1.5e-9 mm off a grid point took it from beyond them and settled 2 deg
+        // elsewhere, a reviewer's); the state itself runs on.
+        std::array<double, kStateSize> held = y;
+        checkAngles(request.params, LimitPolicy::Clamp, held);
+        if (system.updateDamping(gridAt(update), held))
           integrator->restart(gridAt(update) / v, y.data());
       }
       if (result.status == Status::SolverFailed || !advanceTo(s_mm)) break;

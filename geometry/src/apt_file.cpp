@@ -162,6 +162,7 @@ struct AptChunk {
   std::vector<Feed> feeds;
   std::size_t from_line = 0;  ///< its first FROM record's line (0: none)
   std::size_t msys_line = 0;  ///< its first MSYS record that is not the identity (0: none)
+  std::size_t cutcom_line = 0;  ///< its first CUTCOM record that is not CUTCOM/OFF (0: none)
 };
 
 /// The leading finite numbers of comma-separated `values` (at most `max`, into v): how many.
@@ -303,6 +304,12 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
       if (out.from_line == 0) out.from_line = record_line;
       continue;
     }
+    if (major == "CUTCOM") {  // the control's offset of the cutter: read past, said unless OFF
+      const bool off = slash != std::string::npos &&
+                       trimmed(std::string_view(statement).substr(slash + 1)).starts_with("OFF");
+      if (!off && out.cutcom_line == 0) out.cutcom_line = record_line;
+      continue;
+    }
     if (major == "MSYS") {  // origin, x axis, y axis: read past, a shifted or turned frame said
       double v[9] = {};
       const bool identity =
@@ -317,6 +324,16 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
       if (slash != std::string::npos)
         if (auto cutter = cutterOf(std::string_view(statement).substr(slash + 1), record_line))
           out.cutters.emplace_back(out.units.size(), *cutter);
+      continue;
+    }
+    if (major == "TLDATA" && slash != std::string::npos) {  // TLDATA/MILL, d, r, ...: a cutter
+      const std::string_view values = trimmed(std::string_view(statement).substr(slash + 1));
+      const auto comma = values.find(',');
+      if (trimmed(values.substr(0, comma)) == "MILL" && comma != std::string_view::npos)
+        if (auto cutter = cutterOf(values.substr(comma + 1), record_line)) {
+          cutter->record = "TLDATA";
+          out.cutters.emplace_back(out.units.size(), *cutter);
+        }
       continue;
     }
     if (major == "UNITS") {
@@ -420,7 +437,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   std::vector<std::size_t> link_postures;
   std::vector<PathFile::Cutter> cutters;
   std::vector<PathFile::Feed> feeds;
-  std::size_t from_line = 0, msys_line = 0;
+  std::size_t from_line = 0, msys_line = 0, cutcom_line = 0;
   bool pending = false, ended = false;
   double scale = 1.0;
   std::size_t offset = 0;
@@ -438,6 +455,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
     ended = c.fini;
     if (from_line == 0) from_line = c.from_line;
     if (msys_line == 0) msys_line = c.msys_line;
+    if (cutcom_line == 0) cutcom_line = c.cutcom_line;
     for (auto& [units_before, cutter] : c.cutters) {  // in the unit of the record before it
       const double unit = units_before ? c.units[units_before - 1].second : scale;
       cutter.diameter_mm *= unit;
@@ -482,6 +500,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   path.cutters = std::move(cutters);
   path.from_line = from_line;
   path.msys_line = msys_line;
+  path.cutcom_line = cutcom_line;
   for (const PathFile::Feed& f : feeds)
     if (f.from < offset) path.feeds.push_back(f);  // a FEDRAT after the last GOTO feeds nothing
   if (offset == 0) throw InputError(file.string() + ": no GOTO records");

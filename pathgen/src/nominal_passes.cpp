@@ -24,10 +24,10 @@ constexpr double kRepeatMm = 1e-9;
 /// The nominal axis must be at least this far from the feed direction (sin of 0.5°): closer, the
 /// frame's normal is the rounding noise of a projection.
 constexpr double kMinAxisToFeedSin = 0.0087;
-/// A step at a pass's end within this of the tool axis (deg), down it before the cut or up it
-/// after, is an approach or a retract (a link's): a ball-end mill does not finish along its axis,
-/// and a frame with the feed that near the axis lays the nominal axis over (an approach
-/// straight down z with the tool tilted 11 deg was turned 66 deg within its pass: a reviewer's).
+/// A move into a lone posture a gap parts from the rest of its block within this of the tool axis
+/// (deg) is an approach's start above the cut or a retract's end (the link's); a lone posture
+/// reached across the axis is a cut written as its two ends, refused as before (a regression
+/// hunt: a 7 mm line on the floor written so was dropped from every pass).
 constexpr double kApproachDeg = 30.0;
 
 /// The vertices of one pass: ball centres, arc lengths, tangents, normals.
@@ -162,12 +162,23 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
       }
       kept.push_back(i);
     }
-    // A lone posture that a gap parts from the cut of its block (an approach's start above the
-    // part, written after FEDRAT: a verifier's "pass 1 has a single posture") is the link's too.
-    const bool whole_block =
-        std::any_of(path.blocks.begin(), path.blocks.end(),
-                    [&](const PathBlock& b) { return b.begin == begin && b.end == end; });
-    if (kept.size() < 2 && !whole_block) {
+    // A lone posture that a gap parts from the cut of its block, reached along the tool axis
+    // (within kApproachDeg): an approach's start above the cut, written after FEDRAT (a
+    // verifier's "pass 1 has a single posture"), or a retract's end: the link's too.
+    const auto block =
+        std::find_if(path.blocks.begin(), path.blocks.end(),
+                     [&](const PathBlock& b) { return b.begin <= begin && begin < b.end; });
+    const auto steepTo = [&](std::size_t neighbour) {  // the move between it and a neighbour
+      const Vec3 step = geometry::ballCentre(path.postures[neighbour], r) -
+                        geometry::ballCentre(path.postures[begin], r);
+      return std::abs(path.postures[begin].axis.dot(step)) >=
+             std::cos(kApproachDeg * M_PI / 180.0) * step.norm();
+    };
+    const bool lone_approach =
+        kept.size() < 2 && block != path.blocks.end() &&
+        !(block->begin == begin && block->end == end) &&
+        ((end < block->end && steepTo(end)) || (begin > block->begin && steepTo(begin - 1)));
+    if (lone_approach) {
       if (said.axial == 0) said.first_axial = begin;
       said.axial += kept.size();
       continue;
@@ -183,17 +194,18 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
       throw InputError(msg.str());
     }
     // An approach down the tool axis at feed before the cut, and a retract up it after (CAM
-    // systems write them as feed moves: FEDRAT, GOTO down the axis; or straight down z with the
-    // tool tilted), are the link's: links are made anew, and a step along the axis has no frame
-    // (a verifier's APT was refused at its approach). A step within kApproachDeg of the axis,
-    // down it at the start, up it at the end, of a pass that cuts (a pass all along its axis is
+    // systems write them as feed moves: FEDRAT, GOTO down the axis), are the link's: links are
+    // made anew, and a step along the axis has no frame (a verifier's APT was refused at its
+    // approach). Only steps along the axis (within kMinAxisToFeedSin), which had been refused:
+    // within 30 deg it dropped a ball's climb of a 75 deg wall, a cut (a regression hunt). Down
+    // it at the start, up it at the end, of a pass that cuts (a pass all along its axis is
     // refused below, naming its line; a plunge down the axis at the end is the cut's).
     const auto alongAxis = [&](std::size_t from, std::size_t to) {  // cos(step, axis)
       const Vec3 step = geometry::ballCentre(path.postures[kept[to]], r) -
                         geometry::ballCentre(path.postures[kept[from]], r);
       return path.postures[kept[from]].axis.dot(step) / step.norm();
     };
-    const double steep = std::cos(kApproachDeg * M_PI / 180.0);
+    const double steep = std::sqrt(1.0 - kMinAxisToFeedSin * kMinAxisToFeedSin);
     std::size_t head = 0, tail = kept.size();
     bool cuts = false;
     for (std::size_t k = 1; k < kept.size() && !cuts; ++k)

@@ -166,9 +166,32 @@ TEST(ConvertFeeds, FromIsReadPastAndSaid) {
       nlohmann::json::parse(slurp(dir.path() / "out2" / "check.json"))["path_notes"].empty());
 }
 
-// A non-identity MSYS (a frame shifted or turned) is read past, and said: the path is taken in the
-// file's coordinates (a CAM engineer's MSYS/0,-5,0 put the ball 1 mm into a wall the check read
-// 3.98 mm clear, unsaid); the identity is no note. Whatever the chunks.
+// The tool of `TLDATA/MILL, d, r, ...` (as NX writes it) is compared with the scene's, as CUTTER's
+// is: a 16 mm flat end mill against a 6 mm ball went unsaid (a CAM engineer's); TLDATA of
+// another kind is not a cutter.
+TEST(ConvertFeeds, TldataMillIsTheFilesCutter) {
+  const TempDir dir;
+  dir.write("nx.cls",
+            "TLDATA/MILL,16.0000,0.0000,50.0000,0.0000,0.0000\nTLDATA/DRILL,5,118\n"
+            "GOTO/0,0,5,0,0,1\nGOTO/5,0,5\n");
+  const PathFile read = geometry::readPathFile(dir.path() / "nx.cls");
+  ASSERT_EQ(read.cutters.size(), 1u);
+  EXPECT_EQ(read.cutters[0].record, "TLDATA");
+  EXPECT_EQ(read.cutters[0].diameter_mm, 16.0);
+  EXPECT_EQ(read.cutters[0].corner_mm, 0.0);
+  dir.write("wall.stl", squareStl(20.0, -30.0));
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, length: 40 }\n");
+  const Outcome check = runFieldpath(dir, "check scene.yaml --path nx.cls --out out");
+  EXPECT_NE(check.err.find("nx.cls:1: TLDATA says the path was written for a 16 mm cutter"),
+            std::string::npos)
+      << check.err;
+}
+
+// A non-identity MSYS (a frame shifted or turned), and a CUTCOM that is not OFF, are read past,
+// and said: the path is taken in the file's coordinates, where it is written (a CAM engineer's
+// MSYS/0,-5,0 put the ball 1 mm into a wall the check read 3.98 mm clear, unsaid); the identity is
+// no note. Whatever the chunks.
 TEST(ConvertFeeds, AShiftedMsysIsSaid) {
   const TempDir dir;
   const std::string motions = "GOTO/0,0,5,0,0,1\nGOTO/5,0,5\n";
@@ -189,6 +212,13 @@ TEST(ConvertFeeds, AShiftedMsysIsSaid) {
       << check.err;
   const Outcome same = runFieldpath(dir, "check scene.yaml --path identity.apt --out same");
   EXPECT_EQ(same.err.find("MSYS"), std::string::npos) << same.err;
+  // CUTCOM/LEFT too (the control's offset), CUTCOM/OFF not.
+  dir.write("cutcom.apt", "PARTNO/X\nCUTCOM / OFF\nCUTCOM/LEFT\n" + motions + "CUTCOM/OFF\n");
+  EXPECT_EQ(geometry::readPathFile(dir.path() / "cutcom.apt").cutcom_line, 3u);
+  const Outcome offset = runFieldpath(dir, "check scene.yaml --path cutcom.apt --out cc");
+  EXPECT_NE(offset.err.find("note: cutcom.apt:3: CUTCOM/ (the control's cutter offset) is read"),
+            std::string::npos)
+      << offset.err;
 }
 
 }  // namespace

@@ -47,7 +47,7 @@ TEST(CutterNotes, SaidWhenTheFileWasWrittenForAnotherTool) {
   const auto many =
       cutterNotes(ball, withCutters({{8, -1, 1}, {8, -1, 2}, {8, -1, 3}, {8, -1, 4}, {8, -1, 5}}));
   ASSERT_EQ(many.size(), 3u);
-  EXPECT_EQ(many[2], "job.apt: 3 more CUTTER records differ from the scene's tool");
+  EXPECT_EQ(many[2], "job.apt: 3 more CUTTER / TLDATA records differ from the scene's tool");
 }
 
 }  // namespace

@@ -182,3 +182,44 @@ TEST(CheckVerdict, APartThatIsAlsoAnObstacleIsSaid) {
   ASSERT_EQ(apart.exit_code, 0) << apart.output();
   EXPECT_EQ(apart.err.find("also an obstacle"), std::string::npos) << apart.err;
 }
+
+// A move from one pass straight into the next (no link between) is named with the pass it leaves,
+// at the line it leaves from (a helper read "pass 5" beside the last line of pass 4).
+TEST(CheckClearance, AMoveBetweenTwoPassesIsNamedWithThePassItLeaves) {
+  const TempDir dir;
+  geometry::TriangleMesh post;
+  pathgen::test::addBox(post, 8, 12, 9, 11, -5, 5);
+  geometry::saveMesh(post, dir.path() / "post.stl");
+  std::string cl = "# pass 1\n";
+  for (int i = 0; i <= 10; ++i) cl += "0 " + std::to_string(i) + " 0 0 0 1\n";
+  cl += "# pass 2\n";
+  for (int i = 10; i >= 0; --i) cl += "20 " + std::to_string(i) + " 0 0 0 1\n";
+  dir.write("two.cl", cl);
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: post.stl\ntool: { shape: ball, radius: 3, length: 40 }\n"
+            "clearance: 0.5\n");
+  const auto c = test::runFieldpath(dir, "check scene.yaml --path two.cl --out chk");
+  ASSERT_EQ(c.exit_code, 0) << c.output();
+  const auto checked = nlohmann::json::parse(test::slurp(dir.path() / "chk" / "check.json"));
+  EXPECT_EQ(checked["clearance"]["colliding_postures"].get<int>(), 0) << checked["clearance"];
+  ASSERT_EQ(checked["unsafe"].size(), 1u) << checked["unsafe"];
+  // Posture 10, the last of pass 1, on line 12 of the file.
+  EXPECT_NE(checked["unsafe"][0].get<std::string>().find(
+                "motions touch an obstacle (first: posture 10 to the next (pass 1, two.cl:12))"),
+            std::string::npos)
+      << checked["unsafe"];
+  EXPECT_EQ(checked["passes"].get<int>(), 2);
+  EXPECT_EQ(checked["passes_split_at_gaps"].get<int>(), 2);
+  // Without markers the file is one pass block, as clearance.csv and the reasons number it; the
+  // gap of 20 mm makes it two as generate would read it.
+  std::string plain = cl;
+  for (const char* marker : {"# pass 1\n", "# pass 2\n"}) plain.erase(plain.find(marker), 9);
+  dir.write("plain.cl", plain);
+  ASSERT_EQ(test::runFieldpath(dir, "check scene.yaml --path plain.cl --out plain").exit_code, 0);
+  const auto unmarked = nlohmann::json::parse(test::slurp(dir.path() / "plain" / "check.json"));
+  EXPECT_EQ(unmarked["passes"].get<int>(), 1);
+  EXPECT_EQ(unmarked["passes_split_at_gaps"].get<int>(), 2);
+  EXPECT_NE(unmarked["unsafe"][0].get<std::string>().find("(pass 1, plain.cl:11))"),
+            std::string::npos)
+      << unmarked["unsafe"];
+}

@@ -295,8 +295,9 @@ TEST(NominalPasses, ApproachesAndRetractsAtFeedAreTheLinks) {
   ASSERT_EQ(after_gap.size(), 1u);
   EXPECT_DOUBLE_EQ(after_gap[0].length_mm, 10.0);
   EXPECT_EQ(alone.axial, 1u);
-  // Straight down z with the tool tilted 11.3 deg (within 30 deg of its axis), in steps no gap
-  // parts from the cut: an approach too, and the pass is named by its first cut line.
+  // Straight down z with the tool tilted 11.3 deg, in steps no gap parts from the cut: not along
+  // the axis, so the cut's (a ball climbing a 75 deg wall with the axis upright steps 15 deg off
+  // it, and was dropped as an approach when 30 deg did: a regression hunt).
   std::string tilted_cut;
   for (int x = 0; x <= 10; ++x)
     tilted_cut += std::to_string(x) + " 0 0 0 0.19611613513818402 0.98058067569092010\n";
@@ -307,9 +308,19 @@ TEST(NominalPasses, ApproachesAndRetractsAtFeedAreTheLinks) {
   NominalDropped down_z;
   const auto tilted_passes = nominalPasses(geometry::readPathFile(tilted), {}, kR, &down_z);
   ASSERT_EQ(tilted_passes.size(), 1u);
-  EXPECT_EQ(down_z.axial, 2u);
-  EXPECT_NE(tilted_passes[0].label.find("tilted.cl:3"), std::string::npos)
-      << tilted_passes[0].label;
+  EXPECT_EQ(down_z.axial, 0u);
+  EXPECT_EQ(tilted_passes[0].samples.size(), 13u);
+  // Along the axis, the pass is named by its first cut line.
+  const auto along = dir.write("along.cl", "0 0 3 0 0 1\n0 0 1.5 0 0 1\n" + cut);
+  const auto along_passes = nominalPasses(geometry::readPathFile(along), {}, kR);
+  ASSERT_EQ(along_passes.size(), 1u);
+  EXPECT_NE(along_passes[0].label.find("along.cl:3"), std::string::npos) << along_passes[0].label;
+  // A cut written as its two ends at a pass's start (7 mm along the floor, then steps of 1 mm):
+  // the lone posture is reached across the axis, no approach: refused as before, not dropped.
+  std::string two_ends = "-7 0 0 0 0 1\n" + cut;
+  const std::string lone_cut = errorOf(
+      [&] { nominalPasses(geometry::readPathFile(dir.write("ends2.cl", two_ends)), {}, kR); });
+  EXPECT_NE(lone_cut.find("a single posture"), std::string::npos) << lone_cut;
   // A plunge down the axis at the end is no retract: the cut's, refused at its line (it was
   // dropped as a retract, its cut lost: a reviewer's).
   const auto plunge_end = dir.write("plunge_end.cl", cut + "10 0 -1 0 0 1\n");

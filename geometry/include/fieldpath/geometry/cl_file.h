@@ -47,6 +47,9 @@ struct PathFile {
     double diameter_mm = 0.0;
     double corner_mm = -1.0;  ///< -1: not given
     std::size_t line = 0;     ///< 1-based
+    /// The record: CUTTER, or TLDATA (`TLDATA/MILL,d,r,...`, as NX writes the tool: a 16 mm flat
+    /// end mill there against a 6 mm ball in the scene went unsaid).
+    std::string record = "CUTTER";
   };
   std::vector<Cutter> cutters;
   /// The safety marks `generate` and `check` write at the top of a path: `# UNSAFE TO RUN: ...`
@@ -69,6 +72,9 @@ struct PathFile {
   /// APT: the line of the first `MSYS/` record that is not the identity (0: none). Read past:
   /// the path is taken in the file's coordinates, not shifted nor turned into the frame it names.
   std::size_t msys_line = 0;
+  /// APT: the line of the first `CUTCOM/` record that is not `CUTCOM/OFF` (0: none). Read past:
+  /// the control's cutter offset is not applied, the path is taken where it is written.
+  std::size_t cutcom_line = 0;
 
   /// "FILE:LINE" or "FILE: row R" of posture i, for messages.
   std::string where(std::size_t i) const;
