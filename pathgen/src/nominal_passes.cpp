@@ -165,9 +165,12 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
     // A lone posture that a gap parts from the cut of its block, reached along the tool axis
     // (within kApproachDeg): an approach's start above the cut, written after FEDRAT (a
     // verifier's "pass 1 has a single posture"), or a retract's end: the link's too.
+    // (its block looked up only for a lone posture: a file of 100 000 passes has as many blocks)
     const auto block =
-        std::find_if(path.blocks.begin(), path.blocks.end(),
-                     [&](const PathBlock& b) { return b.begin <= begin && begin < b.end; });
+        kept.size() >= 2
+            ? path.blocks.end()
+            : std::find_if(path.blocks.begin(), path.blocks.end(),
+                           [&](const PathBlock& b) { return b.begin <= begin && begin < b.end; });
     const auto steepTo = [&](std::size_t neighbour) {  // the move between it and a neighbour
       const Vec3 step = geometry::ballCentre(path.postures[neighbour], r) -
                         geometry::ballCentre(path.postures[begin], r);
