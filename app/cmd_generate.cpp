@@ -516,8 +516,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                             : "note: %zu pass%s came under the required clearance steered "
                               "(first: %s, %zu postures under it there or on the move to the "
                               "next: the tilt away from one obstacle brought the tool nearer "
-                              "another) and %s written with the nominal axes, which keep it "
-                              "(report.json kept_nominal)\n",
+                              "another) and %s written with the nominal axes, which come less "
+                              "near (report.json kept_nominal)\n",
                    n, n == 1 ? "" : "es", first->label.c_str(),
                    collided ? first->steered_colliding : first->steered_under,
                    n == 1 ? "is" : "are");

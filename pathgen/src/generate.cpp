@@ -564,7 +564,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
     if (keepClearNominalPasses(request, checker, result, part_marks)) {
       common::report(request.progress, steer_end, "passes kept nominal: checked again");
       linkAndCheck();
-      if (pathFaults(request, result) > pathFaults(request, steered)) {
+      if (pathFaults(result) > pathFaults(steered)) {
         steered.kept_nominal_undone = result.kept_nominal.size();
         result = std::move(steered);
         part_marks = steered_marks;

@@ -1,5 +1,7 @@
 #include "nominal_fallback.h"
 
+#include <algorithm>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -13,14 +15,18 @@ namespace fieldpath::pathgen {
 namespace {
 
 /// Per pass, the postures of the checked path that collide there or on the move to the pass's
-/// next posture, and those that come under the required clearance there without colliding.
+/// next posture, those that come under the required clearance there without colliding, and the
+/// least clearance of its postures and in-pass motions (mm).
 struct PassFaults {
   std::vector<std::size_t> colliding, under;
+  std::vector<double> min_mm;
 };
 PassFaults faultsByPass(const GenerateResult& result, double required_mm,
                         const std::optional<PartContacts::Marks>& part_marks) {
-  PassFaults out{std::vector<std::size_t>(result.passes.size(), 0),
-                 std::vector<std::size_t>(result.passes.size(), 0)};
+  PassFaults out{
+      std::vector<std::size_t>(result.passes.size(), 0),
+      std::vector<std::size_t>(result.passes.size(), 0),
+      std::vector<double>(result.passes.size(), std::numeric_limits<double>::infinity())};
   const auto& postures = result.postures;
   const auto& at = result.clearance.clearance_mm;
   const auto& moving = result.motions.clearance_mm;
@@ -30,12 +36,14 @@ PassFaults faultsByPass(const GenerateResult& result, double required_mm,
     bool under = i < at.size() && at[i] < required_mm;
     hit = hit || (part_marks && i < part_marks->posture.size() && part_marks->posture[i]);
     // The motion to the pass's next posture (a link's motions are the links').
+    const auto p = static_cast<std::size_t>(postures[k].pass);
+    if (i < at.size()) out.min_mm[p] = std::min(out.min_mm[p], at[i]);
     if (k + 1 < postures.size() && postures[k + 1].pass == postures[k].pass) {
       hit = hit || (i < moving.size() && moving[i] <= 0.0);
       under = under || (i < moving.size() && moving[i] < required_mm);
       hit = hit || (part_marks && i < part_marks->motion.size() && part_marks->motion[i]);
+      if (i < moving.size()) out.min_mm[p] = std::min(out.min_mm[p], moving[i]);
     }
-    const auto p = static_cast<std::size_t>(postures[k].pass);
     out.colliding[p] += hit;
     out.under[p] += !hit && under;
   }
@@ -44,18 +52,18 @@ PassFaults faultsByPass(const GenerateResult& result, double required_mm,
 
 /// Whether `postures` (one pass) clear the obstacles and the part (`part`: its model, prepared
 /// once for every pass tried: a 1 M-triangle part takes seconds) at every posture and motion,
-/// and with `keep_required` the obstacles by the required clearance too.
+/// the obstacles by more than `above_mm` (0: clear; the steered pass's least clearance: nearer
+/// to the required one than the steering came).
 bool clearPass(const GenerateRequest& request, const ClearanceChecker& checker,
                const std::shared_ptr<const ObstacleModel>& part,
-               const std::vector<geometry::Posture>& postures, bool keep_required) {
+               const std::vector<geometry::Posture>& postures, double above_mm) {
   const ClearanceResult at_postures = checker.check(postures);
-  if (at_postures.colliding > 0) return false;
-  if (keep_required && at_postures.min_clearance_mm < request.clearance_mm) return false;
+  if (at_postures.colliding > 0 || !(at_postures.min_clearance_mm > above_mm)) return false;
   MotionRequest motions;
   motions.required_mm = request.clearance_mm;
   motions.posture_clearance_mm = at_postures.clearance_mm;
   const MotionResult moved = checker.checkMotions(postures, motions);
-  if (moved.colliding > 0 || (keep_required && moved.under_required > 0)) return false;
+  if (moved.colliding > 0 || !(moved.min_clearance_mm > above_mm)) return false;
   if (!part) return true;
   const std::optional<LinkPartResult> holder =
       checkHolderAgainstPart(request.tool, request.holder, part, postures);
@@ -74,14 +82,12 @@ bool hasFaultyPasses(const GenerateRequest& request, const GenerateResult& resul
   return false;
 }
 
-std::pair<std::size_t, std::size_t> pathFaults(const GenerateRequest& request,
-                                               const GenerateResult& result) {
+std::pair<std::size_t, double> pathFaults(const GenerateResult& result) {
   std::size_t collisions = result.clearance.colliding + result.motions.colliding;
   for (const auto* part : {&result.link_part, &result.holder_part})
     if (*part) collisions += (*part)->colliding_postures + (*part)->colliding_motions;
-  std::size_t under = result.motions.under_required;
-  for (const double c : result.clearance.clearance_mm) under += c > 0.0 && c < request.clearance_mm;
-  return {collisions, under};
+  return {collisions,
+          -std::min(result.clearance.min_clearance_mm, result.motions.min_clearance_mm)};
 }
 
 bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceChecker& checker,
@@ -104,9 +110,11 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
         nominalPostures(std::span(&pass, 1), lead_rad, request.tool.radius_mm);
     if (request.part && !part) part = prepareObstacle(*request.part, "part");
     // A pass that collided steered takes axes that clear; one that only came under the required
-    // clearance, axes that keep it (a helper's channel: the tilt away from one fin brought the
-    // shank 0.45 mm from the other, leaning over it, where the nominal axes kept 0.64 of 0.5).
-    if (!clearPass(request, checker, part, nominal, colliding == 0)) continue;
+    // clearance, axes that come less near (a helper's channel: the tilt away from one fin
+    // brought the shank 0.45 mm from the other, leaning over it, where the nominal axes kept
+    // 0.64 of 0.5; a vertical-arc engage's steered pass came to 0.065, its nominal one 0.375).
+    if (!clearPass(request, checker, part, nominal, colliding == 0 ? faults.min_mm[p] : 0.0))
+      continue;
     for (std::size_t k = begin; k < end; ++k) {
       GeneratedPosture& g = result.postures[k];
       g.posture = nominal[k - begin];

@@ -28,11 +28,10 @@ bool hasFaultyPasses(const GenerateRequest& request, const GenerateResult& resul
                      const std::optional<PartContacts::Marks>& part_marks);
 
 /// How bad a checked path is, compared lexicographically: its collisions (postures and motions
-/// with the obstacles, the links and the holder in the part), then the postures and motions under
-/// the required clearance. A path written with nominal passes is kept only where it is no worse
-/// than the steered one by this: the links to a pass come down its new axes, and can meet what
-/// the steered ones missed (a reviewer's cube 400 mm up a nominal axis).
-std::pair<std::size_t, std::size_t> pathFaults(const GenerateRequest& request,
-                                               const GenerateResult& result);
+/// with the obstacles, the links and the holder in the part), then its least clearance of the
+/// obstacles, negated. A path written with nominal passes is kept only where it is no worse than
+/// the steered one by this: the links to a pass come down its new axes, and can meet what the
+/// steered ones missed (a reviewer's cube 400 mm up a nominal axis).
+std::pair<std::size_t, double> pathFaults(const GenerateResult& result);
 
 }  // namespace fieldpath::pathgen

@@ -404,12 +404,14 @@ TEST(GenerateEdges, APassTheSteeringBringsUnderTheClearanceKeepsNominalAxesThatK
   EXPECT_EQ(test::slurp(dir.path() / "steered/path.cl").find("UNDER THE REQUIRED"),
             std::string::npos);
   EXPECT_EQ(report["clearance"]["min_mm"], nominal["clearance"]["min_mm"]);
-  // Required 0.6 mm, which the nominal axes (0.55 mm) do not keep either: the steering stays,
-  // marked.
+  // Required 0.6 mm, which the nominal axes (0.55 mm) do not keep either: they still come less
+  // near than the steering (0.45), and are written, marked (a helper's vertical-arc engage: the
+  // steering came to 0.065 mm, its nominal axes 0.375, and the steering stayed).
   writeScene("0.6");
   ASSERT_EQ(test::runFieldpath(dir, "generate scene.yaml --out strict").exit_code, 0);
   const auto strict = nlohmann::json::parse(test::slurp(dir.path() / "strict/report.json"));
-  EXPECT_EQ(strict["kept_nominal"].size(), 0u) << strict["kept_nominal"];
+  EXPECT_EQ(strict["kept_nominal"].size(), 1u) << strict["kept_nominal"];
+  EXPECT_EQ(strict["clearance"]["min_mm"], nominal["clearance"]["min_mm"]);
   EXPECT_NE(test::slurp(dir.path() / "strict/path.cl").find("UNDER THE REQUIRED"),
             std::string::npos);
   // A cube up the nominal axis of the last posture: the link after the nominal pass comes down

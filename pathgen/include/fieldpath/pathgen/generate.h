@@ -157,8 +157,8 @@ struct GenerateResult {
   /// Passes that collided steered (with the obstacles, or the holder or the cutter with the
   /// part) and are written with their nominal axes, which clear them at every posture and motion
   /// (the part never repels: steering away from an obstacle can drive the holder into it); and
-  /// passes that came under the required clearance steered, written with nominal axes that keep
-  /// it at every posture and motion.
+  /// passes that came under the required clearance steered, written with nominal axes that come
+  /// less near the obstacles at every posture and motion than the steered pass's nearest.
   struct KeptNominal {
     int pass = 0;                       ///< Pass::index
     std::string label;                  ///< the pass and its line
