@@ -267,8 +267,8 @@ std::string farLinkNote(const Scene& scene, const geometry::PathFile& path) {
   std::ostringstream note;
   note << std::fixed;
   note.precision(0);
-  note << "the links climb along the tool axis to the travel plane: posture " << at
-       << " of path.cl lies " << farthest_mm
+  note << "the links climb along the tool axis to the travel plane: " << postureWhere(path, at)
+       << " lies " << farthest_mm
        << " mm outside the meshes' x-y box; fixtures and the machine's travel are not in the "
           "scene, so check that room on the machine (a lower links.safe_z or a steeper axis at "
           "the pass ends shortens the climb)";

@@ -255,6 +255,13 @@ TEST(GenerateEdges, ALinkFarOutsideTheMeshesIsSaidInTheReport) {
       const double outside = std::stod(note.substr(note.find(" lies ") + 6));
       EXPECT_GT(outside, 120.0) << note;
       EXPECT_LT(outside, 200.0) << note;
+      // The posture named with its block and its line in path.cl, as the reader gives it.
+      const std::size_t open = note.find("travel plane: posture ") + 22;
+      const std::size_t at = std::stoul(note.substr(open));
+      const geometry::PathFile written = geometry::readPathFile(dir.path() / out / "path.cl");
+      EXPECT_NE(note.find("path.cl:" + std::to_string(written.lines.at(at)) + ") lies "),
+                std::string::npos)
+          << note;
     }
   }
 }
