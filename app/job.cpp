@@ -81,13 +81,13 @@ pathgen::GenerateRequest sceneJob(const Scene& scene) {
                  scene.nominal->where(g.at - 1).c_str(), scene.nominal->where(g.at).c_str(),
                  common::shortNumber(g.move_mm).c_str());
   }
-  if (dropped.axial > 0)
+  if (dropped.approaches > 0)
     std::fprintf(stderr,
                  "note: %zu posture%s of approaches and retracts at feed at the ends of passes "
                  "(moves along the tool axis, or a lone posture a gap parts from the cut; first: "
                  "%s) made into links: the passes start and end where the cut does\n",
-                 dropped.axial, dropped.axial == 1 ? "" : "s",
-                 scene.nominal->where(dropped.first_axial).c_str());
+                 dropped.approaches, dropped.approaches == 1 ? "" : "s",
+                 scene.nominal->where(dropped.first_approach).c_str());
   if (!impeller) {  // link blocks are dropped (links are made anew): said, with their size, as
     // a `# link` with no `# pass` or blank line after its moves takes the cutting that follows
     std::size_t blocks = 0, postures = 0, first = 0;

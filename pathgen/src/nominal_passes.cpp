@@ -182,8 +182,8 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
         !(block->begin == begin && block->end == end) &&
         ((end < block->end && steepTo(end)) || (begin > block->begin && steepTo(begin - 1)));
     if (lone_approach) {
-      if (said.axial == 0) said.first_axial = begin;
-      said.axial += kept.size();
+      if (said.approaches == 0) said.first_approach = begin;
+      said.approaches += kept.size();
       continue;
     }
     if (kept.size() < 2) {
@@ -216,8 +216,8 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
     while (cuts && alongAxis(head, head + 1) <= -steep) ++head;
     while (cuts && alongAxis(tail - 2, tail - 1) >= steep) --tail;
     if (head > 0 || tail < kept.size()) {
-      if (said.axial == 0) said.first_axial = kept[head > 0 ? 0 : tail];
-      said.axial += head + (kept.size() - tail);
+      if (said.approaches == 0) said.first_approach = kept[head > 0 ? 0 : tail];
+      said.approaches += head + (kept.size() - tail);
       kept = std::vector<std::size_t>(kept.begin() + head, kept.begin() + tail);
     }
     // A cutting move does not turn the axis over (repeats dropped: between the kept postures).

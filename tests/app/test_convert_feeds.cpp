@@ -36,6 +36,14 @@ std::vector<std::pair<int, std::string>> fedrats(const std::string& apt) {
   return out;
 }
 
+/// A scene of one wall 30 mm below the paths and a ball of radius 3: for what `check` says of a
+/// path file's records.
+void writeWallScene(const TempDir& dir) {
+  dir.write("wall.stl", squareStl(20.0, -30.0));
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, length: 40 }\n");
+}
+
 TEST(ConvertFeeds, AnAptInputsFeedsAreWrittenBackWhereTheyWere) {
   const TempDir dir;
   // Pass 1 at 150 mm/min, a change within it to 3 in/min; a link; pass 2 in inches at 5 in/min
@@ -148,9 +156,7 @@ TEST(ConvertFeeds, FromIsReadPastAndSaid) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.err.find("from.apt:2: FROM/ (the start point) is not carried"), std::string::npos)
       << run.err;
-  dir.write("wall.stl", squareStl(20.0, -30.0));
-  dir.write("scene.yaml",
-            "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, length: 40 }\n");
+  writeWallScene(dir);
   const Outcome check = runFieldpath(dir, "check scene.yaml --path from.apt --out out");
   EXPECT_NE(check.err.find("note: from.apt:2: FROM/ (the start point) is read past: the machine's "
                            "move from it to the first GOTO is not checked"),
@@ -179,9 +185,7 @@ TEST(ConvertFeeds, TldataMillIsTheFilesCutter) {
   EXPECT_EQ(read.cutters[0].record, "TLDATA");
   EXPECT_EQ(read.cutters[0].diameter_mm, 16.0);
   EXPECT_EQ(read.cutters[0].corner_mm, 0.0);
-  dir.write("wall.stl", squareStl(20.0, -30.0));
-  dir.write("scene.yaml",
-            "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, length: 40 }\n");
+  writeWallScene(dir);
   const Outcome check = runFieldpath(dir, "check scene.yaml --path nx.cls --out out");
   EXPECT_NE(check.err.find("nx.cls:1: TLDATA says the path was written for a 16 mm cutter"),
             std::string::npos)
@@ -203,9 +207,7 @@ TEST(ConvertFeeds, AShiftedMsysIsSaid) {
     EXPECT_EQ(geometry::readPathFile(dir.path() / "shifted.apt", options).msys_line, 3u) << chunk;
     EXPECT_EQ(geometry::readPathFile(dir.path() / "identity.apt", options).msys_line, 0u) << chunk;
   }
-  dir.write("wall.stl", squareStl(20.0, -30.0));
-  dir.write("scene.yaml",
-            "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, length: 40 }\n");
+  writeWallScene(dir);
   const Outcome check = runFieldpath(dir, "check scene.yaml --path shifted.apt --out out");
   EXPECT_NE(check.err.find("note: shifted.apt:3: MSYS/ (a frame shifted or turned) is read past"),
             std::string::npos)

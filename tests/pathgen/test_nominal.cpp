@@ -286,15 +286,15 @@ TEST(NominalPasses, ApproachesAndRetractsAtFeedAreTheLinks) {
   EXPECT_EQ(passes[0].samples.size(), 11u);
   EXPECT_DOUBLE_EQ(passes[0].samples.front().centre_mm.x(), 0.0);
   EXPECT_DOUBLE_EQ(passes[0].samples.front().centre_mm.z(), kR);
-  EXPECT_EQ(dropped.axial, 3u);
-  EXPECT_EQ(dropped.first_axial, 0u);
+  EXPECT_EQ(dropped.approaches, 3u);
+  EXPECT_EQ(dropped.first_approach, 0u);
   // The approach's start 20 mm above, a gap from the cut: alone, dropped.
   const auto lone = dir.write("lone.cl", "0 0 20 0 0 1\n" + cut);
   NominalDropped alone;
   const auto after_gap = nominalPasses(geometry::readPathFile(lone), {}, kR, &alone);
   ASSERT_EQ(after_gap.size(), 1u);
   EXPECT_DOUBLE_EQ(after_gap[0].length_mm, 10.0);
-  EXPECT_EQ(alone.axial, 1u);
+  EXPECT_EQ(alone.approaches, 1u);
   // Straight down z with the tool tilted 11.3 deg, in steps no gap parts from the cut: not along
   // the axis, so the cut's (a ball climbing a 75 deg wall with the axis upright steps 15 deg off
   // it, and was dropped as an approach when 30 deg did: a regression hunt).
@@ -308,7 +308,7 @@ TEST(NominalPasses, ApproachesAndRetractsAtFeedAreTheLinks) {
   NominalDropped down_z;
   const auto tilted_passes = nominalPasses(geometry::readPathFile(tilted), {}, kR, &down_z);
   ASSERT_EQ(tilted_passes.size(), 1u);
-  EXPECT_EQ(down_z.axial, 0u);
+  EXPECT_EQ(down_z.approaches, 0u);
   EXPECT_EQ(tilted_passes[0].samples.size(), 13u);
   // Along the axis, the pass is named by its first cut line.
   const auto along = dir.write("along.cl", "0 0 3 0 0 1\n0 0 1.5 0 0 1\n" + cut);
@@ -337,7 +337,7 @@ TEST(NominalPasses, ApproachesAndRetractsAtFeedAreTheLinks) {
       nominalPasses(geometry::readPathFile(dir.write("dip.cl", dip)), {}, kR, &within);
   ASSERT_EQ(stepped.size(), 1u);
   EXPECT_EQ(stepped[0].samples.size(), 12u);
-  EXPECT_EQ(within.axial, 0u);
+  EXPECT_EQ(within.approaches, 0u);
 }
 
 TEST(NominalPasses, LargestAxisTurnIsOfThePassesAndItsClosedForm) {

@@ -81,9 +81,9 @@ struct NominalDropped {
   /// Postures of approaches and retracts written as feed moves at a pass's ends: reached by a
   /// move along the tool axis (down it before the cut, up it after), or alone between a gap and
   /// the cut of their block (an approach's start above the part): the link's, made anew;
-  /// `first_axial` the first (npos: none).
-  std::size_t axial = 0;
-  std::size_t first_axial = static_cast<std::size_t>(-1);
+  /// `first_approach` the first (npos: none).
+  std::size_t approaches = 0;
+  std::size_t first_approach = static_cast<std::size_t>(-1);
   /// The moves between two passes of one block that a gap split (passRanges): made into links,
   /// not cut (a line written as one GOTO between arcs written fine is such a move: said).
   std::vector<GapSplit> gaps;
