@@ -27,6 +27,7 @@
 #include "fieldpath/field/voxel_field.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/units.h"
+#include "generate_repairs.h"
 #include "job.h"
 #include "json_text.h"
 #include "progress.h"
@@ -98,12 +99,6 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
   json passes = json::array();
   json settled = json::array();  // 1-based, as per_pass
   for (const int p : r.settled_starts) settled.push_back(p + 1);
-  json kept_nominal = json::array();
-  for (const auto& k : r.kept_nominal)
-    kept_nominal.push_back({{"pass", k.pass + 1},
-                            {"at", k.label},
-                            {"steered_colliding", k.steered_colliding},
-                            {"steered_under_required", k.steered_under}});
   json balls_under = json::array();
   for (const auto& b : r.balls_under_clearance)
     balls_under.push_back({{"pass", b.pass + 1},
@@ -192,7 +187,9 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
         {"retract_mm", job.links.retract_mm},
         {"safe_z_mm", r.safe_z_mm},
         {"safe_z", job.links.safe_z_mm ? "given" : "auto: highest mesh point + clearance + 2 mm"},
-        {"max_turn_deg", pathgen::kMaxLinkTurnDeg}}},
+        {"max_turn_deg", pathgen::kMaxLinkTurnDeg},
+        {"routed_off_axis", routedLinkEndsJson(r)},
+        {"routed_off_axis_undone", r.routed_link_ends_undone}}},
       {"limits",
        {{"on_limit", job.dynamics.on_limit == dynamics::LimitPolicy::Clamp ? "clamp" : "fail"},
         {"max_tilt_deg", job.dynamics.max_tilt_deg},
@@ -208,7 +205,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"max_lead_deg", r.max_lead_deg},
       // The balls themselves within `clearance` (no axis clears them): what marks such a path.
       {"balls_under_clearance", balls_under},
-      {"kept_nominal", kept_nominal},
+      {"kept_nominal", keptNominalJson(r)},
       {"kept_nominal_undone", r.kept_nominal_undone},
       {"axis_turn", axisTurnJson(axis_turn)},
       {"start",
@@ -499,35 +496,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
             dogLegNote(result.path, dog_leg, result.motions, scene.part.has_value());
         !rapids.empty())
       std::fprintf(stderr, "note: %s (report.json dog_leg_rapids)\n", rapids.c_str());
-    // Passes kept nominal: those that collided steered (a warning), and those that only came
-    // under the required clearance steered (a note: the path written keeps it).
-    for (const bool collided : {true, false}) {
-      std::size_t n = 0;
-      const pathgen::GenerateResult::KeptNominal* first = nullptr;
-      for (const auto& k : result.kept_nominal)
-        if ((k.steered_colliding > 0) == collided) n += 1, first = first ? first : &k;
-      if (n == 0) continue;
-      std::fprintf(stderr,
-                   collided ? "warning: %zu pass%s collided steered (first: %s, %zu postures "
-                              "colliding there or on the move to the next: the field of the "
-                              "obstacles turned the tool into them or into the part, which never "
-                              "repels) and %s written with the nominal axes, which clear the "
-                              "obstacles and the part (report.json kept_nominal)\n"
-                            : "note: %zu pass%s came under the required clearance steered "
-                              "(first: %s, %zu postures under it there or on the move to the "
-                              "next: the tilt away from one obstacle brought the tool nearer "
-                              "another) and %s written with the nominal axes, which come less "
-                              "near (report.json kept_nominal)\n",
-                   n, n == 1 ? "" : "es", first->label.c_str(),
-                   collided ? first->steered_colliding : first->steered_under,
-                   n == 1 ? "is" : "are");
-    }
-    if (result.kept_nominal_undone > 0)
-      std::fprintf(stderr,
-                   "note: %zu pass%s cleared with the nominal axes, but the path linked to them "
-                   "(the links come down the new axes) was checked worse than the steered one: "
-                   "the steering is written (report.json kept_nominal_undone)\n",
-                   result.kept_nominal_undone, result.kept_nominal_undone == 1 ? "" : "es");
+    printRepairs(result);
     if (!result.balls_under_clearance.empty()) {
       const auto& b = result.balls_under_clearance.front();
       std::fprintf(stderr,

@@ -22,8 +22,8 @@
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/geometry/units.h"
 #include "fieldpath/pathgen/reach_box.h"
-#include "nominal_fallback.h"
 #include "open_sheets.h"
+#include "path_check.h"
 
 namespace fieldpath::pathgen {
 namespace {
@@ -501,82 +501,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
 
   // ---- links, then the exact clearance of every posture and motion ----------------------------
   const auto clearance_start = Clock::now();
-  std::optional<PartContacts::Marks> part_marks;  // of result.path, where the part is touched
-  const auto linkAndCheck = [&] {
-    std::vector<std::vector<geometry::Posture>> pass_postures(result.passes.size());
-    for (const GeneratedPosture& g : result.postures) pass_postures[g.pass].push_back(g.posture);
-    result.link_postures = 0;
-    result.path = {};
-    if (request.passes_only) {
-      for (const auto& postures : pass_postures)
-        for (const auto& p : postures) result.path.postures.push_back(p);
-      result.path = geometry::singlePass(std::move(result.path.postures));
-    } else {
-      LinkRequest links;
-      links.params = request.links;
-      links.tool = tool;
-      links.holder = request.holder;
-      links.safe_z_mm = safe_z_mm;
-      result.safe_z_mm = links.safe_z_mm;
-      result.path = linkPasses(pass_postures, links);
-    }
-    // Where each pass posture landed in the output path.
-    {
-      std::size_t next = 0;
-      for (const geometry::PathBlock& block : result.path.blocks) {
-        if (block.kind == geometry::PathBlock::Kind::Link) {
-          result.link_postures += block.size();
-          continue;
-        }
-        for (std::size_t i = block.begin; i < block.end; ++i) result.postures[next++].output = i;
-      }
-    }
-    for (const GeneratedPosture& g : result.postures)
-      if (g.limited) result.path.limited.push_back(g.output);
-    result.clearance = checker.check(
-        result.path.postures, {}, scaled(request.progress, steer_end, clearance_end, "clearance"));
-    if (!request.passes_only) {
-      MotionRequest motions;
-      motions.required_mm = request.clearance_mm;
-      motions.posture_clearance_mm = result.clearance.clearance_mm;
-      result.motions =
-          checker.checkMotions(result.path.postures, motions,
-                               scaled(request.progress, clearance_end, motions_end, "motions"));
-      if (request.part) {
-        // With its own progress: the cutter's stamps along 46 000 postures took 95 s after the
-        // motions' 100 %, with no word (a scale sweep's finding).
-        PartContacts contacts =
-            checkAgainstPart(tool, request.holder, *request.part, result.path, kGougeToleranceMm,
-                             scaled(request.progress, motions_end, 1.0, "part"));
-        part_marks = contacts.marks(result.path.postures.size());
-        result.link_part = std::move(contacts.links);
-        result.holder_part = std::move(contacts.holder);
-        result.cutter_part = std::move(contacts.cutter);
-      }
-    }
-  };
-  linkAndCheck();
-  if (!request.nominal && !request.passes_only && hasFaultyPasses(request, result, part_marks)) {
-    // The steered path, kept until the one with nominal passes is checked no worse (its links
-    // come down the new axes): a copy only where a pass is faulty.
-    GenerateResult steered = result;
-    const std::optional<PartContacts::Marks> steered_marks = part_marks;
-    if (keepClearNominalPasses(request, checker, result, part_marks)) {
-      common::report(request.progress, steer_end, "passes kept nominal: checked again");
-      linkAndCheck();
-      if (pathFaults(result) > pathFaults(steered)) {
-        steered.kept_nominal_undone = result.kept_nominal.size();
-        result = std::move(steered);
-        part_marks = steered_marks;
-      }
-    }
-  }
-  for (GeneratedPosture& g : result.postures) {
-    g.clearance_mm = result.clearance.clearance_mm[g.output];
-    result.max_tilt_deg = std::max(result.max_tilt_deg, std::abs(g.tilt_rad) / kDegToRad);
-    result.max_lead_deg = std::max(result.max_lead_deg, std::abs(g.lead_rad) / kDegToRad);
-    result.limited_colliding += g.limited && g.clearance_mm <= 0.0;
-  }
+  linkCheckAndRepair(request, checker, safe_z_mm, {steer_end, clearance_end, motions_end}, result);
   result.times.clearance_s = seconds(clearance_start);
   result.times.total_s = seconds(start);
   if (request.keep_voxels) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/pathgen/generate.h"
 #include "fixtures.h"
 
@@ -232,4 +233,51 @@ TEST(Generate, APassBesideAWallDoesNotRingIntoTheFarWall) {
   const GenerateResult ringing = generatePath(spring_only);
   EXPECT_LT(ringing.clearance.min_clearance_mm, critical.clearance.min_clearance_mm - 0.3);
   EXPECT_GT(largest_turn_deg(ringing), 2.0 * largest_turn_deg(critical));
+}
+
+// A pass on a floor, its axis leaning 30 deg toward a shelf 15-20 mm up: the tool's top clears
+// the shelf's edge by 2.4 mm at the pass, but DESIGN's link (up the leaning axis) drives the
+// tool into the shelf (closed form: 10 mm up the axis its top is at y 11, z 19, in it). The
+// link ends go up another way, the axis held (straighter up: the tool's top stays under the
+// edge's side), and the path written is clear at every posture and motion.
+TEST(Generate, ALinkUpAnAxisIntoAShelfGoesUpAnotherWayTheAxisHeld) {
+  GenerateRequest job;
+  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 12.0};
+  job.mode = FieldMode::Direct;
+  job.nominal = true;
+  job.obstacles = {test::boxMesh(-20, 30, 11, 30, 15, 20)};
+  const double t = 30.0 * M_PI / 180.0;
+  const Vec3 axis(0.0, std::sin(t), std::cos(t));
+  std::vector<geometry::Posture> nominal;
+  for (int k = 0; k <= 20; ++k) nominal.push_back({Vec3(0.5 * k, 0, 0), axis, 0.0, false});
+  job.passes = nominalPasses(geometry::singlePass(std::move(nominal)), PathParams{}, 3.0);
+  ASSERT_EQ(job.passes.size(), 1u);
+
+  // The reference: the retract along the axis collides (the checker on its own).
+  const ClearanceChecker checker(geometry::toolMesh(job.tool, job.holder, kClearanceMeshTolMm),
+                                 std::span(job.obstacles), kClearanceMeshTolMm);
+  const geometry::Posture start{Vec3(0, 0, 0), axis, 0.0, false};
+  const geometry::Posture up_the_axis{Vec3(0, 0, 0) + job.links.retract_mm * axis, axis, 0.0,
+                                      false};
+  EXPECT_GT(checker.checkMotions(std::vector{start, up_the_axis}, MotionRequest{}).colliding, 0u);
+
+  const GenerateResult r = generatePath(job);
+  EXPECT_EQ(r.clearance.colliding, 0u);
+  EXPECT_EQ(r.motions.colliding, 0u);
+  EXPECT_GE(std::min(r.clearance.min_clearance_mm, r.motions.min_clearance_mm), job.clearance_mm);
+  ASSERT_EQ(r.routed_link_ends.size(), 2u);  // into the pass and out of it
+  EXPECT_EQ(r.routed_link_ends_undone, 0u);
+  for (const auto& end : r.routed_link_ends) {
+    EXPECT_GT(end.axis_collisions, 0u);
+    EXPECT_EQ(end.taken_collisions, 0u);
+    EXPECT_GT(end.way.z(), axis.z());  // straighter up
+    EXPECT_NEAR(end.way.norm(), 1.0, 1e-12);
+    // The link's posture beside the pass: `retract` along the way, the pass's axis held.
+    const std::size_t pass_end = end.into ? r.postures.front().output : r.postures.back().output;
+    const geometry::Posture& pass_posture = r.path.postures[pass_end];
+    const geometry::Posture& retracted = r.path.postures[end.into ? pass_end - 1 : pass_end + 1];
+    EXPECT_NEAR((retracted.tip_mm - pass_posture.tip_mm - job.links.retract_mm * end.way).norm(),
+                0.0, 1e-9);
+    EXPECT_NEAR((retracted.axis - axis).norm(), 0.0, 1e-12);
+  }
 }

@@ -172,6 +172,26 @@ struct GenerateResult {
   /// Passes whose nominal axes cleared them but were not kept: the path linked to them was
   /// checked worse than the steered one (pathFaults), and is not written.
   std::size_t kept_nominal_undone = 0;
+  /// Link ends taken off the pass's axis (DESIGN's way: up and down the axis): where the link
+  /// along the axis collided or came under the required clearance, a way up from the pass
+  /// nearer the vertical, the axis held, that came clearer (a pass settled at 34 deg tilt in a
+  /// channel: its link came down the leaning axis through the channel's wall). rerouteLinkEnds.
+  struct RoutedLinkEnd {
+    int pass = 0;               ///< Pass::index
+    std::string label;          ///< the pass and its line
+    bool into = true;           ///< the way into the pass (else out of it)
+    geometry::Vec3 way;         ///< unit, from the pass's end posture up to the travel plane
+    double off_axis_deg = 0.0;  ///< the way's angle from the axis
+    /// Collisions (postures and motions, obstacles and part) and least clearance of the
+    /// obstacles (mm) of the way along the axis and of the way taken, from the pass's posture
+    /// (its own clearance not counted) to the travel plane.
+    std::size_t axis_collisions = 0, taken_collisions = 0;
+    double axis_min_mm = 0.0, taken_min_mm = 0.0;
+  };
+  std::vector<RoutedLinkEnd> routed_link_ends;
+  /// Link ends a way off the axis cleared, not kept: the path linked that way was checked worse
+  /// (pathFaults) than the one along the axes.
+  std::size_t routed_link_ends_undone = 0;
   StageTimes times;
   std::size_t obstacle_points = 0;  ///< field samples
   std::size_t tool_nodes = 0;       ///< tool + holder nodes of the moment

@@ -39,6 +39,10 @@ struct LinkRequest {
   double safe_z_mm = 0.0;  ///< resolved: nothing of tool + holder goes below it while travelling
   geometry::ToolSpec tool;
   geometry::HolderProfile holder;
+  /// Per pass (by position in `passes`), the unit direction its link leaves it along and comes
+  /// into it along, the axis held; absent or zero: along its axis (DESIGN). rerouteLinkEnds
+  /// sets them where the axis's way runs into something.
+  std::vector<Vec3> out_ways, in_ways;
 };
 
 /// The whole output path: an approach link before the first pass (down its axis from the travel

@@ -1,0 +1,80 @@
+#include "generate_repairs.h"
+
+#include <cstdio>
+
+namespace fieldpath::app {
+
+nlohmann::json keptNominalJson(const pathgen::GenerateResult& r) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& k : r.kept_nominal)
+    out.push_back({{"pass", k.pass + 1},
+                   {"at", k.label},
+                   {"steered_colliding", k.steered_colliding},
+                   {"steered_under_required", k.steered_under}});
+  return out;
+}
+
+nlohmann::json routedLinkEndsJson(const pathgen::GenerateResult& r) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& e : r.routed_link_ends)
+    out.push_back(
+        {{"pass", e.pass + 1},
+         {"at", e.label},
+         {"end", e.into ? "into" : "out of"},
+         {"way", {e.way.x(), e.way.y(), e.way.z()}},
+         {"off_axis_deg", e.off_axis_deg},
+         {"along_axis", {{"collisions", e.axis_collisions}, {"min_clearance_mm", e.axis_min_mm}}},
+         {"taken", {{"collisions", e.taken_collisions}, {"min_clearance_mm", e.taken_min_mm}}}});
+  return out;
+}
+
+void printRepairs(const pathgen::GenerateResult& result) {
+  // Passes kept nominal: those that collided steered (a warning), and those that only came
+  // under the required clearance steered (a note: the path written keeps it).
+  for (const bool collided : {true, false}) {
+    std::size_t n = 0;
+    const pathgen::GenerateResult::KeptNominal* first = nullptr;
+    for (const auto& k : result.kept_nominal)
+      if ((k.steered_colliding > 0) == collided) n += 1, first = first ? first : &k;
+    if (n == 0) continue;
+    std::fprintf(stderr,
+                 collided ? "warning: %zu pass%s collided steered (first: %s, %zu postures "
+                            "colliding there or on the move to the next: the field of the "
+                            "obstacles turned the tool into them or into the part, which never "
+                            "repels) and %s written with the nominal axes, which clear the "
+                            "obstacles and the part (report.json kept_nominal)\n"
+                          : "note: %zu pass%s came under the required clearance steered "
+                            "(first: %s, %zu postures under it there or on the move to the "
+                            "next: the tilt away from one obstacle brought the tool nearer "
+                            "another) and %s written with the nominal axes, which come less "
+                            "near (report.json kept_nominal)\n",
+                 n, n == 1 ? "" : "es", first->label.c_str(),
+                 collided ? first->steered_colliding : first->steered_under, n == 1 ? "is" : "are");
+  }
+  if (result.kept_nominal_undone > 0)
+    std::fprintf(stderr,
+                 "note: %zu pass%s cleared with the nominal axes, but the path linked to them "
+                 "(the links come down the new axes) was checked worse than the steered one: "
+                 "the steering is written (report.json kept_nominal_undone)\n",
+                 result.kept_nominal_undone, result.kept_nominal_undone == 1 ? "" : "es");
+  if (!result.routed_link_ends.empty()) {
+    const auto& e = result.routed_link_ends.front();
+    const std::size_t n = result.routed_link_ends.size();
+    std::fprintf(stderr,
+                 "note: %zu link end%s taken off the pass's tool axis, the axis held (first: the "
+                 "way %s %s, %.1f deg from its axis toward the vertical: along the axis %zu "
+                 "collisions and %.3f mm of the obstacles, the way taken %zu and %.3f mm; the "
+                 "tool moves straight along it, the rotary axes still) (report.json "
+                 "links.routed_off_axis)\n",
+                 n, n == 1 ? "" : "s", e.into ? "into" : "out of", e.label.c_str(), e.off_axis_deg,
+                 e.axis_collisions, e.axis_min_mm, e.taken_collisions, e.taken_min_mm);
+  }
+  if (result.routed_link_ends_undone > 0)
+    std::fprintf(stderr,
+                 "note: %zu link end%s cleared off the pass's axis, but the path linked that way "
+                 "was checked worse than the one along the axes, which is written (report.json "
+                 "links.routed_off_axis_undone)\n",
+                 result.routed_link_ends_undone, result.routed_link_ends_undone == 1 ? "" : "s");
+}
+
+}  // namespace fieldpath::app

@@ -1,0 +1,120 @@
+#include "path_check.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "fieldpath/geometry/units.h"
+#include "link_reroute.h"
+#include "nominal_fallback.h"
+
+namespace fieldpath::pathgen {
+
+using common::scaled;
+
+void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& checker,
+                        double safe_z_mm, const CheckStages& stages, GenerateResult& result) {
+  std::optional<PartContacts::Marks> part_marks;  // of result.path, where the part is touched
+  const auto linkAndCheck = [&] {
+    std::vector<std::vector<geometry::Posture>> pass_postures(result.passes.size());
+    for (const GeneratedPosture& g : result.postures) pass_postures[g.pass].push_back(g.posture);
+    result.link_postures = 0;
+    result.path = {};
+    if (request.passes_only) {
+      for (const auto& postures : pass_postures)
+        for (const auto& p : postures) result.path.postures.push_back(p);
+      result.path = geometry::singlePass(std::move(result.path.postures));
+    } else {
+      LinkRequest links;
+      links.params = request.links;
+      links.tool = request.tool;
+      links.holder = request.holder;
+      links.safe_z_mm = safe_z_mm;
+      linkWays(result, links);
+      result.safe_z_mm = links.safe_z_mm;
+      result.path = linkPasses(pass_postures, links);
+    }
+    // Where each pass posture landed in the output path.
+    {
+      std::size_t next = 0;
+      for (const geometry::PathBlock& block : result.path.blocks) {
+        if (block.kind == geometry::PathBlock::Kind::Link) {
+          result.link_postures += block.size();
+          continue;
+        }
+        for (std::size_t i = block.begin; i < block.end; ++i) result.postures[next++].output = i;
+      }
+    }
+    for (const GeneratedPosture& g : result.postures)
+      if (g.limited) result.path.limited.push_back(g.output);
+    result.clearance = checker.check(
+        result.path.postures, {},
+        scaled(request.progress, stages.steer_end, stages.clearance_end, "clearance"));
+    if (!request.passes_only) {
+      MotionRequest motions;
+      motions.required_mm = request.clearance_mm;
+      motions.posture_clearance_mm = result.clearance.clearance_mm;
+      result.motions = checker.checkMotions(
+          result.path.postures, motions,
+          scaled(request.progress, stages.clearance_end, stages.motions_end, "motions"));
+      if (request.part) {
+        // With its own progress: the cutter's stamps along 46 000 postures took 95 s after the
+        // motions' 100 %, with no word (a scale sweep's finding).
+        PartContacts contacts = checkAgainstPart(
+            request.tool, request.holder, *request.part, result.path, kGougeToleranceMm,
+            scaled(request.progress, stages.motions_end, 1.0, "part"));
+        part_marks = contacts.marks(result.path.postures.size());
+        result.link_part = std::move(contacts.links);
+        result.holder_part = std::move(contacts.holder);
+        result.cutter_part = std::move(contacts.cutter);
+      }
+    }
+  };
+  linkAndCheck();
+  // `result` changed by a repair (`changed` things): linked and checked again, and kept only
+  // where its path checks no worse than `before`'s (pathFaults), else `before` is restored with
+  // its `undone` counting them.
+  const auto keepIfNoWorse =
+      [&](GenerateResult before, std::optional<PartContacts::Marks> before_marks,
+          std::size_t changed, std::size_t GenerateResult::*undone, const char* what) {
+        common::report(request.progress, stages.steer_end, what);
+        linkAndCheck();
+        if (pathFaults(result) > pathFaults(before)) {
+          before.*undone = changed;
+          result = std::move(before);
+          part_marks = std::move(before_marks);
+        }
+      };
+  if (!request.nominal && !request.passes_only && hasFaultyPasses(request, result, part_marks)) {
+    // The steered path, kept until the one with nominal passes is checked no worse (its links
+    // come down the new axes): a copy only where a pass is faulty.
+    GenerateResult steered = result;
+    std::optional<PartContacts::Marks> steered_marks = part_marks;
+    if (keepClearNominalPasses(request, checker, result, part_marks))
+      keepIfNoWorse(std::move(steered), std::move(steered_marks), result.kept_nominal.size(),
+                    &GenerateResult::kept_nominal_undone, "passes kept nominal: checked again");
+  }
+  if (!request.passes_only) {
+    // Links whose way along a pass's axis runs into something, taken another way up where one
+    // checks clearer.
+    auto routed = rerouteLinkEnds(request, checker, safe_z_mm, result, part_marks);
+    if (!routed.empty()) {
+      GenerateResult along_axes = result;
+      std::optional<PartContacts::Marks> along_marks = part_marks;
+      result.routed_link_ends = std::move(routed);
+      keepIfNoWorse(std::move(along_axes), std::move(along_marks), result.routed_link_ends.size(),
+                    &GenerateResult::routed_link_ends_undone,
+                    "links taken off the axis: checked again");
+    }
+  }
+  for (GeneratedPosture& g : result.postures) {
+    g.clearance_mm = result.clearance.clearance_mm[g.output];
+    result.max_tilt_deg = std::max(result.max_tilt_deg, std::abs(g.tilt_rad) / geometry::kDegToRad);
+    result.max_lead_deg = std::max(result.max_lead_deg, std::abs(g.lead_rad) / geometry::kDegToRad);
+    result.limited_colliding += g.limited && g.clearance_mm <= 0.0;
+  }
+}
+
+}  // namespace fieldpath::pathgen
