@@ -3,9 +3,10 @@
 /// starts a comment, `RAPID` makes the next motion a rapid (a link) unless a `FEDRAT` comes
 /// between them, `UNITS/INCHES` scales the coordinates that follow to mm, `TLAXIS/i,j,k` sets the
 /// axis of the 3-value GOTOs that follow, `FEDRAT/` records give the feeds (kept for `convert`),
-/// `FROM/` is read past (its line kept: the move from the start point is not the path's),
+/// `FROM/` is read past (its line kept: the move from the start point is not the path's; it is
+/// GOHOME's point), `GODLTA` moves by dx, dy, dz or by d along the axis, `GOHOME` goes home,
 /// `FINI` ends the program (nothing after it is read); motions it does not take (arcs, cycles,
-/// relative and drive-surface moves) are refused; every other record is read past.
+/// drive-surface moves) are refused; every other record is read past.
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -15,12 +16,10 @@
 #include <iterator>
 #include <limits>
 #include <optional>
-#include <span>
 #include <string_view>
 #include <utility>
 #include <vector>
 
-#include "fieldpath/common/atomic_file.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "path_chunks.h"
 #include "path_text.h"
@@ -30,69 +29,6 @@ namespace {
 
 using namespace detail;
 using common::InputError;
-
-std::string upperCase(std::string_view text) {
-  std::string s(text);
-  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return s;
-}
-
-/// The PPRINT of every APT output: how its motions were checked (README, "Path files").
-constexpr std::string_view kAptMotionNote =
-    "MOTIONS CHECKED WITH THE TIP ON A LINE AND THE TOOL AXIS ON THE GREAT CIRCLE BETWEEN "
-    "GOTOS, RAPIDS TOO: POST THE TOOL VECTOR (NOT INTERPOLATED ROTARY ANGLES) AND RAPIDS AS "
-    "LINEAR MOVES";
-/// ... and what it leaves to the post or the operator (a post reading no SPINDL writes no M03).
-constexpr std::string_view kAptSetupNote =
-    "NO LOADTL, SPINDL OR COOLNT RECORDS: TOOL, SPINDLE SPEED AND COOLANT ARE SET IN THE POST OR "
-    "AT THE MACHINE";
-
-/// The columns of an APT card: a record is continued on the next line with `$` past them.
-constexpr std::size_t kAptColumns = 72;
-/// The text of a PPRINT or PARTNO card after its `/`.
-constexpr std::size_t kAptTextColumns = kAptColumns - 7;
-
-/// `MAJOR/` followed by `values` (numbers as the shortest text that reads back the same double),
-/// on cards of kAptColumns: a line that would run past them ends after a comma with `$`, and the
-/// record goes on in the next (a fixed-format post-processor cut the 131-column GOTOs).
-void appendRecord(std::string& text, std::string_view major, std::span<const double> values) {
-  std::string line(major);
-  line += '/';
-  for (std::size_t k = 0; k < values.size(); ++k) {
-    std::string number;
-    appendNumber(number, values[k]);
-    if (k + 1 < values.size()) number += ',';
-    // Room for the number and, unless it ends the record, a `$` after it.
-    if (line.size() + number.size() + (k + 1 < values.size() ? 1 : 0) > kAptColumns &&
-        line.back() == ',') {
-      text += line + "$\n";
-      line.clear();
-    }
-    line += number;
-  }
-  text += line + '\n';
-}
-
-void appendGoto(std::string& text, const Posture& p) {
-  const double values[] = {p.tip_mm.x(), p.tip_mm.y(), p.tip_mm.z(),
-                           p.axis.x(),   p.axis.y(),   p.axis.z()};
-  appendRecord(text, "GOTO", values);
-}
-
-/// `major/text` as cards of kAptTextColumns characters of text, split between words where it
-/// can (a PPRINT has no continuation: each card is a PPRINT of its own).
-void appendTextCards(std::string& text, std::string_view major, std::string_view words) {
-  do {
-    std::size_t take = std::min(words.size(), kAptTextColumns);
-    if (take < words.size())
-      if (const auto blank = words.substr(0, take + 1).rfind(' ');
-          blank != std::string_view::npos && blank > 0)
-        take = blank;
-    text += std::string(major) + "/" + std::string(words.substr(0, take)) + "\n";
-    words.remove_prefix(take);
-    while (!words.empty() && words.front() == ' ') words.remove_prefix(1);
-  } while (!words.empty());
-}
 
 /// PPRINT, PARTNO, INSERT and REMARK carry text: a `$` in it is the text's (at its end it
 /// swallowed the next GOTO; a Siemens post's `INSERT/R1=$P_TOOLNO` names a variable).
@@ -161,6 +97,23 @@ struct AptChunk {
   };
   std::vector<Feed> feeds;
   std::size_t from_line = 0;  ///< its first FROM record's line (0: none)
+  /// FROM/x, y, z[, i, j, k] records (the start and home point), in file units: `posture` is the
+  /// chunk's posture after it, `units_before` the count of its UNITS records before it.
+  struct From {
+    Vec3 tip;
+    std::optional<Vec3> axis;
+    std::size_t posture = 0, units_before = 0, line = 0;
+  };
+  std::vector<From> froms;
+  /// GODLTA postures (their tip holds the move, in file units: dx, dy, dz, or d along the tool
+  /// axis in x) and GOHOME ones, by index: resolved where the chunks are joined, from where the
+  /// motion before ends (an earlier chunk's, or FROM/'s).
+  struct Relative {
+    std::size_t posture = 0;
+    bool along_axis = false;
+  };
+  std::vector<Relative> relative;
+  std::vector<std::size_t> home;
   std::size_t msys_line = 0;  ///< its first MSYS record that is not the identity (0: none)
   std::size_t cutcom_line = 0;  ///< its first CUTCOM record that is not CUTCOM/OFF (0: none)
 };
@@ -302,6 +255,18 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
     }
     if (major == "FROM") {
       if (out.from_line == 0) out.from_line = record_line;
+      double v[6];
+      const std::size_t n =
+          slash == std::string::npos
+              ? 0
+              : leadingNumbers(std::string_view(statement).substr(slash + 1), v, 6);
+      if (n >= 3) {  // the home point of a GOHOME (another form: no home, GOHOME refused)
+        const auto where = [&] { return file.string() + ":" + std::to_string(record_line); };
+        AptChunk::From from{Vec3(v[0], v[1], v[2]), std::nullopt, chunk.postures.size(),
+                            out.units.size(), record_line};
+        if (n == 6) from.axis = checkedAxis(Vec3(v[3], v[4], v[5]), where);
+        out.froms.push_back(from);
+      }
       continue;
     }
     if (major == "CUTCOM") {  // the control's offset of the cutter: read past, said unless OFF
@@ -358,12 +323,43 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
       }
       continue;
     }
+    // The motions the reader takes: GOTO, GODLTA (a move by dx, dy, dz, or by d along the tool
+    // axis) and GOHOME (to the FROM/ point: a rapid, as posts run it); they keep the axis.
+    if (major == "GODLTA" || major == "GOHOME") {
+      Posture p;
+      bool along_axis = false;
+      if (major == "GODLTA") {
+        double v[3] = {};
+        const std::size_t n = leadingNumbers(values, v, 3);
+        const auto fields =
+            static_cast<std::size_t>(std::count(values.begin(), values.end(), ',')) + 1;
+        if (slash == std::string::npos || (n != 1 && n != 3) || fields != n)
+          fail(file, record_line,
+               "GODLTA/: need d (a move along the tool axis) or dx, dy, dz (a move by them)");
+        along_axis = n == 1;
+        p.tip_mm = Vec3(v[0], v[1], v[2]);
+        out.relative.push_back({chunk.postures.size(), along_axis});
+      } else {
+        if (slash != std::string::npos && !trimmed(values).empty())
+          fail(file, record_line, "GOHOME/: this reader takes GOHOME alone (to the FROM/ point)");
+        out.home.push_back(chunk.postures.size());
+      }
+      p.axis = axis_now;
+      if (!own_axis) ++out.inherit_axis;
+      const bool link = rapid || major == "GOHOME";
+      if (chunk.postures.empty()) out.first_without_rapid = !link;
+      if (link) chunk.links.push_back(chunk.postures.size());
+      rapid = false;
+      chunk.postures.push_back(p);
+      chunk.lines.push_back(record_line);
+      continue;
+    }
     // A motion the reader does not take would be a posture lost without a word: GOTO not at
-    // the record's start (`RAPID,GOTO/`, `N40 GOTO/`, `GO TO/`), a relative GODLTA, arcs
-    // (CIRCLE/ before a GOTO makes it an arc; MOVARC), drive-surface motions (GOFWD, GOLFT, ...),
-    // GOHOME, a canned cycle (its GOTOs become plunges).
-    static constexpr std::string_view kMotions[] = {"GODLTA", "CIRCLE", "MOVARC", "GOFWD", "GOLFT",
-                                                    "GORGT",  "GOBACK", "GOUP",   "GODOWN", "GOHOME"};
+    // the record's start (`RAPID,GOTO/`, `N40 GOTO/`, `GO TO/`), arcs (CIRCLE/ before a GOTO
+    // makes it an arc; MOVARC), drive-surface motions (GOFWD, GOLFT, ...), a canned cycle (its
+    // GOTOs become plunges).
+    static constexpr std::string_view kMotions[] = {"CIRCLE", "MOVARC", "GOFWD", "GOLFT",
+                                                    "GORGT",  "GOBACK", "GOUP",  "GODOWN"};
     const bool motion_word =
         std::find(std::begin(kMotions), std::end(kMotions), major) != std::end(kMotions);
     const bool cycle = major == "CYCLE" && trimmed(values) != "OFF";
@@ -413,6 +409,48 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
   if (own_axis) out.end_axis = axis_now;
 }
 
+/// The GODLTA and GOHOME postures of chunk `c` (its tips in mm, its axes set), from where the
+/// motion before each ends: `last_tip` (the chunks before), or the FROM/ point `home` for a
+/// GODLTA before any motion; both carried on to the next chunk. `chunk_scale`: mm per file
+/// unit at the chunk's start (a FROM/ before its first UNITS record is in it).
+void resolveRelativeMoves(AptChunk& c, double chunk_scale, const std::filesystem::path& file,
+                          std::optional<AptChunk::From>& home, std::optional<Vec3>& last_tip) {
+  std::vector<Posture>& postures = c.postures.postures;
+  std::size_t next_from = 0, next_relative = 0, next_home = 0;
+  const auto takeFromsUpTo = [&](std::size_t k) {
+    for (; next_from < c.froms.size() && c.froms[next_from].posture <= k; ++next_from) {
+      AptChunk::From from = c.froms[next_from];
+      from.tip *= from.units_before ? c.units[from.units_before - 1].second : chunk_scale;
+      home = from;
+    }
+  };
+  for (std::size_t k = 0; k < postures.size(); ++k) {
+    takeFromsUpTo(k);
+    const std::size_t line = c.postures.lines[k];
+    if (next_relative < c.relative.size() && c.relative[next_relative].posture == k) {
+      const bool along_axis = c.relative[next_relative++].along_axis;
+      const std::optional<Vec3> before = k > 0      ? std::optional<Vec3>(postures[k - 1].tip_mm)
+                                         : last_tip ? last_tip
+                                         : home     ? std::optional<Vec3>(home->tip)
+                                                    : std::nullopt;
+      if (!before)
+        fail(file, line, "GODLTA/: no position before it to move from (a GOTO or a FROM/)");
+      const Vec3 move = along_axis ? postures[k].tip_mm.x() * postures[k].axis : postures[k].tip_mm;
+      postures[k].tip_mm = *before + move;
+    } else if (next_home < c.home.size() && c.home[next_home] == k) {
+      ++next_home;
+      if (!home) fail(file, line, "GOHOME: no FROM/x, y, z before it (the home point it goes to)");
+      postures[k].tip_mm = home->tip;
+      if (home->axis) postures[k].axis = *home->axis;
+    } else {
+      continue;
+    }
+    checkTip(postures[k].tip_mm, [&] { return file.string() + ":" + std::to_string(line); });
+  }
+  takeFromsUpTo(std::numeric_limits<std::size_t>::max());
+  if (!postures.empty()) last_tip = postures.back().tip_mm;
+}
+
 }  // namespace
 
 PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& options) {
@@ -442,6 +480,8 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   double scale = 1.0;
   std::size_t offset = 0;
   Vec3 carried_axis = Vec3::UnitZ();  // the axis in force at the end of the chunks so far
+  std::optional<AptChunk::From> home;  // the FROM/ point in force, in mm
+  std::optional<Vec3> last_tip;        // where the chunks so far end, mm
   for (std::size_t i = 0; i < chunks.size(); ++i) {
     AptChunk& c = chunks[i];
     auto& postures = c.postures.postures;
@@ -472,6 +512,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
       feed.from += offset;
       feeds.push_back(feed);
     }
+    const double chunk_scale = scale;  // the unit in force at the chunk's start
     std::size_t next_unit = 0;
     for (std::size_t k = 0; k < postures.size(); ++k) {
       while (next_unit < c.units.size() && c.units[next_unit].first <= k)
@@ -486,6 +527,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
     if (next_unit < c.units.size()) scale = c.units.back().second;
     for (std::size_t k = 0; k < c.inherit_axis; ++k) postures[k].axis = carried_axis;
     if (c.end_axis) carried_axis = *c.end_axis;
+    resolveRelativeMoves(c, chunk_scale, file, home, last_tip);
     if (postures.empty()) {
       pending = c.trailing_rapid || (pending && !c.cancels_rapid);
       continue;
@@ -518,74 +560,6 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   concatenate(parts, options.threads, path);
   checkDeclaredCount(text, kAptCountPrefix, path.postures.size(), file, ended);
   return path;
-}
-
-void writeAptFile(const std::filesystem::path& file, const PathFile& path,
-                  const AptHeader& header) {
-  // CUTTER/d,r,e,f,a,b,h: diameter, corner radius, corner centre offsets (radial e, axial f),
-  // taper angles a, b (0 for these tools), height h.
-  const ToolSpec& t = header.tool;
-  const double corner_mm = cornerRadius(t);
-  // PARTNO is one card: a longer name is cut.
-  std::string text =
-      "PARTNO/" + header.part_name.substr(0, std::min(header.part_name.size(), kAptTextColumns)) +
-      "\n";
-  // The count first: a safety mark's text runs on into the PPRINT cards after it.
-  text += std::string(kAptCountPrefix) + std::to_string(path.postures.size()) +
-          " (A FILE HOLDING FEWER WAS CUT SHORT)\n";
-  for (const std::string& remark : header.remarks) {
-    std::string line = upperCase(remark);
-    for (char& c : line)
-      if (c == '\n' || c == '\r' || c == '$') c = ' ';  // one record, no continuation
-    appendTextCards(text, "PPRINT", line);
-  }
-  text += "UNITS/MM\nMULTAX/ON\n";
-  const double cutter[] = {2 * t.radius_mm, corner_mm, t.radius_mm - corner_mm, corner_mm, 0.0, 0.0,
-                           t.length_mm};
-  appendRecord(text, "CUTTER", cutter);
-  // What check proves of a motion, for whoever writes the post: a controller that runs rotary
-  // angles (A/B/C) interpolated, or a rapid axis by axis, sweeps other space (a machine-side
-  // helper's finding: a dog-leg rapid crossed a wall that the straight retract cleared). After
-  // CUTTER, not beside the safety marks: a mark's text runs on in the PPRINT cards after it.
-  appendTextCards(text, "PPRINT", kAptMotionNote);
-  appendTextCards(text, "PPRINT", kAptSetupNote);
-  // A path marked unsafe halts before its first motion (STOP: M00 on post-processors): a PPRINT
-  // is only read, and the program ran on (a machine-safety helper's finding).
-  if (std::any_of(header.remarks.begin(), header.remarks.end(), [](const std::string& remark) {
-        return upperCase(detail::safetyMark(remark)).rfind("UNSAFE TO RUN", 0) == 0;
-      }))
-    text += "STOP\n";
-  // The feed in force: the path's own from the first of its FEDRATs (none before it, as read),
-  // else the header's. Written before a pass and where it changes within one; a change at a link
-  // waits for the next pass (a FEDRAT after RAPID would make the link's motion a feed move).
-  double in_force =
-      path.feeds.empty() ? header.feed_mm_per_min : std::numeric_limits<double>::quiet_NaN();
-  std::size_t next_feed = 0;
-  bool changed = true;
-  for (const PathBlock& block : path.blocks) {
-    for (std::size_t i = block.begin; i < block.end; ++i) {
-      for (; next_feed < path.feeds.size() && path.feeds[next_feed].from <= i; ++next_feed) {
-        changed = changed || !(path.feeds[next_feed].mm_per_min == in_force);
-        in_force = path.feeds[next_feed].mm_per_min;
-      }
-      if (block.kind == PathBlock::Kind::Link) {
-        text += "RAPID\n";
-      } else if ((i == block.begin || changed) && std::isfinite(in_force)) {
-        text += "FEDRAT/MMPM,";
-        appendNumber(text, in_force);
-        text += '\n';
-        changed = false;
-      }
-      appendGoto(text, path.postures[i]);
-    }
-  }
-  text += "FINI\n";
-  common::writeTextAtomically(file, text);
-}
-
-void writeAptFile(const std::filesystem::path& file, std::span<const Posture> postures,
-                  const AptHeader& header) {
-  writeAptFile(file, singlePass({postures.begin(), postures.end()}), header);
 }
 
 }  // namespace fieldpath::geometry

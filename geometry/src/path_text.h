@@ -148,6 +148,13 @@ inline std::vector<std::string_view> splitWhitespace(std::string_view text) {
   return tokens;
 }
 
+/// `text` in upper case (APT records are read whatever their case).
+inline std::string upperCase(std::string_view text) {
+  std::string s(text);
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
 inline std::string_view trimmed(std::string_view text) {
   while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front())))
     text.remove_prefix(1);
@@ -222,6 +229,9 @@ inline void addToBlocks(std::vector<PathBlock>& blocks, PathBlock::Kind kind, bo
 /// The header lines that declare a path's posture count (checkDeclaredCount), as written.
 inline constexpr std::string_view kClCountPrefix = "# postures: ";
 inline constexpr std::string_view kAptCountPrefix = "PPRINT/POSTURES ";
+/// The columns of an APT card: a record is continued on the next line with `$` past them (the
+/// writer), and a card sequence number stands past them (the reader).
+inline constexpr std::size_t kAptColumns = 72;
 
 /// Whether `s` starts with `prefix`, ASCII letters compared without case.
 inline bool startsWithNoCase(std::string_view s, std::string_view prefix) {

@@ -387,10 +387,12 @@ TEST(AptFile, UnitsFiniAndRemarks) {
 // and a `$` ending a PPRINT is its text's, not a continuation (it swallowed the next GOTO).
 TEST(AptFile, MotionsNotReadAreRefusedAndPprintKeepsItsDollar) {
   for (const std::string& record :
-       {"RAPID,GOTO/1,2,3", "N40 GOTO/1,2,3", "GO TO/1,2,3", "GODLTA/0,0,5",
-        // an arc (CIRCLE/ makes the next GOTO one), drive-surface moves, a cycle, home
-        "CIRCLE/0,0,0,0,0,1,18,0.01,0.5,6,0", "MOVARC/0,0,0,0,0,1,18,ANGLE,90", "GOFWD/(CIRCLE/0,0,0,5)",
-        "GOHOME", "CYCLE/DRILL,5,FEDTO,0,MMPM,100"}) {
+       {"RAPID,GOTO/1,2,3", "N40 GOTO/1,2,3", "GO TO/1,2,3", "GODLTA/0,5",
+        // an arc (CIRCLE/ makes the next GOTO one), drive-surface moves, a cycle, home without
+        // a FROM/ point, a move by what is not a number
+        "CIRCLE/0,0,0,0,0,1,18,0.01,0.5,6,0", "MOVARC/0,0,0,0,0,1,18,ANGLE,90",
+        "GOFWD/(CIRCLE/0,0,0,5)", "GOHOME", "CYCLE/DRILL,5,FEDTO,0,MMPM,100", "GODLTA/0,0,5,1",
+        "GODLTA/Z,5", "GOHOME/XAXIS"}) {
     try {
       readAptFile(writeBytes("m.apt", "GOTO/0,0,0,0,0,1\n" + record + "\nGOTO/1,0,0\n"));
       ADD_FAILURE() << record << " was read past";
@@ -451,4 +453,52 @@ TEST(AptFile, TlaxisSetsTheAxisOfThreeValueGotos) {
   ASSERT_EQ(n.size(), 3u);
   EXPECT_EQ(n[1].axis, Vec3(0.6, 0, 0.8));
   EXPECT_EQ(n[2].axis, Vec3(0, 0.6, 0.8));
+}
+
+// GODLTA moves by dx, dy, dz (or by d along the tool axis) from where the motion before ends,
+// GOHOME to the FROM/ point (a rapid, as posts run it), each keeping the axis, in the unit in
+// force, whatever the chunks (the move before may be an earlier chunk's); they were refused, and
+// a CAM system's program ending in them with it.
+TEST(AptFile, GodltaMovesFromThePostureBeforeAndGohomeGoesToTheFromPoint) {
+  const double s = std::sqrt(0.5);
+  const auto file =
+      writeBytes("rel.apt", "FROM/0,0,4,0,0,1\nUNITS/INCHES\nRAPID\nGOTO/1,0,2,0," +
+                                std::to_string(s) + "," + std::to_string(s) +
+                                "\nFEDRAT/IPM,20\nGODLTA/0,0,-1\nGOTO/2,0,1\nGODLTA/2\n"
+                                "RAPID\nGODLTA/0,0,1\nGOHOME\nFINI\n");
+  for (const std::size_t chunk : {std::size_t{8}, std::size_t{16}, std::size_t{1} << 20}) {
+    PathReadOptions options;
+    options.chunk_bytes = chunk;
+    const PathFile p = readPathFile(file, options);
+    ASSERT_EQ(p.postures.size(), 6u) << chunk;
+    const double in = 25.4;
+    const Vec3 axis(0, s, s);
+    const Vec3 expected[] = {Vec3(1, 0, 2) * in,
+                             Vec3(1, 0, 1) * in,
+                             Vec3(2, 0, 1) * in,
+                             Vec3(2, 0, 1) * in + 2 * in * axis,
+                             Vec3(2, 0, 2) * in + 2 * in * axis,
+                             Vec3(0, 0, 4)};  // FROM/ before UNITS: in mm
+    for (std::size_t k = 0; k < 6; ++k) {
+      EXPECT_NEAR((p.postures[k].tip_mm - expected[k]).norm(), 0.0, 1e-4) << chunk << " " << k;
+      const Vec3 a = k == 5 ? Vec3::UnitZ() : axis;  // GOHOME takes FROM/'s axis
+      EXPECT_NEAR((p.postures[k].axis - a).norm(), 0.0, 1e-5) << chunk << " " << k;
+    }
+    // The rapid, the pass of three (the GODLTA along the axis at feed), the rapid and home.
+    ASSERT_EQ(p.blocks.size(), 3u) << chunk;
+    EXPECT_EQ(p.blocks[0].kind, PathBlock::Kind::Link);
+    EXPECT_EQ(p.blocks[1].size(), 3u);
+    EXPECT_EQ(p.blocks[2].kind, PathBlock::Kind::Link);
+    EXPECT_EQ(p.blocks[2].size(), 2u);
+    EXPECT_EQ(p.lines[5], 11u);
+  }
+  // A GODLTA with nothing before it to move from is refused at its line.
+  try {
+    readAptFile(writeBytes("first.apt", "PARTNO/X\nGODLTA/0,0,5\nGOTO/1,0,0,0,0,1\n"));
+    ADD_FAILURE() << "a GODLTA from nowhere was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("first.apt:2: GODLTA/: no position before it"),
+              std::string::npos)
+        << e.what();
+  }
 }
