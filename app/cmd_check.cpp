@@ -29,6 +29,7 @@
 #include "fieldpath/pathgen/clearance.h"
 #include "fieldpath/pathgen/generate.h"
 #include "fieldpath/pathgen/link_check.h"
+#include "fieldpath/pathgen/passes.h"
 #include "fieldpath/zbuffer/outputs.h"
 #include "job.h"
 #include "json_text.h"
@@ -61,13 +62,16 @@ std::pair<std::size_t, std::size_t> rapidsOntoPasses(const geometry::PathFile& p
       continue;
     // The pass written from the rapid's end, down the tool axis at feed (an engage: RAPID to a
     // point above the part, FEDRAT, the same point again, down): the ball does not cut there (a
-    // CAM engineer's file read UNSAFE). Within 30 deg of the axis, as generate reads approaches.
+    // CAM engineer's file read UNSAFE). Within kApproachDeg of the axis, as generate reads
+    // approaches.
     std::size_t next = pass.begin + 1;
     while (next < pass.end && geometry::samePose(path.postures[next], path.postures[pass.begin]))
       ++next;
     if (next < pass.end) {
       const geometry::Vec3 step = path.postures[next].tip_mm - path.postures[pass.begin].tip_mm;
-      if (path.postures[pass.begin].axis.dot(step) <= -std::cos(M_PI / 6.0) * step.norm()) continue;
+      if (path.postures[pass.begin].axis.dot(step) <=
+          -std::cos(pathgen::kApproachDeg * M_PI / 180.0) * step.norm())
+        continue;
     }
     if (count++ == 0) first = end;
   }

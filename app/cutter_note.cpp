@@ -49,6 +49,23 @@ std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool,
                     " says the path was written for " + file_tool + "; the scene's tool is " +
                     toolWords(tool) + ": what follows is for the scene's tool, not the file's");
   }
+  // A file that changes tools: each is proven as the scene's one (the cutters of the loads are
+  // compared above where CUTTER or TLDATA records give them).
+  std::vector<const geometry::PathFile::ToolLoad*> loads;
+  for (const auto& load : path.tool_loads)
+    if (loads.empty() || load.number != loads.back()->number) loads.push_back(&load);
+  if (loads.size() > 1) {
+    std::string which;
+    for (std::size_t k = 0; k < loads.size() && k < 4; ++k)
+      which +=
+          (k ? ", " : "") + loads[k]->number + " (line " + std::to_string(loads[k]->line) + ")";
+    if (loads.size() > 4) which += ", ...";
+    notes.insert(notes.begin(),
+                 path.file.string() + ":" + std::to_string(loads[1]->line) +
+                     ": the file changes tools (" + std::to_string(loads.size()) +
+                     " loads: " + which + "): every motion is proven with the scene's one tool, " +
+                     toolWords(tool) + "; split the file by tool and give each its scene");
+  }
   if (notes.size() > kMaxLines) {
     const std::size_t more = notes.size() - (kMaxLines - 1);
     notes.resize(kMaxLines - 1);

@@ -22,6 +22,7 @@ nlohmann::json routedLinkEndsJson(const pathgen::GenerateResult& r) {
          {"at", e.label},
          {"end", e.into ? "into" : "out of"},
          {"way", {e.way.x(), e.way.y(), e.way.z()}},
+         {"retract", e.retract_along_axis ? "along the axis" : "along the way"},
          {"off_axis_deg", e.off_axis_deg},
          {"along_axis", {{"collisions", e.axis_collisions}, {"min_clearance_mm", e.axis_min_mm}}},
          {"taken", {{"collisions", e.taken_collisions}, {"min_clearance_mm", e.taken_min_mm}}}});
@@ -62,12 +63,13 @@ void printRepairs(const pathgen::GenerateResult& result) {
     const std::size_t n = result.routed_link_ends.size();
     std::fprintf(stderr,
                  "note: %zu link end%s taken off the pass's tool axis, the axis held (first: the "
-                 "way %s %s, %.1f deg from its axis toward the vertical: along the axis %zu "
-                 "collisions and %.3f mm of the obstacles, the way taken %zu and %.3f mm; the "
-                 "tool moves straight along it, the rotary axes still) (report.json "
-                 "links.routed_off_axis)\n",
-                 n, n == 1 ? "" : "s", e.into ? "into" : "out of", e.label.c_str(), e.off_axis_deg,
-                 e.axis_collisions, e.axis_min_mm, e.taken_collisions, e.taken_min_mm);
+                 "way %s %s, the retract along %s, the climb %.1f deg from the axis toward the "
+                 "vertical: along the axis %zu collisions and %.3f mm of the obstacles, the way "
+                 "taken %zu and %.3f mm; the tool moves straight, the rotary axes still) "
+                 "(report.json links.routed_off_axis)\n",
+                 n, n == 1 ? "" : "s", e.into ? "into" : "out of", e.label.c_str(),
+                 e.retract_along_axis ? "the axis" : "the climb", e.off_axis_deg, e.axis_collisions,
+                 e.axis_min_mm, e.taken_collisions, e.taken_min_mm);
   }
   if (result.routed_link_ends_undone > 0)
     std::fprintf(stderr,

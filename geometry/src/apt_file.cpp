@@ -87,6 +87,7 @@ struct AptChunk {
   bool fini = false;  ///< FINI seen: the program ends there; later records are not read
   /// CUTTER records in file units, each with the count of this chunk's UNITS records before it.
   std::vector<std::pair<std::size_t, PathFile::Cutter>> cutters;
+  std::vector<PathFile::ToolLoad> tool_loads;  ///< in the file's order
   /// FEDRAT records: the feed (`from`: this chunk's posture after it) as written, in mm per
   /// minute times `unit` (0: the file's unit in force, the count of this chunk's UNITS records
   /// before it in `units_before`).
@@ -291,6 +292,18 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
           out.cutters.emplace_back(out.units.size(), *cutter);
       continue;
     }
+    if ((major == "LOAD" || major == "LOADTL") && slash != std::string::npos) {
+      // LOAD/TOOL, n[, ...] or LOADTL/n[, ...]: the number (or name) of the tool loaded.
+      std::string_view values = trimmed(std::string_view(statement).substr(slash + 1));
+      if (major == "LOAD") {
+        const auto comma = values.find(',');
+        if (trimmed(values.substr(0, comma)) != "TOOL" || comma == std::string_view::npos) continue;
+        values = values.substr(comma + 1);
+      }
+      const std::string_view number = trimmed(values.substr(0, values.find(',')));
+      if (!number.empty()) out.tool_loads.push_back({std::string(number), record_line});
+      continue;
+    }
     if (major == "TLDATA" && slash != std::string::npos) {  // TLDATA/MILL, d, r, ...: a cutter
       const std::string_view values = trimmed(std::string_view(statement).substr(slash + 1));
       const auto comma = values.find(',');
@@ -474,6 +487,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   // And the unit: a UNITS record holds until the next; inches are read as mm x 25.4.
   std::vector<std::size_t> link_postures;
   std::vector<PathFile::Cutter> cutters;
+  std::vector<PathFile::ToolLoad> tool_loads;
   std::vector<PathFile::Feed> feeds;
   std::size_t from_line = 0, msys_line = 0, cutcom_line = 0;
   bool pending = false, ended = false;
@@ -496,6 +510,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
     if (from_line == 0) from_line = c.from_line;
     if (msys_line == 0) msys_line = c.msys_line;
     if (cutcom_line == 0) cutcom_line = c.cutcom_line;
+    tool_loads.insert(tool_loads.end(), c.tool_loads.begin(), c.tool_loads.end());
     for (auto& [units_before, cutter] : c.cutters) {  // in the unit of the record before it
       const double unit = units_before ? c.units[units_before - 1].second : scale;
       cutter.diameter_mm *= unit;
@@ -540,6 +555,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   PathFile path;
   path.file = file;
   path.cutters = std::move(cutters);
+  path.tool_loads = std::move(tool_loads);
   path.from_line = from_line;
   path.msys_line = msys_line;
   path.cutcom_line = cutcom_line;

@@ -36,8 +36,8 @@ struct WayCheck {
   }
 };
 
-/// Checks a pass's end posture `p` left (or entered) along `way` with its axis held: retract
-/// along it, then on to the travel plane, as linkPasses writes it.
+/// Checks a pass's end posture `p` left (or entered) by `way` with its axis held (along the axis
+/// where `way` is), as linkPasses writes it.
 class WayChecker {
  public:
   WayChecker(const GenerateRequest& request, const ClearanceChecker& obstacles, double safe_z_mm)
@@ -50,13 +50,15 @@ class WayChecker {
     }
   }
 
-  WayCheck check(const Posture& p, const Vec3& way, bool into) const {
+  WayCheck check(const Posture& p, const LinkEndWay& way, bool into) const {
     const double z_mm = safe_z_mm_ - lowestPointBelowTip(request_.tool, request_.holder, p.axis);
+    const Vec3 climb = way.alongAxis() ? p.axis : way.climb;
     Posture retracted = p, travel = p;
-    retracted.tip_mm = p.tip_mm + request_.links.retract_mm * way;
+    retracted.tip_mm =
+        p.tip_mm + request_.links.retract_mm * (way.alongAxis() ? p.axis : way.retract_dir);
     travel.tip_mm = retracted.tip_mm;
-    if (way.z() >= kMinWayRise)
-      travel.tip_mm += std::max(0.0, (z_mm - retracted.tip_mm.z()) / way.z()) * way;
+    if (climb.z() >= kMinWayRise)
+      travel.tip_mm += std::max(0.0, (z_mm - retracted.tip_mm.z()) / climb.z()) * climb;
     else  // an axis near horizontal: its link goes straight up from the retract (linkPasses)
       travel.tip_mm.z() = std::max(travel.tip_mm.z(), z_mm);
     const std::vector<Posture> up = {p, retracted, travel};
@@ -103,10 +105,14 @@ class WayChecker {
   std::optional<GrazingChecker> grazing_;
 };
 
-/// The ways up tried after the axis: on the great circle from `axis` through +z (none for an axis
-/// within 0.5 deg of vertical, whose way is already straight up).
-std::vector<Vec3> waysUp(const Vec3& axis) {
-  std::vector<Vec3> out;
+/// The ways up tried after the axis, climbing on the great circle from `axis` through +z (none
+/// for an axis within 0.5 deg of vertical, whose way is already straight up): at each angle,
+/// first after the retract along the axis (DESIGN's), then with the retract along the climb too
+/// (where the retract's end is in the way: a pass settled in a channel). An axis near horizontal
+/// climbs straight up from its retract (linkPasses), but one 5.7 deg up climbed along itself,
+/// 460 mm sideways through a block (a helper's), where the retract then straight up was clear.
+std::vector<LinkEndWay> waysUp(const Vec3& axis) {
+  std::vector<LinkEndWay> out;
   const double angle = std::acos(std::clamp(axis.z(), -1.0, 1.0));
   Vec3 side = axis - axis.z() * Vec3::UnitZ();  // the horizontal the axis leans to
   if (angle < 0.5 * geometry::kDegToRad || side.norm() < 1e-9) return out;
@@ -114,7 +120,9 @@ std::vector<Vec3> waysUp(const Vec3& axis) {
   for (const double t : kWayFractions) {
     const double from_vertical = (1.0 - t) * angle;  // negative: past the vertical
     const Vec3 way = std::cos(from_vertical) * Vec3::UnitZ() + std::sin(from_vertical) * side;
-    if (way.z() >= kMinWayRise) out.push_back(way);
+    if (way.z() < kMinWayRise) continue;
+    out.push_back({axis, way});
+    out.push_back({way, way});
   }
   return out;
 }
@@ -169,9 +177,9 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
       if (!faultyEnd(result, part_marks, g.output, into, request.clearance_mm)) continue;
       if (!ways) ways.emplace(request, checker, safe_z_mm);
       const Posture& posture = g.posture;
-      const WayCheck along = ways->check(posture, posture.axis, into);
-      std::optional<std::pair<Vec3, WayCheck>> best;
-      for (const Vec3& way : waysUp(posture.axis)) {
+      const WayCheck along = ways->check(posture, LinkEndWay{}, into);
+      std::optional<std::pair<LinkEndWay, WayCheck>> best;
+      for (const LinkEndWay& way : waysUp(posture.axis)) {
         const WayCheck c = ways->check(posture, way, into);
         if (!best || c.betterThan(best->second)) best.emplace(way, c);
         if (c.collisions == 0 && c.min_mm >= request.clearance_mm)
@@ -182,9 +190,10 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
       end.pass = result.passes[p].index;
       end.label = result.passes[p].label;
       end.into = into;
-      end.way = best->first;
+      end.way = best->first.climb;
+      end.retract_along_axis = best->first.retract_dir == posture.axis;
       end.off_axis_deg =
-          std::acos(std::clamp(best->first.dot(posture.axis), -1.0, 1.0)) / geometry::kDegToRad;
+          std::acos(std::clamp(end.way.dot(posture.axis), -1.0, 1.0)) / geometry::kDegToRad;
       end.axis_collisions = along.collisions;
       end.axis_min_mm = along.min_mm;
       end.taken_collisions = best->second.collisions;
@@ -196,13 +205,22 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
 }
 
 void linkWays(const GenerateResult& result, LinkRequest& links) {
-  links.in_ways.assign(result.passes.size(), Vec3::Zero());
-  links.out_ways.assign(result.passes.size(), Vec3::Zero());
-  for (const auto& end : result.routed_link_ends) {
-    for (std::size_t p = 0; p < result.passes.size(); ++p)
-      if (result.passes[p].index == end.pass)
-        (end.into ? links.in_ways : links.out_ways)[p] = end.way;
+  links.in_ways.assign(result.passes.size(), LinkEndWay{});
+  links.out_ways.assign(result.passes.size(), LinkEndWay{});
+  // Each pass's end postures, for the retract along the axis.
+  std::vector<const geometry::Posture*> first(result.passes.size()), last(result.passes.size());
+  for (const GeneratedPosture& g : result.postures) {
+    const auto p = static_cast<std::size_t>(g.pass);
+    if (!first[p]) first[p] = &g.posture;
+    last[p] = &g.posture;
   }
+  for (const auto& end : result.routed_link_ends)
+    for (std::size_t p = 0; p < result.passes.size(); ++p)
+      if (result.passes[p].index == end.pass && first[p]) {
+        const Vec3& axis = (end.into ? first[p] : last[p])->axis;
+        (end.into ? links.in_ways : links.out_ways)[p] =
+            LinkEndWay{end.retract_along_axis ? axis : end.way, end.way};
+      }
 }
 
 }  // namespace fieldpath::pathgen

@@ -68,20 +68,20 @@ Posture at(const Vec3& tip, const Vec3& axis) {
 /// milling, a wall finished with the ball: the climb along it ran hundreds of mm sideways, or
 /// never rose, and the job was refused), `retract` along it, then straight up. An axis below
 /// horizontal is left from beneath (an undercut): no link from above reaches it.
-/// `way` (unit) other than the axis: the way generate took where the axis's collided
-/// (rerouteLinkEnds), `retract` along it, then on along it to the plane.
-Vec3 travelPoint(const Posture& p, double z_mm, double retract_mm, const char* which, int pass,
-                 const Vec3& way) {
-  if (way != p.axis) {
-    const Vec3 out = p.tip_mm + retract_mm * way;
-    return out + std::max(0.0, (z_mm - out.z()) / way.z()) * way;
+/// Another `way` (rerouteLinkEnds: the axis's collided): `retract` along its retract direction,
+/// then on along its climb to the plane.
+Vec3 travelPoint(const Posture& p, double z_mm, double retract_mm, const char* which,
+                 const std::string& pass, const LinkEndWay& way) {
+  if (!way.alongAxis()) {
+    const Vec3 out = p.tip_mm + retract_mm * way.retract_dir;
+    return out + std::max(0.0, (z_mm - out.z()) / way.climb.z()) * way.climb;
   }
   if (p.axis.z() >= kMinAxisRise)
     return p.tip_mm + std::max(retract_mm, (z_mm - p.tip_mm.z()) / p.axis.z()) * p.axis;
   if (p.axis.z() < -kHorizontalZ) {
     std::ostringstream msg;
     msg.precision(3);
-    msg << "links: pass " << pass << " " << which << " with the tool axis "
+    msg << "links: " << pass << " " << which << " with the tool axis "
         << std::acos(std::clamp(p.axis.z(), -1.0, 1.0)) * 180.0 / M_PI
         << " deg from vertical, pointing down: no link from the travel plane above reaches it "
            "(write its links in the nominal path and run `check` on it)";
@@ -161,28 +161,35 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
     return request.safe_z_mm - lowest;
   };
   // The way out of pass k and into it: along its axis, or as rerouteLinkEnds chose.
-  auto way = [&](const std::vector<Vec3>& ways, std::size_t k, const Posture& p) {
-    return k < ways.size() && ways[k] != Vec3::Zero() ? ways[k] : p.axis;
+  auto way = [&](const std::vector<LinkEndWay>& ways, std::size_t k) {
+    return k < ways.size() ? ways[k] : LinkEndWay{};
+  };
+  // Where the link's retract out of `p` along `w` ends.
+  auto retracted = [&](const Posture& p, const LinkEndWay& w) {
+    return p.tip_mm + params.retract_mm * (w.alongAxis() ? p.axis : w.retract_dir);
+  };
+  // A pass as messages name it: its label (with its line) where given.
+  auto label = [&](std::size_t k) {
+    return k < request.labels.size() ? request.labels[k] : "pass " + std::to_string(k + 1);
   };
   const auto link = PathBlock::Kind::Link;
   for (std::size_t k = 0; k < passes.size(); ++k) {
     const std::vector<Posture>& pass = passes[k];
     if (pass.empty()) continue;
     const Posture& first = pass.front();
-    const int number = static_cast<int>(k) + 1;
     // Down into pass k: from the travel plane (the approach for the first pass, the end of the
     // link otherwise) along its first axis to `retract` above its start.
     const Vec3 from_axis = k == 0 ? first.axis : passes[k - 1].back().axis;
     const double z = travelTipZ(from_axis, first.axis);
-    const Vec3 in = way(request.in_ways, k, first);
+    const LinkEndWay in = way(request.in_ways, k);
     if (k == 0) {
-      add(link, at(travelPoint(first, z, params.retract_mm, "starts", number, in), first.axis));
+      add(link, at(travelPoint(first, z, params.retract_mm, "starts", label(k), in), first.axis));
     } else {
       const Posture& last = passes[k - 1].back();
-      const Vec3 out = way(request.out_ways, k - 1, last);
-      add(link, at(last.tip_mm + params.retract_mm * out, last.axis));
-      const Vec3 a = travelPoint(last, z, params.retract_mm, "ends", number - 1, out);
-      const Vec3 b = travelPoint(first, z, params.retract_mm, "starts", number, in);
+      const LinkEndWay out = way(request.out_ways, k - 1);
+      add(link, at(retracted(last, out), last.axis));
+      const Vec3 a = travelPoint(last, z, params.retract_mm, "ends", label(k - 1), out);
+      const Vec3 b = travelPoint(first, z, params.retract_mm, "starts", label(k), in);
       const AxisTurn turn(last.axis, first.axis);
       const int steps = std::max(1, static_cast<int>(std::ceil(turn.degrees() / kMaxLinkTurnDeg)));
       for (int j = 0; j <= steps; ++j) {
@@ -190,7 +197,7 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
         add(link, at((1 - t) * a + t * b, turn.at(t)));
       }
     }
-    add(link, at(first.tip_mm + params.retract_mm * in, first.axis));
+    add(link, at(retracted(first, in), first.axis));
     for (const Posture& p : pass) add(PathBlock::Kind::Pass, p);
   }
   // Departure: back along the last axis to the travel plane.
@@ -198,10 +205,10 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
     const Posture final_posture = out.postures.back();
     std::size_t last = passes.size() - 1;
     while (passes[last].empty()) --last;
-    const Vec3 leave = way(request.out_ways, last, final_posture);
+    const LinkEndWay leave = way(request.out_ways, last);
     const Vec3 up = travelPoint(final_posture, travelTipZ(final_posture.axis, final_posture.axis),
-                                params.retract_mm, "ends", static_cast<int>(passes.size()), leave);
-    add(link, at(final_posture.tip_mm + params.retract_mm * leave, final_posture.axis));
+                                params.retract_mm, "ends", label(last), leave);
+    add(link, at(retracted(final_posture, leave), final_posture.axis));
     add(link, at(up, final_posture.axis));
   }
   return out;

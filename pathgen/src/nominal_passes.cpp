@@ -24,11 +24,6 @@ constexpr double kRepeatMm = 1e-9;
 /// The nominal axis must be at least this far from the feed direction (sin of 0.5°): closer, the
 /// frame's normal is the rounding noise of a projection.
 constexpr double kMinAxisToFeedSin = 0.0087;
-/// A move into a lone posture a gap parts from the rest of its block within this of the tool axis
-/// (deg) is an approach's start above the cut or a retract's end (the link's); a lone posture
-/// reached across the axis is a cut written as its two ends, refused as before (a regression
-/// hunt: a 7 mm line on the floor written so was dropped from every pass).
-constexpr double kApproachDeg = 30.0;
 
 /// The vertices of one pass: ball centres, arc lengths, tangents, normals.
 struct Polyline {

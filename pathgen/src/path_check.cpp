@@ -33,6 +33,7 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
       links.holder = request.holder;
       links.safe_z_mm = safe_z_mm;
       linkWays(result, links);
+      for (const Pass& pass : result.passes) links.labels.push_back(pass.label);
       result.safe_z_mm = links.safe_z_mm;
       result.path = linkPasses(pass_postures, links);
     }

@@ -192,6 +192,33 @@ TEST(ConvertFeeds, TldataMillIsTheFilesCutter) {
       << check.err;
 }
 
+// A file that loads a second tool (`LOAD/TOOL,n`, `LOADTL/n`) is said: every motion is proven
+// with the scene's one tool (a CAM engineer's program with a tool change went unsaid); the same
+// tool loaded again is no change. Whatever the chunks.
+TEST(ConvertFeeds, AToolChangeIsSaid) {
+  const TempDir dir;
+  dir.write("two.apt",
+            "PARTNO/X\nLOAD/TOOL,1\nGOTO/0,0,5,0,0,1\nLOAD / TOOL, 1, ADJUST, 1\nGOTO/5,0,5\n"
+            "LOADTL/7\nGOTO/6,0,5\n");
+  dir.write("one.apt", "PARTNO/X\nLOAD/TOOL,1\nGOTO/0,0,5,0,0,1\nLOADTL/1\nGOTO/5,0,5\n");
+  for (const std::size_t chunk : {std::size_t{16}, std::size_t{1} << 20}) {
+    geometry::PathReadOptions options;
+    options.chunk_bytes = chunk;
+    const PathFile two = geometry::readPathFile(dir.path() / "two.apt", options);
+    ASSERT_EQ(two.tool_loads.size(), 3u) << chunk;
+    EXPECT_EQ(two.tool_loads[2].number, "7");
+    EXPECT_EQ(two.tool_loads[2].line, 6u);
+  }
+  writeWallScene(dir);
+  const Outcome check = runFieldpath(dir, "check scene.yaml --path two.apt --out out");
+  EXPECT_NE(check.err.find("note: two.apt:6: the file changes tools (2 loads: 1 (line 2), 7 (line "
+                           "6)): every motion is proven with the scene's one tool"),
+            std::string::npos)
+      << check.err;
+  const Outcome same = runFieldpath(dir, "check scene.yaml --path one.apt --out same");
+  EXPECT_EQ(same.err.find("changes tools"), std::string::npos) << same.err;
+}
+
 // A non-identity MSYS (a frame shifted or turned), and a CUTCOM that is not OFF, are read past,
 // and said: the path is taken in the file's coordinates, where it is written (a CAM engineer's
 // MSYS/0,-5,0 put the ball 1 mm into a wall the check read 3.98 mm clear, unsaid); the identity is

@@ -281,3 +281,45 @@ TEST(Generate, ALinkUpAnAxisIntoAShelfGoesUpAnotherWayTheAxisHeld) {
     EXPECT_NEAR((retracted.axis - axis).norm(), 0.0, 1e-12);
   }
 }
+
+// A wall's side finished with the ball, the axis 5.7 deg above horizontal (past the 5 deg under
+// which a link climbs straight up after its retract): DESIGN's link climbs along the axis, 460 mm
+// sideways through a block 35 mm beyond the holder (a helper's). The way taken keeps the retract
+// along the axis, then climbs straight up: any lean toward the block brings the holder (50 mm
+// out along x) into it over the 45 mm climb, and past the vertical the ball into the wall.
+TEST(Generate, AnAxisNearHorizontalRetractsThenClimbsStraightUpWhereItsOwnClimbHitsABlock) {
+  GenerateRequest job;
+  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 15.0};
+  job.holder = {{15, 5}, {30, 5}};
+  job.clearance_mm = 0.5;
+  job.links.retract_mm = 3.0;
+  job.mode = FieldMode::Direct;
+  job.nominal = true;
+  job.part = test::boxMesh(0, 20, -30, 30, -30, 0);
+  job.obstacles = {test::boxMesh(58, 70, -30, 30, -30, 30)};
+  const Vec3 axis = Vec3(1, 0, 0.1).normalized();
+  std::vector<geometry::Posture> nominal;
+  for (int k = 0; k <= 20; ++k)
+    nominal.push_back({Vec3(23, -20 + 2.0 * k, -10) - 3.0 * axis, axis, 0.0, false});
+  job.passes = nominalPasses(geometry::singlePass(std::move(nominal)), PathParams{}, 3.0);
+
+  const GenerateResult r = generatePath(job);
+  EXPECT_EQ(r.clearance.colliding + r.motions.colliding, 0u);
+  ASSERT_TRUE(r.link_part.has_value());
+  EXPECT_FALSE(r.link_part->collides());
+  ASSERT_EQ(r.routed_link_ends.size(), 2u);
+  for (const auto& end : r.routed_link_ends) {
+    EXPECT_GT(end.axis_collisions, 0u);
+    EXPECT_TRUE(end.retract_along_axis);
+    EXPECT_GT(end.way.z(), 0.999);
+    // The posture beside the pass is the retract along the axis; the next one straight above it.
+    const std::size_t pass_end = end.into ? r.postures.front().output : r.postures.back().output;
+    const int side = end.into ? -1 : 1;
+    const geometry::Posture& retracted = r.path.postures[pass_end + side];
+    const geometry::Posture& above = r.path.postures[pass_end + 2 * side];
+    EXPECT_NEAR((retracted.tip_mm - r.path.postures[pass_end].tip_mm - 3.0 * axis).norm(), 0.0,
+                1e-9);
+    EXPECT_NEAR((above.tip_mm - retracted.tip_mm).head<2>().norm(), 0.0, 1e-9);
+    EXPECT_GT(above.tip_mm.z(), 30.0);  // above the block
+  }
+}

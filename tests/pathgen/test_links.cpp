@@ -124,6 +124,12 @@ TEST(Links, AHorizontalAxisIsLeftStraightUpAfterItsRetract) {
                        "the nominal path and run `check` on it)"),
             std::string::npos)
       << error;
+  // Named by its label where the caller gives one (generate: the pass's line in its file).
+  request.labels = {"pass 1 (p.cl:2)", "pass 2 (p.cl:40)"};
+  EXPECT_NE(errorOf([&] {
+              linkPasses(passes, request);
+            }).find("links: pass 2 (p.cl:40) starts with the tool axis 107 deg"),
+            std::string::npos);
 }
 
 TEST(Motions, AThinWallBetweenTwoClearPosturesIsACollidingMotion) {

@@ -52,6 +52,13 @@ struct PathFile {
     std::string record = "CUTTER";
   };
   std::vector<Cutter> cutters;
+  /// APT tool loads (`LOAD/TOOL,n`, `LOADTL/n`): the tool's number as written and the line. More
+  /// than one number: the file changes tools, the commands prove the scene's one.
+  struct ToolLoad {
+    std::string number;
+    std::size_t line = 0;  ///< 1-based
+  };
+  std::vector<ToolLoad> tool_loads;
   /// The safety marks `generate` and `check` write at the top of a path: `# UNSAFE TO RUN: ...`
   /// and `# UNDER THE REQUIRED CLEARANCE: ...` comment lines (`.cl`), the same after `PPRINT/`
   /// (APT), as their text (from UNSAFE / UNDER on), in file order. `convert` carries them over.

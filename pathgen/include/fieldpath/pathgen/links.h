@@ -4,6 +4,7 @@
 /// mesh with the axis turned smoothly.
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "fieldpath/geometry/cl_file.h"
@@ -34,15 +35,25 @@ double topOfMeshes(std::span<const geometry::TriangleMesh> meshes);
 /// top + clearance + kSafeZMarginMm.
 double resolveSafeZ(std::optional<double> given_mm, double top_mm, double clearance_mm);
 
+/// A way a link leaves a pass's end posture or comes into it, the axis held: `retract` along
+/// `retract_dir`, then on along `climb` to the travel plane (unit vectors). Zero `climb`: DESIGN's
+/// way, along the axis (rerouteLinkEnds sets others where that one runs into something).
+struct LinkEndWay {
+  Vec3 retract_dir = Vec3::Zero();
+  Vec3 climb = Vec3::Zero();
+  bool alongAxis() const { return climb == Vec3::Zero(); }
+};
+
 struct LinkRequest {
   LinkParams params;
   double safe_z_mm = 0.0;  ///< resolved: nothing of tool + holder goes below it while travelling
   geometry::ToolSpec tool;
   geometry::HolderProfile holder;
-  /// Per pass (by position in `passes`), the unit direction its link leaves it along and comes
-  /// into it along, the axis held; absent or zero: along its axis (DESIGN). rerouteLinkEnds
-  /// sets them where the axis's way runs into something.
-  std::vector<Vec3> out_ways, in_ways;
+  /// Per pass (by position in `passes`), the way its link leaves it and comes into it; absent:
+  /// along its axis (DESIGN).
+  std::vector<LinkEndWay> out_ways, in_ways;
+  /// Per pass, its name in messages ("pass 3 (nominal.cl:120)"); absent: "pass K".
+  std::vector<std::string> labels;
 };
 
 /// The whole output path: an approach link before the first pass (down its axis from the travel

@@ -88,6 +88,13 @@ struct NominalDropped {
   /// not cut (a line written as one GOTO between arcs written fine is such a move: said).
   std::vector<GapSplit> gaps;
 };
+/// A move into a lone posture a gap parts from the rest of its block within this of the tool axis
+/// (deg) is an approach's start above the cut or a retract's end (the link's); a lone posture
+/// reached across the axis is a cut written as its two ends, refused as before (a regression
+/// hunt: a 7 mm line on the floor written so was dropped from every pass). `check` reads a pass
+/// written from a rapid's end down the axis within it as an engage, not a rapid onto the cut.
+inline constexpr double kApproachDeg = 30.0;
+
 std::vector<Pass> nominalPasses(const geometry::PathFile& path, const PathParams& params,
                                 double ball_radius_mm, NominalDropped* dropped = nullptr);
 
