@@ -63,8 +63,8 @@ void printRepairs(const pathgen::GenerateResult& result) {
     const std::size_t n = result.routed_link_ends.size();
     std::fprintf(stderr,
                  "note: %zu link end%s taken off the pass's tool axis, the axis held (first: the "
-                 "way %s %s, the retract along %s, the climb %.1f deg from the axis toward the "
-                 "vertical: along the axis %zu collisions and %.3f mm of the obstacles, the way "
+                 "way %s %s, the retract along %s, the climb %.1f deg from the axis: along the "
+                 "axis %zu collisions and %.3f mm of the obstacles, the way "
                  "taken %zu and %.3f mm; the tool moves straight, the rotary axes still) "
                  "(report.json links.routed_off_axis)\n",
                  n, n == 1 ? "" : "s", e.into ? "into" : "out of", e.label.c_str(),

@@ -98,11 +98,10 @@ struct AptChunk {
   };
   std::vector<Feed> feeds;
   std::size_t from_line = 0;  ///< its first FROM record's line (0: none)
-  /// FROM/x, y, z[, i, j, k] records (the start and home point), in file units: `posture` is the
+  /// FROM/x, y, z[, ...] records (the start and home point), in file units: `posture` is the
   /// chunk's posture after it, `units_before` the count of its UNITS records before it.
   struct From {
     Vec3 tip;
-    std::optional<Vec3> axis;
     std::size_t posture = 0, units_before = 0, line = 0;
   };
   std::vector<From> froms;
@@ -256,18 +255,14 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
     }
     if (major == "FROM") {
       if (out.from_line == 0) out.from_line = record_line;
-      double v[6];
+      double v[3];
       const std::size_t n =
           slash == std::string::npos
               ? 0
-              : leadingNumbers(std::string_view(statement).substr(slash + 1), v, 6);
-      if (n >= 3) {  // the home point of a GOHOME (another form: no home, GOHOME refused)
-        const auto where = [&] { return file.string() + ":" + std::to_string(record_line); };
-        AptChunk::From from{Vec3(v[0], v[1], v[2]), std::nullopt, chunk.postures.size(),
-                            out.units.size(), record_line};
-        if (n == 6) from.axis = checkedAxis(Vec3(v[3], v[4], v[5]), where);
-        out.froms.push_back(from);
-      }
+              : leadingNumbers(std::string_view(statement).substr(slash + 1), v, 3);
+      if (n == 3)  // the home point of a GOHOME (another form: no home, GOHOME refused)
+        out.froms.push_back(
+            {Vec3(v[0], v[1], v[2]), chunk.postures.size(), out.units.size(), record_line});
       continue;
     }
     if (major == "CUTCOM") {  // the control's offset of the cutter: read past, said unless OFF
@@ -453,8 +448,9 @@ void resolveRelativeMoves(AptChunk& c, double chunk_scale, const std::filesystem
     } else if (next_home < c.home.size() && c.home[next_home] == k) {
       ++next_home;
       if (!home) fail(file, line, "GOHOME: no FROM/x, y, z before it (the home point it goes to)");
+      // The axis kept, as every motion here keeps it: FROM/'s axis taken here swung 37 deg out
+      // and back, the next 3-value GOTO keeping the old one (a regression hunt's).
       postures[k].tip_mm = home->tip;
-      if (home->axis) postures[k].axis = *home->axis;
     } else {
       continue;
     }

@@ -18,10 +18,11 @@ constexpr double kLinkTightenFraction = 0.1;
 /// The motion a → b against the shrunk tool, each pose's tip `shrink_mm` up its axis (the shrunk
 /// ball's centre is the ball's): counted in `out` as motion `index`.
 void checkGrazingMove(const GrazingChecker& grazing, const geometry::Posture& a,
-                      const geometry::Posture& b, std::size_t index, LinkPartResult& out) {
+                      const geometry::Posture& b, std::size_t index, LinkPartResult& out,
+                      const MotionRequest& request) {
   std::vector<geometry::Posture> move = {a, b};
   for (geometry::Posture& p : move) p.tip_mm += grazing.shrink_mm * p.axis;
-  const MotionResult m = grazing.checker.checkMotions(move, MotionRequest{});  // required 0
+  const MotionResult m = grazing.checker.checkMotions(move, request);
   // Counted, but not in the links' minimum (it is the shrunk tool's).
   out.motions += 1;
   if (m.colliding) {
@@ -77,8 +78,12 @@ GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
 
 LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const GrazingChecker& grazing,
                                      const geometry::PathFile& path,
-                                     const common::Progress& progress) {
+                                     const common::Progress& progress, bool contacts_only) {
   LinkPartResult out;
+  // Touching is what counts: required 0. Contacts only: the lowest piece certified above 0 ends
+  // a motion (a slack of its whole nearest sample).
+  MotionRequest grazing_request;
+  if (contacts_only) grazing_request.tighten_fraction = 1.0;
   const auto& all = path.postures;
   // Said link by link (~12 ms each: 1320 passes' links took 16 s without a word, a helper's).
   const double links = static_cast<double>(path.count(geometry::PathBlock::Kind::Link));
@@ -95,9 +100,11 @@ LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const Grazing
     // The moves out of the pass before and into the pass after (a retract along a tool axis
     // leaning over a fin of the part drove the ball into it): they may graze what the ball cuts.
     if (block.begin > 0)
-      checkGrazingMove(grazing, all[block.begin - 1], all[block.begin], block.begin - 1, out);
+      checkGrazingMove(grazing, all[block.begin - 1], all[block.begin], block.begin - 1, out,
+                       grazing_request);
     if (block.end < all.size())
-      checkGrazingMove(grazing, all[block.end - 1], all[block.end], block.end - 1, out);
+      checkGrazingMove(grazing, all[block.end - 1], all[block.end], block.end - 1, out,
+                       grazing_request);
     const std::span<const geometry::Posture> postures(all.data() + block.begin, block.size());
     const ClearanceResult c = part.check(postures);
     out.postures += c.postures;
@@ -112,7 +119,7 @@ LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const Grazing
     // Its minimum told to within 10 % (a lower bound), not 1 %: a link 10 mm over a concave part
     // whose axis turns took ~150 distance queries a motion to tell 9.88 mm to 0.1 mm, and a
     // helper's 439 links on a concave cylinder did not finish in 300 s.
-    request.tighten_fraction = kLinkTightenFraction;
+    request.tighten_fraction = contacts_only ? 1.0 : kLinkTightenFraction;
     const MotionResult m = part.checkMotions(postures, request);
     out.motions += m.motions;
     out.min_clearance_mm = std::min(out.min_clearance_mm, m.min_clearance_mm);

@@ -19,6 +19,9 @@ using geometry::Vec3;
 /// Fractions of the turn from the axis to the vertical tried for a way up (past 1: on past the
 /// vertical, leaning the other way), in order: the first that clears is taken, the least turn.
 constexpr double kWayFractions[] = {0.25, 0.5, 0.75, 1.0, 1.25, 1.5};
+/// The leans from the vertical (deg) and the directions of the climbs tried round the vertical.
+constexpr double kSideClimbDeg[] = {30.0, 60.0};
+constexpr int kSideClimbAzimuths = 8;
 /// A way up must rise at least this much (its z component): sin 5°, as the links' own climb.
 constexpr double kMinWayRise = 0.0872;
 
@@ -50,7 +53,9 @@ class WayChecker {
     }
   }
 
-  WayCheck check(const Posture& p, const LinkEndWay& way, bool into) const {
+  /// Stops counting at `give_up_at` collisions (a way no better than one found).
+  WayCheck check(const Posture& p, const LinkEndWay& way, bool into,
+                 std::size_t give_up_at = std::numeric_limits<std::size_t>::max()) const {
     const double z_mm = safe_z_mm_ - lowestPointBelowTip(request_.tool, request_.holder, p.axis);
     const Vec3 climb = way.alongAxis() ? p.axis : way.climb;
     Posture retracted = p, travel = p;
@@ -64,26 +69,19 @@ class WayChecker {
     const std::vector<Posture> up = {p, retracted, travel};
     WayCheck out;
     const ClearanceResult at = obstacles_.check(up);
-    MotionRequest motions;
-    motions.required_mm = request_.clearance_mm;
-    motions.posture_clearance_mm = at.clearance_mm;
-    // Told to within 10 % (a lower bound), as the links are against the part: a way is chosen
-    // here, the path taken is checked in full after.
-    motions.tighten_fraction = 0.1;
-    // Told to within 10 % (a lower bound), as the links are against the part: a way is chosen
-    // here, the path taken is checked in full after.
-    motions.tighten_fraction = 0.1;
-    const MotionResult moved = obstacles_.checkMotions(up, motions);
     for (std::size_t k = 1; k < up.size(); ++k) {
       out.collisions += at.clearance_mm[k] <= 0.0;
       out.min_mm = std::min(out.min_mm, at.clearance_mm[k]);
     }
+    if (out.collisions >= give_up_at) return out;
+    // Bounded as the path's own motions are (a bound within the slack keptMm allows).
+    MotionRequest motions;
+    motions.required_mm = request_.clearance_mm;
+    motions.posture_clearance_mm = at.clearance_mm;
+    const MotionResult moved = obstacles_.checkMotions(up, motions);
     out.collisions += moved.colliding;
-    // The move from the pass's posture is no clearer than that posture: counted only where the
-    // posture keeps the clearance (a pass under it would make every way as bad).
-    out.min_mm = std::min(out.min_mm, moved.clearance_mm[1]);
-    if (at.clearance_mm[0] >= request_.clearance_mm)
-      out.min_mm = std::min(out.min_mm, moved.clearance_mm[0]);
+    out.min_mm = std::min(out.min_mm, moved.min_clearance_mm);
+    if (out.collisions >= give_up_at) return out;
     if (whole_) {
       // As the path holds it: the pass's posture, then the link (the move between them grazes).
       geometry::PathFile path;
@@ -91,7 +89,7 @@ class WayChecker {
       using Kind = geometry::PathBlock::Kind;
       path.blocks = into ? std::vector<geometry::PathBlock>{{Kind::Link, 0, 2}, {Kind::Pass, 2, 3}}
                          : std::vector<geometry::PathBlock>{{Kind::Pass, 0, 1}, {Kind::Link, 1, 3}};
-      const LinkPartResult part = checkLinksAgainstPart(*whole_, *grazing_, path);
+      const LinkPartResult part = checkLinksAgainstPart(*whole_, *grazing_, path, {}, true);
       out.collisions += part.colliding_postures + part.colliding_motions;
     }
     return out;
@@ -111,44 +109,69 @@ class WayChecker {
 /// (where the retract's end is in the way: a pass settled in a channel). An axis near horizontal
 /// climbs straight up from its retract (linkPasses), but one 5.7 deg up climbed along itself,
 /// 460 mm sideways through a block (a helper's), where the retract then straight up was clear.
-std::vector<LinkEndWay> waysUp(const Vec3& axis) {
+/// Then (`around`), where none of those does better than the axis (an upright axis has none: a
+/// pass under a shelf climbed into it, a helper's), climbs leaning kSideClimbDeg from the
+/// vertical toward kSideClimbAzimuths directions, the nearest the axis's lean first.
+std::vector<LinkEndWay> waysUp(const Vec3& axis, bool around) {
   std::vector<LinkEndWay> out;
-  const double angle = std::acos(std::clamp(axis.z(), -1.0, 1.0));
-  Vec3 side = axis - axis.z() * Vec3::UnitZ();  // the horizontal the axis leans to
-  if (angle < 0.5 * geometry::kDegToRad || side.norm() < 1e-9) return out;
-  side.normalize();
-  for (const double t : kWayFractions) {
-    const double from_vertical = (1.0 - t) * angle;  // negative: past the vertical
-    const Vec3 way = std::cos(from_vertical) * Vec3::UnitZ() + std::sin(from_vertical) * side;
-    if (way.z() < kMinWayRise) continue;
+  const auto add = [&](const Vec3& way) {
+    if (way.z() < kMinWayRise) return;
     out.push_back({axis, way});
     out.push_back({way, way});
-  }
+  };
+  const double angle = std::acos(std::clamp(axis.z(), -1.0, 1.0));
+  Vec3 side = axis - axis.z() * Vec3::UnitZ();  // the horizontal the axis leans to
+  const bool leans = angle >= 0.5 * geometry::kDegToRad && side.norm() > 1e-9;
+  side = leans ? side.normalized() : Vec3::UnitX();
+  if (leans && !around)
+    for (const double t : kWayFractions) {
+      const double from_vertical = (1.0 - t) * angle;  // negative: past the vertical
+      add(std::cos(from_vertical) * Vec3::UnitZ() + std::sin(from_vertical) * side);
+    }
+  if (!around) return out;
+  const Vec3 across = Vec3::UnitZ().cross(side);
+  for (const double lean_deg : kSideClimbDeg)
+    for (int k = 0; k < kSideClimbAzimuths; ++k) {
+      // Azimuths 0, +1, -1, +2, ... steps from the axis's lean.
+      const int step = (k + 1) / 2 * (k % 2 ? 1 : -1);
+      const double azimuth = 2.0 * M_PI * step / kSideClimbAzimuths;
+      const Vec3 horizontal = std::cos(azimuth) * side + std::sin(azimuth) * across;
+      const double lean = lean_deg * geometry::kDegToRad;
+      add(std::cos(lean) * Vec3::UnitZ() + std::sin(lean) * horizontal);
+    }
   return out;
 }
 
+/// The clearance a link end must keep (mm): the required one, or the pass's end posture's own
+/// where that is less (every way starts there: a link no nearer than its pass does not make the
+/// path nearer), less the motions' bound's slack (max(0.01 mm, 1 %), clearance.h): a link 0.0004
+/// mm under its pass's 0.955 was taken 60 deg off its axis for 0.045 mm more (a regression
+/// hunt's; 2 s to 8 s).
+double keptMm(double required_mm, double end_mm) {
+  const double target = std::min(required_mm, end_mm);
+  return target - std::max(0.01, 0.01 * target);
+}
+
 /// Whether the link's postures and motions at the pass's end posture `i` (output index) on the
-/// side `into` (before it) or out (after it) collide or come under `required_mm`.
+/// side `into` (before it) or out (after it) collide or come under keptMm.
 bool faultyEnd(const GenerateResult& result, const std::optional<PartContacts::Marks>& marks,
                std::size_t i, bool into, double required_mm) {
   const auto& at = result.clearance.clearance_mm;
   const auto& moving = result.motions.clearance_mm;
+  const double kept_mm = keptMm(required_mm, i < at.size() ? at[i] : required_mm);
   // Into: postures i-2, i-1 and the motions from them; out: postures i+1, i+2, motions from i, i+1.
-  // The move from the pass's posture is no clearer than that posture: it counts under the
-  // required clearance only where the posture is not.
-  const bool end_under = i < at.size() && at[i] < required_mm;
   for (int d = 1; d <= 2; ++d) {
     const std::ptrdiff_t posture = into ? static_cast<std::ptrdiff_t>(i) - d : i + d;
     const std::ptrdiff_t motion = into ? static_cast<std::ptrdiff_t>(i) - d : i + d - 1;
     if (posture >= 0 && static_cast<std::size_t>(posture) < at.size()) {
       const auto k = static_cast<std::size_t>(posture);
-      if (at[k] < required_mm || (marks && k < marks->posture.size() && marks->posture[k]))
+      if (at[k] <= 0.0 || at[k] < kept_mm ||
+          (marks && k < marks->posture.size() && marks->posture[k]))
         return true;
     }
     if (motion >= 0 && static_cast<std::size_t>(motion) < moving.size()) {
       const auto k = static_cast<std::size_t>(motion);
-      const bool from_end = d == 1;  // the move touching the pass's posture
-      if (moving[k] <= 0.0 || (moving[k] < required_mm && !(from_end && end_under)) ||
+      if (moving[k] <= 0.0 || moving[k] < kept_mm ||
           (marks && k < marks->motion.size() && marks->motion[k]))
         return true;
     }
@@ -177,15 +200,29 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
       if (!faultyEnd(result, part_marks, g.output, into, request.clearance_mm)) continue;
       if (!ways) ways.emplace(request, checker, safe_z_mm);
       const Posture& posture = g.posture;
+      const double kept_mm = keptMm(request.clearance_mm, result.clearance.clearance_mm[g.output]);
+      const auto keeps = [&](const WayCheck& c) {
+        return c.collisions == 0 && c.min_mm >= kept_mm;
+      };
       const WayCheck along = ways->check(posture, LinkEndWay{}, into);
       std::optional<std::pair<LinkEndWay, WayCheck>> best;
-      for (const LinkEndWay& way : waysUp(posture.axis)) {
-        const WayCheck c = ways->check(posture, way, into);
-        if (!best || c.betterThan(best->second)) best.emplace(way, c);
-        if (c.collisions == 0 && c.min_mm >= request.clearance_mm)
-          break;  // the least turn that clears
+      // Off the axis only to keep the clearance, or with fewer collisions where the axis's way
+      // collides: not for a little more clearance where nothing keeps it.
+      const auto taken = [&] {
+        return best && (keeps(best->second) || best->second.collisions < along.collisions);
+      };
+      for (const bool around : {false, true}) {
+        if (taken()) break;  // the ways round the vertical only where the others do no better
+        for (const LinkEndWay& way : waysUp(posture.axis, around)) {
+          // A way colliding as often as the best one found cannot be better: counted to there.
+          const WayCheck c = ways->check(posture, way, into,
+                                         best ? std::max<std::size_t>(best->second.collisions, 1)
+                                              : std::numeric_limits<std::size_t>::max());
+          if (!best || c.betterThan(best->second)) best.emplace(way, c);
+          if (keeps(c)) break;  // the least turn that keeps it
+        }
       }
-      if (!best || !best->second.betterThan(along)) continue;
+      if (!taken()) continue;
       GenerateResult::RoutedLinkEnd end;
       end.pass = result.passes[p].index;
       end.label = result.passes[p].label;

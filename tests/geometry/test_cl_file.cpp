@@ -481,8 +481,8 @@ TEST(AptFile, GodltaMovesFromThePostureBeforeAndGohomeGoesToTheFromPoint) {
                              Vec3(0, 0, 4)};  // FROM/ before UNITS: in mm
     for (std::size_t k = 0; k < 6; ++k) {
       EXPECT_NEAR((p.postures[k].tip_mm - expected[k]).norm(), 0.0, 1e-4) << chunk << " " << k;
-      const Vec3 a = k == 5 ? Vec3::UnitZ() : axis;  // GOHOME takes FROM/'s axis
-      EXPECT_NEAR((p.postures[k].axis - a).norm(), 0.0, 1e-5) << chunk << " " << k;
+      // GOHOME too keeps the axis (not FROM/'s).
+      EXPECT_NEAR((p.postures[k].axis - axis).norm(), 0.0, 1e-5) << chunk << " " << k;
     }
     // The rapid, the pass of three (the GODLTA along the axis at feed), the rapid and home.
     ASSERT_EQ(p.blocks.size(), 3u) << chunk;

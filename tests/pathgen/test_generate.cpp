@@ -323,3 +323,29 @@ TEST(Generate, AnAxisNearHorizontalRetractsThenClimbsStraightUpWhereItsOwnClimbH
     EXPECT_GT(above.tip_mm.z(), 30.0);  // above the block
   }
 }
+
+// A pass with an upright axis under a shelf 8 mm above the tool's top, open 3 mm past the pass's
+// side (+y): its climb straight up runs into the shelf, and there is no great circle from an
+// upright axis to lean along. The climbs round the vertical find the way out from under it:
+// toward +y, leaning more than atan(7 / 8) = 41 deg (3 mm to the edge, the 3 mm shank radius and
+// the 1 mm clearance across the 8 mm rise); along x the shelf runs past the climb.
+TEST(Generate, AnUprightPassUnderAShelfClimbsOutFromUnderIt) {
+  GenerateRequest job;
+  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 12.0};
+  job.mode = FieldMode::Direct;
+  job.nominal = true;
+  job.obstacles = {test::boxMesh(-20, 30, -30, 3, 20, 25)};
+  std::vector<geometry::Posture> nominal;
+  for (int k = 0; k <= 20; ++k) nominal.push_back({Vec3(0.5 * k, 0, 0), Vec3::UnitZ(), 0.0, false});
+  job.passes = nominalPasses(geometry::singlePass(std::move(nominal)), PathParams{}, 3.0);
+
+  const GenerateResult r = generatePath(job);
+  EXPECT_EQ(r.clearance.colliding + r.motions.colliding, 0u);
+  ASSERT_EQ(r.routed_link_ends.size(), 2u);
+  for (const auto& end : r.routed_link_ends) {
+    EXPECT_GT(end.axis_collisions, 0u);
+    EXPECT_EQ(end.taken_collisions, 0u);
+    EXPECT_GT(end.way.y(), 0.0);
+    EXPECT_GT(std::acos(end.way.z()) * 180.0 / M_PI, 41.0);
+  }
+}

@@ -59,9 +59,12 @@ GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
 /// the part, so they may touch it, not enter it by more than kPassGrazeMm (a retract along an
 /// axis leaning over a fin of the part did). Link postures at a pass's first or last posture
 /// (a path written with no retract) are that pass's. `progress` after each link.
+/// `contacts_only`: each motion refined only until it is certified clear or touches (its bound
+/// then loose): what a way being chosen needs (rerouteLinkEnds: 53 ms a way told to 10 %).
 LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const GrazingChecker& grazing,
                                      const geometry::PathFile& path,
-                                     const common::Progress& progress = {});
+                                     const common::Progress& progress = {},
+                                     bool contacts_only = false);
 
 /// The holder (geometry::holderMesh) against the part at every posture and every motion of the
 /// path, passes and links. The holder never cuts: touching the part anywhere is a crash, also
