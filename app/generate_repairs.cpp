@@ -71,6 +71,13 @@ void printRepairs(const pathgen::GenerateResult& result) {
                  e.retract_along_axis ? "the axis" : "the climb", e.off_axis_deg, e.axis_collisions,
                  e.axis_min_mm, e.taken_collisions, e.taken_min_mm);
   }
+  if (!result.unfreed_link_ends.empty())
+    std::fprintf(stderr,
+                 "note: %zu link end%s collide or come under the clearance whichever straight way "
+                 "up from the pass, the axis held, is taken (first: %s): write that link in the "
+                 "nominal path by hand and `check` the path (report.json links.unfreed)\n",
+                 result.unfreed_link_ends.size(), result.unfreed_link_ends.size() == 1 ? "" : "s",
+                 result.unfreed_link_ends.front().c_str());
   if (result.routed_link_ends_undone > 0)
     std::fprintf(stderr,
                  "note: %zu link end%s cleared off the pass's axis, but the path linked that way "

@@ -53,7 +53,7 @@ class WayChecker {
     }
   }
 
-  /// Stops counting at `give_up_at` collisions (a way no better than one found).
+  /// Stops counting at `give_up_at` collisions.
   WayCheck check(const Posture& p, const LinkEndWay& way, bool into,
                  std::size_t give_up_at = std::numeric_limits<std::size_t>::max()) const {
     const double z_mm = safe_z_mm_ - lowestPointBelowTip(request_.tool, request_.holder, p.axis);
@@ -183,7 +183,8 @@ bool faultyEnd(const GenerateResult& result, const std::optional<PartContacts::M
 
 std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
     const GenerateRequest& request, const ClearanceChecker& checker, double safe_z_mm,
-    const GenerateResult& result, const std::optional<PartContacts::Marks>& part_marks) {
+    const GenerateResult& result, const std::optional<PartContacts::Marks>& part_marks,
+    std::vector<std::string>* unfreed) {
   std::vector<GenerateResult::RoutedLinkEnd> routed;
   // Each pass's first and last posture in result.postures.
   std::vector<std::pair<std::size_t, std::size_t>> ends(result.passes.size(), {std::size_t(-1), 0});
@@ -198,6 +199,12 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
     for (const bool into : {true, false}) {
       const GeneratedPosture& g = result.postures[into ? ends[p].first : ends[p].second];
       if (!faultyEnd(result, part_marks, g.output, into, request.clearance_mm)) continue;
+      // A pass whose end posture collides itself: every way from it does (the impeller's
+      // nominal path), and no link of its can be freed.
+      const auto& at = result.clearance.clearance_mm;
+      if ((g.output < at.size() && at[g.output] <= 0.0) ||
+          (part_marks && g.output < part_marks->posture.size() && part_marks->posture[g.output]))
+        continue;
       if (!ways) ways.emplace(request, checker, safe_z_mm);
       const Posture& posture = g.posture;
       const double kept_mm = keptMm(request.clearance_mm, result.clearance.clearance_mm[g.output]);
@@ -206,23 +213,27 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
       };
       const WayCheck along = ways->check(posture, LinkEndWay{}, into);
       std::optional<std::pair<LinkEndWay, WayCheck>> best;
-      // Off the axis only to keep the clearance, or with fewer collisions where the axis's way
-      // collides: not for a little more clearance where nothing keeps it.
+      // Off the axis only to keep the clearance, or clear of everything where the axis's way
+      // collides: not for a little more clearance where nothing keeps it, nor for fewer
+      // collisions (still unsafe: a detour that frees nothing).
       const auto taken = [&] {
-        return best && (keeps(best->second) || best->second.collisions < along.collisions);
+        return best &&
+               (keeps(best->second) || (along.collisions > 0 && best->second.collisions == 0));
       };
       for (const bool around : {false, true}) {
         if (taken()) break;  // the ways round the vertical only where the others do no better
         for (const LinkEndWay& way : waysUp(posture.axis, around)) {
-          // A way colliding as often as the best one found cannot be better: counted to there.
-          const WayCheck c = ways->check(posture, way, into,
-                                         best ? std::max<std::size_t>(best->second.collisions, 1)
-                                              : std::numeric_limits<std::size_t>::max());
-          if (!best || c.betterThan(best->second)) best.emplace(way, c);
+          const WayCheck c = ways->check(posture, way, into, 1);  // a collision rules it out
+          if (c.collisions == 0 && (!best || c.betterThan(best->second))) best.emplace(way, c);
           if (keeps(c)) break;  // the least turn that keeps it
         }
       }
-      if (!taken()) continue;
+      if (!taken()) {
+        if (unfreed)
+          unfreed->push_back(std::string(into ? "the way into " : "the way out of ") +
+                             result.passes[p].label);
+        continue;
+      }
       GenerateResult::RoutedLinkEnd end;
       end.pass = result.passes[p].index;
       end.label = result.passes[p].label;

@@ -2,6 +2,7 @@
 /// Link ends taken off the pass's axis where DESIGN's way (up and down the axis) runs into
 /// something.
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "fieldpath/pathgen/clearance.h"
@@ -17,10 +18,12 @@ namespace fieldpath::pathgen {
 /// are checked against the obstacles and the part, and the first that clears them by the
 /// required clearance (else the best: fewer collisions, then more clearance) is returned where
 /// it is better than the axis's way (the caller puts them in `result.routed_link_ends`, links
-/// and checks the path again: the links take them, linkWays).
+/// and checks the path again: the links take them, linkWays). The faulty ends no way frees are
+/// added to `unfreed` ("the way into pass 2 (nominal.cl:44)").
 std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
     const GenerateRequest& request, const ClearanceChecker& checker, double safe_z_mm,
-    const GenerateResult& result, const std::optional<PartContacts::Marks>& part_marks);
+    const GenerateResult& result, const std::optional<PartContacts::Marks>& part_marks,
+    std::vector<std::string>* unfreed = nullptr);
 
 /// The ways of `result.routed_link_ends` as the links take them (LinkRequest::out_ways, in_ways).
 void linkWays(const GenerateResult& result, LinkRequest& links);

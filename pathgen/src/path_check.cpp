@@ -100,7 +100,8 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
   if (!request.passes_only) {
     // Links whose way along a pass's axis runs into something, taken another way up where one
     // checks clearer.
-    auto routed = rerouteLinkEnds(request, checker, safe_z_mm, result, part_marks);
+    std::vector<std::string> unfreed;
+    auto routed = rerouteLinkEnds(request, checker, safe_z_mm, result, part_marks, &unfreed);
     if (!routed.empty()) {
       GenerateResult along_axes = result;
       std::optional<PartContacts::Marks> along_marks = part_marks;
@@ -109,6 +110,7 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
                     &GenerateResult::routed_link_ends_undone,
                     "links taken off the axis: checked again");
     }
+    result.unfreed_link_ends = std::move(unfreed);
   }
   for (GeneratedPosture& g : result.postures) {
     g.clearance_mm = result.clearance.clearance_mm[g.output];

@@ -348,4 +348,15 @@ TEST(Generate, AnUprightPassUnderAShelfClimbsOutFromUnderIt) {
     EXPECT_GT(end.way.y(), 0.0);
     EXPECT_GT(std::acos(end.way.z()) * 180.0 / M_PI, 41.0);
   }
+  EXPECT_TRUE(r.unfreed_link_ends.empty());
+
+  // Under a shelf 100 mm wide every straight way up runs into it: the ends are named, not moved.
+  GenerateRequest deep = job;
+  deep.obstacles = {test::boxMesh(-50, 60, -50, 50, 20, 25)};
+  const GenerateResult under = generatePath(deep);
+  EXPECT_TRUE(under.routed_link_ends.empty());
+  EXPECT_EQ(under.unfreed_link_ends,
+            (std::vector<std::string>{"the way into " + under.passes[0].label,
+                                      "the way out of " + under.passes[0].label}));
+  EXPECT_GT(under.motions.colliding, 0u);
 }

@@ -193,6 +193,9 @@ struct GenerateResult {
   /// Link ends a way off the axis cleared, not kept: the path linked that way was checked worse
   /// (pathFaults) than the one along the axes.
   std::size_t routed_link_ends_undone = 0;
+  /// Link ends that collide or come under the clearance every straight way up tried (a pass deep
+  /// under an overhang): "the way into pass 2 (nominal.cl:44)".
+  std::vector<std::string> unfreed_link_ends;
   StageTimes times;
   std::size_t obstacle_points = 0;  ///< field samples
   std::size_t tool_nodes = 0;       ///< tool + holder nodes of the moment
