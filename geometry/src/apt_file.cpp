@@ -492,6 +492,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   Vec3 carried_axis = Vec3::UnitZ();  // the axis in force at the end of the chunks so far
   std::optional<AptChunk::From> home;  // the FROM/ point in force, in mm
   std::optional<Vec3> last_tip;        // where the chunks so far end, mm
+  std::exception_ptr unresolved;       // the first GODLTA or GOHOME with nowhere to go
   for (std::size_t i = 0; i < chunks.size(); ++i) {
     AptChunk& c = chunks[i];
     auto& postures = c.postures.postures;
@@ -538,7 +539,13 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
     if (next_unit < c.units.size()) scale = c.units.back().second;
     for (std::size_t k = 0; k < c.inherit_axis; ++k) postures[k].axis = carried_axis;
     if (c.end_axis) carried_axis = *c.end_axis;
-    resolveRelativeMoves(c, chunk_scale, file, home, last_tip);
+    // Its errors wait for the chunks' own, as a reader of the whole file meets those first (a
+    // fuzzer: a GODLTA from nowhere on line 6 was said before a bad GOTO on line 7 in chunks).
+    try {
+      resolveRelativeMoves(c, chunk_scale, file, home, last_tip);
+    } catch (const InputError&) {
+      if (!unresolved) unresolved = std::current_exception();
+    }
     if (postures.empty()) {
       pending = c.trailing_rapid || (pending && !c.cancels_rapid);
       continue;
@@ -548,6 +555,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
     pending = c.trailing_rapid;
     offset += postures.size();
   }
+  if (unresolved) std::rethrow_exception(unresolved);
   PathFile path;
   path.file = file;
   path.cutters = std::move(cutters);

@@ -492,6 +492,19 @@ TEST(AptFile, GodltaMovesFromThePostureBeforeAndGohomeGoesToTheFromPoint) {
     EXPECT_EQ(p.blocks[2].size(), 2u);
     EXPECT_EQ(p.lines[5], 11u);
   }
+  // Its error waits for the file's own errors, whatever the chunks (a fuzzer's: in chunks the
+  // GODLTA from nowhere on line 2 was said, whole the bad GOTO on line 3).
+  const auto both = writeBytes("both.apt", "GODLTA/0,0,-1\nGOTO/NI\n");
+  for (const std::size_t chunk : {std::size_t{4}, std::size_t{1} << 20}) {
+    PathReadOptions options;
+    options.chunk_bytes = chunk;
+    try {
+      readPathFile(both, options);
+      ADD_FAILURE() << "read";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("both.apt:2:"), std::string::npos) << chunk << e.what();
+    }
+  }
   // A GODLTA with nothing before it to move from is refused at its line.
   try {
     readAptFile(writeBytes("first.apt", "PARTNO/X\nGODLTA/0,0,5\nGOTO/1,0,0,0,0,1\n"));
