@@ -23,6 +23,7 @@ nlohmann::json routedLinkEndsJson(const pathgen::GenerateResult& r) {
          {"end", e.into ? "into" : "out of"},
          {"way", {e.way.x(), e.way.y(), e.way.z()}},
          {"retract", e.retract_along_axis ? "along the axis" : "along the way"},
+         {"sideways_mm", {e.sideways_mm.x(), e.sideways_mm.y(), e.sideways_mm.z()}},
          {"off_axis_deg", e.off_axis_deg},
          {"along_axis", {{"collisions", e.axis_collisions}, {"min_clearance_mm", e.axis_min_mm}}},
          {"taken", {{"collisions", e.taken_collisions}, {"min_clearance_mm", e.taken_min_mm}}}});

@@ -22,6 +22,10 @@ constexpr double kWayFractions[] = {0.25, 0.5, 0.75, 1.0, 1.25, 1.5};
 /// The leans from the vertical (deg) and the directions of the climbs tried round the vertical.
 constexpr double kSideClimbDeg[] = {30.0, 60.0};
 constexpr int kSideClimbAzimuths = 8;
+/// The moves sideways before a climb straight up, in widest radii of the tool and holder.
+constexpr double kAsideReaches[] = {2.0, 4.0, 8.0};
+/// The ways tried, family by family (waysUp).
+enum class WayFamily { Circle, Around, Aside };
 /// A way up must rise at least this much (its z component): sin 5°, as the links' own climb.
 constexpr double kMinWayRise = 0.0872;
 
@@ -61,12 +65,16 @@ class WayChecker {
     Posture retracted = p, travel = p;
     retracted.tip_mm =
         p.tip_mm + request_.links.retract_mm * (way.alongAxis() ? p.axis : way.retract_dir);
-    travel.tip_mm = retracted.tip_mm;
+    Posture aside = retracted;  // after the move sideways, if any
+    aside.tip_mm += way.sideways_mm;
+    travel.tip_mm = aside.tip_mm;
     if (climb.z() >= kMinWayRise)
-      travel.tip_mm += std::max(0.0, (z_mm - retracted.tip_mm.z()) / climb.z()) * climb;
+      travel.tip_mm += std::max(0.0, (z_mm - aside.tip_mm.z()) / climb.z()) * climb;
     else  // an axis near horizontal: its link goes straight up from the retract (linkPasses)
       travel.tip_mm.z() = std::max(travel.tip_mm.z(), z_mm);
-    const std::vector<Posture> up = {p, retracted, travel};
+    std::vector<Posture> up = {p, retracted};
+    if (way.sideways_mm != Vec3::Zero()) up.push_back(aside);
+    up.push_back(travel);
     WayCheck out;
     const ClearanceResult at = obstacles_.check(up);
     for (std::size_t k = 1; k < up.size(); ++k) {
@@ -85,10 +93,13 @@ class WayChecker {
     if (whole_) {
       // As the path holds it: the pass's posture, then the link (the move between them grazes).
       geometry::PathFile path;
-      path.postures = into ? std::vector<Posture>{travel, retracted, p} : up;
+      path.postures = up;
+      if (into) std::reverse(path.postures.begin(), path.postures.end());
+      const std::size_t n = up.size();
       using Kind = geometry::PathBlock::Kind;
-      path.blocks = into ? std::vector<geometry::PathBlock>{{Kind::Link, 0, 2}, {Kind::Pass, 2, 3}}
-                         : std::vector<geometry::PathBlock>{{Kind::Pass, 0, 1}, {Kind::Link, 1, 3}};
+      path.blocks =
+          into ? std::vector<geometry::PathBlock>{{Kind::Link, 0, n - 1}, {Kind::Pass, n - 1, n}}
+               : std::vector<geometry::PathBlock>{{Kind::Pass, 0, 1}, {Kind::Link, 1, n}};
       const LinkPartResult part = checkLinksAgainstPart(*whole_, *grazing_, path, {}, true);
       out.collisions += part.colliding_postures + part.colliding_motions;
     }
@@ -109,10 +120,13 @@ class WayChecker {
 /// (where the retract's end is in the way: a pass settled in a channel). An axis near horizontal
 /// climbs straight up from its retract (linkPasses), but one 5.7 deg up climbed along itself,
 /// 460 mm sideways through a block (a helper's), where the retract then straight up was clear.
-/// Then (`around`), where none of those does better than the axis (an upright axis has none: a
+/// Then (Around), where none of those does better than the axis (an upright axis has none: a
 /// pass under a shelf climbed into it, a helper's), climbs leaning kSideClimbDeg from the
-/// vertical toward kSideClimbAzimuths directions, the nearest the axis's lean first.
-std::vector<LinkEndWay> waysUp(const Vec3& axis, bool around) {
+/// vertical toward kSideClimbAzimuths directions, the nearest the axis's lean first. Then
+/// (Aside), where no straight climb frees it (a pass 10 mm under a shelf, a 90 mm holder below
+/// it: a helper's), the retract along the axis, a move sideways of kAsideReaches times the tool
+/// and holder's widest radius `reach_mm` toward those directions, then straight up.
+std::vector<LinkEndWay> waysUp(const Vec3& axis, WayFamily family, double reach_mm) {
   std::vector<LinkEndWay> out;
   const auto add = [&](const Vec3& way) {
     if (way.z() < kMinWayRise) return;
@@ -123,22 +137,31 @@ std::vector<LinkEndWay> waysUp(const Vec3& axis, bool around) {
   Vec3 side = axis - axis.z() * Vec3::UnitZ();  // the horizontal the axis leans to
   const bool leans = angle >= 0.5 * geometry::kDegToRad && side.norm() > 1e-9;
   side = leans ? side.normalized() : Vec3::UnitX();
-  if (leans && !around)
-    for (const double t : kWayFractions) {
-      const double from_vertical = (1.0 - t) * angle;  // negative: past the vertical
-      add(std::cos(from_vertical) * Vec3::UnitZ() + std::sin(from_vertical) * side);
-    }
-  if (!around) return out;
+  if (family == WayFamily::Circle) {
+    if (leans)
+      for (const double t : kWayFractions) {
+        const double from_vertical = (1.0 - t) * angle;  // negative: past the vertical
+        add(std::cos(from_vertical) * Vec3::UnitZ() + std::sin(from_vertical) * side);
+      }
+    return out;
+  }
   const Vec3 across = Vec3::UnitZ().cross(side);
-  for (const double lean_deg : kSideClimbDeg)
-    for (int k = 0; k < kSideClimbAzimuths; ++k) {
-      // Azimuths 0, +1, -1, +2, ... steps from the axis's lean.
-      const int step = (k + 1) / 2 * (k % 2 ? 1 : -1);
-      const double azimuth = 2.0 * M_PI * step / kSideClimbAzimuths;
-      const Vec3 horizontal = std::cos(azimuth) * side + std::sin(azimuth) * across;
-      const double lean = lean_deg * geometry::kDegToRad;
-      add(std::cos(lean) * Vec3::UnitZ() + std::sin(lean) * horizontal);
-    }
+  const auto horizontal = [&](int k) {  // azimuths 0, +1, -1, +2, ... steps from the lean
+    const int step = (k + 1) / 2 * (k % 2 ? 1 : -1);
+    const double azimuth = 2.0 * M_PI * step / kSideClimbAzimuths;
+    return Vec3(std::cos(azimuth) * side + std::sin(azimuth) * across);
+  };
+  if (family == WayFamily::Around) {
+    for (const double lean_deg : kSideClimbDeg)
+      for (int k = 0; k < kSideClimbAzimuths; ++k) {
+        const double lean = lean_deg * geometry::kDegToRad;
+        add(std::cos(lean) * Vec3::UnitZ() + std::sin(lean) * horizontal(k));
+      }
+    return out;
+  }
+  for (const double reaches : kAsideReaches)
+    for (int k = 0; k < kSideClimbAzimuths; ++k)
+      out.push_back({axis, Vec3::UnitZ(), reaches * reach_mm * horizontal(k)});
   return out;
 }
 
@@ -194,6 +217,9 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
     last = std::max(last, k);
   }
   std::optional<WayChecker> ways;  // the part's model built only where a link end is faulty
+  // The tool and holder's widest radius: the moves sideways are in it.
+  double reach_mm = request.tool.radius_mm;
+  for (const auto& station : request.holder) reach_mm = std::max(reach_mm, station.radius_mm);
   for (std::size_t p = 0; p < ends.size(); ++p) {
     if (ends[p].first == std::size_t(-1)) continue;
     for (const bool into : {true, false}) {
@@ -220,9 +246,9 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
         return best &&
                (keeps(best->second) || (along.collisions > 0 && best->second.collisions == 0));
       };
-      for (const bool around : {false, true}) {
-        if (taken()) break;  // the ways round the vertical only where the others do no better
-        for (const LinkEndWay& way : waysUp(posture.axis, around)) {
+      for (const WayFamily family : {WayFamily::Circle, WayFamily::Around, WayFamily::Aside}) {
+        if (taken()) break;  // each family only where the ones before it do no better
+        for (const LinkEndWay& way : waysUp(posture.axis, family, reach_mm)) {
           const WayCheck c = ways->check(posture, way, into, 1);  // a collision rules it out
           if (c.collisions == 0 && (!best || c.betterThan(best->second))) best.emplace(way, c);
           if (keeps(c)) break;  // the least turn that keeps it
@@ -240,6 +266,7 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
       end.into = into;
       end.way = best->first.climb;
       end.retract_along_axis = best->first.retract_dir == posture.axis;
+      end.sideways_mm = best->first.sideways_mm;
       end.off_axis_deg =
           std::acos(std::clamp(end.way.dot(posture.axis), -1.0, 1.0)) / geometry::kDegToRad;
       end.axis_collisions = along.collisions;
@@ -267,7 +294,7 @@ void linkWays(const GenerateResult& result, LinkRequest& links) {
       if (result.passes[p].index == end.pass && first[p]) {
         const Vec3& axis = (end.into ? first[p] : last[p])->axis;
         (end.into ? links.in_ways : links.out_ways)[p] =
-            LinkEndWay{end.retract_along_axis ? axis : end.way, end.way};
+            LinkEndWay{end.retract_along_axis ? axis : end.way, end.way, end.sideways_mm};
       }
 }
 

@@ -73,7 +73,7 @@ Posture at(const Vec3& tip, const Vec3& axis) {
 Vec3 travelPoint(const Posture& p, double z_mm, double retract_mm, const char* which,
                  const std::string& pass, const LinkEndWay& way) {
   if (!way.alongAxis()) {
-    const Vec3 out = p.tip_mm + retract_mm * way.retract_dir;
+    const Vec3 out = p.tip_mm + retract_mm * way.retract_dir + way.sideways_mm;
     return out + std::max(0.0, (z_mm - out.z()) / way.climb.z()) * way.climb;
   }
   if (p.axis.z() >= kMinAxisRise)
@@ -164,15 +164,20 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
   auto way = [&](const std::vector<LinkEndWay>& ways, std::size_t k) {
     return k < ways.size() ? ways[k] : LinkEndWay{};
   };
+  const auto link = PathBlock::Kind::Link;
   // Where the link's retract out of `p` along `w` ends.
   auto retracted = [&](const Posture& p, const LinkEndWay& w) {
     return p.tip_mm + params.retract_mm * (w.alongAxis() ? p.axis : w.retract_dir);
+  };
+  // The posture after the retract where `w` moves sideways before its climb.
+  auto sideways = [&](const Posture& p, const LinkEndWay& w) {
+    if (!w.alongAxis() && w.sideways_mm != Vec3::Zero())
+      add(link, at(retracted(p, w) + w.sideways_mm, p.axis));
   };
   // A pass as messages name it: its label (with its line) where given.
   auto label = [&](std::size_t k) {
     return k < request.labels.size() ? request.labels[k] : "pass " + std::to_string(k + 1);
   };
-  const auto link = PathBlock::Kind::Link;
   for (std::size_t k = 0; k < passes.size(); ++k) {
     const std::vector<Posture>& pass = passes[k];
     if (pass.empty()) continue;
@@ -188,6 +193,7 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
       const Posture& last = passes[k - 1].back();
       const LinkEndWay out = way(request.out_ways, k - 1);
       add(link, at(retracted(last, out), last.axis));
+      sideways(last, out);
       const Vec3 a = travelPoint(last, z, params.retract_mm, "ends", label(k - 1), out);
       const Vec3 b = travelPoint(first, z, params.retract_mm, "starts", label(k), in);
       const AxisTurn turn(last.axis, first.axis);
@@ -197,6 +203,7 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
         add(link, at((1 - t) * a + t * b, turn.at(t)));
       }
     }
+    sideways(first, in);
     add(link, at(retracted(first, in), first.axis));
     for (const Posture& p : pass) add(PathBlock::Kind::Pass, p);
   }
@@ -209,6 +216,7 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
     const Vec3 up = travelPoint(final_posture, travelTipZ(final_posture.axis, final_posture.axis),
                                 params.retract_mm, "ends", label(last), leave);
     add(link, at(retracted(final_posture, leave), final_posture.axis));
+    sideways(final_posture, leave);
     add(link, at(up, final_posture.axis));
   }
   return out;

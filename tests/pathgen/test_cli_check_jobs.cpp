@@ -256,7 +256,8 @@ TEST(CheckClearance, UnsafeAndUnderTheClearanceAreBothMarked) {
 TEST(CheckClearance, AnUnsafeLinkIsNamedWithItsBlockAndTheKeysThatPlaceIt) {
   const TempDir dir;
   geometry::TriangleMesh bar, part;
-  pathgen::test::addBox(bar, 30, 200, -50, 50, 25, 30);
+  // (1 m wide: no move sideways of the link gets out from under it)
+  pathgen::test::addBox(bar, 30, 200, -500, 500, 25, 30);
   pathgen::test::addBox(part, -60, -3, -50, 50, -20, 20);
   geometry::saveMesh(bar, dir.path() / "bar.stl");
   geometry::saveMesh(part, dir.path() / "part.stl");

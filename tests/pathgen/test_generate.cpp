@@ -359,4 +359,19 @@ TEST(Generate, AnUprightPassUnderAShelfClimbsOutFromUnderIt) {
             (std::vector<std::string>{"the way into " + under.passes[0].label,
                                       "the way out of " + under.passes[0].label}));
   EXPECT_GT(under.motions.colliding, 0u);
+
+  // A shelf 1 mm over the tool's top (a 0.5 mm retract): no climb from the pass clears it; the
+  // link moves sideways out from under it first (8 tool radii: 2 and 4 leave the shank under
+  // the shelf's edge 10 mm off), then climbs straight up.
+  GenerateRequest low = job;
+  low.links.retract_mm = 0.5;
+  low.obstacles = {test::boxMesh(-50, 60, -50, 10, 13, 25)};
+  const GenerateResult aside = generatePath(low);
+  EXPECT_EQ(aside.clearance.colliding + aside.motions.colliding, 0u);
+  ASSERT_EQ(aside.routed_link_ends.size(), 2u);
+  for (const auto& end : aside.routed_link_ends) {
+    EXPECT_NEAR(end.sideways_mm.norm(), 24.0, 1e-9);
+    EXPECT_GT(end.sideways_mm.y(), 10.0 + 3.0);
+    EXPECT_NEAR(end.way.z(), 1.0, 1e-12);
+  }
 }

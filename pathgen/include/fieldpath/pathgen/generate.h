@@ -182,6 +182,7 @@ struct GenerateResult {
     bool into = true;           ///< the way into the pass (else out of it)
     geometry::Vec3 way;         ///< unit, the climb from the retract up to the travel plane
     bool retract_along_axis = false;  ///< the retract along the axis (else along `way` too)
+    geometry::Vec3 sideways_mm = geometry::Vec3::Zero();  ///< a move sideways before the climb
     double off_axis_deg = 0.0;  ///< the way's angle from the axis
     /// Collisions (postures and motions, obstacles and part) and least clearance of the
     /// obstacles (mm) of the way along the axis and of the way taken, from the pass's posture

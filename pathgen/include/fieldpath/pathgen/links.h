@@ -36,11 +36,13 @@ double topOfMeshes(std::span<const geometry::TriangleMesh> meshes);
 double resolveSafeZ(std::optional<double> given_mm, double top_mm, double clearance_mm);
 
 /// A way a link leaves a pass's end posture or comes into it, the axis held: `retract` along
-/// `retract_dir`, then on along `climb` to the travel plane (unit vectors). Zero `climb`: DESIGN's
-/// way, along the axis (rerouteLinkEnds sets others where that one runs into something).
+/// `retract_dir`, then by `sideways_mm` (a horizontal move, mm; zero: none), then on along `climb`
+/// to the travel plane (unit vectors). Zero `climb`: DESIGN's way, along the axis
+/// (rerouteLinkEnds sets others where that one runs into something).
 struct LinkEndWay {
   Vec3 retract_dir = Vec3::Zero();
   Vec3 climb = Vec3::Zero();
+  Vec3 sideways_mm = Vec3::Zero();
   bool alongAxis() const { return climb == Vec3::Zero(); }
 };
 
