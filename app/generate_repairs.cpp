@@ -1,5 +1,6 @@
 #include "generate_repairs.h"
 
+#include <cmath>
 #include <cstdio>
 
 namespace fieldpath::app {
@@ -24,6 +25,8 @@ nlohmann::json routedLinkEndsJson(const pathgen::GenerateResult& r) {
          {"way", {e.way.x(), e.way.y(), e.way.z()}},
          {"retract", e.retract_along_axis ? "along the axis" : "along the way"},
          {"sideways_mm", {e.sideways_mm.x(), e.sideways_mm.y(), e.sideways_mm.z()}},
+         // then straight up; null: along `way` to the travel plane
+         {"climb_mm", std::isfinite(e.climb_mm) ? nlohmann::json(e.climb_mm) : nlohmann::json()},
          {"off_axis_deg", e.off_axis_deg},
          {"along_axis", {{"collisions", e.axis_collisions}, {"min_clearance_mm", e.axis_min_mm}}},
          {"taken", {{"collisions", e.taken_collisions}, {"min_clearance_mm", e.taken_min_mm}}}});

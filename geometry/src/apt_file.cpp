@@ -492,6 +492,10 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   Vec3 carried_axis = Vec3::UnitZ();  // the axis in force at the end of the chunks so far
   std::optional<AptChunk::From> home;  // the FROM/ point in force, in mm
   std::optional<Vec3> last_tip;        // where the chunks so far end, mm
+  // The errors found here wait for the chunks' own (a reader of the whole file meets those first;
+  // fuzzers: a tip too far in inches, or a GODLTA from nowhere, said before a bad GOTO further on
+  // in chunks), the tips too far first, as the whole file's scaling meets them before its moves.
+  std::exception_ptr too_far;          // the first tip past the readers' range once in mm
   std::exception_ptr unresolved;       // the first GODLTA or GOHOME with nowhere to go
   for (std::size_t i = 0; i < chunks.size(); ++i) {
     AptChunk& c = chunks[i];
@@ -532,15 +536,18 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
       postures[k].tip_mm *= scale;
       // Checked in mm: 50000 inches passed the readers' +-1e6 as read, then `convert` refused
       // its own 1.27e6 mm output (a helper's finding).
-      if (scale != 1.0)
-        checkTip(postures[k].tip_mm,
-                 [&] { return file.string() + ":" + std::to_string(c.postures.lines[k]); });
+      if (scale != 1.0 && !too_far) {
+        try {
+          checkTip(postures[k].tip_mm,
+                   [&] { return file.string() + ":" + std::to_string(c.postures.lines[k]); });
+        } catch (const InputError&) {
+          too_far = std::current_exception();
+        }
+      }
     }
     if (next_unit < c.units.size()) scale = c.units.back().second;
     for (std::size_t k = 0; k < c.inherit_axis; ++k) postures[k].axis = carried_axis;
     if (c.end_axis) carried_axis = *c.end_axis;
-    // Its errors wait for the chunks' own, as a reader of the whole file meets those first (a
-    // fuzzer: a GODLTA from nowhere on line 6 was said before a bad GOTO on line 7 in chunks).
     try {
       resolveRelativeMoves(c, chunk_scale, file, home, last_tip);
     } catch (const InputError&) {
@@ -555,6 +562,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
     pending = c.trailing_rapid;
     offset += postures.size();
   }
+  if (too_far) std::rethrow_exception(too_far);
   if (unresolved) std::rethrow_exception(unresolved);
   PathFile path;
   path.file = file;

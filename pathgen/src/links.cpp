@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 #include "fieldpath/common/errors.h"
 
@@ -72,10 +73,7 @@ Posture at(const Vec3& tip, const Vec3& axis) {
 /// then on along its climb to the plane.
 Vec3 travelPoint(const Posture& p, double z_mm, double retract_mm, const char* which,
                  const std::string& pass, const LinkEndWay& way) {
-  if (!way.alongAxis()) {
-    const Vec3 out = p.tip_mm + retract_mm * way.retract_dir + way.sideways_mm;
-    return out + std::max(0.0, (z_mm - out.z()) / way.climb.z()) * way.climb;
-  }
+  if (!way.alongAxis()) return wayTips(p.tip_mm, z_mm, retract_mm, way).back();
   if (p.axis.z() >= kMinAxisRise)
     return p.tip_mm + std::max(retract_mm, (z_mm - p.tip_mm.z()) / p.axis.z()) * p.axis;
   if (p.axis.z() < -kHorizontalZ) {
@@ -93,6 +91,21 @@ Vec3 travelPoint(const Posture& p, double z_mm, double retract_mm, const char* w
 }
 
 }  // namespace
+
+std::vector<Vec3> wayTips(const Vec3& tip_mm, double z_mm, double retract_mm,
+                          const LinkEndWay& way) {
+  std::vector<Vec3> out = {tip_mm + retract_mm * way.retract_dir};
+  if (way.sideways_mm != Vec3::Zero()) out.push_back(out.back() + way.sideways_mm);
+  const Vec3 from = out.back();
+  const double full = std::max(0.0, (z_mm - from.z()) / way.climb.z());
+  if (way.climb_mm < full) {  // the knee, then straight up
+    out.push_back(from + way.climb_mm * way.climb);
+    out.push_back(Vec3(out.back().x(), out.back().y(), z_mm));
+  } else {
+    out.push_back(from + full * way.climb);
+  }
+  return out;
+}
 
 double lowestPointBelowTip(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
                            const Vec3& axis) {
@@ -169,10 +182,14 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
   auto retracted = [&](const Posture& p, const LinkEndWay& w) {
     return p.tip_mm + params.retract_mm * (w.alongAxis() ? p.axis : w.retract_dir);
   };
-  // The posture after the retract where `w` moves sideways before its climb.
-  auto sideways = [&](const Posture& p, const LinkEndWay& w) {
-    if (!w.alongAxis() && w.sideways_mm != Vec3::Zero())
-      add(link, at(retracted(p, w) + w.sideways_mm, p.axis));
+  // The postures between the retract and the travel plane of a way off the axis (the move
+  // sideways' end, the knee), in the order the link passes them: out of the pass, or into it.
+  auto between = [&](const Posture& p, const LinkEndWay& w, double z, bool into) {
+    if (w.alongAxis()) return;
+    std::vector<Vec3> tips = wayTips(p.tip_mm, z, params.retract_mm, w);
+    tips = std::vector<Vec3>(tips.begin() + 1, tips.end() - 1);
+    if (into) std::reverse(tips.begin(), tips.end());
+    for (const Vec3& tip : tips) add(link, at(tip, p.axis));
   };
   // A pass as messages name it: its label (with its line) where given.
   auto label = [&](std::size_t k) {
@@ -193,7 +210,7 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
       const Posture& last = passes[k - 1].back();
       const LinkEndWay out = way(request.out_ways, k - 1);
       add(link, at(retracted(last, out), last.axis));
-      sideways(last, out);
+      between(last, out, z, false);
       const Vec3 a = travelPoint(last, z, params.retract_mm, "ends", label(k - 1), out);
       const Vec3 b = travelPoint(first, z, params.retract_mm, "starts", label(k), in);
       const AxisTurn turn(last.axis, first.axis);
@@ -203,7 +220,7 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
         add(link, at((1 - t) * a + t * b, turn.at(t)));
       }
     }
-    sideways(first, in);
+    between(first, in, z, true);
     add(link, at(retracted(first, in), first.axis));
     for (const Posture& p : pass) add(PathBlock::Kind::Pass, p);
   }
@@ -213,10 +230,10 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
     std::size_t last = passes.size() - 1;
     while (passes[last].empty()) --last;
     const LinkEndWay leave = way(request.out_ways, last);
-    const Vec3 up = travelPoint(final_posture, travelTipZ(final_posture.axis, final_posture.axis),
-                                params.retract_mm, "ends", label(last), leave);
+    const double z = travelTipZ(final_posture.axis, final_posture.axis);
+    const Vec3 up = travelPoint(final_posture, z, params.retract_mm, "ends", label(last), leave);
     add(link, at(retracted(final_posture, leave), final_posture.axis));
-    sideways(final_posture, leave);
+    between(final_posture, leave, z, false);
     add(link, at(up, final_posture.axis));
   }
   return out;

@@ -494,15 +494,20 @@ TEST(AptFile, GodltaMovesFromThePostureBeforeAndGohomeGoesToTheFromPoint) {
   }
   // Its error waits for the file's own errors, whatever the chunks (a fuzzer's: in chunks the
   // GODLTA from nowhere on line 2 was said, whole the bad GOTO on line 3).
-  const auto both = writeBytes("both.apt", "GODLTA/0,0,-1\nGOTO/NI\n");
-  for (const std::size_t chunk : {std::size_t{4}, std::size_t{1} << 20}) {
-    PathReadOptions options;
-    options.chunk_bytes = chunk;
-    try {
-      readPathFile(both, options);
-      ADD_FAILURE() << "read";
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("both.apt:2:"), std::string::npos) << chunk << e.what();
+  // So does a tip past the readers' range once in mm (50 000 inches).
+  for (const std::string text :
+       {"GODLTA/0,0,-1\nGOTO/NI\n", "UNITS/INCHES\nGOTO/0,0,50000,0,0,1\nGOTO/NI\n"}) {
+    const auto both = writeBytes("both.apt", text);
+    const std::string line = text.starts_with("UNITS") ? "both.apt:3:" : "both.apt:2:";
+    for (const std::size_t chunk : {std::size_t{4}, std::size_t{1} << 20}) {
+      PathReadOptions options;
+      options.chunk_bytes = chunk;
+      try {
+        readPathFile(both, options);
+        ADD_FAILURE() << "read";
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(line), std::string::npos) << chunk << e.what();
+      }
     }
   }
   // A GODLTA with nothing before it to move from is refused at its line.

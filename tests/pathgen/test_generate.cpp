@@ -347,6 +347,13 @@ TEST(Generate, AnUprightPassUnderAShelfClimbsOutFromUnderIt) {
     EXPECT_EQ(end.taken_collisions, 0u);
     EXPECT_GT(end.way.y(), 0.0);
     EXPECT_GT(std::acos(end.way.z()) * 180.0 / M_PI, 41.0);
+    // The lean stops once out from under the shelf (a knee), then straight up: the link's tips
+    // stay within the shelf's edge and a margin, not the travel plane's 28 mm of rise at 60 deg.
+    EXPECT_TRUE(std::isfinite(end.climb_mm));
+    const std::size_t pass_end = end.into ? r.postures.front().output : r.postures.back().output;
+    const int side = end.into ? -1 : 1;
+    for (int k = 1; k <= 3; ++k)
+      EXPECT_LT(r.path.postures[pass_end + k * side].tip_mm.y(), 30.0) << k;
   }
   EXPECT_TRUE(r.unfreed_link_ends.empty());
 

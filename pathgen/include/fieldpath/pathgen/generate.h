@@ -3,6 +3,7 @@
 /// benchmark share it): passes (from the impeller or a nominal path) → field (direct or voxels) →
 /// steered tool axis per pass → links → exact clearance of every posture and motion.
 #include <cstddef>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -183,6 +184,8 @@ struct GenerateResult {
     geometry::Vec3 way;         ///< unit, the climb from the retract up to the travel plane
     bool retract_along_axis = false;  ///< the retract along the axis (else along `way` too)
     geometry::Vec3 sideways_mm = geometry::Vec3::Zero();  ///< a move sideways before the climb
+    /// The climb's length along `way` before straight up (infinite: to the travel plane).
+    double climb_mm = std::numeric_limits<double>::infinity();
     double off_axis_deg = 0.0;  ///< the way's angle from the axis
     /// Collisions (postures and motions, obstacles and part) and least clearance of the
     /// obstacles (mm) of the way along the axis and of the way taken, from the pass's posture

@@ -2,6 +2,7 @@
 /// Links between passes (DESIGN.md "Links and motion"): the output must be safe to run. Each pass
 /// is entered and left along its tool axis; between passes the tool travels in a plane above every
 /// mesh with the axis turned smoothly.
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -39,12 +40,21 @@ double resolveSafeZ(std::optional<double> given_mm, double top_mm, double cleara
 /// `retract_dir`, then by `sideways_mm` (a horizontal move, mm; zero: none), then on along `climb`
 /// to the travel plane (unit vectors). Zero `climb`: DESIGN's way, along the axis
 /// (rerouteLinkEnds sets others where that one runs into something).
+/// `climb_mm`: the climb's length along `climb`, then straight up (a knee where the tool is out
+/// from under what its axis's way ran into; infinite: all the way to the plane).
 struct LinkEndWay {
   Vec3 retract_dir = Vec3::Zero();
   Vec3 climb = Vec3::Zero();
   Vec3 sideways_mm = Vec3::Zero();
+  double climb_mm = std::numeric_limits<double>::infinity();
   bool alongAxis() const { return climb == Vec3::Zero(); }
 };
+
+/// The tips a link way off the axis (`way`, not alongAxis) passes from the pass's end posture
+/// `tip_mm` out to the travel plane (the tip at `z_mm`), in that order: the retract's end, the
+/// move sideways' end (if any), the knee (if the climb stops short), the point in the plane.
+std::vector<Vec3> wayTips(const Vec3& tip_mm, double z_mm, double retract_mm,
+                          const LinkEndWay& way);
 
 struct LinkRequest {
   LinkParams params;
