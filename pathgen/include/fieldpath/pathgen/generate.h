@@ -187,10 +187,10 @@ struct GenerateResult {
     /// The climb's length along `way` before straight up (infinite: to the travel plane).
     double climb_mm = std::numeric_limits<double>::infinity();
     double off_axis_deg = 0.0;  ///< the way's angle from the axis
-    /// Collisions (postures and motions, obstacles and part) and least clearance of the
-    /// obstacles (mm) of the way along the axis and of the way taken, from the pass's posture
-    /// (its own clearance not counted) to the travel plane.
-    std::size_t axis_collisions = 0, taken_collisions = 0;
+    /// Collisions (postures and motions, obstacles and part) of the way along the axis (the way
+    /// taken has none), and the least clearance of the obstacles (mm) of both, from the pass's
+    /// posture (its own clearance not counted) to the travel plane.
+    std::size_t axis_collisions = 0;
     double axis_min_mm = 0.0, taken_min_mm = 0.0;
   };
   std::vector<RoutedLinkEnd> routed_link_ends;
