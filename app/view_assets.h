@@ -5,5 +5,6 @@ namespace fieldpath::app::view_assets {
 extern const char* const kPageHtml;  ///< app/view/page.html
 extern const char* const kViewCss;   ///< app/view/view.css
 extern const char* const kColoursJs;  ///< app/view/colours.js (before view.js)
+extern const char* const kGeometryJs;  ///< app/view/geometry.js (after colours.js)
 extern const char* const kViewJs;    ///< app/view/view.js
 }  // namespace fieldpath::app::view_assets

@@ -382,7 +382,7 @@ std::string viewPage(const ViewData& d, const ThreeJs& three, const PageBudget& 
   const std::string meta_text = scriptJson(meta), blob_text = base64(blob.bytes());
   const std::string title_text = htmlEscape(title), generator_text = htmlEscape(generator);
   const std::string css = view_assets::kViewCss, colours = view_assets::kColoursJs,
-                    js = view_assets::kViewJs;
+                    geometry = view_assets::kGeometryJs, js = view_assets::kViewJs;
   const std::string page = fill(view_assets::kPageHtml, {{"GENERATOR", &generator_text},
                                                          {"TITLE", &title_text},
                                                          {"CSS", &css},
@@ -391,6 +391,7 @@ std::string viewPage(const ViewData& d, const ThreeJs& three, const PageBudget& 
                                                          {"THREE", &three.three},
                                                          {"ORBIT", &three.orbit_controls},
                                                          {"COLOURSJS", &colours},
+                                                         {"GEOMETRYJS", &geometry},
                                                          {"VIEWJS", &js}});
   st.bytes = page.size();
   if (stats) *stats = st;

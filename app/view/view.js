@@ -131,15 +131,7 @@
   var layers = {};  // name → { object, label }
   var meshObjects = [];
   function decodeMesh(m) {
-    var q = arr(m.positions), n = q.length / 3, p = new Float32Array(q.length);
-    for (var i = 0; i < n; ++i)
-      for (var k = 0; k < 3; ++k) p[3 * i + k] = m.origin[k] + m.step[k] * q[3 * i + k];
-    var g = new THREE.BufferGeometry();
-    g.setAttribute('position', new THREE.BufferAttribute(p, 3));
-    g.setIndex(new THREE.BufferAttribute(arr(m.indices), 1));
-    g.computeVertexNormals();
-    g.computeBoundingSphere();
-    return g;
+    return fpGeometry.meshGeometry(m, arr(m.positions), arr(m.indices));
   }
   var PART_COLOUR = 0xc9a26b, OBSTACLE_COLOUR = 0x7d9cc0;
   meta.meshes.forEach(function (m, i) {
@@ -309,61 +301,37 @@
 
   // ---------------------------------------------------------------- tool + holder
   var tool = null;
-  (function () {
-    var t = meta.tool, p = arr(t.positions), colours = new Float32Array(p.length);
-    var toolColour = new THREE.Color(0xe8e2c8), holderColour = new THREE.Color(0x6e7682);
-    for (var i = 0; i < p.length / 3; ++i)
-      (p[3 * i + 2] <= t.length_mm + 1e-6 ? toolColour : holderColour).toArray(colours, 3 * i);
-    var g = new THREE.BufferGeometry();
-    g.setAttribute('position', new THREE.BufferAttribute(p, 3));
-    g.setAttribute('color', new THREE.BufferAttribute(colours, 3));
-    g.setIndex(new THREE.BufferAttribute(arr(t.indices), 1));
-    g.computeVertexNormals();
-    tool = new THREE.Mesh(g, shaded({ vertexColors: THREE.VertexColors }, 60, 0x444444));
-    tool.visible = !!P;
-    tool.userData.top =
-        0;  // the top of tool + holder on its axis (mm): where the page's state says it is
-    for (var k = 2; k < p.length; k += 3) tool.userData.top = Math.max(tool.userData.top, p[k]);
-    scene.add(tool);
-    layers.tool = { object: tool, label: 'tool + holder', count: t.triangles + ' triangles' };
+  (function() {
+var t = meta.tool, built = fpGeometry.toolGeometry(t, arr(t.positions), arr(t.indices));
+tool = new THREE.Mesh(built.geometry, shaded({vertexColors: THREE.VertexColors}, 60, 0x444444));
+tool.visible = !!P;
+tool.userData.top = built.top;  // the top of tool + holder on its axis (mm): the page's state
+scene.add(tool);
+layers.tool = {
+  object: tool,
+  label: 'tool + holder',
+  count: t.triangles + ' triangles'
+};
   })();
 
   mark('path');
   // ---------------------------------------------------------------- surface
   var surface = meta.surface, surfaceMap = null;
   if (surface) {
-    (function () {
-      var s = surface, h = arr(s.height), v = arr(s.value), nx = s.nx, ny = s.ny;
+    (function() {
+      var s = surface;
       surfaceMap = s.kind === 'deviation' ? deviationMap(s.range[0], s.range[1], s.uncut_um)
                                           : withUncut(sequential(s.range[0], s.range[1]), s.uncut_um);
-      var pos = new Float32Array(3 * nx * ny), col = new Float32Array(3 * nx * ny);
-      var ok = new Uint8Array(nx * ny);
-      for (var iy = 0; iy < ny; ++iy)
-        for (var ix = 0; ix < nx; ++ix) {
-          var k = iy * nx + ix, c = surfaceMap(v[k]);
-          pos[3 * k] = s.x0 + (ix + 0.5) * s.dx;
-          pos[3 * k + 1] = s.y0 + (iy + 0.5) * s.dy;
-          pos[3 * k + 2] = isFinite(h[k]) ? h[k] : 0;
-          ok[k] = isFinite(h[k]) && c !== null ? 1 : 0;
-          if (c) col.set(c, 3 * k);
-        }
-      var index = [];
-      for (var iy = 0; iy + 1 < ny; ++iy)
-        for (var ix = 0; ix + 1 < nx; ++ix) {
-          var a = iy * nx + ix, b = a + 1, c = a + nx, d = c + 1;
-          if (ok[a] && ok[b] && ok[d]) index.push(a, b, d);
-          if (ok[a] && ok[d] && ok[c]) index.push(a, d, c);
-        }
-      var g = new THREE.BufferGeometry();
-      g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
-      g.setAttribute('color', new THREE.BufferAttribute(col, 3));
-      g.setIndex(nx * ny > 65535 ? new THREE.Uint32BufferAttribute(index, 1)
-                                 : new THREE.Uint16BufferAttribute(index, 1));
-      g.computeVertexNormals();
+      var built = fpGeometry.surfaceGeometry(s, arr(s.height), arr(s.value), surfaceMap),
+          g = built.geometry;
       var mesh = new THREE.Mesh(g, shaded({ vertexColors: THREE.VertexColors, side: THREE.DoubleSide },
                                           10, 0x111111));
       scene.add(mesh);
-      layers.surface = { object: mesh, label: 'machined surface', count: (index.length / 3) + ' triangles' };
+      layers.surface = {
+        object: mesh,
+        label: 'machined surface',
+        count: built.triangles + ' triangles'
+      };
       // The simulated surface lies on the part: the part is drawn behind it where they meet.
       meshObjects.forEach(function (o) {
         if (o.meta.role !== 'part') return;
@@ -376,56 +344,17 @@
 
   mark('surface');
   // ---------------------------------------------------------------- axes, millimetres
-  var axes = new THREE.Group();
-  (function () {
-    var size = box.getSize(new THREE.Vector3()), step = niceStep(Math.max(size.x, size.y, size.z), 5);
-    var o = new THREE.Vector3(Math.floor(box.min.x / step) * step, Math.floor(box.min.y / step) * step,
-                              Math.floor(box.min.z / step) * step);
-    var ends = [Math.ceil(box.max.x / step) * step, Math.ceil(box.max.y / step) * step,
-                Math.ceil(box.max.z / step) * step];
-    var COLOURS = [0xe45756, 0x54a24b, 0x4c78a8], NAMES = ['x', 'y', 'z'];
-    var labelSize = step * 0.32;
-    for (var k = 0; k < 3; ++k) {
-      var dir = new THREE.Vector3(), tickDir = new THREE.Vector3();
-      dir.setComponent(k, 1);
-      tickDir.setComponent(k === 0 ? 1 : 0, -1);
-      var start = o.getComponent(k), pts = [];
-      var a = o.clone(), b = o.clone();
-      b.setComponent(k, ends[k]);
-      pts.push(a, b);
-      for (var x = start; x <= ends[k] + 1e-9; x += step) {
-        var p = o.clone();
-        p.setComponent(k, x);
-        pts.push(p, p.clone().addScaledVector(tickDir, step * 0.12));
-        var last = x + step > ends[k] + 1e-9;
-        axes.add(label(last ? (x.toFixed(step < 1 ? 2 : 0) + ' mm ' + NAMES[k])
-                            : x.toFixed(step < 1 ? 2 : 0),
-                       p.clone().addScaledVector(tickDir, step * 0.3), labelSize, COLOURS[k]));
-      }
-      var g = new THREE.BufferGeometry().setFromPoints(pts);
-      axes.add(new THREE.LineSegments(g, new THREE.LineBasicMaterial({ color: COLOURS[k] })));
-    }
-    scene.add(axes);
-    layers.axes = { object: axes, label: 'axes (mm)', count: 'ticks every ' + step + ' mm' };
+  var axes;
+  (function() {
+var size = box.getSize(new THREE.Vector3()), step = niceStep(Math.max(size.x, size.y, size.z), 5);
+axes = fpGeometry.axesGroup(box, step);
+scene.add(axes);
+layers.axes = {
+  object: axes,
+  label: 'axes (mm)',
+  count: 'ticks every ' + step + ' mm'
+};
   })();
-  function label(text, at, height, colour) {
-    var canvas = document.createElement('canvas'), ctx = canvas.getContext('2d');
-    var px = 28;
-    ctx.font = px + 'px sans-serif';
-    canvas.width = Math.ceil(ctx.measureText(text).width) + 8;
-    canvas.height = px + 8;
-    ctx.font = px + 'px sans-serif';
-    ctx.fillStyle = '#' + new THREE.Color(colour).lerp(new THREE.Color(0xffffff), 0.45).getHexString();
-    ctx.textBaseline = 'middle';
-    ctx.fillText(text, 4, canvas.height / 2);
-    var texture = new THREE.CanvasTexture(canvas);
-    texture.minFilter = THREE.LinearFilter;
-    var sprite = new THREE.Sprite(new THREE.SpriteMaterial({ map: texture, depthTest: false }));
-    sprite.scale.set(height * canvas.width / canvas.height, height, 1);
-    sprite.position.copy(at);
-    sprite.renderOrder = 20;
-    return sprite;
-  }
 
   mark('axes');
   // ---------------------------------------------------------------- side panel

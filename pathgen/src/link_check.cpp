@@ -173,11 +173,18 @@ std::optional<LinkPartResult> checkHolderAgainstPart(
 PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
                               const geometry::TriangleMesh& part, const geometry::PathFile& path,
                               double gouge_tolerance_mm, const common::Progress& progress) {
-  PartContacts out;
   // The part's tree and shells once, for the four checks (a 1 M-triangle part took four builds
   // of ~8 s and ~300 B a triangle each, without a progress line).
   common::report(progress, 0.0, "part");
-  const std::shared_ptr<const ObstacleModel> model = prepareObstacle(part, "part");
+  return checkAgainstPart(tool, holder, prepareObstacle(part, "part"), path, gouge_tolerance_mm,
+                          progress);
+}
+
+PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
+                              const std::shared_ptr<const ObstacleModel>& model,
+                              const geometry::PathFile& path, double gouge_tolerance_mm,
+                              const common::Progress& progress) {
+  PartContacts out;  // its progress from 0.2 (0 to 0.2: the model's preparation, above)
   common::report(progress, 0.2, "links vs part");
   const ClearanceChecker whole(geometry::toolMesh(tool, holder, kClearanceMeshTolMm),
                                std::span(&model, 1), kClearanceMeshTolMm);

@@ -40,10 +40,10 @@ struct WayCheck {
 /// where `way` is), as linkPasses writes it.
 class WayChecker {
  public:
-  WayChecker(const GenerateRequest& request, const ClearanceChecker& obstacles, double safe_z_mm)
+  WayChecker(const GenerateRequest& request, const ClearanceChecker& obstacles,
+             const std::shared_ptr<const ObstacleModel>& model, double safe_z_mm)
       : request_(request), obstacles_(obstacles), safe_z_mm_(safe_z_mm) {
-    if (request.part) {
-      const auto model = prepareObstacle(*request.part, "part");
+    if (model) {
       whole_.emplace(geometry::toolMesh(request.tool, request.holder, kClearanceMeshTolMm),
                      std::span(&model, 1), kClearanceMeshTolMm);
       grazing_.emplace(grazingPartChecker(request.tool, request.holder, model));
@@ -201,7 +201,8 @@ bool faultyEnd(const GenerateResult& result, const std::optional<PartContacts::M
 }  // namespace
 
 std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
-    const GenerateRequest& request, const ClearanceChecker& checker, double safe_z_mm,
+    const GenerateRequest& request, const ClearanceChecker& checker,
+    const std::shared_ptr<const ObstacleModel>& part, double safe_z_mm,
     const GenerateResult& result, const std::optional<PartContacts::Marks>& part_marks,
     std::vector<std::string>* unfreed) {
   std::vector<GenerateResult::RoutedLinkEnd> routed;
@@ -212,7 +213,7 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
     first = std::min(first, k);
     last = std::max(last, k);
   }
-  std::optional<WayChecker> ways;  // the part's model built only where a link end is faulty
+  std::optional<WayChecker> ways;  // built only where a link end is faulty
   // The tool and holder's widest radius: the moves sideways are in it.
   double reach_mm = request.tool.radius_mm;
   for (const auto& station : request.holder) reach_mm = std::max(reach_mm, station.radius_mm);
@@ -227,7 +228,7 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
       if ((g.output < at.size() && at[g.output] <= 0.0) ||
           (part_marks && g.output < part_marks->posture.size() && part_marks->posture[g.output]))
         continue;
-      if (!ways) ways.emplace(request, checker, safe_z_mm);
+      if (!ways) ways.emplace(request, checker, part, safe_z_mm);
       const Posture& posture = g.posture;
       const double kept_mm = keptMm(request.clearance_mm, result.clearance.clearance_mm[g.output]);
       const auto keeps = [&](const WayCheck& c) {

@@ -1,6 +1,7 @@
 #pragma once
 /// Link ends taken off the pass's axis where DESIGN's way (up and down the axis) runs into
 /// something.
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -19,9 +20,11 @@ namespace fieldpath::pathgen {
 /// required clearance (else the best: fewer collisions, then more clearance) is returned where
 /// it is better than the axis's way (the caller puts them in `result.routed_link_ends`, links
 /// and checks the path again: the links take them, linkWays). The faulty ends no way frees are
-/// added to `unfreed` ("the way into pass 2 (nominal.cl:44)").
+/// added to `unfreed` ("the way into pass 2 (nominal.cl:44)"). `part`: the part's model
+/// (prepareObstacle), where the request has one.
 std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
-    const GenerateRequest& request, const ClearanceChecker& checker, double safe_z_mm,
+    const GenerateRequest& request, const ClearanceChecker& checker,
+    const std::shared_ptr<const ObstacleModel>& part, double safe_z_mm,
     const GenerateResult& result, const std::optional<PartContacts::Marks>& part_marks,
     std::vector<std::string>* unfreed = nullptr);
 

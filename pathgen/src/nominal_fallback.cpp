@@ -91,11 +91,11 @@ std::pair<std::size_t, double> pathFaults(const GenerateResult& result) {
 }
 
 bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceChecker& checker,
+                            const std::shared_ptr<const ObstacleModel>& part,
                             GenerateResult& result,
                             const std::optional<PartContacts::Marks>& part_marks) {
   const PassFaults faults = faultsByPass(result, request.clearance_mm, part_marks);
   const double lead_rad = request.path.lead_deg * geometry::kDegToRad;
-  std::shared_ptr<const ObstacleModel> part;
   bool replaced = false;
   std::size_t first = 0;  // the pass's first posture in result.postures
   for (std::size_t p = 0; p < result.passes.size(); ++p) {
@@ -108,7 +108,6 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
     if ((colliding == 0 && under == 0) || end - begin != pass.samples.size()) continue;
     const std::vector<geometry::Posture> nominal =
         nominalPostures(std::span(&pass, 1), lead_rad, request.tool.radius_mm);
-    if (request.part && !part) part = prepareObstacle(*request.part, "part");
     // A pass that collided steered takes axes that clear; one that only came under the required
     // clearance, axes that come less near (a helper's channel: the tilt away from one fin
     // brought the shank 0.45 mm from the other, leaning over it, where the nominal axes kept

@@ -1,5 +1,6 @@
 #pragma once
 /// Passes the steering made collide, written with their nominal axes where those are clear.
+#include <memory>
 #include <optional>
 #include <utility>
 
@@ -16,9 +17,11 @@ namespace fieldpath::pathgen {
 /// `result.postures` replaced by the nominal ones, listed in `result.kept_nominal`. The part never
 /// repels, so the steering can turn a clear pass into a crash (a helper's mould cavity: the axis
 /// tilted 23 deg away from a boss, into the cavity's draft walls); a pass that collides either
-/// way keeps its steering. Returns whether any pass was replaced (the caller links and checks
+/// way keeps its steering. `part`: the part's model (prepareObstacle), where the request has one.
+/// Returns whether any pass was replaced (the caller links and checks
 /// the path again).
 bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceChecker& checker,
+                            const std::shared_ptr<const ObstacleModel>& part,
                             GenerateResult& result,
                             const std::optional<PartContacts::Marks>& part_marks);
 

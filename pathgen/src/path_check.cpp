@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -17,6 +18,9 @@ using common::scaled;
 void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& checker,
                         double safe_z_mm, const CheckStages& stages, GenerateResult& result) {
   std::optional<PartContacts::Marks> part_marks;  // of result.path, where the part is touched
+  // The part's model (its tree and shells), prepared once for every check of the path and of the
+  // repairs: a 1 M-triangle part takes seconds a preparation.
+  std::shared_ptr<const ObstacleModel> part_model;
   const auto linkAndCheck = [&] {
     std::vector<std::vector<geometry::Posture>> pass_postures(result.passes.size());
     for (const GeneratedPosture& g : result.postures) pass_postures[g.pass].push_back(g.posture);
@@ -63,9 +67,11 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
       if (request.part) {
         // With its own progress: the cutter's stamps along 46 000 postures took 95 s after the
         // motions' 100 %, with no word (a scale sweep's finding).
-        PartContacts contacts = checkAgainstPart(
-            request.tool, request.holder, *request.part, result.path, kGougeToleranceMm,
-            scaled(request.progress, stages.motions_end, 1.0, "part"));
+        const common::Progress progress = scaled(request.progress, stages.motions_end, 1.0, "part");
+        common::report(progress, 0.0, "part");
+        if (!part_model) part_model = prepareObstacle(*request.part, "part");
+        PartContacts contacts = checkAgainstPart(request.tool, request.holder, part_model,
+                                                 result.path, kGougeToleranceMm, progress);
         part_marks = contacts.marks(result.path.postures.size());
         result.link_part = std::move(contacts.links);
         result.holder_part = std::move(contacts.holder);
@@ -93,7 +99,7 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
     // come down the new axes): a copy only where a pass is faulty.
     GenerateResult steered = result;
     std::optional<PartContacts::Marks> steered_marks = part_marks;
-    if (keepClearNominalPasses(request, checker, result, part_marks))
+    if (keepClearNominalPasses(request, checker, part_model, result, part_marks))
       keepIfNoWorse(std::move(steered), std::move(steered_marks), result.kept_nominal.size(),
                     &GenerateResult::kept_nominal_undone, "passes kept nominal: checked again");
   }
@@ -101,7 +107,8 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
     // Links whose way along a pass's axis runs into something, taken another way up where one
     // checks clearer.
     std::vector<std::string> unfreed;
-    auto routed = rerouteLinkEnds(request, checker, safe_z_mm, result, part_marks, &unfreed);
+    auto routed =
+        rerouteLinkEnds(request, checker, part_model, safe_z_mm, result, part_marks, &unfreed);
     if (!routed.empty()) {
       GenerateResult along_axes = result;
       std::optional<PartContacts::Marks> along_marks = part_marks;

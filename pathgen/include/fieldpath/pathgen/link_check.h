@@ -105,5 +105,12 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
                               const geometry::TriangleMesh& part, const geometry::PathFile& path,
                               double gouge_tolerance_mm = kGougeToleranceMm,
                               const common::Progress& progress = {});
+/// The same with the part's model already prepared (prepareObstacle): generate checks its path
+/// again after each repair and the repairs check against the part too, one model for them all.
+PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
+                              const std::shared_ptr<const ObstacleModel>& part,
+                              const geometry::PathFile& path,
+                              double gouge_tolerance_mm = kGougeToleranceMm,
+                              const common::Progress& progress = {});
 
 }  // namespace fieldpath::pathgen
