@@ -242,8 +242,10 @@ std::string anglesCsv(const pathgen::GenerateResult& r) {
 /// the scene's meshes in x-y (DESIGN's links climb along the axis: at 78 deg from vertical a
 /// 33 mm climb ran 230 mm sideways, 223 mm past the part, unsaid: a helper's finding). Fixtures
 /// and the machine's travel are not in the scene: said in a note when a link leaves the meshes'
-/// x-y box by more than a quarter of its size. Empty when none does.
-std::string farLinkNote(const Scene& scene, const geometry::PathFile& path) {
+/// x-y box by more than a quarter of its size. Empty when none does. The advice is the way's: a
+/// steeper axis shortens a climb along the axis, not one taken off it (rerouteLinkEnds).
+std::string farLinkNote(const Scene& scene, const pathgen::GenerateResult& result) {
+  const geometry::PathFile& path = result.path;
   Eigen::AlignedBox2d box;
   const auto extend = [&box](const geometry::TriangleMesh& mesh) {
     for (const geometry::Vec3& v : mesh.vertices) box.extend(Eigen::Vector2d(v.x(), v.y()));
@@ -262,14 +264,31 @@ std::string farLinkNote(const Scene& scene, const geometry::PathFile& path) {
     }
   }
   if (!(farthest_mm > 0.25 * box.sizes().maxCoeff())) return {};
+  // The passes on either side of that link posture, and whether their ends there climb off the
+  // axis.
+  int before = -1, after = -1;  // Pass::index (GeneratedPosture::pass is the position)
+  for (const pathgen::GeneratedPosture& g : result.postures) {
+    const int index = result.passes[static_cast<std::size_t>(g.pass)].index;
+    if (g.output < at) before = index;
+    if (g.output > at && after < 0) after = index;
+  }
+  const pathgen::GenerateResult::RoutedLinkEnd* routed = nullptr;
+  for (const auto& end : result.routed_link_ends)
+    if ((!end.into && end.pass == before) || (end.into && end.pass == after)) routed = &end;
   std::ostringstream note;
   note << std::fixed;
   note.precision(0);
-  note << "the links climb along the tool axis to the travel plane: " << postureWhere(path, at)
-       << " lies " << farthest_mm
+  if (routed)
+    note << "the links climb to the travel plane (the way " << (routed->into ? "into " : "out of ")
+         << routed->label << " off its axis, the note above): ";
+  else
+    note << "the links climb along the tool axis to the travel plane: ";
+  note << postureWhere(path, at) << " lies " << farthest_mm
        << " mm outside the meshes' x-y box; fixtures and the machine's travel are not in the "
-          "scene, so check that room on the machine (a lower links.safe_z or a steeper axis at "
-          "the pass ends shortens the climb)";
+          "scene, so check that room on the machine ("
+       << (routed ? "a lower links.safe_z shortens the climb"
+                  : "a lower links.safe_z or a steeper axis at the pass ends shortens the climb")
+       << ")";
   return note.str();
 }
 
@@ -428,7 +447,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (std::string holder = noHolderNote(scene.tool, scene.holder); !holder.empty())
       notes.tool.push_back(std::move(holder));
     notes.obstacle = openObstacleNotes(scene);
-    if (std::string far = farLinkNote(scene, result.path); !far.empty())
+    if (std::string far = farLinkNote(scene, result); !far.empty())
       notes.link.push_back(std::move(far));
     nlohmann::json report = reportJson(scene, job, result, axis_turn, notes);
     const pathgen::RotaryStray rotary =

@@ -24,6 +24,7 @@ nlohmann::json routedLinkEndsJson(const pathgen::GenerateResult& r) {
          {"end", e.into ? "into" : "out of"},
          {"way", {e.way.x(), e.way.y(), e.way.z()}},
          {"retract", e.retract_along_axis ? "along the axis" : "along the way"},
+         {"retract_mm", e.retract_mm},
          {"sideways_mm", {e.sideways_mm.x(), e.sideways_mm.y(), e.sideways_mm.z()}},
          // then straight up; null: along `way` to the travel plane
          {"climb_mm", std::isfinite(e.climb_mm) ? nlohmann::json(e.climb_mm) : nlohmann::json()},
@@ -67,19 +68,22 @@ void printRepairs(const pathgen::GenerateResult& result) {
     const std::size_t n = result.routed_link_ends.size();
     std::fprintf(stderr,
                  "note: %zu link end%s taken off the pass's tool axis, the axis held (first: the "
-                 "way %s %s, the retract along %s, the climb %.1f deg from the axis: along the "
+                 "way %s %s, the retract along %s (%.3g mm), the climb %.1f deg from the axis: "
+                 "along the "
                  "axis %zu collisions and %.3f mm of the obstacles, the way "
                  "taken none and %.3f mm; the tool moves straight, the rotary axes still) "
                  "(report.json links.routed_off_axis)\n",
                  n, n == 1 ? "" : "s", e.into ? "into" : "out of", e.label.c_str(),
-                 e.retract_along_axis ? "the axis" : "the climb", e.off_axis_deg, e.axis_collisions,
-                 e.axis_min_mm, e.taken_min_mm);
+                 e.retract_along_axis ? "the axis" : "the climb", e.retract_mm, e.off_axis_deg,
+                 e.axis_collisions, e.axis_min_mm, e.taken_min_mm);
   }
   if (!result.unfreed_link_ends.empty())
     std::fprintf(stderr,
                  "note: %zu link end%s collide or come under the clearance whichever straight way "
-                 "up from the pass, the axis held, is taken (first: %s): write that link in the "
-                 "nominal path by hand and `check` the path (report.json links.unfreed)\n",
+                 "up from the pass, the axis held, is taken (first: %s): generate makes its links "
+                 "anew from the passes (a nominal path's `# link` blocks are dropped), so edit "
+                 "that link in the written path.cl by hand and `check` it (report.json "
+                 "links.unfreed)\n",
                  result.unfreed_link_ends.size(), result.unfreed_link_ends.size() == 1 ? "" : "s",
                  result.unfreed_link_ends.front().c_str());
   if (result.routed_link_ends_undone > 0)

@@ -24,6 +24,9 @@ constexpr double kSideClimbDeg[] = {30.0, 60.0};
 constexpr int kSideClimbAzimuths = 8;
 /// The moves sideways before a climb straight up, in widest radii of the tool and holder.
 constexpr double kAsideReaches[] = {2.0, 4.0, 8.0};
+/// The shorter retracts tried before a move sideways, in parts of links.retract: a pass just
+/// under a shelf, whose full retract runs into it (a helper's 90 mm holder 5 mm under one).
+constexpr double kAsideRetracts[] = {0.25};
 /// The ways tried, family by family (waysUp).
 enum class WayFamily { Circle, Around, Aside };
 /// A way up must rise at least this much (its z component): sin 5°, as the links' own climb.
@@ -121,8 +124,11 @@ class WayChecker {
 /// vertical toward kSideClimbAzimuths directions, the nearest the axis's lean first. Then
 /// (Aside), where no straight climb frees it (a pass 10 mm under a shelf, a 90 mm holder below
 /// it: a helper's), the retract along the axis, a move sideways of kAsideReaches times the tool
-/// and holder's widest radius `reach_mm` toward those directions, then straight up.
-std::vector<LinkEndWay> waysUp(const Vec3& axis, WayFamily family, double reach_mm) {
+/// and holder's widest radius `reach_mm` toward those directions, then straight up; then the
+/// same after shorter retracts (`retract_mm` links.retract: kAsideRetracts of it, then twice the
+/// clearance `clearance_mm`), where the full one runs into what is over the pass.
+std::vector<LinkEndWay> waysUp(const Vec3& axis, WayFamily family, double reach_mm,
+                               double retract_mm, double clearance_mm) {
   std::vector<LinkEndWay> out;
   const auto add = [&](const Vec3& way) {
     if (way.z() < kMinWayRise) return;
@@ -155,9 +161,22 @@ std::vector<LinkEndWay> waysUp(const Vec3& axis, WayFamily family, double reach_
       }
     return out;
   }
-  for (const double reaches : kAsideReaches)
-    for (int k = 0; k < kSideClimbAzimuths; ++k)
-      out.push_back({axis, Vec3::UnitZ(), reaches * reach_mm * horizontal(k)});
+  // The full retract first; then shorter ones, none under twice the clearance (0.2 mm at least):
+  // the move sideways runs over the surface the pass has just cut, checked against the part
+  // for contacts only.
+  const double shortest_mm = std::max(2.0 * clearance_mm, 0.2);
+  std::vector<double> retracts = {retract_mm};
+  for (const double part : kAsideRetracts)
+    if (part * retract_mm >= shortest_mm) retracts.push_back(part * retract_mm);
+  if (shortest_mm < retracts.back()) retracts.push_back(shortest_mm);
+  for (std::size_t i = 0; i < retracts.size(); ++i) {
+    for (const double reaches : kAsideReaches)
+      for (int k = 0; k < kSideClimbAzimuths; ++k) {
+        LinkEndWay way{axis, Vec3::UnitZ(), reaches * reach_mm * horizontal(k)};
+        if (i > 0) way.retract_mm = retracts[i];
+        out.push_back(way);
+      }
+  }
   return out;
 }
 
@@ -242,7 +261,8 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
       const auto taken = [&] { return best && (keeps(best->second) || along.collisions > 0); };
       for (const WayFamily family : {WayFamily::Circle, WayFamily::Around, WayFamily::Aside}) {
         if (taken()) break;  // each family only where the ones before it do no better
-        for (const LinkEndWay& way : waysUp(posture.axis, family, reach_mm)) {
+        for (const LinkEndWay& way : waysUp(posture.axis, family, reach_mm,
+                                            request.links.retract_mm, request.clearance_mm)) {
           const WayCheck c = ways->check(posture, way, into, 1);  // a collision rules it out
           // Only a way clear of everything is taken (fewer collisions is still unsafe): the
           // clearest of those.
@@ -282,6 +302,8 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
       end.into = into;
       end.way = best->first.climb;
       end.retract_along_axis = best->first.retract_dir == posture.axis;
+      end.retract_mm =
+          std::isnan(best->first.retract_mm) ? request.links.retract_mm : best->first.retract_mm;
       end.sideways_mm = best->first.sideways_mm;
       end.climb_mm = best->first.climb_mm;
       end.off_axis_deg =
@@ -309,8 +331,9 @@ void linkWays(const GenerateResult& result, LinkRequest& links) {
     for (std::size_t p = 0; p < result.passes.size(); ++p)
       if (result.passes[p].index == end.pass && first[p]) {
         const Vec3& axis = (end.into ? first[p] : last[p])->axis;
-        (end.into ? links.in_ways : links.out_ways)[p] = LinkEndWay{
-            end.retract_along_axis ? axis : end.way, end.way, end.sideways_mm, end.climb_mm};
+        (end.into ? links.in_ways : links.out_ways)[p] =
+            LinkEndWay{end.retract_along_axis ? axis : end.way, end.way, end.sideways_mm,
+                       end.climb_mm, end.retract_mm};
       }
 }
 

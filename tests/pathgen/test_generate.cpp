@@ -378,5 +378,29 @@ TEST(Generate, AnUprightPassUnderAShelfClimbsOutFromUnderIt) {
     EXPECT_NEAR(end.sideways_mm.norm(), 24.0, 1e-9);
     EXPECT_GT(end.sideways_mm.y(), 10.0 + 3.0);
     EXPECT_NEAR(end.way.z(), 1.0, 1e-12);
+    EXPECT_EQ(end.retract_mm, 0.5);
   }
+
+  // A shelf 4 mm over the tool's top, the retract 10 mm: the retract itself runs into it. A
+  // quarter of it (2.5 mm) leaves 1.5 mm under the shelf, then the move sideways and up.
+  GenerateRequest close = job;
+  close.links.retract_mm = 10.0;
+  close.obstacles = {test::boxMesh(-50, 60, -50, 10, 16, 25)};
+  const GenerateResult shorter = generatePath(close);
+  EXPECT_EQ(shorter.clearance.colliding + shorter.motions.colliding, 0u);
+  EXPECT_GE(std::min(shorter.clearance.min_clearance_mm, shorter.motions.min_clearance_mm),
+            close.clearance_mm - 0.01);
+  ASSERT_EQ(shorter.routed_link_ends.size(), 2u);
+  for (const auto& end : shorter.routed_link_ends) {
+    EXPECT_TRUE(end.retract_along_axis);
+    EXPECT_EQ(end.retract_mm, 2.5);
+    EXPECT_GT(end.sideways_mm.y(), 10.0 + 3.0);
+    // The link's first posture off the pass is the short retract's end.
+    const std::size_t pass_end =
+        end.into ? shorter.postures.front().output : shorter.postures.back().output;
+    const std::size_t next = end.into ? pass_end - 1 : pass_end + 1;
+    EXPECT_NEAR(shorter.path.postures[next].tip_mm.z() - shorter.path.postures[pass_end].tip_mm.z(),
+                2.5, 1e-9);
+  }
+  EXPECT_TRUE(shorter.unfreed_link_ends.empty());
 }

@@ -183,6 +183,7 @@ struct GenerateResult {
     bool into = true;           ///< the way into the pass (else out of it)
     geometry::Vec3 way;         ///< unit, the climb from the retract up to the travel plane
     bool retract_along_axis = false;  ///< the retract along the axis (else along `way` too)
+    double retract_mm = 0.0;          ///< its length (links.retract, or shorter: LinkEndWay)
     geometry::Vec3 sideways_mm = geometry::Vec3::Zero();  ///< a move sideways before the climb
     /// The climb's length along `way` before straight up (infinite: to the travel plane).
     double climb_mm = std::numeric_limits<double>::infinity();

@@ -41,18 +41,22 @@ double resolveSafeZ(std::optional<double> given_mm, double top_mm, double cleara
 /// to the travel plane (unit vectors). Zero `climb`: DESIGN's way, along the axis
 /// (rerouteLinkEnds sets others where that one runs into something).
 /// `climb_mm`: the climb's length along `climb`, then straight up (a knee where the tool is out
-/// from under what its axis's way ran into; infinite: all the way to the plane).
+/// from under what its axis's way ran into; infinite: all the way to the plane). `retract_mm`:
+/// the retract's length, where shorter than `links.retract` (NaN: that one; a pass just under a
+/// shelf, whose full retract runs into it, moves out sideways after a shorter one).
 struct LinkEndWay {
   Vec3 retract_dir = Vec3::Zero();
   Vec3 climb = Vec3::Zero();
   Vec3 sideways_mm = Vec3::Zero();
   double climb_mm = std::numeric_limits<double>::infinity();
+  double retract_mm = std::numeric_limits<double>::quiet_NaN();
   bool alongAxis() const { return climb == Vec3::Zero(); }
 };
 
 /// The tips a link way off the axis (`way`, not alongAxis) passes from the pass's end posture
 /// `tip_mm` out to the travel plane (the tip at `z_mm`), in that order: the retract's end, the
 /// move sideways' end (if any), the knee (if the climb stops short), the point in the plane.
+/// `retract_mm`: links.retract, used where the way has no length of its own.
 std::vector<Vec3> wayTips(const Vec3& tip_mm, double z_mm, double retract_mm,
                           const LinkEndWay& way);
 
