@@ -170,6 +170,13 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"link_part", linkPartJson(r.link_part)},
       {"holder_part", holderPartJson(r.holder_part)},
       {"cutter_part", cutterPartJson(r.cutter_part)},
+      // The passes' balls' least distance to the part (a ball end mill and a part), exact up to
+      // `far_mm`: at or past it the passes never finish the part.
+      {"ball_part", r.ball_part_mm
+                        ? json{{"min_mm", *r.ball_part_mm},  // a lower bound at or past far_mm
+                               {"far_mm", pathgen::farFromPartMm(job.tool.radius_mm)},
+                               {"reaches", *r.ball_part_mm <= pathgen::kReachesPartMm}}
+                        : json(nullptr)},
       {"cutter_part_skipped",
        r.cutter_part ? json(nullptr) : json("no `part` in the scene, or a flat end")},
       {"link_part_skipped",
@@ -219,7 +226,8 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
         {"jacobian_evals", r.jacobian_evals},
         {"error_test_failures", r.error_test_failures},
         {"convergence_failures", r.convergence_failures},
-        {"loosened", r.loosened_solver}}},
+        {"loosened", r.loosened_solver},
+        {"response_mm", job.dynamics.responseLengthMm()}}},
       {"per_pass", passes},
   };
 }
@@ -482,6 +490,33 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                    "warning: %s: a gouge, or the part's chordal error where it is concave "
                    "(report.json cutter_part; `check --gouge-tol` sets the tolerance)\n",
                    gouge.c_str());
+    // Steered passes under the clearance: the axis may answer too late. The feed is the
+    // dynamics' time scale, unsaid (a helper's feed 10 000 mm/min: 127 postures in the blades).
+    if (!job.nominal) {
+      std::size_t under = 0;
+      for (const pathgen::GeneratedPosture& g : result.postures)
+        under += g.clearance_mm < job.clearance_mm;
+      if (under > 0)
+        std::fprintf(stderr,
+                     "note: %zu pass postures under `clearance`: the steered axis answers the "
+                     "field over about %.3g mm of path (dynamics.feed, %.3g mm/s, times "
+                     "sqrt(inertia / stiffness), %.3g s): a lower feed or inertia turns it sooner "
+                     "(the same steering at n times the feed with inertia / n^2; dynamics.feed is "
+                     "also path.apt's FEDRAT; report.json solver.response_mm)\n",
+                     under, job.dynamics.responseLengthMm(), job.dynamics.feed_mm_per_min / 60.0,
+                     std::sqrt(job.dynamics.inertia / job.dynamics.stiffness));
+    }
+    // Passes that never come near the part: a path in other units or another frame (an inch
+    // CAM file over a part in mm read "min clearance 28.378 mm", max tilt 0, no word; check
+    // refuses it, but only if run).
+    if (const double far_mm = pathgen::farFromPartMm(job.tool.radius_mm);
+        result.ball_part_mm && *result.ball_part_mm >= far_mm)
+      std::fprintf(stderr,
+                   "warning: the passes' ball stays more than %.3g mm from the part (`part`) "
+                   "everywhere: they do not finish it. A path in other units or another frame "
+                   "(an inch file over a part in mm?), or for another part (report.json "
+                   "ball_part)\n",
+                   far_mm);
     if (under_required)
       std::fprintf(stderr,
                    "warning: the path comes closer to the obstacles than `clearance` (%.3f mm): "

@@ -338,6 +338,33 @@ ViewData gatherView(const ViewRequest& request) {
         throw InputError(p.file.file.string() + ": " + s.str() + ": a path for another scene?");
       d.warnings.push_back(s.str());
     }
+    // With a part, the passes' tips lie on it: the margin above (the holder's reach) let an inch
+    // file over a part 5 mm wide pass (its postures 41 mm outside, a helper's). A pass posture
+    // farther from the part's box than its ball's reach and generate's far-from-part distance
+    // cannot finish it.
+    if (scene.part && !scene.part->vertices.empty()) {
+      Eigen::AlignedBox3d part_box;
+      for (const geometry::Vec3& v : scene.part->vertices) part_box.extend(v);
+      const double pass_margin =
+          pathgen::farFromPartMm(scene.tool.radius_mm) + 2.0 * scene.tool.radius_mm;
+      std::size_t pass_postures = 0, far = 0, first_far = 0;
+      for (const geometry::PathBlock& block : p.file.blocks) {
+        if (block.kind != geometry::PathBlock::Kind::Pass) continue;
+        for (std::size_t i = block.begin; i < block.end; ++i, ++pass_postures)
+          if (part_box.exteriorDistance(postures[i].tip_mm) > pass_margin && far++ == 0)
+            first_far = i;
+      }
+      if (2 * far > pass_postures) {
+        std::ostringstream s;
+        s.precision(4);
+        s << far << " of " << pass_postures << " pass postures lie more than " << pass_margin
+          << " mm outside the part's box (the first at posture " << first_far << ", "
+          << p.file.where(first_far)
+          << "): the passes do not finish the part; a path in other units or another frame, "
+             "or for another scene?";
+        throw InputError(p.file.file.string() + ": " + s.str());
+      }
+    }
 
     if (check) {
       if (check->postures != n)

@@ -61,10 +61,19 @@ void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>
     const double d = checker.ballClearance(centres, ball_radius_mm, &at, &obstacle, clearance_mm);
     if (d <= 0.0) {
       std::ostringstream msg;
-      msg << pass.label << ": at s = " << pass.samples[at].s_mm << " mm the ball touches or "
-          << "enters obstacle " << obstacle + 1
-          << ": the passage is narrower than the ball there, or the pass runs through the "
-             "obstacle (in another frame or units?)";
+      const double s_mm = pass.samples[at].s_mm;
+      msg << pass.label << ": at s = " << s_mm << " mm";
+      // The input's line there (a pass's first line named an entry 40 lines on, a helper's).
+      if (pass.whereAt) msg << " (" << pass.whereAt(s_mm) << ")";
+      msg << " the ball touches or enters obstacle " << obstacle + 1
+          << ": the passage is narrower than the ball there (a smaller tool.radius";
+      // The parametric impeller's passes are placed by its passes_v, a nominal path's by its
+      // file: no frame or unit to get wrong there.
+      if (pass.whereAt)
+        msg << "), or the pass runs through the obstacle (a nominal path in another frame or "
+               "units?)";
+      else
+        msg << ", or the impeller's passes_v nearer the channel's middle, 0.5)";
       throw InputError(msg.str());
     }
     if (d < clearance_mm)

@@ -183,7 +183,7 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
 PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
                               const std::shared_ptr<const ObstacleModel>& model,
                               const geometry::PathFile& path, double gouge_tolerance_mm,
-                              const common::Progress& progress) {
+                              const common::Progress& progress, double ball_exact_below_mm) {
   PartContacts out;  // its progress from 0.2 (0 to 0.2: the model's preparation, above)
   common::report(progress, 0.2, "links vs part");
   const ClearanceChecker whole(geometry::toolMesh(tool, holder, kClearanceMeshTolMm),
@@ -198,8 +198,8 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
         for (std::size_t i = block.begin; i < block.end; ++i)
           centres.push_back(geometry::ballCentre(path.postures[i], tool.radius_mm));
     if (!centres.empty())
-      out.ball_part_mm =
-          whole.ballClearance(centres, tool.radius_mm, nullptr, nullptr, kReachesPartMm);
+      out.ball_part_mm = whole.ballClearance(centres, tool.radius_mm, nullptr, nullptr,
+                                             std::max(kReachesPartMm, ball_exact_below_mm));
   }
   out.holder = checkHolderAgainstPart(tool, holder, model, path.postures,
                                       common::scaled(progress, 0.3, 0.6, "holder vs part"));

@@ -70,8 +70,10 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
         const common::Progress progress = scaled(request.progress, stages.motions_end, 1.0, "part");
         common::report(progress, 0.0, "part");
         if (!part_model) part_model = prepareObstacle(*request.part, "part");
-        PartContacts contacts = checkAgainstPart(request.tool, request.holder, part_model,
-                                                 result.path, kGougeToleranceMm, progress);
+        PartContacts contacts =
+            checkAgainstPart(request.tool, request.holder, part_model, result.path,
+                             kGougeToleranceMm, progress, farFromPartMm(request.tool.radius_mm));
+        result.ball_part_mm = contacts.ball_part_mm;
         part_marks = contacts.marks(result.path.postures.size());
         result.link_part = std::move(contacts.links);
         result.holder_part = std::move(contacts.holder);

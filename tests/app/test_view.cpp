@@ -127,6 +127,10 @@ TEST(View, BadInputIsExitOneWithOneLineOrAPageThatSaysWhatIsMissing) {
   const TempDir dir;
   writeBlockScene(dir, /*nominal=*/false);
   dir.write("far.cl", pathCl(1e4));
+  // Passes 33 mm along x: 37 of 82 postures past the scene's margin (14.2 mm, a quarter of its
+  // diagonal), but 64 of the 80 pass postures more than 7 mm off the floor (the part) it finishes
+  // (5 mm and the ball's diameter): an inch file over a small part (a helper's) was shown.
+  dir.write("off.cl", pathCl(33));
   dir.write("short.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
   ASSERT_EQ(runFieldpath(dir, "check scene.yaml --path short.cl --out chk_short").exit_code, 0);
   // The same file, edited after its check (same name, same posture count): the check is stale.
@@ -139,6 +143,7 @@ TEST(View, BadInputIsExitOneWithOneLineOrAPageThatSaysWhatIsMissing) {
   };
   const Case cases[] = {
       {"--path far.cl", "a path for another scene?"},
+      {"--path off.cl", "64 of 80 pass postures lie more than 7 mm outside the part's box"},
       {"--path path.cl --surface nowhere", "--surface nowhere: no such folder"},
       {"--path path.cl --surface empty", "neither deviation.npy"},
       {"--path path.cl --check nowhere", "--check nowhere: no such folder"},

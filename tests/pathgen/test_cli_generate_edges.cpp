@@ -1,6 +1,7 @@
 /// `generate` at the edges of what a scene allows, through the built `fieldpath`: a nominal pass
 /// whose ball itself comes within `clearance` of a wall (no axis can clear it); a voxel grid
 /// coarse against r0.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -8,6 +9,7 @@
 #include <numbers>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -40,7 +42,14 @@ TEST(GenerateEdges, ABallWithinTheClearanceIsWrittenAndMarkedOneInsideIsRefused)
     return cl.str();
   };
   dir.write("near.cl", pass(6.7));    // the ball 0.3 mm from the wall's face x = 10
-  dir.write("inside.cl", pass(7.2));  // 0.2 mm into it
+  // Into it from the middle on, deepest (0.1 mm) at the last posture, line 42 of the file.
+  {
+    std::ostringstream cl;
+    cl << "# pass 1\n";
+    for (int i = -20; i <= 20; ++i)
+      cl << 6.7 + 0.02 * std::max(0, i) << ' ' << 0.5 * i << " 0 0 0 1\n";
+    dir.write("inside.cl", cl.str());
+  }
   for (const char* name : {"near", "inside"})
     dir.write(std::string(name) + ".yaml",
               "obstacles:\n  - mesh: wall.stl\npart: plate.stl\n"
@@ -63,7 +72,9 @@ TEST(GenerateEdges, ABallWithinTheClearanceIsWrittenAndMarkedOneInsideIsRefused)
 
   const auto inside = test::runFieldpath(dir, "generate inside.yaml --out inside");
   EXPECT_EQ(inside.exit_code, 1) << inside.output();
-  EXPECT_NE(inside.err.find("the ball touches or enters obstacle 1"), std::string::npos)
+  // Named where it enters: the input's line there, not the pass's first (a helper's).
+  EXPECT_NE(inside.err.find("(inside.cl:42) the ball touches or enters obstacle 1"),
+            std::string::npos)
       << inside.err;
   EXPECT_FALSE(fs::exists(dir.path() / "inside/path.cl"));
 }
@@ -456,4 +467,41 @@ TEST(GenerateEdges, NominalAxesThatClearThePosturesButNotAMotionAreNotKept) {
   const auto report = nlohmann::json::parse(test::slurp(dir.path() / "steered/report.json"));
   EXPECT_EQ(report["kept_nominal"].size(), 0u) << report["kept_nominal"];
   EXPECT_FALSE(report["safe"].get<bool>());
+}
+
+// Passes that never come near the part: a CAM file in inches over a part in mm (the same numbers
+// read 25.4 times larger) read "min clearance 28 mm", max tilt 0, not a word (a helper's; check
+// refuses it, but only if run). Said in a warning and report.json `ball_part`; none for the same
+// passes in mm, whose ball rides on the plate, nor for passes 2 mm over it (a stock allowance).
+TEST(GenerateEdges, PassesThatNeverComeNearThePartAreSaid) {
+  const TempDir dir;
+  geometry::TriangleMesh plate, post;
+  pathgen::test::addBox(plate, -2, 2, -2, 2, -0.5, 0);
+  pathgen::test::addBox(post, 2.5, 3, -2, 2, -0.5, 1);
+  geometry::saveMesh(plate, dir.path() / "plate.stl");
+  geometry::saveMesh(post, dir.path() / "post.stl");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: post.stl\npart: plate.stl\n"
+            "tool: { shape: ball, radius: 0.5, length: 10 }\nclearance: 0.05\n"
+            "field: { r0: 1.0, r_min: 0.05, sample_step: 0.1, voxel_size: 0.1 }\n"
+            "path: { nominal: p.apt }\n");
+  for (const auto& [units, z, far] :
+       {std::tuple{"MM", 0.0, false}, {"MM", 2.0, false}, {"INCHES", 0.0, true}}) {
+    std::ostringstream apt;
+    apt << "UNITS/" << units << "\n";
+    for (int i = -3; i <= 3; ++i) apt << "GOTO/" << 0.5 * i << ",1," << z << ",0,0,1\n";
+    dir.write("p.apt", apt.str());
+    const auto r = test::runFieldpath(dir, "generate scene.yaml --nominal --out out");
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out/report.json"));
+    const auto& ball = report["ball_part"];
+    EXPECT_EQ(ball["far_mm"].get<double>(), 5.0);
+    EXPECT_EQ(r.err.find("stays more than 5 mm from the part") != std::string::npos, far)
+        << units << ' ' << z << '\n'
+        << r.err;
+    EXPECT_EQ(ball["reaches"].get<bool>(), !far && z == 0.0) << ball;
+    // The plate's top at z 0: the ball rides on it, 2 mm over it, or 25.4 mm off its side.
+    if (!far) EXPECT_NEAR(ball["min_mm"].get<double>(), z, 1e-3) << ball;
+    if (far) EXPECT_GE(ball["min_mm"].get<double>(), 5.0) << ball;
+  }
 }

@@ -235,6 +235,46 @@ TEST(Generate, APassBesideAWallDoesNotRingIntoTheFarWall) {
   EXPECT_GT(largest_turn_deg(ringing), 2.0 * largest_turn_deg(critical));
 }
 
+// The feed is the dynamics' time scale (s = v t): in s the equation is J v² θ'' + c v θ' +
+// k (θ - θ0) = τ, and critical damping scales with √J, so n times the feed with J / n² steers
+// the same path, and n times the feed alone answers the wall n times later (a helper's feed
+// 10 000 mm/min drove 127 postures into the blades, unsaid: a note now names
+// DynamicsParams::responseLengthMm, v √(J/k)).
+TEST(Generate, TenTimesTheFeedSteersAsAHundredthOfTheInertia) {
+  GenerateRequest job;
+  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 30.0};
+  job.holder = {{30, 6}, {45, 6}, {45, 12}, {75, 12}};
+  job.mode = FieldMode::Direct;
+  job.passes_only = true;
+  job.obstacles = {test::boxMesh(-10, 70, 8, 10, 0, 20), test::boxMesh(-10, 70, -10, -8, 0, 20)};
+  std::vector<geometry::Posture> nominal;
+  for (int k = 0; k <= 80; ++k) nominal.push_back({Vec3(0.5 * k, 4, 0), Vec3::UnitZ(), 0.0, false});
+  job.passes = nominalPasses(geometry::singlePass(std::move(nominal)), PathParams{}, 3.0);
+  EXPECT_NEAR(job.dynamics.responseLengthMm(), 1000.0 / 60.0, 1e-12);
+  const GenerateResult base = generatePath(job);
+
+  GenerateRequest scaled = job;
+  scaled.dynamics.feed_mm_per_min *= 10.0;
+  scaled.dynamics.inertia /= 100.0;
+  EXPECT_NEAR(scaled.dynamics.responseLengthMm(), job.dynamics.responseLengthMm(), 1e-9);
+  const GenerateResult same = generatePath(scaled);
+  GenerateRequest fast = job;
+  fast.dynamics.feed_mm_per_min *= 10.0;
+  const GenerateResult late = generatePath(fast);
+  ASSERT_EQ(same.postures.size(), base.postures.size());
+  ASSERT_EQ(late.postures.size(), base.postures.size());
+  double same_deg = 0.0, late_deg = 0.0, base_max = 0.0;
+  for (std::size_t i = 0; i < base.postures.size(); ++i) {
+    same_deg = std::max(same_deg, std::abs(same.postures[i].tilt_rad - base.postures[i].tilt_rad));
+    late_deg = std::max(late_deg, std::abs(late.postures[i].tilt_rad - base.postures[i].tilt_rad));
+    base_max = std::max(base_max, std::abs(base.postures[i].tilt_rad));
+  }
+  same_deg *= 180.0 / M_PI, late_deg *= 180.0 / M_PI, base_max *= 180.0 / M_PI;
+  EXPECT_GT(base_max, 3.0);             // the wall 1 mm off the ball turns the axis
+  EXPECT_LT(same_deg, 1e-4);            // the same steering, to the solver's tolerances (3e-9 deg)
+  EXPECT_GT(late_deg, 0.3 * base_max);  // ten times the feed alone: another path
+}
+
 // A pass on a floor, its axis leaning 30 deg toward a shelf 15-20 mm up: the tool's top clears
 // the shelf's edge by 2.4 mm at the pass, but DESIGN's link (up the leaning axis) drives the
 // tool into the shelf (closed form: 10 mm up the axis its top is at y 11, z 19, in it). The

@@ -46,6 +46,15 @@ struct DynamicsParams {
   double effectiveDamping() const {
     return damping >= 0.0 ? damping : 2.0 * std::sqrt(stiffness * inertia);
   }
+
+  /// The path length (mm) over which the axis answers a change of torque: v √(J/k), the spring's
+  /// time constant at the feed (a wall's own stiffness shortens it). The feed is the dynamics'
+  /// time scale (s = v t): ten times the feed, ten times the length, and the axis turns from a
+  /// wall after passing it (a helper's 10 000 mm/min: 127 postures into the blades). In s the
+  /// equation is J v² θ'' + c v θ' + k (θ - θ0) = τ: n times the feed steers as J / n² does.
+  double responseLengthMm() const {
+    return feed_mm_per_min / 60.0 * std::sqrt(inertia / stiffness);
+  }
 };
 
 }  // namespace fieldpath::dynamics

@@ -2,6 +2,7 @@
 /// The whole job of `fieldpath generate`, as a library call (the CLI, the study, the tests and the
 /// benchmark share it): passes (from the impeller or a nominal path) → field (direct or voxels) →
 /// steered tool axis per pass → links → exact clearance of every posture and motion.
+#include <algorithm>
 #include <cstddef>
 #include <limits>
 #include <memory>
@@ -107,6 +108,10 @@ struct StageTimes {
   double near_path_s = 0;
 };
 
+/// Passes whose ball comes no nearer the part than this anywhere (mm) never finish it: a path in
+/// another frame or units (an inch CAM file over a part in mm), or for another part.
+inline double farFromPartMm(double ball_radius_mm) { return std::max(5.0, 2.0 * ball_radius_mm); }
+
 struct GenerateResult {
   std::vector<GeneratedPosture> postures;  ///< the passes' postures, in order
   std::vector<Pass> passes;
@@ -122,6 +127,9 @@ struct GenerateResult {
   /// The cutter against the part, exactly (when the job has a part and a ball or torus tool):
   /// entries deeper than kGougeToleranceMm.
   std::optional<CutterPartResult> cutter_part;
+  /// A ball end mill and a part: the least distance (mm) from the passes' balls to the part,
+  /// exact under farFromPartMm (a lower bound above it).
+  std::optional<double> ball_part_mm;
   double safe_z_mm = 0.0;     ///< the links' travel plane
   /// A given links.safe_z below this (mm) lets the links pass within the checks' own margin of
   /// `clearance` (the tool mesh's chordal tolerance, the motions' resolution): they may read as

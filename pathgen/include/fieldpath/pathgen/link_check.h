@@ -107,10 +107,12 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
                               const common::Progress& progress = {});
 /// The same with the part's model already prepared (prepareObstacle): generate checks its path
 /// again after each repair and the repairs check against the part too, one model for them all.
+/// `ball_exact_below_mm`: ball_part_mm exact under it (kReachesPartMm at least).
 PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
                               const std::shared_ptr<const ObstacleModel>& part,
                               const geometry::PathFile& path,
                               double gouge_tolerance_mm = kGougeToleranceMm,
-                              const common::Progress& progress = {});
+                              const common::Progress& progress = {},
+                              double ball_exact_below_mm = kReachesPartMm);
 
 }  // namespace fieldpath::pathgen
