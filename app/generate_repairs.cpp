@@ -66,16 +66,20 @@ void printRepairs(const pathgen::GenerateResult& result) {
   if (!result.routed_link_ends.empty()) {
     const auto& e = result.routed_link_ends.front();
     const std::size_t n = result.routed_link_ends.size();
+    char sideways[64] = "";
+    if (e.sideways_mm.norm() > 0.0)
+      std::snprintf(sideways, sizeof sideways, ", a move sideways of %.3g mm",
+                    e.sideways_mm.norm());
     std::fprintf(stderr,
                  "note: %zu link end%s taken off the pass's tool axis, the axis held (first: the "
-                 "way %s %s, the retract along %s (%.3g mm), the climb %.1f deg from the axis: "
+                 "way %s %s, the retract along %s (%.3g mm)%s, the climb %.1f deg from the axis: "
                  "along the "
                  "axis %zu collisions and %.3f mm of the obstacles, the way "
                  "taken none and %.3f mm; the tool moves straight, the rotary axes still) "
                  "(report.json links.routed_off_axis)\n",
                  n, n == 1 ? "" : "s", e.into ? "into" : "out of", e.label.c_str(),
-                 e.retract_along_axis ? "the axis" : "the climb", e.retract_mm, e.off_axis_deg,
-                 e.axis_collisions, e.axis_min_mm, e.taken_min_mm);
+                 e.retract_along_axis ? "the axis" : "the climb", e.retract_mm, sideways,
+                 e.off_axis_deg, e.axis_collisions, e.axis_min_mm, e.taken_min_mm);
   }
   if (!result.unfreed_link_ends.empty())
     std::fprintf(stderr,

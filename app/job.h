@@ -350,6 +350,7 @@ inline nlohmann::json dogLegJson(const pathgen::DogLegRapids& d) {
            "checked are the check's findings, not counted here"},
           {"rapids", d.rapids},
           {"unproven", d.unproven},
+          {"checked_under_required", d.checked_under},
           {"lowest_motion", jsonIndex(d.lowest)},
           {"lowest_bound_mm", d.unproven ? nlohmann::json(d.lowest_bound_mm) : nlohmann::json()},
           {"lowest_box_mm", d.unproven ? nlohmann::json(d.lowest_box_mm) : nlohmann::json()}};
@@ -362,18 +363,24 @@ inline nlohmann::json dogLegJson(const pathgen::DogLegRapids& d) {
 /// sloped plate cut 1.17 mm into the part).
 inline std::string dogLegNote(const geometry::PathFile& path, const pathgen::DogLegRapids& d,
                               const pathgen::MotionResult& m, bool has_part) {
-  if (d.unproven == 0 && !(has_part && d.rapids > 0)) return {};
+  const std::size_t clear = d.rapids - d.checked_under;  // as checked: the proof's rapids
+  if (d.unproven == 0 && !(has_part && clear > 0)) return {};
+  // Those under the clearance as checked are the check's own findings, in no proof.
+  const std::string of = d.checked_under == 0 ? std::to_string(d.rapids) + " rapid moves"
+                                              : std::to_string(clear) +
+                                                    " rapid moves clear as "
+                                                    "checked (of " +
+                                                    std::to_string(d.rapids) + ")";
   std::string note;
   if (d.unproven > 0) {
     char numbers[96];
     std::snprintf(numbers, sizeof numbers, "%.3f mm clear as checked, up to %.2f mm off it",
                   m.clearance_mm[d.lowest], d.lowest_box_mm);
-    note = std::to_string(d.unproven) + " of " + std::to_string(d.rapids) +
-           " rapid moves are proven clear of the obstacles only when run straight (lowest: " +
+    note = std::to_string(d.unproven) + " of the " + of +
+           " are proven clear of the obstacles only when run straight (lowest: " +
            motionWhere(path, d.lowest) + ", " + numbers + " run axis by axis)";
   } else {
-    note = "the " + std::to_string(d.rapids) +
-           " rapid moves are proven clear of the obstacles run axis by axis";
+    note = "the " + of + " are proven clear of the obstacles run axis by axis";
   }
   if (has_part)
     note += (d.unproven > 0 ? "; " : ", ") +

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -81,14 +82,19 @@ class WayChecker {
       out.min_mm = std::min(out.min_mm, at.clearance_mm[k]);
     }
     if (out.collisions >= give_up_at) return out;
-    // Bounded as the path's own motions are (a bound within the slack keptMm allows).
-    MotionRequest motions;
-    motions.required_mm = request_.clearance_mm;
-    motions.posture_clearance_mm = at.clearance_mm;
-    const MotionResult moved = obstacles_.checkMotions(up, motions);
-    out.collisions += moved.colliding;
-    out.min_mm = std::min(out.min_mm, moved.min_clearance_mm);
-    if (out.collisions >= give_up_at) return out;
+    // Bounded as the path's own motions are (a bound within the slack keptMm allows), one
+    // motion at a time from the climb down: the climb is where a way runs into what is over the
+    // pass, and a motion kept under the clearance is sampled finely (a shelf over every way: 13 s
+    // an end with the moves under it certified first, a links adversary's).
+    for (std::size_t k = up.size() - 1; k-- > 0;) {
+      MotionRequest motions;
+      motions.required_mm = request_.clearance_mm;
+      motions.posture_clearance_mm = std::span(at.clearance_mm).subspan(k, 2);
+      const MotionResult moved = obstacles_.checkMotions(std::span(up).subspan(k, 2), motions);
+      out.collisions += moved.colliding;
+      out.min_mm = std::min(out.min_mm, moved.min_clearance_mm);
+      if (out.collisions >= give_up_at) return out;
+    }
     if (whole_) {
       // As the path holds it: the pass's posture, then the link (the move between them grazes).
       geometry::PathFile path;
@@ -217,6 +223,14 @@ bool faultyEnd(const GenerateResult& result, const std::optional<PartContacts::M
   return false;
 }
 
+/// The pass as a message about its end names it: a nominal pass's way out at its last line (its
+/// label names the first: "the way out of pass 1 (nominal.cl:2)" for a link leaving from line
+/// 32, a links adversary's).
+std::string endLabel(const Pass& pass, bool into) {
+  if (into || !pass.whereAt) return pass.label;
+  return "pass " + std::to_string(pass.index + 1) + " (" + pass.whereAt(pass.length_mm) + ")";
+}
+
 }  // namespace
 
 std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
@@ -260,7 +274,10 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
       // collisions (still unsafe: a detour that frees nothing).
       const auto taken = [&] { return best && (keeps(best->second) || along.collisions > 0); };
       for (const WayFamily family : {WayFamily::Circle, WayFamily::Around, WayFamily::Aside}) {
-        if (taken()) break;  // each family only where the ones before it do no better
+        // Each family only where none before it keeps the clearance: a clear way under it is
+        // kept only if no later family keeps it (a 60 deg climb 0.169 mm from a wall was taken
+        // where a move sideways kept 5.9 mm, a links adversary's).
+        if (best && keeps(best->second)) break;
         for (const LinkEndWay& way : waysUp(posture.axis, family, reach_mm,
                                             request.links.retract_mm, request.clearance_mm)) {
           const WayCheck c = ways->check(posture, way, into, 1);  // a collision rules it out
@@ -273,7 +290,7 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
       if (!taken()) {
         if (unfreed)
           unfreed->push_back(std::string(into ? "the way into " : "the way out of ") +
-                             result.passes[p].label);
+                             endLabel(result.passes[p], into));
         continue;
       }
       // A leaning climb stops where it is out from under what the axis's way ran into, then
@@ -298,7 +315,7 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
       }
       GenerateResult::RoutedLinkEnd end;
       end.pass = result.passes[p].index;
-      end.label = result.passes[p].label;
+      end.label = endLabel(result.passes[p], into);
       end.into = into;
       end.way = best->first.climb;
       end.retract_along_axis = best->first.retract_dir == posture.axis;

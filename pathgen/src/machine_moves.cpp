@@ -124,7 +124,11 @@ DogLegRapids dogLegRapids(const geometry::PathFile& path, const MotionResult& mo
                           motions.tool_reach_mm * geometry::axisAngle(a.axis, b.axis);
     const double bound = motions.clearance_mm[i] - box_mm;
     // A motion under the required clearance as checked is said by the check itself.
-    if (motions.clearance_mm[i] < required_mm || bound >= required_mm) continue;
+    if (motions.clearance_mm[i] < required_mm) {
+      ++out.checked_under;
+      continue;
+    }
+    if (bound >= required_mm) continue;
     if (out.unproven++ == 0 || bound < out.lowest_bound_mm) {
       out.lowest = i;
       out.lowest_bound_mm = bound;

@@ -115,7 +115,7 @@ TEST_F(ImpellerRun, MatchesTheGoldenSummary) {
   const int unproven = field["dog_leg_rapids"]["unproven"].get<int>();
   EXPECT_GT(unproven, 0);
   EXPECT_LT(unproven, rapids);
-  EXPECT_NE(field_.output.find(std::to_string(unproven) + " of " + std::to_string(rapids) +
+  EXPECT_NE(field_.output.find(std::to_string(unproven) + " of the " + std::to_string(rapids) +
                                " rapid moves are proven clear of the obstacles only when run "
                                "straight"),
             std::string::npos)

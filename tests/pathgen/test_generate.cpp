@@ -235,6 +235,39 @@ TEST(Generate, APassBesideAWallDoesNotRingIntoTheFarWall) {
   EXPECT_GT(largest_turn_deg(ringing), 2.0 * largest_turn_deg(critical));
 }
 
+// A pass leaning 30 deg across a channel (walls 10 mm high at |y| >= 14) ends under a roof 92 mm
+// up (x 35-80): every climb toward the vertical runs into the roof, and the first way clear of
+// everything, a 60 deg climb out past the roof's end, passes a wall's top 0.17 mm off. A way
+// under the clearance is kept only where no later family keeps it: the move sideways out from
+// under the roof, then straight up, keeps 5.9 mm (a links adversary's scene: the 60 deg climb
+// was taken, `check: NOT OK`).
+TEST(Generate, AClearWayUnderTheClearanceGivesWayToALaterOneThatKeepsIt) {
+  GenerateRequest job;
+  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
+  job.holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
+  job.mode = FieldMode::Direct;
+  job.nominal = true;
+  job.links.retract_mm = 2.0;
+  job.obstacles = {test::boxMesh(-10, 100, -40, -14, 0, 10), test::boxMesh(-10, 100, 14, 40, 0, 10),
+                   test::boxMesh(35, 80, -40, 40, 92, 97)};
+  job.part = test::boxMesh(-10, 100, -40, 40, -10, 0);
+  const Vec3 axis(0.0, 0.5, std::sqrt(0.75));
+  std::vector<geometry::Posture> nominal;
+  for (int k = 0; k <= 30; ++k)
+    nominal.push_back({Vec3(5.0 + 1.5 * k, -7.5, 3.0 * (1.0 - axis.z())), axis, 0.0, false});
+  job.passes = nominalPasses(geometry::singlePass(std::move(nominal)), PathParams{}, 3.0);
+  const GenerateResult r = generatePath(job);
+  EXPECT_EQ(r.clearance.colliding + r.motions.colliding, 0u);
+  EXPECT_EQ(r.motions.under_required, 0u) << r.motions.min_clearance_mm;
+  ASSERT_EQ(r.routed_link_ends.size(), 1u);
+  const auto& end = r.routed_link_ends.front();
+  EXPECT_FALSE(end.into);
+  EXPECT_GT(end.axis_collisions, 0u);  // up the axis into the roof
+  EXPECT_GE(end.taken_min_mm, job.clearance_mm);
+  EXPECT_LT(end.sideways_mm.x(), -12.0);  // out past the roof's end at x 35, from x 50
+  EXPECT_NEAR(end.way.z(), 1.0, 1e-12);
+}
+
 // The feed is the dynamics' time scale (s = v t): in s the equation is J v² θ'' + c v θ' +
 // k (θ - θ0) = τ, and critical damping scales with √J, so n times the feed with J / n² steers
 // the same path, and n times the feed alone answers the wall n times later (a helper's feed

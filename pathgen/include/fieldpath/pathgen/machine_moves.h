@@ -57,6 +57,9 @@ struct DogLegRapids {
   static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
   std::size_t rapids = 0;
   std::size_t unproven = 0;      ///< rapids whose bound falls under the required clearance
+  /// Rapids under the required clearance as checked (straight): the check's own findings, in
+  /// no proof (a note said "the 7 rapid moves are proven clear" with 2 of them colliding).
+  std::size_t checked_under = 0;
   std::size_t lowest = npos;     ///< the unproven rapid of the lowest bound
   double lowest_bound_mm = 0.0;  ///< the bound there (may be negative)
   double lowest_box_mm = 0.0;    ///< its dev + reach × turn
