@@ -216,6 +216,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     std::string scene, path, out;
     double spacing_mm = 0.05;
     double gouge_tol_um = kGougeToleranceUm;
+    std::optional<double> max_scallop_um;  // none: the scallop is measured, not judged
     std::string backend = "auto";
   };
   auto options = std::make_shared<Options>();
@@ -235,6 +236,11 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                   "error reads as a gouge where it is concave; 0.1 to 1000)")
       ->check(numberFromTo(0.1, 1000.0, "um"))  // (CLI::Range let nan through)
       ->capture_default_str();
+  cmd->add_option("--max-scallop", options->max_scallop_um,
+                  "The finish the check holds the path to, um: a larger scallop, or lines "
+                  "between passes no pass cut, make it NOT OK (0.1 to 1e5; default: measured, "
+                  "not judged)")
+      ->check(numberFromTo(0.1, 1e5, "um"));
   cmd->add_option("--backend", options->backend, "Z-buffer backend: auto | cpu | cuda")
       ->check(CLI::IsMember({"auto", "cpu", "cuda"}))
       ->capture_default_str();
@@ -370,6 +376,19 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     const bool part_never_reached = scene.part && !surface && !touches_part && !reaches_part;
     if (part_never_reached)
       not_ok.push_back(std::string("the surface is not checked: ") + surface_skipped);
+    // The finish, where the user gives one: a check `ok` with 2 mm of stock between passes (a
+    // tool too small for the passes' spacing) read as a finished part (a helper's).
+    if (options->max_scallop_um && surface) {
+      if (surface->band_lines > 0 && surface->max_scallop_um > *options->max_scallop_um)
+        not_ok.push_back(
+            "max scallop " +
+            std::to_string(static_cast<long long>(std::lround(surface->max_scallop_um))) +
+            " um, over --max-scallop " + common::shortNumber(*options->max_scallop_um) + " um");
+      if (surface->uncut_band_lines > 0)
+        not_ok.push_back(std::to_string(surface->uncut_band_lines) +
+                         " lines between passes not cut (the stock stands there; --max-scallop " +
+                         common::shortNumber(*options->max_scallop_um) + " um)");
+    }
     if (surface && surface->gouged_lines > 0)
       not_ok.push_back(std::to_string(surface->gouged_lines) + " Z-buffer lines cut below the part "
                        "by more than the gouge tolerance (max " +
@@ -418,6 +437,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                                                    ? json(path.where(path.limited.front()))
                                                    : json(nullptr)}})}}},
         {"surface", surface ? surfaceJson(*surface) : json(nullptr)},
+        {"max_scallop_um",
+         options->max_scallop_um ? json(*options->max_scallop_um) : json(nullptr)},
         {"surface_skipped", surface_skipped ? json(surface_skipped) : json(nullptr)},
         {"ok", not_ok.empty()},
         {"not_ok_because", not_ok},

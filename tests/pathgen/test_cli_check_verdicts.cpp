@@ -113,6 +113,54 @@ TEST(CheckVerdict, TheGougeToleranceIsTheOptions) {
       << nan.err;
 }
 
+// `--max-scallop`: the finish the check holds a path to. Two passes 4 mm apart over a flat
+// part with a 3 mm ball leave a cusp of 3 - sqrt(9 - 2^2) = 764 um between them (closed form):
+// ok at 800 um, not at 700; passes 10 mm apart leave lines no pass cut (the stock stands), not
+// ok whatever the bound. Without the option the scallop is measured, not judged (a helper's
+// check `ok` of a path leaving the whole 2 mm allowance between passes).
+TEST(CheckVerdict, MaxScallopHoldsThePathToAFinish) {
+  const TempDir dir;
+  pathgen::test::writeBoxPartScene(dir, {{-20, 20, -20, 20, -10, 0}});
+  const auto passes = [](double gap_mm) {
+    std::string cl;
+    for (int p = 0; p < 2; ++p) {
+      cl += "# pass " + std::to_string(p + 1) + "\n";
+      for (int i = -10; i <= 10; ++i)
+        cl += std::to_string(i) + " " + std::to_string((p - 0.5) * gap_mm) + " 0 0 0 1\n";
+    }
+    return cl;
+  };
+  dir.write("near.cl", passes(4.0));
+  dir.write("far.cl", passes(10.0));
+  const double cusp_um = 1e3 * (3.0 - std::sqrt(9.0 - 4.0));
+  struct Case {
+    std::string path, option;
+    bool ok;
+    std::string reason;
+  };
+  for (const Case& c : {Case{"near", "", true, ""}, Case{"near", "--max-scallop 800", true, ""},
+                        Case{"near", "--max-scallop 700", false, "over --max-scallop 700 um"},
+                        Case{"far", "", true, ""},
+                        Case{"far", "--max-scallop 5000", false, "lines between passes not cut"}}) {
+    const std::string out = c.path + (c.option.empty() ? "" : "_" + c.option.substr(14));
+    const auto r = test::runFieldpath(
+        dir, "check scene.yaml --path " + c.path + ".cl " + c.option + " --out " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    const nlohmann::json check = checkJson(dir, out);
+    EXPECT_EQ(check["ok"].get<bool>(), c.ok)
+        << c.path << ' ' << c.option << ": " << check["not_ok_because"];
+    if (!c.reason.empty()) EXPECT_TRUE(says(check["not_ok_because"], c.reason)) << check;
+    if (c.path == "near") {  // the lines may miss the cusp by up to the grid error they state
+      const double measured = check["surface"]["max_scallop_um"].get<double>();
+      EXPECT_LE(measured, cusp_um + 1.0) << check["surface"];
+      EXPECT_GE(measured + check["surface"]["scallop_grid_error_um"].get<double>(), cusp_um - 1.0)
+          << check["surface"];
+      EXPECT_GT(measured, 700.0) << check["surface"];
+    }
+    EXPECT_EQ(check["max_scallop_um"].is_null(), c.option.empty());
+  }
+}
+
 // A 400 mm square part at a 0.02 mm spacing is 4 · 10^8 lines: the grid is coarsened to the
 // largest the check makes, and says so (check.json and stdout).
 TEST(CheckVerdict, AFineSpacingOverALargePartIsCoarsenedAndSaid) {
