@@ -180,8 +180,10 @@ GenerateResult generatePath(const GenerateRequest& request) {
   if (!request.nominal && request.dynamics.start != dynamics::StartPolicy::Nominal)
     for (std::size_t p = 0; p < result.passes.size(); ++p) {
       const Pass& pass = result.passes[p];
+      // `auto` settles only under a field that pushes: with gain 0 the axis at rest is the
+      // nominal one, and a note said the pass "started from the axis settled under the field".
       settle[p] = request.dynamics.start == dynamics::StartPolicy::Settled ||
-                  (!pass.samples.empty() &&
+                  (request.field.gain > 0.0 && !pass.samples.empty() &&
                    checker.clearance(geometry::ballEndPosture(
                        pass.samples.front().centre_mm, nominalAxis(pass.samples.front(), lead_rad),
                        r)) < request.clearance_mm);

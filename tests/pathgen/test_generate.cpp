@@ -196,6 +196,14 @@ TEST(Generate, APassStartingInCollisionStartsFromTheSettledAxis) {
   EXPECT_EQ(unsettled.settle_failures.front().pass, 0);
   EXPECT_NE(unsettled.settle_failures.front().why.find("no damping"), std::string::npos);
   EXPECT_LE(unsettled.postures.front().clearance_mm, 0.0);  // the nominal start, in the wall
+
+  // With no field (gain 0) `auto` does not settle: the axis at rest is the nominal one, and a
+  // note said the pass "started from the axis settled under the field" (a links adversary's).
+  GenerateRequest unpushed = job;
+  unpushed.field.gain = 0.0;
+  const GenerateResult still = generatePath(unpushed);
+  EXPECT_TRUE(still.settled_starts.empty());
+  EXPECT_TRUE(still.settle_failures.empty());
 }
 
 // A channel 16 mm wide, walls 20 mm high; the pass runs with the ball 1 mm from one wall, its
