@@ -492,13 +492,17 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                    gouge.c_str());
     // Steered passes under the clearance: the axis may answer too late. The feed is the
     // dynamics' time scale, unsaid (a helper's feed 10 000 mm/min: 127 postures in the blades).
-    if (!job.nominal) {
+    // Said where the response is longer than twice the defaults' (16.7 mm): else the feed is
+    // not why (a fat holder's collisions read "a lower feed turns it sooner", which it did not).
+    const dynamics::DynamicsParams defaults;
+    if (!job.nominal && job.dynamics.responseLengthMm() > 2.0 * defaults.responseLengthMm()) {
       std::size_t under = 0;
       for (const pathgen::GeneratedPosture& g : result.postures)
         under += g.clearance_mm < job.clearance_mm;
       if (under > 0)
         std::fprintf(stderr,
-                     "note: %zu pass postures under `clearance`: the steered axis answers the "
+                     "note: %zu pass postures under `clearance` (colliding ones included): the "
+                     "steered axis answers the "
                      "field over about %.3g mm of path (dynamics.feed, %.3g mm/s, times "
                      "sqrt(inertia / stiffness), %.3g s): a lower feed or inertia turns it sooner "
                      "(the same steering at n times the feed with inertia / n^2; dynamics.feed is "

@@ -366,21 +366,23 @@ inline std::string dogLegNote(const geometry::PathFile& path, const pathgen::Dog
   const std::size_t clear = d.rapids - d.checked_under;  // as checked: the proof's rapids
   if (d.unproven == 0 && !(has_part && clear > 0)) return {};
   // Those under the clearance as checked are the check's own findings, in no proof.
-  const std::string of = d.checked_under == 0 ? std::to_string(d.rapids) + " rapid moves"
-                                              : std::to_string(clear) +
-                                                    " rapid moves clear as "
-                                                    "checked (of " +
+  const auto moves = [](std::size_t n) {
+    return std::to_string(n) + (n == 1 ? " rapid move" : " rapid moves");
+  };
+  const std::string of = d.checked_under == 0 ? moves(d.rapids)
+                                              : moves(clear) + " clear as checked (of " +
                                                     std::to_string(d.rapids) + ")";
+  const char* are = (d.checked_under == 0 ? d.rapids : clear) == 1 ? " is" : " are";
   std::string note;
   if (d.unproven > 0) {
     char numbers[96];
     std::snprintf(numbers, sizeof numbers, "%.3f mm clear as checked, up to %.2f mm off it",
                   m.clearance_mm[d.lowest], d.lowest_box_mm);
-    note = std::to_string(d.unproven) + " of the " + of +
-           " are proven clear of the obstacles only when run straight (lowest: " +
+    note = std::to_string(d.unproven) + " of the " + of + (d.unproven == 1 ? " is" : " are") +
+           " proven clear of the obstacles only when run straight (lowest: " +
            motionWhere(path, d.lowest) + ", " + numbers + " run axis by axis)";
   } else {
-    note = "the " + of + " are proven clear of the obstacles run axis by axis";
+    note = "the " + of + are + " proven clear of the obstacles run axis by axis";
   }
   if (has_part)
     note += (d.unproven > 0 ? "; " : ", ") +

@@ -341,7 +341,8 @@ ViewData gatherView(const ViewRequest& request) {
     // With a part, the passes' tips lie on it: the margin above (the holder's reach) let an inch
     // file over a part 5 mm wide pass (its postures 41 mm outside, a helper's). A pass posture
     // farther from the part's box than its ball's reach and generate's far-from-part distance
-    // cannot finish it.
+    // cannot finish it; a path none of whose pass postures comes nearer is refused (passes that
+    // run on past the part's edge, most of them off it, are a path for this part).
     if (scene.part && !scene.part->vertices.empty()) {
       Eigen::AlignedBox3d part_box;
       for (const geometry::Vec3& v : scene.part->vertices) part_box.extend(v);
@@ -354,10 +355,10 @@ ViewData gatherView(const ViewRequest& request) {
           if (part_box.exteriorDistance(postures[i].tip_mm) > pass_margin && far++ == 0)
             first_far = i;
       }
-      if (2 * far > pass_postures) {
+      if (pass_postures > 0 && far == pass_postures) {
         std::ostringstream s;
         s.precision(4);
-        s << far << " of " << pass_postures << " pass postures lie more than " << pass_margin
+        s << "all " << pass_postures << " pass postures lie more than " << pass_margin
           << " mm outside the part's box (the first at posture " << first_far << ", "
           << p.file.where(first_far)
           << "): the passes do not finish the part; a path in other units or another frame, "

@@ -25,11 +25,13 @@ constexpr double kSideClimbDeg[] = {30.0, 60.0};
 constexpr int kSideClimbAzimuths = 8;
 /// The moves sideways before a climb straight up, in widest radii of the tool and holder.
 constexpr double kAsideReaches[] = {2.0, 4.0, 8.0};
-/// The shorter retracts tried before a move sideways, in parts of links.retract: a pass just
+/// The first shorter retract tried before a move sideways, a part of links.retract: a pass just
 /// under a shelf, whose full retract runs into it (a helper's 90 mm holder 5 mm under one).
-constexpr double kAsideRetracts[] = {0.25};
+constexpr double kAsideRetractPart = 0.25;
 /// The ways tried, family by family (waysUp).
 enum class WayFamily { Circle, Around, Aside };
+/// The motions' resolution in the ways' checks (mm; MotionRequest's is 0.005).
+constexpr double kWayResolutionMm = 0.05;
 /// A way up must rise at least this much (its z component): sin 5°, as the links' own climb.
 constexpr double kMinWayRise = 0.0872;
 
@@ -89,6 +91,12 @@ class WayChecker {
     for (std::size_t k = up.size() - 1; k-- > 0;) {
       MotionRequest motions;
       motions.required_mm = request_.clearance_mm;
+      // Coarser than the path's own check (0.005 mm): a way's motion kept just under the
+      // clearance is halved down to the resolution to tell touching from not, and a 24 mm move
+      // 0.48 mm under a shelf cost ~8 s a link end (a regression hunt's). Coarser can only call
+      // a way colliding that is not (never the reverse), and the path taken is checked again
+      // at the full resolution.
+      motions.resolution_mm = kWayResolutionMm;
       motions.posture_clearance_mm = std::span(at.clearance_mm).subspan(k, 2);
       const MotionResult moved = obstacles_.checkMotions(std::span(up).subspan(k, 2), motions);
       out.collisions += moved.colliding;
@@ -131,8 +139,9 @@ class WayChecker {
 /// (Aside), where no straight climb frees it (a pass 10 mm under a shelf, a 90 mm holder below
 /// it: a helper's), the retract along the axis, a move sideways of kAsideReaches times the tool
 /// and holder's widest radius `reach_mm` toward those directions, then straight up; then the
-/// same after shorter retracts (`retract_mm` links.retract: kAsideRetracts of it, then twice the
-/// clearance `clearance_mm`), where the full one runs into what is over the pass.
+/// same after shorter retracts (`retract_mm` links.retract: kAsideRetractPart of it, 1 mm, twice
+/// the clearance `clearance_mm` within 0.2-1 mm, 0.2 mm), where the full one runs into what is
+/// over the pass.
 std::vector<LinkEndWay> waysUp(const Vec3& axis, WayFamily family, double reach_mm,
                                double retract_mm, double clearance_mm) {
   std::vector<LinkEndWay> out;
@@ -167,14 +176,15 @@ std::vector<LinkEndWay> waysUp(const Vec3& axis, WayFamily family, double reach_
       }
     return out;
   }
-  // The full retract first; then shorter ones, none under twice the clearance (0.2 mm at least):
-  // the move sideways runs over the surface the pass has just cut, checked against the part
-  // for contacts only.
-  const double shortest_mm = std::max(2.0 * clearance_mm, 0.2);
+  // The full retract first; then shorter ones (a quarter of it, 1 mm, twice the clearance up to
+  // 1 mm, 0.2 mm), the longest that frees the end taken: the move sideways runs over the surface
+  // the pass has just cut, checked against the part for contacts only (twice a clearance of 2 mm
+  // left a 1 mm retract under a shelf untried; with clearance 0, 0.2 mm over the part where
+  // 0.7 mm was free: a regression hunt's).
   std::vector<double> retracts = {retract_mm};
-  for (const double part : kAsideRetracts)
-    if (part * retract_mm >= shortest_mm) retracts.push_back(part * retract_mm);
-  if (shortest_mm < retracts.back()) retracts.push_back(shortest_mm);
+  for (const double length :
+       {kAsideRetractPart * retract_mm, 1.0, std::clamp(2.0 * clearance_mm, 0.2, 1.0), 0.2})
+    if (length < retracts.back() && length >= 0.2) retracts.push_back(length);
   for (std::size_t i = 0; i < retracts.size(); ++i) {
     for (const double reaches : kAsideReaches)
       for (int k = 0; k < kSideClimbAzimuths; ++k) {

@@ -112,6 +112,10 @@ TEST(View, ALongPathShownEveryKthKeepsEveryCollisionAndBlockEnd) {
 TEST(View, AFewPosturesOutsideTheSceneAreShownWithAWarning) {
   const TempDir dir;
   writeBlockScene(dir, /*nominal=*/false);
+  // Passes running on 25 mm past the floor's edge (x 20): 60 of 80 pass postures off the part, a
+  // path for it all the same.
+  dir.write("runoff.cl", pathCl(25));
+  EXPECT_EQ(runFieldpath(dir, "view scene.yaml --path runoff.cl --out r.html").exit_code, 0);
   dir.write("home.cl", pathCl() + "# link\n0 0 10000 0 0 1\n");
   const Outcome r = runFieldpath(dir, "view scene.yaml --path home.cl --out v.html");
   ASSERT_EQ(r.exit_code, 0) << r.output();
@@ -127,10 +131,19 @@ TEST(View, BadInputIsExitOneWithOneLineOrAPageThatSaysWhatIsMissing) {
   const TempDir dir;
   writeBlockScene(dir, /*nominal=*/false);
   dir.write("far.cl", pathCl(1e4));
-  // Passes 33 mm along x: 37 of 82 postures past the scene's margin (14.2 mm, a quarter of its
-  // diagonal), but 64 of the 80 pass postures more than 7 mm off the floor (the part) it finishes
+  // Passes 10 mm off the floor's side (y 30): within the scene's margin (14.2 mm, a quarter of
+  // its diagonal), but every pass posture more than 7 mm off the floor (the part) it finishes
   // (5 mm and the ball's diameter): an inch file over a small part (a helper's) was shown.
-  dir.write("off.cl", pathCl(33));
+  // Passes that run on past the part's edge, most of them off it, are shown (a regression
+  // hunt's: 86 of 142 off a part they cut).
+  {
+    std::ostringstream off;
+    off << "# pass 1\n";
+    for (int k = 0; k < 40; ++k) off << -9.75 + 0.5 * k << " 30 0 0 0 1\n";
+    off << "# link\n9.75 30 15 0 0 1\n-9.75 32 15 0 0 1\n# pass 2\n";
+    for (int k = 0; k < 40; ++k) off << -9.75 + 0.5 * k << " 32 0 0 0 1\n";
+    dir.write("off.cl", off.str());
+  }
   dir.write("short.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n");
   ASSERT_EQ(runFieldpath(dir, "check scene.yaml --path short.cl --out chk_short").exit_code, 0);
   // The same file, edited after its check (same name, same posture count): the check is stale.
@@ -143,7 +156,7 @@ TEST(View, BadInputIsExitOneWithOneLineOrAPageThatSaysWhatIsMissing) {
   };
   const Case cases[] = {
       {"--path far.cl", "a path for another scene?"},
-      {"--path off.cl", "64 of 80 pass postures lie more than 7 mm outside the part's box"},
+      {"--path off.cl", "all 80 pass postures lie more than 7 mm outside the part's box"},
       {"--path path.cl --surface nowhere", "--surface nowhere: no such folder"},
       {"--path path.cl --surface empty", "neither deviation.npy"},
       {"--path path.cl --check nowhere", "--check nowhere: no such folder"},

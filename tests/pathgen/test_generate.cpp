@@ -448,7 +448,9 @@ TEST(Generate, AnUprightPassUnderAShelfClimbsOutFromUnderIt) {
 
   // A shelf 1 mm over the tool's top (a 0.5 mm retract): no climb from the pass clears it; the
   // link moves sideways out from under it first (8 tool radii: 2 and 4 leave the shank under
-  // the shelf's edge 10 mm off), then climbs straight up.
+  // the shelf's edge 10 mm off), then climbs straight up. After the 0.5 mm retract the move
+  // runs 0.5 mm under the shelf, less the tool mesh's chord: under the clearance; after 0.2 mm
+  // it keeps it (the shortest retract tried), and that way is taken.
   GenerateRequest low = job;
   low.links.retract_mm = 0.5;
   low.obstacles = {test::boxMesh(-50, 60, -50, 10, 13, 25)};
@@ -459,8 +461,9 @@ TEST(Generate, AnUprightPassUnderAShelfClimbsOutFromUnderIt) {
     EXPECT_NEAR(end.sideways_mm.norm(), 24.0, 1e-9);
     EXPECT_GT(end.sideways_mm.y(), 10.0 + 3.0);
     EXPECT_NEAR(end.way.z(), 1.0, 1e-12);
-    EXPECT_EQ(end.retract_mm, 0.5);
+    EXPECT_EQ(end.retract_mm, 0.2);
   }
+  EXPECT_EQ(aside.motions.under_required, 0u) << aside.motions.min_clearance_mm;
 
   // A shelf 4 mm over the tool's top, the retract 10 mm: the retract itself runs into it. A
   // quarter of it (2.5 mm) leaves 1.5 mm under the shelf, then the move sideways and up.
