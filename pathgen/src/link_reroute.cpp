@@ -329,8 +329,7 @@ std::vector<GenerateResult::RoutedLinkEnd> rerouteLinkEnds(
       end.into = into;
       end.way = best->first.climb;
       end.retract_along_axis = best->first.retract_dir == posture.axis;
-      end.retract_mm =
-          std::isnan(best->first.retract_mm) ? request.links.retract_mm : best->first.retract_mm;
+      end.retract_mm = best->first.retractMm(request.links.retract_mm);
       end.sideways_mm = best->first.sideways_mm;
       end.climb_mm = best->first.climb_mm;
       end.off_axis_deg =

@@ -94,8 +94,7 @@ Vec3 travelPoint(const Posture& p, double z_mm, double retract_mm, const char* w
 
 std::vector<Vec3> wayTips(const Vec3& tip_mm, double z_mm, double retract_mm,
                           const LinkEndWay& way) {
-  const double retract = std::isnan(way.retract_mm) ? retract_mm : way.retract_mm;
-  std::vector<Vec3> out = {tip_mm + retract * way.retract_dir};
+  std::vector<Vec3> out = {tip_mm + way.retractMm(retract_mm) * way.retract_dir};
   if (way.sideways_mm != Vec3::Zero()) out.push_back(out.back() + way.sideways_mm);
   const Vec3 from = out.back();
   const double full = std::max(0.0, (z_mm - from.z()) / way.climb.z());
@@ -181,8 +180,8 @@ geometry::PathFile linkPasses(std::span<const std::vector<Posture>> passes,
   const auto link = PathBlock::Kind::Link;
   // Where the link's retract out of `p` along `w` ends.
   auto retracted = [&](const Posture& p, const LinkEndWay& w) {
-    if (w.alongAxis()) return Vec3(p.tip_mm + params.retract_mm * p.axis);
-    return wayTips(p.tip_mm, p.tip_mm.z(), params.retract_mm, w).front();
+    return Vec3(p.tip_mm +
+                w.retractMm(params.retract_mm) * (w.alongAxis() ? p.axis : w.retract_dir));
   };
   // The postures between the retract and the travel plane of a way off the axis (the move
   // sideways' end, the knee), in the order the link passes them: out of the pass, or into it.

@@ -2,6 +2,7 @@
 /// Links between passes (DESIGN.md "Links and motion"): the output must be safe to run. Each pass
 /// is entered and left along its tool axis; between passes the tool travels in a plane above every
 /// mesh with the axis turned smoothly.
+#include <cmath>
 #include <limits>
 #include <optional>
 #include <span>
@@ -51,6 +52,10 @@ struct LinkEndWay {
   double climb_mm = std::numeric_limits<double>::infinity();
   double retract_mm = std::numeric_limits<double>::quiet_NaN();
   bool alongAxis() const { return climb == Vec3::Zero(); }
+  /// The retract's length (mm): its own, else `links_retract_mm` (links.retract).
+  double retractMm(double links_retract_mm) const {
+    return std::isnan(retract_mm) ? links_retract_mm : retract_mm;
+  }
 };
 
 /// The tips a link way off the axis (`way`, not alongAxis) passes from the pass's end posture
