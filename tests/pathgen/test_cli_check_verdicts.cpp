@@ -159,6 +159,22 @@ TEST(CheckVerdict, MaxScallopHoldsThePathToAFinish) {
     }
     EXPECT_EQ(check["max_scallop_um"].is_null(), c.option.empty());
   }
+  // A bound between the measured scallop and the measured plus the grid's error is not proven:
+  // the cusp between the lines may stand over it.
+  const nlohmann::json surface = checkJson(dir, "near")["surface"];
+  const double measured = surface["max_scallop_um"].get<double>();
+  const double grid_error = surface["scallop_grid_error_um"].get<double>();
+  ASSERT_GT(grid_error, 2.0) << surface;
+  for (const auto& [bound, ok] : {std::pair{measured + grid_error / 2, false},
+                                  std::pair{measured + grid_error + 1.0, true}}) {
+    const std::string option = "--max-scallop " + std::to_string(bound);
+    const auto r = test::runFieldpath(
+        dir, "check scene.yaml --path near.cl " + option + " --out between_" + (ok ? "1" : "0"));
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    const nlohmann::json check = checkJson(dir, std::string("between_") + (ok ? "1" : "0"));
+    EXPECT_EQ(check["ok"].get<bool>(), ok) << option << ": " << check["not_ok_because"];
+    if (!ok) EXPECT_TRUE(says(check["not_ok_because"], "a cusp between them up to")) << check;
+  }
 }
 
 // A 400 mm square part at a 0.02 mm spacing is 4 · 10^8 lines: the grid is coarsened to the
