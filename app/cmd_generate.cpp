@@ -378,7 +378,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
             dogLegNote(result.path, dog_leg, result.motions, scene.part.has_value());
         !rapids.empty())
       std::fprintf(stderr, "note: %s (report.json dog_leg_rapids)\n", rapids.c_str());
-    printRepairs(result);
+    printRepairs(result, job.links.retract_mm);
     if (!result.balls_under_clearance.empty()) {
       const auto& b = result.balls_under_clearance.front();
       std::fprintf(stderr,

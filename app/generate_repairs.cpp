@@ -34,7 +34,7 @@ nlohmann::json routedLinkEndsJson(const pathgen::GenerateResult& r) {
   return out;
 }
 
-void printRepairs(const pathgen::GenerateResult& result) {
+void printRepairs(const pathgen::GenerateResult& result, double links_retract_mm) {
   // Passes kept nominal: those that collided steered (a warning), and those that only came
   // under the required clearance steered (a note: the path written keeps it).
   for (const bool collided : {true, false}) {
@@ -80,6 +80,29 @@ void printRepairs(const pathgen::GenerateResult& result) {
                  n, n == 1 ? "" : "s", e.into ? "into" : "out of", e.label.c_str(),
                  e.retract_along_axis ? "the axis" : "the climb", e.retract_mm, sideways,
                  e.off_axis_deg, e.axis_collisions, e.axis_min_mm, e.taken_min_mm);
+  }
+  // A move sideways after a retract shorter than links.retract runs low over the part, and a
+  // link's moves are rapids (path.apt): over stock not yet cut (a pass's start, the passes
+  // beside it) that height is not free (a diff review's: a 24 mm rapid 0.5 mm over the start of
+  // a pass, links.retract 2).
+  {
+    std::size_t n = 0;
+    const pathgen::GenerateResult::RoutedLinkEnd* lowest = nullptr;
+    for (const auto& e : result.routed_link_ends)
+      if (e.retract_mm < links_retract_mm && e.sideways_mm.norm() > 0.0) {
+        n += 1;
+        if (!lowest || e.retract_mm < lowest->retract_mm) lowest = &e;
+      }
+    if (lowest)
+      std::fprintf(stderr,
+                   "warning: %zu link end%s move%s sideways after a retract shorter than "
+                   "links.retract (%.3g mm; the full one runs into what is over the pass), the "
+                   "lowest %.3g mm along the axis from the way %s %s: path.apt writes a link's "
+                   "moves as rapids, and over stock not yet cut (a pass's start, the passes "
+                   "beside it) that low a rapid cuts: run %s at feed, or make room over the "
+                   "pass (report.json links.routed_off_axis retract_mm)\n",
+                   n, n == 1 ? "" : "s", n == 1 ? "s" : "", links_retract_mm, lowest->retract_mm,
+                   lowest->into ? "into" : "out of", lowest->label.c_str(), n == 1 ? "it" : "them");
   }
   if (!result.unfreed_link_ends.empty())
     std::fprintf(stderr,

@@ -15,6 +15,6 @@ nlohmann::json keptNominalJson(const pathgen::GenerateResult& r);
 nlohmann::json routedLinkEndsJson(const pathgen::GenerateResult& r);
 
 /// The warnings and notes of both, on stderr.
-void printRepairs(const pathgen::GenerateResult& result);
+void printRepairs(const pathgen::GenerateResult& result, double links_retract_mm);
 
 }  // namespace fieldpath::app

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -181,10 +182,14 @@ std::vector<LinkEndWay> waysUp(const Vec3& axis, WayFamily family, double reach_
   // the pass has just cut, checked against the part for contacts only (twice a clearance of 2 mm
   // left a 1 mm retract under a shelf untried; with clearance 0, 0.2 mm over the part where
   // 0.7 mm was free: a regression hunt's).
-  std::vector<double> retracts = {retract_mm};
-  for (const double length :
-       {kAsideRetractPart * retract_mm, 1.0, std::clamp(2.0 * clearance_mm, 0.2, 1.0), 0.2})
-    if (length < retracts.back() && length >= 0.2) retracts.push_back(length);
+  // Longest first, each once: a quarter of a 2 mm retract (0.5) comes after 1 mm (it was
+  // tried before it, and 1 mm never: a diff review's).
+  std::vector<double> retracts = {kAsideRetractPart * retract_mm, 1.0,
+                                  std::clamp(2.0 * clearance_mm, 0.2, 1.0), 0.2};
+  std::erase_if(retracts, [&](double length) { return length >= retract_mm || length < 0.2; });
+  std::sort(retracts.begin(), retracts.end(), std::greater<>());
+  retracts.erase(std::unique(retracts.begin(), retracts.end()), retracts.end());
+  retracts.insert(retracts.begin(), retract_mm);
   for (std::size_t i = 0; i < retracts.size(); ++i) {
     for (const double reaches : kAsideReaches)
       for (int k = 0; k < kSideClimbAzimuths; ++k) {

@@ -505,3 +505,37 @@ TEST(GenerateEdges, PassesThatNeverComeNearThePartAreSaid) {
     if (far) EXPECT_GE(ball["min_mm"].get<double>(), 5.0) << ball;
   }
 }
+
+// A link end freed by a move sideways after a retract shorter than links.retract runs that low
+// over the part, and path.apt writes a link's moves as rapids: over stock not yet cut (here the
+// start of the pass) that is not free, and a warning says so (a diff review's: a 24 mm rapid
+// 1 mm over the pass's start was said only as a note). None where the full retract is taken (a
+// shorter tool, 10 mm under the shelf, climbs out from under it at 60 deg).
+TEST(GenerateEdges, AMoveSidewaysUnderTheRetractIsWarned) {
+  const TempDir dir;
+  geometry::TriangleMesh floor, shelf;
+  pathgen::test::addBox(floor, -20, 30, -20, 20, -10, 0);
+  pathgen::test::addBox(shelf, -50, 60, -50, 10, 14, 25);
+  geometry::saveMesh(floor, dir.path() / "floor.stl");
+  geometry::saveMesh(shelf, dir.path() / "shelf.stl");
+  std::string cl = "# pass 1\n";
+  for (int k = 0; k <= 20; ++k) cl += std::to_string(0.5 * k) + " 0 0 0 0 1\n";
+  dir.write("pass.cl", cl);
+  for (const bool under : {true, false}) {
+    dir.write("scene.yaml", std::string("obstacles:\n  - mesh: shelf.stl\npart: floor.stl\n") +
+                                "tool: { shape: ball, radius: 3, length: " + (under ? "12" : "4") +
+                                " }\nclearance: 0.5\npath: { nominal: pass.cl }\n"
+                                "links: { retract: 2 }\n");
+    const auto r = test::runFieldpath(dir, "generate scene.yaml --nominal --out out");
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out/report.json"));
+    const auto& routed = report["links"]["routed_off_axis"];
+    EXPECT_EQ(routed.size(), 2u) << routed;  // a shorter tool climbs out at 60 deg
+    for (const auto& end : routed)
+      EXPECT_EQ(end["retract_mm"].get<double>(), under ? 1.0 : 2.0) << end;
+    EXPECT_EQ(r.err.find("warning: 2 link ends move sideways after a retract shorter than "
+                         "links.retract (2 mm") != std::string::npos,
+              under)
+        << r.err;
+  }
+}

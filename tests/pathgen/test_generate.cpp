@@ -487,4 +487,16 @@ TEST(Generate, AnUprightPassUnderAShelfClimbsOutFromUnderIt) {
                 2.5, 1e-9);
   }
   EXPECT_TRUE(shorter.unfreed_link_ends.empty());
+
+  // A shelf 2 mm over the tool's top, the retract 2 mm: the shorter ones longest first, 1 mm
+  // before a quarter of it (0.5 mm), and 1 mm leaves the move sideways 1 mm under the shelf,
+  // over the clearance (0.5 mm before: the quarter was tried first, 1 mm never).
+  GenerateRequest two = job;
+  two.links.retract_mm = 2.0;
+  two.clearance_mm = 0.5;
+  two.obstacles = {test::boxMesh(-50, 60, -50, 10, 14, 25)};
+  const GenerateResult longest = generatePath(two);
+  EXPECT_EQ(longest.clearance.colliding + longest.motions.colliding, 0u);
+  ASSERT_EQ(longest.routed_link_ends.size(), 2u);
+  for (const auto& end : longest.routed_link_ends) EXPECT_EQ(end.retract_mm, 1.0);
 }
