@@ -381,6 +381,14 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     // The lines sample the surface: a cusp between them may stand up to the grid error higher,
     // so the finish holds only where the measured scallop plus that bound keeps under it (a
     // measured 457 um with 24 um between the lines read ok under 460).
+    // A finish asked and no scallop measured (one pass, no part, nothing the lines see) is not
+    // held either: `ok` read as the finish proven (a diff review's: one pass, --max-scallop 10).
+    if (options->max_scallop_um && (!surface || surface->band_lines == 0))
+      not_ok.push_back("--max-scallop " + common::shortNumber(*options->max_scallop_um) +
+                       " um not proven: no scallop measured (" +
+                       (surface ? std::string("no two neighbouring passes over the part")
+                                : std::string(surface_skipped)) +
+                       ")");
     if (options->max_scallop_um && surface) {
       const std::string bound = common::shortNumber(*options->max_scallop_um);
       const auto um = [](double v) {

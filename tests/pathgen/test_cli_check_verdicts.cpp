@@ -132,6 +132,7 @@ TEST(CheckVerdict, MaxScallopHoldsThePathToAFinish) {
   };
   dir.write("near.cl", passes(4.0));
   dir.write("far.cl", passes(10.0));
+  dir.write("one.cl", "# pass 1\n-10 0 0 0 0 1\n10 0 0 0 0 1\n");
   const double cusp_um = 1e3 * (3.0 - std::sqrt(9.0 - 4.0));
   struct Case {
     std::string path, option;
@@ -141,7 +142,10 @@ TEST(CheckVerdict, MaxScallopHoldsThePathToAFinish) {
   for (const Case& c : {Case{"near", "", true, ""}, Case{"near", "--max-scallop 800", true, ""},
                         Case{"near", "--max-scallop 700", false, "over --max-scallop 700 um"},
                         Case{"far", "", true, ""},
-                        Case{"far", "--max-scallop 5000", false, "lines between passes not cut"}}) {
+                        Case{"far", "--max-scallop 5000", false, "lines between passes not cut"},
+                        Case{"one", "", true, ""},
+                        Case{"one", "--max-scallop 5000", false,
+                             "--max-scallop 5000 um not proven: no scallop measured"}}) {
     const std::string out = c.path + (c.option.empty() ? "" : "_" + c.option.substr(14));
     const auto r = test::runFieldpath(
         dir, "check scene.yaml --path " + c.path + ".cl " + c.option + " --out " + out);
