@@ -328,7 +328,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                      "steered axis answers the "
                      "field over about %.3g mm of path (dynamics.feed, %.3g mm/s, times "
                      "sqrt(inertia / stiffness), %.3g s): a lower feed or inertia turns it sooner "
-                     "(the same steering at n times the feed with inertia / n^2; dynamics.feed is "
+                     "(the same steering at n times the feed with inertia / n^2 and a given "
+                     "damping / n; dynamics.feed is "
                      "also path.apt's FEDRAT; report.json solver.response_mm)\n",
                      under, job.dynamics.responseLengthMm(), job.dynamics.feed_mm_per_min / 60.0,
                      std::sqrt(job.dynamics.inertia / job.dynamics.stiffness));

@@ -104,7 +104,13 @@ void readDynamics(const Reader& r, const YAML::Node& node, dynamics::DynamicsPar
   r.expectMap(node, "dynamics",
               {"inertia", "damping", "stiffness", "feed", "rtol", "atol", "max_tilt_deg",
                "max_lead_deg", "on_limit", "integrator", "start"});
-  if (node["inertia"]) d.inertia = r.positive(node["inertia"], "dynamics.inertia");
+  const auto inRange = [](double v) {
+    return v >= common::kMinSpringConstant && v <= common::kMaxSpringConstant;
+  };
+  const auto constant = [&](const char* key) {
+    return r.number(node[key], std::string("dynamics.") + key, inRange, "from 1e-12 to 1e12");
+  };
+  if (node["inertia"]) d.inertia = constant("inertia");
   if (node["damping"]) {
     const YAML::Node damping = node["damping"];
     if (damping.IsScalar() && damping.Scalar() == "critical")
@@ -116,10 +122,10 @@ void readDynamics(const Reader& r, const YAML::Node& node, dynamics::DynamicsPar
              "expected a number >= 0 or `critical`, got '" + damping.Scalar() + "'");
     else
       d.damping = r.number(
-          node["damping"], "dynamics.damping", [](double v) { return v >= 0.0; },
-          ">= 0 or `critical`");
+          node["damping"], "dynamics.damping", [&](double v) { return v == 0.0 || inRange(v); },
+          "0, from 1e-12 to 1e12, or `critical`");
   }
-  if (node["stiffness"]) d.stiffness = r.positive(node["stiffness"], "dynamics.stiffness");
+  if (node["stiffness"]) d.stiffness = constant("stiffness");
   if (node["feed"])
     d.feed_mm_per_min = r.number(
         node["feed"], "dynamics.feed",

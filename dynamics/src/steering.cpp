@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <sstream>
@@ -469,10 +470,25 @@ SettledStart settleAtStart(const Pass& pass, const SteeringRequest& request) {
   const PassFrame first = pass.frameAt(0.0);
   Pass held;
   held.length_mm = 2.0 * request.params.inertia / c * v;
+  // A decay longer than kMaxSettleMm of path is no rest the pass could start from (damping
+  // 1e-300 ran an undamped swing over 1e300 s, never ending: a diff review's).
+  if (!(held.length_mm <= kMaxSettleMm)) {
+    char why[200];
+    std::snprintf(why, sizeof why,
+                  "the spring-damper decays over %.3g mm of path (2 inertia / damping at the "
+                  "feed), more than %.3g: no rest to start from (dynamics.damping)",
+                  held.length_mm, kMaxSettleMm);
+    out.why = why;
+    return out;
+  }
   held.frameAt = [first](double) { return first; };
   SteeringRequest run = request;
   run.output_s_mm.clear();
-  run.step_mm = std::min(request.step_mm, held.length_mm);
+  // At most kSettleStations a decay: inertia 1e10 over stiffness 1e-10 made a decay of 1.7e11 mm
+  // at the pass's 0.5 mm (out of memory after 49 s), 1e300 over 1e-300 a count past any index
+  // (a crash: a diff review's). The settling is not machined: its stations may stand apart.
+  run.step_mm =
+      std::max(std::min(request.step_mm, held.length_mm), held.length_mm / kSettleStations);
   run.initial_lead_rad = first.lead0_rad;
   run.initial_tilt_rad = first.tilt0_rad;
   run.initial_lead_rate_rad_per_s = run.initial_tilt_rate_rad_per_s = 0.0;

@@ -89,6 +89,29 @@ TEST(SettledStart, TheSwingToRestIsNotAFailure) {
   EXPECT_EQ(steerPass(pass, request).status, Status::Ok);
 }
 
+// A slow spring-damper settles over fewer stations than its decay holds steps (kSettleStations:
+// inertia 1e10 over stiffness 1e-10 ran out of memory after 49 s, a diff review's), to the same
+// rest; one whose decay runs past kMaxSettleMm of path has none to start from, and says so.
+TEST(SettledStart, ASlowDecayIsSettledInBoundedWork) {
+  const auto wall = wallAt(3.1);
+  SteeringRequest request = requestFor(wall.get());
+  request.params.inertia = 1e4;  // critical c = 2 sqrt(k J) = 200: a decay of 100 s, 1667 mm
+  request.step_mm = 0.5;
+  ASSERT_GT(2.0 * request.params.inertia / request.params.effectiveDamping() *
+                request.params.feed_mm_per_min / 60.0,
+            kSettleStations * request.step_mm);
+  const SettledStart slow = settleAtStart(straightPass(10.0), request);
+  ASSERT_TRUE(slow.settled) << slow.why;
+  EXPECT_NEAR(slow.tilt_rad, staticTilt(*wall, request.params.stiffness, 0.0, 0.6), 1e-6);
+
+  request.params.inertia = 1.0;
+  request.params.damping = 1e-9;  // a decay of 2e9 s
+  const SettledStart never = settleAtStart(straightPass(10.0), request);
+  EXPECT_FALSE(never.settled);
+  EXPECT_NE(never.why.find("no rest to start from (dynamics.damping)"), std::string::npos)
+      << never.why;
+}
+
 TEST(SettledStart, WithoutDampingThereIsNoRest) {
   const auto wall = wallAt(3.1);
   SteeringRequest request = requestFor(wall.get());

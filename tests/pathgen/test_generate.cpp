@@ -314,6 +314,26 @@ TEST(Generate, TenTimesTheFeedSteersAsAHundredthOfTheInertia) {
   EXPECT_GT(base_max, 3.0);             // the wall 1 mm off the ball turns the axis
   EXPECT_LT(same_deg, 1e-4);            // the same steering, to the solver's tolerances (3e-9 deg)
   EXPECT_GT(late_deg, 0.3 * base_max);  // ten times the feed alone: another path
+
+  // A given damping c: J v^2 θ'' + c v θ' + k θ holds with c / n too (the note said inertia / n^2
+  // alone: 3.4 deg apart with damping 2, a diff review's).
+  GenerateRequest damped = job;
+  damped.dynamics.damping = 2.0;
+  GenerateRequest damped_scaled = scaled;
+  damped_scaled.dynamics.damping = 0.2;
+  GenerateRequest damped_unscaled = scaled;
+  damped_unscaled.dynamics.damping = 2.0;
+  const GenerateResult d0 = generatePath(damped), d1 = generatePath(damped_scaled),
+                       d2 = generatePath(damped_unscaled);
+  double scaled_deg = 0.0, unscaled_deg = 0.0;
+  for (std::size_t i = 0; i < d0.postures.size(); ++i) {
+    scaled_deg = std::max(scaled_deg, std::abs(d1.postures[i].tilt_rad - d0.postures[i].tilt_rad));
+    unscaled_deg =
+        std::max(unscaled_deg, std::abs(d2.postures[i].tilt_rad - d0.postures[i].tilt_rad));
+  }
+  EXPECT_LT(scaled_deg * 180.0 / M_PI, 0.01);  // 8e-4 deg: the lighter damping swings, the
+                                               // solver's tolerances tell more
+  EXPECT_GT(unscaled_deg * 180.0 / M_PI, 0.1) << unscaled_deg * 180.0 / M_PI;
 }
 
 // A pass on a floor, its axis leaning 30 deg toward a shelf 15-20 mm up: the tool's top clears

@@ -28,6 +28,12 @@ inline constexpr double kMaxCoordinateMm = 1e6;
 inline constexpr double kMinFeedMmPerMin = 1e-3;
 inline constexpr double kMaxFeedMmPerMin = 1e6;
 
+/// The spring-damper's constants (`dynamics.inertia`, `stiffness`, `damping`) within these: their
+/// ratios set the steering's time scale, and 1e300 over 1e-300 made it infinite (a crash, then
+/// a settling that never ended: a diff review's). The tests' stiffest case is inertia 1e-12.
+inline constexpr double kMinSpringConstant = 1e-12;
+inline constexpr double kMaxSpringConstant = 1e12;
+
 /// Beyond this distance from the origin (mm) a float's step passes 1 um (2^13 mm: 0.98 um): where
 /// single-precision files (meshes read, STL written) stop carrying micron figures.
 inline constexpr double kFloatExactMm = 8192.0;

@@ -101,6 +101,13 @@ struct SteeringResult {
 /// common::Interrupted when the progress hook asks to stop; numerical outcomes are in `status`.
 SteeringResult steerPass(const Pass& pass, const SteeringRequest& request);
 
+/// The most stations settleAtStart integrates a decay time over (its step widened past the pass's
+/// where the decay is longer than this many of them).
+inline constexpr double kSettleStations = 2000.0;
+/// A decay time longer than this much path (mm, at the feed) is not settled: the pass starts from
+/// the nominal axis and settleAtStart says why.
+inline constexpr double kMaxSettleMm = 1e5;
+
 /// The axis at rest at a pass's start (DynamicsParams::start): the pass's first frame held while
 /// the spring-damper runs from the nominal angles at rest, one decay time 2J/c after another
 /// (c the spring's; `critical` adds the field's stiffness, which only shortens the decay; with
