@@ -141,7 +141,7 @@ const char* surfaceSkipped(const SurfaceFacts& f) {
     return "the ball reaches the part where the Z-buffer, looking down, lowers no line (a wall "
            "or an undercut): its gouges are cutter_part's, its scallop is not measured";
   if (f.never_cut)
-    return "the tool never cuts the stock over the part (no line lowered): is the part in the "
+    return "the tool never cuts the stock over the part (no line over it lowered): is the part in the "
            "path's frame and units?";
   if (!f.surface) return "the passes do not pass over the part (`part` mesh)";
   return nullptr;
@@ -169,6 +169,7 @@ json surfaceJson(const SurfaceResult& s) {
       {"sweep_error_um", s.sweep_error_um},
       {"simulated_postures", s.simulated_postures},
       {"cut_lines", s.cut_lines},
+      {"part_cut_lines", s.part_cut_lines},
       {"beneath_lines", s.beneath_lines},
       {"beneath_unmeasured_lines", s.beneath_unmeasured},
       {"beneath",
@@ -339,7 +340,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     }
     // A path that never cuts the stock over the part (another frame or units, a path over
     // another part) left only the stock's figures: 2000 um of 'scallop' and ok read as a check.
-    const bool never_cut = surface && surface->cut_lines == 0;
+    const bool never_cut = surface && surface->part_cut_lines == 0;
     if (never_cut) surface.reset();
     // The cutter entering the part is no path in another frame (a side cut under the stock's
     // lines asked 'is the part in the path's frame?' while cutter_part read its 9.9 um).

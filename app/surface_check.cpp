@@ -445,6 +445,7 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
     const double cos_slope = double(reference_nz[i]);
     const double d = result.deviation_um[i];
     ++result.part_lines;
+    result.part_cut_lines += result.lowered[i] != 0;
     min_dev = std::min(min_dev, d);
     result.gouged_lines += d < -request.gouge_tolerance_um;
     if (!result.in_band[i]) continue;

@@ -71,7 +71,11 @@ struct SurfaceResult {
   /// cutting edge's curvature: a ball's R, a torus's corner r).
   double sweep_step_mm = 0, sweep_error_um = 0;
   std::size_t simulated_postures = 0;  ///< the path's and the interpolated ones
-  std::size_t cut_lines = 0;           ///< lines the tool lowered (0: it never reached the part)
+  std::size_t cut_lines = 0;           ///< lines the tool lowered, over the part or not
+  /// Lines over the part the tool lowered (0: it never cut the stock over the part: a path in
+  /// inches whose tips fell in the bore of a hub lowered 179 981 lines, none over the part, and
+  /// read `ok`).
+  std::size_t part_cut_lines = 0;
   /// Lines the tool reached beneath the layer of the part's top (under an overhang, or through
   /// the part): measured against the top of the part under that layer, if any
   /// (`beneath_unmeasured` have none: not measured, as lines off the part).

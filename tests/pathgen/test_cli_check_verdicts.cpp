@@ -181,6 +181,42 @@ TEST(CheckVerdict, MaxScallopHoldsThePathToAFinish) {
   }
 }
 
+// A part with a bore: passes 25.4 times too small (a path in inches read as mm) fall inside it,
+// where the Z-buffer lowers lines over no part. The check read them as cut ("0 lines in the
+// band", `ok`: a fault injection's); only lines over the part count as the part cut. The same
+// passes at their size run over the ring's top: cut, and ok.
+TEST(CheckVerdict, PassesThatCutOnlyInsideABoreDoNotFinishThePart) {
+  const TempDir dir;
+  // A bore 7 mm square; the passes 1 mm over the part's top: in the bore the ball lowers the
+  // stock's lines (2 mm over the top), over the ring's edge (the ball's reach) it stays above them.
+  pathgen::test::writeBoxPartScene(dir, {{-40, 40, -40, -3.5, -10, 0},
+                                         {-40, 40, 3.5, 40, -10, 0},
+                                         {-40, -3.5, -3.5, 3.5, -10, 0},
+                                         {3.5, 40, -3.5, 3.5, -10, 0}});
+  const auto pass = [](double scale) {
+    std::string cl = "# pass 1\n";
+    for (int i = -10; i <= 10; ++i)
+      cl += std::to_string(2.5 * i * scale) + " " + std::to_string(25.0 * scale) + " 1 0 0 1\n";
+    return cl;
+  };
+  dir.write("mm.cl", pass(1.0));
+  dir.write("inch.cl", pass(1.0 / 25.4));
+  for (const auto& [path, ok] : {std::pair{"mm", true}, {"inch", false}}) {
+    const auto r = test::runFieldpath(
+        dir, std::string("check scene.yaml --path ") + path + ".cl --out " + path);
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    const nlohmann::json check = checkJson(dir, path);
+    EXPECT_EQ(check["ok"].get<bool>(), ok) << path << ": " << check["not_ok_because"];
+    if (!ok) {
+      EXPECT_TRUE(says(check["not_ok_because"], "is the part in the path's frame and units?"))
+          << check["not_ok_because"];
+      EXPECT_TRUE(check["surface"].is_null()) << check["surface"];
+    } else {
+      EXPECT_GT(check["surface"]["part_cut_lines"].get<int>(), 0) << check["surface"];
+    }
+  }
+}
+
 // A 400 mm square part at a 0.02 mm spacing is 4 · 10^8 lines: the grid is coarsened to the
 // largest the check makes, and says so (check.json and stdout).
 TEST(CheckVerdict, AFineSpacingOverALargePartIsCoarsenedAndSaid) {
