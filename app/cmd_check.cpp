@@ -141,7 +141,8 @@ const char* surfaceSkipped(const SurfaceFacts& f) {
     return "the ball reaches the part where the Z-buffer, looking down, lowers no line (a wall "
            "or an undercut): its gouges are cutter_part's, its scallop is not measured";
   if (f.never_cut)
-    return "the tool never cuts the stock over the part (no line over it lowered): is the part in the "
+    return "the tool never cuts the stock over the part (no line over it lowered): is the part in "
+           "the "
            "path's frame and units?";
   if (!f.surface) return "the passes do not pass over the part (`part` mesh)";
   return nullptr;
