@@ -367,12 +367,16 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     std::vector<std::string> not_ok = unsafe;
     if (const std::string gouge = cutterGougeReason(path, cutter_part); !gouge.empty())
       not_ok.push_back(gouge);
+    // Each with where it is first, as the collisions are (a fault injection's: the verdict named
+    // no posture, stdout's lines and check.json's fields did).
     if (clearance.colliding == 0 && clearance.min_clearance_mm < scene.clearance_mm)
       not_ok.push_back("postures come within " + std::to_string(clearance.min_clearance_mm) +
-                       " mm of the obstacles, under the required clearance");
+                       " mm of the obstacles, under the required clearance (lowest: " +
+                       postureWhere(path, clearance.min_index) + ")");
     if (motions.colliding == 0 && motions.under_required > 0)
       not_ok.push_back(std::to_string(motions.under_required) +
-                       " motions come under the required clearance");
+                       " motions come under the required clearance (first: " +
+                       motionWhere(path, motions.first_under_required) + ")");
     // A part given and never reached: the machined surface is unproven, most likely a path in
     // other units or another frame (a helper's inch file 165 mm from its part read `ok: true`).
     const bool part_never_reached = scene.part && !surface && !touches_part && !reaches_part;

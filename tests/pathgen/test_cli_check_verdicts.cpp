@@ -59,6 +59,13 @@ TEST(CheckVerdict, PosturesAndMotionsUnderTheClearanceAreNotOk) {
       EXPECT_EQ(says(check["not_ok_because"], reason), clearance == 0.5)
           << path << " " << clearance << ": " << check["not_ok_because"];
       EXPECT_EQ(check["ok"].get<bool>(), clearance != 0.5) << path << " " << clearance;
+      // Named where, as a collision is: the ball's 1.6 mm off the ridge at every posture (the
+      // first lowest), the move over its top from the first posture.
+      if (clearance == 0.5)
+        EXPECT_TRUE(says(check["not_ok_because"],
+                         path == "beside" ? "(lowest: posture 0 (pass 1, beside.cl:2))"
+                                          : "(first: posture 0 to the next (pass 1, over.cl:2))"))
+            << check["not_ok_because"];
       EXPECT_NE(r.out.find(clearance == 0.5 ? "check: NOT OK" : "check: ok"), std::string::npos)
           << r.out;
     }
