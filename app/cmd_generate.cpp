@@ -147,7 +147,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                     ->check(positiveFinite("mm"));
   direct->excludes(voxel);
   cmd->add_option("--backend", options->backend,
-                  "Where the voxel nodes are computed: auto | cpu | cuda (default: the scene's "
+                  "Where the voxel nodes are computed: auto | cpu | cuda | reference (the "
+                  "per-node build the others are checked against; default: the scene's "
                   "field.backend)")
       ->check(CLI::IsMember({"auto", "cpu", "cuda", "reference"}))
       ->excludes(direct);

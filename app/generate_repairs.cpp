@@ -104,15 +104,23 @@ void printRepairs(const pathgen::GenerateResult& result, double links_retract_mm
                    n, n == 1 ? "" : "s", n == 1 ? "s" : "", links_retract_mm, lowest->retract_mm,
                    lowest->into ? "into" : "out of", lowest->label.c_str(), n == 1 ? "it" : "them");
   }
+  // A retract of a few microns starts every way up within the part's contact tolerance of the
+  // pass: 12 ends of the impeller unfreed at 0.001 mm, all freed at 0.05 (a links adversary's).
+  char short_retract[160] = "";
+  if (links_retract_mm < 1.0)
+    std::snprintf(short_retract, sizeof short_retract,
+                  "; or give a longer links.retract (%.3g mm: a way up that starts that near "
+                  "the pass may read as touching the part)",
+                  links_retract_mm);
   if (!result.unfreed_link_ends.empty())
     std::fprintf(stderr,
                  "note: %zu link end%s collide or come under the clearance whichever straight way "
                  "up from the pass, the axis held, is taken (first: %s): generate makes its links "
                  "anew from the passes (a nominal path's `# link` blocks are dropped), so edit "
-                 "that link in the written path.cl by hand and `check` it (report.json "
+                 "that link in the written path.cl by hand and `check` it%s (report.json "
                  "links.unfreed)\n",
                  result.unfreed_link_ends.size(), result.unfreed_link_ends.size() == 1 ? "" : "s",
-                 result.unfreed_link_ends.front().c_str());
+                 result.unfreed_link_ends.front().c_str(), short_retract);
   if (result.routed_link_ends_undone > 0)
     std::fprintf(stderr,
                  "note: %zu link end%s cleared off the pass's axis, but the path linked that way "

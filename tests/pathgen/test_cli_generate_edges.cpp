@@ -539,3 +539,35 @@ TEST(GenerateEdges, AMoveSidewaysUnderTheRetractIsWarned) {
         << r.err;
   }
 }
+
+// Link ends no way up frees (under a shelf 100 mm wide): a note names the first and says to
+// edit the written path.cl; where links.retract is short it also says a longer one may free
+// them (a links adversary's: 12 ends unfreed at 0.001 mm, all freed at 0.05).
+TEST(GenerateEdges, UnfreedLinkEndsAreNamedWithWhatMayFreeThem) {
+  const TempDir dir;
+  geometry::TriangleMesh floor, shelf;
+  pathgen::test::addBox(floor, -20, 30, -20, 20, -10, 0);
+  pathgen::test::addBox(shelf, -50, 60, -50, 50, 20, 25);
+  geometry::saveMesh(floor, dir.path() / "floor.stl");
+  geometry::saveMesh(shelf, dir.path() / "shelf.stl");
+  std::string cl = "# pass 1\n";
+  for (int k = 0; k <= 20; ++k) cl += std::to_string(0.5 * k) + " 0 0 0 0 1\n";
+  dir.write("pass.cl", cl);
+  for (const double retract : {0.5, 5.0}) {
+    dir.write("scene.yaml",
+              "obstacles:\n  - mesh: shelf.stl\npart: floor.stl\n"
+              "tool: { shape: ball, radius: 3, length: 12 }\nclearance: 0.5\n"
+              "path: { nominal: pass.cl }\nlinks: { retract: " +
+                  std::to_string(retract) + " }\n");
+    const auto r = test::runFieldpath(dir, "generate scene.yaml --nominal --out out");
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    EXPECT_NE(r.err.find("note: 2 link ends collide or come under the clearance whichever "
+                         "straight way up from the pass, the axis held, is taken (first: the "
+                         "way into pass 1 (pass.cl:2))"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.err.find("or give a longer links.retract (0.5 mm") != std::string::npos,
+              retract < 1.0)
+        << r.err;
+  }
+}
