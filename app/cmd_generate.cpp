@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -103,9 +104,26 @@ std::string farLinkNote(const Scene& scene, const pathgen::GenerateResult& resul
     if (g.output < at) before = index;
     if (g.output > at && after < 0) after = index;
   }
+  // The farthest posture tops one of the link's two climbs (the travel between them is straight
+  // in x-y): the way out of the pass before up to the first posture at the travel plane, or the
+  // way into the one after from the last. Only that end's way is named (a diff review's: a
+  // climb along the next pass's own axis was blamed on the way out of the last, rerouted).
+  bool out_of_before = true;
+  for (const geometry::PathBlock& block : path.blocks) {
+    if (block.kind != geometry::PathBlock::Kind::Link || at < block.begin || at >= block.end)
+      continue;
+    double top_mm = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = block.begin; i < block.end; ++i)
+      top_mm = std::max(top_mm, path.postures[i].tip_mm.z());
+    std::size_t first_top = block.end;
+    for (std::size_t i = block.begin; i < block.end && first_top == block.end; ++i)
+      if (path.postures[i].tip_mm.z() >= top_mm - 1e-6) first_top = i;
+    out_of_before = at <= first_top;
+  }
   const pathgen::GenerateResult::RoutedLinkEnd* routed = nullptr;
   for (const auto& end : result.routed_link_ends)
-    if ((!end.into && end.pass == before) || (end.into && end.pass == after)) routed = &end;
+    if (out_of_before ? (!end.into && end.pass == before) : (end.into && end.pass == after))
+      routed = &end;
   std::ostringstream note;
   note << std::fixed;
   note.precision(0);

@@ -571,3 +571,42 @@ TEST(GenerateEdges, UnfreedLinkEndsAreNamedWithWhatMayFreeThem) {
         << r.err;
   }
 }
+
+// The far link's note names the end whose climb runs far: here the way into pass 2 along its own
+// 70 deg axis, not rerouted, while the way out of pass 1 (under a shelf) was rerouted; the note
+// blamed the rerouted end and dropped the advice of a steeper axis (a diff review's).
+TEST(GenerateEdges, AFarLinkIsTheEndWhoseClimbRunsFar) {
+  const TempDir dir;
+  geometry::TriangleMesh floor, shelf;
+  pathgen::test::addBox(floor, -20, 80, -20, 20, -10, 0);
+  pathgen::test::addBox(shelf, -50, 25, -50, 10, 14, 25);
+  geometry::saveMesh(floor, dir.path() / "floor.stl");
+  geometry::saveMesh(shelf, dir.path() / "shelf.stl");
+  const double t = 70.0 * M_PI / 180.0;
+  std::ostringstream cl;
+  cl << "# pass 1\n";
+  for (int k = 0; k <= 20; ++k) cl << 0.5 * k << " 0 0 0 0 1\n";
+  cl << "# pass 2\n";
+  for (int k = 0; k <= 20; ++k)
+    cl << "60 " << 10 - 0.5 * k << ' ' << 3 - 3 * std::cos(t) << ' ' << std::sin(t) << " 0 "
+       << std::cos(t) << "\n";
+  dir.write("p.cl", cl.str());
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: shelf.stl\npart: floor.stl\n"
+            "tool: { shape: ball, radius: 3, length: 12 }\nclearance: 0.5\n"
+            "path: { nominal: p.cl }\nlinks: { retract: 2 }\n");
+  const auto r = test::runFieldpath(dir, "generate scene.yaml --nominal --out out");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out/report.json"));
+  bool out_of_1_routed = false;
+  for (const auto& end : report["links"]["routed_off_axis"])
+    out_of_1_routed |= end["pass"] == 1 && end["end"] == "out of";
+  EXPECT_TRUE(out_of_1_routed) << report["links"]["routed_off_axis"];
+  ASSERT_EQ(report["link_notes"].size(), 1u) << report["link_notes"];
+  const std::string note = report["link_notes"][0];
+  EXPECT_NE(note.find("the links climb along the tool axis to the travel plane: posture "),
+            std::string::npos)
+      << note;
+  EXPECT_NE(note.find("(the link into pass 2, "), std::string::npos) << note;
+  EXPECT_NE(note.find("a steeper axis at the pass ends"), std::string::npos) << note;
+}
