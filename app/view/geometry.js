@@ -100,8 +100,7 @@ var fpGeometry = (function() {
     var COLOURS = [0xe45756, 0x54a24b, 0x4c78a8], NAMES = ['x', 'y', 'z'];
     var labelSize = step * 0.32;
     for (var k = 0; k < 3; ++k) {
-      var dir = new THREE.Vector3(), tickDir = new THREE.Vector3();
-      dir.setComponent(k, 1);
+      var tickDir = new THREE.Vector3();
       tickDir.setComponent(k === 0 ? 1 : 0, -1);
       var start = o.getComponent(k), pts = [];
       var a = o.clone(), b = o.clone();
