@@ -60,6 +60,16 @@ void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>
     int obstacle = -1;
     const double d = checker.ballClearance(centres, ball_radius_mm, &at, &obstacle, clearance_mm);
     if (d <= 0.0) {
+      // Named where the ball first enters, not where it is deepest (a pass entering a wall at
+      // line 37 was named at its line 42): the stations before that one, one at a time.
+      for (std::size_t i = 0; i < at; ++i) {
+        int entered = -1;
+        if (checker.ballClearance(std::span(&centres[i], 1), ball_radius_mm, nullptr, &entered,
+                                  1.0) <= 0.0) {  // exact under 1 mm
+          at = i, obstacle = entered;
+          break;
+        }
+      }
       std::ostringstream msg;
       const double s_mm = pass.samples[at].s_mm;
       msg << pass.label << ": at s = " << s_mm << " mm";

@@ -42,7 +42,8 @@ TEST(GenerateEdges, ABallWithinTheClearanceIsWrittenAndMarkedOneInsideIsRefused)
     return cl.str();
   };
   dir.write("near.cl", pass(6.7));    // the ball 0.3 mm from the wall's face x = 10
-  // Into it from the middle on, deepest (0.1 mm) at the last posture, line 42 of the file.
+  // Into it from the middle on: the ball's side reaches the wall's face at line 37 of the file
+  // (x 6.7 + 0.3), deepest (0.1 mm) at the last posture, line 42.
   {
     std::ostringstream cl;
     cl << "# pass 1\n";
@@ -72,8 +73,9 @@ TEST(GenerateEdges, ABallWithinTheClearanceIsWrittenAndMarkedOneInsideIsRefused)
 
   const auto inside = test::runFieldpath(dir, "generate inside.yaml --out inside");
   EXPECT_EQ(inside.exit_code, 1) << inside.output();
-  // Named where it enters: the input's line there, not the pass's first (a helper's).
-  EXPECT_NE(inside.err.find("(inside.cl:42) the ball touches or enters obstacle 1"),
+  // Named where it enters: the input's line there, not the pass's first (a helper's) nor where
+  // it is deepest.
+  EXPECT_NE(inside.err.find("(inside.cl:37) the ball touches or enters obstacle 1"),
             std::string::npos)
       << inside.err;
   EXPECT_FALSE(fs::exists(dir.path() / "inside/path.cl"));
