@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "check_surface_report.h"
 #include "commands.h"
 #include "cutter_note.h"
 #include "errors.h"
@@ -120,90 +121,6 @@ std::string clearanceCsv(const geometry::PathFile& path, const pathgen::Clearanc
     }
   }
   return csv.str();
-}
-
-/// What `check` learned of the surface and the part, for surfaceSkipped.
-struct SurfaceFacts {
-  bool part = false;          ///< the scene has a part
-  bool surface = false;       ///< a surface was measured
-  bool never_cut = false;     ///< the Z-buffer lowered no line over the part
-  bool touches_part = false;  ///< the cutter enters the part (cutter_part)
-  bool reaches_part = false;  ///< the ball comes within kReachesPartMm of it
-};
-
-/// Why the surface was not checked (nullptr: it was), as check.json's surface_skipped says it.
-const char* surfaceSkipped(const SurfaceFacts& f) {
-  if (!f.part) return "the scene has no `part`";
-  if (f.never_cut && f.touches_part)
-    return "the tool lowers no line of the stock over the part (it enters the part where no "
-           "line falls: cutter_part)";
-  if (!f.surface && f.reaches_part)
-    return "the ball reaches the part where the Z-buffer, looking down, lowers no line (a wall "
-           "or an undercut): its gouges are cutter_part's, its scallop is not measured";
-  if (f.never_cut)
-    return "the tool never cuts the stock over the part (no line over it lowered): is the part in "
-           "the "
-           "path's frame and units?";
-  if (!f.surface) return "the passes do not pass over the part (`part` mesh)";
-  return nullptr;
-}
-
-json surfaceJson(const SurfaceResult& s) {
-  auto scallop = [&s](double um) { return s.band_lines > 0 ? json(um) : json(nullptr); };
-  return {
-      {"grid",
-       {{"origin", {s.grid.x0_mm, s.grid.y0_mm}},
-        {"spacing", {s.grid.dx_mm, s.grid.dy_mm}},
-        {"shape", {s.grid.ny, s.grid.nx}}}},
-      {"spacing_coarsened", s.coarsened},
-      {"deviation",
-       "along the part's normal, um: a line's machined height less the part's, times the "
-       "cosine of the slope of the part's facet under it (exact over a plane facet)"},
-      {"backend", zbuffer::backendName(s.backend)},
-      {"simulation_s", s.simulation_s},
-      {"swept",
-       "the Z-buffer cuts at the postures and along every motion between them that can reach "
-       "the stock (tip and axis interpolated linearly, no point of the tool moving more than "
-       "sweep_step_mm between cuts; a ball's cut between two is at most sweep_error_um "
-       "shallower than the swept one)"},
-      {"sweep_step_mm", s.sweep_step_mm},
-      {"sweep_error_um", s.sweep_error_um},
-      {"simulated_postures", s.simulated_postures},
-      {"cut_lines", s.cut_lines},
-      {"part_cut_lines", s.part_cut_lines},
-      {"beneath_lines", s.beneath_lines},
-      {"beneath_unmeasured_lines", s.beneath_unmeasured},
-      {"beneath",
-       "lines the tool reached beneath the underside of the part's top layer (under an "
-       "overhang, or through the part): a line keeps the tool's lowest point only, which says "
-       "nothing of that layer there; they are measured against the highest top of the part under "
-       "the lowest underside above the cut (beneath_unmeasured_lines: none, not measured); the "
-       "layer's underside is the cutter "
-       "test's (cutter_part, exact)"},
-      {"part_lines", s.part_lines},
-      {"band_lines", s.band_lines},
-      {"uncut_band_lines", s.uncut_band_lines},
-      {"uncut_band",
-       "lines between two passes that no pass cut (passes farther apart than the tool reaches): "
-       "the stock allowance stands there; not in band_lines nor the scallop figures"},
-      {"gouged_lines", s.gouged_lines},
-      {"gouge_tolerance_um", s.gouge_tolerance_um},
-      {"max_gouge_um", s.max_gouge_um},
-      // No band (a lone pass, passes too far apart to be neighbours): no scallop to tell.
-      {"max_scallop_um", scallop(s.max_scallop_um)},
-      {"scallop_grid_error_um",
-       std::isfinite(s.scallop_grid_error_um) ? scallop(s.scallop_grid_error_um) : json(nullptr)},
-      {"scallop_grid_error",
-       "the lines may miss the highest cusp: it may stand up to scallop_grid_error_um above "
-       "max_scallop_um (each cusp within spacing/sqrt(2) of a line, the cutting edge's slope "
-       "there over the part's; null: a band line on a wall of 85 deg or more, where vertical "
-       "lines bound no cusp)"},
-      {"scallop_skipped", s.band_lines > 0 ? json(nullptr)
-                                           : json("no two neighbouring passes: a scallop is "
-                                                  "what is left between them")},
-      {"mean_deviation_um", scallop(s.mean_um)},
-      {"rms_deviation_um", scallop(s.rms_um)},
-      {"stock_allowance_mm", kStockAllowanceMm}};
 }
 
 }  // namespace
@@ -382,44 +299,10 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     const bool part_never_reached = scene.part && !surface && !touches_part && !reaches_part;
     if (part_never_reached)
       not_ok.push_back(std::string("the surface is not checked: ") + surface_skipped);
-    // The finish, where the user gives one: a check `ok` with 2 mm of stock between passes (a
-    // tool too small for the passes' spacing) read as a finished part (a helper's).
-    // The lines sample the surface: a cusp between them may stand up to the grid error higher,
-    // so the finish holds only where the measured scallop plus that bound keeps under it (a
-    // measured 457 um with 24 um between the lines read ok under 460).
-    // A finish asked and no scallop measured (one pass, no part, nothing the lines see) is not
-    // held either: `ok` read as the finish proven (a diff review's: one pass, --max-scallop 10).
-    if (options->max_scallop_um && (!surface || surface->band_lines == 0))
-      not_ok.push_back("--max-scallop " + common::shortNumber(*options->max_scallop_um) +
-                       " um not proven: no scallop measured (" +
-                       (surface ? std::string("no two neighbouring passes over the part")
-                                : std::string(surface_skipped)) +
-                       ")");
-    if (options->max_scallop_um && surface) {
-      const std::string bound = common::shortNumber(*options->max_scallop_um);
-      const auto um = [](double v) {
-        return std::to_string(static_cast<long long>(std::lround(v)));
-      };
-      if (surface->band_lines > 0 && surface->max_scallop_um > *options->max_scallop_um)
-        not_ok.push_back("max scallop " + um(surface->max_scallop_um) + " um, over --max-scallop " +
-                         bound + " um");
-      else if (surface->band_lines > 0 && !std::isfinite(surface->scallop_grid_error_um))
-        not_ok.push_back("max scallop " + um(surface->max_scallop_um) +
-                         " um on the lines, a cusp between them on a wall of 85 deg or more not "
-                         "bounded: --max-scallop " +
-                         bound + " um not proven");
-      else if (surface->band_lines > 0 &&
-               surface->max_scallop_um + surface->scallop_grid_error_um > *options->max_scallop_um)
-        not_ok.push_back("max scallop " + um(surface->max_scallop_um) +
-                         " um on the lines, a cusp between them up to " +
-                         um(surface->max_scallop_um + surface->scallop_grid_error_um) +
-                         " um: over --max-scallop " + bound + " um unless a finer --spacing " +
-                         "bounds it under");
-      if (surface->uncut_band_lines > 0)
-        not_ok.push_back(std::to_string(surface->uncut_band_lines) +
-                         " lines between passes not cut (the stock stands there; --max-scallop " +
-                         common::shortNumber(*options->max_scallop_um) + " um)");
-    }
+    // The finish, where the user gives one (finishReasons).
+    for (std::string& reason :
+         finishReasons(surface ? &*surface : nullptr, options->max_scallop_um, surface_skipped))
+      not_ok.push_back(std::move(reason));
     if (surface && surface->gouged_lines > 0)
       not_ok.push_back(std::to_string(surface->gouged_lines) + " Z-buffer lines cut below the part "
                        "by more than the gouge tolerance (max " +
@@ -531,23 +414,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       std::printf("limits: %zu postures held at an angle limit, %zu of them colliding\n",
                   path.limited.size(), limited_colliding);
     if (surface) {
-      char scallop[160] = "no scallop (no two neighbouring passes)";
-      if (surface->band_lines > 0 && std::isfinite(surface->scallop_grid_error_um))
-        std::snprintf(scallop, sizeof scallop,
-                      "max scallop %.1f um (a cusp between the lines up to %.1f um more), rms "
-                      "%.1f um",
-                      surface->max_scallop_um, surface->scallop_grid_error_um, surface->rms_um);
-      else if (surface->band_lines > 0)
-        std::snprintf(scallop, sizeof scallop,
-                      "max scallop %.1f um (a cusp between the lines on a wall of 85 deg or "
-                      "more: not bounded), rms %.1f um",
-                      surface->max_scallop_um, surface->rms_um);
-      std::printf(
-          "surface: %zu lines in the band, max gouge %.2f um (%zu lines below %.1f um), "
-          "%s (%s, %.2f s)\n",
-          surface->band_lines, surface->max_gouge_um, surface->gouged_lines,
-          -surface->gouge_tolerance_um, scallop, zbuffer::backendName(surface->backend),
-          surface->simulation_s);
+      std::printf("%s\n", surfaceLine(*surface).c_str());
       if (surface->uncut_band_lines > 0)
         std::fprintf(stderr,
                      "warning: %zu lines between passes were not cut: passes there lie farther "
