@@ -62,7 +62,8 @@ nlohmann::json surfaceJson(const SurfaceResult& s) {
       {"band_lines", s.band_lines},
       {"uncut_band_lines", s.uncut_band_lines},
       {"uncut_band",
-       "lines between two passes that no pass cut (passes farther apart than the tool reaches): "
+       "lines between two passes that no pass cut (passes farther apart than the tool reaches, or "
+       "running more than the stock allowance over the part): "
        "the stock allowance stands there; not in band_lines nor the scallop figures"},
       {"gouged_lines", s.gouged_lines},
       {"gouge_tolerance_um", s.gouge_tolerance_um},

@@ -351,6 +351,10 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                                                    ? json(path.where(path.limited.front()))
                                                    : json(nullptr)}})}}},
         {"surface", surface ? surfaceJson(*surface) : json(nullptr)},
+        // The file's passes (from 1) whose ball stays past far_from_part_mm at every posture (a
+        // ball end mill and a part): they cut nothing.
+        {"far_passes", contacts.ball_part_mm ? json(contacts.far_passes) : json(nullptr)},
+        {"far_from_part_mm", pathgen::farFromPartMm(scene.tool.radius_mm)},
         {"max_scallop_um",
          options->max_scallop_um ? json(*options->max_scallop_um) : json(nullptr)},
         {"surface_skipped", surface_skipped ? json(surface_skipped) : json(nullptr)},
@@ -418,7 +422,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       if (surface->uncut_band_lines > 0)
         std::fprintf(stderr,
                      "warning: %zu lines between passes were not cut: passes there lie farther "
-                     "apart than the tool reaches, and the stock stands between them "
+                     "apart than the tool reaches, or run more than the stock allowance (2 mm) "
+                     "over the part, and the stock stands there "
                      "(check.json surface.uncut_band_lines; sand on deviation.png)\n",
                      surface->uncut_band_lines);
     } else
@@ -456,6 +461,11 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                    options->spacing_mm, surface->grid.dx_mm);
     if (rapids_onto_passes > 0)
       std::fprintf(stderr, "warning: %s (check.json unsafe)\n", unsafe.back().c_str());
+    if (const std::string far =
+            farPassesWarning(path, contacts.far_passes, contacts.far_pass_first_posture,
+                             pathgen::farFromPartMm(scene.tool.radius_mm));
+        !far.empty())
+      std::fprintf(stderr, "warning: %s (check.json far_passes)\n", far.c_str());
     if (part_never_reached)
       std::fprintf(stderr,
                    "warning: the path never reaches the part (%s): is the part in the path's "

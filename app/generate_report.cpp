@@ -113,7 +113,9 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"ball_part", r.ball_part_mm
                         ? json{{"min_mm", *r.ball_part_mm},  // a lower bound at or past far_mm
                                {"far_mm", pathgen::farFromPartMm(job.tool.radius_mm)},
-                               {"reaches", *r.ball_part_mm <= pathgen::kReachesPartMm}}
+                               {"reaches", *r.ball_part_mm <= pathgen::kReachesPartMm},
+                               // the path's passes (from 1) whose ball stays past far_mm
+                               {"far_passes", r.far_passes}}
                         : json(nullptr)},
       {"cutter_part_skipped",
        r.cutter_part ? json(nullptr) : json("no `part` in the scene, or a flat end")},

@@ -356,6 +356,24 @@ inline nlohmann::json dogLegJson(const pathgen::DogLegRapids& d) {
           {"lowest_box_mm", d.unproven ? nlohmann::json(d.lowest_box_mm) : nlohmann::json()}};
 }
 
+/// The warning where some passes, not all, keep the ball farther than `far_mm` from the part at
+/// every posture (empty otherwise; all of them is the path's own warning): they cut nothing, most
+/// often passes beside a part turned or offset, or a path in other units (a units adversary's:
+/// a part turned 90 deg under a raster left 22 of 31 passes beside it, unsaid).
+inline std::string farPassesWarning(const geometry::PathFile& path,
+                                    const std::vector<std::size_t>& far_passes,
+                                    std::size_t first_posture, double far_mm) {
+  const std::size_t passes = path.count(geometry::PathBlock::Kind::Pass);
+  if (far_passes.empty() || far_passes.size() >= passes) return {};
+  char far[32];
+  std::snprintf(far, sizeof far, "%.3g", far_mm);
+  return std::to_string(far_passes.size()) + " of the " + std::to_string(passes) +
+         " passes keep the ball more than " + far +
+         " mm from the part at every posture (first: " + postureWhere(path, first_posture) +
+         "): they cut nothing there. Passes beside the part: is it turned or offset from the "
+         "path's frame, or in other units?";
+}
+
 /// The note where some rapids are proven clear of the obstacles only as straight moves, or where
 /// the scene has a part, which the bound leaves out (empty otherwise): a controller whose rapids
 /// are not linear may leave them (a machine-side helper's dog-leg of the impeller's retract came

@@ -192,14 +192,24 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
     out.links = checkLinksAgainstPart(whole, grazingPartChecker(tool, holder, model), path,
                                       common::scaled(progress, 0.2, 0.3, "links vs part"));
   if (tool.shape == geometry::ToolShape::Ball) {
-    std::vector<Vec3> centres;
-    for (const geometry::PathBlock& block : path.blocks)
-      if (block.kind == geometry::PathBlock::Kind::Pass)
-        for (std::size_t i = block.begin; i < block.end; ++i)
-          centres.push_back(geometry::ballCentre(path.postures[i], tool.radius_mm));
-    if (!centres.empty())
-      out.ball_part_mm = whole.ballClearance(centres, tool.radius_mm, nullptr, nullptr,
-                                             std::max(kReachesPartMm, ball_exact_below_mm));
+    // Pass by pass, exact up to the far-from-part distance (each pass's own: a pass beside the
+    // part is not hidden by one on it); the whole path's least of them.
+    const double far_mm = farFromPartMm(tool.radius_mm);
+    std::size_t pass = 0;
+    for (const geometry::PathBlock& block : path.blocks) {
+      if (block.kind != geometry::PathBlock::Kind::Pass || block.size() == 0) continue;
+      ++pass;
+      std::vector<Vec3> centres;
+      for (std::size_t i = block.begin; i < block.end; ++i)
+        centres.push_back(geometry::ballCentre(path.postures[i], tool.radius_mm));
+      const double d = whole.ballClearance(centres, tool.radius_mm, nullptr, nullptr,
+                                           std::max({kReachesPartMm, ball_exact_below_mm, far_mm}));
+      out.ball_part_mm = std::min(out.ball_part_mm.value_or(d), d);
+      if (d >= far_mm) {
+        if (out.far_passes.empty()) out.far_pass_first_posture = block.begin;
+        out.far_passes.push_back(pass);
+      }
+    }
   }
   out.holder = checkHolderAgainstPart(tool, holder, model, path.postures,
                                       common::scaled(progress, 0.3, 0.6, "holder vs part"));

@@ -612,3 +612,55 @@ TEST(GenerateEdges, AFarLinkIsTheEndWhoseClimbRunsFar) {
   EXPECT_NE(note.find("(the link into pass 2, "), std::string::npos) << note;
   EXPECT_NE(note.find("a steeper axis at the pass ends"), std::string::npos) << note;
 }
+
+// Some passes, not all, beside the part (a part turned 90 deg under a raster left 22 of 31
+// passes beside it with `check: ok`, unsaid: a units adversary's). A plate 10 mm wide under 11
+// passes 3 mm apart across y -15..15: the ball (R 3) of the outer two stays 7 mm from the plate's
+// edge, past max(5, 2R) = 6; that of y = 12 comes within 4. Both commands warn and list them.
+TEST(GenerateEdges, PassesBesideThePartAreSaid) {
+  const TempDir dir;
+  geometry::TriangleMesh plate, post;
+  pathgen::test::addBox(plate, -20, 20, -5, 5, -5, 0);
+  pathgen::test::addBox(post, 40, 41, -20, 20, -5, 1);
+  geometry::saveMesh(plate, dir.path() / "plate.stl");
+  geometry::saveMesh(post, dir.path() / "post.stl");
+  std::string cl;
+  for (int p = 0; p <= 10; ++p) {
+    cl += "# pass " + std::to_string(p + 1) + "\n";
+    for (int i = -8; i <= 8; ++i)
+      cl += std::to_string(2.0 * i) + " " + std::to_string(-15.0 + 3.0 * p) + " 0 0 0 1\n";
+  }
+  dir.write("p.cl", cl);
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: post.stl\npart: plate.stl\n"
+            "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.5\n"
+            "path: { nominal: p.cl }\n");
+  const std::vector<std::size_t> outer = {1, 11};
+  const std::string said =
+      "warning: 2 of the 11 passes keep the ball more than 6 mm from the "
+      "part at every posture (first: posture ";
+  const auto g = test::runFieldpath(dir, "generate scene.yaml --nominal --out g");
+  ASSERT_EQ(g.exit_code, 0) << g.output();
+  EXPECT_NE(g.err.find(said), std::string::npos) << g.err;
+  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "g/report.json"));
+  EXPECT_EQ(report["ball_part"]["far_passes"].get<std::vector<std::size_t>>(), outer)
+      << report["ball_part"];
+  const auto c = test::runFieldpath(dir, "check scene.yaml --path p.cl --out c");
+  ASSERT_EQ(c.exit_code, 0) << c.output();
+  EXPECT_NE(c.err.find(said + "0 (pass 1, p.cl:2))"), std::string::npos) << c.err;
+  const auto check = nlohmann::json::parse(test::slurp(dir.path() / "c/check.json"));
+  EXPECT_EQ(check["far_passes"].get<std::vector<std::size_t>>(), outer) << check["far_passes"];
+  // The passes over the plate only: none said.
+  std::string inner;
+  for (int p = 3; p <= 7; ++p) {
+    inner += "# pass " + std::to_string(p) + "\n";
+    for (int i = -8; i <= 8; ++i)
+      inner += std::to_string(2.0 * i) + " " + std::to_string(-15.0 + 3.0 * (p - 1)) + " 0 0 0 1\n";
+  }
+  dir.write("inner.cl", inner);
+  const auto n = test::runFieldpath(dir, "check scene.yaml --path inner.cl --out n");
+  ASSERT_EQ(n.exit_code, 0) << n.output();
+  EXPECT_EQ(n.err.find("passes keep the ball more than"), std::string::npos) << n.err;
+  EXPECT_TRUE(
+      nlohmann::json::parse(test::slurp(dir.path() / "n/check.json"))["far_passes"].empty());
+}

@@ -92,6 +92,12 @@ struct PartContacts {
   /// exact under kReachesPartMm (a lower bound above it): whether the tool reaches the part
   /// where the Z-buffer, looking down, may see no line (a wall finished with a tilted ball).
   std::optional<double> ball_part_mm;
+  /// A ball end mill: the passes (the path's pass blocks, numbered from 1) whose ball stays
+  /// farther than farFromPartMm from the part at every posture: they cut nothing (a part turned
+  /// 90 deg under a raster: 22 of 31 passes beside it read `ok`, a units adversary's), with the
+  /// first posture of the first of them.
+  std::vector<std::size_t> far_passes;
+  std::size_t far_pass_first_posture = 0;
   /// Per posture of a path of n: 1 where the links, the holder or the cutter touch the part there
   /// (posture) or on the motion to the next (motion), from the results' contact lists.
   struct Marks {
