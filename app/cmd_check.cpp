@@ -353,7 +353,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"surface", surface ? surfaceJson(*surface) : json(nullptr)},
         // The file's passes (from 1) whose ball stays past far_from_part_mm at every posture (a
         // ball end mill and a part): they cut nothing.
-        {"far_passes", contacts.ball_part_mm ? json(contacts.far_passes) : json(nullptr)},
+        {"far_passes", contacts.ball_part_mm ? json(contacts.far.passes) : json(nullptr)},
+        {"far_postures", contacts.ball_part_mm ? json(contacts.far.postures) : json(nullptr)},
         {"far_from_part_mm", pathgen::farFromPartMm(scene.tool.radius_mm)},
         {"max_scallop_um",
          options->max_scallop_um ? json(*options->max_scallop_um) : json(nullptr)},
@@ -462,8 +463,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     if (rapids_onto_passes > 0)
       std::fprintf(stderr, "warning: %s (check.json unsafe)\n", unsafe.back().c_str());
     if (const std::string far =
-            farPassesWarning(path, contacts.far_passes, contacts.far_pass_first_posture,
-                             pathgen::farFromPartMm(scene.tool.radius_mm));
+            farPassesWarning(path, contacts.far, pathgen::farFromPartMm(scene.tool.radius_mm));
         !far.empty())
       std::fprintf(stderr, "warning: %s (check.json far_passes)\n", far.c_str());
     if (part_never_reached)

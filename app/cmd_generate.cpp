@@ -364,9 +364,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                    "(an inch file over a part in mm?), or for another part (report.json "
                    "ball_part)\n",
                    far_mm);
-    if (const std::string far =
-            farPassesWarning(result.path, result.far_passes, result.far_pass_first_posture,
-                             pathgen::farFromPartMm(job.tool.radius_mm));
+    if (const std::string far = farPassesWarning(result.path, result.far_from_part,
+                                                 pathgen::farFromPartMm(job.tool.radius_mm));
         !far.empty())
       std::fprintf(stderr, "warning: %s (report.json ball_part.far_passes)\n", far.c_str());
     if (under_required)

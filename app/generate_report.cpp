@@ -115,7 +115,8 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
                                {"far_mm", pathgen::farFromPartMm(job.tool.radius_mm)},
                                {"reaches", *r.ball_part_mm <= pathgen::kReachesPartMm},
                                // the path's passes (from 1) whose ball stays past far_mm
-                               {"far_passes", r.far_passes}}
+                               {"far_passes", r.far_from_part.passes},
+                               {"far_postures", r.far_from_part.postures}}
                         : json(nullptr)},
       {"cutter_part_skipped",
        r.cutter_part ? json(nullptr) : json("no `part` in the scene, or a flat end")},

@@ -200,8 +200,8 @@ double ClearanceChecker::clearance(const geometry::Posture& posture, int* obstac
 }
 
 double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double radius_mm,
-                                       std::size_t* at, int* obstacle,
-                                       double exact_below_mm) const {
+                                       std::size_t* at, int* obstacle, double exact_below_mm,
+                                       std::vector<double>* each) const {
   // A point-sized sphere model: the distance from the centre to the obstacles, less the radius.
   constexpr double kPointRadiusMm = 1e-4;
   auto ball = std::make_shared<Model>();
@@ -246,6 +246,11 @@ double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double 
       if (at) *at = i;
       if (obstacle) *obstacle = nearest[i];
     }
+  }
+  if (each) {
+    each->resize(distance.size());
+    for (size_t i = 0; i < distance.size(); ++i)
+      (*each)[i] = std::max(0.0, distance[i] - radius_mm);
   }
   return std::max(0.0, best - radius_mm);
 }

@@ -2,6 +2,7 @@
 #include "fieldpath/pathgen/link_check.h"
 
 #include <algorithm>
+#include <limits>
 #include <memory>
 #include <span>
 #include <vector>
@@ -192,22 +193,33 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
     out.links = checkLinksAgainstPart(whole, grazingPartChecker(tool, holder, model), path,
                                       common::scaled(progress, 0.2, 0.3, "links vs part"));
   if (tool.shape == geometry::ToolShape::Ball) {
-    // Pass by pass, exact up to the far-from-part distance (each pass's own: a pass beside the
-    // part is not hidden by one on it); the whole path's least of them.
+    // Every pass posture's ball, exact up to the far-from-part distance (a pass beside the part
+    // is not hidden by one on it); the whole path's least of them.
     const double far_mm = farFromPartMm(tool.radius_mm);
-    std::size_t pass = 0;
+    std::vector<Vec3> centres;
+    for (const geometry::PathBlock& block : path.blocks)
+      if (block.kind == geometry::PathBlock::Kind::Pass)
+        for (std::size_t i = block.begin; i < block.end; ++i)
+          centres.push_back(geometry::ballCentre(path.postures[i], tool.radius_mm));
+    std::vector<double> each;
+    if (!centres.empty())
+      out.ball_part_mm =
+          whole.ballClearance(centres, tool.radius_mm, nullptr, nullptr,
+                              std::max({kReachesPartMm, ball_exact_below_mm, far_mm}), &each);
+    out.far.pass_postures = each.size();
+    std::size_t k = 0, pass = 0;
     for (const geometry::PathBlock& block : path.blocks) {
-      if (block.kind != geometry::PathBlock::Kind::Pass || block.size() == 0) continue;
+      if (block.kind != geometry::PathBlock::Kind::Pass) continue;
+      double nearest_mm = std::numeric_limits<double>::infinity();
+      for (std::size_t i = block.begin; i < block.end; ++i, ++k) {
+        nearest_mm = std::min(nearest_mm, each[k]);
+        out.far.postures += each[k] >= far_mm;
+      }
+      if (block.size() == 0) continue;
       ++pass;
-      std::vector<Vec3> centres;
-      for (std::size_t i = block.begin; i < block.end; ++i)
-        centres.push_back(geometry::ballCentre(path.postures[i], tool.radius_mm));
-      const double d = whole.ballClearance(centres, tool.radius_mm, nullptr, nullptr,
-                                           std::max({kReachesPartMm, ball_exact_below_mm, far_mm}));
-      out.ball_part_mm = std::min(out.ball_part_mm.value_or(d), d);
-      if (d >= far_mm) {
-        if (out.far_passes.empty()) out.far_pass_first_posture = block.begin;
-        out.far_passes.push_back(pass);
+      if (nearest_mm >= far_mm) {
+        if (out.far.passes.empty()) out.far.first_posture = block.begin;
+        out.far.passes.push_back(pass);
       }
     }
   }

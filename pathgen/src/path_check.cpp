@@ -74,8 +74,7 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
             checkAgainstPart(request.tool, request.holder, part_model, result.path,
                              kGougeToleranceMm, progress, farFromPartMm(request.tool.radius_mm));
         result.ball_part_mm = contacts.ball_part_mm;
-        result.far_passes = contacts.far_passes;
-        result.far_pass_first_posture = contacts.far_pass_first_posture;
+        result.far_from_part = contacts.far;
         part_marks = contacts.marks(result.path.postures.size());
         result.link_part = std::move(contacts.links);
         result.holder_part = std::move(contacts.holder);

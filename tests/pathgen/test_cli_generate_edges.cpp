@@ -663,4 +663,18 @@ TEST(GenerateEdges, PassesBesideThePartAreSaid) {
   EXPECT_EQ(n.err.find("passes keep the ball more than"), std::string::npos) << n.err;
   EXPECT_TRUE(
       nlohmann::json::parse(test::slurp(dir.path() / "n/check.json"))["far_passes"].empty());
+  // One pass running off the plate along y, 0 to 42 mm: the ball passes 6 mm from the plate's
+  // edge (y 5) at y 14 and stays past it on: 29 of its 43 postures keep the ball that far,
+  // though the pass touches the plate.
+  std::string off = "# pass 1\n";
+  for (int i = 0; i <= 42; ++i) off += "0 " + std::to_string(double(i)) + " 0 0 0 1\n";
+  dir.write("off.cl", off);
+  const auto o = test::runFieldpath(dir, "check scene.yaml --path off.cl --out o");
+  ASSERT_EQ(o.exit_code, 0) << o.output();
+  const auto off_check = nlohmann::json::parse(test::slurp(dir.path() / "o/check.json"));
+  EXPECT_TRUE(off_check["far_passes"].empty());
+  EXPECT_NEAR(off_check["far_postures"].get<double>(), 29.0, 1.0) << off_check;
+  EXPECT_NE(o.err.find(" of the 43 pass postures keep the ball more than 6 mm from the part"),
+            std::string::npos)
+      << o.err;
 }

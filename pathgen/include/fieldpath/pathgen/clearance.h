@@ -130,9 +130,12 @@ class ClearanceChecker {
   /// (the distance to a surface changes no faster than the point moves, and the point stays on
   /// the same side of it), so a dense path far from the walls costs a few queries, not one a
   /// station (97k stations took 17 s); a result of exact_below_mm or more is a lower bound.
+  /// `each` (optional) receives every centre's clearance, exact under exact_below_mm (a lower
+  /// bound at or above it).
   double ballClearance(std::span<const Vec3> centres_mm, double radius_mm,
                        std::size_t* at = nullptr, int* obstacle = nullptr,
-                       double exact_below_mm = std::numeric_limits<double>::infinity()) const;
+                       double exact_below_mm = std::numeric_limits<double>::infinity(),
+                       std::vector<double>* each = nullptr) const;
 
   std::size_t obstacleCount() const;
   double toolChordTolMm() const;

@@ -130,10 +130,7 @@ struct GenerateResult {
   /// A ball end mill and a part: the least distance (mm) from the passes' balls to the part,
   /// exact under farFromPartMm (a lower bound above it).
   std::optional<double> ball_part_mm;
-  /// The passes (path blocks, from 1) whose ball stays past farFromPartMm from the part, and the
-  /// first posture of the first (PartContacts::far_passes).
-  std::vector<std::size_t> far_passes;
-  std::size_t far_pass_first_posture = 0;
+  FarFromPart far_from_part;  ///< (a ball end mill and a part) PartContacts::far
   double safe_z_mm = 0.0;     ///< the links' travel plane
   /// A given links.safe_z below this (mm) lets the links pass within the checks' own margin of
   /// `clearance` (the tool mesh's chordal tolerance, the motions' resolution): they may read as

@@ -85,6 +85,18 @@ std::optional<LinkPartResult> checkHolderAgainstPart(
 /// (checkLinksAgainstPart, when it has link blocks), its holder (checkHolderAgainstPart, when
 /// there is one), each nullopt when not checked, and its cutter entering the part deeper than
 /// the gouge tolerance (checkCutterAgainstPart; a flat end: nullopt).
+/// Where a ball end mill's passes keep the ball farther than farFromPartMm from the part: they cut
+/// nothing there (a part turned 90 deg under a raster: 22 of 31 passes beside it read `ok`; a
+/// path in inches over the impeller's hub hovered over a sliver of it: a units adversary's).
+struct FarFromPart {
+  /// The passes (the path's pass blocks, numbered from 1) far at every posture, and the first
+  /// posture of the first of them.
+  std::vector<std::size_t> passes;
+  std::size_t first_posture = 0;
+  std::size_t postures = 0;       ///< the pass postures far from the part
+  std::size_t pass_postures = 0;  ///< of these
+};
+
 struct PartContacts {
   std::optional<LinkPartResult> links, holder;
   std::optional<CutterPartResult> cutter;
@@ -92,12 +104,8 @@ struct PartContacts {
   /// exact under kReachesPartMm (a lower bound above it): whether the tool reaches the part
   /// where the Z-buffer, looking down, may see no line (a wall finished with a tilted ball).
   std::optional<double> ball_part_mm;
-  /// A ball end mill: the passes (the path's pass blocks, numbered from 1) whose ball stays
-  /// farther than farFromPartMm from the part at every posture: they cut nothing (a part turned
-  /// 90 deg under a raster: 22 of 31 passes beside it read `ok`, a units adversary's), with the
-  /// first posture of the first of them.
-  std::vector<std::size_t> far_passes;
-  std::size_t far_pass_first_posture = 0;
+  /// A ball end mill: where its ball stays farther than farFromPartMm from the part.
+  FarFromPart far;
   /// Per posture of a path of n: 1 where the links, the holder or the cutter touch the part there
   /// (posture) or on the motion to the next (motion), from the results' contact lists.
   struct Marks {
