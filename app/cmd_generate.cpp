@@ -118,7 +118,8 @@ std::string farLinkNote(const Scene& scene, const pathgen::GenerateResult& resul
     std::size_t first_top = block.end;
     for (std::size_t i = block.begin; i < block.end && first_top == block.end; ++i)
       if (path.postures[i].tip_mm.z() >= top_mm - 1e-6) first_top = i;
-    out_of_before = at <= first_top;
+    // The link before the first pass has no way out of one, the one after the last no way in.
+    out_of_before = before >= 0 && (after < 0 || at <= first_top);
   }
   const pathgen::GenerateResult::RoutedLinkEnd* routed = nullptr;
   for (const auto& end : result.routed_link_ends)

@@ -357,30 +357,21 @@ inline nlohmann::json dogLegJson(const pathgen::DogLegRapids& d) {
 }
 
 /// The warning where some passes, not all, keep the ball farther than `far_mm` from the part at
-/// every posture, or a quarter of the pass postures or more do (empty otherwise; all of them is
-/// the path's own warning): they cut nothing there, most often passes beside a part turned or
-/// offset, or a path in other units (a units adversary's: a part turned 90 deg under a raster
-/// left 22 of 31 passes beside it, unsaid; a path in inches over the impeller's hub hovered over
-/// a sliver of it, each pass touching it somewhere, `check: ok`).
+/// every posture (empty otherwise; all of them is the path's own warning): they cut nothing, most
+/// often passes beside a part turned or offset, or a path in other units (a units adversary's:
+/// a part turned 90 deg under a raster left 22 of 31 passes beside it, unsaid). Postures alone
+/// are counted, not warned: a raster's run-off past the part's edge keeps a third of them far.
 inline std::string farPassesWarning(const geometry::PathFile& path, const pathgen::FarFromPart& c,
                                     double far_mm) {
   const std::size_t passes = path.count(geometry::PathBlock::Kind::Pass);
-  const bool some_passes = !c.passes.empty() && c.passes.size() < passes;
-  const bool many_postures =
-      4 * c.postures >= c.pass_postures && c.postures > 0 && c.postures < c.pass_postures;
-  if (!some_passes && !many_postures) return {};
+  if (c.passes.empty() || c.passes.size() >= passes) return {};
   char far[32];
   std::snprintf(far, sizeof far, "%.3g", far_mm);
-  const std::string where =
-      some_passes
-          ? std::to_string(c.passes.size()) + " of the " + std::to_string(passes) + " passes keep" +
-                " the ball more than " + far + " mm from the part at every posture (first: " +
-                postureWhere(path, c.first_posture) + ")"
-          : std::to_string(c.postures) + " of the " + std::to_string(c.pass_postures) +
-                " pass postures keep the ball more than " + far + " mm from the part";
-  return where +
-         ": they cut nothing there. Passes beside or over the part: is it turned or "
-         "offset from the path's frame, or in other units?";
+  return std::to_string(c.passes.size()) + " of the " + std::to_string(passes) +
+         " passes keep the ball more than " + far +
+         " mm from the part at every posture (first: " + postureWhere(path, c.first_posture) +
+         "): they cut nothing there. Passes beside the part: is it turned or offset from the "
+         "path's frame, or in other units?";
 }
 
 /// The note where some rapids are proven clear of the obstacles only as straight moves, or where

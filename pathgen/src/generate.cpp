@@ -58,17 +58,19 @@ void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>
     for (const PassSample& s : pass.samples) centres.push_back(s.centre_mm);
     size_t at = 0;
     int obstacle = -1;
-    const double d = checker.ballClearance(centres, ball_radius_mm, &at, &obstacle, clearance_mm);
+    // Exact under the clearance, and under 1 um at least: a station's 0 is then a touch, never a
+    // lower bound.
+    std::vector<double> each;
+    const double d = checker.ballClearance(centres, ball_radius_mm, &at, &obstacle,
+                                           std::max(clearance_mm, 1e-3), &each);
     if (d <= 0.0) {
       // Named where the ball first enters, not where it is deepest (a pass entering a wall at
-      // line 37 was named at its line 42): the stations before that one, one at a time.
-      for (std::size_t i = 0; i < at; ++i) {
-        int entered = -1;
-        if (checker.ballClearance(std::span(&centres[i], 1), ball_radius_mm, nullptr, &entered,
-                                  1.0) <= 0.0) {  // exact under 1 mm
-          at = i, obstacle = entered;
-          break;
-        }
+      // line 37 was named at its line 42): the first station at 0, its obstacle asked again.
+      const std::size_t first = static_cast<std::size_t>(
+          std::find_if(each.begin(), each.end(), [](double e) { return e <= 0.0; }) - each.begin());
+      if (first < at) {
+        at = first;
+        checker.ballClearance(std::span(&centres[at], 1), ball_radius_mm, nullptr, &obstacle);
       }
       std::ostringstream msg;
       const double s_mm = pass.samples[at].s_mm;

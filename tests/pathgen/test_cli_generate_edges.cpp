@@ -611,6 +611,28 @@ TEST(GenerateEdges, AFarLinkIsTheEndWhoseClimbRunsFar) {
       << note;
   EXPECT_NE(note.find("(the link into pass 2, "), std::string::npos) << note;
   EXPECT_NE(note.find("a steeper axis at the pass ends"), std::string::npos) << note;
+
+  // One upright pass under a shelf, the way into it moved 12 mm sideways: the link into pass 1
+  // has no way out of a pass before it, and its farthest posture (its first) is that way's (it
+  // was called a climb along the axis: a diff review's).
+  geometry::saveMesh(pathgen::test::boxMesh(-15, 5, -5, 5, -10, 0), dir.path() / "floor1.stl");
+  geometry::saveMesh(pathgen::test::boxMesh(-5, 5, -5, 5, 14, 25), dir.path() / "shelf1.stl");
+  std::string one = "# pass 1\n";
+  for (int k = 0; k <= 20; ++k) one += std::to_string(-0.5 * k) + " 0 0 0 0 1\n";
+  dir.write("one.cl", one);
+  dir.write("one.yaml",
+            "obstacles:\n  - mesh: shelf1.stl\npart: floor1.stl\n"
+            "tool: { shape: ball, radius: 3, length: 12 }\nclearance: 0.5\n"
+            "path: { nominal: one.cl }\nlinks: { retract: 2 }\n");
+  const auto first = test::runFieldpath(dir, "generate one.yaml --nominal --out one");
+  ASSERT_EQ(first.exit_code, 0) << first.output();
+  const auto one_report = nlohmann::json::parse(test::slurp(dir.path() / "one/report.json"));
+  ASSERT_EQ(one_report["link_notes"].size(), 1u) << one_report["link_notes"];
+  const std::string into = one_report["link_notes"][0];
+  EXPECT_NE(into.find("the links climb to the travel plane (the way into pass 1 (one.cl:2) off "
+                      "its axis"),
+            std::string::npos)
+      << into;
 }
 
 // Some passes, not all, beside the part (a part turned 90 deg under a raster left 22 of 31
@@ -665,7 +687,8 @@ TEST(GenerateEdges, PassesBesideThePartAreSaid) {
       nlohmann::json::parse(test::slurp(dir.path() / "n/check.json"))["far_passes"].empty());
   // One pass running off the plate along y, 0 to 42 mm: the ball passes 6 mm from the plate's
   // edge (y 5) at y 14 and stays past it on: 29 of its 43 postures keep the ball that far,
-  // though the pass touches the plate.
+  // counted (far_postures), not warned (a raster's run-off keeps a third of its postures far: a
+  // diff review's false alarm), the pass touching the plate.
   std::string off = "# pass 1\n";
   for (int i = 0; i <= 42; ++i) off += "0 " + std::to_string(double(i)) + " 0 0 0 1\n";
   dir.write("off.cl", off);
@@ -673,8 +696,6 @@ TEST(GenerateEdges, PassesBesideThePartAreSaid) {
   ASSERT_EQ(o.exit_code, 0) << o.output();
   const auto off_check = nlohmann::json::parse(test::slurp(dir.path() / "o/check.json"));
   EXPECT_TRUE(off_check["far_passes"].empty());
-  EXPECT_NEAR(off_check["far_postures"].get<double>(), 29.0, 1.0) << off_check;
-  EXPECT_NE(o.err.find(" of the 43 pass postures keep the ball more than 6 mm from the part"),
-            std::string::npos)
-      << o.err;
+  EXPECT_EQ(off_check["far_postures"].get<int>(), 29) << off_check;
+  EXPECT_EQ(o.err.find("keep the ball more than"), std::string::npos) << o.err;
 }
