@@ -469,7 +469,14 @@ SettledStart settleAtStart(const Pass& pass, const SteeringRequest& request) {
   const double v = request.params.feed_mm_per_min / 60.0;
   const PassFrame first = pass.frameAt(0.0);
   Pass held;
-  held.length_mm = 2.0 * request.params.inertia / c * v;
+  // The slower of the two modes: 2J/c, or c/k where the damping is heavy (an overdamped axis
+  // creeps to rest over c/k; with damping 1e4 the axis moved under kSettledRad in a 2J/c and was
+  // called settled far from its rest: a diff review's). The spring's k: the field's stiffness
+  // only quickens it.
+  const double decay_s =
+      std::max(2.0 * request.params.inertia / c,
+               request.params.stiffness > 0.0 ? c / request.params.stiffness : 0.0);
+  held.length_mm = decay_s * v;
   // A decay longer than kMaxSettleMm of path is no rest the pass could start from (damping
   // 1e-300 ran an undamped swing over 1e300 s, never ending: a diff review's).
   if (!(held.length_mm <= kMaxSettleMm)) {

@@ -112,6 +112,17 @@ TEST(SettledStart, ASlowDecayIsSettledInBoundedWork) {
       << never.why;
 }
 
+// Heavy damping: the axis creeps to rest over c/k, not 2J/c (with damping 100 it moved little
+// in each 2J/c and was called settled 20 of them later, far from its rest).
+TEST(SettledStart, AnOverdampedAxisIsSettledAtItsRest) {
+  const auto wall = wallAt(3.1);
+  SteeringRequest request = requestFor(wall.get());
+  request.params.damping = 100.0;  // 2J/c = 0.02 s, c/k = 100 s
+  const SettledStart settled = settleAtStart(straightPass(10.0), request);
+  ASSERT_TRUE(settled.settled) << settled.why;
+  EXPECT_NEAR(settled.tilt_rad, staticTilt(*wall, request.params.stiffness, 0.0, 0.6), 1e-6);
+}
+
 TEST(SettledStart, WithoutDampingThereIsNoRest) {
   const auto wall = wallAt(3.1);
   SteeringRequest request = requestFor(wall.get());
