@@ -109,9 +109,9 @@ inline constexpr double kSettleStations = 2000.0;
 inline constexpr double kMaxSettleMm = 1e5;
 
 /// The axis at rest at a pass's start (DynamicsParams::start): the pass's first frame held while
-/// the spring-damper runs from the nominal angles at rest, one decay time 2J/c after another
-/// (c the spring's; `critical` adds the field's stiffness, which only shortens the decay; with
-/// no spring, the field's at the nominal axis), until the axis moves less than
+/// the spring-damper runs from the nominal angles at rest, one decay time (the slower of 2J/c and
+/// c/k) after another (c the spring's; `critical` adds the field's stiffness, which only shortens
+/// the decay; with no spring, the field's at the nominal axis), until the axis moves less than
 /// kSettledRad in one, or for kSettleDecays of them (the amplitude down by e^-20); the angles
 /// held at their limits on the way (on_limit: clamp whatever the pass's: the settling is not
 /// machined, its swing beyond a limit is no failure; a rest beyond one is held at it, and a pass
