@@ -334,7 +334,18 @@ TEST(InputSizes, FilesReadWholeAreSizedBeforeTheRead) {
   std::string many;  // 60000 postures: ~4.6 MiB held
   for (int i = 0; i < 60000; ++i) many += "1 2 3 0 0 1\n";
   dir.write("many.cl", many);
+  // 60000 postures a generate steers one for one: ~3 KB each (a 1 M posture path ran past an
+  // accepted --max-memory 78M to 0.8 GB: a memory sweep's), refused before the work.
+  std::string steered;
+  for (int i = 0; i < 60000; ++i) steered += std::to_string(0.01 * i) + " 2 3 0 0 1\n";
+  dir.write("steered.cl", steered);
+  dir.write("steered.yaml",
+            "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 1, length: 20 }\n"
+            "path: { nominal: steered.cl }\n");
   const Case cases[] = {
+      {"--max-memory 100M generate steered.yaml --out g",
+       "steered.yaml: path.nominal: needs about 176 MiB of memory (6e+04 postures: the nominal "
+       "path's, one for one)"},
       {"generate s.yaml --out g", "s.yaml:4: path.nominal: huge.cl: NUL bytes near its start"},
       {"check s.yaml --path huge.cl", "huge.cl: NUL bytes near its start"},
       {"convert huge.cl h.npy", "huge.cl: NUL bytes near its start"},
