@@ -331,7 +331,7 @@ TEST(InputSizes, FilesReadWholeAreSizedBeforeTheRead) {
   struct Case {
     std::string args, message;
   };
-  std::string many;  // 60000 postures: ~4.6 MiB held
+  std::string many;  // 60000 postures: ~14.6 MiB held
   for (int i = 0; i < 60000; ++i) many += "1 2 3 0 0 1\n";
   dir.write("many.cl", many);
   // 60000 postures a generate steers one for one: ~3 KB each (a 1 M posture path ran past an
@@ -349,8 +349,8 @@ TEST(InputSizes, FilesReadWholeAreSizedBeforeTheRead) {
       {"generate s.yaml --out g", "s.yaml:4: path.nominal: huge.cl: NUL bytes near its start"},
       {"check s.yaml --path huge.cl", "huge.cl: NUL bytes near its start"},
       {"convert huge.cl h.npy", "huge.cl: NUL bytes near its start"},
-      {"--max-memory 1M check s.yaml --path many.cl", "--path many.cl: needs about 4.58 MiB"},
-      {"--max-memory 1M convert many.cl h.npy", "many.cl: needs about 4.58 MiB"},
+      {"--max-memory 1M check s.yaml --path many.cl", "--path many.cl: needs about 14.6 MiB"},
+      {"--max-memory 1M convert many.cl h.npy", "many.cl: needs about 14.6 MiB"},
       {"generate huge.yaml --out g", "huge.yaml: 1 GiB: not a scene file"},
       {"--max-memory 1G field probe s.yaml --points points.txt", "--points points.txt: needs"}};
   for (const Case& c : cases) {
