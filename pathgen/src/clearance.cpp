@@ -201,7 +201,7 @@ double ClearanceChecker::clearance(const geometry::Posture& posture, int* obstac
 
 double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double radius_mm,
                                        std::size_t* at, int* obstacle, double exact_below_mm,
-                                       std::vector<double>* each) const {
+                                       std::vector<double>* each, double split_mm) const {
   // A point-sized sphere model: the distance from the centre to the obstacles, less the radius.
   constexpr double kPointRadiusMm = 1e-4;
   auto ball = std::make_shared<Model>();
@@ -223,14 +223,18 @@ double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double 
   // come under the exact range (its lower bound d - |c - c_measured|) keeps that bound. The
   // runs in parallel; the bounds, the minimum and its first index as every station measured.
   constexpr size_t kRun = 64;  // (256 left a pass of fewer stations on one core)
-  const double skip_from_mm = radius_mm + exact_below_mm;
+  const bool split = std::isfinite(split_mm) && split_mm > exact_below_mm;
+  const double skip_from_mm = radius_mm + (split ? split_mm : exact_below_mm);
+  const double nearer_from_mm = radius_mm + exact_below_mm, nearer_than_mm = radius_mm + split_mm;
   tbb::parallel_for(size_t{0}, (centres_mm.size() + kRun - 1) / kRun, [&](size_t run) {
     const size_t end = std::min(centres_mm.size(), (run + 1) * kRun);
     size_t measured = run * kRun;
     measure(measured);
     for (size_t i = measured + 1; i < end; ++i) {
-      const double bound = distance[measured] - (centres_mm[i] - centres_mm[measured]).norm();
-      if (std::isfinite(skip_from_mm) && bound >= skip_from_mm) {
+      const double moved = (centres_mm[i] - centres_mm[measured]).norm();
+      const double bound = distance[measured] - moved;
+      if ((std::isfinite(skip_from_mm) && bound >= skip_from_mm) ||
+          (split && bound >= nearer_from_mm && distance[measured] + moved < nearer_than_mm)) {
         distance[i] = bound;
         nearest[i] = nearest[measured];
         continue;

@@ -205,7 +205,7 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
     if (!centres.empty())
       out.ball_part_mm =
           whole.ballClearance(centres, tool.radius_mm, nullptr, nullptr,
-                              std::max({kReachesPartMm, ball_exact_below_mm, far_mm}), &each);
+                              std::max(kReachesPartMm, ball_exact_below_mm), &each, far_mm);
     out.far.pass_postures = each.size();
     std::size_t k = 0, pass = 0;
     for (const geometry::PathBlock& block : path.blocks) {

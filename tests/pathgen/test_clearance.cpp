@@ -186,6 +186,38 @@ TEST(Clearance, BallClearanceSkipsStationsThatCannotComeUnderTheThreshold) {
   }
 }
 
+// Split at `split_mm`: every station of the same swinging path told nearer or farther than it
+// as the every-station clearances tell it (closed form: the ball's distance to the wall x = 5 is
+// 4 - x), the minimum exact under the threshold; a station proven nearer by the walk is not
+// measured, its value a lower bound between the two.
+TEST(Clearance, BallClearanceSplitTellsEachStationNearerOrFartherExactly) {
+  const TriangleMesh tool = box(Vec3(-1, -1, 0), Vec3(1, 1, 10));
+  const std::vector<TriangleMesh> obstacles = {wall(5.0), wall(-20.0)};
+  const pathgen::ClearanceChecker checker(tool, obstacles);
+  for (const double nearest_x : {-7.0, 2.5, 3.99}) {  // ball clearance 11, 1.5, 0.01 at the apex
+    std::vector<Vec3> centres;
+    for (int k = 0; k <= 6000; ++k) {
+      const double t = k / 6000.0;
+      centres.emplace_back(-7.0 + (nearest_x + 7.0) * std::sin(M_PI * t), 60.0 * t, 1.0);
+    }
+    std::vector<double> each;
+    std::size_t at = 0;
+    const double split_mm = 6.0, exact_mm = 0.05;
+    const double least =
+        checker.ballClearance(centres, 1.0, &at, nullptr, exact_mm, &each, split_mm);
+    ASSERT_EQ(each.size(), centres.size());
+    for (std::size_t i = 0; i < centres.size(); ++i) {
+      const double exact = 4.0 - centres[i].x();  // the nearer wall, x = 5
+      EXPECT_EQ(each[i] < split_mm, exact < split_mm) << nearest_x << ' ' << i;
+      EXPECT_LE(each[i], exact + 1e-9) << nearest_x << ' ' << i;
+    }
+    if (4.0 - nearest_x < exact_mm)
+      EXPECT_NEAR(least, 4.0 - nearest_x, 2e-4) << nearest_x;  // the point model: 0.1 um
+    else
+      EXPECT_GE(least, exact_mm) << nearest_x;
+  }
+}
+
 // exact_min_only (the holder against the part): a dense path of a ball-end tool and holder that
 // tilts towards a wall and into it, its axis's azimuth swinging (each posture's minimal rotation
 // then twists the faceted mesh about the axis: a bound by the axes' angle alone was 0.36 um above

@@ -131,11 +131,15 @@ class ClearanceChecker {
   /// the same side of it), so a dense path far from the walls costs a few queries, not one a
   /// station (97k stations took 17 s); a result of exact_below_mm or more is a lower bound.
   /// `each` (optional) receives every centre's clearance, exact under exact_below_mm (a lower
-  /// bound at or above it).
+  /// bound at or above it). With `split_mm` finite (over exact_below_mm) each centre is told
+  /// exactly nearer or farther than split_mm, its value a lower bound between the two (a centre
+  /// proven nearer by its walk, d + |c - c_measured| - R under split_mm, is not measured: a path
+  /// hovering 1.5 mm over a part, told against 6 mm, checked as fast as one on it).
   double ballClearance(std::span<const Vec3> centres_mm, double radius_mm,
                        std::size_t* at = nullptr, int* obstacle = nullptr,
                        double exact_below_mm = std::numeric_limits<double>::infinity(),
-                       std::vector<double>* each = nullptr) const;
+                       std::vector<double>* each = nullptr,
+                       double split_mm = std::numeric_limits<double>::quiet_NaN()) const;
 
   std::size_t obstacleCount() const;
   double toolChordTolMm() const;
