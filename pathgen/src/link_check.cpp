@@ -193,8 +193,8 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
     out.links = checkLinksAgainstPart(whole, grazingPartChecker(tool, holder, model), path,
                                       common::scaled(progress, 0.2, 0.3, "links vs part"));
   if (tool.shape == geometry::ToolShape::Ball) {
-    // Every pass posture's ball, exact up to the far-from-part distance (a pass beside the part
-    // is not hidden by one on it); the whole path's least of them.
+    // Every pass posture's ball told nearer or farther than the far-from-part distance (a pass
+    // beside the part is not hidden by one on it), the least exact under the range asked.
     const double far_mm = farFromPartMm(tool.radius_mm);
     std::vector<Vec3> centres;
     for (const geometry::PathBlock& block : path.blocks)

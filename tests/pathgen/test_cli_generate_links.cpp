@@ -35,6 +35,14 @@ void writeUprightPassUnderAShelf(const TempDir& dir, double shelf_y_mm, double s
   dir.write("pass.cl", cl);
 }
 
+/// `generate SCENE --nominal --out OUT` in `dir`, its report.json: the run must succeed.
+nlohmann::json generateNominal(const TempDir& dir, const std::string& scene,
+                               const std::string& out) {
+  const auto r = test::runFieldpath(dir, "generate " + scene + " --nominal --out " + out);
+  EXPECT_EQ(r.exit_code, 0) << r.output();
+  return nlohmann::json::parse(test::slurp(dir.path() / out / "report.json"));
+}
+
 }  // namespace
 
 // Links climb along the tool axis: with an axis 60 deg from vertical and the travel plane 100 mm
@@ -160,9 +168,7 @@ TEST(GenerateLinks, AFarLinkIsTheEndWhoseClimbRunsFar) {
             "obstacles:\n  - mesh: shelf.stl\npart: floor.stl\n"
             "tool: { shape: ball, radius: 3, length: 12 }\nclearance: 0.5\n"
             "path: { nominal: p.cl }\nlinks: { retract: 2 }\n");
-  const auto r = test::runFieldpath(dir, "generate scene.yaml --nominal --out out");
-  ASSERT_EQ(r.exit_code, 0) << r.output();
-  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out/report.json"));
+  const nlohmann::json report = generateNominal(dir, "scene.yaml", "out");
   bool out_of_1_routed = false;
   for (const auto& end : report["links"]["routed_off_axis"])
     out_of_1_routed |= end["pass"] == 1 && end["end"] == "out of";
@@ -187,9 +193,7 @@ TEST(GenerateLinks, AFarLinkIsTheEndWhoseClimbRunsFar) {
             "obstacles:\n  - mesh: shelf1.stl\npart: floor1.stl\n"
             "tool: { shape: ball, radius: 3, length: 12 }\nclearance: 0.5\n"
             "path: { nominal: one.cl }\nlinks: { retract: 2 }\n");
-  const auto first = test::runFieldpath(dir, "generate one.yaml --nominal --out one");
-  ASSERT_EQ(first.exit_code, 0) << first.output();
-  const auto one_report = nlohmann::json::parse(test::slurp(dir.path() / "one/report.json"));
+  const nlohmann::json one_report = generateNominal(dir, "one.yaml", "one");
   ASSERT_EQ(one_report["link_notes"].size(), 1u) << one_report["link_notes"];
   const std::string into = one_report["link_notes"][0];
   EXPECT_NE(into.find("the links climb to the travel plane (the way into pass 1 (one.cl:2) off "
