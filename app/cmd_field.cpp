@@ -86,8 +86,7 @@ struct Obstacles {
 
 Obstacles loadObstacles(const FieldOptions& o) {
   // The sub-command's --max-memory is the limit of every estimate, the scene's included.
-  if (!o.max_memory.empty())
-    common::setMemoryLimitBytes(common::parseMemorySize(o.max_memory, "--max-memory"));
+  if (!o.max_memory.empty()) common::limitMemory(o.max_memory, "--max-memory");
   Obstacles result{loadScene(o.scene), nullptr, 0.0};
   const auto start = std::chrono::steady_clock::now();
   const Scene& s = result.scene;

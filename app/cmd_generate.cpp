@@ -193,6 +193,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     const Scene scene = loadScene(options->scene);
     common::refuseOutputsOverInputs(options->out,
                                     {"path.cl", "path.apt", "angles.csv", "report.json"}, "--out");
+    requirePostures(scene, common::MemoryUse::kKept);  // held to the end (the field after them)
     pathgen::GenerateRequest job = sceneJob(scene);
     const double read_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();

@@ -74,7 +74,8 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
   request.impeller = scene.impeller_model->params();
   if (o.sample_step_mm > 0.0) request.job.field.sample_step_mm = o.sample_step_mm;
   // What the options drive, estimated before any work (loadScene did the scene's own keys).
-  if (o.sample_step_mm > 0.0) checkSampleStep(scene, o.sample_step_mm, "--sample-step");
+  if (o.sample_step_mm > 0.0)
+    checkSampleStep(scene, o.sample_step_mm, "--sample-step", common::MemoryUse::kPassing);
   for (double h : request.voxel_sizes_mm)
     checkVoxelSize(scene, h, "--voxels " + study_detail::number(h));
   request.progress = makeProgressLine(global.quiet);

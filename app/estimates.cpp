@@ -126,16 +126,18 @@ double sampleCount(const Scene& scene, double step_mm) {
 
 void checkImpellerSize(const pathgen::Impeller& impeller, const std::string& where) {
   const double triangles = static_cast<double>(impeller.meshTriangleCount());
-  common::requireMemory(where + "obstacles.impeller.chord_tol",
-                        triangles * kBytesPerMeshTriangle,
+  // Passing: the meshes, once made, are held as the scene's obstacles (checkSceneSize).
+  common::requireMemory(where + "obstacles.impeller.chord_tol", triangles * kBytesPerMeshTriangle,
                         fmt(triangles) + " triangles in the hub and blade meshes at chord_tol " +
-                            fmt(impeller.params().chord_tol_mm) + " mm");
+                            fmt(impeller.params().chord_tol_mm) + " mm",
+                        common::MemoryUse::kPassing);
 }
 
-void checkSampleStep(const Scene& scene, double step_mm, const std::string& key) {
+void checkSampleStep(const Scene& scene, double step_mm, const std::string& key,
+                     common::MemoryUse use) {
   const double samples = sampleCount(scene, step_mm);
   common::requireMemory(scene.file.string() + ": " + key, samples * kBytesPerSample,
-                        fmt(samples) + " obstacle samples at " + fmt(step_mm) + " mm");
+                        fmt(samples) + " obstacle samples at " + fmt(step_mm) + " mm", use);
 }
 
 void checkSceneSize(const Scene& scene) {
@@ -146,7 +148,9 @@ void checkSceneSize(const Scene& scene) {
   common::requireMemory(where + "obstacles", triangles * kBytesPerMeshTriangle,
                         fmt(triangles) + " mesh triangles with their collision hierarchies");
 
-  checkSampleStep(scene, scene.field.sample_step_mm, "field.sample_step");
+  // Passing: the samples are held by the field made of them, where a command makes one.
+  checkSampleStep(scene, scene.field.sample_step_mm, "field.sample_step",
+                  common::MemoryUse::kPassing);
 
   // field.r0 against the obstacles' extent: beyond it every sample acts on every node, the field
   // is no longer local and its cost (nodes × samples within r0) grows with r0³ for nothing.
@@ -180,23 +184,28 @@ void checkSceneSize(const Scene& scene) {
                  "the scene in metres?)\n",
                  scene.file.string().c_str(), tool_said.c_str(), fmt(span).c_str());
 
+  // Passing: generate holds them (holdPostures) where the other commands make none.
+  requirePostures(scene, common::MemoryUse::kPassing);
+}
+
+void requirePostures(const Scene& scene, common::MemoryUse use) {
   // Output postures: path.step against the passes' length (and path.passes).
   const PassLength length = passLength(scene);
   // A nominal path's postures one for one too (no path.step): 1 M of them ran past an accepted
   // --max-memory 78M to 0.8 GB at 45 % of the passes (a memory sweep's).
   const bool stepped = scene.path.step_given || scene.impeller_model;
-  if (length.total_mm > 0.0 && (stepped || scene.nominal)) {
-    const double postures = (stepped ? length.total_mm / scene.path.step_mm : 0.0) +
-                            2.0 * length.passes + static_cast<double>(length.input_postures);
-    const std::string key = scene.guide_impeller ? "path.step (with path.passes)"
-                            : stepped            ? "path.step"
-                                                 : "path.nominal";
-    common::requireMemory(where + key, postures * kBytesPerPosture,
-                          fmt(postures) + " postures: " +
-                              (stepped ? fmt(length.total_mm) + " mm of passes every " +
-                                             fmt(scene.path.step_mm) + " mm"
-                                       : std::string("the nominal path's, one for one")));
-  }
+  if (!(length.total_mm > 0.0) || !(stepped || scene.nominal)) return;
+  const double postures = (stepped ? length.total_mm / scene.path.step_mm : 0.0) +
+                          2.0 * length.passes + static_cast<double>(length.input_postures);
+  const std::string key = scene.guide_impeller ? "path.step (with path.passes)"
+                          : stepped            ? "path.step"
+                                               : "path.nominal";
+  common::requireMemory(
+      scene.file.string() + ": " + key, postures * kBytesPerPosture,
+      fmt(postures) + " postures: " +
+          (stepped ? fmt(length.total_mm) + " mm of passes every " + fmt(scene.path.step_mm) + " mm"
+                   : std::string("the nominal path's, one for one")),
+      use);
 }
 
 double estimatePostures(const std::filesystem::path& file) {
@@ -264,9 +273,11 @@ void checkVoxelSize(const Scene& scene, double voxel_mm, const std::string& key)
   const double box_volume = size.x() * size.y() * size.z();
   const double shell_volume = obstacleArea(scene) * 2.0 * r0;
   const double nodes = std::min(box_volume, shell_volume) / (voxel_mm * voxel_mm * voxel_mm);
+  // Passing: the field built holds its own bytes while it lives (field::VoxelField).
   common::requireMemory(scene.file.string() + ": " + key, nodes * field::kVoxelBytesPerNode,
-                        fmt(nodes) + " voxel nodes within r0 = " + fmt(r0) + " mm of the obstacles at h = " +
-                            fmt(voxel_mm) + " mm");
+                        fmt(nodes) + " voxel nodes within r0 = " + fmt(r0) +
+                            " mm of the obstacles at h = " + fmt(voxel_mm) + " mm",
+                        common::MemoryUse::kPassing);
 }
 
 }  // namespace fieldpath::app

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string>
 
+#include "fieldpath/common/memory.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/pathgen/impeller.h"
 #include "scene.h"
@@ -35,9 +36,14 @@ void checkImpellerSize(const pathgen::Impeller& impeller, const std::string& whe
 /// postures (`path.step`, `path.passes` against the passes' length).
 void checkSceneSize(const Scene& scene);
 
+/// The output postures of generate (`path.step`, `path.passes` against the passes' length, or a
+/// nominal path's one for one); `use`: held by generate, previewed by loadScene.
+void requirePostures(const Scene& scene, common::MemoryUse use);
+
 /// The obstacle samples at `step_mm` (the scene's `field.sample_step` or an option overriding it,
-/// named by `key`).
-void checkSampleStep(const Scene& scene, double step_mm, const std::string& key);
+/// named by `key`); `use`: held for the run, or a study's variant's made and dropped.
+void checkSampleStep(const Scene& scene, double step_mm, const std::string& key,
+                     common::MemoryUse use);
 
 /// The uniform voxel grid of `field.voxel_size` (or `--voxel`) = `voxel_mm`: the shell within r0
 /// of the obstacles, at most their box padded by r0 (the field module estimates refinement).

@@ -101,9 +101,7 @@ int main(int argc, char** argv) {
                  "machine's available memory)");
   app.parse_complete_callback([&max_memory, &global] {
     fieldpath::app::progressQuiet() = global.quiet;
-    if (!max_memory.empty())
-      fieldpath::common::setMemoryLimitBytes(
-          fieldpath::common::parseMemorySize(max_memory, "--max-memory"));
+    if (!max_memory.empty()) fieldpath::common::limitMemory(max_memory, "--max-memory");
   });
 
   addToolCommand(app, global);

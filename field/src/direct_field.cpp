@@ -48,6 +48,9 @@ DirectField::DirectField(ObstacleSamples samples, const FieldParams& params)
   index_->transform = openvdb::math::Transform::createLinearTransform(params.r0_mm);
   index_->grid = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(
       index_->positions, *index_->transform);
+  // Point, normal, weight (56 B) grown by push_back (x 2) and the point index, rounded up: as
+  // app/estimates.h's kBytesPerSample.
+  index_->held = common::HeldMemory("the obstacle samples", 128.0 * double(index_->samples.size()));
 }
 
 DirectField::~DirectField() = default;

@@ -12,6 +12,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/PointIndexGrid.h>
 
+#include "fieldpath/common/memory.h"
 #include "fieldpath/field/direct_field.h"
 #include "fieldpath/field/law.h"
 
@@ -58,6 +59,9 @@ struct DirectField::Index {
   SamplePositions positions;
   openvdb::math::Transform::Ptr transform;  ///< index voxels of r0 (a search visits 3³ of them)
   openvdb::tools::PointIndexGrid::Ptr grid;
+  /// The samples' bytes, held against --max-memory while the field lives (a study's variants of
+  /// other sample steps are made and dropped).
+  common::HeldMemory held;
 
   using Iterator = openvdb::tools::PointIndexIterator<openvdb::tools::PointIndexTree>;
   using Accessor = openvdb::tree::ValueAccessor<const openvdb::tools::PointIndexTree>;

@@ -432,16 +432,20 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
   trace.lap("cell list");
   const double reach_mm = builder.reach_mm;
 
-  const double limit_bytes = static_cast<double>(
-      request.max_memory_bytes ? request.max_memory_bytes : common::memoryLimitBytes());
+  // What the run's meshes, samples and postures leave (common::memoryLeftBytes), or the request's.
+  const double limit_bytes =
+      request.max_memory_bytes ? double(request.max_memory_bytes) : common::memoryLeftBytes();
   auto refuse = [&](const std::string& what, double nodes, double bytes_per_node,
-                    const std::string& advice = "use a coarser voxel size") {
-    const double bytes = nodes * bytes_per_node;
+                    const std::string& advice = "use a coarser voxel size",
+                    double list_bytes = 0.0) {
+    const double bytes = nodes * bytes_per_node + list_bytes;
     if (bytes <= limit_bytes) return;
-    throw common::InputError("voxel field at h = " + common::shortNumber(h) + " mm: " + what + " " +
-                             std::to_string(static_cast<long long>(nodes)) + " nodes (" +
-                             mib(bytes) + "), over the limit of " + mib(limit_bytes) +
-                             " (--max-memory, else the memory available); " + advice);
+    throw common::InputError(
+        "voxel field at h = " + common::shortNumber(h) + " mm: " + what + " " +
+        std::to_string(static_cast<long long>(nodes)) + " nodes (" + mib(bytes) + "), over " +
+        (request.max_memory_bytes ? "the limit of " + mib(limit_bytes)
+                                  : "what is left" + common::memoryLimitText()) +
+        "; " + advice);
   };
   const std::string refine_advice =
       "raise field.refine_tolerance or lower field.refine_levels (or a coarser voxel size)";
@@ -530,9 +534,14 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
       // new nodes a split cell (the whole build reached 21 GB before the refusal below).
       double levels_nodes = 0.0;  // the levels built so far
       for (const Level& level : levels) levels_nodes += double(level.grid->activeVoxelCount());
+      // With the cell lists beside them: the cells tested (a split byte and a rank each), the
+      // split cells and their halves (a 1 G limit was passed by 15 % without them).
+      const double cell_bytes = double(sizeof(CellIjk));
+      const double list_bytes = double(cells.size()) * (cell_bytes + 1.0 + sizeof(std::size_t)) +
+                                9.0 * double(splits) * cell_bytes;
       refuse("refined level " + std::to_string(l + 1) + " makes at least",
              levels_nodes + 8.0 * double(splits), kVoxelBytesPerNode * value_bytes / 12.0,
-             refine_advice);
+             refine_advice, list_bytes);
       CellList split_cells(splits), next_cells(8 * splits);
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells.size()), [&](const auto& range) {
         for (std::size_t c = range.begin(); c != range.end(); ++c) {
@@ -555,7 +564,7 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
       // All levels so far and the new one, at the estimate's bytes per node.
       const double built_nodes = levels_nodes + double(fine_nodes->activeVoxelCount());
       refuse("refined level " + std::to_string(l + 1) + " makes", built_nodes,
-             kVoxelBytesPerNode * value_bytes / 12.0, refine_advice);
+             kVoxelBytesPerNode * value_bytes / 12.0, refine_advice, list_bytes);
       Level fine;
       fine.h_mm = 0.5 * hl;
       const double share_begin = level0_share + (1.0 - level0_share) * l / refine_levels;

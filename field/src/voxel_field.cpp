@@ -15,6 +15,7 @@
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/memory.h"
 #include "node_cuda.h"
 #include "voxel_grid.h"
 
@@ -326,6 +327,9 @@ struct VoxelField::Impl {
   Interpolation interpolation = Interpolation::Trilinear;
   StoredQuantity stored = StoredQuantity::Force;
   std::optional<PlaneLaw> law;  ///< PlaneRatio
+  /// The levels' bytes, held against --max-memory while the field lives (a study's grids are
+  /// built one after another; a job's is held through its steering and checks).
+  common::HeldMemory held;
 };
 
 VoxelRequest levelZeroRequest(const VoxelRequest& refined, double r_min_mm) {
@@ -347,6 +351,7 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request, V
             u.stored != request.stored || u.interpolation != request.interpolation)
           throw std::invalid_argument(
               "VoxelField: the uniform grid to refine is not this request's level 0");
+        u.held.release();  // its level 0 moves into the refined field, counted there
         return &u.levels[0];
       }()) {}
 
@@ -367,6 +372,7 @@ VoxelField::VoxelField(const DirectField& direct, const VoxelRequest& request, L
     stats.active_nodes += level.grid->activeVoxelCount();
     stats.memory_bytes += level.memUsage();
   }
+  impl_->held = common::HeldMemory("the voxel field", double(stats.memory_bytes));
   const openvdb::CoordBBox active_box = levels[0].grid->evalActiveVoxelBoundingBox();
   stats.dense_box_nodes = active_box.empty() ? 0 : active_box.volume();
   stats.build_seconds =

@@ -360,8 +360,10 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
   if (startsWithByteOrderMark(file, size)) return loadWithoutByteOrderMark(file);
   // assimp's scene, our joined copy and the hash that joins them: about 16 bytes per file byte
   // (a binary STL's 50-byte facet becomes 3 aiVector3D, a face, 3 map entries, 1.5 vertices).
-  common::requireMemory(file.string(), 16.0 * static_cast<double>(size), "mesh file of " +
-                        std::to_string(size >> 20) + " MiB");
+  // Passing: the mesh loaded is held as a scene's (app/estimates.h: its triangles).
+  common::requireMemory(file.string(), 16.0 * static_cast<double>(size),
+                        "mesh file of " + std::to_string(size >> 20) + " MiB",
+                        common::MemoryUse::kPassing);
   detail::checkPly(file, size);
   const StlFeed stl = checkStl(file, size);
 

@@ -152,7 +152,8 @@ std::vector<Stamp> stampsNearPart(std::span<const Posture> postures, const Part&
   common::requireMemory("the cutter's test against the part",
                         (count + double(postures.size())) * double(sizeof(Stamp)),
                         common::shortNumber(count) + " stamps along the motions, " +
-                            common::shortNumber(step_mm) + " mm apart");
+                            common::shortNumber(step_mm) + " mm apart",
+                        common::MemoryUse::kPassing);
   std::vector<Stamp> out;
   out.reserve(postures.size());
   for (std::size_t i = 0; i < postures.size(); ++i) {

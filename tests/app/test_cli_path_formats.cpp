@@ -278,15 +278,16 @@ TEST(SimulateFormats, BadClLineAfterManyBlocksIsOneLineAndNoOutputs) {
     EXPECT_NE(run.err.find("big.cl:4321"), std::string::npos) << run.err;
     EXPECT_FALSE(fs::exists(dir.path() / "out")) << extra;
   }
-  // 60000 postures of 32 bytes (1.9 MB) against a 1 MiB limit: refused before reading, naming
-  // the file and the estimate
+  // 3.5 M postures of 32 bytes (its lines' length and its 40 MiB; the rest sparse) against a
+  // 100 MiB limit that the program (~42 MiB) leaves less of: refused before reading, naming the
+  // file and the estimate
   std::string many;
   for (int i = 0; i < 60000; ++i) many += "1 2 3 0 0 1\n";
-  dir.write("many.cl", many);
+  fs::resize_file(dir.write("many.cl", many), 40 << 20);
   const Outcome big =
-      runFieldpath(dir, "--max-memory 1M simulate --tool ball:1 --path many.cl --out out");
+      runFieldpath(dir, "--max-memory 100M simulate --tool ball:1 --path many.cl --out out");
   EXPECT_EQ(big.exit_code, 1) << big.err;
-  EXPECT_NE(big.err.find("--path many.cl: needs about 1.83 MiB"), std::string::npos) << big.err;
+  EXPECT_NE(big.err.find("--path many.cl: needs about 107 MiB"), std::string::npos) << big.err;
   EXPECT_FALSE(fs::exists(dir.path() / "out"));
 }
 
@@ -331,9 +332,9 @@ TEST(InputSizes, FilesReadWholeAreSizedBeforeTheRead) {
   struct Case {
     std::string args, message;
   };
-  std::string many;  // 60000 postures: ~14.6 MiB held
+  std::string many;  // 3.5 M postures by its lines' length and its 40 MiB (the rest sparse)
   for (int i = 0; i < 60000; ++i) many += "1 2 3 0 0 1\n";
-  dir.write("many.cl", many);
+  fs::resize_file(dir.write("many.cl", many), 40 << 20);
   // 60000 postures a generate steers one for one: ~3 KB each (a 1 M posture path ran past an
   // accepted --max-memory 78M to 0.8 GB: a memory sweep's), refused before the work.
   std::string steered;
@@ -349,8 +350,8 @@ TEST(InputSizes, FilesReadWholeAreSizedBeforeTheRead) {
       {"generate s.yaml --out g", "s.yaml:4: path.nominal: huge.cl: NUL bytes near its start"},
       {"check s.yaml --path huge.cl", "huge.cl: NUL bytes near its start"},
       {"convert huge.cl h.npy", "huge.cl: NUL bytes near its start"},
-      {"--max-memory 1M check s.yaml --path many.cl", "--path many.cl: needs about 14.6 MiB"},
-      {"--max-memory 1M convert many.cl h.npy", "many.cl: needs about 14.6 MiB"},
+      {"--max-memory 100M check s.yaml --path many.cl", "--path many.cl: needs about 853 MiB"},
+      {"--max-memory 100M convert many.cl h.npy", "many.cl: needs about 853 MiB"},
       {"generate huge.yaml --out g", "huge.yaml: 1 GiB: not a scene file"},
       {"--max-memory 1G field probe s.yaml --points points.txt", "--points points.txt: needs"}};
   for (const Case& c : cases) {

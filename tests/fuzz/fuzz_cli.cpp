@@ -20,6 +20,7 @@ std::string line(std::string_view& rest) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  fieldpath::common::releaseHeldMemory();  // each input a run of its own (--max-memory)
   using namespace fieldpath;
   std::string_view rest = fuzz::view(data, size);
   const std::string grid = line(rest), region = line(rest), tool = line(rest), memory = line(rest);

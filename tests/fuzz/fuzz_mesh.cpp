@@ -10,6 +10,7 @@
 #include "fuzz_support.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  fieldpath::common::releaseHeldMemory();  // each input a run of its own (--max-memory)
   using namespace fieldpath;
   if (size < 1) return 0;
   const char* names[] = {"mesh.stl", "mesh.obj", "mesh.ply", "mesh.stl"};

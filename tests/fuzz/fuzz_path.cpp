@@ -62,6 +62,7 @@ std::string outcome(const std::filesystem::path& file, const geometry::PathReadO
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  fieldpath::common::releaseHeldMemory();  // each input a run of its own (--max-memory)
   if (size < 1) return 0;
   const char* ext[] = {"path.cl", "path.apt", "path.npy"};
   const auto file = fuzz::writeScratch(ext[FIELDPATH_FUZZ_FORMAT], fuzz::view(data + 1, size - 1));

@@ -41,6 +41,7 @@ std::string npyPath() {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  fieldpath::common::releaseHeldMemory();  // each input a run of its own (--max-memory)
   using namespace fieldpath;
   static const bool files_ready = [] {
     fuzz::writeScratch("m.stl", kTetraStl);

@@ -33,6 +33,7 @@ double spacingForFewNodes(const fieldpath::geometry::ToolSpec& tool,
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  fieldpath::common::releaseHeldMemory();  // each input a run of its own (--max-memory)
   using namespace fieldpath;
   const std::string_view text = fuzz::view(data, size);
   const auto cut = text.find('\n');
