@@ -25,7 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-// Bits of the page's per-posture flags (view.js reads the same).
+// Bits of the page's per-posture flags (view.js, panel.js and state.js read the same).
 constexpr std::uint8_t kLink = 1, kLimited = 2, kColliding = 4, kMotionColliding = 8,
                        kBlockStart = 16, kPartContact = 32, kMotionPartContact = 64;
 
@@ -382,7 +382,8 @@ std::string viewPage(const ViewData& d, const ThreeJs& three, const PageBudget& 
   const std::string meta_text = scriptJson(meta), blob_text = base64(blob.bytes());
   const std::string title_text = htmlEscape(title), generator_text = htmlEscape(generator);
   const std::string css = view_assets::kViewCss, colours = view_assets::kColoursJs,
-                    geometry = view_assets::kGeometryJs, js = view_assets::kViewJs;
+                    geometry = view_assets::kGeometryJs, js = view_assets::kViewJs,
+                    panel = view_assets::kPanelJs, page_state = view_assets::kStateJs;
   const std::string page = fill(view_assets::kPageHtml, {{"GENERATOR", &generator_text},
                                                          {"TITLE", &title_text},
                                                          {"CSS", &css},
@@ -392,7 +393,9 @@ std::string viewPage(const ViewData& d, const ThreeJs& three, const PageBudget& 
                                                          {"ORBIT", &three.orbit_controls},
                                                          {"COLOURSJS", &colours},
                                                          {"GEOMETRYJS", &geometry},
-                                                         {"VIEWJS", &js}});
+                                                         {"VIEWJS", &js},
+                                                         {"PANELJS", &panel},
+                                                         {"STATEJS", &page_state}});
   st.bytes = page.size();
   if (stats) *stats = st;
   return page;
