@@ -47,6 +47,11 @@ function rectOf(id) {
 function writeState() {
   state.ready = true;
   state.first_frame_ms = state.first_frame_ms || null;
+  if (!renderer) {  // no WebGL: nothing below was built; what the page says is the banner
+    state.errors = window.fpErrors;
+    document.getElementById('fp-state').textContent = JSON.stringify(state);
+    return;
+  }
   state.triangles = renderer.info.render.triangles;
   state.draw_calls = renderer.info.render.calls;
   state.canvas = rectOf('fp-view');

@@ -167,7 +167,7 @@ if (path) {
 }
 var F_LINK = 1, F_LIMITED = 2, F_COLLIDING = 4, F_MOTION_COLLIDING = 8, F_BLOCK_START = 16,
     F_PART = 32, F_MOTION_PART = 64;  // a link or the holder touching the part (not an obstacle)
-var PART_COLOUR = 0xe040fb;
+var PART_MARK_COLOUR = 0xe040fb;      // postures and motions touching the part
 var colourModes = {};
 if (P) {
   var range = function (values) {
@@ -259,8 +259,8 @@ function buildPath() {
   }
   points(F_LIMITED, 0xff9f1c, 7);
   points(F_COLLIDING, 0xff2a1a, 6);
-  points(F_PART, PART_COLOUR, 6);
-  [[hit, 0xff2a1a], [partHit, PART_COLOUR]].forEach(function (h) {
+  points(F_PART, PART_MARK_COLOUR, 6);
+  [[hit, 0xff2a1a], [partHit, PART_MARK_COLOUR]].forEach(function(h) {
     if (!h[0].length) return;
     var motionLines = new THREE.LineSegments(segments(h[0]),
         new THREE.LineBasicMaterial({ color: h[1], depthTest: false }));
@@ -301,6 +301,7 @@ if (P) {
 }
 if (hash.frame in frames) frame = hash.frame;
 
+mark('path');
 // ---------------------------------------------------------------- tool + holder
 var tool = null;
 (function() {
@@ -316,7 +317,6 @@ var tool = null;
   };
 })();
 
-mark('path');
 // ---------------------------------------------------------------- surface
 var surface = meta.surface, surfaceMap = null;
 if (surface) {
