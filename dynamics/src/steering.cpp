@@ -509,6 +509,7 @@ SettledStart settleAtStart(const Pass& pass, const SteeringRequest& request) {
       out.why = chunk.message.empty() ? "no sample" : chunk.message;
       return out;
     }
+    out.stations += chunk.samples.size();
     const PostureSample& end = chunk.samples.back();
     const double moved = std::max(std::abs(end.lead_rad - *run.initial_lead_rad),
                                   std::abs(end.tilt_rad - *run.initial_tilt_rad));

@@ -103,6 +103,10 @@ TEST(SettledStart, ASlowDecayIsSettledInBoundedWork) {
   const SettledStart slow = settleAtStart(straightPass(10.0), request);
   ASSERT_TRUE(slow.settled) << slow.why;
   EXPECT_NEAR(slow.tilt_rad, staticTilt(*wall, request.params.stiffness, 0.0, 0.6), 1e-6);
+  // The work: at most kSettleStations (and the chunk's end) a decay, where the pass's 0.5 mm
+  // would make 3334 of them.
+  EXPECT_GT(slow.stations, 0u);
+  EXPECT_LE(double(slow.stations), kSettleDecays * (kSettleStations + 2.0));
 
   request.params.inertia = 1.0;
   request.params.damping = 1e-9;  // a decay of 2e9 s

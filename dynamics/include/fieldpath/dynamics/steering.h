@@ -121,6 +121,8 @@ struct SettledStart {
   bool settled = false;
   double lead_rad = 0.0, tilt_rad = 0.0;
   std::string why;
+  std::size_t stations =
+      0;  ///< the stations integrated on the way (the work kSettleStations bounds)
 };
 constexpr double kSettleDecays = 20.0;
 constexpr double kSettledRad = 1e-7;  ///< 6e-6 deg: far below DESIGN's 0.01 deg
