@@ -32,6 +32,7 @@
 #include "generate_report.h"
 #include "job.h"
 #include "json_text.h"
+#include "obstacle_reach.h"
 #include "progress.h"
 #include "scene.h"
 
@@ -299,6 +300,10 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (std::string holder = noHolderNote(scene.tool, scene.holder); !holder.empty())
       notes.tool.push_back(std::move(holder));
     notes.obstacle = openObstacleNotes(scene);
+    if (std::string reach = obstaclesOutOfReachNote(
+            scene, obstaclesOutOfReach(scene, result.path, scene.field.r0_mm), scene.field.r0_mm);
+        !reach.empty() && !options->nominal)  // (--nominal: nothing steers)
+      notes.obstacle.push_back(std::move(reach));
     if (std::string far = farLinkNote(scene, result); !far.empty())
       notes.link.push_back(std::move(far));
     nlohmann::json report = reportJson(scene, job, result, axis_turn, notes);

@@ -524,3 +524,49 @@ TEST(GenerateEdges, PassesBesideThePartAreSaid) {
   EXPECT_EQ(off_check["far_postures"].get<int>(), 29) << off_check;
   EXPECT_EQ(o.err.find("keep the ball more than"), std::string::npos) << o.err;
 }
+
+// An obstacle farther than field.r0 from the tool at every posture steers nothing (eq. 1 ends at
+// r0): blades in inches floating in the mesh impeller's bore, the path over the hub in mm, read
+// `safe` with the nominal axes, unsaid (a units adversary's). A post beside passes along x
+// (x <= 1.5, the ball R 0.5: the tool's box reaches x = 2) steers; a box at x = 50 is at least
+// 48 mm away: said, by its entry; alone, the path is said to be the nominal one.
+TEST(GenerateEdges, ObstaclesOutOfTheFieldsReachAreSaid) {
+  const TempDir dir;
+  geometry::TriangleMesh plate, post, far;
+  pathgen::test::addBox(plate, -2, 2, -2, 2, -0.5, 0);
+  pathgen::test::addBox(post, 2.5, 3, -2, 2, -0.5, 1);
+  pathgen::test::addBox(far, 50, 51, -2, 2, -0.5, 1);
+  geometry::saveMesh(plate, dir.path() / "plate.stl");
+  geometry::saveMesh(post, dir.path() / "post.stl");
+  geometry::saveMesh(far, dir.path() / "far.stl");
+  std::ostringstream cl;
+  for (int i = -3; i <= 3; ++i) cl << 0.5 * i << " 1 0 0 0 1\n";
+  dir.write("p.cl", cl.str());
+  const std::string rest =
+      "part: plate.stl\ntool: { shape: ball, radius: 0.5, length: 10 }\nclearance: 0.05\n"
+      "field: { r0: 1.0, r_min: 0.05, sample_step: 0.1, voxel_size: 0.1 }\n"
+      "path: { nominal: p.cl }\n";
+  struct Case {
+    std::string obstacles, said;
+  };
+  for (const Case& c :
+       {Case{"  - mesh: post.stl\n", ""},
+        Case{"  - mesh: post.stl\n  - mesh: far.stl\n",
+             "obstacles[2] (far.stl, at least 48 mm away) stays farther than field.r0 (1 mm) from "
+             "the tool and holder at every posture: it steered nothing"},
+        Case{"  - mesh: far.stl\n",
+             "obstacles[1] (far.stl, at least 48 mm away) stays farther than field.r0 (1 mm) from "
+             "the tool and holder at every posture: no obstacle steered the path"}}) {
+    dir.write("scene.yaml", "obstacles:\n" + c.obstacles + rest);
+    const auto r = test::runFieldpath(dir, "generate scene.yaml --out out");
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out/report.json"));
+    const std::string notes = report["obstacle_notes"].dump();
+    if (c.said.empty()) {
+      EXPECT_EQ(r.output().find("farther than field.r0"), std::string::npos) << r.output();
+    } else {
+      EXPECT_NE(r.output().find(c.said), std::string::npos) << r.output();
+      EXPECT_NE(notes.find(c.said), std::string::npos) << notes;
+    }
+  }
+}
