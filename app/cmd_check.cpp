@@ -218,6 +218,17 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                            ": CUTCOM/ (the control's cutter offset) is read past: the path is "
                            "checked where it is written, not where the offset puts the tool");
     const pathgen::AxisTurn axis_turn = pathgen::largestAxisTurn(path, scene.tool.radius_mm);
+    SurfaceRequest surface_request;
+    if (scene.part) {
+      surface_request.part = &*scene.part;
+      surface_request.path = &path;
+      surface_request.tool = scene.tool;
+      surface_request.spacing_mm = options->spacing_mm;
+      surface_request.gouge_tolerance_um = options->gouge_tol_um;
+      surface_request.backend = backend;
+      surface_request.progress = progress;
+      surfaceGrid(surface_request);  // its grid refused now, not after the clearance work
+    }
 
     // (a) exact clearance of postures and motions
     const geometry::TriangleMesh tool_mesh =
@@ -245,17 +256,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
 
     // (b) the machined part
     std::optional<SurfaceResult> surface;
-    if (scene.part) {
-      SurfaceRequest request;
-      request.part = &*scene.part;
-      request.path = &path;
-      request.tool = scene.tool;
-      request.spacing_mm = options->spacing_mm;
-      request.gouge_tolerance_um = options->gouge_tol_um;
-      request.backend = backend;
-      request.progress = progress;
-      surface = checkSurface(request);
-    }
+    if (scene.part) surface = checkSurface(surface_request);
     // A path that never cuts the stock over the part (another frame or units, a path over
     // another part) left only the stock's figures: 2000 um of 'scallop' and ok read as a check.
     const bool never_cut = surface && surface->part_cut_lines == 0;

@@ -281,7 +281,7 @@ void gougeDepthsToAir(const zbuffer::Grid& grid, const std::vector<float>& top_m
 
 }  // namespace
 
-std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
+std::optional<SurfaceGrid> surfaceGrid(const SurfaceRequest& request) {
   const geometry::TriangleMesh& part = *request.part;
   const geometry::PathFile& path = *request.path;
   const double radius = request.tool.radius_mm;
@@ -309,7 +309,7 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   passes_box.max().array() += radius;
   Eigen::AlignedBox2d region = passes_box.intersection(part_box);
   if (region.isEmpty() || !(region.sizes().minCoeff() > 0.0)) return std::nullopt;
-  SurfaceResult result;
+  SurfaceGrid result;
   double spacing = request.spacing_mm;
   if (!(spacing <= region.sizes().maxCoeff())) {
     char text[160];
@@ -334,11 +334,25 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
   region = passes_box.intersection(part_margin);
   const int nx = std::max(2, static_cast<int>(std::ceil(region.sizes().x() / spacing)));
   const int ny = std::max(2, static_cast<int>(std::ceil(region.sizes().y() / spacing)));
+  result.grid =
+      zbuffer::Grid::fromRegion(region.min().x(), region.min().y(), region.min().x() + nx * spacing,
+                                region.min().y() + ny * spacing, nx, ny);
+  result.spacing_mm = spacing;
+  zbuffer::checkGridFits(result.grid);
+  return result;
+}
+
+std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
+  const geometry::TriangleMesh& part = *request.part;
+  const geometry::PathFile& path = *request.path;
+  const double radius = request.tool.radius_mm;
+  const std::optional<SurfaceGrid> plan = surfaceGrid(request);
+  if (!plan) return std::nullopt;
+  SurfaceResult result;
+  result.coarsened = plan->coarsened;
+  const double spacing = plan->spacing_mm;
   zbuffer::SimulationRequest sim;
-  sim.grid = zbuffer::Grid::fromRegion(region.min().x(), region.min().y(),
-                                       region.min().x() + nx * spacing,
-                                       region.min().y() + ny * spacing, nx, ny);
-  zbuffer::checkGridFits(sim.grid);
+  sim.grid = plan->grid;
   sim.tool = request.tool.shape == geometry::ToolShape::Ball
                  ? zbuffer::Tool::ball(radius, request.tool.length_mm)
              : request.tool.shape == geometry::ToolShape::Torus

@@ -82,6 +82,17 @@ struct SurfaceResult {
   std::size_t beneath_lines = 0, beneath_unmeasured = 0;
 };
 
+/// The Z-buffer's lines over what the passes reach of the part: the grid, its spacing (mm), and
+/// whether it was widened to stay within kMaxSurfaceLines; nothing when the passes do not pass
+/// over the part. Checked against the memory left (zbuffer::checkGridFits), so that check can
+/// refuse it before its clearance work (a grid refused after minutes of it: a memory sweep's).
+struct SurfaceGrid {
+  zbuffer::Grid grid;
+  double spacing_mm = 0.0;
+  bool coarsened = false;
+};
+std::optional<SurfaceGrid> surfaceGrid(const SurfaceRequest& request);
+
 /// Simulates and compares; nothing when the passes do not pass over the part (no surface to
 /// check: the clearance checks still stand).
 std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request);
