@@ -377,10 +377,11 @@ struct NodeBuilder {
 /// Auto: the GPU when one is there (and the program has CUDA), else the CPU.
 FieldBackend resolveBackend(FieldBackend wanted) {
   if (wanted == FieldBackend::Auto)
-    return kernel::cudaNodeBuildAvailable() ? FieldBackend::Cuda : FieldBackend::Cpu;
+    wanted = kernel::cudaNodeBuildAvailable() ? FieldBackend::Cuda : FieldBackend::Cpu;
   if (wanted == FieldBackend::Cuda && !kernel::cudaNodeBuildAvailable())
     throw common::InputError(
         "field.backend: cuda, but this program was built without CUDA or no GPU is present");
+  if (wanted == FieldBackend::Cuda) common::requireCudaContext();
   return wanted;
 }
 

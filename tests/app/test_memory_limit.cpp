@@ -77,6 +77,27 @@ TEST(MemoryLimit, AnObjectHoldsItsBytesWhileItLives) {
   EXPECT_EQ(refusal("grid", 99 * kMiB, MemoryUse::kPassing), "");
 }
 
+// The CUDA context's resident memory (measured on an H200: 101-156 MB over the CPU backend's
+// peak, in no estimate) is held once, before the GPU is first used; refused naming the backend.
+TEST(MemoryLimit, TheCudaContextIsHeldOnce) {
+  {
+    const LimitForTheTest limit(100 * kMiB);
+    try {
+      fieldpath::common::requireCudaContext();
+      ADD_FAILURE() << "160 MiB under a 100 MiB limit";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("the CUDA backend: needs about 160 MiB"),
+                std::string::npos)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find("--backend cpu spares it"), std::string::npos);
+    }
+  }
+  const LimitForTheTest limit(1024 * kMiB);
+  fieldpath::common::requireCudaContext();
+  fieldpath::common::requireCudaContext();
+  EXPECT_DOUBLE_EQ(fieldpath::common::memoryHeld().first, 160 * kMiB);
+}
+
 /// `fieldpath --quiet ARGS...` in `dir`; its exit code and peak resident memory (KiB, wait4).
 struct Peak {
   int exit_code = -1;

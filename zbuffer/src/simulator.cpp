@@ -357,6 +357,7 @@ SimulationResult run(const SimulationRequest& request, std::size_t expected_post
   if (backend == Backend::Auto) backend = cudaAvailable() ? Backend::Cuda : Backend::Cpu;
   if (backend == Backend::Cuda && !cudaAvailable())
     throw InputError("backend cuda: no CUDA device available (built without CUDA or no GPU)");
+  if (backend == Backend::Cuda) common::requireCudaContext();
 
   const auto entered = std::chrono::steady_clock::now();
   const int shift = request.tuning.tile_shift;
@@ -469,7 +470,10 @@ SimulationResult simulateBlocks(const SimulationRequest& request, const BlockSou
 
 void prepare(const Tool& tool, Backend backend) {
   const std::shared_ptr<const detail::ToolData> data = preparedTool(tool);
-  if (backend != Backend::Cpu && cudaAvailable()) detail::warmUpCuda(*data);
+  if (backend != Backend::Cpu && cudaAvailable()) {
+    common::requireCudaContext();  // before the context is made
+    detail::warmUpCuda(*data);
+  }
 }
 
 SimulationResult simulate(const SimulationRequest& request, std::span<const Posture> postures) {
