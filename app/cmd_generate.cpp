@@ -431,7 +431,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                    result.settle_failures.front().pass + 1,
                    result.settle_failures.front().why.c_str());
     for (const auto* list : {&notes.tool, &notes.obstacle, &notes.link})
-      for (const std::string& note : *list) std::printf("note: %s\n", note.c_str());
+      for (const std::string& note : *list) std::fprintf(stderr, "note: %s\n", note.c_str());
     // A lead in the file is not kept: n is ⊥ the feed, steered (the field) or written as it is
     // (--nominal: the written axes were up to 5.6 deg off the file's, unsaid: a helper's finding).
     if (scene.nominal) {
@@ -439,15 +439,17 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
       for (const pathgen::Pass& p : job.passes)
         if (!leanest || p.nominal_lean_deg > leanest->nominal_lean_deg) leanest = &p;
       if (leanest && leanest->nominal_lean_deg > kNoteLeanDeg)
-        std::printf(
-            "note: %s: the nominal axes lean along the feed by up to %.1f deg: %s from "
-            "the axis made square to the feed and path.lead_deg (%g deg), not from the "
-            "file's lead\n",
-            leanest->nominal_lean_at.c_str(), leanest->nominal_lean_deg,
-            job.nominal ? "the path is written" : "the steering starts", job.path.lead_deg);
+        std::fprintf(stderr,
+                     "note: %s: the nominal axes lean along the feed by up to %.1f deg: %s from "
+                     "the axis made square to the feed and path.lead_deg (%g deg), not from the "
+                     "file's lead\n",
+                     leanest->nominal_lean_at.c_str(), leanest->nominal_lean_deg,
+                     job.nominal ? "the path is written" : "the steering starts",
+                     job.path.lead_deg);
     }
     if (!result.settled_starts.empty() && job.dynamics.start == dynamics::StartPolicy::Auto)
-      std::printf(
+      std::fprintf(
+          stderr,
           "note: %zu pass%s (first: pass %d) started from the axis settled under the field "
           "at %s start: %s nominal start posture was within `clearance` of an obstacle "
           "(dynamics.start: auto; `nominal` starts there and collides)\n",
@@ -455,21 +457,23 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
           result.settled_starts.front() + 1, result.settled_starts.size() == 1 ? "its" : "their",
           result.settled_starts.size() == 1 ? "its" : "each one's");
     if (result.safe_z_proven_mm > 0.0)
-      std::printf("note: links.safe_z %g mm leaves the links within the checks' margin of "
-                  "`clearance` (the tool mesh's chordal tolerance, the motions' resolution): they "
-                  "may read as under it though clear; %.3f mm or more is proven clear\n",
-                  result.safe_z_mm, result.safe_z_proven_mm);
+      std::fprintf(stderr,
+                   "note: links.safe_z %g mm leaves the links within the checks' margin of "
+                   "`clearance` (the tool mesh's chordal tolerance, the motions' resolution): they "
+                   "may read as under it though clear; %.3f mm or more is proven clear\n",
+                   result.safe_z_mm, result.safe_z_proven_mm);
     if (result.turned_sheets > 0)
-      std::printf(
+      std::fprintf(
+          stderr,
           "note: %zu open obstacle surface%s faced away from the passes: turned to face them "
           "(the field pushes along the normals)\n",
           result.turned_sheets, result.turned_sheets == 1 ? "" : "s");
     if (result.voxel_outside_points > 0)
-      std::printf(
-          "note: %zu node positions fell outside where the voxels answer (the reach box; "
-          "with field.refine_region: path, near the first path) and were given the exact "
-          "field\n",
-          result.voxel_outside_points);
+      std::fprintf(stderr,
+                   "note: %zu node positions fell outside where the voxels answer (the reach box; "
+                   "with field.refine_region: path, near the first path) and were given the exact "
+                   "field\n",
+                   result.voxel_outside_points);
   });
 }
 

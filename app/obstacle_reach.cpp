@@ -3,11 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include <Eigen/Geometry>
-
-#include <cstdio>
 
 namespace fieldpath::app {
 namespace {
@@ -70,12 +69,12 @@ std::string obstaclesOutOfReachNote(const Scene& scene,
       break;
     }
     named += k == 0 ? "" : k + 1 == out_of_reach.size() ? " and " : ", ";
-    named += (i < scene.obstacle_files.size()
-                  ? "obstacles[" + std::to_string(i + 1) + "] (" +
-                        scene.obstacle_files[i].filename().string() + ", "
-                  : "the impeller's blade " + std::to_string(i + 1 - scene.obstacle_files.size()) +
-                        " (") +
-             "at least " + mm(out_of_reach[k].at_least_mm) + " mm away)";
+    named +=
+        (i < scene.obstacle_files.size() && i < scene.obstacle_keys.size()
+             ? scene.obstacle_keys[i] + " (" + scene.obstacle_files[i].filename().string() + ", "
+             : "the impeller's blade " + std::to_string(i + 1 - scene.obstacle_files.size()) +
+                   " (") +
+        "at least " + mm(out_of_reach[k].at_least_mm) + " mm away)";
   }
   const bool one = out_of_reach.size() == 1;
   const bool all = out_of_reach.size() == scene.obstacles.size();

@@ -55,6 +55,7 @@ void readObstacles(const Reader& r, const YAML::Node& node, Scene& scene,
                  "the same file as an obstacle before it (" + scene.obstacle_files[j].string() +
                      "): its field would count twice");
       scene.obstacle_files.push_back(file);
+      scene.obstacle_keys.push_back(key);
       loads.push_back({item["mesh"], key + ".mesh", false});
     } else {
       if (scene.impeller) r.fail(item, key + ".impeller", "the impeller is given twice");

@@ -26,6 +26,8 @@ struct Scene {
   /// then the impeller's blades once resolveImpeller has run.
   std::vector<geometry::TriangleMesh> obstacles;
   std::vector<std::filesystem::path> obstacle_files;  ///< the `- mesh:` files, resolved
+  /// Their keys in the scene's list (`obstacles[2]`: an impeller entry may come before them).
+  std::vector<std::string> obstacle_keys;
 
   /// `part:` the machined surface (a mesh file, loaded here), or the impeller's hub with
   /// `guide: { impeller: hub }` (once resolveImpeller has run). Never repels.

@@ -164,12 +164,12 @@ TEST(GenerateEdges, ANominalPathsLeadNotKeptIsSaidByBothRuns) {
             "path: { nominal: lean.cl }\n");
   const auto field = test::runFieldpath(dir, "generate scene.yaml --direct --out field");
   ASSERT_EQ(field.exit_code, 0) << field.output();
-  EXPECT_NE(field.out.find("lean along the feed by up to 10.0 deg: the steering starts"),
+  EXPECT_NE(field.err.find("lean along the feed by up to 10.0 deg: the steering starts"),
             std::string::npos)
-      << field.out;
+      << field.err;
   const auto nominal = test::runFieldpath(dir, "generate scene.yaml --nominal --out nominal");
   ASSERT_EQ(nominal.exit_code, 0) << nominal.output();
-  EXPECT_NE(nominal.out.find("lean along the feed by up to 10.0 deg: the path is written"),
+  EXPECT_NE(nominal.err.find("lean along the feed by up to 10.0 deg: the path is written"),
             std::string::npos)
       << nominal.out;
   // A pass of a nominal path has no channel coordinate: v is null with its reason beside it.
@@ -569,4 +569,19 @@ TEST(GenerateEdges, ObstaclesOutOfTheFieldsReachAreSaid) {
       EXPECT_NE(notes.find(c.said), std::string::npos) << notes;
     }
   }
+  // Named by its entry in the scene's list: after the impeller's, the box is obstacles[2] (the
+  // blades' meshes come after the files' in the scene's obstacles: it was called obstacles[1]).
+  std::string impeller =
+      test::slurp(fs::path(FIELDPATH_SOURCE_DIR) / "examples/impeller/scene.yaml");
+  const std::size_t guide = impeller.find("\nguide:");
+  ASSERT_NE(guide, std::string::npos);
+  geometry::TriangleMesh beyond;  // the channel runs along x from 0 to 72
+  pathgen::test::addBox(beyond, 500, 501, -2, 2, 0, 1);
+  geometry::saveMesh(beyond, dir.path() / "beyond.stl");
+  impeller.insert(guide + 1, "  - mesh: beyond.stl\n");
+  dir.write("impeller.yaml", impeller);
+  const auto r = test::runFieldpath(dir, "generate impeller.yaml --out impeller");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  EXPECT_NE(r.err.find("note: obstacles[2] (beyond.stl, at least"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("it steered nothing"), std::string::npos) << r.err;
 }

@@ -72,9 +72,9 @@ TEST(GenerateLinks, ALinkFarOutsideTheMeshesIsSaidInTheReport) {
     const auto r = test::runFieldpath(dir, "generate scene.yaml --nominal --out " + out);
     ASSERT_EQ(r.exit_code, 0) << r.output();
     const auto report = nlohmann::json::parse(test::slurp(dir.path() / out / "report.json"));
-    const std::size_t said = r.out.find("outside the meshes' x-y box") != std::string::npos;
+    const std::size_t said = r.err.find("outside the meshes' x-y box") != std::string::npos;
     EXPECT_EQ(report["link_notes"].size(), tilted ? 1u : 0u) << report["link_notes"];
-    EXPECT_EQ(said, tilted ? 1u : 0u) << r.out;
+    EXPECT_EQ(said, tilted ? 1u : 0u) << r.err;
     if (tilted) {
       // The climb along the axis leaning 60 deg across the feed (+y) from z ~ 0 to where the
       // holder clears z = 100: ~ 100 tan 60 = 173 mm sideways from y = 4, past the box's y = 22.

@@ -113,8 +113,8 @@ TEST_F(MeshJob, ASafeZAtTheLeastAcceptedIsSaid) {
     dir_->write("tight.yaml", sceneText("nominal.cl", extra.str()));
     const auto r = test::runFieldpath(*dir_, "generate tight.yaml --out out_tight");
     ASSERT_EQ(r.exit_code, 0) << r.output();
-    const std::size_t note = r.out.find("leaves the links within the checks' margin");
-    EXPECT_EQ(note != std::string::npos, above == 0.0) << above << ": " << r.out;
+    const std::size_t note = r.err.find("leaves the links within the checks' margin");
+    EXPECT_EQ(note != std::string::npos, above == 0.0) << above << ": " << r.err;
   }
 }
 
@@ -165,7 +165,7 @@ TEST_F(MeshJob, BladesWoundAwayFromThePassesAreTurnedToFaceThem) {
   dir_->write("away.yaml", scene);
   const auto r = test::runFieldpath(*dir_, "generate away.yaml --out out_away");
   ASSERT_EQ(r.exit_code, 0) << r.output();
-  EXPECT_NE(r.out.find("open obstacle surfaces faced away from the passes"), std::string::npos)
+  EXPECT_NE(r.err.find("open obstacle surfaces faced away from the passes"), std::string::npos)
       << r.out;
   const std::string text = test::slurp(dir_->path() / "out_away/path.cl");
   EXPECT_EQ(text.substr(text.find('\n') + 1), expected);
