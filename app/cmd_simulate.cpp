@@ -203,9 +203,15 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     const double postures_estimate = estimatePostures(o->path);
     constexpr std::size_t kPostureBytes = sizeof(geometry::CompactPosture);
     static_assert(kPostureBytes == sizeof(zb::Posture), "read and cut postures alike");
-    common::requireMemory("--path " + o->path, postures_estimate * double(kPostureBytes),
-                          "about " + std::to_string(std::llround(postures_estimate)) +
-                              " postures of " + std::to_string(kPostureBytes) + " bytes");
+    // With the file itself: it is mapped, and its pages read stay resident (a 975 k posture .cl
+    // refused at 94M after reaching 125 MiB: a memory sweep's).
+    std::error_code size_error;
+    const double file_bytes = double(std::filesystem::file_size(o->path, size_error));
+    common::requireMemory(
+        "--path " + o->path,
+        postures_estimate * double(kPostureBytes) + (size_error ? 0.0 : file_bytes),
+        "about " + std::to_string(std::llround(postures_estimate)) + " postures of " +
+            std::to_string(kPostureBytes) + " bytes, and the file mapped");
     const common::FileStamp path_stamp = common::fileStamp(o->path);
     PostureStream stream(o->path, read_options);
     // The part (--part) read beside the path: its top bounds the default region.
@@ -270,6 +276,9 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
         choice = "auto: the GPU where there is one (over 5e6 postures)";
       }
     }
+    // The GPU's context held on this thread, before the grid is sized (prepare's thread made it
+    // while this one sized the grid: a diff review's).
+    if (req.backend != zb::Backend::Cpu && zb::cudaAvailable()) common::requireCudaContext();
     const auto prepare_start = Clock::now();
     // The first CUDA call (the driver's start, ~0.1 s) is made here too, not before the reading.
     std::future<double> prepared = std::async(std::launch::async, [&req, prepare_start] {
@@ -279,7 +288,18 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
       return secondsSince(prepare_start);
     });
     makeGrid();
-    zb::checkGridFits(req.grid);  // before allocating anything grid-sized
+    if (part)  // held, then the grid beside it: the part's top a line and its mesh (the file
+               // read passed): an accepted limit ran 1.26 times over without it (a diff review's)
+      common::requireMemory(
+          "--part " + o->part,
+          8.0 * double(req.grid.lineCount()) + 64.0 * double(part->triangles.size()),
+          "the stock from its top: " + std::to_string(req.grid.lineCount()) + " lines");
+    try {  // before allocating anything grid-sized
+      zb::checkGridFits(req.grid);
+    } catch (const InputError& e) {
+      throw InputError((streamed ? "--region " + o->region : "--grid " + o->grid) + ": " +
+                       e.what());
+    }
 
     if (part) {
       const zb::ToolMesh m = toZbuffer(*part);

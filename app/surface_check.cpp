@@ -12,6 +12,8 @@
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/memory.h"
+#include "fieldpath/common/short_number.h"
 #include "fieldpath/pathgen/passes.h"
 #include "fieldpath/zbuffer/outputs.h"
 #include "machined_band.h"
@@ -338,7 +340,18 @@ std::optional<SurfaceGrid> surfaceGrid(const SurfaceRequest& request) {
       zbuffer::Grid::fromRegion(region.min().x(), region.min().y(), region.min().x() + nx * spacing,
                                 region.min().y() + ny * spacing, nx, ny);
   result.spacing_mm = spacing;
-  zbuffer::checkGridFits(result.grid);
+  // The GPU's context first (held once), then the grid with check's own arrays beside the
+  // Z-buffer's: the part's top and slope, the stock, the heights cut, the deviation, the band and
+  // the reference under overhangs, about 34 B a line measured (simulate's 20 let an accepted
+  // limit run to 1.3 times it: a diff review's), 48 taken.
+  if (request.backend != zbuffer::Backend::Cpu && zbuffer::cudaAvailable())
+    common::requireCudaContext();
+  const double lines = double(nx) * double(ny);
+  char detail[96];
+  std::snprintf(detail, sizeof detail, "%.3g lines %.3g mm apart (--spacing)", lines, spacing);
+  common::requireMemory("check's surface grid " + std::to_string(nx) + "x" + std::to_string(ny),
+                        48.0 * lines + 16.0 * 1024 * 1024, detail, common::MemoryUse::kPassing);
+  zbuffer::checkGridFits(result.grid);  // the 2^31 lines
   return result;
 }
 

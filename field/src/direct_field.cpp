@@ -50,7 +50,11 @@ DirectField::DirectField(ObstacleSamples samples, const FieldParams& params)
       index_->positions, *index_->transform);
   // Point, normal, weight (56 B) grown by push_back (x 2) and the point index, rounded up: as
   // app/estimates.h's kBytesPerSample.
-  index_->held = common::HeldMemory("the obstacle samples", 128.0 * double(index_->samples.size()));
+  const double bytes = 128.0 * double(index_->samples.size());
+  common::requireMemory("the obstacle samples", bytes,
+                        std::to_string(index_->samples.size()) + " samples",
+                        common::MemoryUse::kPassing);  // against what the run holds now
+  index_->held = common::HeldMemory("the obstacle samples", bytes);
 }
 
 DirectField::~DirectField() = default;

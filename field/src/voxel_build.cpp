@@ -444,8 +444,9 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
     throw common::InputError(
         "voxel field at h = " + common::shortNumber(h) + " mm: " + what + " " +
         std::to_string(static_cast<long long>(nodes)) + " nodes (" + mib(bytes) + "), over " +
-        (request.max_memory_bytes ? "the limit of " + mib(limit_bytes)
-                                  : "what is left" + common::memoryLimitText()) +
+        (request.max_memory_bytes
+             ? "the limit of " + mib(limit_bytes)
+             : "what is left (" + mib(limit_bytes) + ")" + common::memoryLimitText()) +
         "; " + advice);
   };
   const std::string refine_advice =

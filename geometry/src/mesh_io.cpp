@@ -362,7 +362,7 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
   // (a binary STL's 50-byte facet becomes 3 aiVector3D, a face, 3 map entries, 1.5 vertices).
   // Passing: the mesh loaded is held as a scene's (app/estimates.h: its triangles).
   common::requireMemory(file.string(), 16.0 * static_cast<double>(size),
-                        "mesh file of " + std::to_string(size >> 20) + " MiB",
+                        "mesh file of " + common::formatBytes(double(size)),
                         common::MemoryUse::kPassing);
   detail::checkPly(file, size);
   const StlFeed stl = checkStl(file, size);

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/memory.h"
 #include "fieldpath/common/short_number.h"
 
 namespace fieldpath::geometry {
@@ -21,6 +22,10 @@ using Vec2 = Eigen::Vector2d;  ///< meridian half-plane: (rho = distance from th
 constexpr double kPi = std::numbers::pi;
 /// Sizes beyond which a tolerance or spacing is taken as a mistake (memory, not accuracy).
 constexpr double kMaxTriangles = 2e7;
+/// Bytes a triangle of the tool mesh costs in `tool`: the mesh, its check (closed, area, volume:
+/// the edges' map) and its STL; measured 414 B (`tool` at --tol 1e-5 and 3e-6: 1.30 M and 4.26 M
+/// triangles, 587 and 1757 MiB), rounded up.
+constexpr double kBytesPerToolTriangle = 448.0;
 constexpr double kMaxNodes = 2e7;
 
 /// One piece of a revolved profile: a straight segment, or a circular arc about `centre` from
@@ -373,18 +378,31 @@ TriangleMesh revolvedMesh(const ToolSpec& tool, const HolderProfile& holder, dou
   // vertices, which keeps the triangles near the tip well shaped.
   const std::size_t count = points.size();
   std::vector<int> first(count), sectors(count);
+  double triangles = 0.0;  // the zip below makes n_lo + n_hi of them a band
+  for (std::size_t k = 0; k < count; ++k) {
+    const double rho_mm = points[k].x();
+    if (rho_mm == 0.0) {
+      sectors[k] = 1;
+    } else {
+      const double widest_mm = std::max({rho_mm, points[k - 1].x(), points[k + 1].x()});
+      sectors[k] =
+          std::max(8, static_cast<int>(std::ceil(2 * kPi / angularStep(widest_mm, sagitta_mm))));
+    }
+    if (k > 0) triangles += sectors[k - 1] + sectors[k];
+  }
+  // Against --max-memory: 4.3 M triangles took `tool` to 1.76 GiB under a limit of 43M (a memory
+  // sweep's). Passing: a job's tool mesh is small, and held by what uses it.
+  common::requireMemory(
+      "chordal tolerance " + shortNumber(chord_tol_mm) + " mm", kBytesPerToolTriangle * triangles,
+      shortNumber(triangles) + " triangles of the tool and holder", common::MemoryUse::kPassing);
   TriangleMesh mesh;
   for (std::size_t k = 0; k < count; ++k) {
     first[k] = static_cast<int>(mesh.vertices.size());
     const double rho_mm = points[k].x(), z_mm = points[k].y();
     if (rho_mm == 0.0) {
-      sectors[k] = 1;
       mesh.vertices.emplace_back(0.0, 0.0, z_mm);
       continue;
     }
-    const double widest_mm = std::max({rho_mm, points[k - 1].x(), points[k + 1].x()});
-    sectors[k] =
-        std::max(8, static_cast<int>(std::ceil(2 * kPi / angularStep(widest_mm, sagitta_mm))));
     for (int j = 0; j < sectors[k]; ++j) {
       const double a = 2 * kPi * j / sectors[k];
       mesh.vertices.emplace_back(rho_mm * std::cos(a), rho_mm * std::sin(a), z_mm);

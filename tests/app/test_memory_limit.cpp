@@ -154,6 +154,23 @@ TEST(MemoryLimit, AnAcceptedRunStaysUnderItsLimit) {
   EXPECT_GE(refused, 2);
 }
 
+// `tool`'s mesh is counted before it is made, to the triangle (4.3 M of them took it to 1.76 GiB
+// under a limit of 43M: a memory sweep's): 1.3 M triangles at --tol 1e-5 (587 MiB).
+TEST(MemoryLimit, TheToolMeshIsSizedBeforeItIsMade) {
+  const TempDir dir;
+  const Peak run = runMeasured(
+      dir, {"--max-memory", "300M", "tool", "--shape", "ball:3", "--holder",
+            "40:6,55:6,55:12,90:12", "--tol", "1e-5", "--out", (dir.path() / "t.stl").string()});
+  const std::string err = fieldpath::test::slurp(dir.path() / "stderr.txt");
+  EXPECT_EQ(run.exit_code, 1) << err;
+  EXPECT_NE(err.find("chordal tolerance 1e-05 mm: needs about 554 MiB of memory (1.2975e+06 "
+                     "triangles of the tool and holder)"),
+            std::string::npos)
+      << err;
+  EXPECT_LT(run.peak_kib, 100 * 1024L);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "t.stl"));
+}
+
 TEST(MemoryLimit, ALimitUnderTheProgramItselfIsRefusedAtOnce) {
   const TempDir dir;
   const Peak run = runMeasured(dir, {"--max-memory", "4M", "convert", "none.cl", "none.npy"});

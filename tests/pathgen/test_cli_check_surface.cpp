@@ -461,8 +461,8 @@ TEST(CheckClearance, AnAxisTurnedFarAcrossAGapIsTakenAFlipInAPassIsNot) {
 // The Z-buffer's grid is sized against the memory left before the clearance and the part's
 // tests run (it was refused after them: minutes of work on a large path, a memory sweep's). Both
 // the cutter's stamps (ten passes 85 times over, stamps 0.025 mm apart at a gouge tolerance of
-// 0.1 um: 1.4 M of them) and the grid (6 M lines: about 130 MiB) pass a 120 MiB limit: the grid
-// is refused first, in one line.
+// 0.1 um: 1.4 M of them) and the grid (6 M lines: about 291 MiB with check's arrays) pass a
+// 120 MiB limit: the grid is refused first, in one line.
 TEST(CheckSurface, AGridOverTheMemoryLimitIsRefusedBeforeTheWork) {
   const TempDir dir;
   writePlateScene(dir);
@@ -474,7 +474,10 @@ TEST(CheckSurface, AGridOverTheMemoryLimitIsRefusedBeforeTheWork) {
                                     "--max-memory 120M check scene.yaml --path p.cl "
                                     "--spacing 0.005 --gouge-tol 0.1 --out out");
   EXPECT_EQ(r.exit_code, 1) << r.output();
-  EXPECT_NE(r.err.find("is too large: it needs about 130 MiB"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("check's surface grid 2550x2354: needs about 291 MiB of memory (6e+06 "
+                       "lines 0.0102 mm apart (--spacing))"),
+            std::string::npos)
+      << r.err;
   EXPECT_EQ(r.err.find("the cutter's test"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_FALSE(fs::exists(dir.path() / "out/check.json"));

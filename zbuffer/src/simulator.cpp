@@ -148,8 +148,8 @@ void checkGridFits(const Grid& grid, std::size_t available_bytes) {
   if (need > available_bytes || grid.lineCount() > (std::size_t{1} << 31)) {
     std::ostringstream os;
     os << "grid " << grid.nx << "x" << grid.ny << " is too large: it needs about "
-       << need / (1 << 20) << " MiB of memory, " << available_bytes / (1 << 20)
-       << " MiB available (and at most 2^31 lines"
+       << common::formatBytes(double(need)) << " of memory, "
+       << common::formatBytes(double(available_bytes)) << " available (and at most 2^31 lines"
        << (given ? std::string("; --max-memory)") : ")" + common::memoryLimitText());
     throw InputError(os.str());
   }
@@ -344,6 +344,11 @@ SimulationResult run(const SimulationRequest& request, std::size_t expected_post
                      NextBlock next) {
   const Grid& grid = request.grid;
   if (grid.nx <= 0 || grid.ny <= 0) throw InputError("grid: no lines");
+  Backend backend = request.backend;
+  if (backend == Backend::Auto) backend = cudaAvailable() ? Backend::Cuda : Backend::Cpu;
+  if (backend == Backend::Cuda && !cudaAvailable())
+    throw InputError("backend cuda: no CUDA device available (built without CUDA or no GPU)");
+  if (backend == Backend::Cuda) common::requireCudaContext();  // before the grid, with it
   checkGridFits(grid);
   if (!request.initial_heights_mm.empty() && request.initial_heights_mm.size() != grid.lineCount())
     throw InputError("initial heights: size does not match the grid");
@@ -353,11 +358,6 @@ SimulationResult run(const SimulationRequest& request, std::size_t expected_post
     if (!std::isfinite(h)) throw InputError("initial heights: a line is not a finite number");
   if (request.engine == Engine::Coarse && request.tool.kind != ToolKind::Mesh)
     throw InputError("the coarse engine needs a mesh tool");
-  Backend backend = request.backend;
-  if (backend == Backend::Auto) backend = cudaAvailable() ? Backend::Cuda : Backend::Cpu;
-  if (backend == Backend::Cuda && !cudaAvailable())
-    throw InputError("backend cuda: no CUDA device available (built without CUDA or no GPU)");
-  if (backend == Backend::Cuda) common::requireCudaContext();
 
   const auto entered = std::chrono::steady_clock::now();
   const int shift = request.tuning.tile_shift;

@@ -51,27 +51,31 @@ inline void setMemoryLimitBytes(std::size_t bytes) { detail::memory_limit_bytes 
 /// counts that one against it, not the reservations of libraries); SIZE_MAX when neither is set.
 /// Under a `ulimit -v` of 200 MB the machine's free memory let FCL's tree allocation fail (and
 /// crash).
+namespace detail {
+/// A "KEY: N kB" line of /proc/self/status (`key` with its colon), as bytes; 0 where unread.
+inline double processStatusBytes(const char* key) {
+  double bytes = 0.0;
+  if (std::FILE* f = std::fopen("/proc/self/status", "r")) {
+    char line[256];
+    unsigned long long kib = 0;
+    const std::size_t n = std::strlen(key);
+    while (std::fgets(line, sizeof line, f))
+      if (std::strncmp(line, key, n) == 0 && std::sscanf(line + n, " %llu", &kib) == 1) {
+        bytes = 1024.0 * double(kib);
+        break;
+      }
+    std::fclose(f);
+  }
+  return bytes;
+}
+}  // namespace detail
+
 inline std::size_t processHeadroomBytes() {
   double headroom = HUGE_VAL;
-  const auto held = [](const char* key) {  // kB of /proc/self/status, as bytes
-    double bytes = 0.0;
-    if (std::FILE* f = std::fopen("/proc/self/status", "r")) {
-      char line[256];
-      unsigned long long kib = 0;
-      const std::size_t n = std::strlen(key);
-      while (std::fgets(line, sizeof line, f))
-        if (std::strncmp(line, key, n) == 0 && std::sscanf(line + n, " %llu", &kib) == 1) {
-          bytes = 1024.0 * double(kib);
-          break;
-        }
-      std::fclose(f);
-    }
-    return bytes;
-  };
   for (const auto& [resource, key] : {std::pair{RLIMIT_AS, "VmSize:"}, {RLIMIT_DATA, "VmData:"}}) {
     rlimit r{};
     if (getrlimit(resource, &r) == 0 && r.rlim_cur != RLIM_INFINITY)
-      headroom = std::min(headroom, double(r.rlim_cur) - held(key));
+      headroom = std::min(headroom, double(r.rlim_cur) - detail::processStatusBytes(key));
   }
   if (headroom == HUGE_VAL) return SIZE_MAX;
   return headroom > 0.0 ? static_cast<std::size_t>(headroom) : 0;
@@ -111,10 +115,11 @@ enum class MemoryUse { kKept, kPassing };
 
 namespace detail {
 struct MemoryLedger {
-  std::mutex mutex;
+  std::mutex mutex;  ///< every field below; an estimate is checked and held under it at once
   double held_bytes = 0.0;
   std::uint64_t next_id = 1;
   std::map<std::uint64_t, std::pair<std::string, double>> items;  ///< id: what holds it, bytes
+  bool cuda_context = false;  ///< requireCudaContext's hold is made
 };
 inline MemoryLedger& memoryLedger() {
   static MemoryLedger ledger;
@@ -125,13 +130,23 @@ inline MemoryLedger& memoryLedger() {
 namespace detail {
 /// Adds an item to the ledger; its id (0: nothing held). Kept only under a limit set
 /// (setMemoryLimitBytes): without one the available memory is measured anew at each estimate.
-inline std::uint64_t holdInLedger(const std::string& what, double bytes) {
+/// (The caller holds ledger.mutex.)
+inline std::uint64_t holdLocked(MemoryLedger& ledger, const std::string& what, double bytes) {
   if (!(bytes > 0.0) || memory_limit_bytes == 0) return 0;
-  MemoryLedger& ledger = memoryLedger();
-  const std::lock_guard lock(ledger.mutex);
   ledger.held_bytes += bytes;
   ledger.items.emplace(ledger.next_id, std::pair{what, bytes});
   return ledger.next_id++;
+}
+inline std::uint64_t holdInLedger(const std::string& what, double bytes) {
+  MemoryLedger& ledger = memoryLedger();
+  const std::lock_guard lock(ledger.mutex);
+  return holdLocked(ledger, what, bytes);
+}
+/// What the limit leaves with `held_bytes` held (see memoryLeftBytes).
+inline double leftWith(double held_bytes) {
+  const std::size_t set = memory_limit_bytes;
+  const double left = set != 0 ? double(set) - held_bytes : double(availableMemoryBytes());
+  return std::max(0.0, std::min(left, double(processHeadroomBytes())));
 }
 }  // namespace detail
 
@@ -179,9 +194,18 @@ inline std::pair<double, std::string> memoryHeld() {
   std::stable_sort(items.begin(), items.end(),
                    [](const auto& a, const auto& b) { return a.second > b.second; });
   std::string named;
-  for (std::size_t i = 0; i < items.size() && i < 3; ++i)
-    named += (i ? ", " : "") + items[i].first + " " + formatBytes(items[i].second);
-  if (items.size() > 3) named += ", ...";
+  for (std::size_t i = 0; i < items.size() && i < 3; ++i) {
+    // By its key: "SCENE: path.step" as "path.step" (the scene is named by the refusal's own).
+    const std::string& what = items[i].first;
+    const std::size_t colon = what.rfind(": ");
+    named += (i ? ", " : "") + (colon == std::string::npos ? what : what.substr(colon + 2)) + " " +
+             formatBytes(items[i].second);
+  }
+  if (items.size() > 3) {
+    double rest = 0.0;
+    for (std::size_t i = 3; i < items.size(); ++i) rest += items[i].second;
+    named += " and " + std::to_string(items.size() - 3) + " more of " + formatBytes(rest);
+  }
   return {ledger.held_bytes, named};
 }
 
@@ -190,30 +214,13 @@ inline std::pair<double, std::string> memoryHeld() {
 /// count it.
 inline void holdProgramMemory() {
   static std::once_flag once;
-  std::call_once(once, [] {
-    double bytes = 0.0;
-    if (std::FILE* f = std::fopen("/proc/self/status", "r")) {
-      char line[256];
-      unsigned long long kib = 0;
-      while (std::fgets(line, sizeof line, f))
-        if (std::sscanf(line, "VmRSS: %llu kB", &kib) == 1) {
-          bytes = 1024.0 * double(kib);
-          break;
-        }
-      std::fclose(f);
-    }
-    holdMemory("the program", bytes);
-  });
+  std::call_once(once, [] { holdMemory("the program", detail::processStatusBytes("VmRSS:")); });
 }
 
 /// What the next item may take, bytes: `--max-memory` less what the run holds; the available
 /// memory where no limit is set (measured now: what the run took is out of it already); never
 /// past what the process's own limits leave it.
-inline double memoryLeftBytes() {
-  const std::size_t set = detail::memory_limit_bytes;
-  const double left = set != 0 ? double(set) - memoryHeld().first : double(availableMemoryBytes());
-  return std::max(0.0, std::min(left, double(processHeadroomBytes())));
-}
+inline double memoryLeftBytes() { return detail::leftWith(memoryHeld().first); }
 
 /// ", limit L (--max-memory)", or with what the run holds: ", limit L (--max-memory), of which the
 /// run holds H (the program 33 MiB, ...)"; the ulimit named where that is what binds.
@@ -234,10 +241,16 @@ inline std::string memoryLimitText() {
 /// integer) exceeds what the limit leaves; an estimate accepted as kKept is then held.
 inline void requireMemory(const std::string& what, double estimate_bytes,
                           const std::string& detail = {}, MemoryUse use = MemoryUse::kKept) {
-  if (estimate_bytes > memoryLeftBytes())
-    throw InputError(what + ": needs about " + formatBytes(estimate_bytes) + " of memory" +
-                     (detail.empty() ? "" : " (" + detail + ")") + memoryLimitText());
-  if (use == MemoryUse::kKept) holdMemory(what, estimate_bytes);
+  {
+    detail::MemoryLedger& ledger = detail::memoryLedger();
+    const std::lock_guard lock(ledger.mutex);  // checked and held at once (threads)
+    if (estimate_bytes <= detail::leftWith(ledger.held_bytes)) {
+      if (use == MemoryUse::kKept) detail::holdLocked(ledger, what, estimate_bytes);
+      return;
+    }
+  }
+  throw InputError(what + ": needs about " + formatBytes(estimate_bytes) + " of memory" +
+                   (detail.empty() ? "" : " (" + detail + ")") + memoryLimitText());
 }
 
 /// Resident memory a process gains once it uses CUDA (its context, the driver's and the
@@ -248,11 +261,17 @@ inline constexpr double kCudaContextBytes = 160.0 * 1024 * 1024;
 /// Holds kCudaContextBytes once, before a backend first uses the GPU; InputError naming it (and
 /// `--backend cpu`, which spares it) where the limit leaves less.
 inline void requireCudaContext() {
-  static std::atomic<bool> held{false};
-  if (held) return;
+  static std::mutex once;  // two backends' threads asking at once hold it once
+  const std::lock_guard lock(once);
+  detail::MemoryLedger& ledger = detail::memoryLedger();
+  {
+    const std::lock_guard held(ledger.mutex);
+    if (ledger.cuda_context) return;
+  }
   requireMemory("the CUDA backend", kCudaContextBytes,
                 "its context and driver: 100-156 MB measured on an H200; --backend cpu spares it");
-  held = true;
+  const std::lock_guard held(ledger.mutex);
+  ledger.cuda_context = true;
 }
 
 /// Forgets what was held: a new run in the same process (a fuzzer's next input).
@@ -261,6 +280,7 @@ inline void releaseHeldMemory() {
   const std::lock_guard lock(ledger.mutex);
   ledger.held_bytes = 0.0;
   ledger.items.clear();
+  ledger.cuda_context = false;
 }
 
 /// Parses a `--max-memory` value: a number of MiB, or a number with a K, M, G or T suffix (binary
