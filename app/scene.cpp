@@ -134,7 +134,7 @@ bool sceneSizeOk(const std::filesystem::path& file, bool refuse) {
 }
 }  // namespace
 
-Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
+Scene loadScene(const std::filesystem::path& file, bool read_nominal, bool read_part) {
   sceneKeyLines() = SceneKeyLines{};  // none of another scene's
   common::requireRegularFile(file, "scene file (YAML)");
   sceneSizeOk(file, /*refuse=*/true);
@@ -182,7 +182,7 @@ Scene loadScene(const std::filesystem::path& file, bool read_nominal) {
     r.fail(root["guide"], "guide", "give either `part: FILE` or `guide: { impeller: hub }`");
   if (root["part"]) {
     scene.part_file = r.path(root["part"], "part");
-    loads.push_back({root["part"], "part", true});
+    if (read_part) loads.push_back({root["part"], "part", true});
   }
   if (root["guide"]) readGuide(r, root["guide"], scene);
   if (root["tool"]) {

@@ -61,7 +61,9 @@ struct Scene {
 /// cannot be loaded.
 /// `read_nominal`: false for the commands given their own path (`check --path`, `view`): the
 /// scene's `path.nominal` is then not read (a stale or broken one does not stop them).
-Scene loadScene(const std::filesystem::path& file, bool read_nominal = true);
+/// `read_part`: false for the field commands (DESIGN: they need only `obstacles` and `field`):
+/// the `part:` file is checked as a key but not loaded (its mesh was estimated and refused).
+Scene loadScene(const std::filesystem::path& file, bool read_nominal = true, bool read_part = true);
 /// The scene's `path.nominal` file, where the file reads as YAML that names one (else empty):
 /// what a command must not take for an output of its own before the scene is loaded.
 std::filesystem::path nominalPathOf(const std::filesystem::path& file);

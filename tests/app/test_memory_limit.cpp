@@ -152,6 +152,21 @@ TEST(MemoryLimit, AnAcceptedRunStaysUnderItsLimit) {
   }
   EXPECT_GE(accepted, 1);
   EXPECT_GE(refused, 2);
+  // check's surface at 0.02 mm (5.6 M lines, 228 MiB at its peak): at 200M its grid had been
+  // counted at the Z-buffer's 20 B a line and accepted (a diff review's).
+  ASSERT_TRUE(std::filesystem::exists(dir.path() / "out/path.cl"));
+  for (int mib : {200, 400}) {
+    const Peak run =
+        runMeasured(dir, {"--max-memory", std::to_string(mib) + "M", "check", scene, "--path",
+                          (dir.path() / "out/path.cl").string(), "--spacing", "0.02", "--backend",
+                          "cpu", "--out", (dir.path() / "check").string()});
+    const std::string err = fieldpath::test::slurp(dir.path() / "stderr.txt");
+    EXPECT_EQ(run.exit_code, mib == 200 ? 1 : 0) << err;
+    if (run.exit_code == 0)
+      EXPECT_LE(run.peak_kib, mib * 1024L) << mib << " MiB: ran to " << run.peak_kib << " KiB";
+    else
+      EXPECT_NE(err.find("check's surface grid"), std::string::npos) << err;
+  }
 }
 
 // `tool`'s mesh is counted before it is made, to the triangle (4.3 M of them took it to 1.76 GiB
