@@ -173,7 +173,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
           {options->scene, options->path});
       common::removeEarlierOutputs();
     }
-    const Scene scene = loadScene(options->scene, /*read_nominal=*/false);
+    const Scene scene = loadScene(options->scene, SceneUse::kPathGiven);
     checkPathFileSize(options->path, "--path " + options->path);
     const common::FileStamp path_stamp = common::fileStamp(options->path);
     const geometry::PathFile path = geometry::readPathFile(options->path);

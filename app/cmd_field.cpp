@@ -88,7 +88,7 @@ Obstacles loadObstacles(const FieldOptions& o) {
   // The sub-command's --max-memory is the limit of every estimate, the scene's included.
   if (!o.max_memory.empty()) common::limitMemory(o.max_memory, "--max-memory");
   // The obstacles and the field's keys: no part, no nominal path (neither is the field's).
-  Obstacles result{loadScene(o.scene, /*read_nominal=*/false, /*read_part=*/false), nullptr, 0.0};
+  Obstacles result{loadScene(o.scene, SceneUse::kField), nullptr, 0.0};
   const auto start = std::chrono::steady_clock::now();
   const Scene& s = result.scene;
   result.direct = std::make_unique<field::DirectField>(

@@ -134,7 +134,8 @@ bool sceneSizeOk(const std::filesystem::path& file, bool refuse) {
 }
 }  // namespace
 
-Scene loadScene(const std::filesystem::path& file, bool read_nominal, bool read_part) {
+Scene loadScene(const std::filesystem::path& file, SceneUse use) {
+  const bool read_nominal = use == SceneUse::kJob, read_part = use != SceneUse::kField;
   sceneKeyLines() = SceneKeyLines{};  // none of another scene's
   common::requireRegularFile(file, "scene file (YAML)");
   sceneSizeOk(file, /*refuse=*/true);
@@ -175,6 +176,7 @@ Scene loadScene(const std::filesystem::path& file, bool read_nominal, bool read_
 
   Scene scene;
   scene.file = file;
+  scene.use = use;
   std::vector<MeshLoad> loads;
   if (!root["obstacles"]) r.fail(root, "obstacles", "missing (the surfaces that repel the tool)");
   readObstacles(r, root["obstacles"], scene, loads);

@@ -19,8 +19,12 @@
 
 namespace fieldpath::app {
 
+/// What a command reads of a scene (loadScene).
+enum class SceneUse { kJob, kPathGiven, kField };
+
 struct Scene {
   std::filesystem::path file;  ///< the scene file itself
+  SceneUse use = SceneUse::kJob;  ///< what it was read for
 
   /// `obstacles:` surfaces that repel (world frame, mm), loaded: `- mesh: FILE` entries in order,
   /// then the impeller's blades once resolveImpeller has run.
@@ -59,11 +63,13 @@ struct Scene {
 /// (key as a dotted path, e.g. `field.r0`, `obstacles[2].mesh`) for a missing or unreadable
 /// file, bad YAML, an unknown key, a value of the wrong type or out of range, or a mesh that
 /// cannot be loaded.
-/// `read_nominal`: false for the commands given their own path (`check --path`, `view`): the
-/// scene's `path.nominal` is then not read (a stale or broken one does not stop them).
-/// `read_part`: false for the field commands (DESIGN: they need only `obstacles` and `field`):
-/// the `part:` file is checked as a key but not loaded (its mesh was estimated and refused).
-Scene loadScene(const std::filesystem::path& file, bool read_nominal = true, bool read_part = true);
+/// `use` SceneUse::kPathGiven for the commands given their own path (`check --path`): the
+/// scene's `path.nominal` is then not read (a stale or broken one does not stop them); kField for
+/// the field commands (DESIGN: they need only `obstacles` and `field`): neither it nor the
+/// `part:` file is read (the part's mesh was estimated and refused). (The meshes are sized with
+/// their collision hierarchies all the same: without them field build ran 1.1 times past an
+/// accepted limit, its build's own passing structures being in no estimate.)
+Scene loadScene(const std::filesystem::path& file, SceneUse use = SceneUse::kJob);
 /// The scene's `path.nominal` file, where the file reads as YAML that names one (else empty):
 /// what a command must not take for an output of its own before the scene is loaded.
 std::filesystem::path nominalPathOf(const std::filesystem::path& file);

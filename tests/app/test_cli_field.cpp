@@ -161,6 +161,27 @@ TEST(CliField, BadInputExitsOneWithOneLine) {
   }
 }
 
+// The field commands need the obstacles and the field's keys only (DESIGN): a scene's part and
+// nominal path are not read (field build was refused naming a part's mesh it never uses, a
+// memory sweep's), whether they are there, broken or missing.
+TEST(CliField, TheFieldCommandsReadNeitherThePartNorTheNominalPath) {
+  TempDir dir;
+  planeScene(dir);
+  dir.write("broken.stl", "solid nothing\nfacet normal 0 0 1\n");
+  dir.write("scene.yaml", slurp(dir.path() / "scene.yaml") +
+                              "part: broken.stl\ntool: { shape: ball, radius: 1, length: 10 }\n"
+                              "path: { nominal: missing.cl }\n");
+  const Outcome build = runFieldpath(dir, "field build scene.yaml --voxel 1 --out f.vdb");
+  EXPECT_EQ(build.exit_code, 0) << build.err;
+  dir.write("points.txt", "0 0 1\n");
+  const Outcome probe = runFieldpath(dir, "field probe scene.yaml --points points.txt --direct");
+  EXPECT_EQ(probe.exit_code, 0) << probe.err;
+  // generate reads both: the part refused by its key.
+  const Outcome generate = runFieldpath(dir, "generate scene.yaml --out g");
+  EXPECT_EQ(generate.exit_code, 1);
+  EXPECT_NE(generate.err.find("part"), std::string::npos) << generate.err;
+}
+
 TEST(CliField, BuildRefusesAnOutputNotNamedVdb) {
   TempDir dir;
   planeScene(dir);
