@@ -102,16 +102,23 @@ bool isPartColour(const std::array<int, 3>& c) {
   return c[0] > 70 && c[0] >= c[1] && c[1] > c[2] && c[0] - c[2] > 30 && c[1] - c[2] > 15;
 }
 
+/// Why the page cannot be looked at here ("" where it can): no chromium, or no three.js.
+std::string whyNoBrowserTest(const std::string& chromium) {
+  if (chromium.empty())
+    return "chromium not found (scripts/setup.sh installs Debian's chromium; or set "
+           "FIELDPATH_CHROMIUM): the page is not looked at";
+  if (!fs::exists("/usr/share/javascript/three/three.min.js") &&
+      !std::getenv("FIELDPATH_THREE_DIR"))
+    return "three.js not found (scripts/setup.sh installs Debian's libjs-three)";
+  return {};
+}
+
 }  // namespace
 
 TEST(ViewBrowser, ImpellerPageRendersAndTheSliderMovesTheTool) {
   const std::string chromium = findChromium();
-  if (chromium.empty())
-    GTEST_SKIP() << "chromium not found (scripts/setup.sh installs Debian's chromium; or set "
-                    "FIELDPATH_CHROMIUM): the page is not looked at";
-  if (!fs::exists("/usr/share/javascript/three/three.min.js") &&
-      !std::getenv("FIELDPATH_THREE_DIR"))
-    GTEST_SKIP() << "three.js not found (scripts/setup.sh installs Debian's libjs-three)";
+  if (const std::string missing = whyNoBrowserTest(chromium); !missing.empty())
+    GTEST_SKIP() << missing;
   const TempDir dir;
   Outcome r =
       runFieldpath(dir, "generate '" + kImpellerScene.string() + "' --nominal --out nominal");
@@ -255,12 +262,8 @@ TEST(ViewBrowser, ImpellerPageRendersAndTheSliderMovesTheTool) {
 // reader's).
 TEST(ViewBrowser, WithoutWebGlThePageSaysSo) {
   const std::string chromium = findChromium();
-  if (chromium.empty())
-    GTEST_SKIP() << "chromium not found (scripts/setup.sh installs Debian's chromium; or set "
-                    "FIELDPATH_CHROMIUM): the page is not looked at";
-  if (!fs::exists("/usr/share/javascript/three/three.min.js") &&
-      !std::getenv("FIELDPATH_THREE_DIR"))
-    GTEST_SKIP() << "three.js not found (scripts/setup.sh installs Debian's libjs-three)";
+  if (const std::string missing = whyNoBrowserTest(chromium); !missing.empty())
+    GTEST_SKIP() << missing;
   const TempDir dir;
   const Outcome r = runFieldpath(dir, "view '" + kImpellerScene.string() + "' --out view.html");
   ASSERT_EQ(r.exit_code, 0) << r.output();
