@@ -297,8 +297,8 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     try {  // before allocating anything grid-sized
       zb::checkGridFits(req.grid);
     } catch (const InputError& e) {
-      throw InputError((streamed ? "--region " + o->region : "--grid " + o->grid) + ": " +
-                       e.what());
+      throw InputError((streamed ? "--region " + o->region : std::string("--grid")) + ": " +
+                       e.what());  // (the grid's own text names its lines)
     }
 
     if (part) {

@@ -125,9 +125,7 @@ inline MemoryLedger& memoryLedger() {
   static MemoryLedger ledger;
   return ledger;
 }
-}  // namespace detail
 
-namespace detail {
 /// Adds an item to the ledger; its id (0: nothing held). Kept only under a limit set
 /// (setMemoryLimitBytes): without one the available memory is measured anew at each estimate.
 /// (The caller holds ledger.mutex.)
