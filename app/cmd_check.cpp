@@ -219,6 +219,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
                            "checked where it is written, not where the offset puts the tool");
     const pathgen::AxisTurn axis_turn = pathgen::largestAxisTurn(path, scene.tool.radius_mm);
     SurfaceRequest surface_request;
+    std::optional<SurfaceGrid> surface_grid;
     if (scene.part) {
       surface_request.part = &*scene.part;
       surface_request.path = &path;
@@ -227,7 +228,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       surface_request.gouge_tolerance_um = options->gouge_tol_um;
       surface_request.backend = backend;
       surface_request.progress = progress;
-      surfaceGrid(surface_request);  // its grid refused now, not after the clearance work
+      surface_grid = surfaceGrid(surface_request);  // refused now, not after the clearance work
     }
 
     // (a) exact clearance of postures and motions
@@ -256,7 +257,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
 
     // (b) the machined part
     std::optional<SurfaceResult> surface;
-    if (scene.part) surface = checkSurface(surface_request);
+    if (surface_grid) surface = checkSurface(surface_request, *surface_grid);
     // A path that never cuts the stock over the part (another frame or units, a path over
     // another part) left only the stock's figures: 2000 um of 'scallop' and ok read as a check.
     const bool never_cut = surface && surface->part_cut_lines == 0;

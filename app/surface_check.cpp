@@ -355,17 +355,15 @@ std::optional<SurfaceGrid> surfaceGrid(const SurfaceRequest& request) {
   return result;
 }
 
-std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request) {
+std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request, const SurfaceGrid& plan) {
   const geometry::TriangleMesh& part = *request.part;
   const geometry::PathFile& path = *request.path;
   const double radius = request.tool.radius_mm;
-  const std::optional<SurfaceGrid> plan = surfaceGrid(request);
-  if (!plan) return std::nullopt;
   SurfaceResult result;
-  result.coarsened = plan->coarsened;
-  const double spacing = plan->spacing_mm;
+  result.coarsened = plan.coarsened;
+  const double spacing = plan.spacing_mm;
   zbuffer::SimulationRequest sim;
-  sim.grid = plan->grid;
+  sim.grid = plan.grid;
   sim.tool = request.tool.shape == geometry::ToolShape::Ball
                  ? zbuffer::Tool::ball(radius, request.tool.length_mm)
              : request.tool.shape == geometry::ToolShape::Torus

@@ -93,9 +93,9 @@ struct SurfaceGrid {
 };
 std::optional<SurfaceGrid> surfaceGrid(const SurfaceRequest& request);
 
-/// Simulates and compares; nothing when the passes do not pass over the part (no surface to
-/// check: the clearance checks still stand).
-std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request);
+/// Simulates and compares on the grid surfaceGrid gave for `request` (sized once, before the
+/// command's other work); nothing when no line of it falls on the part.
+std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request, const SurfaceGrid& plan);
 
 /// deviation.png: the map (row 0 = largest y, grey off the part, sand where no pass cut: the
 /// stock allowance) with a colour bar and its scale in µm on the right.
