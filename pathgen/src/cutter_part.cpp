@@ -131,37 +131,68 @@ double entryDepthMm(const Part& part, const geometry::ToolSpec& tool, const Post
   return inside;
 }
 
+/// How far apart the stamps stand along a motion, and how far from its tip the cutter reaches.
+struct StampSpacing {
+  double step_mm = 0;   ///< no point of the cutter moves farther between two stamps
+  double reach_mm = 0;  ///< the farthest point of the cutter from its tip
+};
+
+/// A cutting surface whose tightest curvature radius is ρ (a ball's R, a torus's corner r; the
+/// shank's R is no tighter) swept between two stamps s apart stands at most s² / (8 ρ) beyond
+/// both: s = √(2 ρ tolerance) keeps that to a quarter of the tolerance. The reach: the top rim's
+/// distance (or the ball's far side, for a ball shorter than its diameter).
+StampSpacing stampSpacing(const geometry::ToolSpec& tool, double tolerance_mm) {
+  const double tightest = geometry::cornerRadius(tool);
+  return {std::sqrt(2.0 * tightest * tolerance_mm),
+          std::max(std::hypot(tool.length_mm, tool.radius_mm), 2.0 * tightest)};
+}
+
+/// `part_box` grown by the cutter's reach: a motion whose tips' box misses it cannot meet the part.
+Eigen::AlignedBox3d nearPart(Eigen::AlignedBox3d part_box, double reach_mm) {
+  part_box.min().array() -= reach_mm;
+  part_box.max().array() += reach_mm;
+  return part_box;
+}
+
+bool motionNear(const Posture& a, const Posture& b, const Eigen::AlignedBox3d& near) {
+  Eigen::AlignedBox3d motion(a.tip_mm);
+  motion.extend(b.tip_mm);
+  return motion.intersects(near);
+}
+
+/// The stamps' bytes said before they are taken (a tolerance of 1e-8 mm made 25.8 M stamps,
+/// 2.6 GB): the postures and the stamps of every motion near the part. Returns how many at most.
+std::size_t requireStampMemory(std::span<const Posture> postures, const Eigen::AlignedBox3d& near,
+                               const StampSpacing& spacing) {
+  double count = 0;
+  for (std::size_t i = 0; i + 1 < postures.size(); ++i)
+    if (motionNear(postures[i], postures[i + 1], near))
+      count +=
+          geometry::motionSteps(postures[i], postures[i + 1], spacing.reach_mm, spacing.step_mm);
+  // Each stamp also has its verdict (one byte) beside it while the test runs.
+  common::requireMemory("the cutter's test against the part",
+                        (count + double(postures.size())) * double(sizeof(Stamp) + 1),
+                        common::shortNumber(count) + " stamps along the motions, " +
+                            common::shortNumber(spacing.step_mm) + " mm apart",
+                        common::MemoryUse::kPassing);
+  return static_cast<std::size_t>(count) + postures.size();
+}
+
 /// The postures and the stamps along the motions that come within the tool's length of the
 /// part's box, `step_mm` apart at most for any point of the tool (geometry::forEachPoseBetween).
 std::vector<Stamp> stampsNearPart(std::span<const Posture> postures, const Part& part,
-                                  double reach_mm, double step_mm) {
-  Eigen::AlignedBox3d near = part.box();
-  near.min().array() -= reach_mm;
-  near.max().array() += reach_mm;
-  const auto motionNear = [&](const Posture& a, const Posture& b) {
-    Eigen::AlignedBox3d motion(a.tip_mm);
-    motion.extend(b.tip_mm);
-    return motion.intersects(near);
-  };
-  // Counted first: the memory they take is said before it is taken (a tolerance of 1e-8 mm made
-  // 25.8 M stamps, 2.6 GB).
-  double count = 0;
-  for (std::size_t i = 0; i + 1 < postures.size(); ++i)
-    if (motionNear(postures[i], postures[i + 1]))
-      count += geometry::motionSteps(postures[i], postures[i + 1], reach_mm, step_mm);
-  common::requireMemory("the cutter's test against the part",
-                        (count + double(postures.size())) * double(sizeof(Stamp)),
-                        common::shortNumber(count) + " stamps along the motions, " +
-                            common::shortNumber(step_mm) + " mm apart",
-                        common::MemoryUse::kPassing);
+                                  const StampSpacing& spacing) {
+  const Eigen::AlignedBox3d near = nearPart(part.box(), spacing.reach_mm);
+  const std::size_t most = requireStampMemory(postures, near, spacing);
+  const double reach_mm = spacing.reach_mm, step_mm = spacing.step_mm;
   std::vector<Stamp> out;
-  out.reserve(postures.size());
+  out.reserve(most);  // once: growing by doubling held up to twice the bytes said
   for (std::size_t i = 0; i < postures.size(); ++i) {
     if (near.contains(postures[i].tip_mm)) out.push_back({postures[i], i, false});
     if (i + 1 == postures.size()) break;
     const Posture& a = postures[i];
     const Posture& b = postures[i + 1];
-    if (!motionNear(a, b)) continue;
+    if (!motionNear(a, b, near)) continue;
     geometry::forEachPoseBetween(a, b, reach_mm, step_mm, [&](const Posture& pose) {
       out.push_back({pose, i, true});
     });
@@ -170,6 +201,15 @@ std::vector<Stamp> stampsNearPart(std::span<const Posture> postures, const Part&
 }
 
 }  // namespace
+
+void requireCutterTestMemory(const geometry::ToolSpec& tool, const Eigen::AlignedBox3d& part_box,
+                             std::span<const Posture> postures, double tolerance_mm) {
+  if (tool.shape == geometry::ToolShape::Flat || part_box.isEmpty() || !(tolerance_mm > 0.0) ||
+      !(tolerance_mm < tool.radius_mm))
+    return;  // nothing the test would stamp
+  const StampSpacing spacing = stampSpacing(tool, tolerance_mm);
+  requireStampMemory(postures, nearPart(part_box, spacing.reach_mm), spacing);
+}
 
 CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
                                         const geometry::TriangleMesh& part_mesh,
@@ -194,17 +234,11 @@ CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
       !(tolerance_mm < tool.radius_mm))
     return result;
   const Part part(*part_model);
-  // A cutting surface whose tightest curvature radius is ρ (a ball's R, a torus's corner r; the
-  // shank's R is no tighter) swept between two stamps s apart stands at most s² / (8 ρ) beyond
-  // both: a quarter of the tolerance.
+  const StampSpacing spacing = stampSpacing(tool, tolerance_mm);
+  result.step_mm = spacing.step_mm;
   const double tightest = geometry::cornerRadius(tool);
-  result.step_mm = std::sqrt(2.0 * tightest * tolerance_mm);
   result.between_stamps_mm = result.step_mm * result.step_mm / (8.0 * tightest);
-  // The farthest any point of the cutter lies from its tip: the top rim's (or the ball's far
-  // side, for a ball shorter than its diameter).
-  const double reach =
-      std::max(std::hypot(tool.length_mm, tool.radius_mm), 2.0 * geometry::cornerRadius(tool));
-  const std::vector<Stamp> stamps = stampsNearPart(postures, part, reach, result.step_mm);
+  const std::vector<Stamp> stamps = stampsNearPart(postures, part, spacing);
   result.stamps = stamps.size();
   std::vector<char> gouging(stamps.size(), 0);
   constexpr std::size_t kBatch = 4096;

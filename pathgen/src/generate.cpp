@@ -21,6 +21,7 @@
 #include "fieldpath/field/voxel_field.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/geometry/units.h"
+#include "fieldpath/pathgen/cutter_part.h"
 #include "fieldpath/pathgen/reach_box.h"
 #include "open_sheets.h"
 #include "path_check.h"
@@ -493,6 +494,22 @@ GenerateResult generatePath(const GenerateRequest& request) {
     }
   }
   result.times.field_s = seconds(field_start);
+
+  // The cutter's test against the part runs last: its stamps are asked for now, so that a run
+  // the test would refuse is refused before the steering (33 s of a run went before such a
+  // refusal). Counted at the ball centres with the axis held: the centres follow the path
+  // whatever the axis does, so the steered path's stamps are at least these (its turns and links
+  // only add; the nominal axes would count turns the steering smooths away).
+  if (request.part && !request.passes_only) {
+    Eigen::AlignedBox3d part_box;
+    for (const Vec3& v : request.part->vertices) part_box.extend(v);
+    std::vector<geometry::Posture> centres;
+    centres.reserve(static_cast<std::size_t>(stations));
+    for (const Pass& pass : result.passes)
+      for (const PassSample& sample : pass.samples)
+        centres.push_back({sample.centre_mm, Vec3::UnitZ(), 0.0, false});
+    requireCutterTestMemory(tool, part_box, centres);
+  }
 
   const auto steer_start = Clock::now();
   std::vector<Steered> steered_passes = steerPasses(force, true, request.dynamics);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/memory.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/pathgen/generate.h"
 #include "fixtures.h"
@@ -519,4 +520,71 @@ TEST(Generate, AnUprightPassUnderAShelfClimbsOutFromUnderIt) {
   EXPECT_EQ(longest.clearance.colliding + longest.motions.colliding, 0u);
   ASSERT_EQ(longest.routed_link_ends.size(), 2u);
   for (const auto& end : longest.routed_link_ends) EXPECT_EQ(end.retract_mm, 1.0);
+}
+
+// The cutter's test against the part runs last; its stamps are asked of the memory ledger before
+// the steering, of the nominal postures, so that a run it would refuse is refused before the work
+// (a memory sweep's run was refused at its end, 33 s in). The nominal job (the steering of an
+// 8 m pass takes 11 s; the test is sized before either).
+TEST(Generate, TheCuttersTestIsSizedBeforeTheSteering) {
+  GenerateRequest job;
+  job.nominal = true;
+  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
+  job.holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
+  job.mode = FieldMode::Direct;
+  job.field.r0_mm = 8.0;
+  job.field.sample_step_mm = 2.0;
+  job.obstacles = {test::boxMesh(20, 22, -25, 25, -5, 60)};
+  job.part = test::boxMesh(-30, 20, -100, 8100, -5, 0);
+  std::vector<geometry::Posture> nominal;  // 4 mm apart: 24 stamps a motion, 48 k in all
+  for (int k = 0; k <= 2000; ++k)
+    nominal.push_back({Vec3(10, -20 + 4.0 * k, 0), Vec3::UnitZ(), 0.0, false});
+  job.passes = nominalPasses(geometry::singlePass(std::move(nominal)), PathParams{}, 3.0);
+  ASSERT_EQ(job.passes.size(), 1u);
+  // The most the run holds at any report, and how far it got: with a limit set, the ledger
+  // counts (the field's samples).
+  double held_most = 0.0, reached = 0.0;
+  job.progress = [&](double fraction, std::string_view) {
+    held_most = std::max(held_most, common::memoryHeld().first);
+    reached = std::max(reached, fraction);
+    return true;
+  };
+  struct Limit {
+    explicit Limit(double bytes) {
+      common::releaseHeldMemory();
+      common::setMemoryLimitBytes(static_cast<std::size_t>(bytes));
+    }
+    ~Limit() {
+      common::setMemoryLimitBytes(0);
+      common::releaseHeldMemory();
+    }
+  };
+  std::size_t stamps = 0;
+  {
+    const Limit ample(1e12);
+    const GenerateResult r = generatePath(job);
+    ASSERT_TRUE(r.cutter_part);
+    stamps = r.cutter_part->stamps;
+  }
+  ASSERT_GT(stamps, 40000u);  // 2.6 MB: more than what passes through the run beside them
+  // Room for what the run holds, 1 MiB for what passes (the tool's mesh: 657 KiB) and half the
+  // stamps: refused, naming the test, before the steering (its progress from 0.3 on).
+  constexpr double kPassingBytes = 1024.0 * 1024.0;
+  {
+    const Limit tight(held_most + kPassingBytes + 0.5 * double(stamps) * 65.0);
+    reached = 0.0;
+    try {
+      (void)generatePath(job);
+      ADD_FAILURE() << "accepted with room for half its stamps";
+    } catch (const common::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("the cutter's test against the part"), std::string::npos)
+          << e.what();
+    }
+    EXPECT_LE(reached, 0.3);
+  }
+  // Room for all of them (65 B each, the verdict beside the stamp): accepted.
+  {
+    const Limit enough(held_most + kPassingBytes + 1.1 * double(stamps) * 65.0);
+    EXPECT_NO_THROW((void)generatePath(job));
+  }
 }
