@@ -33,6 +33,13 @@
 namespace fieldpath::geometry {
 namespace {
 
+/// What reading an STL takes beyond its text: bytes a triangle, and once (the importer's own),
+/// over the worst measured, a soup of separate triangles whose every corner is a vertex (peaks
+/// over the program: 30 MiB for 50 k triangles, 113 MiB for 200 k, 445 MiB for 1 M; a welded
+/// mesh of 1 M, 188 MiB).
+constexpr double kMeshLoadBytesPerTriangle = 600.0;
+constexpr double kMeshLoadBytes = 8.0 * 1024 * 1024;
+
 using common::InputError;
 using common::lowerExtension;
 
@@ -124,6 +131,8 @@ struct StlFeed {
   /// (and misreads the count, "Failed to determine STL storage"), so the copy has them blank.
   bool blank_mark = false;
   std::uintmax_t length = 0;
+  bool ascii = false;
+  std::uintmax_t triangles = 0;  ///< its header's count (binary) or its facets (ASCII)
 };
 
 /// assimp reads an ASCII STL cut after a facet (no `endsolid`) and a facet loop of 4 vertices
@@ -136,7 +145,7 @@ struct StlFeed {
 StlFeed checkAsciiStl(const std::filesystem::path& file, std::uintmax_t size) {
   std::ifstream in(file, std::ios::binary);
   std::string line;
-  std::size_t number = 0, facet_line = 0, vertices = 0;
+  std::size_t number = 0, facet_line = 0, vertices = 0, facets = 0;
   bool in_facet = false, capitals = false, in_solid = false;
   std::uintmax_t offset = 0, solid_end = 0;  // bytes read; the end of the last `endsolid` line
   std::size_t trailing_line = 0;             // the first line of text after it, if any
@@ -168,6 +177,7 @@ StlFeed checkAsciiStl(const std::filesystem::path& file, std::uintmax_t size) {
       in_solid = true;
       trailing_line = 0;
     } else if (word == "facet") {
+      ++facets;
       in_facet = true;
       facet_line = number;
       vertices = 0;
@@ -214,6 +224,8 @@ StlFeed checkAsciiStl(const std::filesystem::path& file, std::uintmax_t size) {
   feed.lower = capitals;
   feed.copy = capitals || trailing_line > 0;
   feed.length = trailing_line > 0 ? solid_end : size;
+  feed.ascii = true;
+  feed.triangles = facets;
   return feed;
 }
 
@@ -253,6 +265,7 @@ StlFeed checkStl(const std::filesystem::path& file, std::uintmax_t size) {
     feed.copy = size != needed || marked;
     feed.blank_mark = marked;
     feed.length = needed;
+    feed.triangles = (needed - 84) / 50;
     return feed;
   };
   if (word == "solid" && got == 84) {
@@ -358,14 +371,25 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
   const std::uintmax_t size = std::filesystem::file_size(file, ec);
   if (ec || size == 0) throw InputError(file.string() + ": empty file");
   if (startsWithByteOrderMark(file, size)) return loadWithoutByteOrderMark(file);
-  // assimp's scene, our joined copy and the hash that joins them: about 16 bytes per file byte
-  // (a binary STL's 50-byte facet becomes 3 aiVector3D, a face, 3 map entries, 1.5 vertices).
-  // Passing: the mesh loaded is held as a scene's (app/estimates.h: its triangles).
-  common::requireMemory(file.string(), 16.0 * static_cast<double>(size),
-                        "mesh file of " + common::formatBytes(double(size)),
-                        common::MemoryUse::kPassing);
   detail::checkPly(file, size);
   const StlFeed stl = checkStl(file, size);
+  // assimp's scene, our joined copy and the hash that joins them. An STL's triangles are known
+  // before it is read: its text (an ASCII one's twice: assimp's buffer; once more where a copy
+  // is made) and kMeshLoadBytesPerTriangle (16 B a file byte, as for the others, refused an
+  // ASCII STL at 4.7 times its need, a welded binary one at 3.5). Others: 16 B per file byte (a
+  // 50-byte facet becomes 3 aiVector3D, a face, 3 map entries, 1.5 vertices; OBJ and PLY pack a
+  // triangle into 20-40 bytes: 6.5-10 times their size measured).
+  // Passing: the mesh loaded is held as a scene's (app/estimates.h: its triangles).
+  const double bytes = double(size);
+  const double estimate = stl.triangles > 0
+                              ? kMeshLoadBytes + bytes * (1.0 + stl.ascii + stl.copy) +
+                                    kMeshLoadBytesPerTriangle * double(stl.triangles)
+                              : 16.0 * bytes;
+  common::requireMemory(file.string(), estimate,
+                        stl.triangles > 0 ? std::to_string(stl.triangles) + " triangles in " +
+                                                common::formatBytes(bytes) + " of STL"
+                                          : "mesh file of " + common::formatBytes(bytes),
+                        common::MemoryUse::kPassing);
 
   Assimp::Importer importer;
   const aiScene* scene = nullptr;

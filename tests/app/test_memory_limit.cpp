@@ -6,6 +6,9 @@
 #include <sys/resource.h>
 #include <sys/wait.h>
 
+#include <cstdint>
+#include <fstream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -184,6 +187,56 @@ TEST(MemoryLimit, TheToolMeshIsSizedBeforeItIsMade) {
       << err;
   EXPECT_LT(run.peak_kib, 100 * 1024L);
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "t.stl"));
+}
+
+// An STL's triangles are known before it is read (its header's count, an ASCII one's facets):
+// counted at 600 B each beside its text, where 16 B a file byte refused an ASCII STL at 4.7
+// times its need. The worst case is a soup of separate triangles (every corner its own vertex):
+// 200 k of them, 9.5 MiB of binary STL, ran to 155 MiB; an accepted run stays under its limit,
+// and 185M, which 16 B a byte refused (195 MiB with the program), is accepted.
+TEST(MemoryLimit, AnStlIsSizedByItsTriangles) {
+  const TempDir dir;
+  const auto soup = dir.path() / "soup.stl";
+  {
+    std::ofstream out(soup, std::ios::binary);
+    const std::string header(80, ' ');
+    out.write(header.data(), 80);
+    const std::uint32_t count = 200000;
+    out.write(reinterpret_cast<const char*>(&count), 4);
+    std::mt19937 random(7);
+    std::uniform_real_distribution<float> at(0.0f, 100.0f), near(-0.5f, 0.5f);
+    for (std::uint32_t i = 0; i < count; ++i) {
+      float facet[12] = {0, 0, 1};
+      const float x = at(random), y = at(random);
+      for (int k = 0; k < 3; ++k) {
+        facet[3 + 3 * k] = x + near(random);
+        facet[4 + 3 * k] = y + near(random);
+        facet[5 + 3 * k] = 0.01f * near(random);
+      }
+      out.write(reinterpret_cast<const char*>(facet), sizeof facet);
+      const std::uint16_t attribute = 0;
+      out.write(reinterpret_cast<const char*>(&attribute), 2);
+    }
+  }
+  const auto path = dir.path() / "one.cl";
+  std::ofstream(path) << "50 50 10 0 0 1\n51 50 10 0 0 1\n";
+  int accepted_at = 0;
+  for (int mib : {120, 185}) {
+    const Peak run =
+        runMeasured(dir, {"--max-memory", std::to_string(mib) + "M", "simulate", "--tool", "ball:3",
+                          "--path", path.string(), "--part", soup.string(), "--grid", "16x16",
+                          "--out", (dir.path() / "out").string()});
+    const std::string err = fieldpath::test::slurp(dir.path() / "stderr.txt");
+    if (run.exit_code == 0) {
+      if (accepted_at == 0) accepted_at = mib;
+      EXPECT_LE(run.peak_kib, mib * 1024L) << mib << " MiB: ran to " << run.peak_kib << " KiB";
+    } else {
+      EXPECT_EQ(run.exit_code, 1) << err;
+      EXPECT_NE(err.find("soup.stl: needs about"), std::string::npos) << err;
+      EXPECT_NE(err.find("(200000 triangles"), std::string::npos) << err;
+    }
+  }
+  EXPECT_EQ(accepted_at, 185);
 }
 
 TEST(MemoryLimit, ALimitUnderTheProgramItselfIsRefusedAtOnce) {
