@@ -380,6 +380,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
               scene.part ? std::optional(contacts.marks(path.postures.size())) : std::nullopt));
       common::writeTextAtomically(out / "check.json", jsonText(report));
     }
+    common::commitOutputs();  // a summary lost from here takes none of them away
     // Postures numbered from 0 in the file's order, as clearance.csv, check.json and view's
     // #posture= number them, with the file's line (motion i: from posture i to i + 1).
     auto index = [&path](std::size_t i) {

@@ -125,6 +125,7 @@ void addConvertCommand(CLI::App& app, const GlobalOptions& /*global*/) {
       geometry::writeAptFile(out, path, header);
     else
       geometry::writeNpyFile(out, path.postures);
+    common::commitOutputs();  // a summary or warning lost from here takes it not away
     for (const std::string& w : path.warnings)
       std::fprintf(stderr, "warning: %s is marked \"%s\": %s\n", in.string().c_str(), w.c_str(),
                    to == PathFormat::Npy ? ".npy cannot carry the mark: DROPPED, the .npy reads "

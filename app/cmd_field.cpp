@@ -175,6 +175,7 @@ void build(const FieldOptions& o, const GlobalOptions& global) {
   }
   const field::VoxelField voxel(*obstacles.direct, request);
   voxel.save(o.out);
+  common::commitOutputs();  // a summary lost from here takes it not away
   const field::VoxelStats& s = voxel.stats();
   const auto& samples = obstacles.direct->samples();
   std::printf("obstacles: %zu meshes, %zu samples (step %g mm, %.0f mm²)\n",

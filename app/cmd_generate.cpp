@@ -41,30 +41,43 @@ namespace {
 
 using geometry::kRadToDeg;
 
-/// Removes `check --out`'s files from `out` where they checked the path.cl or path.apt this run
-/// replaces (check.json's path_digest is the file's): check.json's `"ok": true`, deviation.png
-/// and clearance.csv stayed beside a new path nobody had checked (a helper's finding). A check
-/// of another path (its digest differs), or one that cannot be read, stays.
-void forgetCheckOfReplacedPath(const std::filesystem::path& out) {
+/// Removes `check --out`'s and `simulate --out`'s files from `out` where they are of the path.cl
+/// or path.apt this run replaces (check.json's and simulate.json's path_digest is the file's):
+/// check.json's `"ok": true`, deviation.png and clearance.csv stayed beside a new path nobody had
+/// checked, heights.npy beside one nobody had simulated (helpers' findings). Results of another
+/// path (its digest differs), or ones that cannot be read, stay.
+void forgetResultsOfReplacedPath(const std::filesystem::path& out) {
   namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::path check = out / "check.json";
-  if (!fs::is_regular_file(check, ec)) return;
-  bool replaced = false;
-  try {
-    std::ifstream in(check);
-    const std::string digest = nlohmann::json::parse(in).value("path_digest", std::string());
-    for (const char* name : {"path.cl", "path.apt"})
-      replaced = replaced || (!digest.empty() && fs::is_regular_file(out / name, ec) &&
-                              digest == common::fileDigest(out / name));
-  } catch (const std::exception&) {
-    return;  // not check's, or a path that cannot be read: left as it is
+  struct Results {
+    const char* report;
+    std::initializer_list<const char*> files;
+    const char* what;
+  };
+  for (const Results& results :
+       {Results{"check.json",
+                {"check.json", "clearance.csv", "deviation.npy", "deviation.json", "deviation.png"},
+                "check"},
+        Results{"simulate.json",
+                {"simulate.json", "heights.npy", "heights.json", "surface.stl", "heights.png"},
+                "simulation"}}) {
+    std::error_code ec;
+    const fs::path report = out / results.report;
+    if (!fs::is_regular_file(report, ec)) continue;
+    bool replaced = false;
+    try {
+      std::ifstream in(report);
+      const std::string digest = nlohmann::json::parse(in).value("path_digest", std::string());
+      for (const char* name : {"path.cl", "path.apt"})
+        replaced = replaced || (!digest.empty() && fs::is_regular_file(out / name, ec) &&
+                                digest == common::fileDigest(out / name));
+    } catch (const std::exception&) {
+      continue;  // not theirs, or a path that cannot be read: left as it is
+    }
+    if (!replaced) continue;
+    common::removeStaleOutputs(out, results.files);
+    std::fprintf(stderr, "note: %s: the %s of the path this run replaces is removed with it\n",
+                 out.string().c_str(), results.what);
   }
-  if (!replaced) return;
-  common::removeStaleOutputs(
-      out, {"check.json", "clearance.csv", "deviation.npy", "deviation.json", "deviation.png"});
-  std::fprintf(stderr, "note: %s: the check of the path this run replaces is removed with it\n",
-               out.string().c_str());
 }
 
 /// A nominal path whose axes lean along the feed by more than this (deg) gets a note: the
@@ -186,7 +199,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     // never the scene's own files (a nominal path.cl in --out).
     common::claimOutputs(options->out, {"path.cl", "path.apt", "angles.csv", "report.json"},
                          {options->scene, nominalPathOf(options->scene)});
-    forgetCheckOfReplacedPath(options->out);
+    forgetResultsOfReplacedPath(options->out);
     common::removeEarlierOutputs();
     // Reading (the scene, its meshes, the nominal path, the passes) is counted apart: the job's
     // total left out 9 s of a 70 MB STL (a helper's).
@@ -319,6 +332,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     report["path_digest"] = {{"path.cl", common::fileDigest(out / "path.cl")},
                              {"path.apt", common::fileDigest(out / "path.apt")}};
     common::writeTextAtomically(out / "report.json", jsonText(report));
+    common::commitOutputs();  // a summary or note lost from here takes none of them away
 
     const auto& c = result.clearance;
     const auto& m = result.motions;

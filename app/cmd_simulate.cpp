@@ -381,6 +381,9 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     const double path_mb = double(fs::file_size(o->path, size_ec)) / 1e6;
     nlohmann::json report = {
         {"path", o->path},
+        // Which file it was, for `generate` into this folder: its simulation of the path it
+        // replaces is removed with it (an old heights.npy stood beside a new path.cl).
+        {"path_digest", common::fileDigest(o->path)},
         {"path_megabytes", size_ec ? nlohmann::json(nullptr) : nlohmann::json(path_mb)},
         {"postures", res.postures},
         {"postures_culled", res.postures_culled},
@@ -414,6 +417,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
          finiteOrNull(size_ec || read_s <= 0 ? NAN : path_mb / read_s)},
         {"peak_memory_mib", peakRssMib()}};
     common::writeTextAtomically(out / "simulate.json", jsonText(report));
+    common::commitOutputs();  // a summary lost from here takes none of them away
 
     std::printf("postures        %zu (%zu culled: cannot lower any line)\n", res.postures,
                 res.postures_culled);

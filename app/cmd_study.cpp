@@ -39,13 +39,8 @@ struct StudyOptions {
 
 void run(const StudyOptions& o, const GlobalOptions& global, const std::string& command_line) {
   common::checkOutputDirectory(o.out, "--out");  // before the work, not after
-  // A failed or interrupted study takes the earlier one's files away too (they stayed, read by a
-  // script that did not look at the exit code as this run's), as generate, check and simulate do.
-  common::claimOutputs(o.out,
-                       {"study.csv", "lines.csv", "tilt.csv", "study.md", "speed_vs_error.png",
-                        "force_error_lines.png", "tilt_along_path.png"},
-                       {o.scene});  // never the scene (`study out/study.md --out out` removed it)
-  common::removeEarlierOutputs();
+  // The options' values first: one refused leaves the folder as it was, as the parser's
+  // refusals do (a bad --voxels after a good study took its 7 files away: a study sweep's).
   StudyRequest request;
   request.voxel_sizes_mm = parseVoxelSizes(o.voxels, "--voxels");
   request.interpolations = parseInterpolations(o.interpolations, "--interp");
@@ -64,6 +59,13 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
   request.brute_force = !o.no_brute_force;
   request.line_step_mm = o.line_step_mm;
   request.repeats = o.repeats;
+  // A failed or interrupted study takes the earlier one's files away too (they stayed, read by a
+  // script that did not look at the exit code as this run's), as generate, check and simulate do.
+  common::claimOutputs(o.out,
+                       {"study.csv", "lines.csv", "tilt.csv", "study.md", "speed_vs_error.png",
+                        "force_error_lines.png", "tilt_along_path.png"},
+                       {o.scene});  // never the scene (`study out/study.md --out out` removed it)
+  common::removeEarlierOutputs();
   const Scene scene = loadScene(o.scene);
   if (!scene.impeller_model || !scene.guide_impeller)
     throw InputError(
@@ -88,6 +90,7 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
       dir, {"speed_vs_error.png", "force_error_lines.png", "tilt_along_path.png"});
   std::string message;
   if (!plotStudy(dir, &message)) std::fprintf(stderr, "fieldpath study: %s\n", message.c_str());
+  common::commitOutputs();  // a summary lost from here takes none of them away
 
   std::printf("%-38s %10s %9s %9s %9s %9s %10s %9s\n", "variant", "nodes", "total_s", "x_direct",
               "force_%", "nodes_%", "tilt_deg", "clear_mm");

@@ -37,6 +37,7 @@ void addToolCommand(CLI::App& app, const GlobalOptions& /*global*/) {
                        std::to_string(tool.radius_mm) + " mm (the tool's radius)");
     const geometry::TriangleMesh mesh = geometry::toolMesh(tool, holder, options->tol_mm);
     geometry::saveMesh(mesh, options->out);
+    common::commitOutputs();  // a summary lost from here takes it not away
     const geometry::MeshReport report = geometry::validateMesh(mesh);
     std::printf("%s: %zu triangles, area %.6g mm^2, volume %.6g mm^3, closed %s\n",
                 options->out.c_str(), report.triangles, geometry::meshArea(mesh),

@@ -112,6 +112,7 @@ void addViewCommand(CLI::App& app, const GlobalOptions& global) {
       budget.max_postures = std::max(posture_floor, budget.max_postures / 2);
     }
     common::writeTextAtomically(o->out, page);
+    common::commitOutputs();  // a summary lost from here takes it not away
 
     std::printf("view: %s (%.2f MB)\n", o->out.c_str(), stats.bytes / 1e6);
     std::printf("meshes: %zu, %zu triangles shown of %zu\n", data.meshes.size(), stats.triangles,

@@ -11,6 +11,7 @@
 #include <iterator>
 #include <new>
 #include <string>
+#include <string_view>
 #include <system_error>
 #include <vector>
 
@@ -235,6 +236,15 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     fieldpath::common::removeWrittenOutputs();
     fieldpath::app::endProgressLine();
+    // TBB says a thread it could not start in a plain runtime_error (`ulimit -u`, a container's
+    // pids limit: read as a bug, exit 2, by an environment sweep): the environment, exit 1.
+    if (std::string_view(e.what()).starts_with("pthread_create")) {
+      std::fprintf(stderr,
+                   "fieldpath: error: the system refused a thread (%s): a process or thread "
+                   "limit (ulimit -u, a container's pids limit)?\n",
+                   oneLine(e.what()).c_str());
+      return 1;
+    }
     std::fprintf(stderr, "fieldpath: internal error: %s\n", oneLine(e.what()).c_str());
     return 2;
   }
@@ -242,6 +252,6 @@ int main(int argc, char** argv) {
     fieldpath::common::removeWrittenOutputs();
     return 1;
   }
-  fieldpath::common::releaseClaimedOutputs();  // done: a late signal takes nothing away
+  fieldpath::common::commitOutputs();  // done: a late signal takes nothing away
   return 0;
 }

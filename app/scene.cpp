@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <string>
 #include <utility>
@@ -140,6 +142,7 @@ Scene loadScene(const std::filesystem::path& file, SceneUse use) {
   common::requireRegularFile(file, "scene file (YAML)");
   sceneSizeOk(file, /*refuse=*/true);
   YAML::Node root;
+  errno = 0;  // what a failed open leaves, said beside yaml-cpp's "bad file"
   try {
     // Every document read, so that one past the scene (after `---`, or text after `...`) is
     // refused rather than silently ignored.
@@ -165,7 +168,13 @@ Scene loadScene(const std::filesystem::path& file, SceneUse use) {
     throw InputError(file.string() + ":" + std::to_string(e.mark.line + 1) +
                      ": YAML syntax: " + e.msg + hint);
   } catch (const YAML::Exception& e) {
-    throw InputError(file.string() + ": cannot read scene file: " + e.msg);
+    // yaml-cpp says "bad file" of any open that failed: the system's reason is errno's (too many
+    // open files read as a bad file: an environment sweep's).
+    const int error = errno;
+    throw InputError(file.string() + ": cannot read scene file: " + e.msg +
+                     (error != 0 && e.msg.rfind("bad file", 0) == 0
+                          ? std::string(" (") + std::strerror(error) + ")"
+                          : std::string()));
   }
   const Reader r(file);
   if (!root.IsMap()) r.fail(root, "scene", "expected a map of keys (obstacles, guide, tool, ...)");

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <limits>
@@ -416,6 +417,18 @@ bool plotStudy(const std::filesystem::path& dir, std::string* message) {
   // no shell (a folder named with a quote ran what followed it) and no script file to find (the
   // program looked for a developer's checkout). Its stderr is kept for the message: a traceback
   // is not printed under --quiet.
+  // A plotter killed with an interrupted run leaves its temporary (`.NAME.png.XXXX.tmp.png`,
+  // hidden); the folder is this run's (locked: claimOutputs), so any such is a dead one's.
+  std::error_code listed;
+  for (std::filesystem::directory_iterator it(dir, listed), end; !listed && it != end;
+       it.increment(listed)) {
+    const std::string name = it->path().filename().string();
+    for (const char* png : {"speed_vs_error.png", "force_error_lines.png", "tilt_along_path.png"})
+      if (name.starts_with("." + std::string(png) + ".") && name.ends_with(".tmp.png")) {
+        std::error_code ignored;
+        std::filesystem::remove(it->path(), ignored);
+      }
+  }
   int to_python[2], from_python[2];
   if (::pipe2(to_python, O_CLOEXEC) != 0) return fail("pictures not made: no pipe to python3");
   if (::pipe2(from_python, O_CLOEXEC) != 0) {
@@ -436,6 +449,7 @@ bool plotStudy(const std::filesystem::path& dir, std::string* message) {
                           ? ::posix_spawn(&pid, debian, &actions, nullptr, argv, environ)
                           : ::posix_spawnp(&pid, "python3", &actions, nullptr, argv, environ);
   posix_spawn_file_actions_destroy(&actions);
+  if (spawned == 0) common::detail::output_helper.store(pid);  // a signal ends it with the run
   ::close(to_python[0]);
   ::close(from_python[1]);
   if (spawned != 0) {
@@ -469,6 +483,7 @@ bool plotStudy(const std::filesystem::path& dir, std::string* message) {
   int status = -1;  // a failed waitpid (SIGCHLD ignored: ECHILD) is no success
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
+  common::detail::output_helper.store(0);
   if (status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 0) return true;
   // The last line python3 wrote says why (an ImportError for a missing matplotlib).
   while (!output.empty() && (output.back() == '\n' || output.back() == '\r')) output.pop_back();

@@ -46,9 +46,14 @@ std::vector<double> parseNumbers(const std::string& text, const std::string& key
   std::stringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
+    // Blanks around an item are read past (" 2" was taken, "2 " refused); hexadecimal is no
+    // millimetre (strtod read `0x10` as 16: a study sweep's).
+    const std::size_t first = item.find_first_not_of(" \t"), last = item.find_last_not_of(" \t");
+    item = first == std::string::npos ? std::string() : item.substr(first, last - first + 1);
     char* end = nullptr;
     const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(v) || !ok(v))
+    if (item.empty() || end == item.c_str() || *end != '\0' || !std::isfinite(v) || !ok(v) ||
+        item.find_first_of("xX") != std::string::npos)
       throw InputError(key + ": '" + item + "' is not " + what);
     values.push_back(v);
   }

@@ -80,17 +80,21 @@ void writeAptFile(const std::filesystem::path& file, const PathFile& path,
   // taper angles a, b (0 for these tools), height h.
   const ToolSpec& t = header.tool;
   const double corner_mm = cornerRadius(t);
-  // PARTNO is one card: a longer name is cut.
-  std::string text =
-      "PARTNO/" + header.part_name.substr(0, std::min(header.part_name.size(), kAptTextColumns)) +
-      "\n";
+  // PARTNO is one card: a longer name is cut, and what would end or continue the record there
+  // (a line break, a `$`: a scene file named so put raw lines into the program, an environment
+  // sweep's) or no post-processor reads (control bytes) is a blank.
+  std::string part_name =
+      header.part_name.substr(0, std::min(header.part_name.size(), kAptTextColumns));
+  for (char& c : part_name)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f || c == '$') c = ' ';
+  std::string text = "PARTNO/" + part_name + "\n";
   // The count first: a safety mark's text runs on into the PPRINT cards after it.
   text += std::string(kAptCountPrefix) + std::to_string(path.postures.size()) +
           " (A FILE HOLDING FEWER WAS CUT SHORT)\n";
   for (const std::string& remark : header.remarks) {
     std::string line = upperCase(remark);
-    for (char& c : line)
-      if (c == '\n' || c == '\r' || c == '$') c = ' ';  // one record, no continuation
+    for (char& c : line)  // one record, no continuation, nothing a post-processor cannot read
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f || c == '$') c = ' ';
     appendTextCards(text, "PPRINT", line);
   }
   text += "UNITS/MM\nMULTAX/ON\n";

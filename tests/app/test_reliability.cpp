@@ -77,6 +77,28 @@ TEST(AtomicOutput, ALinkUnderTheTemporaryNameIsNotWrittenThrough) {
   EXPECT_EQ(slurp(out), "the output\n");
 }
 
+// A run killed where no handler runs (SIGKILL) leaves its temporary, hidden: the next write of
+// that output removes it (field build's were 60 and 141 MB, left for good: an environment
+// sweep's), not a live process's nor another output's.
+TEST(AtomicOutput, ADeadRunsTemporaryIsRemovedByTheNextWrite) {
+  const TempDir dir;
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  ASSERT_GT(child, 0);
+  ASSERT_EQ(waitpid(child, nullptr, 0), child);  // gone: its pid answers no signal
+  const std::string dead = std::to_string(child);
+  const fs::path dead_tmp = dir.write(".out.txt.tmp-" + dead, "half a");
+  const fs::path live_tmp = dir.write(".out.txt.tmp-" + std::to_string(::getppid()), "another's");
+  const fs::path other_tmp = dir.write(".other.txt.tmp-" + dead, "another output's");
+  const fs::path named = dir.write(".out.txt.tmp-notapid", "not so named");
+  common::writeTextAtomically(dir.path() / "out.txt", "the output\n");
+  EXPECT_EQ(slurp(dir.path() / "out.txt"), "the output\n");
+  EXPECT_FALSE(fs::exists(dead_tmp));
+  EXPECT_TRUE(fs::exists(live_tmp));
+  EXPECT_TRUE(fs::exists(other_tmp));
+  EXPECT_TRUE(fs::exists(named));
+}
+
 // A signal in the middle of a write: the handler removes the temporary, the target never appears.
 TEST(AtomicOutput, SignalDuringAWriteLeavesNothing) {
   const TempDir dir;
@@ -144,6 +166,9 @@ TEST(AtomicOutput, AFailedRunLeavesNoEarlierRunsOutputs) {
 
 // A check of the path.cl a generate replaces goes with it: check.json's `"ok": true` stayed
 // beside a new path nobody had checked (a helper's finding); a check of another path stays.
+// The same of `simulate --out` into generate's folder (heights.npy stood beside a new path.cl,
+// its simulate.json naming out/path.cl: an environment sweep's): simulate.json has the digest of
+// the path it simulated, written by the program here.
 TEST(AtomicOutput, GenerateTakesAwayTheCheckOfThePathItReplaces) {
   const TempDir dir;
   dir.write("scene.yaml", "obstacles:\n  - mesh: missing.stl\n");
@@ -164,6 +189,24 @@ TEST(AtomicOutput, GenerateTakesAwayTheCheckOfThePathItReplaces) {
   EXPECT_EQ(filesUnder(dir.path() / "apt"), std::vector<std::string>{"mine.txt"});
   EXPECT_EQ(filesUnder(dir.path() / "other"),
             (std::vector<std::string>{"check.json", "deviation.png", "mine.txt"}));
+
+  for (const char* folder : {"sim", "sim_other"}) {
+    const std::string f(folder);
+    dir.write(f + "/path.cl", "0 0 5 0 0 1\n1 0 5 0 0 1\n");
+    dir.write("elsewhere.cl", "0 0 6 0 0 1\n1 0 6 0 0 1\n");
+    const std::string simulated = f == "sim" ? f + "/path.cl" : "elsewhere.cl";
+    ASSERT_EQ(test::runFieldpath(
+                  dir, "simulate --tool ball:3 --path " + simulated + " --grid 8x8 --out " + f)
+                  .exit_code,
+              0);
+    ASSERT_TRUE(fs::exists(dir.path() / f / "heights.npy"));
+    const auto run = test::runFieldpath(dir, "generate scene.yaml --out " + f);
+    EXPECT_EQ(run.exit_code, 1) << run.output();
+  }
+  EXPECT_EQ(filesUnder(dir.path() / "sim"), std::vector<std::string>{});
+  EXPECT_EQ(filesUnder(dir.path() / "sim_other"),
+            (std::vector<std::string>{"heights.json", "heights.npy", "heights.png", "simulate.json",
+                                      "surface.stl"}));
 }
 
 // A folder another run is writing (here: held as that run holds it) is refused before any work,

@@ -82,8 +82,10 @@ const StudyRow& rowNamed(const StudyResult& result, const std::string& name) {
 TEST(StudyOptions, ParsesListsAndRejectsBadOnes) {
   EXPECT_EQ(parseVoxelSizes("2,1,0.5", "--voxels"), (std::vector<double>{2.0, 1.0, 0.5}));
   EXPECT_EQ(parseInterpolations("quadratic,trilinear", "--interp").size(), 2u);
-  for (const char* bad : {"", "2,,1", "2,", "0", "-1", "2,x", "nan", "inf"})
+  for (const char* bad : {"", "2,,1", "2,", "0", "-1", "2,x", "nan", "inf", "0x10", " ", "1,0X2"})
     EXPECT_THROW(parseVoxelSizes(bad, "--voxels"), common::InputError) << bad;
+  // Blanks around an item are read past, before and after alike.
+  EXPECT_EQ(parseVoxelSizes(" 2, 1 ,0.5 ", "--voxels"), (std::vector<double>{2.0, 1.0, 0.5}));
   EXPECT_THROW(parseInterpolations("cubic", "--interp"), common::InputError);
   EXPECT_EQ(parseStored("plane_ratio", "--stored"),
             std::vector<field::StoredQuantity>{field::StoredQuantity::PlaneRatio});
@@ -335,6 +337,17 @@ TEST(StudyCommand, WritesTablesAndPicturesOrSaysWhyNot) {
       EXPECT_TRUE(std::filesystem::exists(study / file)) << file << ": " << run.err;
   else
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+
+  // A value refused into the folder of a good study leaves it as it was, as the parser's
+  // refusals do (a bad --voxels after a good study took its 7 files away: a study sweep's).
+  const std::string tables = test::slurp(study / "study.csv");
+  for (const char* args :
+       {"--voxels 0", "--interp cubic", "--refine-region nowhere", "--backend gpu"}) {
+    const test::Outcome bad =
+        test::runFieldpath(dir, std::string("study scene.yaml ") + args + " --out \"" + out + "\"");
+    EXPECT_EQ(bad.exit_code, 1) << args;
+    EXPECT_EQ(test::slurp(study / "study.csv"), tables) << args;
+  }
 }
 
 TEST(StudyCommand, BadInputIsExitOneWithNoOutputs) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -450,18 +451,47 @@ TEST(Outputs, NeverReplaceAnInputOfTheRun) {
   EXPECT_EQ(slurp(dir.path() / "floor.stl"), floor);
 }
 
-// What a command prints is its result: to a full device it is lost, and the run says so and
-// leaves nothing (`field probe > /dev/full` exited 0, its values gone).
-TEST(Outputs, AStandardOutputThatCannotBeWrittenFailsTheRun) {
+// What a command prints is its result: to a full device it is lost, and the run says so, exit 1
+// (`field probe > /dev/full` exited 0, its values gone). Its files, all written before its
+// summary, stay: a lost summary takes none of them away (`generate ... 2>&1 | grep -q UNSAFE`
+// stopped reading at the warning, and the SIGPIPE of the next note took away the path warned
+// of, and its folder: an environment sweep's), nor does a pipe closed before the summary.
+TEST(Outputs, AStandardOutputThatCannotBeWrittenFailsTheRunAndKeepsItsFiles) {
   const TempDir dir;
-  const std::string command = "cd '" + dir.path().string() +
-                              "' && '" FIELDPATH_EXE
-                              "' --quiet tool --shape ball:3 --out t.stl > /dev/full 2> err.txt";
-  const int status = std::system(command.c_str());
+  const std::string in_dir = "cd '" + dir.path().string() + "' && ";
+  const std::string tool = "'" FIELDPATH_EXE "' --quiet tool --shape ball:3 --out ";
+  ASSERT_EQ(std::system((in_dir + tool + "whole.stl > /dev/null").c_str()), 0);
+  const std::string whole = slurp(dir.path() / "whole.stl");
+  ASSERT_FALSE(whole.empty());
+
+  int status = std::system((in_dir + tool + "t.stl > /dev/full 2> err.txt").c_str());
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 1);
   EXPECT_NE(slurp(dir.path() / "err.txt").find("cannot write the standard output"),
             std::string::npos)
       << slurp(dir.path() / "err.txt");
-  EXPECT_FALSE(fs::exists(dir.path() / "t.stl"));
+  EXPECT_EQ(slurp(dir.path() / "t.stl"), whole);
+
+  // A reader gone before the summary (`true` has exited by the time the tool is made): the
+  // process dies of SIGPIPE at its summary, as a Unix filter does; its file whole.
+  status = std::system(
+      ("bash -c \"set -o pipefail; { sleep 0.3; " + in_dir + tool + "p.stl; } | true\"").c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGPIPE);
+  EXPECT_EQ(slurp(dir.path() / "p.stl"), whole);
+
+  // generate's outputs, claimed by the run (a signal before they are all written takes them
+  // away), written whole before its summary and notes: a pipe closed then keeps them.
+  writeBlockScene(dir);
+  std::string beside;  // a pass beside the block, clear of it (the scene's own path enters it)
+  for (int k = -10; k <= 10; ++k) beside += std::to_string(0.5 * k) + " -5 0 0 0 1\n";
+  dir.write("path.cl", beside);
+  status = std::system(("bash -c \"set -o pipefail; { sleep 0.3; " + in_dir +
+                        "'" FIELDPATH_EXE "' --quiet generate scene.yaml --out g 2>&1; } | true\"")
+                           .c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGPIPE);
+  for (const char* name : {"path.cl", "path.apt", "angles.csv", "report.json"})
+    EXPECT_TRUE(fs::exists(dir.path() / "g" / name)) << name;
+  EXPECT_TRUE(json::accept(slurp(dir.path() / "g/report.json")));
 }

@@ -241,6 +241,28 @@ TEST(ClFile, EmptyAndMissingFiles) {
   EXPECT_THROW(readClFile(fs::temp_directory_path()), InputError);  // a directory
 }
 
+// The part's name (generate's: the scene file's) is one PARTNO card whatever it holds: a scene
+// file named with a line break put a raw line of its name into the program (an environment
+// sweep's; here a GOTO), a `$` would have continued the record into the next.
+TEST(AptFile, APartNameIsOneCardWhateverItHolds) {
+  AptHeader header;
+  header.part_name = "PART\nGOTO/0,0,-50,0,0,1\r$";
+  header.remarks = {"UNSAFE\tTO RUN\n$GOTO/1,1,1"};
+  const fs::path p = tempPath("named.apt");
+  writeAptFile(p, randomPostures(3, false), header);
+  std::ifstream in(p);
+  std::string first, line;
+  std::getline(in, first);
+  EXPECT_EQ(first, "PARTNO/PART GOTO/0,0,-50,0,0,1  ");
+  std::size_t gotos = 0;
+  while (std::getline(in, line)) {
+    gotos += line.rfind("GOTO/", 0) == 0;
+    for (char c : line) EXPECT_GE(static_cast<unsigned char>(c), 0x20) << line;
+  }
+  EXPECT_EQ(gotos, 3u);
+  EXPECT_EQ(readAptFile(p).size(), 3u);
+}
+
 TEST(AptFile, WritesHeaderAndParsesBackExactly) {
   const auto postures = randomPostures(200, false);
   AptHeader header;

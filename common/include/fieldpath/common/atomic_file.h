@@ -161,7 +161,13 @@ inline void removeCreatedDirectoryNow() noexcept {
 }
 
 namespace detail {
+/// A helper process writing outputs of this run (study's python3 plotter), or 0: a signal ends it
+/// first, so that it renames nothing into place after the run is gone (SIGTERM to the program
+/// alone left the plotter to move a PNG into --out a second after the exit: a study sweep's).
+inline std::atomic<pid_t> output_helper{0};
+
 extern "C" inline void removeTemporariesAndDie(int signal_number) {
+  if (const pid_t helper = output_helper.load(); helper > 0) ::kill(helper, SIGKILL);
   removeTemporariesNow();
   removeClaimedOutputsNow();
   removeCreatedDirectoryNow();
@@ -289,6 +295,28 @@ inline void checkOutputFile(const std::filesystem::path& file, const std::string
   checkOutputDirectory(parent, option);
 }
 
+namespace detail {
+/// Removes the temporaries `PREFIX<pid>` in `dir` of processes that are gone: a run killed where
+/// no handler runs (SIGKILL, the out-of-memory killer) left them, hidden, and no later run took
+/// them away (60 and 141 MB of `field build`'s, an environment sweep's). A live process's (or
+/// one this process may not signal: another user's) is left; so is anything not so named.
+inline void removeDeadTemporaries(const std::filesystem::path& dir, const std::string& prefix) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir.empty() ? fs::path(".") : dir, ec), end; !ec && it != end;
+       it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(digits));
+    if (pid <= 0 || pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    std::error_code ignored;
+    fs::remove(it->path(), ignored);  // a link: the link, not its target
+  }
+}
+}  // namespace detail
+
 /// Calls `write(stream)` on a temporary file beside `path` (`.NAME.tmp-PID`), then renames it to
 /// `path`. Throws InputError (one line naming the path and the system's reason: no permission, disk
 /// full, not a directory) if the file cannot be written; the temporary is removed on any failure,
@@ -339,6 +367,7 @@ inline void writeFileAtomically(const std::filesystem::path& given,
   }
   const fs::path tmp = path.parent_path() /
                        ("." + stem + ".tmp-" + std::to_string(static_cast<long>(::getpid())));
+  detail::removeDeadTemporaries(path.parent_path(), "." + stem + ".tmp-");
   const detail::TemporaryListing listing{detail::listTemporary(tmp.string())};
   try {
     {
@@ -500,13 +529,17 @@ inline void refuseOutputsOverInputs(const std::filesystem::path& dir,
                        input.string() + "; choose another " + option);
 }
 
-/// The run succeeded: its outputs are no longer taken away by a failure or a late signal (one in
-/// the process's teardown removed the good outputs of a finished run).
-inline void releaseClaimedOutputs() {
+/// Every output of the run is written: from here neither a failure nor a late signal takes them
+/// away (one in the process's teardown removed the good outputs of a finished run). Commands call
+/// it after their last output, before their summary and notes: a summary that cannot be written
+/// (a closed pipe: `| grep -q UNSAFE` stopped reading at generate's warning and its SIGPIPE took
+/// the path it warned of, and its folder, away; stdout on a full disk) loses the summary only.
+inline void commitOutputs() {
   const std::lock_guard<std::mutex> lock(detail::written_mutex);
   for (auto& slot : detail::claimed_slots) slot.state.store(0);
   for (auto& slot : detail::created_directories) slot.state.store(0);
   detail::claimed_outputs.clear();
+  detail::written_outputs.clear();
 }
 
 /// Removes the files `names` from `dir` where an earlier run left them and this one does not
