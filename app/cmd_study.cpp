@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -89,11 +91,19 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
   common::removeStaleOutputs(
       dir, {"speed_vs_error.png", "force_error_lines.png", "tilt_along_path.png"});
   std::string message;
-  if (!plotStudy(dir, &message)) std::fprintf(stderr, "fieldpath study: %s\n", message.c_str());
+  if (!plotStudy(dir, &message)) {
+    std::fprintf(stderr, "fieldpath study: %s\n", message.c_str());
+    // study.md names the pictures: said there too that they are not (a study sweep's).
+    std::ifstream in(dir / "study.md", std::ios::binary);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    common::writeTextAtomically(dir / "study.md",
+                                text + "\n**The pictures named above are not made:** " + message +
+                                    " (the tables hold their data).\n");
+  }
   common::commitOutputs();  // a summary lost from here takes none of them away
 
   std::printf("%-38s %10s %9s %9s %9s %9s %10s %9s\n", "variant", "nodes", "total_s", "x_direct",
-              "force_%", "nodes_%", "tilt_deg", "clear_mm");
+              "lines_%", "nodes_%", "tilt_deg", "clear_mm");
   for (const StudyRow& row : result.rows)
     std::printf("%-38s %10zu %9.3f %9.2f %9.3f %9.3f %10.4f %9.3f\n", row.variant.name().c_str(),
                 row.active_nodes, row.total_s, row.speedup_vs_direct,

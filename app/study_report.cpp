@@ -70,10 +70,23 @@ double planeInterpolationError(double h_mm, double d_min_mm, const field::FieldP
   return worst;
 }
 
-/// Largest relative force error of a row over both lines and the nodes, fraction.
+/// An error's value where it counted points, else NaN (written "–" or an empty cell): a line of
+/// no points, or a field of gain 0, read "0.000 %" and its targets "met" (a study sweep's).
+double counted(const field::FieldError& error, double value) {
+  return error.count > 0 ? value : std::numeric_limits<double>::quiet_NaN();
+}
+double maxOf(const field::FieldError& e) { return counted(e, e.max_relative); }
+double rmsOf(const field::FieldError& e) { return counted(e, e.rms_relative); }
+
+/// Largest relative force error of a row over both lines and the nodes, fraction; NaN where none
+/// of them counted a point.
 double maxForceError(const StudyRow& row) {
-  return std::max({row.line_a.relative.max_relative, row.line_b.relative.max_relative,
-                   row.nodes.relative.max_relative});
+  double worst = std::numeric_limits<double>::quiet_NaN();
+  for (const field::FieldError* e :
+       {&row.line_a.relative, &row.line_b.relative, &row.nodes.relative})
+    if (e->count > 0)
+      worst = std::isnan(worst) ? e->max_relative : std::max(worst, e->max_relative);
+  return worst;
 }
 
 std::string csvText(const StudyResult& r) {
@@ -100,18 +113,16 @@ std::string csvText(const StudyResult& r) {
       << number(row.times.steering_s) << ',' << number(row.times.clearance_s) << ','
       << number(row.total_s) << ',' << number(row.speedup_vs_brute) << ','
       << number(row.speedup_vs_direct) << ',' << number(row.path_speedup_vs_direct) << ','
-      << number(100 * row.line_a.relative.max_relative) << ','
-      << number(100 * row.line_a.relative.rms_relative) << ','
-      << number(100 * row.line_b.relative.max_relative) << ','
-      << number(100 * row.line_b.relative.rms_relative) << ','
-      << number(100 * row.nodes.relative.max_relative) << ','
-      << number(100 * row.nodes.relative.rms_relative) << ',' << number(100 * maxForceError(row))
-      << ',' << number(100 * row.nodes.max_scaled) << ','
-      << number(100 * row.moment.relative.max_relative) << ','
-      << number(100 * row.moment.relative.rms_relative) << ',' << number(row.tilt_max_deg) << ','
-      << number(row.tilt_rms_deg) << ',' << number(row.tilt_middle_max_deg) << ','
-      << number(row.min_clearance_mm) << ',' << row.colliding << ',' << number(row.max_tilt_deg)
-      << ',' << row.solver_steps << ',' << row.rhs_evals << '\n';
+      << number(100 * maxOf(row.line_a.relative)) << ',' << number(100 * rmsOf(row.line_a.relative))
+      << ',' << number(100 * maxOf(row.line_b.relative)) << ','
+      << number(100 * rmsOf(row.line_b.relative)) << ',' << number(100 * maxOf(row.nodes.relative))
+      << ',' << number(100 * rmsOf(row.nodes.relative)) << ',' << number(100 * maxForceError(row))
+      << ',' << number(100 * counted(row.nodes.relative, row.nodes.max_scaled)) << ','
+      << number(100 * maxOf(row.moment.relative)) << ',' << number(100 * rmsOf(row.moment.relative))
+      << ',' << number(row.tilt_max_deg) << ',' << number(row.tilt_rms_deg) << ','
+      << number(row.tilt_middle_max_deg) << ',' << number(row.min_clearance_mm) << ','
+      << row.colliding << ',' << number(row.max_tilt_deg) << ',' << row.solver_steps << ','
+      << row.rhs_evals << '\n';
   }
   return s.str();
 }
@@ -266,15 +277,15 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
        " tilt diff rms ° | tilt diff max °, middle pass | min clearance mm | colliding |\n"
     << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const StudyRow& row : r.rows)
-    s << "| " << row.variant.name() << " | " << fixed(100 * row.line_a.relative.max_relative, 3)
-      << " | " << fixed(100 * row.line_a.relative.rms_relative, 3) << " | "
-      << fixed(100 * row.line_b.relative.max_relative, 3) << " | "
-      << fixed(100 * row.line_b.relative.rms_relative, 3) << " | "
-      << fixed(100 * row.nodes.relative.max_relative, 3) << " | "
-      << fixed(100 * row.nodes.relative.rms_relative, 3) << " | "
-      << fixed(100 * row.nodes.max_scaled, 3) << " | " << fixed(100 * maxForceError(row), 3)
-      << " | " << fixed(100 * row.moment.relative.max_relative, 3) << " | "
-      << fixed(100 * row.moment.relative.rms_relative, 3) << " | " << fixed(row.tilt_max_deg, 4)
+    s << "| " << row.variant.name() << " | " << fixed(100 * maxOf(row.line_a.relative), 3) << " | "
+      << fixed(100 * rmsOf(row.line_a.relative), 3) << " | "
+      << fixed(100 * maxOf(row.line_b.relative), 3) << " | "
+      << fixed(100 * rmsOf(row.line_b.relative), 3) << " | "
+      << fixed(100 * maxOf(row.nodes.relative), 3) << " | "
+      << fixed(100 * rmsOf(row.nodes.relative), 3) << " | "
+      << fixed(100 * counted(row.nodes.relative, row.nodes.max_scaled), 3) << " | "
+      << fixed(100 * maxForceError(row), 3) << " | " << fixed(100 * maxOf(row.moment.relative), 3)
+      << " | " << fixed(100 * rmsOf(row.moment.relative), 3) << " | " << fixed(row.tilt_max_deg, 4)
       << " | " << fixed(row.tilt_rms_deg, 4) << " | " << fixed(row.tilt_middle_max_deg, 4) << " | "
       << fixed(row.min_clearance_mm, 3) << " | " << row.colliding << " |\n";
   s << "\n**Published (seed 004 Table 2; Matlab, linear interpolation, other hardware):**\n\n"
@@ -320,22 +331,27 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
             std::abs(row.variant.voxel.voxel_size_mm - t.h_mm) > 1e-9 ||
             (row.variant.voxel.refine_tolerance > 0.0) != refined)
           continue;
-        if (!force || maxForceError(row) < maxForceError(*force)) force = &row;
+        if (!force || maxForceError(row) < maxForceError(*force) ||
+            (std::isnan(maxForceError(*force)) && !std::isnan(maxForceError(row))))
+          force = &row;
         if (!tilt || row.tilt_max_deg < tilt->tilt_max_deg) tilt = &row;
       }
       if (!force) continue;
-      const bool force_met = 100 * maxForceError(*force) <= t.force_pct;
+      const bool force_met = 100 * maxForceError(*force) <= t.force_pct;  // (NaN: not measured)
       const bool tilt_met = tilt->tilt_max_deg <= t.tilt_deg;
       s << "| " << t.h_mm << " mm | " << (refined ? "refined" : "uniform") << " | "
         << force->variant.name() << " | " << fixed(100 * maxForceError(*force), 3) << " (≤ "
-        << t.force_pct << ") | " << (force_met ? "yes" : "**no**") << " | " << tilt->variant.name()
-        << " | " << fixed(tilt->tilt_max_deg, 4) << " (≤ " << t.tilt_deg << ") | "
-        << (tilt_met ? "yes" : "**no**") << " |\n";
+        << t.force_pct << ") | "
+        << (force_met                           ? "yes"
+            : std::isnan(maxForceError(*force)) ? "**not measured**"
+                                                : "**no**")
+        << " | " << tilt->variant.name() << " | " << fixed(tilt->tilt_max_deg, 4) << " (≤ "
+        << t.tilt_deg << ") | " << (tilt_met ? "yes" : "**no**") << " |\n";
     }
   // Speed: path only (the field built once per part, seed 004 Table 1 keeps it apart) and total.
   const StudyRow *by_path = nullptr, *by_total = nullptr;
   for (const StudyRow& row : r.rows) {
-    if (!row.variant.isVoxel() || !row.failure.empty() || maxForceError(row) > 0.01) continue;
+    if (!row.variant.isVoxel() || !row.failure.empty() || !(maxForceError(row) <= 0.01)) continue;
     if (!by_path || row.path_speedup_vs_direct > by_path->path_speedup_vs_direct) by_path = &row;
     if (!by_total || row.speedup_vs_direct > by_total->speedup_vs_direct) by_total = &row;
   }

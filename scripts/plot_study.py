@@ -28,6 +28,11 @@ def read(path):
         return list(csv.DictReader(f))
 
 
+def positive(values):
+    """Whether any value is a positive finite number (what a log scale can show)."""
+    return any(v > 0 and math.isfinite(v) for v in values)
+
+
 def num(text):
     try:
         return float(text)
@@ -127,12 +132,19 @@ def force_error_lines(lines, out, colour):
                         color=colour[variant])
         top.set_title("line %s: |F| along the line" % name)
         top.set_ylabel("|F|")
-        top.set_yscale("log")
         peak = max([num(r["direct_force"]) for r in rows] + [1e-30])
-        top.set_ylim(bottom=peak * 1e-4)
+        # Log scales only over positive values: a line of no points counted (a field of gain 0,
+        # a line step longer than the line) stopped every picture after this one (a study sweep's).
+        if positive([num(r["direct_force"]) for r in rows]):
+            top.set_yscale("log")
+            top.set_ylim(bottom=peak * 1e-4)
         bottom.set_title("line %s: relative error (counted points only)" % name)
         bottom.set_ylabel("|F_v - F_d| / |F_d|, %")
-        bottom.set_yscale("log")
+        if positive([num(r["relative_error"]) for r in rows]):
+            bottom.set_yscale("log")
+        else:
+            bottom.text(0.5, 0.5, "no point of this line counted", transform=bottom.transAxes,
+                        ha="center", va="center")
         bottom.set_xlabel("t along the line, mm")
         for ax in (top, bottom):
             ax.grid(True, which="both", alpha=0.3)
