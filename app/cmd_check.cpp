@@ -130,16 +130,21 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       "check",
       "Check a path of a scene: exact clearance of tool + holder (FCL) at every posture and along "
       "every motion (links included), and the machined part (Z-buffer) against the `part` mesh: "
-      "gouge, scallop, deviation.png. Exit 0 even when postures collide (they are reported)");
+      "gouge, scallop, deviation.png. Exit 0 even when postures collide (they are reported), "
+      "unless --fail-unsafe");
   struct Options {
     std::string scene, path, out;
     double spacing_mm = 0.05;
     double gouge_tol_um = kGougeToleranceUm;
     std::optional<double> max_scallop_um;  // none: the scallop is measured, not judged
     std::string backend = "auto";
+    bool fail_unsafe = false;
   };
   auto options = std::make_shared<Options>();
   cmd->add_option("scene", options->scene, "Scene file (YAML)")->required();
+  cmd->add_flag("--fail-unsafe", options->fail_unsafe,
+                "Exit 3 when the verdict is NOT OK (the outputs written all the same), so that "
+                "`check ... --fail-unsafe && post` stops");
   cmd->add_option("--path", options->path,
                   "Path file: .cl (x y z i j k per line, `# pass` / `# link` blocks), APT "
                   "(.apt/.cls) or .npy")
@@ -441,6 +446,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     else
       std::printf("check: NOT OK%s: %s (check.json not_ok_because)\n",
                   unsafe.empty() ? "" : ", UNSAFE TO RUN", reasons.c_str());
+    if (options->fail_unsafe && !not_ok.empty()) verdictExitCode() = kVerdictExitCode;
     for (const std::string& note : tool_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
     for (const std::string& note : obstacle_notes) std::fprintf(stderr, "note: %s\n", note.c_str());
     for (const std::string& note : path_notes) std::fprintf(stderr, "note: %s\n", note.c_str());

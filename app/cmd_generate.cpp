@@ -167,7 +167,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
       "angles.csv, report.json");
   struct Options {
     std::string scene, out;
-    bool direct = false, nominal = false;
+    bool direct = false, nominal = false, fail_unsafe = false;
     double voxel_mm = 0.0;
     std::string backend;  ///< "": the scene's field.backend
   };
@@ -193,6 +193,9 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
       ->excludes(voxel)
       ->excludes("--backend");
   cmd->add_option("--out", options->out, "Output folder")->required();
+  cmd->add_flag("--fail-unsafe", options->fail_unsafe,
+                "Exit 3 when path.cl is marked UNSAFE TO RUN (the outputs written all the same), "
+                "so that `generate ... --fail-unsafe && post` stops");
   cmd->callback([options, &global] {
     common::checkOutputDirectory(options->out, "--out");  // before the work, not after
     // Claimed before the scene is read (a refused scene takes the earlier run's path away), but
@@ -313,6 +316,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (std::string holder = noHolderNote(scene.tool, scene.holder); !holder.empty())
       notes.tool.push_back(std::move(holder));
     notes.obstacle = openObstacleNotes(scene);
+    for (const std::string& warning : meshScaleWarnings(scene))  // said at load, kept here
+      notes.obstacle.push_back("WARNING: " + warning);
     if (std::string reach = obstaclesOutOfReachNote(
             scene, obstaclesOutOfReach(scene, result.path, scene.field.r0_mm), scene.field.r0_mm);
         !reach.empty() && !options->nominal)  // (--nominal: nothing steers)
@@ -347,6 +352,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
         job.clearance_mm, c.colliding, m.colliding, m.motions, m.min_clearance_mm,
         read_s + result.times.total_s, read_s, out.string().c_str());
     if (!unsafe.empty()) std::fprintf(stderr, "warning: %s\n", unsafe_text.c_str());
+    if (options->fail_unsafe && !unsafe.empty()) verdictExitCode() = kVerdictExitCode;
     if (const std::string gouge = cutterGougeReason(result.path, result.cutter_part);
         !gouge.empty())
       std::fprintf(stderr,

@@ -54,6 +54,15 @@ struct GlobalOptions {
   bool quiet = false;  ///< silence progress lines on stderr
 };
 
+/// Exit code of a command that ran to its end with a verdict against it: 3 for `check
+/// --fail-unsafe` NOT OK and `generate --fail-unsafe` UNSAFE TO RUN (a script's `check && post`
+/// posted a path check had marked unsafe: a CAM engineer's), else 0. The outputs are written.
+inline constexpr int kVerdictExitCode = 3;
+inline int& verdictExitCode() {
+  static int code = 0;
+  return code;
+}
+
 void addToolCommand(CLI::App& app, const GlobalOptions& global);
 void addSimulateCommand(CLI::App& app, const GlobalOptions& global);
 void addFieldCommand(CLI::App& app, const GlobalOptions& global);

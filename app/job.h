@@ -237,6 +237,40 @@ inline std::string motionWhere(const geometry::PathFile& path, std::size_t i) {
          (open == std::string::npos ? "" : where.substr(open));
 }
 
+/// " in passes 1, 2 and 28" (up to 8 named, then "and N more"; links as "links"): the blocks of
+/// the postures whose clearance reads 0 (`posture_mm`: ClearanceResult::clearance_mm, empty where
+/// it was not kept); empty when none. A summary named the first colliding posture only, and which
+/// passes collide was in report.json only (a CAM engineer's mould: 19 passes).
+inline std::string collidingPasses(const geometry::PathFile& path,
+                                   const std::vector<double>& posture_mm) {
+  std::vector<std::size_t> passes;
+  bool links = false;
+  std::size_t passes_before = 0;
+  for (const geometry::PathBlock& b : path.blocks) {
+    const bool pass = b.kind == geometry::PathBlock::Kind::Pass;
+    passes_before += pass;
+    for (std::size_t i = b.begin; i < b.end && i < posture_mm.size(); ++i)
+      if (posture_mm[i] <= 0.0) {
+        if (pass)
+          passes.push_back(passes_before);
+        else
+          links = true;
+        break;
+      }
+  }
+  if (passes.empty() && !links) return {};
+  constexpr std::size_t kNamed = 8;
+  std::vector<std::string> names;
+  for (std::size_t k = 0; k < passes.size() && k < kNamed; ++k)
+    names.push_back(std::to_string(passes[k]));
+  if (passes.size() > kNamed) names.push_back(std::to_string(passes.size() - kNamed) + " more");
+  std::string text = passes.empty() ? "" : passes.size() == 1 ? "pass " : "passes ";
+  for (std::size_t k = 0; k < names.size(); ++k)
+    text += (k == 0 ? "" : k + 1 == names.size() ? " and " : ", ") + names[k];
+  if (links) text += passes.empty() ? "links" : " and links";
+  return " in " + text;
+}
+
 /// Why a path is not safe to run as it stands (empty: it is): postures or motions that touch an
 /// obstacle, links that touch the part, the holder touching the part. Postures numbered from 0,
 /// as in the JSON and clearance.csv, with their block and line (postureWhere); motion i from
@@ -257,9 +291,11 @@ inline std::vector<std::string> unsafeReasons(const geometry::PathFile& path,
     const bool link = inLink(path, i) || inLink(path, i + 1);
     return motionWhere(path, i) + (link && !link_hint.empty() ? ": " + link_hint : "");
   };
-  if (c.colliding)
-    out.push_back(std::to_string(c.colliding) +
-                  " postures touch an obstacle (first: " + posture(c.first_colliding) + ")");
+  if (c.colliding) {
+    const std::string in = collidingPasses(path, c.clearance_mm);
+    out.push_back(std::to_string(c.colliding) + " postures touch an obstacle (first: " +
+                  posture(c.first_colliding) + (in.empty() ? "" : ";" + in) + ")");
+  }
   if (m.colliding)
     out.push_back(std::to_string(m.colliding) +
                   " motions touch an obstacle (first: " + motion(m.first_colliding) + ")");

@@ -253,5 +253,5 @@ int main(int argc, char** argv) {
     return 1;
   }
   fieldpath::common::commitOutputs();  // done: a late signal takes nothing away
-  return 0;
+  return fieldpath::app::verdictExitCode();
 }

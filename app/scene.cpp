@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -257,6 +258,8 @@ Scene loadScene(const std::filesystem::path& file, SceneUse use) {
   }
   if (scene.impeller || scene.guide_impeller) resolveImpeller(scene);
   checkSceneSize(scene);  // before any command's heavy work
+  for (const std::string& warning : meshScaleWarnings(scene))
+    std::fprintf(stderr, "warning: %s: %s\n", scene.file.string().c_str(), warning.c_str());
   return scene;
 }
 

@@ -1,6 +1,8 @@
 /// What a scene's meshes leave unproven, said as notes by `generate` and `check`: open shells
 /// (no inside) of the obstacles and of the part, and a part named as an obstacle too (scene.h
 /// openObstacleNotes).
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <system_error>
@@ -54,6 +56,58 @@ std::vector<std::string> openObstacleNotes(const Scene& scene) {
                     "clear (close the mesh to have its inside checked)");
   }
   return notes;
+}
+
+std::vector<std::string> meshScaleWarnings(const Scene& scene) {
+  // Each mesh file's extent (its box's diagonal, mm), and the largest of them and of the nominal
+  // path's tips: what a mesh in metres stands beside.
+  struct Extent {
+    std::string name;
+    double diagonal_mm = 0.0;
+  };
+  const auto diagonal = [](const geometry::TriangleMesh& mesh) {
+    if (mesh.vertices.empty()) return 0.0;
+    Eigen::AlignedBox3d box;
+    for (const geometry::Vec3& v : mesh.vertices) box.extend(v);
+    return box.diagonal().norm();
+  };
+  std::vector<Extent> meshes;
+  for (std::size_t i = 0; i < scene.obstacle_files.size() && i < scene.obstacles.size(); ++i)
+    meshes.push_back({(i < scene.obstacle_keys.size() ? scene.obstacle_keys[i] + " " : "") + "(" +
+                          scene.obstacle_files[i].filename().string() + ")",
+                      diagonal(scene.obstacles[i])});
+  if (scene.part && scene.part_file)
+    meshes.push_back(
+        {"part (" + scene.part_file->filename().string() + ")", diagonal(*scene.part)});
+  Extent largest{"", 0.0};
+  for (const Extent& m : meshes)
+    if (m.diagonal_mm > largest.diagonal_mm) largest = m;
+  if (scene.nominal && !scene.nominal->postures.empty()) {
+    Eigen::AlignedBox3d box;
+    for (const geometry::Posture& p : scene.nominal->postures) box.extend(p.tip_mm);
+    if (box.diagonal().norm() > largest.diagonal_mm)
+      largest = {"the nominal path (" + scene.nominal->file.filename().string() + ")",
+                 box.diagonal().norm()};
+  }
+  // A whole mesh under 1 mm beside one at least 100 times larger: a pin exported in metres stood
+  // 8 um wide 3 mm from the passes, its field too weak to steer and its solid never met, and the
+  // path read safe where the holder ran into the real pin (a CAM engineer's mould, a helper's).
+  // Not refused: a speck of that size may be meant, and the scene's other units are right.
+  std::vector<std::string> warnings;
+  for (const Extent& m : meshes) {
+    if (!(m.diagonal_mm > 0.0) || m.diagonal_mm >= 1.0 ||
+        largest.diagonal_mm < 100.0 * m.diagonal_mm)
+      continue;
+    char text[512];
+    std::snprintf(text, sizeof text,
+                  "%s spans %.3g mm, %.0f times less than %s (%.4g mm): every length is read in "
+                  "millimetres; a mesh in metres (scale it by 1000) is checked at that size, "
+                  "and a path read safe beside it is not",
+                  m.name.c_str(), m.diagonal_mm, largest.diagonal_mm / m.diagonal_mm,
+                  largest.name.c_str(), largest.diagonal_mm);
+    warnings.push_back(text);
+  }
+  return warnings;
 }
 
 }  // namespace fieldpath::app

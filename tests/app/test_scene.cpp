@@ -411,3 +411,27 @@ TEST(ProgressLine, TheTimeLeftIsTheStagesPaceSoFar) {
 
 }  // namespace
 }  // namespace fieldpath::app
+
+// The passes whose postures touch, named in the reason's summary (the first posture alone was
+// named, the passes only in report.json: a CAM engineer's mould, 19 passes): up to 8, then how
+// many more; a link's said as links.
+TEST(JobText, CollidingPassesAreNamed) {
+  using geometry::PathBlock;
+  geometry::PathFile path;
+  path.postures.resize(24);
+  std::vector<double> clearance(24, 1.0);
+  // Pass 1 [0, 2), link [2, 3), passes 2..11 of two postures each from 3.
+  path.blocks = {{PathBlock::Kind::Pass, 0, 2}, {PathBlock::Kind::Link, 2, 3}};
+  for (std::size_t b = 3; b + 1 < 24; b += 2)
+    path.blocks.push_back({PathBlock::Kind::Pass, b, b + 2});
+  EXPECT_EQ(app::collidingPasses(path, clearance), "");
+  EXPECT_EQ(app::collidingPasses(path, {}), "");  // not kept: nothing said
+  clearance[1] = 0.0;
+  EXPECT_EQ(app::collidingPasses(path, clearance), " in pass 1");
+  clearance[2] = 0.0;
+  clearance[4] = 0.0;  // pass 2
+  EXPECT_EQ(app::collidingPasses(path, clearance), " in passes 1 and 2 and links");
+  clearance[2] = 1.0;
+  for (std::size_t i = 5; i < 24; i += 2) clearance[i] = 0.0;  // passes 3..11
+  EXPECT_EQ(app::collidingPasses(path, clearance), " in passes 1, 2, 3, 4, 5, 6, 7, 8 and 3 more");
+}

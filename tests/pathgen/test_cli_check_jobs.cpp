@@ -246,6 +246,10 @@ TEST(CheckClearance, UnsafeAndUnderTheClearanceAreBothMarked) {
   EXPECT_NE(r.err.find("warning: UNSAFE TO RUN"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("closer to the obstacles than `clearance`"), std::string::npos) << r.err;
   EXPECT_EQ(geometry::readPathFile(dir.path() / "out" / "path.cl").warnings.size(), 2u);
+  // --fail-unsafe: exit 3, the same marked files written (`generate && post` posted them).
+  const auto strict = test::runFieldpath(dir, "generate scene.yaml --fail-unsafe --out strict");
+  EXPECT_EQ(strict.exit_code, 3) << strict.output();
+  EXPECT_EQ(test::slurp(dir.path() / "strict" / "path.apt"), apt);
 }
 
 // An unsafe reason says where its first posture lies: its block (the link into pass K) and, for a

@@ -68,6 +68,12 @@ TEST(CheckVerdict, PosturesAndMotionsUnderTheClearanceAreNotOk) {
             << check["not_ok_because"];
       EXPECT_NE(r.out.find(clearance == 0.5 ? "check: NOT OK" : "check: ok"), std::string::npos)
           << r.out;
+      // --fail-unsafe: exit 3 on NOT OK, its outputs written (`check && post` posted a path
+      // check had marked: a CAM engineer's); 0 on ok.
+      const auto strict = test::runFieldpath(
+          dir, "check scene.yaml --path " + path + ".cl --fail-unsafe --out strict_" + out);
+      EXPECT_EQ(strict.exit_code, clearance == 0.5 ? 3 : 0) << strict.output();
+      EXPECT_EQ(checkJson(dir, "strict_" + out)["ok"], check["ok"]);
     }
   }
 }
