@@ -525,31 +525,34 @@ TEST(GenerateEdges, PassesBesideThePartAreSaid) {
   EXPECT_EQ(o.err.find("keep the ball more than"), std::string::npos) << o.err;
 }
 
-// An obstacle farther than field.r0 from the tool at every posture steers nothing (eq. 1 ends at
-// r0): blades in inches floating in the mesh impeller's bore, the path over the hub in mm, read
-// `safe` with the nominal axes, unsaid (a units adversary's). A post beside passes along x
-// (x <= 1.5, the ball R 0.5: the tool's box reaches x = 2) steers; a box at x = 50 is at least
-// 48 mm away: said, by its entry; alone, the path is said to be the nominal one.
+namespace {
+/// A plate 4 mm square (the part, plate.stl), a post beside it (x 2.5 to 3, post.stl) and passes
+/// along x over the plate (p.cl); returns the scene's keys after its obstacles.
+std::string writePlateAndPost(const TempDir& dir) {
+  geometry::TriangleMesh plate, post;
+  pathgen::test::addBox(plate, -2, 2, -2, 2, -0.5, 0);
+  pathgen::test::addBox(post, 2.5, 3, -2, 2, -0.5, 1);
+  geometry::saveMesh(plate, dir.path() / "plate.stl");
+  geometry::saveMesh(post, dir.path() / "post.stl");
+  std::ostringstream cl;
+  for (int i = -3; i <= 3; ++i) cl << 0.5 * i << " 1 0 0 0 1\n";
+  dir.write("p.cl", cl.str());
+  return "part: plate.stl\ntool: { shape: ball, radius: 0.5, length: 10 }\nclearance: 0.05\n"
+         "field: { r0: 1.0, r_min: 0.05, sample_step: 0.1, voxel_size: 0.1 }\n"
+         "path: { nominal: p.cl }\n";
+}
+}  // namespace
+
 // A mesh exported in metres among millimetres: a pin 8 um wide 3 mm from the passes steered
 // nothing and was never met, and the path read safe where the holder ran into the real pin (a
 // CAM engineer's mould). Warned by the scene's loading, kept in report.json; a mesh of the same
 // scale as the others is not.
 TEST(GenerateEdges, AMeshInMetresBesideOnesInMillimetresIsWarned) {
   const TempDir dir;
-  geometry::TriangleMesh plate, post, post_m;
-  pathgen::test::addBox(plate, -2, 2, -2, 2, -0.5, 0);
-  pathgen::test::addBox(post, 2.5, 3, -2, 2, -0.5, 1);
+  const std::string rest = writePlateAndPost(dir);
+  geometry::TriangleMesh post_m;  // the post in metres
   pathgen::test::addBox(post_m, 0.0025, 0.003, -0.002, 0.002, -0.0005, 0.001);
-  geometry::saveMesh(plate, dir.path() / "plate.stl");
-  geometry::saveMesh(post, dir.path() / "post.stl");
   geometry::saveMesh(post_m, dir.path() / "post_m.stl");
-  std::ostringstream cl;
-  for (int i = -3; i <= 3; ++i) cl << 0.5 * i << " 1 0 0 0 1\n";
-  dir.write("p.cl", cl.str());
-  const std::string rest =
-      "part: plate.stl\ntool: { shape: ball, radius: 0.5, length: 10 }\nclearance: 0.05\n"
-      "field: { r0: 1.0, r_min: 0.05, sample_step: 0.1, voxel_size: 0.1 }\n"
-      "path: { nominal: p.cl }\n";
   // (the largest mesh: the part, 5.68 mm across; the post in metres 0.0043 mm)
   const std::string said = "obstacles[2] (post_m.stl) spans 0.0043 mm, ";
   const std::string than = " times less than part (plate.stl) (5.679 mm)";
@@ -571,22 +574,17 @@ TEST(GenerateEdges, AMeshInMetresBesideOnesInMillimetresIsWarned) {
   }
 }
 
+// An obstacle farther than field.r0 from the tool at every posture steers nothing (eq. 1 ends at
+// r0): blades in inches floating in the mesh impeller's bore, the path over the hub in mm, read
+// `safe` with the nominal axes, unsaid (a units adversary's). A post beside passes along x
+// (x <= 1.5, the ball R 0.5: the tool's box reaches x = 2) steers; a box at x = 50 is at least
+// 48 mm away: said, by its entry; alone, the path is said to be the nominal one.
 TEST(GenerateEdges, ObstaclesOutOfTheFieldsReachAreSaid) {
   const TempDir dir;
-  geometry::TriangleMesh plate, post, far;
-  pathgen::test::addBox(plate, -2, 2, -2, 2, -0.5, 0);
-  pathgen::test::addBox(post, 2.5, 3, -2, 2, -0.5, 1);
+  const std::string rest = writePlateAndPost(dir);
+  geometry::TriangleMesh far;
   pathgen::test::addBox(far, 50, 51, -2, 2, -0.5, 1);
-  geometry::saveMesh(plate, dir.path() / "plate.stl");
-  geometry::saveMesh(post, dir.path() / "post.stl");
   geometry::saveMesh(far, dir.path() / "far.stl");
-  std::ostringstream cl;
-  for (int i = -3; i <= 3; ++i) cl << 0.5 * i << " 1 0 0 0 1\n";
-  dir.write("p.cl", cl.str());
-  const std::string rest =
-      "part: plate.stl\ntool: { shape: ball, radius: 0.5, length: 10 }\nclearance: 0.05\n"
-      "field: { r0: 1.0, r_min: 0.05, sample_step: 0.1, voxel_size: 0.1 }\n"
-      "path: { nominal: p.cl }\n";
   struct Case {
     std::string obstacles, said;
   };
