@@ -16,6 +16,7 @@
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/memory.h"
 #include "fieldpath/common/stats.h"
 #include "fieldpath/field/direct_field.h"
 #include "fieldpath/field/law.h"
@@ -221,6 +222,37 @@ StudyResult runStudy(const StudyRequest& request) {
         built.push_back(variant);
       }
     variants = std::move(built);
+  }
+
+  // What the study holds to its end, asked before any variant runs (study swept: an accepted
+  // --max-memory 57M ran to 106 MiB, 3.2 times a limit with --line-step 0.001: none of it was
+  // estimated). Measured on the impeller example (2 variants): the tool nodes at every posture of
+  // the direct path with their exact and one variant's forces, ~75 B a node (1035 postures x 529
+  // nodes: 40 MB); the lines, ~800 B a point with their exact values, wall distances, per-variant
+  // magnitudes and errors and lines.csv's text (100 k points: 79 MB); every variant's postures.
+  {
+    const pathgen::GenerateRequest& job = request.job;
+    std::size_t stations = 0;
+    for (const pathgen::Pass& pass : job.passes) stations += pass.samples.size();
+    const double nodes =
+        double(geometry::surfaceNodes(job.tool, job.holder,
+                                      pathgen::defaultNodeSpacingMm(job.tool, job.holder))
+                   .size());
+    const pathgen::Impeller impeller(request.impeller);
+    const auto& u_range = request.impeller.u_range;
+    const double line_points =
+        double(lineAPoints(impeller, 0.5 * job.field.r0_mm, request.line_step_mm).size() +
+               lineBPoints(impeller, 0.5 * (u_range[0] + u_range[1]), request.line_step_mm).size());
+    const double variant_count = double(variants.size());
+    const double bytes = double(stations) * nodes * 90.0 +
+                         line_points * (600.0 + 150.0 * variant_count) +
+                         double(stations) * variant_count * sizeof(pathgen::GeneratedPosture);
+    common::requireMemory(
+        "study", bytes,
+        std::to_string(stations) + " postures x " + std::to_string(std::llround(nodes)) +
+            " tool nodes, " + std::to_string(std::llround(line_points)) +
+            " line points (--line-step) and " + std::to_string(variants.size()) + " variants",
+        common::MemoryUse::kKept);
   }
 
   // Shares of the progress bar: each variant's path run and its error evaluation.

@@ -239,6 +239,30 @@ TEST(MemoryLimit, AnStlIsSizedByItsTriangles) {
   EXPECT_EQ(accepted_at, 185);
 }
 
+// study holds the tool nodes at every posture of the direct path and the lines' points to its
+// end: in no estimate, an accepted --max-memory 57M ran to 106 MiB (a study sweep's). Asked
+// before any variant runs; an accepted study stays under its limit.
+TEST(MemoryLimit, AStudyIsSizedBeforeItsVariantsRun) {
+  const TempDir dir;
+  const std::string scene = std::string(FIELDPATH_SOURCE_DIR) + "/examples/impeller/scene.yaml";
+  for (int mib : {95, 130}) {
+    const Peak run =
+        runMeasured(dir, {"--max-memory", std::to_string(mib) + "M", "study", scene, "--voxels",
+                          "2", "--interp", "trilinear", "--stored", "force", "--no-brute-force",
+                          "--line-step", "0.05", "--out", (dir.path() / "study").string()});
+    const std::string err = fieldpath::test::slurp(dir.path() / "stderr.txt");
+    if (mib == 95) {
+      EXPECT_EQ(run.exit_code, 1) << err;
+      EXPECT_NE(err.find("study: needs about"), std::string::npos) << err;
+      EXPECT_NE(err.find("1035 postures x 559 tool nodes"), std::string::npos) << err;
+      EXPECT_LT(run.peak_kib, 95 * 1024L);
+    } else {
+      EXPECT_EQ(run.exit_code, 0) << err;
+      EXPECT_LE(run.peak_kib, mib * 1024L) << "ran to " << run.peak_kib << " KiB";
+    }
+  }
+}
+
 TEST(MemoryLimit, ALimitUnderTheProgramItselfIsRefusedAtOnce) {
   const TempDir dir;
   const Peak run = runMeasured(dir, {"--max-memory", "4M", "convert", "none.cl", "none.npy"});
