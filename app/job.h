@@ -287,8 +287,16 @@ inline std::vector<std::string> unsafeReasons(const geometry::PathFile& path,
   auto posture = [&](std::size_t i) {
     return postureWhere(path, i) + (inLink(path, i) && !link_hint.empty() ? ": " + link_hint : "");
   };
+  // A pass posture that touches itself: a link's plunge into it (or retract out of it) touches
+  // because the pass does, and the link's keys are not the cure (a CAM engineer's mould: the
+  // holder met a pin at pass 1's start, and the hint named links.retract and links.safe_z).
+  auto passTouches = [&](std::size_t k) {
+    return k < c.clearance_mm.size() && !inLink(path, k) && c.clearance_mm[k] <= 0.0;
+  };
   auto motion = [&](std::size_t i) {
     const bool link = inLink(path, i) || inLink(path, i + 1);
+    if (link && !link_hint.empty() && (passTouches(i) || passTouches(i + 1)))
+      return motionWhere(path, i) + ": its end in the pass touches too (the pass collides there)";
     return motionWhere(path, i) + (link && !link_hint.empty() ? ": " + link_hint : "");
   };
   if (c.colliding) {

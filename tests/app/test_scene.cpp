@@ -435,3 +435,30 @@ TEST(JobText, CollidingPassesAreNamed) {
   for (std::size_t i = 5; i < 24; i += 2) clearance[i] = 0.0;  // passes 3..11
   EXPECT_EQ(app::collidingPasses(path, clearance), " in passes 1, 2, 3, 4, 5, 6, 7, 8 and 3 more");
 }
+
+// A link's plunge into a pass posture that touches itself touches because the pass does: the
+// reason says so, not the link's keys (a CAM engineer's mould: the holder met a pin at pass 1's
+// start, and the hint named links.retract and links.safe_z); a plunge into a clear posture keeps
+// the hint.
+TEST(JobText, APlungeIntoATouchingPassBlamesThePass) {
+  using geometry::PathBlock;
+  geometry::PathFile path;
+  path.postures.resize(6);
+  path.blocks = {{PathBlock::Kind::Link, 0, 2}, {PathBlock::Kind::Pass, 2, 6}};
+  pathgen::ClearanceResult c;
+  c.clearance_mm = {5, 5, 1, 1, 1, 1};
+  pathgen::MotionResult m;
+  m.colliding = 1;
+  m.first_colliding = 1;  // from the link's last posture into the pass's first
+  const std::string hint = "THE LINK'S KEYS";
+  std::vector<std::string> reasons = app::unsafeReasons(path, c, m, {}, {}, hint);
+  ASSERT_EQ(reasons.size(), 1u);
+  EXPECT_NE(reasons[0].find(hint), std::string::npos) << reasons[0];
+  c.clearance_mm[2] = 0.0;
+  c.colliding = 1;
+  c.first_colliding = 2;
+  reasons = app::unsafeReasons(path, c, m, {}, {}, hint);
+  ASSERT_EQ(reasons.size(), 2u);
+  EXPECT_EQ(reasons[1].find(hint), std::string::npos) << reasons[1];
+  EXPECT_NE(reasons[1].find("its end in the pass touches too"), std::string::npos) << reasons[1];
+}
