@@ -35,6 +35,7 @@
 #include "obstacle_reach.h"
 #include "progress.h"
 #include "scene.h"
+#include "scene_mesh.h"
 
 namespace fieldpath::app {
 namespace {
@@ -331,6 +332,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     const pathgen::DogLegRapids dog_leg =
         pathgen::dogLegRapids(result.path, result.motions, job.clearance_mm);
     report["dog_leg_rapids"] = dogLegJson(dog_leg);
+    report["mesh_notes"] = meshNotes();  // what loading the meshes mended or turned
     report["times_s"]["read"] = read_s;  // before `total`, which counts from the passes on
     // The files this report is of (written before it, renamed one by one): a folder holding
     // another run's path beside this report can be told (as check.json's path_digest).

@@ -140,6 +140,7 @@ bool sceneSizeOk(const std::filesystem::path& file, bool refuse) {
 Scene loadScene(const std::filesystem::path& file, SceneUse use) {
   const bool read_nominal = use == SceneUse::kJob, read_part = use != SceneUse::kField;
   sceneKeyLines() = SceneKeyLines{};  // none of another scene's
+  meshNotes().clear();
   common::requireRegularFile(file, "scene file (YAML)");
   sceneSizeOk(file, /*refuse=*/true);
   YAML::Node root;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/limits.h"
@@ -11,17 +12,38 @@
 #include "progress.h"
 
 namespace fieldpath::app {
+
+std::vector<std::string>& meshNotes() {
+  static std::vector<std::string> notes;
+  return notes;
+}
+
 namespace {
+
+/// Says `text` on stderr as a note and keeps it for the reports (meshNotes).
+void sayMeshNote(const std::string& text) {
+  std::fprintf(stderr, "note: %s\n", text.c_str());
+  meshNotes().push_back(text);
+}
+
+/// printf's text of `format` and its arguments.
+template <class... Args>
+std::string formatted(const char* format, Args... args) {
+  const int n = std::snprintf(nullptr, 0, format, args...);
+  std::string text(n > 0 ? std::size_t(n) : 0, '\0');
+  if (n > 0) std::snprintf(text.data(), text.size() + 1, format, args...);
+  return text;
+}
 
 /// A solid exported with a T-junction, a sliver or a facet wound the wrong way had no inside: a
 /// tool wholly inside it read as clear. Mended where that closes it, and said.
 void mendExportDefects(geometry::TriangleMesh& mesh, const std::filesystem::path& file) {
   const geometry::ShellRepair mend = geometry::repairShells(mesh);
   if (mend.search_given_up)
-    std::fprintf(stderr,
-                 "note: %s: %zu open edges; the search for T-junctions to mend them was given up "
-                 "(a triangle soup?): the shells stay as they came\n",
-                 file.string().c_str(), mend.open_edges_before);
+    sayMeshNote(
+        formatted("%s: %zu open edges; the search for T-junctions to mend them was given "
+                  "up (a triangle soup?): the shells stay as they came",
+                  file.string().c_str(), mend.open_edges_before));
   if (!mend.any()) return;
   std::string what;
   const auto add = [&what](std::size_t n, const char* one, const char* many) {
@@ -32,9 +54,9 @@ void mendExportDefects(geometry::TriangleMesh& mesh, const std::filesystem::path
   add(mend.slivers_removed, "sliver of no area left out", "slivers of no area left out");
   add(mend.facets_turned, "facet turned to agree with its neighbours",
       "facets turned to agree with their neighbours");
-  std::fprintf(stderr,
-               "note: %s: mended as exported solids need (%s): %zu open edges before, %zu now\n",
-               file.string().c_str(), what.c_str(), mend.open_edges_before, mend.open_edges_after);
+  sayMeshNote(formatted("%s: mended as exported solids need (%s): %zu open edges before, %zu now",
+                        file.string().c_str(), what.c_str(), mend.open_edges_before,
+                        mend.open_edges_after));
 }
 
 }  // namespace
@@ -51,20 +73,21 @@ geometry::TriangleMesh loadSceneMesh(const std::filesystem::path& file) {
   // Shells wound against their kind would make the field pull into the walls (the samples'
   // normals) and the part's top its bottom: turned, and said.
   if (const std::size_t turned = geometry::orientClosedShells(mesh))
-    std::fprintf(stderr,
-                 "note: %s: %zu closed shell%s wound the wrong way round (normals into a solid "
-                 "or out of a void), turned\n",
-                 file.string().c_str(), turned, turned == 1 ? "" : "s");
+    sayMeshNote(
+        formatted("%s: %zu closed shell%s wound the wrong way round (normals into a solid "
+                  "or out of a void), turned",
+                  file.string().c_str(), turned, turned == 1 ? "" : "s"));
   // Mesh files are read in single precision (binary STL stores floats; assimp reads every format
   // so): far from the origin their points move by half a float's step, which check then reads
   // as microns of gouge or clearance (5e5 mm: 32 um, 32 769 false gouged lines).
   double far_mm = 0.0;
   for (const auto& v : mesh.vertices) far_mm = std::max(far_mm, v.cwiseAbs().maxCoeff());
   if (far_mm > common::kFloatExactMm)
-    std::fprintf(stderr,
-                 "note: %s: points up to %.4g mm from the origin, read in single precision "
-                 "(steps of %.2g mm there): place the job near the origin for micron figures\n",
-                 file.string().c_str(), far_mm, common::floatStepMm(far_mm));
+    sayMeshNote(
+        formatted("%s: points up to %.4g mm from the origin, read in single precision "
+                  "(steps of %.2g mm there): place the job near the origin for micron "
+                  "figures",
+                  file.string().c_str(), far_mm, common::floatStepMm(far_mm)));
   return mesh;
 }
 

@@ -574,6 +574,24 @@ TEST(GenerateEdges, AMeshInMetresBesideOnesInMillimetresIsWarned) {
   }
 }
 
+// What loading a mesh mended or turned is kept in report.json, not only said on stderr (a CAM
+// engineer's walls wound inward were turned with a note that the report lacked).
+TEST(GenerateEdges, AMeshTurnedOnLoadingIsInTheReport) {
+  const TempDir dir;
+  const std::string rest = writePlateAndPost(dir);
+  geometry::TriangleMesh inward;
+  pathgen::test::addBox(inward, 2.5, 3, -2, 2, -0.5, 1);
+  for (auto& t : inward.triangles) std::swap(t[1], t[2]);
+  geometry::saveMesh(inward, dir.path() / "inward.stl");
+  dir.write("scene.yaml", "obstacles:\n  - mesh: inward.stl\n" + rest);
+  const auto r = test::runFieldpath(dir, "generate scene.yaml --out out");
+  ASSERT_EQ(r.exit_code, 0) << r.output();
+  const std::string said = "inward.stl: 1 closed shell wound the wrong way round";
+  EXPECT_NE(r.err.find(said), std::string::npos) << r.err;
+  const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out/report.json"));
+  EXPECT_NE(report["mesh_notes"].dump().find(said), std::string::npos) << report["mesh_notes"];
+}
+
 // An obstacle farther than field.r0 from the tool at every posture steers nothing (eq. 1 ends at
 // r0): blades in inches floating in the mesh impeller's bore, the path over the hub in mm, read
 // `safe` with the nominal axes, unsaid (a units adversary's). A post beside passes along x
