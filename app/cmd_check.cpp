@@ -183,6 +183,17 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     const common::FileStamp path_stamp = common::fileStamp(options->path);
     const geometry::PathFile path = geometry::readPathFile(options->path);
     const std::string path_digest = common::fileDigest(options->path);
+    // The scene's meshes beside the path checked (loading compared them with each other only: a
+    // scene in metres beside the path read ok, a reviewer's): what the path adds, said.
+    {
+      // (each mesh once: a warning begins with the mesh's name, then " spans ")
+      const auto mesh = [](const std::string& w) { return w.substr(0, w.find(" spans ")); };
+      const std::vector<std::string> at_load = meshScaleWarnings(scene);
+      for (const std::string& warning : meshScaleWarnings(scene, &path))
+        if (std::none_of(at_load.begin(), at_load.end(),
+                         [&](const std::string& w) { return mesh(w) == mesh(warning); }))
+          std::fprintf(stderr, "warning: %s: %s\n", scene.file.string().c_str(), warning.c_str());
+    }
     const common::Progress progress = makeProgressLine(global.quiet);
     if (!scene.tool_given)
       throw InputError(scene.file.string() + ": tool: missing: check needs the cutter (`tool: { "

@@ -6,10 +6,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <future>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -42,18 +44,28 @@ namespace {
 
 using geometry::kRadToDeg;
 
-/// Removes `check --out`'s and `simulate --out`'s files from `out` where they are of the path.cl
-/// or path.apt this run replaces (check.json's and simulate.json's path_digest is the file's):
-/// check.json's `"ok": true`, deviation.png and clearance.csv stayed beside a new path nobody had
-/// checked, heights.npy beside one nobody had simulated (helpers' findings). Results of another
-/// path (its digest differs), or ones that cannot be read, stay.
-void forgetResultsOfReplacedPath(const std::filesystem::path& out) {
+/// The results of `check --out` and `simulate --out` in `out` that are of the path.cl or path.apt
+/// this run replaces (check.json's and simulate.json's path_digest is the file's): check.json's
+/// `"ok": true`, deviation.png and clearance.csv stayed beside a new path nobody had checked,
+/// heights.npy beside one nobody had simulated (helpers' findings). Results of another path (its
+/// digest differs), or ones that cannot be read, are not listed. Decided before the earlier
+/// path is removed; removed by forgetResults once the scene is read.
+struct StaleResults {
+  struct Group {
+    std::vector<std::filesystem::path> files;
+    std::string what;          ///< "check", "simulation"
+    std::filesystem::path of;  ///< the path file they are of (out/path.cl or path.apt)
+  };
+  std::vector<Group> groups;
+};
+StaleResults resultsOfReplacedPath(const std::filesystem::path& out) {
   namespace fs = std::filesystem;
   struct Results {
     const char* report;
     std::initializer_list<const char*> files;
     const char* what;
   };
+  StaleResults stale;
   for (const Results& results :
        {Results{"check.json",
                 {"check.json", "clearance.csv", "deviation.npy", "deviation.json", "deviation.png"},
@@ -64,22 +76,55 @@ void forgetResultsOfReplacedPath(const std::filesystem::path& out) {
     std::error_code ec;
     const fs::path report = out / results.report;
     if (!fs::is_regular_file(report, ec)) continue;
-    bool replaced = false;
+    fs::path of;
     try {
       std::ifstream in(report);
       const std::string digest = nlohmann::json::parse(in).value("path_digest", std::string());
       for (const char* name : {"path.cl", "path.apt"})
-        replaced = replaced || (!digest.empty() && fs::is_regular_file(out / name, ec) &&
-                                digest == common::fileDigest(out / name));
+        if (of.empty() && !digest.empty() && fs::is_regular_file(out / name, ec) &&
+            digest == common::fileDigest(out / name))
+          of = out / name;
     } catch (const std::exception&) {
       continue;  // not theirs, or a path that cannot be read: left as it is
     }
-    if (!replaced) continue;
-    common::removeStaleOutputs(out, results.files);
+    if (of.empty()) continue;
+    StaleResults::Group group{{}, results.what, of};
+    for (const char* name : results.files) group.files.push_back(out / name);
+    stale.groups.push_back(std::move(group));
+  }
+  return stale;
+}
+
+/// Removes `stale` once the scene is read and this run may write its folder: never a file the run
+/// reads (a scene whose part is the earlier simulation's surface.stl lost it before it was read,
+/// a reviewer's), nor anything of a run refused before (refused for replacing its own input, it
+/// had taken 10 result files away).
+/// `failed`: the run failed before it wrote its path; the results go only where the path they
+/// are of went (taken away as the run's claimed output), and stay where it stays (an input of the
+/// run is never taken: a refused run had removed the check of the path it kept).
+void forgetResults(const std::filesystem::path& out, const StaleResults& stale,
+                   bool failed = false) noexcept {
+  for (const StaleResults::Group& group : stale.groups) {
+    std::error_code ec;
+    if (failed && std::filesystem::exists(group.of, ec)) continue;
+    for (const std::filesystem::path& file : group.files)
+      if (common::inputAt(file).empty() &&
+          std::filesystem::symlink_status(file, ec).type() == std::filesystem::file_type::regular)
+        std::filesystem::remove(file, ec);
     std::fprintf(stderr, "note: %s: the %s of the path this run replaces is removed with it\n",
-                 out.string().c_str(), results.what);
+                 out.string().c_str(), group.what.c_str());
   }
 }
+
+/// Calls forgetResults(failed) if the run leaves its scope by an exception.
+struct ForgetResultsOnFailure {
+  const std::filesystem::path& out;
+  const StaleResults& stale;
+  const int uncaught = std::uncaught_exceptions();
+  ~ForgetResultsOnFailure() {
+    if (std::uncaught_exceptions() > uncaught) forgetResults(out, stale, /*failed=*/true);
+  }
+};
 
 /// A nominal path whose axes lean along the feed by more than this (deg) gets a note: the
 /// steering starts from path.lead_deg, not from the file's lead.
@@ -203,7 +248,9 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     // never the scene's own files (a nominal path.cl in --out).
     common::claimOutputs(options->out, {"path.cl", "path.apt", "angles.csv", "report.json"},
                          {options->scene, nominalPathOf(options->scene)});
-    forgetResultsOfReplacedPath(options->out);
+    const StaleResults stale = resultsOfReplacedPath(options->out);
+    const std::filesystem::path out_dir = options->out;
+    std::optional<ForgetResultsOnFailure> on_failure(std::in_place, out_dir, stale);
     common::removeEarlierOutputs();
     // Reading (the scene, its meshes, the nominal path, the passes) is counted apart: the job's
     // total left out 9 s of a 70 MB STL (a helper's).
@@ -211,6 +258,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     const Scene scene = loadScene(options->scene);
     common::refuseOutputsOverInputs(options->out,
                                     {"path.cl", "path.apt", "angles.csv", "report.json"}, "--out");
+    on_failure.reset();  // (an exception from here on finds them gone already)
+    forgetResults(options->out, stale);
     requirePostures(scene, common::MemoryUse::kKept);  // held to the end (the field after them)
     pathgen::GenerateRequest job = sceneJob(scene);
     const double read_s =
@@ -317,8 +366,6 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (std::string holder = noHolderNote(scene.tool, scene.holder); !holder.empty())
       notes.tool.push_back(std::move(holder));
     notes.obstacle = openObstacleNotes(scene);
-    for (const std::string& warning : meshScaleWarnings(scene))  // said at load, kept here
-      notes.obstacle.push_back("WARNING: " + warning);
     if (std::string reach = obstaclesOutOfReachNote(
             scene, obstaclesOutOfReach(scene, result.path, scene.field.r0_mm), scene.field.r0_mm);
         !reach.empty() && !options->nominal)  // (--nominal: nothing steers)
@@ -332,7 +379,12 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     const pathgen::DogLegRapids dog_leg =
         pathgen::dogLegRapids(result.path, result.motions, job.clearance_mm);
     report["dog_leg_rapids"] = dogLegJson(dog_leg);
-    report["mesh_notes"] = meshNotes();  // what loading the meshes mended or turned
+    // What loading the meshes mended or turned, and the warnings of their scale (said at load:
+    // not said again with the notes at the end, a reviewer's).
+    std::vector<std::string> mesh_notes = meshNotes();
+    for (const std::string& warning : meshScaleWarnings(scene))
+      mesh_notes.push_back("WARNING: " + warning);
+    report["mesh_notes"] = mesh_notes;
     report["times_s"]["read"] = read_s;  // before `total`, which counts from the passes on
     // The files this report is of (written before it, renamed one by one): a folder holding
     // another run's path beside this report can be told (as check.json's path_digest).

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <iterator>
 #include <memory>
 #include <sstream>
@@ -104,11 +105,21 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
 
   std::printf("%-38s %10s %9s %9s %9s %9s %10s %9s\n", "variant", "nodes", "total_s", "x_direct",
               "lines_%", "nodes_%", "tilt_deg", "clear_mm");
+  // An error over no counted point is "–", as in study.md (it read 0.000: a reviewer's).
+  const auto percent = [](std::initializer_list<const field::FieldError*> errors) {
+    double worst = -1.0;
+    for (const field::FieldError* e : errors)
+      if (e->count > 0) worst = std::max(worst, e->max_relative);
+    char text[32];
+    if (worst < 0.0) return std::string("–");
+    std::snprintf(text, sizeof text, "%.3f", 100 * worst);
+    return std::string(text);
+  };
   for (const StudyRow& row : result.rows)
-    std::printf("%-38s %10zu %9.3f %9.2f %9.3f %9.3f %10.4f %9.3f\n", row.variant.name().c_str(),
+    std::printf("%-38s %10zu %9.3f %9.2f %9s %9s %10.4f %9.3f\n", row.variant.name().c_str(),
                 row.active_nodes, row.total_s, row.speedup_vs_direct,
-                100 * std::max(row.line_a.relative.max_relative, row.line_b.relative.max_relative),
-                100 * row.nodes.relative.max_relative, row.tilt_max_deg, row.min_clearance_mm);
+                percent({&row.line_a.relative, &row.line_b.relative}).c_str(),
+                percent({&row.nodes.relative}).c_str(), row.tilt_max_deg, row.min_clearance_mm);
   std::printf("study: %s\n", (dir / "study.md").string().c_str());
 }
 

@@ -101,10 +101,12 @@ inline std::string toolShapeWhere(const Scene& scene) {
 /// have no inside for the cutter test, and their winding says which side is the part's). A part
 /// file named as an obstacle too gets one (it repels the tool from the surface it cuts).
 std::vector<std::string> openObstacleNotes(const Scene& scene);
-/// A mesh file (an obstacle or the part) whose whole extent is under 1 mm beside a mesh or the
-/// nominal path 100 times larger: one warning each (a mesh in metres among millimetres). Said
-/// by loadScene on stderr, and kept in generate's report.json.
-std::vector<std::string> meshScaleWarnings(const Scene& scene);
+/// A mesh file (an obstacle or the part) whose whole extent is under 1 mm beside a mesh, the
+/// nominal path or `path` (check's) 100 times larger: one warning each (a mesh in metres among
+/// millimetres). Said by loadScene on stderr (check says those `path` adds), kept in
+/// generate's report.json (mesh_notes).
+std::vector<std::string> meshScaleWarnings(const Scene& scene,
+                                           const geometry::PathFile* path = nullptr);
 
 /// Turns scene.impeller / scene.guide_impeller into meshes (obstacles, part) and
 /// scene.impeller_model. Lives in scene_impeller.cpp (the impeller's owner replaces it).

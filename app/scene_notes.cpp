@@ -58,7 +58,7 @@ std::vector<std::string> openObstacleNotes(const Scene& scene) {
   return notes;
 }
 
-std::vector<std::string> meshScaleWarnings(const Scene& scene) {
+std::vector<std::string> meshScaleWarnings(const Scene& scene, const geometry::PathFile* path) {
   // Each mesh file's extent (its box's diagonal, mm), and the largest of them and of the nominal
   // path's tips: what a mesh in metres stands beside.
   struct Extent {
@@ -82,12 +82,21 @@ std::vector<std::string> meshScaleWarnings(const Scene& scene) {
   Extent largest{"", 0.0};
   for (const Extent& m : meshes)
     if (m.diagonal_mm > largest.diagonal_mm) largest = m;
-  if (scene.nominal && !scene.nominal->postures.empty()) {
+  // The parametric impeller's meshes (obstacles past the files', and its hub) are references
+  // too, not suspects (a pin in metres beside the impeller went unsaid: a reviewer's).
+  for (std::size_t i = scene.obstacle_files.size(); i < scene.obstacles.size(); ++i)
+    if (const double d = diagonal(scene.obstacles[i]); d > largest.diagonal_mm)
+      largest = {"the impeller's blades", d};
+  if (scene.part && !scene.part_file)
+    if (const double d = diagonal(*scene.part); d > largest.diagonal_mm)
+      largest = {"the impeller's hub", d};
+  // The paths the scene's meshes stand beside: its nominal path, and the path `check` reads.
+  for (const geometry::PathFile* p : {scene.nominal ? &*scene.nominal : nullptr, path}) {
+    if (!p || p->postures.empty()) continue;
     Eigen::AlignedBox3d box;
-    for (const geometry::Posture& p : scene.nominal->postures) box.extend(p.tip_mm);
+    for (const geometry::Posture& posture : p->postures) box.extend(posture.tip_mm);
     if (box.diagonal().norm() > largest.diagonal_mm)
-      largest = {"the nominal path (" + scene.nominal->file.filename().string() + ")",
-                 box.diagonal().norm()};
+      largest = {"the path (" + p->file.filename().string() + ")", box.diagonal().norm()};
   }
   // A whole mesh under 1 mm beside one at least 100 times larger: a pin exported in metres stood
   // 8 um wide 3 mm from the passes, its field too weak to steer and its solid never met, and the

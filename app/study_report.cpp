@@ -304,11 +304,12 @@ std::string markdownText(const StudyResult& r, const std::string& command_line,
     if (!r.rows[v].variant.isVoxel()) continue;
     s << "| " << r.rows[v].variant.name() << " |";
     for (int b = 0; b + 1 < 4; ++b) {
-      double worst = 0.0;
+      double worst = std::numeric_limits<double>::quiet_NaN();  // "–": no point counted there
       for (const StudyLine* line : {&r.line_a, &r.line_b})
         for (std::size_t i = 0; i < line->t_mm.size(); ++i) {
           const double d = line->wall_distance_mm[i], e = line->relative_error[v][i];
-          if (d >= bands[b] && d < bands[b + 1] && std::isfinite(e)) worst = std::max(worst, e);
+          if (d >= bands[b] && d < bands[b + 1] && std::isfinite(e))
+            worst = std::isnan(worst) ? e : std::max(worst, e);
         }
       s << " " << fixed(100 * worst, 3) << " |";
     }

@@ -503,11 +503,10 @@ GenerateResult generatePath(const GenerateRequest& request) {
   if (request.part && !request.passes_only) {
     Eigen::AlignedBox3d part_box;
     for (const Vec3& v : request.part->vertices) part_box.extend(v);
-    std::vector<geometry::Posture> centres;
-    centres.reserve(static_cast<std::size_t>(stations));
-    for (const Pass& pass : result.passes)
-      for (const PassSample& sample : pass.samples)
-        centres.push_back({sample.centre_mm, Vec3::UnitZ(), 0.0, false});
+    std::vector<std::vector<geometry::Posture>> centres(result.passes.size());
+    for (std::size_t p = 0; p < result.passes.size(); ++p)
+      for (const PassSample& sample : result.passes[p].samples)
+        centres[p].push_back({sample.centre_mm, Vec3::UnitZ(), 0.0, false});
     requireCutterTestMemory(tool, part_box, centres);
   }
 

@@ -91,12 +91,19 @@ TEST(AtomicOutput, ADeadRunsTemporaryIsRemovedByTheNextWrite) {
   const fs::path live_tmp = dir.write(".out.txt.tmp-" + std::to_string(::getppid()), "another's");
   const fs::path other_tmp = dir.write(".other.txt.tmp-" + dead, "another output's");
   const fs::path named = dir.write(".out.txt.tmp-notapid", "not so named");
+  const fs::path padded = dir.write(".out.txt.tmp-0" + dead, "no PID the writer names");
+  const fs::path fresh = dir.write(".out.txt.tmp-" + std::to_string(child + 1000000), "now");
+  // Written a minute ago or more (a fresh one may be a live writer's in another PID namespace).
+  for (const fs::path& old : {dead_tmp, live_tmp, other_tmp, named, padded})
+    fs::last_write_time(old, fs::file_time_type::clock::now() - std::chrono::minutes(2));
   common::writeTextAtomically(dir.path() / "out.txt", "the output\n");
   EXPECT_EQ(slurp(dir.path() / "out.txt"), "the output\n");
   EXPECT_FALSE(fs::exists(dead_tmp));
   EXPECT_TRUE(fs::exists(live_tmp));
   EXPECT_TRUE(fs::exists(other_tmp));
   EXPECT_TRUE(fs::exists(named));
+  EXPECT_TRUE(fs::exists(padded));
+  EXPECT_TRUE(fs::exists(fresh));
 }
 
 // A signal in the middle of a write: the handler removes the temporary, the target never appears.
@@ -204,6 +211,17 @@ TEST(AtomicOutput, GenerateTakesAwayTheCheckOfThePathItReplaces) {
     EXPECT_EQ(run.exit_code, 1) << run.output();
   }
   EXPECT_EQ(filesUnder(dir.path() / "sim"), std::vector<std::string>{});
+  // Never an input of the run: a scene whose obstacle is the earlier simulation's surface.stl lost
+  // it before it was read ("no such mesh file", the folder left empty: a reviewer's).
+  dir.write("keep/path.cl", "0 0 5 0 0 1\n1 0 5 0 0 1\n");
+  ASSERT_EQ(
+      test::runFieldpath(dir, "simulate --tool ball:3 --path keep/path.cl --grid 8x8 --out keep")
+          .exit_code,
+      0);
+  dir.write("scene_in.yaml", "obstacles:\n  - mesh: keep/surface.stl\n");
+  const auto in = test::runFieldpath(dir, "generate scene_in.yaml --out keep");
+  EXPECT_EQ(in.err.find("no such mesh file"), std::string::npos) << in.output();
+  EXPECT_TRUE(fs::exists(dir.path() / "keep/surface.stl")) << in.output();
   EXPECT_EQ(filesUnder(dir.path() / "sim_other"),
             (std::vector<std::string>{"heights.json", "heights.npy", "heights.png", "simulate.json",
                                       "surface.stl"}));

@@ -562,7 +562,7 @@ TEST(GenerateEdges, AMeshInMetresBesideOnesInMillimetresIsWarned) {
     const auto r = test::runFieldpath(dir, "generate scene.yaml --out out");
     ASSERT_EQ(r.exit_code, 0) << r.output();
     const std::string notes =
-        nlohmann::json::parse(test::slurp(dir.path() / "out/report.json"))["obstacle_notes"].dump();
+        nlohmann::json::parse(test::slurp(dir.path() / "out/report.json"))["mesh_notes"].dump();
     if (!metres) {
       EXPECT_EQ(r.err.find("times less than"), std::string::npos) << r.err;
       continue;

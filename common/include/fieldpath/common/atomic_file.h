@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -299,7 +300,9 @@ namespace detail {
 /// Removes the temporaries `PREFIX<pid>` in `dir` of processes that are gone: a run killed where
 /// no handler runs (SIGKILL, the out-of-memory killer) left them, hidden, and no later run took
 /// them away (60 and 141 MB of `field build`'s, an environment sweep's). A live process's (or
-/// one this process may not signal: another user's) is left; so is anything not so named.
+/// one this process may not signal: another user's) is left; so is anything not so named, and one
+/// written in the last minute (a live writer in another PID namespace, whose PID reads as gone
+/// here, is writing it now: a reviewer's).
 inline void removeDeadTemporaries(const std::filesystem::path& dir, const std::string& prefix) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -308,7 +311,12 @@ inline void removeDeadTemporaries(const std::filesystem::path& dir, const std::s
     const std::string name = it->path().filename().string();
     if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
     const std::string digits = name.substr(prefix.size());
-    if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (digits.size() > 9 || digits[0] == '0' ||
+        digits.find_first_not_of("0123456789") != std::string::npos)
+      continue;  // (the writer names a PID in decimal, no leading zero)
+    std::error_code time_ec;
+    const auto written = fs::last_write_time(it->path(), time_ec);
+    if (time_ec || fs::file_time_type::clock::now() - written < std::chrono::minutes(1)) continue;
     const pid_t pid = static_cast<pid_t>(std::stol(digits));
     if (pid <= 0 || pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
     std::error_code ignored;

@@ -61,12 +61,12 @@ CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
                                         double tolerance_mm = kGougeToleranceMm,
                                         const common::Progress& progress = {});
 /// Requires of the memory ledger (common::requireMemory, passing) the bytes that
-/// checkCutterAgainstPart takes to test `postures` against a part within `part_box`. `generate`
-/// asks it of the nominal postures before the steering: the steered path's turns and its links
-/// only add stamps, so a test refused at the end of the job is refused before its work (33 s of a
-/// run were spent before the refusal).
+/// checkCutterAgainstPart takes to test the postures of `passes` and the motions within each
+/// against a part within `part_box`. `generate` asks it before the steering (at the ball centres,
+/// the axis held): the steered path's turns and its links only add stamps, so a test refused at
+/// the end of the job is refused before its work (33 s of a run were spent before the refusal).
 void requireCutterTestMemory(const geometry::ToolSpec& tool, const Eigen::AlignedBox3d& part_box,
-                             std::span<const geometry::Posture> postures,
+                             std::span<const std::vector<geometry::Posture>> passes,
                              double tolerance_mm = kGougeToleranceMm);
 /// The same against the part prepared once (prepareObstacle), shared with the other checks.
 CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
