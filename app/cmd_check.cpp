@@ -186,13 +186,12 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     // The scene's meshes beside the path checked (loading compared them with each other only: a
     // scene in metres beside the path read ok, a reviewer's): what the path adds, said.
     {
-      // (each mesh once: a warning begins with the mesh's name, then " spans ")
-      const auto mesh = [](const std::string& w) { return w.substr(0, w.find(" spans ")); };
-      const std::vector<std::string> at_load = meshScaleWarnings(scene);
-      for (const std::string& warning : meshScaleWarnings(scene, &path))
+      const std::vector<MeshScaleWarning>& at_load = scene.scale_warnings;  // each mesh once
+      for (const MeshScaleWarning& warning : meshScaleWarnings(scene, &path))
         if (std::none_of(at_load.begin(), at_load.end(),
-                         [&](const std::string& w) { return mesh(w) == mesh(warning); }))
-          std::fprintf(stderr, "warning: %s: %s\n", scene.file.string().c_str(), warning.c_str());
+                         [&](const MeshScaleWarning& w) { return w.mesh == warning.mesh; }))
+          std::fprintf(stderr, "warning: %s: %s\n", scene.file.string().c_str(),
+                       warning.text.c_str());
     }
     const common::Progress progress = makeProgressLine(global.quiet);
     if (!scene.tool_given)

@@ -11,7 +11,7 @@
 #include <fstream>
 #include <future>
 #include <limits>
-#include <optional>
+#include <span>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -37,92 +37,87 @@
 #include "obstacle_reach.h"
 #include "progress.h"
 #include "scene.h"
-#include "scene_mesh.h"
 
 namespace fieldpath::app {
 namespace {
 
 using geometry::kRadToDeg;
 
-/// The results of `check --out` and `simulate --out` in `out` that are of the path.cl or path.apt
-/// this run replaces (check.json's and simulate.json's path_digest is the file's): check.json's
-/// `"ok": true`, deviation.png and clearance.csv stayed beside a new path nobody had checked,
-/// heights.npy beside one nobody had simulated (helpers' findings). Results of another path (its
-/// digest differs), or ones that cannot be read, are not listed. Decided before the earlier
-/// path is removed; removed by forgetResults once the scene is read.
+/// The files `check --out` and `simulate --out` write, by the report that names their path.
+struct ResultsOfAPath {
+  const char* report;  ///< holds path_digest: the path file they are of
+  std::span<const char* const> files;
+  const char* what;
+};
+constexpr const char* kCheckFiles[] = {"check.json", "clearance.csv", "deviation.npy",
+                                       "deviation.json", "deviation.png"};
+constexpr const char* kSimulateFiles[] = {"simulate.json", "heights.npy", "heights.json",
+                                          "surface.stl", "heights.png"};
+constexpr ResultsOfAPath kResultsOfAPath[] = {{"check.json", kCheckFiles, "check"},
+                                              {"simulate.json", kSimulateFiles, "simulation"}};
+
+/// The results in `out` that are of the path.cl or path.apt this run replaces (their report's
+/// path_digest is the file's): check.json's `"ok": true`, deviation.png and clearance.csv stayed
+/// beside a new path nobody had checked, heights.npy beside one nobody had simulated (helpers'
+/// findings). Results of another path, or ones that cannot be read, are not listed. Decided
+/// before the earlier path is removed; removed by forgetResults once the scene is read.
 struct StaleResults {
   struct Group {
-    std::vector<std::filesystem::path> files;
-    std::string what;          ///< "check", "simulation"
-    std::filesystem::path of;  ///< the path file they are of (out/path.cl or path.apt)
+    const ResultsOfAPath* kind;
+    std::filesystem::path of;  ///< the path file they are of (out/path.cl or out/path.apt)
   };
   std::vector<Group> groups;
 };
 StaleResults resultsOfReplacedPath(const std::filesystem::path& out) {
   namespace fs = std::filesystem;
-  struct Results {
-    const char* report;
-    std::initializer_list<const char*> files;
-    const char* what;
-  };
   StaleResults stale;
-  for (const Results& results :
-       {Results{"check.json",
-                {"check.json", "clearance.csv", "deviation.npy", "deviation.json", "deviation.png"},
-                "check"},
-        Results{"simulate.json",
-                {"simulate.json", "heights.npy", "heights.json", "surface.stl", "heights.png"},
-                "simulation"}}) {
+  for (const ResultsOfAPath& kind : kResultsOfAPath) {
     std::error_code ec;
-    const fs::path report = out / results.report;
+    const fs::path report = out / kind.report;
     if (!fs::is_regular_file(report, ec)) continue;
-    fs::path of;
     try {
       std::ifstream in(report);
       const std::string digest = nlohmann::json::parse(in).value("path_digest", std::string());
       for (const char* name : {"path.cl", "path.apt"})
-        if (of.empty() && !digest.empty() && fs::is_regular_file(out / name, ec) &&
-            digest == common::fileDigest(out / name))
-          of = out / name;
+        if (!digest.empty() && fs::is_regular_file(out / name, ec) &&
+            digest == common::fileDigest(out / name)) {
+          stale.groups.push_back({&kind, out / name});
+          break;
+        }
     } catch (const std::exception&) {
-      continue;  // not theirs, or a path that cannot be read: left as it is
+      // not theirs, or a path that cannot be read: left as it is
     }
-    if (of.empty()) continue;
-    StaleResults::Group group{{}, results.what, of};
-    for (const char* name : results.files) group.files.push_back(out / name);
-    stale.groups.push_back(std::move(group));
   }
   return stale;
 }
 
-/// Removes `stale` once the scene is read and this run may write its folder: never a file the run
-/// reads (a scene whose part is the earlier simulation's surface.stl lost it before it was read,
-/// a reviewer's), nor anything of a run refused before (refused for replacing its own input, it
-/// had taken 10 result files away).
-/// `failed`: the run failed before it wrote its path; the results go only where the path they
-/// are of went (taken away as the run's claimed output), and stay where it stays (an input of the
-/// run is never taken: a refused run had removed the check of the path it kept).
-void forgetResults(const std::filesystem::path& out, const StaleResults& stale,
-                   bool failed = false) noexcept {
+/// Removes `stale` (never a file the run reads: removeStaleOutputs) once the scene is read and
+/// the run may write its folder: a scene whose part was the earlier simulation's surface.stl lost
+/// it before it was read, and a run refused for replacing its own input had taken 10 result
+/// files of the path it kept (a reviewer's). `failed`: the run failed before writing its path;
+/// the results go only where the path they are of went (taken away as the run's claimed output).
+void forgetResults(const std::filesystem::path& out, const StaleResults& stale, bool failed) {
   for (const StaleResults::Group& group : stale.groups) {
     std::error_code ec;
     if (failed && std::filesystem::exists(group.of, ec)) continue;
-    for (const std::filesystem::path& file : group.files)
-      if (common::inputAt(file).empty() &&
-          std::filesystem::symlink_status(file, ec).type() == std::filesystem::file_type::regular)
-        std::filesystem::remove(file, ec);
+    common::removeStaleOutputs(out, group.kind->files);
     std::fprintf(stderr, "note: %s: the %s of the path this run replaces is removed with it\n",
-                 out.string().c_str(), group.what.c_str());
+                 out.string().c_str(), group.kind->what);
   }
 }
 
-/// Calls forgetResults(failed) if the run leaves its scope by an exception.
+/// forgetResults(failed) where the run leaves its scope by an exception, until disarmed.
 struct ForgetResultsOnFailure {
-  const std::filesystem::path& out;
+  const std::filesystem::path out;
   const StaleResults& stale;
+  bool armed = true;
   const int uncaught = std::uncaught_exceptions();
   ~ForgetResultsOnFailure() {
-    if (std::uncaught_exceptions() > uncaught) forgetResults(out, stale, /*failed=*/true);
+    if (!armed || std::uncaught_exceptions() <= uncaught) return;
+    try {
+      forgetResults(out, stale, /*failed=*/true);
+    } catch (const std::exception&) {  // (a file that cannot be removed: the run's error stands)
+    }
   }
 };
 
@@ -249,8 +244,7 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     common::claimOutputs(options->out, {"path.cl", "path.apt", "angles.csv", "report.json"},
                          {options->scene, nominalPathOf(options->scene)});
     const StaleResults stale = resultsOfReplacedPath(options->out);
-    const std::filesystem::path out_dir = options->out;
-    std::optional<ForgetResultsOnFailure> on_failure(std::in_place, out_dir, stale);
+    ForgetResultsOnFailure on_failure{options->out, stale};
     common::removeEarlierOutputs();
     // Reading (the scene, its meshes, the nominal path, the passes) is counted apart: the job's
     // total left out 9 s of a 70 MB STL (a helper's).
@@ -258,8 +252,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     const Scene scene = loadScene(options->scene);
     common::refuseOutputsOverInputs(options->out,
                                     {"path.cl", "path.apt", "angles.csv", "report.json"}, "--out");
-    on_failure.reset();  // (an exception from here on finds them gone already)
-    forgetResults(options->out, stale);
+    on_failure.armed = false;  // (an exception from here on finds them gone already)
+    forgetResults(options->out, stale, /*failed=*/false);
     requirePostures(scene, common::MemoryUse::kKept);  // held to the end (the field after them)
     pathgen::GenerateRequest job = sceneJob(scene);
     const double read_s =
@@ -381,9 +375,9 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     report["dog_leg_rapids"] = dogLegJson(dog_leg);
     // What loading the meshes mended or turned, and the warnings of their scale (said at load:
     // not said again with the notes at the end, a reviewer's).
-    std::vector<std::string> mesh_notes = meshNotes();
-    for (const std::string& warning : meshScaleWarnings(scene))
-      mesh_notes.push_back("WARNING: " + warning);
+    std::vector<std::string> mesh_notes = scene.mesh_notes;
+    for (const MeshScaleWarning& warning : scene.scale_warnings)
+      mesh_notes.push_back("WARNING: " + warning.text);
     report["mesh_notes"] = mesh_notes;
     report["times_s"]["read"] = read_s;  // before `total`, which counts from the passes on
     // The files this report is of (written before it, renamed one by one): a folder holding

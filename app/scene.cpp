@@ -259,8 +259,10 @@ Scene loadScene(const std::filesystem::path& file, SceneUse use) {
   }
   if (scene.impeller || scene.guide_impeller) resolveImpeller(scene);
   checkSceneSize(scene);  // before any command's heavy work
-  for (const std::string& warning : meshScaleWarnings(scene))
-    std::fprintf(stderr, "warning: %s: %s\n", scene.file.string().c_str(), warning.c_str());
+  scene.mesh_notes = meshNotes();
+  scene.scale_warnings = meshScaleWarnings(scene);
+  for (const MeshScaleWarning& warning : scene.scale_warnings)
+    std::fprintf(stderr, "warning: %s: %s\n", scene.file.string().c_str(), warning.text.c_str());
   return scene;
 }
 

@@ -22,6 +22,12 @@ namespace fieldpath::app {
 /// What a command reads of a scene (loadScene).
 enum class SceneUse { kJob, kPathGiven, kField };
 
+/// A mesh file of a scene much smaller than the rest of it (meshScaleWarnings).
+struct MeshScaleWarning {
+  std::string mesh;  ///< "obstacles[2] (pin.stl)", "part (hub.stl)"
+  std::string text;  ///< the whole warning, naming the mesh first
+};
+
 struct Scene {
   std::filesystem::path file;  ///< the scene file itself
   SceneUse use = SceneUse::kJob;  ///< what it was read for
@@ -37,6 +43,10 @@ struct Scene {
   /// `guide: { impeller: hub }` (once resolveImpeller has run). Never repels.
   std::optional<geometry::TriangleMesh> part;
   std::optional<std::filesystem::path> part_file;
+  /// What loading the meshes said: their mending and turning (meshNotes), and the warnings of
+  /// their scale against each other and the nominal path (meshScaleWarnings), for the reports.
+  std::vector<std::string> mesh_notes;
+  std::vector<MeshScaleWarning> scale_warnings;
 
   /// `obstacles: - impeller: {...}`: the node as written, for resolveImpeller.
   std::optional<YAML::Node> impeller;
@@ -105,8 +115,8 @@ std::vector<std::string> openObstacleNotes(const Scene& scene);
 /// nominal path or `path` (check's) 100 times larger: one warning each (a mesh in metres among
 /// millimetres). Said by loadScene on stderr (check says those `path` adds), kept in
 /// generate's report.json (mesh_notes).
-std::vector<std::string> meshScaleWarnings(const Scene& scene,
-                                           const geometry::PathFile* path = nullptr);
+std::vector<MeshScaleWarning> meshScaleWarnings(const Scene& scene,
+                                                const geometry::PathFile* path = nullptr);
 
 /// Turns scene.impeller / scene.guide_impeller into meshes (obstacles, part) and
 /// scene.impeller_model. Lives in scene_impeller.cpp (the impeller's owner replaces it).

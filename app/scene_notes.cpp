@@ -58,7 +58,8 @@ std::vector<std::string> openObstacleNotes(const Scene& scene) {
   return notes;
 }
 
-std::vector<std::string> meshScaleWarnings(const Scene& scene, const geometry::PathFile* path) {
+std::vector<MeshScaleWarning> meshScaleWarnings(const Scene& scene,
+                                                const geometry::PathFile* path) {
   // Each mesh file's extent (its box's diagonal, mm), and the largest of them and of the nominal
   // path's tips: what a mesh in metres stands beside.
   struct Extent {
@@ -102,7 +103,7 @@ std::vector<std::string> meshScaleWarnings(const Scene& scene, const geometry::P
   // 8 um wide 3 mm from the passes, its field too weak to steer and its solid never met, and the
   // path read safe where the holder ran into the real pin (a CAM engineer's mould, a helper's).
   // Not refused: a speck of that size may be meant, and the scene's other units are right.
-  std::vector<std::string> warnings;
+  std::vector<MeshScaleWarning> warnings;
   for (const Extent& m : meshes) {
     if (!(m.diagonal_mm > 0.0) || m.diagonal_mm >= 1.0 ||
         largest.diagonal_mm < 100.0 * m.diagonal_mm)
@@ -114,7 +115,7 @@ std::vector<std::string> meshScaleWarnings(const Scene& scene, const geometry::P
                   "and a path read safe beside it is not",
                   m.name.c_str(), m.diagonal_mm, largest.diagonal_mm / m.diagonal_mm,
                   largest.name.c_str(), largest.diagonal_mm);
-    warnings.push_back(text);
+    warnings.push_back({m.name, text});
   }
   return warnings;
 }

@@ -13,6 +13,7 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/errors.h"
@@ -224,12 +225,21 @@ StudyResult runStudy(const StudyRequest& request) {
     variants = std::move(built);
   }
 
+  // The study lines' points (a and b): made once, counted below, evaluated in prepareErrors.
+  const pathgen::Impeller impeller(request.impeller);
+  const auto& u_range = request.impeller.u_range;
+  const double u_mid = 0.5 * (u_range[0] + u_range[1]);
+  std::vector<Vec3> line_a_points =
+      lineAPoints(impeller, 0.5 * request.job.field.r0_mm, request.line_step_mm);
+  std::vector<Vec3> line_b_points = lineBPoints(impeller, u_mid, request.line_step_mm);
+
   // What the study holds to its end, asked before any variant runs (study swept: an accepted
   // --max-memory 57M ran to 106 MiB, 3.2 times a limit with --line-step 0.001: none of it was
   // estimated). Measured on the impeller example (2 variants): the tool nodes at every posture of
   // the direct path with their exact and one variant's forces, ~75 B a node (1035 postures x 529
-  // nodes: 40 MB); the lines, ~800 B a point with their exact values, wall distances, per-variant
-  // magnitudes and errors and lines.csv's text (100 k points: 79 MB); every variant's postures.
+  // nodes: 40 MB; 90 counted); the lines, ~800 B a point with their exact values, wall distances,
+  // per-variant magnitudes and errors and lines.csv's text (100 k points: 79 MB); every
+  // variant's postures.
   {
     const pathgen::GenerateRequest& job = request.job;
     std::size_t stations = 0;
@@ -238,11 +248,7 @@ StudyResult runStudy(const StudyRequest& request) {
         double(geometry::surfaceNodes(job.tool, job.holder,
                                       pathgen::defaultNodeSpacingMm(job.tool, job.holder))
                    .size());
-    const pathgen::Impeller impeller(request.impeller);
-    const auto& u_range = request.impeller.u_range;
-    const double line_points =
-        double(lineAPoints(impeller, 0.5 * job.field.r0_mm, request.line_step_mm).size() +
-               lineBPoints(impeller, 0.5 * (u_range[0] + u_range[1]), request.line_step_mm).size());
+    const double line_points = double(line_a_points.size() + line_b_points.size());
     const double variant_count = double(variants.size());
     const double bytes = double(stations) * nodes * 90.0 +
                          line_points * (600.0 + 150.0 * variant_count) +
@@ -272,23 +278,20 @@ StudyResult runStudy(const StudyRequest& request) {
   std::unique_ptr<field::DirectField> direct;
   ErrorSets sets;
   auto prepareErrors = [&](const pathgen::GenerateResult& direct_run) {
-    const pathgen::Impeller impeller(request.impeller);
     const std::vector<geometry::TriangleMesh>& obstacles = job.obstacles;
     const pathgen::ClearanceChecker checker(
         geometry::toolMesh(job.tool, job.holder, pathgen::kClearanceMeshTolMm), obstacles);
     direct = std::make_unique<field::DirectField>(
         field::sampleObstacles(obstacles, job.field.sample_step_mm, job.field.weights), job.field);
 
-    const auto& u_range = request.impeller.u_range;
-    const double u_mid = 0.5 * (u_range[0] + u_range[1]);
     result.line_a =
         makeLine("a",
                  "along the channel (u " + number(u_range[0]) + " to " + number(u_range[1]) +
                      ", the passes' range), mid blade height, r0/2 off the left blade",
-                 lineAPoints(impeller, 0.5 * job.field.r0_mm, request.line_step_mm), checker);
+                 std::move(line_a_points), checker);
     result.line_b = makeLine(
         "b", "across the channel at u = " + number(u_mid) + ", mid blade height, wall to wall",
-        lineBPoints(impeller, u_mid, request.line_step_mm), checker);
+        std::move(line_b_points), checker);
 
     std::vector<Vec3> tool_nodes;
     for (const auto& node : geometry::surfaceNodes(

@@ -22,6 +22,7 @@
 #include <functional>
 #include <initializer_list>
 #include <mutex>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -554,7 +555,7 @@ inline void commitOutputs() {
 /// write them (a check that read no surface, a simulate without `--outputs png`): a folder never
 /// mixes two runs' outputs (`view --check` showed an earlier path's surface as this one's).
 inline void removeStaleOutputs(const std::filesystem::path& dir,
-                               std::initializer_list<const char*> names) {
+                               std::span<const char* const> names) {
   for (const char* name : names) {
     std::error_code ec;  // regular files only: a FIFO or a link the user put there stays
     if (std::filesystem::symlink_status(dir / name, ec).type() !=
@@ -566,6 +567,10 @@ inline void removeStaleOutputs(const std::filesystem::path& dir,
       throw InputError((dir / name).string() +
                        ": cannot remove the earlier run's file: " + ec.message());
   }
+}
+inline void removeStaleOutputs(const std::filesystem::path& dir,
+                               std::initializer_list<const char*> names) {
+  removeStaleOutputs(dir, std::span<const char* const>(names.begin(), names.size()));
 }
 
 /// Writes `text` atomically (see writeFileAtomically).
