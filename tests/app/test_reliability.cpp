@@ -399,8 +399,13 @@ void interruptMidway(const std::vector<std::string>& args, std::chrono::millisec
         EXPECT_TRUE(nlohmann::json::accept(slurp(dir.path() / "out" / name))) << name;
     }
   }
-  // Interrupted midway: killed by the signal (the work outlasts the wait), nothing partial left.
+  // Interrupted midway: killed by the signal (the work outlasts the wait), nothing partial left,
+  // and it says so (a run killed by `timeout` ended its log as if it had stopped on its own).
   EXPECT_EQ(code, 128 + sig) << err;
+  EXPECT_NE(
+      err.find(std::string("fieldpath: interrupted by ") + (sig == SIGINT ? "SIGINT" : "SIGTERM")),
+      std::string::npos)
+      << err;
 }
 
 TEST(Interrupted, GenerateLeavesNoPartialFile) {

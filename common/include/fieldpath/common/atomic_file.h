@@ -8,6 +8,7 @@
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
+#include <termios.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -168,16 +169,6 @@ namespace detail {
 /// alone left the plotter to move a PNG into --out a second after the exit: a study sweep's).
 inline std::atomic<pid_t> output_helper{0};
 
-extern "C" inline void removeTemporariesAndDie(int signal_number) {
-  if (const pid_t helper = output_helper.load(); helper > 0) ::kill(helper, SIGKILL);
-  removeTemporariesNow();
-  removeClaimedOutputsNow();
-  removeCreatedDirectoryNow();
-  ::raise(signal_number);  // SA_RESETHAND restored the default action: die of the signal
-}
-}  // namespace detail
-
-namespace detail {
 inline void writeAll(int fd, const char* text) noexcept {
   for (std::size_t n = std::strlen(text); n > 0;) {
     const ssize_t w = ::write(fd, text, n);
@@ -186,6 +177,39 @@ inline void writeAll(int fd, const char* text) noexcept {
   }
 }
 
+/// The line an interrupted run ends with (a run killed by `timeout` or Ctrl-C said nothing, its
+/// log read as if it had stopped on its own): the signal, and whether the outputs it was to write
+/// were taken away. Not for SIGPIPE (`| head` done reading: nothing to tell). Async-signal-safe.
+inline void sayInterrupted(int signal_number) noexcept {
+  const char* name = signal_number == SIGINT    ? "SIGINT"
+                     : signal_number == SIGTERM ? "SIGTERM"
+                     : signal_number == SIGHUP  ? "SIGHUP"
+                     : signal_number == SIGQUIT ? "SIGQUIT"
+                                                : nullptr;
+  if (!name) return;
+  bool claimed = false;
+  for (auto& slot : claimed_slots) claimed = claimed || slot.state.load() == 2;
+  // On a terminal the progress line may be open (drawn with "\r", no line end): ended first.
+  struct termios terminal {};
+  if (::tcgetattr(STDERR_FILENO, &terminal) == 0) writeAll(STDERR_FILENO, "\n");
+  writeAll(STDERR_FILENO, "fieldpath: interrupted by ");
+  writeAll(STDERR_FILENO, name);
+  writeAll(
+      STDERR_FILENO,
+      claimed ? ": its outputs not written, nor an earlier run's left under their names\n" : "\n");
+}
+
+extern "C" inline void removeTemporariesAndDie(int signal_number) {
+  if (const pid_t helper = output_helper.load(); helper > 0) ::kill(helper, SIGKILL);
+  sayInterrupted(signal_number);
+  removeTemporariesNow();
+  removeClaimedOutputsNow();
+  removeCreatedDirectoryNow();
+  ::raise(signal_number);  // SA_RESETHAND restored the default action: die of the signal
+}
+}  // namespace detail
+
+namespace detail {
 /// SIGBUS at an address of a mapped input (listMappedInput: the file was cut short while it was
 /// read, and it crashed with "Bus error", an empty output folder left): one line naming it, the
 /// run's files removed as for a failed run, exit 1; the first thread in says it (the readers
