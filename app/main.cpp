@@ -21,6 +21,7 @@
 #include "errors.h"
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/limits.h"
+#include "fieldpath/common/output_signals.h"
 #include "progress.h"
 #include "scene.h"
 

@@ -21,6 +21,7 @@
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/output_signals.h"
 #include "fieldpath/field/law.h"
 #include "fieldpath/geometry/units.h"
 #include "study.h"

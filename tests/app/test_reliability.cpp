@@ -25,6 +25,7 @@
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/file_digest.h"
+#include "fieldpath/common/output_signals.h"
 #include "files.h"
 #include "reliability_runs.h"
 #include "run_fieldpath.h"
