@@ -17,8 +17,9 @@ struct ObstacleOutOfReach {
   double at_least_mm = 0.0;  ///< a lower bound of its distance to tool + holder over the path
 };
 
-/// The obstacles farther than `reach_mm` from the tool and holder (a capsule from the tip to the
-/// top of the holder, of their largest radius) at every posture of `path`, told by boxes: each
+/// The obstacles farther than `reach_mm` from the tool and holder (the cutter, and each span of
+/// the holder, in a box of its own about the axis) at every posture of `path`, told by boxes
+/// (of groups of nearby triangles of the obstacle): each
 /// distance is a lower bound, so an obstacle listed is surely out of reach (one within it by the
 /// boxes alone is not listed).
 std::vector<ObstacleOutOfReach> obstaclesOutOfReach(const Scene& scene,

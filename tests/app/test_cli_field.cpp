@@ -2,6 +2,8 @@
 /// bad input → exit 1 with one line on stderr and nothing on stdout.
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -130,6 +132,37 @@ TEST(CliField, BuildWritesTheVdbAndReportsNodes) {
     EXPECT_EQ(lines(refused.err), 1u) << refused.err;
     EXPECT_FALSE(std::filesystem::exists(dir.path() / "big.vdb"));
   }
+}
+
+// A refined build's share of the dense box is level 0's (the box is of h): all levels' nodes
+// over it read "1532.86 % of the dense box" (a claims audit's).
+TEST(CliField, ARefinedBuildsShareOfTheDenseBoxIsItsFirstLevels) {
+  TempDir dir;
+  const std::string scene =
+      (std::filesystem::path(FIELDPATH_SOURCE_DIR) / "examples/impeller/scene.yaml").string();
+  const Outcome run = runFieldpath(
+      dir, "field build " + scene + " --voxel 1 --refine-tolerance 0.02 --out field.vdb");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  std::size_t all = 0, first = 0, dense = 0, levels = 0, refined_cells = 0, refined = 0;
+  double percent = 0.0;
+  const std::size_t at = run.out.find("active nodes: ");
+  ASSERT_NE(at, std::string::npos) << run.out;
+  ASSERT_EQ(std::sscanf(run.out.c_str() + at, "active nodes: %zu (level 0 %zu: %lf %%", &all,
+                        &first, &percent),
+            3)
+      << run.out;
+  ASSERT_EQ(std::sscanf(run.out.c_str() + run.out.find("dense-box nodes: "), "dense-box nodes: %zu",
+                        &dense),
+            1);
+  ASSERT_EQ(std::sscanf(run.out.c_str() + run.out.find("levels: "),
+                        "levels: %zu (%zu refined cells, %zu refined nodes)", &levels,
+                        &refined_cells, &refined),
+            3)
+      << run.out;
+  EXPECT_GT(levels, 1u);
+  EXPECT_EQ(first + refined, all);
+  EXPECT_LE(first, dense);
+  EXPECT_NEAR(percent, 100.0 * double(first) / double(dense), 0.01);
 }
 
 TEST(CliField, BadInputExitsOneWithOneLine) {

@@ -96,8 +96,15 @@ TEST(GenerateEdges, ObstaclesOutOfTheFieldsReachAreSaid) {
   geometry::TriangleMesh far;
   pathgen::test::addBox(far, 50, 51, -2, 2, -0.5, 1);
   geometry::saveMesh(far, dir.path() / "far.stl");
+  // A wall 1.1 mm beside the ball's side (y = 1.5), under a holder of radius 3 (z 10 to 20): one
+  // box of the holder's radius from the tip up kept it "near" (the note fired only far beyond
+  // r0, a claims audit's finding); the cutter and the holder in boxes of their own tell it.
+  geometry::TriangleMesh wall;
+  pathgen::test::addBox(wall, -2, 2, 2.6, 3, -0.5, 1);
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  const std::string holder = "holder: [[10, 3], [20, 3]]\n";
   struct Case {
-    std::string obstacles, said;
+    std::string obstacles, said, more = "";
   };
   for (const Case& c :
        {Case{"  - mesh: post.stl\n", ""},
@@ -106,8 +113,12 @@ TEST(GenerateEdges, ObstaclesOutOfTheFieldsReachAreSaid) {
              "the tool and holder at every posture: it steered nothing"},
         Case{"  - mesh: far.stl\n",
              "obstacles[1] (far.stl, at least 48 mm away) stays farther than field.r0 (1 mm) from "
-             "the tool and holder at every posture: no obstacle steered the path"}}) {
-    dir.write("scene.yaml", "obstacles:\n" + c.obstacles + rest);
+             "the tool and holder at every posture: no obstacle steered the path"},
+        Case{"  - mesh: wall.stl\n",
+             "obstacles[1] (wall.stl, at least 1.1 mm away) stays farther than field.r0 (1 mm) "
+             "from the tool and holder at every posture",
+             holder}}) {
+    dir.write("scene.yaml", "obstacles:\n" + c.obstacles + rest + c.more);
     const auto r = test::runFieldpath(dir, "generate scene.yaml --out out");
     ASSERT_EQ(r.exit_code, 0) << r.output();
     const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out/report.json"));
