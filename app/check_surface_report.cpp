@@ -43,7 +43,9 @@ nlohmann::json surfaceJson(const SurfaceResult& s) {
        "the Z-buffer cuts at the postures and along every motion between them that can reach "
        "the stock (tip and axis interpolated linearly, no point of the tool moving more than "
        "sweep_step_mm between cuts; a ball's cut between two is at most sweep_error_um "
-       "shallower than the swept one)"},
+       "shallower than the swept one along the ball's normal there, so along the part's normal "
+       "where the ball finishes it; vertically 1/cos of the ball's slope more, e.g. 2-3 um on "
+       "the stock a pass's end leaves to the ball's side)"},
       {"sweep_step_mm", s.sweep_step_mm},
       {"sweep_error_um", s.sweep_error_um},
       {"simulated_postures", s.simulated_postures},

@@ -68,7 +68,10 @@ struct SurfaceResult {
   bool coarsened = false;  ///< the spacing was widened to stay within kMaxSurfaceLines
   /// The motions are swept: postures interpolated no farther apart than this (mm) where the tool
   /// can reach the stock; the cut between two of them is at most sweep_error_um shallower (the
-  /// cutting edge's curvature: a ball's R, a torus's corner r).
+  /// cutting edge's curvature: a ball's R, a torus's corner r) along the edge's normal there:
+  /// along the part's normal where the edge finishes the part, as the deviation is told; 1/cos
+  /// of the edge's slope more vertically (stock left to the ball's side at a pass's end: a
+  /// claims audit read 3.1 um against 1.25).
   double sweep_step_mm = 0, sweep_error_um = 0;
   std::size_t simulated_postures = 0;  ///< the path's and the interpolated ones
   std::size_t cut_lines = 0;           ///< lines the tool lowered, over the part or not
