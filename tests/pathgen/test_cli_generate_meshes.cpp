@@ -83,6 +83,14 @@ TEST(GenerateEdges, AMeshTurnedOnLoadingIsInTheReport) {
   EXPECT_NE(r.err.find(said), std::string::npos) << r.err;
   const auto report = nlohmann::json::parse(test::slurp(dir.path() / "out/report.json"));
   EXPECT_NE(report["mesh_notes"].dump().find(said), std::string::npos) << report["mesh_notes"];
+  // Its times: the total holds the stages, reading included (they summed past it: a claims
+  // audit's), field_near_path being part of field.
+  const auto& t = report["times_s"];
+  double stages = 0.0;
+  for (const char* stage : {"read", "setup", "field", "steering", "clearance"})
+    stages += t[stage].get<double>();
+  EXPECT_LE(stages, t["total"].get<double>()) << t;
+  EXPECT_LE(t["field_near_path"].get<double>(), t["field"].get<double>()) << t;
 }
 
 // An obstacle farther than field.r0 from the tool at every posture steers nothing (eq. 1 ends at
