@@ -115,11 +115,19 @@ void run(const StudyOptions& o, const GlobalOptions& global, const std::string& 
     std::snprintf(text, sizeof text, "%.3f", 100 * worst);
     return std::string(text);
   };
-  for (const StudyRow& row : result.rows)
-    std::printf("%-38s %10zu %9.3f %9.2f %9s %9s %10.4f %9.3f\n", row.variant.name().c_str(),
+  bool under = false;
+  for (const StudyRow& row : result.rows) {
+    const bool this_under = underClearance(row, result.clearance_mm);
+    under = under || this_under;
+    std::printf("%-38s %10zu %9.3f %9.2f %9s %9s %10.4f %9.3f%s\n", row.variant.name().c_str(),
                 row.active_nodes, row.total_s, row.speedup_vs_direct,
                 percent({&row.line_a.relative, &row.line_b.relative}).c_str(),
-                percent({&row.nodes.relative}).c_str(), row.tilt_max_deg, row.min_clearance_mm);
+                percent({&row.nodes.relative}).c_str(), row.tilt_max_deg, row.min_clearance_mm,
+                this_under ? " *" : "");
+  }
+  if (under)
+    std::printf("* its path went under the required clearance (%.3f mm) or collided\n",
+                result.clearance_mm);
   std::printf("study: %s\n", (dir / "study.md").string().c_str());
 }
 

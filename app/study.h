@@ -110,6 +110,13 @@ struct StudyRow {
   long solver_steps = 0, rhs_evals = 0;  ///< CVODE, all passes: a rough field costs steps
 };
 
+/// Whether a row's path went under the required clearance or collided (the FCL check of its
+/// postures): its speed is no answer (a study named a 2 mm quadratic variant's path at 0.391 mm,
+/// required 0.5, beside the others unflagged). False for a row whose path failed (NaN).
+inline bool underClearance(const StudyRow& row, double clearance_mm) {
+  return row.failure.empty() && (row.colliding > 0 || row.min_clearance_mm < clearance_mm);
+}
+
 /// A study line: points, the exact field along it and each variant's field.
 struct StudyLine {
   std::string name;  ///< "a" or "b"
