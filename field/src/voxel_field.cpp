@@ -520,7 +520,7 @@ void VoxelField::save(const std::filesystem::path& file) const {
     }
   }
   common::writeFileAtomically(
-      file, [&](std::ofstream& out) { openvdb::io::Stream(out).write(grids); },
+      file, [&](std::ostream& out) { openvdb::io::Stream(out).write(grids); },
       std::ios::out | std::ios::binary);
 }
 

@@ -485,7 +485,7 @@ void saveMesh(const TriangleMesh& mesh, const std::filesystem::path& file) {
     throw std::runtime_error(file.string() + ": mesh export failed: " + exporter.GetErrorString());
   common::writeFileAtomically(
       file,
-      [blob](std::ofstream& out) {
+      [blob](std::ostream& out) {
         out.write(static_cast<const char*>(blob->data), static_cast<std::streamsize>(blob->size));
       },
       std::ios::out | std::ios::binary);

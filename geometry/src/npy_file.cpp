@@ -246,7 +246,10 @@ void writeNpyFile(const std::filesystem::path& file, std::span<const Posture> po
     bytes.append(reinterpret_cast<const char*>(values), columns * sizeof(double));
   }
   common::writeFileAtomically(
-      file, [&](std::ofstream& out) { out.write(bytes.data(), static_cast<std::streamsize>(bytes.size())); },
+      file,
+      [&](std::ostream& out) {
+        out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+      },
       std::ios::out | std::ios::binary);
 }
 

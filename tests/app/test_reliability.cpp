@@ -115,7 +115,7 @@ TEST(AtomicOutput, SignalDuringAWriteLeavesNothing) {
     const pid_t pid = fork();
     if (pid == 0) {
       common::installTemporaryCleanupOnSignals();
-      common::writeFileAtomically(target, [&](std::ofstream& out) {
+      common::writeFileAtomically(target, [&](std::ostream& out) {
         out << std::string(1 << 20, 'x');  // half written...
         out.flush();
         raise(sig);                         // ...when the user presses Ctrl-C

@@ -123,7 +123,7 @@ void writeHeightsNpy(const std::filesystem::path& file, const Grid& grid,
   header.push_back('\n');
   common::writeFileAtomically(
       file,
-      [&](std::ofstream& out) {
+      [&](std::ostream& out) {
         out.write("\x93NUMPY\x01\x00", 8);
         const std::uint16_t len = static_cast<std::uint16_t>(header.size());
         const char le[2] = {static_cast<char>(len & 0xff), static_cast<char>(len >> 8)};
@@ -190,7 +190,7 @@ std::size_t writeSurfaceStl(const std::filesystem::path& file, const Grid& grid,
   };
   common::writeFileAtomically(
       file,
-      [&](std::ofstream& out) {
+      [&](std::ostream& out) {
         char header[80] = "fieldpath simulate: machined surface (Z-buffer)";
         out.write(header, 80);
         const std::uint32_t n = static_cast<std::uint32_t>(count);

@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <ext/stdio_filebuf.h>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -257,7 +258,7 @@ inline void removeDeadTemporaries(const std::filesystem::path& dir, const std::s
 /// atomically); a name that is a device, FIFO or socket (`/dev/null`, `/dev/stdout`) is written
 /// into directly and never removed: renaming over it replaced /dev/null with a regular file.
 inline void writeFileAtomically(const std::filesystem::path& given,
-                                const std::function<void(std::ofstream&)>& write,
+                                const std::function<void(std::ostream&)>& write,
                                 std::ios::openmode mode = std::ios::out) {
   namespace fs = std::filesystem;
   std::error_code status_ec;
@@ -306,7 +307,8 @@ inline void writeFileAtomically(const std::filesystem::path& given,
       // planted, a link to another file that an open would write through (a helper's, in a
       // shared folder). Unlinked (a link, not its target), then created new by this process
       // (O_EXCL | O_NOFOLLOW: a link planted again in between is refused, not followed); the
-      // stream then opens the file this process owns.
+      // stream writes through that descriptor (opened again by name, a file swapped in
+      // between, in a world-writable folder without the sticky bit, would have been written).
       errno = 0;
       detail::beginCreating(listing.slot);
       int created = -1;
@@ -315,23 +317,19 @@ inline void writeFileAtomically(const std::filesystem::path& given,
         created = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
         if (created < 0 && errno != EEXIST) break;
       }
-      const int create_error = errno;
-      if (created >= 0) ::close(created);
-      std::ofstream out;
-      if (created >= 0) out.open(tmp, mode | std::ios::trunc);
       detail::endCreating(listing.slot);
-      if (created < 0) errno = create_error;
-      if (!out)
+      if (created < 0)
         throw InputError(path.string() + ": cannot open for writing: " +
                          detail::systemReason(errno));
+      __gnu_cxx::stdio_filebuf<char> file(created, mode | std::ios::out);  // closes `created`
+      std::ostream out(&file);
       errno = 0;
       write(out);
       out.flush();
       if (!out)
         throw InputError(path.string() + ": cannot write: " +
                          detail::writeReason(errno, path.parent_path()));
-      out.close();
-      if (out.fail())
+      if (!file.close())
         throw InputError(path.string() + ": cannot write: " +
                          detail::writeReason(errno, path.parent_path()));
     }
@@ -497,7 +495,7 @@ inline void removeStaleOutputs(const std::filesystem::path& dir,
 
 /// Writes `text` atomically (see writeFileAtomically).
 inline void writeTextAtomically(const std::filesystem::path& path, const std::string& text) {
-  writeFileAtomically(path, [&](std::ofstream& out) { out << text; });
+  writeFileAtomically(path, [&](std::ostream& out) { out << text; });
 }
 
 }  // namespace fieldpath::common
