@@ -196,8 +196,23 @@ int main(int argc, char** argv) {
       return 1;
     }
     // A usage error is bad input: one line, exit 1 (CLI11's own report adds a second line).
+    // A file named with a leading '-' reads as an option ("scene is required" for
+    // `-scene.yaml`): said, with the way round it.
+    std::string dash_file;
+    for (int i = 1; i < argc && dash_file.empty(); ++i) {
+      std::error_code ec;
+      const std::string arg = argv[i];
+      if (arg.size() > 1 && arg[0] == '-' && arg != "--" &&
+          std::filesystem::is_regular_file(arg, ec))
+        dash_file = arg;
+    }
     fieldpath::app::endProgressLine();
-    std::fprintf(stderr, "fieldpath: error: %s (see --help)\n", oneLine(e.what()).c_str());
+    std::fprintf(stderr, "fieldpath: error: %s%s (see --help)\n", oneLine(e.what()).c_str(),
+                 dash_file.empty()
+                     ? ""
+                     : ("; '" + oneLine(dash_file.c_str()) + "' reads as an option: name it ./" +
+                        oneLine(dash_file.c_str()))
+                           .c_str());
     return 1;
   } catch (const InputError& e) {
     fieldpath::common::removeWrittenOutputs();  // a failed run leaves no partial set of outputs

@@ -245,4 +245,15 @@ TEST(CliField, AnUnknownCommandIsNamed) {
     EXPECT_EQ(lines(run.err), 1u) << run.err;
     EXPECT_NE(run.err.find("unknown command " + said), std::string::npos) << run.err;
   }
+  // A scene named with a leading '-' reads as an option: said, with the way round it ("scene is
+  // required" alone, a review's).
+  planeScene(dir);
+  std::filesystem::copy_file(dir.path() / "scene.yaml", dir.path() / "-scene.yaml");
+  const Outcome dashed = runFieldpath(dir, "field build -scene.yaml --voxel 1 --out f.vdb");
+  EXPECT_EQ(dashed.exit_code, 1);
+  EXPECT_EQ(lines(dashed.err), 1u) << dashed.err;
+  EXPECT_NE(dashed.err.find("'-scene.yaml' reads as an option: name it ./-scene.yaml"),
+            std::string::npos)
+      << dashed.err;
+  EXPECT_EQ(runFieldpath(dir, "field build ./-scene.yaml --voxel 1 --out f.vdb").exit_code, 0);
 }
