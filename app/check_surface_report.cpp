@@ -82,6 +82,15 @@ nlohmann::json surfaceJson(const SurfaceResult& s) {
       {"scallop_skipped", s.band_lines > 0 ? json(nullptr)
                                            : json("no two neighbouring passes: a scallop is "
                                                   "what is left between them")},
+      {"unreachable_band_lines", s.unreachable_band_lines},
+      {"max_reachable_scallop_um",
+       std::isnan(s.max_reachable_scallop_um) ? json(nullptr) : json(s.max_reachable_scallop_um)},
+      {"unreachable",
+       "band lines above max_reachable_scallop_um where the ball, set on the part (its centre R "
+       "along the part's normal), meets an obstacle: stock beside a wall or a rib that no ball "
+       "of R reaches, counted in max_scallop_um, not a cusp the passes leave; "
+       "max_reachable_scallop_um: the highest band line the ball can touch (null: not told: no "
+       "obstacle, not a ball)"},
       {"mean_deviation_um", scallop(s.mean_um)},
       {"rms_deviation_um", scallop(s.rms_um)},
       {"stock_allowance_mm", kStockAllowanceMm}};
@@ -98,12 +107,18 @@ std::string surfaceLine(const SurfaceResult& s) {
                   "max scallop %.1f um (a cusp between the lines on a wall of 85 deg or more: not "
                   "bounded), rms %.1f um",
                   s.max_scallop_um, s.rms_um);
-  char line[400];
+  char beside[200] = "";
+  if (s.unreachable_band_lines > 0 && !std::isnan(s.max_reachable_scallop_um))
+    std::snprintf(beside, sizeof beside,
+                  "; %.1f um where the ball can reach (%zu lines above it lie beside obstacles no "
+                  "ball of R reaches)",
+                  s.max_reachable_scallop_um, s.unreachable_band_lines);
+  char line[600];
   std::snprintf(line, sizeof line,
-                "surface: %zu lines in the band, max gouge %.2f um (%zu lines below %.1f um), %s "
-                "(%s, %.2f s)",
+                "surface: %zu lines in the band, max gouge %.2f um (%zu lines below %.1f um), "
+                "%s%s (%s, %.2f s)",
                 s.band_lines, s.max_gouge_um, s.gouged_lines, -s.gouge_tolerance_um, scallop,
-                zbuffer::backendName(s.backend), s.simulation_s);
+                beside, zbuffer::backendName(s.backend), s.simulation_s);
   return line;
 }
 
@@ -123,7 +138,13 @@ std::vector<std::string> finishReasons(const SurfaceResult* surface,
   const auto um = [](double v) { return std::to_string(static_cast<long long>(std::lround(v))); };
   const double measured = surface->max_scallop_um, between = surface->scallop_grid_error_um;
   if (surface->band_lines > 0 && measured > *max_scallop_um)
-    out.push_back("max scallop " + um(measured) + " um, over --max-scallop " + bound + " um");
+    out.push_back(
+        "max scallop " + um(measured) + " um, over --max-scallop " + bound + " um" +
+        (surface->unreachable_band_lines > 0 && !std::isnan(surface->max_reachable_scallop_um)
+             ? " (" + um(surface->max_reachable_scallop_um) + " um where the ball can reach: " +
+                   std::to_string(surface->unreachable_band_lines) +
+                   " lines above it lie beside obstacles no ball of this radius reaches)"
+             : std::string()));
   else if (surface->band_lines > 0 && !std::isfinite(between))
     out.push_back("max scallop " + um(measured) +
                   " um on the lines, a cusp between them on a wall of 85 deg or more not "

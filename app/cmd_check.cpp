@@ -251,6 +251,7 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         geometry::toolMesh(scene.tool, scene.holder, pathgen::kClearanceMeshTolMm);
     const pathgen::ClearanceChecker checker(tool_mesh, scene.obstacles,
                                             pathgen::kClearanceMeshTolMm);
+    surface_request.obstacles = &checker;  // the stock beside them told from the scallop
     const pathgen::ClearanceResult clearance = checker.check(path.postures, {}, progress);
     pathgen::MotionRequest motion_request;
     motion_request.required_mm = scene.clearance_mm;

@@ -14,6 +14,7 @@
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/memory.h"
 #include "fieldpath/common/short_number.h"
+#include "fieldpath/pathgen/clearance.h"
 #include "fieldpath/pathgen/passes.h"
 #include "fieldpath/zbuffer/outputs.h"
 #include "machined_band.h"
@@ -355,6 +356,52 @@ std::optional<SurfaceGrid> surfaceGrid(const SurfaceRequest& request) {
   return result;
 }
 
+namespace {
+
+/// SurfaceResult::unreachable_band_lines and max_reachable_scallop_um: the band's lines from the
+/// highest down, in chunks (doubling from 256: on a part without walls beside the band the first
+/// line answers), the ball set on the part at each (centre R along the part's normal, `top`
+/// in the frame `z0_mm` below the world's), until one clears the obstacles.
+void tellUnreachable(SurfaceResult& result, const pathgen::ClearanceChecker& obstacles,
+                     double radius_mm, const zbuffer::Grid& grid, const std::vector<float>& top,
+                     double z0_mm) {
+  std::vector<std::size_t> order;
+  order.reserve(result.band_lines);
+  for (std::size_t i = 0; i < result.in_band.size(); ++i)
+    if (result.in_band[i] && !std::isnan(top[i])) order.push_back(i);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return result.deviation_um[a] > result.deviation_um[b] ||
+           (result.deviation_um[a] == result.deviation_um[b] && a < b);
+  });
+  // Shrunk a little: a ball that only grazes a wall (a fillet of radius R) reaches the part.
+  const double ball_mm = radius_mm - std::min(0.01, 0.01 * radius_mm);
+  std::vector<Vec3> centres;
+  std::vector<double> clear_mm;
+  for (std::size_t begin = 0, chunk = 256; begin < order.size(); begin += chunk, chunk *= 2) {
+    const std::size_t end = std::min(order.size(), begin + chunk);
+    centres.clear();
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::size_t i = order[k];
+      const Vec2 at(grid.x0_mm + (i % grid.nx + 0.5) * grid.dx_mm,
+                    grid.y0_mm + (i / grid.nx + 0.5) * grid.dy_mm);
+      const Vec3 on_part(at.x(), at.y(), double(top[i]) + z0_mm);
+      centres.push_back(on_part + radius_mm * partNormal(grid, top, at));
+    }
+    clear_mm.clear();
+    obstacles.ballClearance(centres, ball_mm, nullptr, nullptr,
+                            std::numeric_limits<double>::infinity(), &clear_mm);
+    for (std::size_t k = begin; k < end; ++k) {
+      if (clear_mm[k - begin] > 0.0) {
+        result.max_reachable_scallop_um = result.deviation_um[order[k]];
+        return;
+      }
+      ++result.unreachable_band_lines;
+    }
+  }
+}
+
+}  // namespace
+
 std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request, const SurfaceGrid& plan) {
   const geometry::TriangleMesh& part = *request.part;
   const geometry::PathFile& path = *request.path;
@@ -495,6 +542,8 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request, const S
   }
   result.max_gouge_um = std::max(0.0, -min_dev);
   result.max_scallop_um = max_dev;
+  if (request.obstacles && request.tool.shape == geometry::ToolShape::Ball && result.band_lines > 0)
+    tellUnreachable(result, *request.obstacles, radius, world_grid, reference, origin.z());
   return result;
 }
 

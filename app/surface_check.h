@@ -6,6 +6,7 @@
 /// of the slope of the facet under the line: exact over a plane facet), as a profile tolerance is.
 #include <cstddef>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -14,6 +15,10 @@
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/geometry/tool.h"
 #include "fieldpath/zbuffer/simulator.h"
+
+namespace fieldpath::pathgen {
+class ClearanceChecker;
+}
 
 namespace fieldpath::app {
 
@@ -34,6 +39,10 @@ struct SurfaceRequest {
   double gouge_tolerance_um = kGougeToleranceUm;
   zbuffer::Backend backend = zbuffer::Backend::Auto;
   common::Progress progress;
+  /// The scene's obstacles (their checker, built for the clearance): where given, the band's
+  /// highest lines are told apart where the ball cannot touch the part without meeting one
+  /// (SurfaceResult::unreachable_band_lines). Ball tools only.
+  const pathgen::ClearanceChecker* obstacles = nullptr;
 };
 
 struct SurfaceResult {
@@ -55,6 +64,14 @@ struct SurfaceResult {
   std::size_t gouged_lines = 0;  ///< anywhere on the part, deeper than the tolerance
   double gouge_tolerance_um = kGougeToleranceUm;
   double max_gouge_um = 0, max_scallop_um = 0, mean_um = 0, rms_um = 0;  ///< scallop stats: band
+  /// The band's lines above the highest one the ball can touch, told by the ball set on the part
+  /// there (its centre R along the part's normal, R less 0.01 mm) meeting an obstacle: stock
+  /// beside a wall or a rib that no ball of R reaches, not a cusp the passes leave (a mould's
+  /// 1994 um "scallop" beside its ribs, its cusps 95 um). `max_reachable_scallop_um`: the highest
+  /// band line the ball can touch; NaN where not told (no obstacles, not a ball, or no band line
+  /// it can touch).
+  std::size_t unreachable_band_lines = 0;
+  double max_reachable_scallop_um = std::numeric_limits<double>::quiet_NaN();
   /// How far the highest cusp may stand above max_scallop_um, µm: a cusp between two cuts of
   /// the cutting edge (curvature radius ρ: a ball's R, a torus's corner r) may fall up to a
   /// spacing/√2 from every line, where the vertical deviation climbs at most tan(θ + α) − tan(θ)

@@ -155,6 +155,39 @@ TEST(CheckSurface, TheHighestCuspBetweenTheLinesIsWithinTheStatedBound) {
 
 // One pass has no neighbour: no scallop to tell (its band of ±R/2 read the ball's own profile,
 // R - sqrt(R² - (R/2)²) = 402 um, as one), and no gouge either.
+// Stock beside a rib that no ball of R reaches is told apart from the cusps the passes leave (a
+// mould's 1994 um "scallop" beside its ribs, its cusps 95 um): passes 2 mm apart each side of a
+// rib 0.5 mm thick, the ball R 3 kept 0.25 mm off it. The cusp between two passes: 3 - sqrt(9 -
+// 1) = 171.6 um (the lines read it from below); the lines by the rib, up to the allowance, are
+// counted apart. On an open plate every band line is one the ball reaches.
+TEST(CheckSurface, StockBesideAnObstacleNoBallReachesIsToldApartFromTheCusps) {
+  const TempDir dir;
+  writePlateScene(dir);
+  const std::string open = passes(3, -2, 2, 0);
+  dir.write("open.cl", open);
+  const nlohmann::json plate = check(dir, "open.cl", "plate")["surface"];
+  EXPECT_EQ(plate["unreachable_band_lines"], 0) << plate;
+  EXPECT_EQ(plate["max_reachable_scallop_um"], plate["max_scallop_um"]) << plate;
+
+  geometry::TriangleMesh part, rib;
+  pathgen::test::addBox(part, -10, 30, -15, 15, -5, 0);
+  pathgen::test::addBox(rib, -10, 30, -0.25, 0.25, -1, 5);
+  geometry::saveMesh(part, dir.path() / "part.stl");
+  geometry::saveMesh(rib, dir.path() / "rib.stl");
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: rib.stl\npart: part.stl\n"
+            "tool: { shape: ball, radius: 3, length: 20 }\nclearance: 0.1\n");
+  dir.write("ribbed.cl", passes(2, -5.5, 2, 0) +
+                             "# over the rib\n20 -3.5 8 0 0 1\n0 3.5 8 0 0 1\n" +
+                             passes(2, 3.5, 2, 0));
+  const nlohmann::json s = check(dir, "ribbed.cl", "ribbed")["surface"];
+  const double cusp_um = 1e3 * (3.0 - std::sqrt(9.0 - 1.0));
+  EXPECT_GT(s["max_scallop_um"].get<double>(), 1000.0) << s;  // the stock beside the rib
+  EXPECT_GT(s["unreachable_band_lines"].get<double>(), 0.0) << s;
+  EXPECT_LE(s["max_reachable_scallop_um"].get<double>(), cusp_um + 0.5) << s;
+  EXPECT_GT(s["max_reachable_scallop_um"].get<double>(), 0.9 * cusp_um) << s;
+}
+
 TEST(CheckSurface, ALonePassHasNoScallop) {
   const TempDir dir;
   writePlateScene(dir);
