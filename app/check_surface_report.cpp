@@ -90,7 +90,8 @@ nlohmann::json surfaceJson(const SurfaceResult& s) {
        "along the part's normal), meets an obstacle: stock beside a wall or a rib that no ball "
        "of R reaches, counted in max_scallop_um, not a cusp the passes leave; "
        "max_reachable_scallop_um: the highest band line the ball can touch (null: not told: no "
-       "obstacle, not a ball)"},
+       "obstacle, not a ball, or none among the highest 262144 lines, unreachable_band_lines then "
+       "counting those told)"},
       {"mean_deviation_um", scallop(s.mean_um)},
       {"rms_deviation_um", scallop(s.rms_um)},
       {"stock_allowance_mm", kStockAllowanceMm}};

@@ -377,8 +377,12 @@ void tellUnreachable(SurfaceResult& result, const pathgen::ClearanceChecker& obs
   const double ball_mm = radius_mm - std::min(0.01, 0.01 * radius_mm);
   std::vector<Vec3> centres;
   std::vector<double> clear_mm;
-  for (std::size_t begin = 0, chunk = 256; begin < order.size(); begin += chunk, chunk *= 2) {
-    const std::size_t end = std::min(order.size(), begin + chunk);
+  // At most 2^18 lines told (a second or two of queries): a band wholly under obstacles (a slab
+  // hovering over the part) would have queried every line of it; beyond, not told.
+  constexpr std::size_t kMaxTold = std::size_t{1} << 18;
+  for (std::size_t begin = 0, chunk = 256; begin < std::min(order.size(), kMaxTold);
+       begin += chunk, chunk *= 2) {
+    const std::size_t end = std::min({order.size(), begin + chunk, kMaxTold});
     centres.clear();
     for (std::size_t k = begin; k < end; ++k) {
       const std::size_t i = order[k];
