@@ -4,6 +4,7 @@
 /// keeps them where a handler can read them), end a helper writing outputs, say so in one line
 /// and end the process by the signal; SIGBUS at a mapped input (input_file.h) is one line and
 /// exit 1. Split out of atomic_file.h: the handlers, not the writing.
+#include <poll.h>
 #include <signal.h>
 #include <termios.h>
 #include <unistd.h>
@@ -32,32 +33,47 @@ inline void writeAll(int fd, const char* text) noexcept {
 
 /// The line an interrupted run ends with (a run killed by `timeout` or Ctrl-C said nothing, its
 /// log read as if it had stopped on its own): the signal, and whether the outputs it was to write
-/// were taken away. Not for SIGPIPE (`| head` done reading: nothing to tell). Async-signal-safe.
-inline void sayInterrupted(int signal_number) noexcept {
+/// were taken away (`claimed`). Not for SIGPIPE (`| head` done reading: nothing to tell). Said
+/// after the files are removed, and only where it cannot block: SIGPIPE ignored (a closed stderr
+/// ended the run by SIGPIPE, not by its signal), and not said where stderr takes no bytes now
+/// (poll: a full pipe, `2>&1 | less` not read, or a terminal paused by Ctrl-S held the run in
+/// the handler, its signal blocked there). Async-signal-safe: one write of a line built on the
+/// stack.
+inline void sayInterrupted(int signal_number, bool claimed) noexcept {
   const char* name = signal_number == SIGINT    ? "SIGINT"
                      : signal_number == SIGTERM ? "SIGTERM"
                      : signal_number == SIGHUP  ? "SIGHUP"
                      : signal_number == SIGQUIT ? "SIGQUIT"
                                                 : nullptr;
   if (!name) return;
-  bool claimed = false;
-  for (auto& slot : claimed_slots) claimed = claimed || slot.state.load() == 2;
+  char line[160] = "";
   // On a terminal the progress line may be open (drawn with "\r", no line end): ended first.
   struct termios terminal {};
-  if (::tcgetattr(STDERR_FILENO, &terminal) == 0) writeAll(STDERR_FILENO, "\n");
-  writeAll(STDERR_FILENO, "fieldpath: interrupted by ");
-  writeAll(STDERR_FILENO, name);
-  writeAll(
-      STDERR_FILENO,
-      claimed ? ": its outputs not written, nor an earlier run's left under their names\n" : "\n");
+  if (::tcgetattr(STDERR_FILENO, &terminal) == 0) std::strcat(line, "\n");
+  std::strcat(line, "fieldpath: interrupted by ");
+  std::strcat(line, name);
+  std::strcat(line, claimed ? ": its outputs not written, nor an earlier run's left under their "
+                              "names\n"
+                            : "\n");
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  ::sigaction(SIGPIPE, &ignore, nullptr);
+  // A pipe with room takes a line under PIPE_BUF whole; a stopped terminal reports no room.
+  struct pollfd err {
+    STDERR_FILENO, POLLOUT, 0
+  };
+  if (::poll(&err, 1, 0) == 1 && (err.revents & POLLOUT) != 0) writeAll(STDERR_FILENO, line);
 }
 
 extern "C" inline void removeTemporariesAndDie(int signal_number) {
   if (const pid_t helper = output_helper.load(); helper > 0) ::kill(helper, SIGKILL);
-  sayInterrupted(signal_number);
+  bool claimed = false;
+  for (auto& slot : claimed_slots) claimed = claimed || slot.state.load() == 2;
   removeTemporariesNow();
   removeClaimedOutputsNow();
   removeCreatedDirectoryNow();
+  sayInterrupted(signal_number, claimed);
   ::raise(signal_number);  // SA_RESETHAND restored the default action: die of the signal
 }
 }  // namespace detail
