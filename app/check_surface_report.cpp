@@ -88,10 +88,10 @@ nlohmann::json surfaceJson(const SurfaceResult& s) {
       {"unreachable",
        "band lines above max_reachable_scallop_um where the ball, set on the part (its centre R "
        "along the part's normal), meets an obstacle: stock beside a wall or a rib that no ball "
-       "of R reaches, counted in max_scallop_um, not a cusp the passes leave; "
-       "max_reachable_scallop_um: the highest band line the ball can touch (null: not told: no "
-       "obstacle, not a ball, or none among the highest 262144 lines, unreachable_band_lines then "
-       "counting those told)"},
+       "of R reaches without meeting one, counted in max_scallop_um, not a cusp the passes "
+       "leave; max_reachable_scallop_um: the highest band line the ball can touch (null: none "
+       "can, unreachable_band_lines then band_lines; or not told: no obstacle, not a ball, "
+       "unreachable_band_lines then 0)"},
       {"mean_deviation_um", scallop(s.mean_um)},
       {"rms_deviation_um", scallop(s.rms_um)},
       {"stock_allowance_mm", kStockAllowanceMm}};
@@ -114,6 +114,10 @@ std::string surfaceLine(const SurfaceResult& s) {
                   "; %.1f um where the ball can reach (%zu lines above it lie beside obstacles no "
                   "ball of R reaches)",
                   s.max_reachable_scallop_um, s.unreachable_band_lines);
+  else if (s.unreachable_band_lines > 0)
+    std::snprintf(beside, sizeof beside,
+                  "; no band line where a ball of R can touch the part without meeting an "
+                  "obstacle");
   char line[600];
   std::snprintf(line, sizeof line,
                 "surface: %zu lines in the band, max gouge %.2f um (%zu lines below %.1f um), "
@@ -141,11 +145,13 @@ std::vector<std::string> finishReasons(const SurfaceResult* surface,
   if (surface->band_lines > 0 && measured > *max_scallop_um)
     out.push_back(
         "max scallop " + um(measured) + " um, over --max-scallop " + bound + " um" +
-        (surface->unreachable_band_lines > 0 && !std::isnan(surface->max_reachable_scallop_um)
+        (surface->unreachable_band_lines == 0 ? std::string()
+         : !std::isnan(surface->max_reachable_scallop_um)
              ? " (" + um(surface->max_reachable_scallop_um) + " um where the ball can reach: " +
                    std::to_string(surface->unreachable_band_lines) +
                    " lines above it lie beside obstacles no ball of this radius reaches)"
-             : std::string()));
+             : std::string(" (no band line where a ball of this radius can touch the part "
+                           "without meeting an obstacle)")));
   else if (surface->band_lines > 0 && !std::isfinite(between))
     out.push_back("max scallop " + um(measured) +
                   " um on the lines, a cusp between them on a wall of 85 deg or more not "

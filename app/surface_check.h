@@ -68,8 +68,8 @@ struct SurfaceResult {
   /// there (its centre R along the part's normal, R less 0.01 mm) meeting an obstacle: stock
   /// beside a wall or a rib that no ball of R reaches, not a cusp the passes leave (a mould's
   /// 1994 um "scallop" beside its ribs, its cusps 95 um). `max_reachable_scallop_um`: the highest
-  /// band line the ball can touch; NaN where not told (no obstacles, not a ball, no band line it
-  /// can touch, or none among the highest 2^18).
+  /// band line the ball can touch; NaN where not told (no obstacles, not a ball) or where it can
+  /// touch none (unreachable_band_lines is then band_lines).
   std::size_t unreachable_band_lines = 0;
   double max_reachable_scallop_um = std::numeric_limits<double>::quiet_NaN();
   /// How far the highest cusp may stand above max_scallop_um, µm: a cusp between two cuts of
