@@ -196,16 +196,21 @@ int main(int argc, char** argv) {
       return 1;
     }
     // A usage error is bad input: one line, exit 1 (CLI11's own report adds a second line).
-    // A file named with a leading '-' reads as an option ("scene is required" for
-    // `-scene.yaml`): said, with the way round it.
+    // A file named with a leading '-' where a positional is missing reads as an option ("scene
+    // is required" for `-scene.yaml`): said, with the way round it. Not for an option's value
+    // (`--path -in.cl` is read as a path) nor after `--` (positional there).
     std::string dash_file;
-    for (int i = 1; i < argc && dash_file.empty(); ++i) {
-      std::error_code ec;
-      const std::string arg = argv[i];
-      if (arg.size() > 1 && arg[0] == '-' && arg != "--" &&
-          std::filesystem::is_regular_file(arg, ec))
-        dash_file = arg;
-    }
+    if (std::string(e.what()).find(" is required") != std::string::npos)
+      for (int i = 1; i < argc && dash_file.empty(); ++i) {
+        std::error_code ec;
+        const std::string arg = argv[i];
+        if (arg == "--") break;
+        const bool a_value = i > 1 && std::string(argv[i - 1]).rfind("--", 0) == 0 &&
+                             std::string(argv[i - 1]).find('=') == std::string::npos;
+        if (arg.size() > 1 && arg[0] == '-' && !a_value &&
+            std::filesystem::is_regular_file(arg, ec))
+          dash_file = arg;
+      }
     fieldpath::app::endProgressLine();
     std::fprintf(stderr, "fieldpath: error: %s%s (see --help)\n", oneLine(e.what()).c_str(),
                  dash_file.empty()

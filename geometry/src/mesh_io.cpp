@@ -371,7 +371,7 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
   const std::uintmax_t size = std::filesystem::file_size(file, ec);
   if (ec || size == 0) throw InputError(file.string() + ": empty file");
   if (startsWithByteOrderMark(file, size)) return loadWithoutByteOrderMark(file);
-  detail::checkPly(file, size);
+  const std::uintmax_t ply_crlf_header = detail::checkPly(file, size);
   const StlFeed stl = checkStl(file, size);
   // assimp's scene, our joined copy and the hash that joins them. An STL's triangles are known
   // before it is read: its text (an ASCII one's twice: assimp's buffer; once more where a copy
@@ -407,6 +407,20 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
       if (stl.blank_mark) text.replace(0, 3, 3, ' ');
       scene = importer.ReadFileFromMemory(text.data(), text.size(), aiProcess_ValidateDataStructure,
                                           "stl");
+    } else if (ply_crlf_header > 0) {  // the header's line ends as CRLF (checkPly says why)
+      std::ifstream in(file, std::ios::binary);
+      std::string text(static_cast<std::size_t>(size), '\0');
+      in.read(text.data(), static_cast<std::streamsize>(text.size()));
+      text.resize(static_cast<std::size_t>(in.gcount()));
+      std::string crlf;
+      crlf.reserve(text.size() + 256);
+      for (std::size_t i = 0; i < text.size(); ++i) {
+        if (i < ply_crlf_header && text[i] == '\n' && (i == 0 || text[i - 1] != '\r')) crlf += '\r';
+        crlf += text[i];
+      }
+      text = std::string();
+      scene = importer.ReadFileFromMemory(crlf.data(), crlf.size(), aiProcess_ValidateDataStructure,
+                                          "ply");
     } else {
       scene = importer.ReadFile(file.string(), aiProcess_ValidateDataStructure);
     }

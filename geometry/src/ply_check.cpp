@@ -99,17 +99,17 @@ long long listCount(const unsigned char* bytes, const PlyProperty& property, boo
 /// Walks a binary body from `at` element by element as the header declares it: every list count
 /// read (none negative), every byte within the file. Where it does not fit, assimp read past the
 /// file's end (a SEGV found by CI's smoke fuzz) or took counts from float bytes.
-void walkBinaryBody(const std::filesystem::path& file, std::uintmax_t size, std::uintmax_t at,
-                    const std::vector<PlyElement>& elements, bool big_endian, bool crlf_header) {
+/// Returns the header's bytes where assimp must read it with CRLF line ends (checkPly), else 0.
+std::uintmax_t walkBinaryBody(const std::filesystem::path& file, std::uintmax_t size,
+                              std::uintmax_t at, const std::vector<PlyElement>& elements,
+                              bool big_endian, bool crlf_header) {
   ByteReader reader(file);
   // assimp 5.2 skips a line end after `end_header\n`: a body whose first byte is 0x0A (1 in 256
   // of binary files: the first float's lowest byte) is read one byte late ("no triangles", or
-  // counts from the wrong bytes: a reviewer's file). After `end_header\r\n` it is read right.
-  if (at < size && !crlf_header && *reader.at(at, 1) == '\n')
-    throw InputError(file.string() +
-                     ": binary PLY: its body starts with the byte 0x0A, which assimp 5.2 reads "
-                     "as part of the header's line end and then misreads the file: save it with "
-                     "CRLF header lines, or as STL");
+  // counts from the wrong bytes: a reviewer's file). After `end_header\r\n` it is read right:
+  // the loader is given the header so (a valid file was refused for its first float: a CAM
+  // engineer's shroud).
+  const std::uintmax_t crlf_bytes = at < size && !crlf_header && *reader.at(at, 1) == '\n' ? at : 0;
   // `instance` counted from 0, said from 1.
   const auto cutShort = [&](const PlyElement& element, std::uintmax_t instance) {
     throw InputError(file.string() + ": binary PLY: the body ends inside " + element.name + " " +
@@ -162,6 +162,7 @@ void walkBinaryBody(const std::filesystem::path& file, std::uintmax_t size, std:
                        " byte(s) after the body its header declares, not padding (the header's "
                        "counts are short of the data, or the file was joined with another)");
   }
+  return crlf_bytes;
 }
 
 /// What a mesh needs of the elements, and what assimp would drop without a word (a helper's
@@ -206,12 +207,12 @@ void countAsciiLines(const std::filesystem::path& file, std::ifstream& in, doubl
 /// with properties takes at least one byte), `property TYPE NAME` or `property list TYPE TYPE
 /// NAME` of known types after an element, `comment ...`, `obj_info ...`, and `end_header` alone
 /// on its line. Then the body is checked against it.
-void checkPly(const std::filesystem::path& file, std::uintmax_t size) {
+std::uintmax_t checkPly(const std::filesystem::path& file, std::uintmax_t size) {
   std::ifstream in(file, std::ios::binary);
   char magic[3] = {};
   in.read(magic, 3);
   const bool looks_ply = in.gcount() == 3 && std::string(magic, 3) == "ply";
-  if (!looks_ply && common::lowerExtension(file) != ".ply") return;  // assimp decides
+  if (!looks_ply && common::lowerExtension(file) != ".ply") return 0;  // assimp decides
   in.seekg(0);
   const auto refuse = [&](std::size_t number, const std::string& why) {
     throw InputError(file.string() + ":" + std::to_string(number) + ": PLY header: " + why);
@@ -277,7 +278,10 @@ void checkPly(const std::filesystem::path& file, std::uintmax_t size) {
       if (line != "end_header") refuse(number, "`end_header` must be alone on its line");
       if (!format) refuse(number, "no `format` line");
       checkMeshElements(elements, [&](const std::string& why) { refuse(number, why); });
-      if (ascii) return countAsciiLines(file, in, lines_declared);
+      if (ascii) {
+        countAsciiLines(file, in, lines_declared);
+        return 0;
+      }
       // (No line end after `end_header`: the body starts past the file's end.)
       return walkBinaryBody(file, size, std::min(read, size), elements, big_endian, crlf);
     } else if (word != "comment" && word != "obj_info") {

@@ -135,34 +135,40 @@ TEST(CliField, BuildWritesTheVdbAndReportsNodes) {
 }
 
 // A refined build's share of the dense box is level 0's (the box is of h): all levels' nodes
-// over it read "1532.86 % of the dense box" (a claims audit's).
+// over it read "1532.86 % of the dense box" (a claims audit's). Level 0 is the uniform grid of h:
+// its nodes and share are the uniform build's, run apart.
 TEST(CliField, ARefinedBuildsShareOfTheDenseBoxIsItsFirstLevels) {
   TempDir dir;
   const std::string scene =
       (std::filesystem::path(FIELDPATH_SOURCE_DIR) / "examples/impeller/scene.yaml").string();
-  const Outcome run = runFieldpath(
-      dir, "field build " + scene + " --voxel 1 --refine-tolerance 0.02 --out field.vdb");
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  std::size_t all = 0, first = 0, dense = 0, levels = 0, refined_cells = 0, refined = 0;
-  double percent = 0.0;
-  const std::size_t at = run.out.find("active nodes: ");
-  ASSERT_NE(at, std::string::npos) << run.out;
-  ASSERT_EQ(std::sscanf(run.out.c_str() + at, "active nodes: %zu (level 0 %zu: %lf %%", &all,
-                        &first, &percent),
-            3)
-      << run.out;
-  ASSERT_EQ(std::sscanf(run.out.c_str() + run.out.find("dense-box nodes: "), "dense-box nodes: %zu",
-                        &dense),
-            1);
-  ASSERT_EQ(std::sscanf(run.out.c_str() + run.out.find("levels: "),
-                        "levels: %zu (%zu refined cells, %zu refined nodes)", &levels,
-                        &refined_cells, &refined),
-            3)
-      << run.out;
-  EXPECT_GT(levels, 1u);
-  EXPECT_EQ(first + refined, all);
-  EXPECT_LE(first, dense);
-  EXPECT_NEAR(percent, 100.0 * double(first) / double(dense), 0.01);
+  struct Share {
+    std::size_t all = 0, first = 0;
+    double percent = 0.0;
+  };
+  auto build = [&](const std::string& tolerance) {
+    const Outcome run =
+        runFieldpath(dir, "field build " + scene + " --voxel 1 --refine-tolerance " + tolerance +
+                              " --out field.vdb");
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    Share share;
+    const std::size_t at = run.out.find("active nodes: ");
+    EXPECT_NE(at, std::string::npos) << run.out;
+    if (at == std::string::npos) return share;
+    if (std::sscanf(run.out.c_str() + at, "active nodes: %zu (level 0 %zu: %lf %%", &share.all,
+                    &share.first, &share.percent) != 3) {
+      EXPECT_EQ(std::sscanf(run.out.c_str() + at, "active nodes: %zu (%lf %%", &share.all,
+                            &share.percent),
+                2)
+          << run.out;
+      share.first = share.all;
+    }
+    return share;
+  };
+  const Share refined = build("0.02"), uniform = build("0");
+  EXPECT_GT(refined.all, refined.first);  // refined
+  EXPECT_EQ(refined.first, uniform.all);
+  EXPECT_EQ(refined.percent, uniform.percent);
+  EXPECT_LE(refined.percent, 100.0);
 }
 
 TEST(CliField, BadInputExitsOneWithOneLine) {
@@ -256,4 +262,9 @@ TEST(CliField, AnUnknownCommandIsNamed) {
             std::string::npos)
       << dashed.err;
   EXPECT_EQ(runFieldpath(dir, "field build ./-scene.yaml --voxel 1 --out f.vdb").exit_code, 0);
+  // Not for an option's value, read as one, beside another mistake (a review's: `--path -in.cl`
+  // and a bad --spacing were told to rename the path).
+  const Outcome other = runFieldpath(dir, "field build scene.yaml --out -scene.yaml --voxel 0");
+  EXPECT_EQ(other.exit_code, 1);
+  EXPECT_EQ(other.err.find("reads as an option"), std::string::npos) << other.err;
 }

@@ -317,19 +317,36 @@ inline void writeFileAtomically(const std::filesystem::path& given,
         created = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
         if (created < 0 && errno != EEXIST) break;
       }
+#if !FIELDPATH_HAS_STDIO_FILEBUF  // another standard library (libc++): opened again by name
+      std::ofstream file;
+      if (created >= 0) {
+        ::close(created);
+        file.open(tmp, mode | std::ios::trunc);  // (still bracketed against the handler's sweep)
+        if (!file) created = -1;
+      }
+#endif
       detail::endCreating(listing.slot);
       if (created < 0)
         throw InputError(path.string() + ": cannot open for writing: " +
                          detail::systemReason(errno));
+#if FIELDPATH_HAS_STDIO_FILEBUF
       __gnu_cxx::stdio_filebuf<char> file(created, mode | std::ios::out);  // closes `created`
       std::ostream out(&file);
+#else
+      std::ostream& out = file;
+#endif
       errno = 0;
       write(out);
       out.flush();
       if (!out)
         throw InputError(path.string() + ": cannot write: " +
                          detail::writeReason(errno, path.parent_path()));
+#if FIELDPATH_HAS_STDIO_FILEBUF
       if (!file.close())
+#else
+      file.close();
+      if (file.fail())
+#endif
         throw InputError(path.string() + ": cannot write: " +
                          detail::writeReason(errno, path.parent_path()));
     }
