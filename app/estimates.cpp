@@ -168,7 +168,13 @@ void checkSceneSize(const Scene& scene) {
     if (scene.field.r0_mm > limit)
       throw InputError(where + "field.r0: " + fmt(scene.field.r0_mm) +
                        " mm exceeds the obstacles' extent plus the tool's reach (" + fmt(limit) +
-                       " mm): every sample would act on every node at a cost growing as r0^3");
+                       " mm): every sample would act on every node at a cost growing as r0^3" +
+                       // A scene written in metres lands here first (a blisk in metres read as a
+                       // field.r0 its user never set).
+                       (box.diagonal() < 1.0 ? "; the obstacles span " + fmt(box.diagonal()) +
+                                                   " mm: is the scene in metres? every length is "
+                                                   "read in millimetres"
+                                             : std::string()));
   }
 
   // Lengths are millimetres: a scene written in metres (a tool radius of 0.003) ran for minutes

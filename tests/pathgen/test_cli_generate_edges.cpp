@@ -126,6 +126,19 @@ TEST(GenerateEdges, ASceneInMetresIsSaid) {
     ASSERT_EQ(r.exit_code, 0) << r.output();
     EXPECT_EQ(r.err.find("is the scene in metres?") != std::string::npos, scale < 0.01) << r.err;
   }
+  // Metres with field.r0 left at its 5 mm: refused for r0, and the refusal asks about the units
+  // (it named only field.r0, which its user never set: a blisk in metres).
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 0.003, length: 0.04 }\n");
+  geometry::TriangleMesh wall;
+  pathgen::test::addBox(wall, 0.01, 0.012, -0.02, 0.02, -0.005, 0.02);
+  geometry::saveMesh(wall, dir.path() / "wall.stl");
+  const auto r = test::runFieldpath(dir, "field probe scene.yaml --points points.txt --direct");
+  EXPECT_EQ(r.exit_code, 1) << r.output();
+  EXPECT_NE(r.err.find("field.r0: 5 mm exceeds"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("is the scene in metres? every length is read in millimetres"),
+            std::string::npos)
+      << r.err;
 }
 
 // A field-only scene (no `tool:`) that spans 0.1 mm: the note names the obstacles' span, not the
