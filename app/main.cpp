@@ -196,17 +196,24 @@ int main(int argc, char** argv) {
       return 1;
     }
     // A usage error is bad input: one line, exit 1 (CLI11's own report adds a second line).
-    // A file named with a leading '-' where a positional is missing reads as an option ("scene
-    // is required" for `-scene.yaml`): said, with the way round it. Not for an option's value
-    // (`--path -in.cl` is read as a path) nor after `--` (positional there).
+    // A file named with a leading '-' where a positional is missing ("scene is required", not
+    // "--path is required": `./` helps the first only) reads as an option: said, with the way
+    // round it. Not for an option's value (`--path -in.cl` is read as a path; a flag such as
+    // --fail-unsafe takes none) nor after `--` (positional there).
     std::string dash_file;
-    if (std::string(e.what()).find(" is required") != std::string::npos)
+    const std::string what = e.what();
+    const std::size_t required = what.find(" is required");
+    if (required != std::string::npos && required > 0 && what[0] != '-')
       for (int i = 1; i < argc && dash_file.empty(); ++i) {
         std::error_code ec;
-        const std::string arg = argv[i];
+        const std::string arg = argv[i], before = i > 1 ? argv[i - 1] : "";
         if (arg == "--") break;
-        const bool a_value = i > 1 && std::string(argv[i - 1]).rfind("--", 0) == 0 &&
-                             std::string(argv[i - 1]).find('=') == std::string::npos;
+        const CLI::Option* option =
+            before.rfind("--", 0) == 0 && before.find('=') == std::string::npos
+                ? at->get_option_no_throw(before)
+                : nullptr;
+        if (!option && before.rfind("--", 0) == 0) option = app.get_option_no_throw(before);
+        const bool a_value = option && option->get_expected_min() > 0;
         if (arg.size() > 1 && arg[0] == '-' && !a_value &&
             std::filesystem::is_regular_file(arg, ec))
           dash_file = arg;

@@ -267,4 +267,13 @@ TEST(CliField, AnUnknownCommandIsNamed) {
   const Outcome other = runFieldpath(dir, "field build scene.yaml --out -scene.yaml --voxel 0");
   EXPECT_EQ(other.exit_code, 1);
   EXPECT_EQ(other.err.find("reads as an option"), std::string::npos) << other.err;
+  // Nor where a required option is missing (`./` would not help: --points is required); said
+  // after a flag, which takes no value (--quiet read as waiting for one hid the hint).
+  const Outcome option = runFieldpath(dir, "field probe scene.yaml -scene.yaml");
+  EXPECT_EQ(option.exit_code, 1);
+  EXPECT_EQ(option.err.find("reads as an option"), std::string::npos) << option.err;
+  const Outcome after_flag =
+      runFieldpath(dir, "field build --quiet -scene.yaml --voxel 1 --out f.vdb");
+  EXPECT_NE(after_flag.err.find("'-scene.yaml' reads as an option"), std::string::npos)
+      << after_flag.err;
 }

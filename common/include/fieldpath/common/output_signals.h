@@ -34,11 +34,11 @@ inline void writeAll(int fd, const char* text) noexcept {
 /// The line an interrupted run ends with (a run killed by `timeout` or Ctrl-C said nothing, its
 /// log read as if it had stopped on its own): the signal, and whether the outputs it was to write
 /// were taken away (`claimed`). Not for SIGPIPE (`| head` done reading: nothing to tell). Said
-/// after the files are removed, and only where it cannot block: SIGPIPE ignored (a closed stderr
-/// ended the run by SIGPIPE, not by its signal), and not said where stderr takes no bytes now
-/// (poll: a full pipe, `2>&1 | less` not read, or a terminal paused by Ctrl-S held the run in
-/// the handler, its signal blocked there). Async-signal-safe: one write of a line built on the
-/// stack.
+/// after the files are removed, and only where it cannot block: SIGPIPE and SIGTTOU ignored (a
+/// closed stderr ended the run by SIGPIPE, not by its signal), and not said where stderr takes no
+/// bytes now (poll: a full pipe, `2>&1 | less` not read, or a terminal paused by Ctrl-S held the
+/// run in the handler, its signal blocked there). Async-signal-safe: one write of a line built on
+/// the stack.
 inline void sayInterrupted(int signal_number, bool claimed) noexcept {
   const char* name = signal_number == SIGINT    ? "SIGINT"
                      : signal_number == SIGTERM ? "SIGTERM"
@@ -55,10 +55,13 @@ inline void sayInterrupted(int signal_number, bool claimed) noexcept {
   std::strcat(line, claimed ? ": its outputs not written, nor an earlier run's left under their "
                               "names\n"
                             : "\n");
+  // SIGTTOU ignored too: a background run on a terminal set to `stty tostop` was stopped by the
+  // line's write, not ended by its signal (a review's); ignored, the write is let through.
   struct sigaction ignore {};
   ignore.sa_handler = SIG_IGN;
   sigemptyset(&ignore.sa_mask);
   ::sigaction(SIGPIPE, &ignore, nullptr);
+  ::sigaction(SIGTTOU, &ignore, nullptr);
   // A pipe with room takes a line under PIPE_BUF whole; a stopped terminal reports no room.
   struct pollfd err {
     STDERR_FILENO, POLLOUT, 0
