@@ -350,9 +350,10 @@ inline std::string cutterGougeReason(const geometry::PathFile& path,
 inline nlohmann::json rotaryJson(const pathgen::RotaryStray& s, double reach_mm) {
   return {{"assumes",
            "a post that writes (tilt >= 0 from z, C about z) angles, each interpolated linearly "
-           "(A/C, B/C machines), against the tool vector on the great circle at an even pace; an "
-           "upper bound of how far the tool may move from the checked one "
-           "(Fanuc G43.5, Siemens ORIVECT, Heidenhain LN), the same instant, at the tool's reach"},
+           "(A/C, B/C machines), against the tool vector on the great circle at an even pace "
+           "(Fanuc G43.5, Siemens ORIVECT, Heidenhain LN): how far the tool moves from the "
+           "checked one at the same instant, at the tool's reach (no point of the tool moves "
+           "more), sampled along each motion (within about a micrometre of its largest)"},
           {"reach_mm", reach_mm},
           {"max_stray_mm", s.max_offset_mm},
           {"max_stray_motion", jsonIndex(s.max_at)},
