@@ -134,7 +134,10 @@ class ClearanceChecker {
   /// bound at or above it). With `split_mm` finite (over exact_below_mm) each centre is told
   /// exactly nearer or farther than split_mm, its value a lower bound between the two (a centre
   /// proven nearer by its walk, d + |c - c_measured| - R under split_mm, is not measured: a path
-  /// hovering 1.5 mm over a part, told against 6 mm, checked as fast as one on it).
+  /// hovering 1.5 mm over a part, told against 6 mm, checked as fast as one on it). With
+  /// exact_below_mm = -radius_mm and split_mm = 0 a centre is told only touching (0) or clear
+  /// (> 0), each measured one telling its neighbours within min(d, R - d) and beyond d - R
+  /// (check's stock beside obstacles).
   double ballClearance(std::span<const Vec3> centres_mm, double radius_mm,
                        std::size_t* at = nullptr, int* obstacle = nullptr,
                        double exact_below_mm = std::numeric_limits<double>::infinity(),
