@@ -26,6 +26,12 @@ namespace {
 using geometry::Vec3;
 using Vec2 = Eigen::Vector2d;
 
+/// The centre of line `i` of `grid` (row-major), mm.
+Vec2 lineAt(const zbuffer::Grid& grid, std::size_t i) {
+  return Vec2(grid.x0_mm + (double(i % grid.nx) + 0.5) * grid.dx_mm,
+              grid.y0_mm + (double(i / grid.nx) + 0.5) * grid.dy_mm);
+}
+
 /// How far a line's deviation `scallop_um` may lie under a cusp's within spacing/√2 of it
 /// (µm), for lines `spacing_mm` apart, a cutting edge of curvature radius `edge_mm` and the
 /// part's upward normal `n` there (SurfaceResult::scallop_grid_error_um). A cusp of height h
@@ -387,8 +393,7 @@ void tellUnreachable(SurfaceResult& result, const pathgen::ClearanceChecker& obs
     std::sort(lines.begin(), lines.end());  // the grid's order: neighbours follow each other
     centres.clear();
     for (const std::size_t i : lines) {
-      const Vec2 at(grid.x0_mm + (i % grid.nx + 0.5) * grid.dx_mm,
-                    grid.y0_mm + (i / grid.nx + 0.5) * grid.dy_mm);
+      const Vec2 at = lineAt(grid, i);
       const Vec3 on_part(at.x(), at.y(), double(top[i]) + z0_mm);
       centres.push_back(on_part + radius_mm * partNormal(grid, top, at));
     }
@@ -477,10 +482,6 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request, const S
   result.lowered.assign(sim.grid.lineCount(), 0);
   for (std::size_t i = 0; i < result.lowered.size(); ++i)
     result.lowered[i] = simulated.heights_mm[i] < sim.initial_heights_mm[i];
-  const auto lineAt = [&](std::size_t i) {
-    return Vec2(world_grid.x0_mm + (i % world_grid.nx + 0.5) * world_grid.dx_mm,
-                world_grid.y0_mm + (i / world_grid.nx + 0.5) * world_grid.dy_mm);
-  };
   // The surface each line is measured against: the part's top, or, where the tool passed
   // beneath the top's layer (under an overhang), the top of what lies under it (the Z-buffer
   // keeps a line's lowest tool point only: under an overhang it is no cut of the overhang,
@@ -537,7 +538,7 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request, const S
     sum += d;
     sum2 += d * d;
     max_dev = std::max(max_dev, d);
-    const Vec2 at = lineAt(i);
+    const Vec2 at = lineAt(world_grid, i);
     const double bound_um =
         scallopGridErrorUm(vertical_um, spacing_mm, edge_mm, partNormal(world_grid, reference, at));
     highest_cusp = std::max(highest_cusp, (vertical_um + bound_um) * cos_slope);
