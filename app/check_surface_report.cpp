@@ -97,6 +97,25 @@ nlohmann::json surfaceJson(const SurfaceResult& s) {
       {"stock_allowance_mm", kStockAllowanceMm}};
 }
 
+namespace {
+
+/// What the summary and the --max-scallop reason add of the stock no ball reaches (empty where
+/// none was told).
+std::string unreachableText(const SurfaceResult& s) {
+  if (s.unreachable_band_lines == 0) return {};
+  if (std::isnan(s.max_reachable_scallop_um))
+    return "no band line where a ball of this radius can touch the part without meeting an "
+           "obstacle";
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "%.1f um where the ball can reach: %zu lines above it lie beside obstacles no "
+                "ball of this radius reaches",
+                s.max_reachable_scallop_um, s.unreachable_band_lines);
+  return text;
+}
+
+}  // namespace
+
 std::string surfaceLine(const SurfaceResult& s) {
   char scallop[160] = "no scallop (no two neighbouring passes)";
   if (s.band_lines > 0 && std::isfinite(s.scallop_grid_error_um))
@@ -108,22 +127,14 @@ std::string surfaceLine(const SurfaceResult& s) {
                   "max scallop %.1f um (a cusp between the lines on a wall of 85 deg or more: not "
                   "bounded), rms %.1f um",
                   s.max_scallop_um, s.rms_um);
-  char beside[200] = "";
-  if (s.unreachable_band_lines > 0 && !std::isnan(s.max_reachable_scallop_um))
-    std::snprintf(beside, sizeof beside,
-                  "; %.1f um where the ball can reach (%zu lines above it lie beside obstacles no "
-                  "ball of R reaches)",
-                  s.max_reachable_scallop_um, s.unreachable_band_lines);
-  else if (s.unreachable_band_lines > 0)
-    std::snprintf(beside, sizeof beside,
-                  "; no band line where a ball of R can touch the part without meeting an "
-                  "obstacle");
+  const std::string unreachable = unreachableText(s);
+  const std::string beside = unreachable.empty() ? "" : "; " + unreachable;
   char line[600];
   std::snprintf(line, sizeof line,
                 "surface: %zu lines in the band, max gouge %.2f um (%zu lines below %.1f um), "
                 "%s%s (%s, %.2f s)",
                 s.band_lines, s.max_gouge_um, s.gouged_lines, -s.gouge_tolerance_um, scallop,
-                beside, zbuffer::backendName(s.backend), s.simulation_s);
+                beside.c_str(), zbuffer::backendName(s.backend), s.simulation_s);
   return line;
 }
 
@@ -145,13 +156,7 @@ std::vector<std::string> finishReasons(const SurfaceResult* surface,
   if (surface->band_lines > 0 && measured > *max_scallop_um)
     out.push_back(
         "max scallop " + um(measured) + " um, over --max-scallop " + bound + " um" +
-        (surface->unreachable_band_lines == 0 ? std::string()
-         : !std::isnan(surface->max_reachable_scallop_um)
-             ? " (" + um(surface->max_reachable_scallop_um) + " um where the ball can reach: " +
-                   std::to_string(surface->unreachable_band_lines) +
-                   " lines above it lie beside obstacles no ball of this radius reaches)"
-             : std::string(" (no band line where a ball of this radius can touch the part "
-                           "without meeting an obstacle)")));
+        (unreachableText(*surface).empty() ? "" : " (" + unreachableText(*surface) + ")"));
   else if (surface->band_lines > 0 && !std::isfinite(between))
     out.push_back("max scallop " + um(measured) +
                   " um on the lines, a cusp between them on a wall of 85 deg or more not "

@@ -33,6 +33,15 @@
 namespace fieldpath::geometry {
 namespace {
 
+/// The first `bytes` of `file` (fewer where it is shorter), for assimp to read from memory.
+std::string firstBytes(const std::filesystem::path& file, std::uintmax_t bytes) {
+  std::ifstream in(file, std::ios::binary);
+  std::string text(static_cast<std::size_t>(bytes), '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  return text;
+}
+
 /// What reading an STL takes beyond its text: bytes a triangle, and once (the importer's own),
 /// over the worst measured, a soup of separate triangles whose every corner is a vertex (peaks
 /// over the program: 30 MiB for 50 k triangles, 113 MiB for 200 k, 445 MiB for 1 M; a welded
@@ -398,28 +407,17 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
     // (ai_assert in Triangulate) or crash on malformed files (found by tests/fuzz fuzz_mesh), so
     // polygons are split and node transforms applied below, with every index checked.
     if (stl.copy) {  // its solids or triangles only; lower case where asked (keywords, exponents)
-      std::ifstream in(file, std::ios::binary);
-      std::string text(static_cast<std::size_t>(stl.length), '\0');
-      in.read(text.data(), static_cast<std::streamsize>(text.size()));
-      text.resize(static_cast<std::size_t>(in.gcount()));
+      std::string text = firstBytes(file, stl.length);
       if (stl.lower)
         text = common::lowerCase(std::move(text));
       if (stl.blank_mark) text.replace(0, 3, 3, ' ');
       scene = importer.ReadFileFromMemory(text.data(), text.size(), aiProcess_ValidateDataStructure,
                                           "stl");
     } else if (ply_crlf_header > 0) {  // the header's line ends as CRLF (checkPly says why)
-      std::ifstream in(file, std::ios::binary);
-      std::string text(static_cast<std::size_t>(size), '\0');
-      in.read(text.data(), static_cast<std::streamsize>(text.size()));
-      text.resize(static_cast<std::size_t>(in.gcount()));
-      std::string crlf;
-      crlf.reserve(text.size() + 256);
-      for (std::size_t i = 0; i < text.size(); ++i) {
-        if (i < ply_crlf_header && text[i] == '\n' && (i == 0 || text[i - 1] != '\r')) crlf += '\r';
-        crlf += text[i];
-      }
-      text = std::string();
-      scene = importer.ReadFileFromMemory(crlf.data(), crlf.size(), aiProcess_ValidateDataStructure,
+      std::string text = firstBytes(file, size);
+      for (std::size_t i = static_cast<std::size_t>(ply_crlf_header); i-- > 0;)
+        if (text[i] == '\n' && (i == 0 || text[i - 1] != '\r')) text.insert(i, 1, '\r');
+      scene = importer.ReadFileFromMemory(text.data(), text.size(), aiProcess_ValidateDataStructure,
                                           "ply");
     } else {
       scene = importer.ReadFile(file.string(), aiProcess_ValidateDataStructure);
