@@ -306,10 +306,24 @@ using CellList = UninitVector<CellIjk>;
 CellList cellsWithValues(const Level& level);
 
 /// Origins (index space) of the leaves of a level of size h within reach_mm of a sample and
-/// inside `reach` (the region's box), sorted (voxel_leaves.cpp).
-std::vector<openvdb::Coord> candidateLeaves(const ObstacleSamples& samples,
-                                            const Eigen::AlignedBox3d& reach, double h,
-                                            double reach_mm);
+/// inside `reach` (the region's box), sorted (voxel_leaves.cpp). Stops once more than
+/// `max_leaves` are found (`more` set, `origins` then incomplete), its own list held to about
+/// twice that: a grid far finer than memory allows is refused from its leaves' count, not after
+/// listing them all.
+struct LeafCandidates {
+  std::vector<openvdb::Coord> origins;
+  bool more = false;         ///< more than max_leaves
+  std::size_t at_least = 0;  ///< with `more`: how many were found before the search stopped
+};
+LeafCandidates candidateLeaves(const ObstacleSamples& samples, const Eigen::AlignedBox3d& reach,
+                               double h, double reach_mm, std::size_t max_leaves = std::size_t(-1));
+/// Bytes a level holds at most when it has the leaves at `origins` (sorted candidateLeaves, all
+/// of them made before the prune): the value and closeness trees (leaves, their buffers and
+/// internal nodes, from the parents the origins have), the block index and the blocks
+/// (Level::memUsage's parts), from the types' sizes (voxel_leaves.cpp).
+double levelBytesBound(const std::vector<openvdb::Coord>& origins, bool ratio);
+/// Bytes a level's leaf costs at least in levelBytesBound (its share without internal nodes).
+double levelBytesPerLeaf(bool ratio);
 /// Adds a level's leaves (made apart, in parallel) to its tree, which takes them: grouped by
 /// their parent nodes, each parent filled by one task (voxel_leaves.cpp).
 void addLeaves(std::vector<std::unique_ptr<Leaf>>& made, Grid::TreeType& tree);

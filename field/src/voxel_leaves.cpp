@@ -3,6 +3,7 @@
 /// made from a level's leaves, and the nodes of the halves of a level's split cells. Split out
 /// of voxel_build.cpp.
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -118,14 +119,15 @@ namespace voxel {
 /// region's box), sorted. Marked on a byte per leaf of that box (a sample touches ~60 leaves:
 /// a list of them all, sorted and made unique, cost more than the uniform grid's nodes on the
 /// GPU), or listed and sorted where the box has too many leaves.
-std::vector<openvdb::Coord> candidateLeaves(const ObstacleSamples& samples,
-                                            const Eigen::AlignedBox3d& reach, double h,
-                                            double reach_mm) {
-  std::vector<openvdb::Coord> origins;
-  if (reach.isEmpty()) return origins;
+LeafCandidates candidateLeaves(const ObstacleSamples& samples, const Eigen::AlignedBox3d& reach,
+                               double h, double reach_mm, std::size_t max_leaves) {
+  LeafCandidates found;
+  std::vector<openvdb::Coord>& origins = found.origins;
+  if (reach.isEmpty()) return found;
   const Vec3 lo_region = reach.min() / h, hi_region = reach.max() / h;
   const double leaf_mm = kLeafDim * h;
-  // Calls hit(i, j, k) for each leaf origin within reach of q (inside the region).
+  // Calls hit(i, j, k) for each leaf origin within reach of q (inside the region) while it
+  // returns true.
   auto leavesNear = [&](const Vec3& q, auto&& hit) {
     const Vec3 lo = ((q.array() - reach_mm) / h).max(lo_region.array()).ceil();
     const Vec3 hi = ((q.array() + reach_mm) / h).min(hi_region.array()).floor();
@@ -139,11 +141,28 @@ std::vector<openvdb::Coord> candidateLeaves(const ObstacleSamples& samples,
           // Distance from q to the leaf's node box.
           const Vec3 box_lo = Vec3(i, j, k) * h;
           const Vec3 nearest = q.cwiseMax(box_lo).cwiseMin(box_lo + Vec3::Constant(leaf_mm - h));
-          if ((nearest - q).squaredNorm() < reach_mm * reach_mm) hit(i, j, k);
+          if ((nearest - q).squaredNorm() < reach_mm * reach_mm && !hit(i, j, k)) return;
         }
   };
   const Vec3 lo_all = lo_region.array().ceil(), hi_all = hi_region.array().floor();
-  if ((lo_all.array() > hi_all.array()).any()) return origins;
+  if ((lo_all.array() > hi_all.array()).any()) return found;
+  // The leaves one sample has at least (those holding a node of the cube inscribed in its
+  // ball): more than max_leaves refused before listing any (a sample at a grid of 0.1 um walked
+  // 1e8 leaf positions of its ball's box before its first ones came).
+  const double inscribed = reach_mm / std::sqrt(3.0) * (1.0 - 1e-9);
+  for (const Vec3& q : samples.points_mm) {
+    const Vec3 lo = ((q.array() - inscribed) / h).max(lo_all.array()).ceil();
+    const Vec3 hi = ((q.array() + inscribed) / h).min(hi_all.array()).floor();
+    double leaves = 1.0;
+    for (int a = 0; a < 3; ++a)
+      leaves *=
+          lo[a] > hi[a] ? 0.0 : std::floor(hi[a] / kLeafDim) - std::floor(lo[a] / kLeafDim) + 1.0;
+    if (leaves > double(max_leaves)) {
+      found.more = true;
+      found.at_least = std::size_t(std::min(leaves, 1e18));
+      return found;
+    }
+  }
   const openvdb::Coord box_lo =
       openvdb::Coord(int(lo_all.x()), int(lo_all.y()), int(lo_all.z())) & ~(kLeafDim - 1);
   const openvdb::Coord box_hi =
@@ -152,30 +171,131 @@ std::vector<openvdb::Coord> candidateLeaves(const ObstacleSamples& samples,
                           (box_hi.y() - box_lo.y()) / kLeafDim + 1,
                           (box_hi.z() - box_lo.z()) / kLeafDim + 1);
   const double box_leaves = double(dim.x()) * dim.y() * dim.z();
-  if (box_leaves > double(kDenseIndexMax)) {
-    for (const Vec3& q : samples.points_mm)
-      leavesNear(q, [&](int i, int j, int k) { origins.emplace_back(i, j, k); });
+  auto compact = [&origins] {
     std::sort(origins.begin(), origins.end());
     origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
-    return origins;
+  };
+  if (box_leaves > double(kDenseIndexMax)) {
+    // Listed, and made unique whenever the list passes twice the most wanted: past max_leaves
+    // unique ones the search stops (within a sample too: one may reach millions of leaves).
+    const std::size_t compact_at = std::max<std::size_t>(
+        std::size_t{1} << 16,
+        max_leaves > (std::size_t(-1) >> 2) ? std::size_t(-1) : 2 * max_leaves);
+    for (const Vec3& q : samples.points_mm) {
+      leavesNear(q, [&](int i, int j, int k) {
+        origins.emplace_back(i, j, k);
+        if (origins.size() > compact_at) {
+          compact();
+          found.more = origins.size() > max_leaves;
+        }
+        return !found.more;
+      });
+      if (found.more) break;
+    }
+    compact();
+    found.more = origins.size() > max_leaves;
+    if (found.more) found.at_least = origins.size();
+    return found;
   }
   std::vector<std::uint8_t> near(std::size_t(box_leaves), 0);
   auto at = [&](int i, int j, int k) {
     return (std::size_t((i - box_lo.x()) / kLeafDim) * dim.y() + (j - box_lo.y()) / kLeafDim) *
                dim.z() + (k - box_lo.z()) / kLeafDim;
   };
-  // The samples in parallel: a leaf's byte may be set by several threads (the same 1).
+  // The samples in parallel: a leaf's byte may be set by several threads (the same 1); the
+  // leaves set first counted, the samples left skipped once more than max_leaves are (a grid far
+  // finer than memory allows: a sample alone may reach millions of leaves).
+  std::atomic<std::size_t> marked{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, samples.size(), 256), [&](const auto& r) {
-    for (std::size_t s = r.begin(); s != r.end(); ++s)
+    for (std::size_t s = r.begin(); s != r.end(); ++s) {
+      if (marked.load(std::memory_order_relaxed) > max_leaves) return;
+      std::size_t fresh = 0;
       leavesNear(samples.points_mm[s], [&](int i, int j, int k) {
-        std::atomic_ref<std::uint8_t>(near[at(i, j, k)]).store(1, std::memory_order_relaxed);
+        fresh += std::atomic_ref<std::uint8_t>(near[at(i, j, k)])
+                     .exchange(1, std::memory_order_relaxed) == 0;
+        return true;
       });
+      marked.fetch_add(fresh, std::memory_order_relaxed);
+    }
   });
+  if (marked.load() > max_leaves) {
+    found.more = true;
+    found.at_least = marked.load();
+    return found;
+  }
   for (int i = box_lo.x(); i <= box_hi.x(); i += kLeafDim)  // sorted: x, then y, then z
     for (int j = box_lo.y(); j <= box_hi.y(); j += kLeafDim)
       for (int k = box_lo.z(); k <= box_hi.z(); k += kLeafDim)
         if (near[at(i, j, k)]) origins.emplace_back(i, j, k);
-  return origins;
+  return found;
+}
+
+namespace {
+
+/// Malloc's bookkeeping a heap block, at most (glibc: 16 bytes on 64 bits; rounded up).
+constexpr double kHeapBlockBytes = 32.0;
+
+/// How many distinct coordinates `coords` has once each is masked to its parent of span 2^log2.
+std::size_t distinctParents(std::vector<openvdb::Coord> coords, int log2) {
+  const int mask = ~((1 << log2) - 1);
+  for (openvdb::Coord& c : coords) c = openvdb::Coord(c.x() & mask, c.y() & mask, c.z() & mask);
+  std::sort(coords.begin(), coords.end());
+  return std::size_t(std::unique(coords.begin(), coords.end()) - coords.begin());
+}
+
+/// Bytes of a tree whose leaves have the origins `leaves` (index space of the tree): each leaf
+/// (its node, its buffer on the heap), the internal nodes above them and the root's entries.
+template <class TreeT>
+double treeBytesBound(const std::vector<openvdb::Coord>& leaves) {
+  using LeafT = typename TreeT::LeafNodeType;
+  using Node2 = typename TreeT::RootNodeType::ChildNodeType;
+  using Node1 = typename Node2::ChildNodeType;
+  const double leaf = double(sizeof(LeafT)) + kHeapBlockBytes +
+                      double(LeafT::SIZE) * sizeof(typename LeafT::ValueType) + kHeapBlockBytes;
+  const std::size_t n1 = distinctParents(leaves, int(Node1::TOTAL));
+  const std::size_t n2 = distinctParents(leaves, int(Node2::TOTAL));
+  // A root entry: a std::map node holding the child's pointer and its tile (~64 bytes).
+  return double(leaves.size()) * leaf + double(n1) * (sizeof(Node1) + kHeapBlockBytes) +
+         double(n2) * (sizeof(Node2) + kHeapBlockBytes + 64.0) + double(sizeof(TreeT));
+}
+
+/// A leaf's block (makeBlocks): 9³ entries, its flags, the leaf's pointer and its state.
+double blockBytes() {
+  return double(kBlockNodes) * sizeof(std::array<float, 4>) + 8.0 * (kBlockWords + kCellWords) +
+         sizeof(const Leaf*) + 1.0;
+}
+
+}  // namespace
+
+double levelBytesPerLeaf(bool ratio) {
+  const double value_leaf = double(sizeof(Leaf)) + Leaf::SIZE * sizeof(Leaf::ValueType);
+  const double closeness_leaf =
+      ratio ? double(sizeof(FloatLeaf)) + FloatLeaf::SIZE * sizeof(float) : 0.0;
+  return value_leaf + closeness_leaf + blockBytes();
+}
+
+double levelBytesBound(const std::vector<openvdb::Coord>& origins, bool ratio) {
+  double bytes = treeBytesBound<Grid::TreeType>(origins);
+  if (ratio) bytes += treeBytesBound<FloatGrid::TreeType>(origins);
+  // The block index (makeBlocks): an int a leaf coordinate (origin >> 3), as a tree, and as a
+  // dense array over their box where that is small enough.
+  std::vector<openvdb::Coord> index_leaves(origins.size());
+  openvdb::CoordBBox box;
+  for (std::size_t l = 0; l < origins.size(); ++l) {
+    const openvdb::Coord c = origins[l] >> 3;
+    box.expand(c);
+    const int m = ~(int(IndexGrid::TreeType::LeafNodeType::DIM) - 1);
+    index_leaves[l] = openvdb::Coord(c.x() & m, c.y() & m, c.z() & m);
+  }
+  std::sort(index_leaves.begin(), index_leaves.end());
+  index_leaves.erase(std::unique(index_leaves.begin(), index_leaves.end()), index_leaves.end());
+  bytes += treeBytesBound<IndexGrid::TreeType>(index_leaves);
+  if (!origins.empty()) {
+    const openvdb::Coord dim = box.dim();
+    const double entries = double(dim.x()) * dim.y() * dim.z();
+    if (entries <= double(kDenseIndexMax)) bytes += entries * sizeof(std::int32_t);
+  }
+  return bytes + double(origins.size()) * blockBytes() + 4.0 * kHeapBlockBytes;
 }
 
 namespace {

@@ -128,7 +128,7 @@ TEST(CliField, BuildWritesTheVdbAndReportsNodes) {
         runFieldpath(dir, std::string("field build scene.yaml --voxel 0.01 --max-memory ") + limit +
                               " --out big.vdb");
     EXPECT_EQ(refused.exit_code, 1);
-    EXPECT_NE(refused.err.find("estimated"), std::string::npos) << refused.err;
+    EXPECT_NE(refused.err.find("candidate leaves hold"), std::string::npos) << refused.err;
     EXPECT_EQ(lines(refused.err), 1u) << refused.err;
     EXPECT_FALSE(std::filesystem::exists(dir.path() / "big.vdb"));
   }

@@ -157,7 +157,7 @@ TEST(Voxel, EstimateIsTheSameOnTheDenseBitmapAndTheSparseMask) {
   }
 }
 
-TEST(Voxel, RefusesBeyondTheMemoryLimitWithTheEstimate) {
+TEST(Voxel, RefusesBeyondTheMemoryLimitFromTheLeavesItWouldMake) {
   const DirectField direct = cubeField(FieldParams{});
   VoxelRequest r = request(0.01);
   r.max_memory_bytes = std::size_t{1} << 30;
@@ -166,10 +166,24 @@ TEST(Voxel, RefusesBeyondTheMemoryLimitWithTheEstimate) {
     FAIL() << "expected a refusal";
   } catch (const fieldpath::common::InputError& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("estimated"), std::string::npos) << what;
-    EXPECT_NE(what.find(std::to_string(estimateVoxelNodes(direct.samples(), FieldParams{}, r))),
-              std::string::npos)
-        << what;
+    EXPECT_NE(what.find("candidate leaves hold more than"), std::string::npos) << what;
+  }
+  // The refusal's bytes bound the level as built and are close to it: a grid refused under
+  // its own bytes, built above them by 10 % (the node estimate was 1.1-1.9 times the nodes;
+  // refused on it, a grid of 0.84 GB was refused under 2.5 GB).
+  for (StoredQuantity stored : {StoredQuantity::Force, StoredQuantity::PlaneRatio}) {
+    const VoxelRequest open = request(0.125, Interpolation::Trilinear, stored);
+    const double built = double(VoxelField(direct, open).stats().memory_bytes);
+    VoxelRequest under = open, over = open;
+    under.max_memory_bytes = std::size_t(built * 0.999);
+    over.max_memory_bytes = std::size_t(built * 1.1);
+    try {
+      VoxelField voxel(direct, under);
+      ADD_FAILURE() << "expected a refusal under " << built << " bytes";
+    } catch (const fieldpath::common::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("candidate leaves hold"), std::string::npos) << e.what();
+    }
+    EXPECT_NO_THROW(VoxelField(direct, over)) << built;
   }
   EXPECT_THROW(VoxelField(direct, request(0.0)), fieldpath::common::InputError);
   VoxelRequest tiny = request(1e-9);  // index coordinates beyond 32 bits

@@ -54,7 +54,9 @@ struct VoxelRequest : VoxelSettings {
   /// Refinement only where this mask holds a cell's centre (a job's path, pathgen); null:
   /// wherever the error asks, in the region.
   std::shared_ptr<const CellMask> refine_mask;
-  /// A build whose estimated memory (estimateVoxelNodes) exceeds this is refused (InputError).
+  /// A build whose level would hold more than this is refused (InputError): its bytes bound
+  /// from the leaves it makes, before they are made (the levels' types' sizes, voxel_grid.h
+  /// levelBytesBound).
   /// 0: the process's limit when the build starts (common::memoryLimitBytes: `--max-memory`, else
   /// the memory available): generate's grid was built past --max-memory (a fixed 4 GiB here; a
   /// helper's 10M gave a 35 MB grid).
@@ -115,7 +117,8 @@ namespace detail {
 std::size_t estimateVoxelNodes(const ObstacleSamples& samples, const FieldParams& params,
                                const VoxelRequest& request, double dense_limit_cells);
 }  // namespace detail
-/// Bytes per node of the estimate: a Vec3f per node of leaves that are ~2/3 full (18), and the
+/// Bytes per node of the estimates before a build (app's checks of a scene's voxel size, the
+/// least a refined level adds): a Vec3f per node of leaves that are ~2/3 full (18), and the
 /// query block of the leaf, 16 bytes per node of 9³ (≈ 34 per active node). Measured with the
 /// plane ratio's closeness grid on top (× 16/12): 74-95 bytes per active node.
 inline constexpr double kVoxelBytesPerNode = 52.0;
