@@ -69,6 +69,10 @@ geometry::TriangleMesh loadSceneMesh(const std::filesystem::path& file) {
   if (!(geometry::meshArea(mesh) > 0.0))
     throw common::InputError(file.string() +
                              ": every triangle has zero area: the mesh has no surface");
+  // A facet written twice pushed twice as hard (the field sums the samples of both copies).
+  if (const std::size_t repeated = geometry::removeRepeatedFacets(mesh))
+    sayMeshNote(formatted("%s: %zu triangle%s written again the same way round, left out",
+                          file.string().c_str(), repeated, repeated == 1 ? "" : "s"));
   mendExportDefects(mesh, file);
   // Shells wound against their kind would make the field pull into the walls (the samples'
   // normals) and the part's top its bottom: turned, and said.
@@ -85,8 +89,8 @@ geometry::TriangleMesh loadSceneMesh(const std::filesystem::path& file) {
   if (far_mm > common::kFloatExactMm)
     sayMeshNote(
         formatted("%s: points up to %.4g mm from the origin, read in single precision "
-                  "(steps of %.2g mm there): place the job near the origin for micron "
-                  "figures",
+                  "(steps of %.2g mm there): every clearance is lowered by half of that "
+                  "step; place the job near the origin for micron figures",
                   file.string().c_str(), far_mm, common::floatStepMm(far_mm)));
   return mesh;
 }

@@ -8,6 +8,7 @@
 #include <system_error>
 #include <vector>
 
+#include "fieldpath/field/sampling.h"
 #include "fieldpath/geometry/closed_shells.h"
 #include "fieldpath/geometry/mesh.h"
 #include "scene.h"
@@ -44,6 +45,25 @@ std::vector<std::string> openObstacleNotes(const Scene& scene) {
                       "repels the tool and a ball on it reads as colliding; obstacles are the "
                       "surfaces to keep clear of (give the machined surface as `part` only)");
     }
+  // Walls thinner than half the sample step: the surface rule may take the far face's sample for
+  // the nearest beside the near face and pull a point there in (a helper's 0.2 mm plate sampled
+  // every 1 mm; 0.4 mm held).
+  const double step_mm = scene.field.sample_step_mm;
+  for (std::size_t i = 0; i < scene.obstacle_files.size() && i < scene.obstacles.size(); ++i) {
+    if (!(step_mm > 0.0)) break;
+    const field::ThinWall wall = field::thinnestWall(
+        field::sampleObstacles({&scene.obstacles[i], 1}, step_mm, scene.field.weights), step_mm);
+    if (!(wall.thickness_mm < 0.5 * step_mm)) continue;
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  ": walls down to %.3g mm thick (at %.4g, %.4g, %.4g), under half of "
+                  "field.sample_step (%g mm): beside them the field may read a point as inside "
+                  "the wall and pull it in; a sample_step of at most %.3g mm (twice their "
+                  "thickness) keeps it outward",
+                  wall.thickness_mm, wall.at_mm.x(), wall.at_mm.y(), wall.at_mm.z(), step_mm,
+                  2.0 * wall.thickness_mm);
+    notes.push_back(scene.obstacle_files[i].string() + text);
+  }
   for (std::size_t i = 0; i < scene.obstacle_files.size() && i < scene.obstacles.size(); ++i) {
     const std::size_t open = geometry::openShells(scene.obstacles[i]).size();
     if (open == 0) continue;

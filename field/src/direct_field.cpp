@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/short_number.h"
 #include "point_index.h"
 
 namespace fieldpath::field {
@@ -24,6 +25,13 @@ void validate(const FieldParams& p) {
   if (!std::isfinite(p.gain)) bad("gain", "must be finite", p.gain);
   if (!(p.sample_step_mm > 0.0) || !std::isfinite(p.sample_step_mm))
     bad("sample_step", "must be > 0", p.sample_step_mm);
+  // Samples r0 apart or more leave gaps between their balls that no field covers (the voxel
+  // grid, built within r0 of a sample's surface rule, read 0 beside a triangle of one sample).
+  if (!(p.sample_step_mm < p.r0_mm))
+    bad("sample_step",
+        "must be under field.r0 (" + common::shortNumber(p.r0_mm) +
+            " mm): samples farther apart leave gaps no field covers",
+        p.sample_step_mm);
   if (!(p.voxel.voxel_size_mm > 0.0) || !std::isfinite(p.voxel.voxel_size_mm))
     bad("voxel_size", "must be > 0", p.voxel.voxel_size_mm);
 }

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "fieldpath/common/errors.h"
 
@@ -166,6 +167,44 @@ ObstacleSamples sampleObstacles(std::span<const geometry::TriangleMesh> meshes, 
   }
   small.appendTo(out, weights);
   return out;
+}
+
+ThinWall thinnestWall(const ObstacleSamples& samples, double within_mm) {
+  ThinWall thinnest;
+  if (!(within_mm > 0.0) || samples.size() < 2) return thinnest;
+  // Samples in cells of side within_mm: a pair lies in neighbouring cells.
+  auto cellOf = [within_mm](const Vec3& p) {
+    return Eigen::Vector3i(int(std::floor(p.x() / within_mm)), int(std::floor(p.y() / within_mm)),
+                           int(std::floor(p.z() / within_mm)));
+  };
+  auto keyOf = [](const Eigen::Vector3i& c) {
+    return (std::uint64_t(std::uint32_t(c.x()) & 0x1fffff) << 42) |
+           (std::uint64_t(std::uint32_t(c.y()) & 0x1fffff) << 21) |
+           std::uint64_t(std::uint32_t(c.z()) & 0x1fffff);
+  };
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells;
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    cells[keyOf(cellOf(samples.points_mm[i]))].push_back(i);
+  const double within_sq = within_mm * within_mm;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const Vec3& p = samples.points_mm[i];
+    const Vec3& n = samples.normals[i];
+    const Eigen::Vector3i c = cellOf(p);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = cells.find(keyOf(c + Eigen::Vector3i(dx, dy, dz)));
+          if (it == cells.end()) continue;
+          for (const std::size_t j : it->second) {
+            const Vec3 d = samples.points_mm[j] - p;
+            if (d.squaredNorm() > within_sq || n.dot(samples.normals[j]) >= -0.5) continue;
+            const double depth = -d.dot(n);  // j behind i's face, i behind j's
+            if (depth > 0.0 && d.dot(samples.normals[j]) > 0.0 && depth < thinnest.thickness_mm)
+              thinnest = {depth, p};
+          }
+        }
+  }
+  return thinnest;
 }
 
 }  // namespace fieldpath::field

@@ -2,6 +2,7 @@
 /// of no area, T-junctions, facets wound against their neighbours. A solid with any of them had
 /// no inside for the checks: a tool wholly inside it read as clear (a helper's finding).
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <queue>
@@ -229,6 +230,43 @@ std::size_t agreeWindings(TriangleMesh& mesh) {
 }
 
 }  // namespace
+
+std::size_t removeRepeatedFacets(TriangleMesh& mesh) {
+  using Key = std::array<double, 9>;
+  const auto& v = mesh.vertices;
+  // A triangle's points from its least one (lexicographically) on, in its own cyclic order.
+  auto keyOf = [&v](const Eigen::Vector3i& t) {
+    int first = 0;
+    for (int e = 1; e < 3; ++e) {
+      const Eigen::Vector3d &a = v[std::size_t(t[e])], &b = v[std::size_t(t[first])];
+      if (std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3)) first = e;
+    }
+    Key key;
+    for (int e = 0; e < 3; ++e)
+      for (int a = 0; a < 3; ++a)
+        key[std::size_t(3 * e + a)] = v[std::size_t(t[(first + e) % 3])][a];
+    return key;
+  };
+  std::vector<std::pair<Key, std::size_t>> keys;
+  keys.reserve(mesh.triangles.size());
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
+    keys.emplace_back(keyOf(mesh.triangles[i]), i);
+  std::sort(keys.begin(), keys.end());
+  std::vector<char> repeated(mesh.triangles.size(), 0);
+  std::size_t count = 0;
+  for (std::size_t k = 1; k < keys.size(); ++k)
+    if (keys[k].first == keys[k - 1].first) {
+      repeated[keys[k].second] = 1;
+      ++count;
+    }
+  if (count == 0) return 0;
+  std::vector<Eigen::Vector3i> kept;
+  kept.reserve(mesh.triangles.size() - count);
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
+    if (!repeated[i]) kept.push_back(mesh.triangles[i]);
+  mesh.triangles = std::move(kept);
+  return count;
+}
 
 ShellRepair repairShells(TriangleMesh& mesh) {
   ShellRepair out;

@@ -17,6 +17,7 @@
 #include <tbb/parallel_for.h>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/common/limits.h"
 #include "fieldpath/geometry/closed_shells.h"
 #include "obstacle_model.h"
 
@@ -28,16 +29,43 @@ std::shared_ptr<BvhModel> buildBvhModel(const geometry::TriangleMesh& mesh,
   std::vector<fcl::Vector3d> points(mesh.vertices.begin(), mesh.vertices.end());
   std::vector<fcl::Triangle> triangles;
   triangles.reserve(mesh.triangles.size());
-  // Triangles of no area (a sliver closing a T-junction, sin of its angle under 1e-6) left out:
-  // FCL's sphere-triangle test takes a zero normal for "inside the triangle" and met a ball
-  // 0.54 mm clear of such a sliver (a reviewer's case: 841 um of false gouge). They add no
-  // surface; the shells (inside tests) still see them.
+  // Triangles of no area (a sliver closing a T-junction, sin of its angle under 1e-6): FCL's
+  // sphere-triangle test takes a zero normal for "inside the triangle" and met a ball 0.54 mm
+  // clear of such a sliver (a reviewer's case: 841 um of false gouge). Left out, a lone needle
+  // 100 mm long and 1e-5 mm wide vanished and a ball through it read 199 mm clear (a later
+  // review's): each is its longest edge, padded sideways by kSliverPad of that edge's length (at
+  // most 1 um) to a triangle FCL measures; more obstacle, never less. The shells (inside tests)
+  // keep the sliver as it is.
+  constexpr double kSliverPad = 1e-4, kSliverPadMaxMm = 1e-3;
   for (const auto& t : mesh.triangles) {
     const Eigen::Vector3d a = mesh.vertices[static_cast<std::size_t>(t[0])];
     const Eigen::Vector3d e1 = mesh.vertices[static_cast<std::size_t>(t[1])] - a;
     const Eigen::Vector3d e2 = mesh.vertices[static_cast<std::size_t>(t[2])] - a;
-    if (e1.cross(e2).squaredNorm() > 1e-12 * e1.squaredNorm() * e2.squaredNorm())
+    if (e1.cross(e2).squaredNorm() > 1e-12 * e1.squaredNorm() * e2.squaredNorm()) {
       triangles.emplace_back(t[0], t[1], t[2]);
+      continue;
+    }
+    int longest = 0;  // the edge from corner `longest` to the next
+    double length = -1.0;
+    for (int e = 0; e < 3; ++e) {
+      const double l =
+          (mesh.vertices[std::size_t(t[(e + 1) % 3])] - mesh.vertices[std::size_t(t[e])]).norm();
+      if (l > length) {
+        length = l;
+        longest = e;
+      }
+    }
+    if (!(length > 0.0)) continue;  // a point: no surface
+    const Eigen::Vector3d p = mesh.vertices[std::size_t(t[longest])];
+    const Eigen::Vector3d q = mesh.vertices[std::size_t(t[(longest + 1) % 3])];
+    const Eigen::Vector3d r = mesh.vertices[std::size_t(t[(longest + 2) % 3])];
+    const Eigen::Vector3d u = (q - p) / length;
+    Eigen::Vector3d side = (r - p) - (r - p).dot(u) * u;  // the apex's side, else any
+    if (!(side.norm() > 1e-12 * length)) side = u.unitOrthogonal();
+    const Eigen::Vector3d apex =
+        0.5 * (p + q) + std::min(kSliverPad * length, kSliverPadMaxMm) * side.normalized();
+    points.emplace_back(apex);
+    triangles.emplace_back(t[longest], t[(longest + 1) % 3], static_cast<int>(points.size() - 1));
   }
   if (triangles.empty())
     throw common::InputError(what + ": every triangle has zero area, nothing to check");
@@ -81,6 +109,10 @@ struct ClearanceChecker::Impl {
   std::shared_ptr<Model> tool;
   std::vector<std::shared_ptr<const ObstacleModel>> obstacles;
   double chord_tol_mm = 0.0;
+  /// Half a float's step at the obstacles' farthest coordinate past common::kFloatExactMm, taken
+  /// off every distance: mesh files are read in single precision, and a face written at
+  /// x = 900000.03 read 0.03 mm farther, a path 0.490 mm clear read 0.508 (a review's).
+  double read_margin_mm = 0.0;
   double reach_mm = 0.0;
   /// The closed shells of the tool (tool frame): an obstacle wholly inside the tool touches no
   /// triangle (FCL: clear). The obstacles' own are in their ObstacleModel.
@@ -143,6 +175,13 @@ ClearanceChecker::ClearanceChecker(const geometry::TriangleMesh& tool_mesh,
     impl->tool_anchor = tool_mesh.vertices[static_cast<std::size_t>(tool_mesh.triangles[0][0])];
   impl->obstacles.assign(obstacles.begin(), obstacles.end());
   impl->chord_tol_mm = tool_chord_tol_mm;
+  for (const auto& obstacle : impl->obstacles) {
+    if (obstacle->box.isEmpty()) continue;
+    const double far_mm = std::max(obstacle->box.min().cwiseAbs().maxCoeff(),
+                                   obstacle->box.max().cwiseAbs().maxCoeff());
+    if (far_mm > common::kFloatExactMm)
+      impl->read_margin_mm = std::max(impl->read_margin_mm, 0.5 * common::floatStepMm(far_mm));
+  }
   for (const auto& v : tool_mesh.vertices) impl->reach_mm = std::max(impl->reach_mm, v.norm());
   impl_ = std::move(impl);
 }
@@ -196,7 +235,7 @@ double ClearanceChecker::clearance(const geometry::Posture& posture, int* obstac
         if (obstacle) *obstacle = static_cast<int>(i);
         return 0.0;
       }
-  return std::max(0.0, d - impl_->chord_tol_mm);
+  return std::max(0.0, d - impl_->chord_tol_mm - impl_->read_margin_mm);
 }
 
 double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double radius_mm,
@@ -254,9 +293,9 @@ double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double 
   if (each) {
     each->resize(distance.size());
     for (size_t i = 0; i < distance.size(); ++i)
-      (*each)[i] = std::max(0.0, distance[i] - radius_mm);
+      (*each)[i] = std::max(0.0, distance[i] - radius_mm - impl_->read_margin_mm);
   }
-  return std::max(0.0, best - radius_mm);
+  return std::max(0.0, best - radius_mm - impl_->read_margin_mm);
 }
 
 ClearanceResult ClearanceChecker::check(std::span<const geometry::Posture> postures,
@@ -402,7 +441,7 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
         lowest = 0.0;
         break;
       }
-      const double dm = std::max(0.0, raw - impl_->chord_tol_mm);
+      const double dm = std::max(0.0, raw - impl_->chord_tol_mm - impl_->read_margin_mm);
       best = std::min(best, dm);
       queue.push(piece(p.t0, tm, p.d0, dm, p.p0, pm));
       queue.push(piece(tm, p.t1, dm, p.d1, pm, p.p1));

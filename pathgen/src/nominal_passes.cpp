@@ -21,6 +21,9 @@ using geometry::Posture;
 
 /// Ball centres closer than this are one posture repeated (mm).
 constexpr double kRepeatMm = 1e-9;
+/// A resampled pass (path.step) keeps the input vertices that its stations would cut by more
+/// than this (mm).
+constexpr double kCornerCutMm = 0.001;
 /// The nominal axis must be at least this far from the feed direction (sin of 0.5°): closer, the
 /// frame's normal is the rounding noise of a projection.
 constexpr double kMinAxisToFeedSin = 0.0087;
@@ -275,10 +278,33 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
       };
     }
     if (params.step_given) {
-      const int intervals =
-          std::max(1, static_cast<int>(std::ceil(pass.length_mm / params.step_mm - 1e-9)));
-      for (int j = 0; j <= intervals; ++j)
-        pass.samples.push_back(pass.at(pass.length_mm * j / intervals));
+      // Every `step` mm between the corners, which are kept: a corner between two stations was
+      // cut (a 90° corner 0.385 mm inside at step 1.8, unsaid), as a CAM system's corners are
+      // not. A corner: an input vertex that stations d = min(step/2, its segments) either side
+      // would cut by more than kCornerCutMm (by d·sin(θ/2), θ its turn); a smooth curve's small
+      // turns are stepped over, as `step` asks.
+      std::size_t from = 0;
+      pass.samples.push_back(vertexSample(*line, 0));
+      for (std::size_t k = 1; k < n; ++k) {
+        bool corner = false;
+        if (k + 1 < n) {
+          const Vec3 in = line->centre_mm[k] - line->centre_mm[k - 1];
+          const Vec3 out = line->centre_mm[k + 1] - line->centre_mm[k];
+          const double d = std::min({0.5 * params.step_mm, in.norm(), out.norm()});
+          const double cos_turn = std::clamp(in.normalized().dot(out.normalized()), -1.0, 1.0);
+          corner = d * std::sqrt(0.5 * (1.0 - cos_turn)) > kCornerCutMm;  // sin(θ/2)
+        }
+        if (!corner && k + 1 < n) continue;
+        const double s0 = line->s_mm[from], length = line->s_mm[k] - s0;
+        // (a spacing over `step` by 1e-6 of it is allowed: a 90 mm pass at 0.25 mm had 361
+        // intervals by its length's rounding)
+        const int intervals =
+            std::max(1, static_cast<int>(std::ceil(length / params.step_mm * (1.0 - 1e-6))));
+        for (int j = 1; j < intervals; ++j)
+          pass.samples.push_back(pass.at(s0 + length * j / intervals));
+        pass.samples.push_back(vertexSample(*line, k));
+        from = k;
+      }
     } else {
       for (std::size_t k = 0; k < n; ++k) pass.samples.push_back(vertexSample(*line, k));
     }

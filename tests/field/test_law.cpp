@@ -176,6 +176,19 @@ TriangleMesh finePlane(double a, int k, double z, bool flipped = false) {
 // 1 M samples, 100× the density asked, and a 200 s field) is sampled about once per step²: its
 // small triangles merged per cell and normal direction, the area an exact partition still, the
 // field the plane's closed form as from two triangles.
+// A plate thinner than its sample step is found at its thickness (its two faces' samples face
+// apart, each behind the other); a thick one's faces are farther apart than the search, and a
+// box's faces meeting at its edges do not face apart.
+TEST(Sampling, TheThinnestWallIsFoundAtItsThickness) {
+  const TriangleMesh thin = test::box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(10, 10, 0.2));
+  const ThinWall wall = thinnestWall(sampleObstacles({&thin, 1}, 1.0, Weights::Area), 1.0);
+  EXPECT_NEAR(wall.thickness_mm, 0.2, 1e-9);
+  EXPECT_TRUE(wall.at_mm.z() < 1e-9 || wall.at_mm.z() > 0.2 - 1e-9) << wall.at_mm.transpose();
+  const TriangleMesh thick = test::box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(10, 10, 3));
+  EXPECT_EQ(thinnestWall(sampleObstacles({&thick, 1}, 1.0, Weights::Area), 1.0).thickness_mm,
+            HUGE_VAL);
+}
+
 TEST(Sampling, AFineTessellationIsSampledAtTheStepAsked) {
   FieldParams p;
   const TriangleMesh fine = finePlane(8.0, 160, 0.0);  // 51 200 triangles of 0.005 mm²

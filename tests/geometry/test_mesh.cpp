@@ -203,6 +203,25 @@ TEST(Mesh, AnInwardShellInsideAnOpenShellStaysAVoid) {
   EXPECT_FALSE(ClosedShells(part).contains(Eigen::Vector3d(5, 5.1, 5)));
 }
 
+// A cube written twice (the second copy's vertices its own, its triangles turned cyclically) is
+// one cube: the copies are left out; a copy written the other way round (a sheet's other side)
+// stays.
+TEST(Mesh, TrianglesWrittenAgainTheSameWayRoundAreLeftOut) {
+  TriangleMesh twice = unitCube();
+  const TriangleMesh once = twice;
+  const int at = static_cast<int>(twice.vertices.size());
+  twice.vertices.insert(twice.vertices.end(), once.vertices.begin(), once.vertices.end());
+  for (const auto& t : once.triangles)
+    twice.triangles.emplace_back(at + t[1], at + t[2], at + t[0]);
+  EXPECT_EQ(removeRepeatedFacets(twice), once.triangles.size());
+  EXPECT_EQ(twice.triangles.size(), once.triangles.size());
+  EXPECT_NEAR(meshArea(twice), meshArea(once), 1e-12);
+  TriangleMesh sides = once;
+  for (const auto& t : once.triangles) sides.triangles.emplace_back(t[0], t[2], t[1]);
+  EXPECT_EQ(removeRepeatedFacets(sides), 0u);
+  EXPECT_EQ(sides.triangles.size(), 2 * once.triangles.size());
+}
+
 // Export defects that left a solid's shell open (its inside unknown: a tool wholly inside read
 // clear), each mended to the closed cube of the same surface: a T-junction (the top face split at
 // a point on one of its edges, the face beside it not), a sliver of no area on an edge, facets

@@ -61,6 +61,38 @@ TEST(Clearance, ASheetWhollyInsideTheToolCollides) {
   EXPECT_NEAR(checker.clearance(beside), 1.5, 1e-9);
 }
 
+// A lone sliver is its longest edge (a review's needle 100 mm long and 1e-5 mm wide was left out
+// of the tree: a tool through it read 199 mm clear): the box tool through it collides, beside it
+// reads the closed form less the padding (at most 1 um).
+TEST(Clearance, ALoneSliverIsItsLongestEdge) {
+  const TriangleMesh tool = box(Vec3(-1, -1, 0), Vec3(1, 1, 10));
+  TriangleMesh needle;
+  needle.vertices = {{-50, 0, 5}, {50, 0, 5}, {50, 1e-5, 5}};
+  needle.triangles = {{0, 1, 2}};
+  const std::vector<TriangleMesh> obstacles = {needle, wall(-200.0)};
+  const pathgen::ClearanceChecker checker(tool, obstacles);
+  int obstacle = -1;
+  EXPECT_EQ(checker.clearance(Posture{}, &obstacle), 0.0);
+  EXPECT_EQ(obstacle, 0);
+  Posture above;  // the tool's tip 2 mm over the needle
+  above.tip_mm = Vec3(0, 0, 7);
+  EXPECT_NEAR(checker.clearance(above), 2.0, 1e-3 + 1e-9);
+  EXPECT_LE(checker.clearance(above), 2.0);
+}
+
+// Far from the origin (mesh files hold single precision there) every distance is lowered by half
+// a float's step at the farthest point: 0.031 mm at 9e5 mm (a review's face written at 900000.03
+// read 0.03 mm farther: a path 0.490 mm clear read 0.508, ok); near the origin, not at all.
+TEST(Clearance, FarFromTheOriginDistancesAreLoweredByHalfAFloatStep) {
+  const TriangleMesh tool = box(Vec3(-1, -1, 0), Vec3(1, 1, 10));
+  const std::vector<TriangleMesh> far = {wall(900005.0)};
+  Posture beside;
+  beside.tip_mm = Vec3(900000.0, 0, 0);
+  EXPECT_NEAR(pathgen::ClearanceChecker(tool, far).clearance(beside), 4.0 - 0.03125, 1e-6);
+  const std::vector<TriangleMesh> near = {wall(5.0)};
+  EXPECT_NEAR(pathgen::ClearanceChecker(tool, near).clearance(Posture{}), 4.0, 1e-9);
+}
+
 // Closed form: a 2 × 2 × 10 "tool" (tool frame, tip at the origin) beside the wall x = 5.
 TEST(Clearance, BoxToolBesideAWallClosedForm) {
   const TriangleMesh tool = box(Vec3(-1, -1, 0), Vec3(1, 1, 10));

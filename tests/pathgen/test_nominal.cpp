@@ -237,6 +237,47 @@ TEST(NominalPasses, FramesFollowThePolylineAndKeepPosturesOneForOne) {
             static_cast<std::size_t>(std::ceil(resampled[0].length_mm / 0.25 - 1e-9)) + 1);
 }
 
+// path.step keeps the corners it would cut (a helper's 90° corner at step 1.8: the written
+// centre line passed 0.385 mm inside it, unsaid) and steps over a smooth curve's small turns.
+TEST(NominalPasses, AResampledPassKeepsItsCornersAndStepsOverSmoothTurns) {
+  TempDir dir;
+  // An L: 50 mm along x, then 40 mm along y, a posture every 1 mm.
+  std::string text = straightLines(0, 50, 1, 0);
+  for (int y = 1; y <= 40; ++y) text += "50 " + std::to_string(y) + " 0 0 0 1\n";
+  PathParams step;
+  step.step_given = true;
+  step.step_mm = 1.8;
+  const auto corner = nominalPasses(geometry::readPathFile(dir.write("l.cl", text)), step, kR);
+  ASSERT_EQ(corner.size(), 1u);
+  const Eigen::Vector3d vertex(50, 0, kR);  // the corner's ball centre
+  double nearest = HUGE_VAL, widest = 0.0;
+  const auto& samples = corner[0].samples;
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    nearest = std::min(nearest, (samples[k].centre_mm - vertex).norm());
+    if (k > 0) widest = std::max(widest, (samples[k].centre_mm - samples[k - 1].centre_mm).norm());
+  }
+  EXPECT_LT(nearest, 1e-12);
+  EXPECT_LE(widest, 1.8 + 1e-9);
+  // 50 mm in 28 steps, 40 in 23 (a step each of 50/28 and 40/23 mm): 52 stations.
+  EXPECT_EQ(samples.size(), 52u);
+  // A 90 mm straight pass at 0.25 mm: 360 steps (361 by its length's rounding before).
+  step.step_mm = 0.25;
+  const auto straight = nominalPasses(
+      geometry::readPathFile(dir.write("s.cl", straightLines(0, 90, 0.1, 0))), step, kR);
+  EXPECT_EQ(straight[0].samples.size(), 361u);
+  // An arc of radius 50 every 0.05 mm (0.057° a posture: cut by 0.25 mm · sin(0.029°) = 0.1 um)
+  // resampled every 0.5 mm: evenly, its vertices stepped over.
+  std::string arc;
+  for (int k = 0; k <= 400; ++k) {
+    const double t = k * 0.001;
+    arc += std::to_string(50 * std::cos(t)) + " " + std::to_string(50 * std::sin(t)) + " 0 0 0 1\n";
+  }
+  step.step_mm = 0.5;
+  const auto smooth = nominalPasses(geometry::readPathFile(dir.write("a.cl", arc)), step, kR);
+  EXPECT_EQ(smooth[0].samples.size(),
+            static_cast<std::size_t>(std::ceil(smooth[0].length_mm / 0.5 * (1 - 1e-6))) + 1);
+}
+
 TEST(NominalPasses, DegeneratePosturesAreClearErrorsNamingTheLine) {
   TempDir dir;
   // Feed along the axis (a plunge) on line 3.

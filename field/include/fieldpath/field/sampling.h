@@ -1,6 +1,7 @@
 #pragma once
 /// Obstacle meshes → sample points q_j with outward normals and weights (DESIGN.md "The field").
 /// The guide surface (the one being machined) is never passed here.
+#include <cmath>
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -46,5 +47,17 @@ int triangleSplits(const Vec3& a, const Vec3& b, const Vec3& c, double step_mm);
 inline bool isSmallPiece(double area_mm2, double step_mm) {
   return area_mm2 < 0.25 * step_mm * step_mm;
 }
+
+/// The thinnest wall of a sample set: two samples within `within_mm` of each other whose normals
+/// face apart (cosine under -0.5), each behind the other's face, `thickness_mm` their distance
+/// along the first one's normal. Such walls, thinner than about a third of the sample step, let
+/// the surface rule (law.h) take the far face's sample for the nearest beside the near face, and
+/// read a point there as inside: the field pulls it in (a helper's 0.2 mm plate sampled every
+/// 1 mm).
+struct ThinWall {
+  double thickness_mm = HUGE_VAL;  ///< HUGE_VAL: none found
+  Vec3 at_mm = Vec3::Zero();       ///< the first sample of the pair
+};
+ThinWall thinnestWall(const ObstacleSamples& samples, double within_mm);
 
 }  // namespace fieldpath::field

@@ -29,8 +29,9 @@ namespace fieldpath::field {
 /// max(mean corner |F|, floor), floor = kRefineFloorFraction · P(2 r_min) (law.h PlaneLaw).
 /// Where that exceeds the tolerance the cell's 3³ nodes at half the size are built from the
 /// exact law and queries inside it read the finer level; fine nodes on a face shared with an
-/// unsplit cell (hanging nodes) take the coarser level's value, so the field is continuous
-/// across levels. Trilinear only (quadratic with a tolerance > 0 is refused).
+/// unsplit cell (hanging nodes) take the coarser level's value, so a stored force is continuous
+/// across levels (the plane ratio is not across a face whose two cells read it differently:
+/// ratioHolds, voxel_grid.h). Trilinear only (quadratic with a tolerance > 0 is refused).
 struct VoxelRequest : VoxelSettings {
   VoxelRequest() = default;
   explicit VoxelRequest(const VoxelSettings& settings) : VoxelSettings(settings) {}
