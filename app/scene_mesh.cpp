@@ -69,10 +69,13 @@ geometry::TriangleMesh loadSceneMesh(const std::filesystem::path& file) {
   if (!(geometry::meshArea(mesh) > 0.0))
     throw common::InputError(file.string() +
                              ": every triangle has zero area: the mesh has no surface");
-  // A facet written twice pushed twice as hard (the field sums the samples of both copies).
-  if (const std::size_t repeated = geometry::removeRepeatedFacets(mesh))
-    sayMeshNote(formatted("%s: %zu triangle%s written again the same way round, left out",
-                          file.string().c_str(), repeated, repeated == 1 ? "" : "s"));
+  // A facet written twice pushed twice as hard: the field samples it once (field/sampling.h).
+  const std::vector<char> repeated = geometry::repeatedFacets(mesh);
+  if (const auto n = std::size_t(std::count(repeated.begin(), repeated.end(), 1)))
+    sayMeshNote(
+        formatted("%s: %zu triangle%s written again the same way round: sampled once for "
+                  "the field, kept for the checks",
+                  file.string().c_str(), n, n == 1 ? "" : "s"));
   mendExportDefects(mesh, file);
   // Shells wound against their kind would make the field pull into the walls (the samples'
   // normals) and the part's top its bottom: turned, and said.
@@ -89,7 +92,7 @@ geometry::TriangleMesh loadSceneMesh(const std::filesystem::path& file) {
   if (far_mm > common::kFloatExactMm)
     sayMeshNote(
         formatted("%s: points up to %.4g mm from the origin, read in single precision "
-                  "(steps of %.2g mm there): every clearance is lowered by half of that "
+                  "(steps of %.2g mm there): every clearance is lowered by √3 of that "
                   "step; place the job near the origin for micron figures",
                   file.string().c_str(), far_mm, common::floatStepMm(far_mm)));
   return mesh;

@@ -8,6 +8,8 @@
 #include <system_error>
 #include <vector>
 
+#include "estimates.h"
+#include "fieldpath/common/memory.h"
 #include "fieldpath/field/sampling.h"
 #include "fieldpath/geometry/closed_shells.h"
 #include "fieldpath/geometry/mesh.h"
@@ -45,18 +47,23 @@ std::vector<std::string> openObstacleNotes(const Scene& scene) {
                       "repels the tool and a ball on it reads as colliding; obstacles are the "
                       "surfaces to keep clear of (give the machined surface as `part` only)");
     }
-  // Walls thinner than half the sample step: the surface rule may take the far face's sample for
-  // the nearest beside the near face and pull a point there in (a helper's 0.2 mm plate sampled
-  // every 1 mm; 0.4 mm held).
+  // Walls thinner than a third of the sample step: the surface rule may take the far face's
+  // sample for the nearest beside the near face and pull a point there in (a helper's 0.2 mm
+  // plate sampled every 1 mm; 0.4 mm held).
+  // Looked for where the samples fit what is left (they are made again here, one obstacle at a
+  // time, with a cell map beside them: `check` makes none otherwise).
   const double step_mm = scene.field.sample_step_mm;
+  const bool look_for_thin =
+      step_mm > 0.0 &&
+      sampleCount(scene, step_mm) * (kBytesPerSample + 64.0) <= common::memoryLeftBytes();
   for (std::size_t i = 0; i < scene.obstacle_files.size() && i < scene.obstacles.size(); ++i) {
-    if (!(step_mm > 0.0)) break;
+    if (!look_for_thin) break;
     const field::ThinWall wall = field::thinnestWall(
         field::sampleObstacles({&scene.obstacles[i], 1}, step_mm, scene.field.weights), step_mm);
-    if (!(wall.thickness_mm < 0.5 * step_mm)) continue;
+    if (!(wall.thickness_mm < step_mm / 3.0)) continue;
     char text[400];
     std::snprintf(text, sizeof text,
-                  ": walls down to %.3g mm thick (at %.4g, %.4g, %.4g), under half of "
+                  ": walls down to %.3g mm thick (at %.4g, %.4g, %.4g), under a third of "
                   "field.sample_step (%g mm): beside them the field may read a point as inside "
                   "the wall and pull it in; a sample_step of at most %.3g mm (twice their "
                   "thickness) keeps it outward",

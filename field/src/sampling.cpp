@@ -131,9 +131,12 @@ ObstacleSamples sampleObstacles(std::span<const geometry::TriangleMesh> meshes, 
     for (const auto& v : mesh.vertices)
       if (!v.allFinite())
         throw common::InputError("obstacle " + std::to_string(m + 1) + ": non-finite vertex");
-    for (const auto& t : mesh.triangles) {
+    // A triangle written again the same way round is sampled once (each copy pushed).
+    const std::vector<char> repeated = geometry::repeatedFacets(mesh);
+    for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+      const auto& t = mesh.triangles[i];
       const int nv = static_cast<int>(mesh.vertices.size());
-      if (t.minCoeff() < 0 || t.maxCoeff() >= nv) continue;
+      if (t.minCoeff() < 0 || t.maxCoeff() >= nv || repeated[i]) continue;
       const Vec3 a = mesh.vertices[t[0]], b = mesh.vertices[t[1]], c = mesh.vertices[t[2]];
       const Vec3 cross = (b - a).cross(c - a);
       const double area = 0.5 * cross.norm();
@@ -172,10 +175,12 @@ ObstacleSamples sampleObstacles(std::span<const geometry::TriangleMesh> meshes, 
 ThinWall thinnestWall(const ObstacleSamples& samples, double within_mm) {
   ThinWall thinnest;
   if (!(within_mm > 0.0) || samples.size() < 2) return thinnest;
-  // Samples in cells of side within_mm: a pair lies in neighbouring cells.
-  auto cellOf = [within_mm](const Vec3& p) {
-    return Eigen::Vector3i(int(std::floor(p.x() / within_mm)), int(std::floor(p.y() / within_mm)),
-                           int(std::floor(p.z() / within_mm)));
+  // Samples in cells of side 1.5 within_mm (a sample's split steps up to 1.5 steps apart: the
+  // samples beside one on its face are sought that far): a pair lies in neighbouring cells.
+  const double cell_mm = 1.5 * within_mm;
+  auto cellOf = [cell_mm](const Vec3& p) {
+    return Eigen::Vector3i(int(std::floor(p.x() / cell_mm)), int(std::floor(p.y() / cell_mm)),
+                           int(std::floor(p.z() / cell_mm)));
   };
   auto keyOf = [](const Eigen::Vector3i& c) {
     return (std::uint64_t(std::uint32_t(c.x()) & 0x1fffff) << 42) |
@@ -185,24 +190,47 @@ ThinWall thinnestWall(const ObstacleSamples& samples, double within_mm) {
   std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells;
   for (std::size_t i = 0; i < samples.size(); ++i)
     cells[keyOf(cellOf(samples.points_mm[i]))].push_back(i);
-  const double within_sq = within_mm * within_mm;
-  for (std::size_t i = 0; i < samples.size(); ++i) {
+  // Calls fn(j) for the samples within `radius` (at most cell_mm) of sample i.
+  auto forNear = [&](std::size_t i, double radius, auto&& fn) {
+    const double within_sq = radius * radius;
     const Vec3& p = samples.points_mm[i];
-    const Vec3& n = samples.normals[i];
     const Eigen::Vector3i c = cellOf(p);
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
           const auto it = cells.find(keyOf(c + Eigen::Vector3i(dx, dy, dz)));
           if (it == cells.end()) continue;
-          for (const std::size_t j : it->second) {
-            const Vec3 d = samples.points_mm[j] - p;
-            if (d.squaredNorm() > within_sq || n.dot(samples.normals[j]) >= -0.5) continue;
-            const double depth = -d.dot(n);  // j behind i's face, i behind j's
-            if (depth > 0.0 && d.dot(samples.normals[j]) > 0.0 && depth < thinnest.thickness_mm)
-              thinnest = {depth, p};
-          }
+          for (const std::size_t j : it->second)
+            if (j != i && (samples.points_mm[j] - p).squaredNorm() <= within_sq) fn(j);
         }
+  };
+  // A sample's wall: the least depth behind its face of a sample facing the other way (normals
+  // within 18° of opposite), each behind the other's face.
+  std::vector<double> depth(samples.size(), HUGE_VAL);
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const Vec3& n = samples.normals[i];
+    forNear(i, within_mm, [&](std::size_t j) {
+      const Vec3 d = samples.points_mm[j] - samples.points_mm[i];
+      if (n.dot(samples.normals[j]) >= -0.95) return;
+      const double behind = -d.dot(n);
+      if (behind > 0.0 && d.dot(samples.normals[j]) > 0.0) depth[i] = std::min(depth[i], behind);
+    });
+  }
+  // A wall, not a crease nor a rounded edge (whose opposite faces meet, or part, within a
+  // step: their depth changes across it, however long the edge): every sample within 1.5 steps on
+  // the same face (within 18°), three at least, finds the same depth within a fifth.
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (!(depth[i] < thinnest.thickness_mm)) continue;
+    int alike = 0;
+    bool unlike = false;
+    forNear(i, cell_mm, [&](std::size_t j) {
+      if (samples.normals[i].dot(samples.normals[j]) <= 0.95) return;
+      if (std::abs(depth[j] - depth[i]) <= 0.2 * depth[i])
+        ++alike;
+      else
+        unlike = true;
+    });
+    if (alike >= 3 && !unlike) thinnest = {depth[i], samples.points_mm[i]};
   }
   return thinnest;
 }

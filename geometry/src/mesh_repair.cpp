@@ -231,7 +231,7 @@ std::size_t agreeWindings(TriangleMesh& mesh) {
 
 }  // namespace
 
-std::size_t removeRepeatedFacets(TriangleMesh& mesh) {
+std::vector<char> repeatedFacets(const TriangleMesh& mesh) {
   using Key = std::array<double, 9>;
   const auto& v = mesh.vertices;
   // A triangle's points from its least one (lexicographically) on, in its own cyclic order.
@@ -249,23 +249,16 @@ std::size_t removeRepeatedFacets(TriangleMesh& mesh) {
   };
   std::vector<std::pair<Key, std::size_t>> keys;
   keys.reserve(mesh.triangles.size());
-  for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
-    keys.emplace_back(keyOf(mesh.triangles[i]), i);
+  const int nv = static_cast<int>(v.size());
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const Eigen::Vector3i& t = mesh.triangles[i];
+    if (t.minCoeff() >= 0 && t.maxCoeff() < nv) keys.emplace_back(keyOf(t), i);  // (others: not)
+  }
   std::sort(keys.begin(), keys.end());
   std::vector<char> repeated(mesh.triangles.size(), 0);
-  std::size_t count = 0;
   for (std::size_t k = 1; k < keys.size(); ++k)
-    if (keys[k].first == keys[k - 1].first) {
-      repeated[keys[k].second] = 1;
-      ++count;
-    }
-  if (count == 0) return 0;
-  std::vector<Eigen::Vector3i> kept;
-  kept.reserve(mesh.triangles.size() - count);
-  for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
-    if (!repeated[i]) kept.push_back(mesh.triangles[i]);
-  mesh.triangles = std::move(kept);
-  return count;
+    if (keys[k].first == keys[k - 1].first) repeated[keys[k].second] = 1;
+  return repeated;
 }
 
 ShellRepair repairShells(TriangleMesh& mesh) {
@@ -309,6 +302,28 @@ ShellRepair repairShells(TriangleMesh& mesh) {
   if (!better || worse) return {};
   out.open_edges_before = before.open_edges;
   out.open_edges_after = after.open_edges;
+  // A sliver none of whose edges the mended shells use closed nothing (a lone needle or cap, 100
+  // mm long: left out, a tool through it read 200 mm clear): it is surface, and stays (the
+  // clearance tree pads it, pathgen/clearance.cpp).
+  std::vector<std::uint64_t> used;
+  used.reserve(3 * mended.triangles.size());
+  for (const auto& t : mended.triangles)
+    for (int e = 0; e < 3; ++e) used.push_back(edgeKey(t[e], t[(e + 1) % 3]));
+  std::sort(used.begin(), used.end());
+  for (const auto& t : mesh.triangles) {
+    if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) continue;
+    const Eigen::Vector3d& a = mesh.vertices[t[0]];
+    if (!isSliver(a, mesh.vertices[t[1]], mesh.vertices[t[2]])) continue;
+    bool touches = false;
+    for (int e = 0; e < 3 && !touches; ++e)
+      touches = std::binary_search(used.begin(), used.end(), edgeKey(t[e], t[(e + 1) % 3]));
+    if (!touches) {
+      mended.triangles.push_back(t);
+      --out.slivers_removed;
+    }
+  }
+  if (!out.any()) return {};
+  out.open_edges_after = validateMesh(mended).open_edges;
   mesh = std::move(mended);
   return out;
 }

@@ -109,9 +109,11 @@ struct ClearanceChecker::Impl {
   std::shared_ptr<Model> tool;
   std::vector<std::shared_ptr<const ObstacleModel>> obstacles;
   double chord_tol_mm = 0.0;
-  /// Half a float's step at the obstacles' farthest coordinate past common::kFloatExactMm, taken
-  /// off every distance: mesh files are read in single precision, and a face written at
-  /// x = 900000.03 read 0.03 mm farther, a path 0.490 mm clear read 0.508 (a review's).
+  /// √3 float steps at the obstacles' farthest coordinate past common::kFloatExactMm, taken off
+  /// every distance: mesh files are read in single precision (each coordinate off by up to a
+  /// step, allowing the text reader's last digit), and a face written at x = 900000.03 read 0.03
+  /// mm farther, a path 0.490 mm clear read 0.508 (a review's); a slanted face moves by up to √3
+  /// times what one coordinate does (half a step each read a face 0.022 mm too far: a later one).
   double read_margin_mm = 0.0;
   double reach_mm = 0.0;
   /// The closed shells of the tool (tool frame): an obstacle wholly inside the tool touches no
@@ -180,7 +182,8 @@ ClearanceChecker::ClearanceChecker(const geometry::TriangleMesh& tool_mesh,
     const double far_mm = std::max(obstacle->box.min().cwiseAbs().maxCoeff(),
                                    obstacle->box.max().cwiseAbs().maxCoeff());
     if (far_mm > common::kFloatExactMm)
-      impl->read_margin_mm = std::max(impl->read_margin_mm, 0.5 * common::floatStepMm(far_mm));
+      impl->read_margin_mm =
+          std::max(impl->read_margin_mm, std::sqrt(3.0) * common::floatStepMm(far_mm));
   }
   for (const auto& v : tool_mesh.vertices) impl->reach_mm = std::max(impl->reach_mm, v.norm());
   impl_ = std::move(impl);

@@ -24,6 +24,8 @@ constexpr double kRepeatMm = 1e-9;
 /// A resampled pass (path.step) keeps the input vertices that its stations would cut by more
 /// than this (mm).
 constexpr double kCornerCutMm = 0.001;
+/// Vertex tests of the corners' search past which every vertex is kept.
+constexpr std::size_t kMaxCornerWork = 50'000'000;
 /// The nominal axis must be at least this far from the feed direction (sin of 0.5°): closer, the
 /// frame's normal is the rounding noise of a projection.
 constexpr double kMinAxisToFeedSin = 0.0087;
@@ -43,6 +45,84 @@ PassSample vertexSample(const Polyline& line, std::size_t i) {
   sample.normal = line.normal[i];
   sample.binormal = sample.normal.cross(sample.feed);
   return sample;
+}
+
+/// A station of a resampled pass: at arc length s_mm, or an input vertex (its index).
+struct Station {
+  double s_mm = 0.0;
+  long vertex = -1;
+};
+
+/// The stations of a pass resampled every `step_mm` (path.step): evenly between kept input
+/// vertices, a vertex kept wherever the even stations would leave it more than kCornerCutMm off
+/// (split at the worst one, Douglas-Peucker's way, until none is): the ends always. Stations
+/// between single vertices of a corner were cut by 0.385 mm at step 1.8 (a 90° corner between
+/// two stations), by 0.38 mm where the corner was written as two vertices 2 um apart or as a
+/// 0.05 mm fillet, a smooth S of R 5 by 0.076 mm (three reviews'). Past kMaxCornerWork vertex
+/// tests (an adversarial million-vertex zigzag) every vertex is kept: exact, and no slower.
+std::vector<Station> stations(const Polyline& line, double step_mm) {
+  const auto& s = line.s_mm;
+  const auto& c = line.centre_mm;
+  const std::size_t n = s.size();
+  if (n < 2) return {{s.empty() ? 0.0 : s[0], 0}};
+  // Equal steps no longer than step (over it by 1e-6 of it at most: a 90 mm pass at 0.25 mm had
+  // 361 intervals by its length's rounding).
+  auto intervals = [step_mm](double length) {
+    return std::max(1L, static_cast<long>(std::ceil(length / step_mm * (1.0 - 1e-6))));
+  };
+  auto centreAt = [&](double at) {
+    const std::size_t j = std::min<std::size_t>(
+        n - 1, std::size_t(std::lower_bound(s.begin(), s.end(), at) - s.begin()));
+    if (j == 0 || s[j] == at) return c[j];
+    const double w = (at - s[j - 1]) / (s[j] - s[j - 1]);
+    return Vec3((1 - w) * c[j - 1] + w * c[j]);
+  };
+  std::vector<std::pair<std::size_t, std::size_t>> todo = {{0, n - 1}}, done;
+  std::size_t work = 0;
+  bool all = false;
+  while (!todo.empty() && !all) {
+    const auto [a, b] = todo.back();
+    todo.pop_back();
+    const double length = s[b] - s[a];
+    const long m = intervals(length);
+    double worst = kCornerCutMm;
+    std::size_t at = 0;
+    for (std::size_t k = a + 1; k < b; ++k) {
+      const long j = std::min(m - 1, static_cast<long>((s[k] - s[a]) / length * double(m)));
+      const Vec3 p = centreAt(s[a] + length * double(j) / double(m));
+      const Vec3 q = centreAt(s[a] + length * double(j + 1) / double(m));
+      const Vec3 pq = q - p;
+      const double t = pq.squaredNorm() > 0.0
+                           ? std::clamp((c[k] - p).dot(pq) / pq.squaredNorm(), 0.0, 1.0)
+                           : 0.0;
+      const double off = (c[k] - (p + t * pq)).norm();
+      if (off > worst) {
+        worst = off;
+        at = k;
+      }
+    }
+    work += b - a;
+    all = work > kMaxCornerWork;
+    if (at == 0) {
+      done.emplace_back(a, b);
+    } else {
+      todo.emplace_back(a, at);
+      todo.emplace_back(at, b);
+    }
+  }
+  if (all) {
+    done.clear();
+    for (std::size_t k = 0; k + 1 < n; ++k) done.emplace_back(k, k + 1);
+  }
+  std::sort(done.begin(), done.end());
+  std::vector<Station> out = {{s[0], 0}};
+  for (const auto& [a, b] : done) {
+    const double length = s[b] - s[a];
+    const long m = intervals(length);
+    for (long j = 1; j < m; ++j) out.push_back({s[a] + length * double(j) / double(m), -1});
+    out.push_back({s[b], static_cast<long>(b)});
+  }
+  return out;
 }
 
 /// The station at arc length s: exact at the vertices, linear in between.
@@ -278,33 +358,9 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
       };
     }
     if (params.step_given) {
-      // Every `step` mm between the corners, which are kept: a corner between two stations was
-      // cut (a 90° corner 0.385 mm inside at step 1.8, unsaid), as a CAM system's corners are
-      // not. A corner: an input vertex that stations d = min(step/2, its segments) either side
-      // would cut by more than kCornerCutMm (by d·sin(θ/2), θ its turn); a smooth curve's small
-      // turns are stepped over, as `step` asks.
-      std::size_t from = 0;
-      pass.samples.push_back(vertexSample(*line, 0));
-      for (std::size_t k = 1; k < n; ++k) {
-        bool corner = false;
-        if (k + 1 < n) {
-          const Vec3 in = line->centre_mm[k] - line->centre_mm[k - 1];
-          const Vec3 out = line->centre_mm[k + 1] - line->centre_mm[k];
-          const double d = std::min({0.5 * params.step_mm, in.norm(), out.norm()});
-          const double cos_turn = std::clamp(in.normalized().dot(out.normalized()), -1.0, 1.0);
-          corner = d * std::sqrt(0.5 * (1.0 - cos_turn)) > kCornerCutMm;  // sin(θ/2)
-        }
-        if (!corner && k + 1 < n) continue;
-        const double s0 = line->s_mm[from], length = line->s_mm[k] - s0;
-        // (a spacing over `step` by 1e-6 of it is allowed: a 90 mm pass at 0.25 mm had 361
-        // intervals by its length's rounding)
-        const int intervals =
-            std::max(1, static_cast<int>(std::ceil(length / params.step_mm * (1.0 - 1e-6))));
-        for (int j = 1; j < intervals; ++j)
-          pass.samples.push_back(pass.at(s0 + length * j / intervals));
-        pass.samples.push_back(vertexSample(*line, k));
-        from = k;
-      }
+      for (const Station& st : stations(*line, params.step_mm))
+        pass.samples.push_back(st.vertex >= 0 ? vertexSample(*line, std::size_t(st.vertex))
+                                              : pass.at(st.s_mm));
     } else {
       for (std::size_t k = 0; k < n; ++k) pass.samples.push_back(vertexSample(*line, k));
     }

@@ -176,6 +176,17 @@ TriangleMesh finePlane(double a, int k, double z, bool flipped = false) {
 // 1 M samples, 100× the density asked, and a 200 s field) is sampled about once per step²: its
 // small triangles merged per cell and normal direction, the area an exact partition still, the
 // field the plane's closed form as from two triangles.
+// A cube written twice is sampled once: the field of one cube, not twice it (a review's).
+TEST(Sampling, ATriangleWrittenAgainIsSampledOnce) {
+  const TriangleMesh once = test::box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(10, 10, 10));
+  TriangleMesh twice = once;
+  for (const auto& t : once.triangles) twice.triangles.emplace_back(t[2], t[0], t[1]);
+  const ObstacleSamples a = sampleObstacles({&once, 1}, 1.0, Weights::Area);
+  const ObstacleSamples b = sampleObstacles({&twice, 1}, 1.0, Weights::Area);
+  EXPECT_EQ(a.size(), b.size());
+  EXPECT_NEAR(a.area_mm2, b.area_mm2, 1e-9);
+}
+
 // A plate thinner than its sample step is found at its thickness (its two faces' samples face
 // apart, each behind the other); a thick one's faces are farther apart than the search, and a
 // box's faces meeting at its edges do not face apart.
@@ -186,6 +197,14 @@ TEST(Sampling, TheThinnestWallIsFoundAtItsThickness) {
   EXPECT_TRUE(wall.at_mm.z() < 1e-9 || wall.at_mm.z() > 0.2 - 1e-9) << wall.at_mm.transpose();
   const TriangleMesh thick = test::box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(10, 10, 3));
   EXPECT_EQ(thinnestWall(sampleObstacles({&thick, 1}, 1.0, Weights::Area), 1.0).thickness_mm,
+            HUGE_VAL);
+  // A 20° wedge 10 mm long (a sharp edge, thin only at its crease): no wall.
+  TriangleMesh wedge;
+  const double h = 10 * std::tan(10 * M_PI / 180);
+  wedge.vertices = {{0, 0, 0}, {10, 0, h}, {10, 0, -h}, {0, 10, 0}, {10, 10, h}, {10, 10, -h}};
+  wedge.triangles = {{0, 1, 2}, {3, 5, 4}, {0, 3, 4}, {0, 4, 1},
+                     {0, 2, 5}, {0, 5, 3}, {1, 4, 5}, {1, 5, 2}};
+  EXPECT_EQ(thinnestWall(sampleObstacles({&wedge, 1}, 1.0, Weights::Area), 1.0).thickness_mm,
             HUGE_VAL);
 }
 

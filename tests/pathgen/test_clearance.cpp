@@ -80,15 +80,17 @@ TEST(Clearance, ALoneSliverIsItsLongestEdge) {
   EXPECT_LE(checker.clearance(above), 2.0);
 }
 
-// Far from the origin (mesh files hold single precision there) every distance is lowered by half
-// a float's step at the farthest point: 0.031 mm at 9e5 mm (a review's face written at 900000.03
-// read 0.03 mm farther: a path 0.490 mm clear read 0.508, ok); near the origin, not at all.
-TEST(Clearance, FarFromTheOriginDistancesAreLoweredByHalfAFloatStep) {
+// Far from the origin (mesh files hold single precision there) every distance is lowered by √3
+// float steps at the farthest point: 0.108 mm at 9e5 mm (a review's face written at 900000.03
+// read 0.03 mm farther: a path 0.490 mm clear read 0.508, ok; a slanted face's three coordinates
+// rounded alike, 0.022 mm more); near the origin, not at all.
+TEST(Clearance, FarFromTheOriginDistancesAreLoweredByFloatSteps) {
   const TriangleMesh tool = box(Vec3(-1, -1, 0), Vec3(1, 1, 10));
   const std::vector<TriangleMesh> far = {wall(900005.0)};
   Posture beside;
   beside.tip_mm = Vec3(900000.0, 0, 0);
-  EXPECT_NEAR(pathgen::ClearanceChecker(tool, far).clearance(beside), 4.0 - 0.03125, 1e-6);
+  EXPECT_NEAR(pathgen::ClearanceChecker(tool, far).clearance(beside), 4.0 - std::sqrt(3.0) * 0.0625,
+              1e-6);
   const std::vector<TriangleMesh> near = {wall(5.0)};
   EXPECT_NEAR(pathgen::ClearanceChecker(tool, near).clearance(Posture{}), 4.0, 1e-9);
 }

@@ -49,11 +49,14 @@ inline bool isSmallPiece(double area_mm2, double step_mm) {
 }
 
 /// The thinnest wall of a sample set: two samples within `within_mm` of each other whose normals
-/// face apart (cosine under -0.5), each behind the other's face, `thickness_mm` their distance
-/// along the first one's normal. Such walls, thinner than about a third of the sample step, let
-/// the surface rule (law.h) take the far face's sample for the nearest beside the near face, and
-/// read a point there as inside: the field pulls it in (a helper's 0.2 mm plate sampled every
-/// 1 mm).
+/// face apart (within 18° of opposite), each behind the other's face, `thickness_mm` their
+/// distance along the first one's normal, where every sample beside the first on its face (three at
+/// least) finds the same within a fifth (a wall, not a crease or a rounded edge, whose depth
+/// changes across a step: a review's 30° wedge, a blade's sharp edge and its nose were called
+/// walls). Such walls, thinner than
+/// about a third of the sample step, let the surface rule (law.h) take the far face's sample for
+/// the nearest beside the near face, and read a point there as inside: the field pulls it in (a
+/// helper's 0.2 mm plate sampled every 1 mm).
 struct ThinWall {
   double thickness_mm = HUGE_VAL;  ///< HUGE_VAL: none found
   Vec3 at_mm = Vec3::Zero();       ///< the first sample of the pair

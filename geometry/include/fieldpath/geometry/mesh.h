@@ -65,11 +65,12 @@ struct ShellRepair {
 /// (a sheet), where the mesh is closed already, or where the search would be a soup's.
 ShellRepair repairShells(TriangleMesh& mesh);
 
-/// Leaves out the triangles written again the same way round (the same three points in the
-/// same cyclic order, whatever their indices): the surface is there once, and each copy added its
-/// samples to the field (a cube written twice pushed twice as hard). Those written the other way
-/// round (a sheet's two sides) stay. Returns how many were left out.
-std::size_t removeRepeatedFacets(TriangleMesh& mesh);
+/// The triangles written again the same way round (the same three points in the same cyclic
+/// order, whatever their indices), marked 1 past their first: the surface is there once, and the
+/// field sums each copy's samples (a cube written twice pushed twice as hard). The mesh keeps them:
+/// two bodies of a file sharing a face each need it to be closed (left out, a tool inside one
+/// read clear: a review's). Those written the other way round (a sheet's two sides) are not.
+std::vector<char> repeatedFacets(const TriangleMesh& mesh);
 
 /// Winds every closed, consistently wound shell (a connected set of triangles whose every edge is
 /// used twice, once each way) as its kind (ClosedShells: from its nesting and its winding against
