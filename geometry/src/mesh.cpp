@@ -134,38 +134,68 @@ std::vector<Shell> shellsOf(const TriangleMesh& mesh) {
   // share a face or an edge, as a multi-body export writes them, use it twice each way: the
   // vertical-ray parity of ClosedShells still tells inside from outside). The directed edges as
   // sorted keys (u << 32 | v): a count is the length of a key's run (a std::map of pairs took 1 s
-  // at a million triangles).
+  // at a million triangles). Counted three ways, the first that closes a shell kept: without the
+  // repeats; also without triangles of no area (a needle or cap touching a solid at a vertex
+  // opened it: a tool inside read 20 mm clear, a review's; they are surface for the distances,
+  // not for the inside); with every triangle (two bodies sharing a face, each writing it the same
+  // way round, need both copies).
   const auto key = [](int u, int v) {
     return (std::uint64_t(std::uint32_t(u)) << 32) | std::uint32_t(v);
   };
-  std::vector<std::uint64_t> directed;
-  directed.reserve(3 * mesh.triangles.size());
+  std::vector<char> flat(mesh.triangles.size(), 0);
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
-    if (repeat[i]) continue;
     const auto& t = mesh.triangles[i];
-    for (int e = 0; e < 3; ++e) directed.push_back(key(t[e], t[(e + 1) % 3]));
+    const Eigen::Vector3d &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]],
+                          &c = mesh.vertices[t[2]];
+    const double longest2 =
+        std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
+    flat[i] = !((b - a).cross(c - a).norm() > 1e-6 * longest2);
   }
-  std::sort(directed.begin(), directed.end());
-  const auto uses = [&](std::uint64_t k) {
-    const auto [first, last] = std::equal_range(directed.begin(), directed.end(), k);
-    return last - first;
+  const auto counted = [&](int way, std::size_t i) {
+    return way == 2 || (!repeat[i] && (way == 0 || !flat[i]));
   };
-  // Per shell (its union-find root): its triangles, and whether it is closed.
-  std::vector<std::vector<int>> triangles_of(static_cast<std::size_t>(n));
-  std::vector<char> closed(static_cast<std::size_t>(n), 1);
-  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
-    if (repeat[i]) continue;
-    const auto& t = mesh.triangles[i];
-    const int shell = root(t[0]);
-    triangles_of[static_cast<std::size_t>(shell)].push_back(static_cast<int>(i));
-    if (!closed[static_cast<std::size_t>(shell)]) continue;
-    for (int e = 0; e < 3; ++e) {
-      const int u = t[e], v = t[(e + 1) % 3];
-      if (u == v || uses(key(u, v)) != uses(key(v, u))) {
-        closed[static_cast<std::size_t>(shell)] = 0;
-        break;
+  // Per shell (its union-find root): the way that closed it, -1 while none has.
+  std::vector<int> closed_by(static_cast<std::size_t>(n), -1);
+  for (int way = 0; way < 3; ++way) {
+    std::vector<std::uint64_t> directed;
+    directed.reserve(3 * mesh.triangles.size());
+    for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+      if (!counted(way, i) || closed_by[std::size_t(root(mesh.triangles[i][0]))] >= 0) continue;
+      const auto& t = mesh.triangles[i];
+      for (int e = 0; e < 3; ++e) directed.push_back(key(t[e], t[(e + 1) % 3]));
+    }
+    if (directed.empty()) break;
+    std::sort(directed.begin(), directed.end());
+    const auto uses = [&](std::uint64_t k) {
+      const auto [first, last] = std::equal_range(directed.begin(), directed.end(), k);
+      return last - first;
+    };
+    // Per shell not closed yet (its union-find root): closed this way unless an edge says not.
+    std::vector<char> ok(static_cast<std::size_t>(n), 1), any(static_cast<std::size_t>(n), 0);
+    for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+      const auto& t = mesh.triangles[i];
+      const std::size_t shell = std::size_t(root(t[0]));
+      if (closed_by[shell] >= 0 || !counted(way, i) || !ok[shell]) continue;
+      any[shell] = 1;
+      for (int e = 0; e < 3; ++e) {
+        const int u = t[e], v = t[(e + 1) % 3];
+        if (u == v || uses(key(u, v)) != uses(key(v, u))) {
+          ok[shell] = 0;
+          break;
+        }
       }
     }
+    for (std::size_t shell = 0; shell < std::size_t(n); ++shell)
+      if (closed_by[shell] < 0 && any[shell] && ok[shell]) closed_by[shell] = way;
+  }
+  // Each shell's triangles as the way that closed it counts them; an open one's but the repeats.
+  std::vector<std::vector<int>> triangles_of(static_cast<std::size_t>(n));
+  std::vector<char> closed(static_cast<std::size_t>(n), 0);
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const std::size_t shell = std::size_t(root(mesh.triangles[i][0]));
+    const int way = closed_by[shell];
+    closed[shell] = way >= 0;
+    if (way >= 0 ? counted(way, i) : !repeat[i]) triangles_of[shell].push_back(static_cast<int>(i));
   }
   std::vector<Shell> out;
   for (std::size_t shell = 0; shell < triangles_of.size(); ++shell)

@@ -224,6 +224,39 @@ TEST(Mesh, TrianglesWrittenAgainTheSameWayRoundAreMarked) {
   EXPECT_EQ(std::count(none.begin(), none.end(), 1), 0);
 }
 
+// A solid keeps its inside beside what touches it: a needle of no area sharing its corner (its
+// single-use edges opened the shell: a tool inside read 20 mm clear, a review's), and a second
+// body sharing its bottom face written the same way round (counted once, the edges of both
+// bodies did not balance: 4.98 mm clear). Points in the solid, outside it.
+TEST(Mesh, ASolidKeepsItsInsideBesideANeedleOrABodySharingAFace) {
+  TriangleMesh needle = unitCube();
+  const int at = static_cast<int>(needle.vertices.size());
+  needle.vertices.insert(needle.vertices.end(), {{101, 1, 1}, {51, 1 + 1e-5, 1}});
+  needle.triangles.emplace_back(7, at, at + 1);  // from the corner (1, 1, 1)
+  const ClosedShells with_needle(needle);
+  EXPECT_TRUE(with_needle.contains(Eigen::Vector3d(0.5, 0.4, 0.3)));
+  EXPECT_FALSE(with_needle.contains(Eigen::Vector3d(1.5, 0.4, 0.3)));
+
+  TriangleMesh stacked = unitCube();  // [0,1]³ and [0,1]²×[0,0.5] sharing the bottom z = 0
+  const int b = static_cast<int>(stacked.vertices.size());
+  for (int i = 0; i < 8; ++i) {
+    Eigen::Vector3d v = stacked.vertices[std::size_t(i)];
+    if (v.z() > 0.5) v.z() = 0.5;
+    stacked.vertices.push_back(v);
+  }
+  const std::size_t cube_triangles = stacked.triangles.size();
+  for (std::size_t t = 0; t < cube_triangles; ++t) {
+    const Eigen::Vector3i& tri = stacked.triangles[t];
+    // the bottom face through the cube's own vertices (0-3: z = 0), the rest the lower body's
+    Eigen::Vector3i lower;
+    for (int e = 0; e < 3; ++e) lower[e] = tri[e] < 4 ? tri[e] : b + tri[e];
+    stacked.triangles.push_back(lower);
+  }
+  const ClosedShells both(stacked);
+  EXPECT_TRUE(both.contains(Eigen::Vector3d(0.5, 0.4, 0.8)));  // in the cube, over the lower body
+  EXPECT_FALSE(both.contains(Eigen::Vector3d(0.5, 0.4, 1.2)));
+}
+
 // Export defects that left a solid's shell open (its inside unknown: a tool wholly inside read
 // clear), each mended to the closed cube of the same surface: a T-junction (the top face split at
 // a point on one of its edges, the face beside it not), a sliver of no area on an edge, facets
