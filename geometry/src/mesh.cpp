@@ -92,6 +92,12 @@ double meshArea(const TriangleMesh& mesh) {
   return area_mm2;
 }
 
+bool hasNoArea(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const double longest2 =
+      std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
+  return !((b - a).cross(c - a).norm() > 1e-6 * longest2);
+}
+
 double meshVolume(const TriangleMesh& mesh) {
   double six_volume_mm3 = 0.0;
   for (const auto& t : mesh.triangles)
@@ -145,11 +151,7 @@ std::vector<Shell> shellsOf(const TriangleMesh& mesh) {
   std::vector<char> flat(mesh.triangles.size(), 0);
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
     const auto& t = mesh.triangles[i];
-    const Eigen::Vector3d &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]],
-                          &c = mesh.vertices[t[2]];
-    const double longest2 =
-        std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
-    flat[i] = !((b - a).cross(c - a).norm() > 1e-6 * longest2);
+    flat[i] = hasNoArea(mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]);
   }
   const auto counted = [&](int way, std::size_t i) {
     return way == 2 || (!repeat[i] && (way == 0 || !flat[i]));

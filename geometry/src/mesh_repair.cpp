@@ -92,7 +92,7 @@ bool isSliver(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::V
     const double l2 = (*p[(e + 1) % 3] - *p[e]).squaredNorm();
     if (l2 > longest2) longest2 = l2, longest = e;
   }
-  if (!((b - a).cross(c - a).norm() <= kFlatRelative * longest2)) return false;
+  if (!hasNoArea(a, b, c)) return false;
   const Eigen::Vector3d& u = *p[longest];
   const Eigen::Vector3d& v = *p[(longest + 1) % 3];
   const Eigen::Vector3d& apex = *p[(longest + 2) % 3];

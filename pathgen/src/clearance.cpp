@@ -29,19 +29,18 @@ std::shared_ptr<BvhModel> buildBvhModel(const geometry::TriangleMesh& mesh,
   std::vector<fcl::Vector3d> points(mesh.vertices.begin(), mesh.vertices.end());
   std::vector<fcl::Triangle> triangles;
   triangles.reserve(mesh.triangles.size());
-  // Triangles of no area (a sliver closing a T-junction, sin of its angle under 1e-6): FCL's
+  // Triangles of no area (geometry::hasNoArea: a sliver closing a T-junction, a needle): FCL's
   // sphere-triangle test takes a zero normal for "inside the triangle" and met a ball 0.54 mm
   // clear of such a sliver (a reviewer's case: 841 um of false gouge). Left out, a lone needle
   // 100 mm long and 1e-5 mm wide vanished and a ball through it read 199 mm clear (a later
   // review's): each is its longest edge, padded sideways by kSliverPad of that edge's length (at
-  // most 1 um) to a triangle FCL measures; more obstacle, never less. The shells (inside tests)
-  // keep the sliver as it is.
+  // most 1 um) to a triangle FCL measures. The edge is measured whole; the sliver's apex stands
+  // within its own height (under 1e-6 of the edge) of it. The shells (inside tests) keep the
+  // sliver as it is.
   constexpr double kSliverPad = 1e-4, kSliverPadMaxMm = 1e-3;
   for (const auto& t : mesh.triangles) {
-    const Eigen::Vector3d a = mesh.vertices[static_cast<std::size_t>(t[0])];
-    const Eigen::Vector3d e1 = mesh.vertices[static_cast<std::size_t>(t[1])] - a;
-    const Eigen::Vector3d e2 = mesh.vertices[static_cast<std::size_t>(t[2])] - a;
-    if (e1.cross(e2).squaredNorm() > 1e-12 * e1.squaredNorm() * e2.squaredNorm()) {
+    if (!geometry::hasNoArea(mesh.vertices[std::size_t(t[0])], mesh.vertices[std::size_t(t[1])],
+                             mesh.vertices[std::size_t(t[2])])) {
       triangles.emplace_back(t[0], t[1], t[2]);
       continue;
     }

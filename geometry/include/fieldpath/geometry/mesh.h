@@ -32,6 +32,12 @@ struct MeshReport {
 };
 
 MeshReport validateMesh(const TriangleMesh& mesh);
+/// Whether triangle (a, b, c) has no area: twice its area at most 1e-6 of its longest edge
+/// squared (its height under 1e-6 of that edge; a float STL's points sit off their edge by
+/// ~1e-7 of their size). Such a triangle is no surface for the shells' inside tests (it may touch
+/// a solid without opening it) and a segment for the distances (FCL's tests need a normal).
+bool hasNoArea(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c);
+
 /// Total triangle area, mm².
 double meshArea(const TriangleMesh& mesh);
 /// Signed enclosed volume (divergence theorem), mm³; positive for outward orientation of a closed
