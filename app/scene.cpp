@@ -18,6 +18,7 @@
 #include "fieldpath/common/limits.h"
 #include "fieldpath/common/short_number.h"
 #include "fieldpath/geometry/mesh.h"
+#include "fieldpath/geometry/tool_model.h"
 #include "scene_mesh.h"
 #include "scene_reader.h"
 #include "scene_sections.h"
@@ -204,7 +205,12 @@ Scene loadScene(const std::filesystem::path& file, SceneUse use) {
     if (root["tool"]["shape"].Mark().line >= 0)
       scene.tool_shape_line = root["tool"]["shape"].Mark().line + 1;
   }
-  if (root["holder"]) readHolder(r, root["holder"], scene.holder);
+  if (root["holder"]) {
+    readHolder(r, root["holder"], scene.holder);
+    // Named here, with the file and line (it was said with neither where the mesh was made).
+    r.check(root["holder"], "holder",
+            [&] { geometry::validateHolderOnTool(scene.tool, scene.holder); });
+  }
   if (root["clearance"])
     scene.clearance_mm = r.number(
         root["clearance"], "clearance", [](double v) { return v >= 0.0; }, ">= 0");

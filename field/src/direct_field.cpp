@@ -52,6 +52,7 @@ DirectField::DirectField(ObstacleSamples samples, const FieldParams& params)
   initializeOpenVdb();
   index_->samples = std::move(samples);
   index_->params = params;
+  index_->far_face = farFaces(index_->samples, kThinReachSteps * params.sample_step_mm);
   index_->positions.points = &index_->samples.points_mm;
   index_->transform = openvdb::math::Transform::createLinearTransform(params.r0_mm);
   index_->grid = openvdb::tools::createPointIndexGrid<openvdb::tools::PointIndexGrid>(
@@ -86,6 +87,7 @@ BruteForceField::BruteForceField(ObstacleSamples samples, const FieldParams& par
     : samples_(std::move(samples)), params_(params) {
   validate(params);
   checkSamples(samples_);
+  far_face_ = farFaces(samples_, kThinReachSteps * params.sample_step_mm);
 }
 
 void BruteForceField::evaluate(std::span<const Vec3> points_mm, std::span<Vec3> forces) const {
@@ -98,7 +100,7 @@ void BruteForceField::evaluate(std::span<const Vec3> points_mm, std::span<Vec3> 
       points_mm.size(), [] { return 0; },
       [&](std::size_t i, int&) {
         forces[i] = detail::fieldAt(points_mm[i], every, samples_.points_mm, samples_.normals,
-                                    samples_.weights, params_)
+                                    samples_.weights, far_face_, params_)
                         .value_or(Vec3::Zero());
       });
 }

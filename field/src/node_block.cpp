@@ -17,7 +17,11 @@ using kernel::D3;
 using kernel::Law;
 using kernel::SampleSpan;
 
-SampleTable::SampleTable(const ObstacleSamples& samples, double r0_mm) {
+SampleTable::SampleTable(const ObstacleSamples& samples, const std::vector<std::uint8_t>& far,
+                         double r0_mm)
+    : far_face_by_id(far) {
+  if (far.size() != samples.size())
+    throw std::logic_error("SampleTable: far-face flags and samples differ in size");
   const std::size_t n = samples.size();
   double hi[3] = {0, 0, 0};
   for (int a = 0; a < 3; ++a) {
@@ -50,6 +54,7 @@ SampleTable::SampleTable(const ObstacleSamples& samples, double r0_mm) {
   std::vector<std::int32_t> next(cell_start.begin(), cell_start.end() - 1);
   for (auto* v : {&x, &y, &z, &nx, &ny, &nz, &w}) v->resize(n);
   id.resize(n);
+  far_face.resize(n);
   for (std::size_t j = 0; j < n; ++j) {  // stable: ids rise within a cell
     const std::size_t at = std::size_t(next[cell_of[j]]++);
     x[at] = samples.points_mm[j].x();
@@ -60,6 +65,7 @@ SampleTable::SampleTable(const ObstacleSamples& samples, double r0_mm) {
     nz[at] = samples.normals[j].z();
     w[at] = samples.weights[j];
     id[at] = std::int32_t(j);
+    far_face[at] = far[j];
   }
 }
 
@@ -77,6 +83,8 @@ struct ReplayHood {
   int answered;
   SumRequest* request;
   const ObstacleSamples* samples;
+  const kernel::CellTable* cells;  ///< the thin-wall rule's search (rare: far faces read inside)
+  const std::uint8_t* far_face;    ///< by sample id
   int asked = 0;
   bool missing = false;
 
@@ -95,6 +103,10 @@ struct ReplayHood {
   D3 normal(const Accum& a) const {
     const Vec3& n = samples->normals[std::size_t(a.best_id)];
     return {n.x(), n.y(), n.z()};
+  }
+  bool farFace(const Accum& a) const { return far_face[a.best_id] != 0; }
+  void nearFace(D3 x, D3 q, D3 n, double eta, Accum& a) const {
+    kernel::nearFaceIn(*cells, x, q, n, eta, a);
   }
   bool pending() const { return missing; }
 };
@@ -182,6 +194,7 @@ kernel::CellTable cellTableOf(const SampleTable& t) {
   kernel::CellTable c;
   c.all = t.span(0, int(t.size()));
   c.cell_start = t.cell_start.data();
+  c.far_face = t.far_face.data();
   for (int a = 0; a < 3; ++a) {
     c.lo[a] = t.lo[a];
     c.dim[a] = t.dim[a];
@@ -264,8 +277,12 @@ void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, co
       const D3 x{(task.origin[0] + (node >> 6)) * h, (task.origin[1] + ((node >> 3) & 7)) * h,
                  (task.origin[2] + (node & 7)) * h};
       SumRequest request;
-      ReplayHood hood{&scratch.answers[std::size_t(node) * kMaxNodeSums], scratch.answered[node],
-                      &request, &samples};
+      ReplayHood hood{&scratch.answers[std::size_t(node) * kMaxNodeSums],
+                      scratch.answered[node],
+                      &request,
+                      &samples,
+                      &cells,
+                      table.far_face_by_id.data()};
       const kernel::NodeValue value = kernel::nodeValue(hood, job.law, job.rules, x);
       if (!hood.missing) {
         out[node] = value;

@@ -21,12 +21,16 @@ struct SampleTable {
   static constexpr int kMaxCellsPerAxis = 160;
   std::vector<double> x, y, z, nx, ny, nz, w;
   std::vector<std::int32_t> id;
+  std::vector<std::uint8_t> far_face;        ///< farFaces' flags in this table's order
+  std::vector<std::uint8_t> far_face_by_id;  ///< ... and in ObstacleSamples' order
   std::vector<std::int32_t> cell_start;  ///< per cell (x-major, z fastest), then the end
   double lo[3] = {0, 0, 0};              ///< world corner of cell (0, 0, 0), mm
   double cell_mm = 1.0;
   int dim[3] = {0, 0, 0};
 
-  explicit SampleTable(const ObstacleSamples& samples, double r0_mm);
+  /// `far_face`: farFaces(samples, ...), in the samples' order.
+  SampleTable(const ObstacleSamples& samples, const std::vector<std::uint8_t>& far_face,
+              double r0_mm);
   std::size_t size() const { return x.size(); }
   kernel::SampleSpan span(int begin, int end) const {
     return {x.data() + begin, y.data() + begin, z.data() + begin, nx.data() + begin,

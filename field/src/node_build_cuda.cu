@@ -74,6 +74,7 @@ struct CudaNodeBuild::State {
   // The device's copies (freed on scope exit; the stream is synchronised first, ~CudaNodeBuild).
   std::unique_ptr<DeviceArray<double>> x, y, z, nx, ny, nz, w;
   std::unique_ptr<DeviceArray<std::int32_t>> id, starts;
+  std::unique_ptr<DeviceArray<std::uint8_t>> far_face;
   std::unique_ptr<DeviceArray<LeafTask>> tasks;
   std::unique_ptr<DeviceArray<unsigned long long>> firsts;
   std::unique_ptr<DeviceArray<NodeValue>> out;
@@ -105,6 +106,7 @@ CudaNodeBuild::CudaNodeBuild(const CellTable& table, const NodeJob& job,
   st.w = up(table.all.w);
   st.id = std::make_unique<DeviceArray<std::int32_t>>(table.all.id, n, stream);
   st.starts = std::make_unique<DeviceArray<std::int32_t>>(table.cell_start, cells, stream);
+  st.far_face = std::make_unique<DeviceArray<std::uint8_t>>(table.far_face, n, stream);
   st.tasks = std::make_unique<DeviceArray<LeafTask>>(leaves.data(), leaves.size(), stream);
   st.firsts = std::make_unique<DeviceArray<unsigned long long>>(st.first.data(), st.first.size(),
                                                                 stream);
@@ -113,6 +115,7 @@ CudaNodeBuild::CudaNodeBuild(const CellTable& table, const NodeJob& job,
   device.all = SampleSpan{st.x->ptr, st.y->ptr, st.z->ptr, st.nx->ptr, st.ny->ptr, st.nz->ptr,
                           st.w->ptr, st.id->ptr, table.all.count, 0};
   device.cell_start = st.starts->ptr;
+  device.far_face = st.far_face->ptr;
   nodeKernel<<<unsigned(leaves.size()), 512, 0, stream>>>(device, job, st.tasks->ptr,
                                                           st.firsts->ptr, st.out->ptr);
   FIELDPATH_CUDA_CHECK(cudaGetLastError());

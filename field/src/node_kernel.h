@@ -8,6 +8,9 @@
 ///       radius of center (a superset is fine: the terms and the nearest search filter by
 ///       distance), tracking the nearest sample if `track`
 ///   D3 point(const Accum& a), normal(const Accum& a);  // of the nearest sample (a.best_at)
+///   bool farFace(const Accum& a);  // whether the nearest sample is a far face (farFaces)
+///   void nearFace(D3 x, D3 q, D3 n, double eta, Accum& a);  // law.h's thin-wall rule: the
+///       nearest near face within sqrt(a.best_sq) of x (nearFaceScalar), every sample searched
 ///   bool pending() const;  // a sum it could not answer yet: the value being made is thrown
 ///                          // away, so probe() and nodeValue() stop at once
 /// The GPU passes a cell list (never pending); the CPU block build a node's sums made in lanes
@@ -64,6 +67,7 @@ struct Law {
   double r0, r0_sq, inv_r0, r_min, r_min_sq, gain;
   double inv_r_min;     ///< 1 / r_min
   double plane_scale;  ///< PlaneLaw::scale
+  double face_reach;   ///< law.h thin-wall rule: kThinReachSteps · sample_step, mm
   /// PlaneLaw::at
   FP_HD double planeAt(double d_mm) const {
     const double d = dmax(fabs(d_mm), r_min);
@@ -143,10 +147,32 @@ FP_HD void accumulateScalar(const Law& L, const SampleSpan& s, D3 at, bool track
   }
 }
 
+/// law.h isNearFace: sample j a face between x and the face of q (normal n) behind which x
+/// reads at height eta < 0.
+FP_HD bool isNearFace(D3 x, D3 q, D3 n, double eta, D3 qj, D3 nj) {
+  return dot(nj, n) < 0.0 && dot(qj - q, n) < 0.0 && fabs(dot(x - qj, nj)) < -eta;
+}
+
+/// The thin-wall rule's search over one span (law.h probe): the nearest near face (isNearFace)
+/// within sqrt(a.best_sq) of x, ties to the lowest id, into a's best_*; no terms summed.
+FP_HD void nearFaceScalar(const SampleSpan& s, D3 x, D3 q, D3 n, double eta, Accum& a) {
+  for (int j = 0; j < s.count; ++j) {
+    const double dx = x.x - s.x[j], dy = x.y - s.y[j], dz = x.z - s.z[j];
+    const double r2 = dx * dx + dy * dy + dz * dz;
+    if (!(r2 < a.best_sq || (r2 == a.best_sq && a.best_id >= 0 && s.id[j] < a.best_id))) continue;
+    if (!isNearFace(x, q, n, eta, D3{s.x[j], s.y[j], s.z[j]}, D3{s.nx[j], s.ny[j], s.nz[j]}))
+      continue;
+    a.best_sq = r2;
+    a.best_id = s.id[j];
+    a.best_at = s.base + j;
+  }
+}
+
 /// The samples sorted by cell (node_block.h SampleTable) as plain pointers.
 struct CellTable {
   SampleSpan all;  ///< every sample, base 0
   const std::int32_t* cell_start;
+  const std::uint8_t* far_face;  ///< farFaces' flags (law.h's thin-wall rule), table order
   double lo[3];
   double cell_mm, inv_cell;
   int dim[3];
@@ -184,6 +210,17 @@ FP_HD void cellSpans(const CellTable& T, D3 c, double radius, Visit& visit) {
   }
 }
 
+/// The thin-wall rule's search (nearFaceScalar) over the cells within sqrt(a.best_sq) of x.
+FP_HD void nearFaceIn(const CellTable& T, D3 x, D3 q, D3 n, double eta, Accum& a) {
+  struct Visit {
+    D3 x, q, n;
+    double eta;
+    Accum* a;
+    FP_HD void operator()(const SampleSpan& s) { nearFaceScalar(s, x, q, n, eta, *a); }
+  } v{x, q, n, eta, &a};
+  cellSpans(T, x, sqrt(a.best_sq), v);
+}
+
 /// The cell list as a neighbourhood, summing with accumulateScalar (the GPU's).
 struct CellHood {
   const CellTable* table;
@@ -198,6 +235,10 @@ struct CellHood {
   FP_HD void sum(D3 c, double radius, bool track, Accum& a) {
     Visit v{law, c, track, &a};
     cellSpans(*table, c, radius, v);
+  }
+  FP_HD bool farFace(const Accum& a) const { return table->far_face[a.best_at] != 0; }
+  FP_HD void nearFace(D3 x, D3 q, D3 n, double eta, Accum& a) {
+    nearFaceIn(*table, x, q, n, eta, a);
   }
   FP_HD D3 point(const Accum& a) const {
     return {table->all.x[a.best_at], table->all.y[a.best_at], table->all.z[a.best_at]};
@@ -232,6 +273,17 @@ FP_HD Probe probe(Hood& hood, const Law& L, D3 x, double search_mm) {
   out.n = hood.normal(a);
   out.nearest_mm = sqrt(a.best_sq);
   out.height_mm = dot(x - out.q, out.n);
+  if (out.height_mm < 0.0 && hood.farFace(a)) {  // law.h's thin-wall rule
+    Accum face;
+    face.best_sq = (out.nearest_mm + L.face_reach) * (out.nearest_mm + L.face_reach);
+    hood.nearFace(x, out.q, out.n, out.height_mm, face);
+    if (face.best_id >= 0) {
+      out.q = hood.point(face);
+      out.n = hood.normal(face);
+      out.nearest_mm = sqrt(face.best_sq);
+      out.height_mm = dot(x - out.q, out.n);
+    }
+  }
   if (a.best_sq >= L.r0_sq) return out;
   D3 f{a.fx, a.fy, a.fz};
   if (out.height_mm < L.r_min) {

@@ -2,6 +2,7 @@
 /// Internal to field/: the OpenVDB point index behind DirectField (never include from a public
 /// header; each OpenVDB translation unit costs ~15 s and 0.7 GiB to compile).
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <stdexcept>
 #include <vector>
@@ -56,6 +57,7 @@ void initializeOpenVdb();  ///< openvdb::initialize() once per process
 struct DirectField::Index {
   ObstacleSamples samples;
   FieldParams params;
+  std::vector<std::uint8_t> far_face;  ///< farFaces(samples, kThinReachSteps · sample_step)
   SamplePositions positions;
   openvdb::math::Transform::Ptr transform;  ///< index voxels of r0 (a search visits 3³ of them)
   openvdb::tools::PointIndexGrid::Ptr grid;
@@ -93,7 +95,7 @@ struct DirectField::Index {
   std::optional<Vec3> fieldAt(Searcher& s, const Vec3& x_mm) const {
     return detail::fieldAt(
         x_mm, [&](const Vec3& c, double r, auto&& fn) { forEachNear(s, c, r, fn); },
-        samples.points_mm, samples.normals, samples.weights, params);
+        samples.points_mm, samples.normals, samples.weights, far_face, params);
   }
 };
 

@@ -172,38 +172,72 @@ ObstacleSamples sampleObstacles(std::span<const geometry::TriangleMesh> meshes, 
   return out;
 }
 
+namespace {
+
+/// The samples in cells of side `cell_mm` (hashed): forNear(i, radius, fn) calls fn(j) for every
+/// other sample j within radius (at most cell_mm) of sample i.
+class SampleCells {
+ public:
+  SampleCells(const ObstacleSamples& samples, double cell_mm)
+      : samples_(samples), cell_mm_(cell_mm) {
+    for (std::size_t i = 0; i < samples.size(); ++i)
+      cells_[keyOf(cellOf(samples.points_mm[i]))].push_back(i);
+  }
+  template <class Fn>
+  void forNear(std::size_t i, double radius, Fn&& fn) const {
+    const double within_sq = radius * radius;
+    const Vec3& p = samples_.points_mm[i];
+    const Eigen::Vector3i c = cellOf(p);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto it = cells_.find(keyOf(c + Eigen::Vector3i(dx, dy, dz)));
+          if (it == cells_.end()) continue;
+          for (const std::size_t j : it->second)
+            if (j != i && (samples_.points_mm[j] - p).squaredNorm() <= within_sq) fn(j);
+        }
+  }
+
+ private:
+  Eigen::Vector3i cellOf(const Vec3& p) const {
+    return Eigen::Vector3i(int(std::floor(p.x() / cell_mm_)), int(std::floor(p.y() / cell_mm_)),
+                           int(std::floor(p.z() / cell_mm_)));
+  }
+  static std::uint64_t keyOf(const Eigen::Vector3i& c) {
+    return (std::uint64_t(std::uint32_t(c.x()) & 0x1fffff) << 42) |
+           (std::uint64_t(std::uint32_t(c.y()) & 0x1fffff) << 21) |
+           std::uint64_t(std::uint32_t(c.z()) & 0x1fffff);
+  }
+  const ObstacleSamples& samples_;
+  double cell_mm_;
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells_;
+};
+
+}  // namespace
+
+std::vector<std::uint8_t> farFaces(const ObstacleSamples& samples, double reach_mm) {
+  std::vector<std::uint8_t> far(samples.size(), 0);
+  if (!(reach_mm > 0.0) || samples.size() < 2) return far;
+  const SampleCells cells(samples, reach_mm);
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const Vec3& n = samples.normals[k];
+    cells.forNear(k, reach_mm, [&](std::size_t j) {
+      if (samples.normals[j].dot(n) < 0.0 &&
+          (samples.points_mm[j] - samples.points_mm[k]).dot(n) < 0.0)
+        far[k] = 1;
+    });
+  }
+  return far;
+}
+
 ThinWall thinnestWall(const ObstacleSamples& samples, double within_mm) {
   ThinWall thinnest;
   if (!(within_mm > 0.0) || samples.size() < 2) return thinnest;
   // Samples in cells of side 1.5 within_mm (a sample's split steps up to 1.5 steps apart: the
   // samples beside one on its face are sought that far): a pair lies in neighbouring cells.
   const double cell_mm = 1.5 * within_mm;
-  auto cellOf = [cell_mm](const Vec3& p) {
-    return Eigen::Vector3i(int(std::floor(p.x() / cell_mm)), int(std::floor(p.y() / cell_mm)),
-                           int(std::floor(p.z() / cell_mm)));
-  };
-  auto keyOf = [](const Eigen::Vector3i& c) {
-    return (std::uint64_t(std::uint32_t(c.x()) & 0x1fffff) << 42) |
-           (std::uint64_t(std::uint32_t(c.y()) & 0x1fffff) << 21) |
-           std::uint64_t(std::uint32_t(c.z()) & 0x1fffff);
-  };
-  std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells;
-  for (std::size_t i = 0; i < samples.size(); ++i)
-    cells[keyOf(cellOf(samples.points_mm[i]))].push_back(i);
-  // Calls fn(j) for the samples within `radius` (at most cell_mm) of sample i.
-  auto forNear = [&](std::size_t i, double radius, auto&& fn) {
-    const double within_sq = radius * radius;
-    const Vec3& p = samples.points_mm[i];
-    const Eigen::Vector3i c = cellOf(p);
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          const auto it = cells.find(keyOf(c + Eigen::Vector3i(dx, dy, dz)));
-          if (it == cells.end()) continue;
-          for (const std::size_t j : it->second)
-            if (j != i && (samples.points_mm[j] - p).squaredNorm() <= within_sq) fn(j);
-        }
-  };
+  const SampleCells cells(samples, cell_mm);
+  auto forNear = [&](std::size_t i, double radius, auto&& fn) { cells.forNear(i, radius, fn); };
   // A sample's wall: the least depth behind its face of a sample facing the other way (normals
   // within 18° of opposite), each behind the other's face.
   std::vector<double> depth(samples.size(), HUGE_VAL);

@@ -62,6 +62,7 @@ struct NodeBuilder {
     job.law.inv_r_min = 1.0 / params.r_min_mm;
     job.law.gain = params.gain;
     job.law.plane_scale = law.scale;
+    job.law.face_reach = kThinReachSteps * params.sample_step_mm;
     job.rules.ratio = ratio;
     job.rules.band_in_mm = band_in_mm;
     job.rules.reach_mm = reach_mm;
@@ -260,14 +261,14 @@ struct NodeBuilder {
             const Vec3 x(ijk.x() * h, ijk.y() * h, ijk.z() * h);
             if (request.region_mm && !request.region_mm->contains(x)) continue;
             auto for_each_near = [&](const Vec3& center, double radius, auto&& fn) {
-              if (center == x)
+              if (center == x && radius <= reach_mm)  // `near` holds those within reach
                 for (std::size_t j : near) fn(j);
               else
                 index.forEachNear(searcher, center, radius, fn);
             };
             const detail::Probe p =
                 detail::probe(x, for_each_near, samples.points_mm, samples.normals, samples.weights,
-                              params, reach_mm);
+                              index.far_face, params, reach_mm);
             if (p.nearest < 0 || (p.height_mm < -band_in_mm && overSurface(p, over_mm))) continue;
             Vec3 value;
             if (ratio) {
@@ -352,7 +353,8 @@ BuiltLevels buildLevels(const DirectField& direct, const VoxelRequest& request,
                       resolveBackend(request.backend),
                       std::nullopt};
   PhaseTrace trace;
-  if (builder.backend != FieldBackend::Reference) builder.table.emplace(samples, params.r0_mm);
+  if (builder.backend != FieldBackend::Reference)
+    builder.table.emplace(samples, index.far_face, params.r0_mm);
   trace.lap("cell list");
   const double reach_mm = builder.reach_mm;
 

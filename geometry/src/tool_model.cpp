@@ -163,10 +163,7 @@ Profile fullProfile(const ToolSpec& tool, const HolderProfile& holder) {
     p.push_back(line(p.back().to, Vec2(0.0, len)));
     return p;
   }
-  if (!(holder.front().z_mm > cornerRadius(tool)))
-    throw InputError("holder starts at z " + std::to_string(holder.front().z_mm) +
-                     " mm, not above the cutting end of the tool (" +
-                     std::to_string(cornerRadius(tool)) + " mm)");
+  validateHolderOnTool(tool, holder);
   // The shank runs up to the first station, also past L into a holder that starts above the tool.
   // Past L it does not cut: holder surface (checked against the part as the holder is; as tool
   // surface a shank 1 mm into an overhang above L went unseen, `check` ok: a reviewer's case).
@@ -305,6 +302,13 @@ void validateToolSpec(const ToolSpec& tool) {
     throw InputError("tool length must be > 0 mm");
   if (!(tool.length_mm >= end_mm))
     throw InputError("tool length must cover the cutting end (>= " + shortNumber(end_mm) + " mm)");
+}
+
+void validateHolderOnTool(const ToolSpec& tool, const HolderProfile& holder) {
+  if (!holder.empty() && !(holder.front().z_mm > cornerRadius(tool)))
+    throw InputError("holder starts at z " + shortNumber(holder.front().z_mm) +
+                     " mm, not above the cutting end of the tool (" +
+                     shortNumber(cornerRadius(tool)) + " mm)");
 }
 
 void validateHolderProfile(const HolderProfile& holder) {

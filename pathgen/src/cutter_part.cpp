@@ -25,6 +25,46 @@ namespace {
 using geometry::Posture;
 using geometry::Vec3;
 
+/// Whether triangle (a, b, c) meets the ball of radius `reach_mm` about `centre` cut by the plane
+/// (x - centre)·axis <= cap_mm: the triangle clipped to the half-space, then its distance from the
+/// centre (inside its plane's projection: the plane's; else the nearest edge's).
+bool triangleMeetsCappedBall(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& centre,
+                             const Vec3& axis, double reach_mm, double cap_mm) {
+  // Sutherland-Hodgman against one plane: at most 4 vertices.
+  Vec3 poly[4];
+  int n = 0;
+  const Vec3 in[3] = {a, b, c};
+  for (int i = 0; i < 3; ++i) {
+    const Vec3 &p = in[i], &q = in[(i + 1) % 3];
+    const double hp = (p - centre).dot(axis) - cap_mm, hq = (q - centre).dot(axis) - cap_mm;
+    if (hp <= 0.0) poly[n++] = p;
+    if ((hp < 0.0 && hq > 0.0) || (hp > 0.0 && hq < 0.0))
+      poly[n++] = p + (hp / (hp - hq)) * (q - p);
+  }
+  if (n == 0) return false;
+  const double reach_sq = reach_mm * reach_mm;
+  auto segmentSq = [&](const Vec3& p, const Vec3& q) {
+    const Vec3 d = q - p;
+    const double len_sq = d.squaredNorm();
+    const double t = len_sq > 0.0 ? std::clamp((centre - p).dot(d) / len_sq, 0.0, 1.0) : 0.0;
+    return (p + t * d - centre).squaredNorm();
+  };
+  double nearest_sq = HUGE_VAL;
+  for (int i = 0; i < n; ++i)
+    nearest_sq = std::min(nearest_sq, segmentSq(poly[i], poly[(i + 1) % n]));
+  if (nearest_sq <= reach_sq) return true;
+  // The centre's foot inside the clipped polygon (convex, in the triangle's plane): the plane's
+  // distance.
+  const Vec3 normal = (b - a).cross(c - a);
+  const double area_sq = normal.squaredNorm();
+  if (!(area_sq > 0.0) || n < 3) return false;
+  const double height = (centre - a).dot(normal);
+  const Vec3 foot = centre - (height / area_sq) * normal;
+  for (int i = 0; i < n; ++i)
+    if ((poly[(i + 1) % n] - poly[i]).cross(foot - poly[i]).dot(normal) < 0.0) return false;
+  return height * height / area_sq <= reach_sq;
+}
+
 /// One stamp: a pose of the tool, at posture `index` (on_motion false) or on the motion from
 /// posture `index` to the next.
 struct Stamp {
@@ -41,8 +81,11 @@ class Part {
   const Eigen::AlignedBox3d& box() const { return model_.box; }
 
   /// Whether the cutter shrunk by `shrink_mm` meets the part at `pose`: a ball, radius R − s
-  /// about its centre; a torus's corner, the points within r − s of its disc (radius R − r, at
-  /// height r, square to the axis: the corner eroded by s is exactly that); the shank, radius
+  /// about its centre, under its top L − s (a ball shorter than its diameter: a necked tool
+  /// written with L = R has no material above L; the whole sphere read the neck's side of a
+  /// step in the part 0.16 mm deep, a helper's); a torus's corner, the points within r − s of
+  /// its disc (radius R − r, at height r, square to the axis: the corner eroded by s is exactly
+  /// that; one shorter than 2 r is tested whole, which can only say more); the shank, radius
   /// R − s from the corner's top to L − s.
   bool touches(const geometry::ToolSpec& tool, const Posture& pose, double shrink_mm) const {
     const double corner = geometry::cornerRadius(tool);
@@ -50,9 +93,16 @@ class Part {
     if (!(radius > 0.0)) return false;
     const Eigen::Matrix3d turn = geometry::rotationFromZ(pose.axis);
     const Vec3 axis = turn.col(2);
-    if (corner - shrink_mm > 0.0 &&
-        cornerMeets(pose.tip_mm + corner * axis, turn, tool.radius_mm - corner, corner - shrink_mm))
-      return true;
+    const double reach_mm = corner - shrink_mm, disc_mm = tool.radius_mm - corner;
+    const double cap_mm = tool.length_mm - shrink_mm - corner;  // the top over the corner's centre
+    if (reach_mm > 0.0) {
+      const Vec3 centre = pose.tip_mm + corner * axis;
+      if (!(disc_mm > 1e-9) && cap_mm < reach_mm) {
+        if (cappedBallMeets(centre, turn, reach_mm, cap_mm)) return true;
+      } else if (cornerMeets(centre, turn, disc_mm, reach_mm)) {
+        return true;
+      }
+    }
     // Shrunk past its corner radius, a torus's bottom rises with the shrink (its flat end).
     const double bottom = std::max(corner, shrink_mm), top = tool.length_mm - shrink_mm;
     if (top > bottom) {
@@ -76,6 +126,34 @@ class Part {
     fcl::CollisionResultd result;
     return fcl::collide(&shape, at, model_.tree.get(), fcl::Transform3d::Identity(), request,
                         result) > 0;
+  }
+
+  /// Whether the part meets the ball of radius `reach_mm` about `centre` under the plane `cap_mm`
+  /// over it along the axis (turn's third column): the triangles in the ball, each clipped.
+  bool cappedBallMeets(const Vec3& centre, const Eigen::Matrix3d& turn, double reach_mm,
+                       double cap_mm) const {
+    if (!(cap_mm > -reach_mm)) return false;  // nothing of the ball under its top
+    const Vec3 axis = turn.col(2);
+    // A point of the cut ball: wholly inside a closed part, it meets it.
+    if (model_.solids.contains(centre + 0.5 * (std::min(cap_mm, reach_mm) - reach_mm) * axis))
+      return true;
+    constexpr std::size_t kMaxContacts = std::size_t{1} << 22;
+    fcl::CollisionRequestd request(kMaxContacts);
+    fcl::CollisionResultd result;
+    const fcl::Sphered ball(reach_mm);
+    if (fcl::collide(&ball, placed(turn, centre), model_.tree.get(), fcl::Transform3d::Identity(),
+                     request, result) == 0)
+      return false;
+    if (result.numContacts() >= kMaxContacts) return true;  // the list cut short: not cleared
+    const auto& tree = *model_.tree;
+    for (std::size_t i = 0; i < result.numContacts(); ++i) {
+      const fcl::Contactd& contact = result.getContact(i);
+      const fcl::Triangle& t = tree.tri_indices[contact.o1 == &tree ? contact.b1 : contact.b2];
+      if (triangleMeetsCappedBall(tree.vertices[t[0]], tree.vertices[t[1]], tree.vertices[t[2]],
+                                  centre, axis, reach_mm, cap_mm))
+        return true;
+    }
+    return false;
   }
 
   /// Whether the part comes within `reach_mm` of the disc of radius `disc_mm` about `centre`,

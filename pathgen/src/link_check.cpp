@@ -51,6 +51,33 @@ void sortContacts(LinkPartResult& out) {
 
 }  // namespace
 
+geometry::HolderProfile thinnerHolder(const geometry::HolderProfile& holder, double by_mm) {
+  // Thinner by `by` (but never below half its radius: a neck of 0.1 mm under a 0.1 mm graze
+  // had no radius left and the job was refused), its top 2 `by` lower: the stations under the
+  // new top, and one there on the profile (a last station lowered alone fell under a step at
+  // the top, [90, 12], [90, 20]: "z must increase", refused). Its bottom is already `by` up
+  // with the shrunk tool's tip.
+  auto thinner = [by_mm](double radius_mm) { return std::max(radius_mm - by_mm, 0.5 * radius_mm); };
+  geometry::HolderProfile out;
+  if (holder.empty()) return out;
+  const double top_mm = holder.back().z_mm - 2 * by_mm;
+  for (std::size_t i = 0; i < holder.size(); ++i) {
+    const geometry::HolderStation& s = holder[i];
+    if (s.z_mm < top_mm) {
+      out.push_back({s.z_mm, thinner(s.radius_mm)});
+      continue;
+    }
+    if (i > 0 && holder[i - 1].z_mm < top_mm) {  // then s.z_mm > holder[i - 1].z_mm
+      const geometry::HolderStation& a = holder[i - 1];
+      const double f = (top_mm - a.z_mm) / (s.z_mm - a.z_mm);
+      out.push_back({top_mm, thinner(a.radius_mm + f * (s.radius_mm - a.radius_mm))});
+    }
+    break;
+  }
+  if (out.size() < 2) out.clear();  // a holder shorter than 2 `by`: none left to graze
+  return out;
+}
+
 GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
                                   const geometry::HolderProfile& holder,
                                   const geometry::TriangleMesh& part) {
@@ -69,12 +96,10 @@ GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
   // Its top `by` under the tool's, but never below its own cutting end (a ball as long as
   // its radius, L < R + by, was refused as too short for its end after the job's work).
   shrunk.length_mm = std::max(shrunk.length_mm - 2 * by, geometry::cornerRadius(shrunk));
-  geometry::HolderProfile thinner = holder;  // its bottom already `by` up with the tip
-  for (auto& station : thinner) station.radius_mm -= by;
-  if (!thinner.empty()) thinner.back().z_mm -= 2 * by;
-  return {ClearanceChecker(geometry::toolMesh(shrunk, thinner, kClearanceMeshTolMm),
-                           std::span(&part, 1), kClearanceMeshTolMm),
-          by};
+  return {
+      ClearanceChecker(geometry::toolMesh(shrunk, thinnerHolder(holder, by), kClearanceMeshTolMm),
+                       std::span(&part, 1), kClearanceMeshTolMm),
+      by};
 }
 
 LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const GrazingChecker& grazing,

@@ -24,4 +24,17 @@ inline geometry::TriangleMesh box(const Eigen::Vector3d& lo, const Eigen::Vector
   return m;
 }
 
+/// A plate [0, side]² × [0, t], closed, outward normals, its bottom split otherwise than its top
+/// (four triangles fanned from (0.365, 0.405)·side against two), so that the faces' samples lie
+/// apart: beside a face the nearest sample may be the other face's (law.h's thin-wall rule).
+inline geometry::TriangleMesh plateSampledApart(double side_mm, double t_mm) {
+  geometry::TriangleMesh m = box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(side_mm, side_mm, t_mm));
+  m.vertices.emplace_back(0.365 * side_mm, 0.405 * side_mm, 0.0);  // 8
+  m.triangles[0] = {0, 8, 1};  // the bottom (0 1 3 2 round it), seen from below
+  m.triangles[1] = {1, 8, 3};
+  m.triangles.push_back({3, 8, 2});
+  m.triangles.push_back({2, 8, 0});
+  return m;
+}
+
 }  // namespace fieldpath::field::test

@@ -208,6 +208,46 @@ TEST(Sampling, TheThinnestWallIsFoundAtItsThickness) {
             HUGE_VAL);
 }
 
+TEST(Sampling, FarFacesAreTheFacesOfAThinPlateAndNoneOfAThickBox) {
+  const auto plate = test::plateSampledApart(10.0, 0.2);
+  const ObstacleSamples thin = sampleObstacles({&plate, 1}, 1.0, Weights::Area);
+  const std::vector<std::uint8_t> far = farFaces(thin, kThinReachSteps);
+  std::size_t faces = 0;
+  for (std::size_t j = 0; j < thin.size(); ++j) {
+    if (std::abs(thin.normals[j].z()) < 0.99) continue;
+    ++faces;
+    EXPECT_TRUE(far[j]) << thin.points_mm[j].transpose();
+  }
+  EXPECT_GT(faces, 100u);
+  const TriangleMesh thick = test::box(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(10, 10, 3));
+  const ObstacleSamples box = sampleObstacles({&thick, 1}, 1.0, Weights::Area);
+  for (const std::uint8_t flag : farFaces(box, kThinReachSteps)) EXPECT_FALSE(flag);
+}
+
+TEST(Field, AThinPlateSampledApartPushesOutOnBothSidesAndFromWithin) {
+  // A 0.2 mm plate whose faces are sampled apart every 1 mm: beside a face the nearest sample
+  // may be the other face's, and the surface rule alone read the point as inside and mirrored
+  // it through the plate (Fz -25 at 0.1 mm over it, +5.9 at 0.5 mm under it). With law.h's
+  // thin-wall rule the field points away from the plate on both sides, and out of the nearer
+  // face from within; brute force and the indexed sum agree.
+  const auto plate = test::plateSampledApart(20.0, 0.2);
+  FieldParams p;
+  const ObstacleSamples samples = sampleObstacles({&plate, 1}, 1.0, Weights::Area);
+  const DirectField direct(samples, p);
+  const BruteForceField brute(samples, p);
+  for (double x = 3.0; x <= 17.0; x += 0.37)
+    for (double y = 3.0; y <= 17.0; y += 0.41)
+      for (const double z : {-2.0, -0.5, -0.1, -0.02, 0.05, 0.15, 0.22, 0.3, 0.7, 2.2}) {
+        const Vec3 at(x, y, z);
+        const Vec3 f = direct.at(at);
+        EXPECT_EQ(f.z() > 0.0, z > 0.1) << at.transpose() << ": " << f.transpose();
+        EXPECT_LE((brute.at(at) - f).norm(), 1e-12 * f.norm()) << at.transpose();
+      }
+  // 1 mm over it, the two faces' planes: P(1) + P(1.2) (the plane law), within the sampling's 5 %.
+  const double both = planeFieldMagnitude(1.0, p) + planeFieldMagnitude(1.2, p);
+  EXPECT_NEAR(direct.at(Vec3(10.1, 9.7, 1.2)).z(), both, 0.05 * both);
+}
+
 TEST(Sampling, AFineTessellationIsSampledAtTheStepAsked) {
   FieldParams p;
   const TriangleMesh fine = finePlane(8.0, 160, 0.0);  // 51 200 triangles of 0.005 mm²

@@ -195,6 +195,35 @@ TEST(VoxelBuild, CudaBuildEqualsTheCpuBuild) {
     EXPECT_EQ(cuda.stats().backend, "cuda");
     expectSameNodes(cpu, cuda, cpu.stats().active_nodes / 10000);
   }
+  // The thin-wall rule's search (its far faces uploaded with the samples).
+  const auto plate = test::plateSampledApart(20.0, 0.2);
+  const DirectField thin(sampleObstacles({&plate, 1}, 1.0, Weights::Area), FieldParams{});
+  const VoxelField cpu(thin, requestOn(0.2, FieldBackend::Cpu, StoredQuantity::PlaneRatio));
+  const VoxelField cuda(thin, requestOn(0.2, FieldBackend::Cuda, StoredQuantity::PlaneRatio));
+  expectSameNodes(cpu, cuda, cpu.stats().active_nodes / 10000);
+}
+
+TEST(VoxelBuild, BesideAThinPlateTheBuildsAgreeAndPushOut) {
+  // A 0.2 mm plate whose faces are sampled apart (every 1 mm): beside a face the nearest sample
+  // may be the other face's; law.h's thin-wall rule reads such a node as outside, in the
+  // reference, the block build's replay and (above) the CUDA kernel alike. At h 0.2 (the
+  // plate's thickness: a node layer on each face) the field interpolated 0.02-0.5 mm off either
+  // face points away from the plate (before the rule, nodes on the top face read inside through
+  // the bottom's samples: -7 at 0.02 mm over it).
+  const auto plate = test::plateSampledApart(20.0, 0.2);
+  const DirectField direct(sampleObstacles({&plate, 1}, 1.0, Weights::Area), FieldParams{});
+  for (const StoredQuantity stored : {StoredQuantity::PlaneRatio, StoredQuantity::Force}) {
+    const VoxelField reference(direct, requestOn(0.2, FieldBackend::Reference, stored));
+    const VoxelField block(direct, requestOn(0.2, FieldBackend::Cpu, stored));
+    expectSameNodes(reference, block, reference.stats().active_nodes / 5000);
+    if (stored != StoredQuantity::PlaneRatio) continue;
+    for (double x = 3.0; x <= 17.0; x += 0.37)
+      for (double y = 3.0; y <= 17.0; y += 0.41)
+        for (const double off : {0.02, 0.1, 0.5}) {
+          EXPECT_GT(block.at(Vec3(x, y, 0.2 + off)).z(), 0.0) << x << " " << y << " +" << off;
+          EXPECT_LT(block.at(Vec3(x, y, -off)).z(), 0.0) << x << " " << y << " -" << off;
+        }
+  }
 }
 
 TEST(VoxelBuild, CudaBackendIsRefusedWithoutAGpu) {

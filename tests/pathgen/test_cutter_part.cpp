@@ -56,6 +56,29 @@ TEST(CutterPart, AShankBesideAWallEntersItByTheGapShortOfItsRadius) {
   }
 }
 
+// A ball shorter than its diameter (a necked tool written with L = R, its neck in the holder) has
+// no material above its top: a ledge of the part 0.3 mm over the ball's equator and 2.8 mm from
+// the axis is within the whole sphere (by 3 - √(2.8² + 0.3²) = 0.184 mm: a false gouge before,
+// a helper's) and clear of the tool; under the top (L 20) the shank meets it by 0.2 mm.
+TEST(CutterPart, ABallShorterThanItsDiameterHasNoMaterialAboveItsTop) {
+  const geometry::TriangleMesh ledge = boxMesh(2.8, 12, -30, 30, 3.3, 30);
+  const std::vector<Posture> at = {upright(0, 0, 0)};
+  for (const double length : {3.0, 3.2, 5.5}) {
+    const geometry::ToolSpec necked{geometry::ToolShape::Ball, 3.0, 0.0, length};
+    const CutterPartResult r = checkCutterAgainstPart(necked, ledge, at);
+    // Under 3.3 no part of the tool reaches the ledge; at 5.5 the shank does, by 0.2.
+    EXPECT_EQ(r.gouges(), length > 3.3) << length;
+    if (length > 3.3) EXPECT_NEAR(r.max_depth_mm, 0.2, kDepthTolMm);
+  }
+  // The ledge lowered to 2.5 (under the top of L 3): the cut ball's rim at (2.8, 0, 3 - s) is
+  // within 3 - s of the centre while 2.8² + s² <= (3 - s)²: s = 1.16 / 6.
+  const geometry::TriangleMesh low = boxMesh(2.8, 12, -30, 30, 2.5, 30);
+  const CutterPartResult r =
+      checkCutterAgainstPart({geometry::ToolShape::Ball, 3.0, 0.0, 3.0}, low, at);
+  ASSERT_TRUE(r.gouges());
+  EXPECT_NEAR(r.max_depth_mm, 1.16 / 6.0, kDepthTolMm);
+}
+
 // Tilted θ = 10° towards a wall, the shank's top rim reaches x = L sin θ + R cos θ. With the wall
 // e = 0.05 mm short of it, the cutter shrunk by s (radius R − s, top L − s) stops meeting the
 // wall at s = e / (sin θ + cos θ) = 0.0432 mm: the distance from the cutter's surface to the

@@ -195,6 +195,40 @@ TEST(Links, AGivenSafeZBelowTheMeshesIsRefusedNamingTheKey) {
   }
 }
 
+// The grazing checker's holder: thinner by the graze and 2 grazes shorter, as any holder the
+// scene accepts (a helper's holders ending in a step, a short top piece or a 0.1 mm neck were
+// refused mid-job: a last station lowered under a step at its z, a radius thinned to 0).
+TEST(Links, TheGrazingHolderIsValidForEveryHolderTheSceneAccepts) {
+  const double by = kPassGrazeMm;
+  const geometry::HolderProfile top_step = {{40, 6}, {55, 6}, {55, 12}, {90, 12}, {90, 20}};
+  const geometry::HolderProfile thin = thinnerHolder(top_step, by);
+  EXPECT_NO_THROW(geometry::validateHolderProfile(thin));
+  ASSERT_EQ(thin.size(), 4u);  // the step at the top is above the new top (89.8)
+  EXPECT_DOUBLE_EQ(thin.back().z_mm, 90 - 2 * by);
+  EXPECT_DOUBLE_EQ(thin.back().radius_mm, 12 - by);
+  EXPECT_DOUBLE_EQ(thin[2].radius_mm, 12 - by);
+  EXPECT_EQ(thin[2].z_mm, thin[1].z_mm);  // the step kept
+  // A cone to its top: the new top on the cone.
+  const geometry::HolderProfile cone = thinnerHolder({{40, 6}, {90, 11}}, by);
+  ASSERT_EQ(cone.size(), 2u);
+  EXPECT_NEAR(cone.back().radius_mm, 6 + 5 * (90 - 2 * by - 40) / 50 - by, 1e-12);
+  // A 0.1 mm neck keeps half its radius; a holder 0.15 mm high keeps nothing.
+  const geometry::HolderProfile neck = thinnerHolder({{0.5, 0.1}, {20, 0.1}, {20, 3}, {40, 3}}, by);
+  EXPECT_NO_THROW(geometry::validateHolderProfile(neck));
+  EXPECT_DOUBLE_EQ(neck.front().radius_mm, 0.05);
+  EXPECT_TRUE(thinnerHolder({{40, 6}, {40.15, 6}}, by).empty());
+  // The whole checker is made for each (it validates tool and holder again).
+  geometry::TriangleMesh part;
+  pathgen::test::addBox(part, -10, 10, -10, 10, -5, 0);
+  const geometry::ToolSpec ball{geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
+  for (const geometry::HolderProfile& h :
+       {top_step, geometry::HolderProfile{{40, 6}, {90, 12}, {90, 3}},
+        geometry::HolderProfile{{40, 6}, {40.15, 6}}})
+    EXPECT_NO_THROW((void)grazingPartChecker(ball, h, part));
+  const geometry::ToolSpec micro{geometry::ToolShape::Ball, 0.25, 0.0, 0.5};
+  EXPECT_NO_THROW((void)grazingPartChecker(micro, {{0.5, 0.1}, {20, 0.1}}, part));
+}
+
 // The links against the part: a link that travels through a block standing on the part is
 // reported (its postures and the motion between them), the ball's contact where a pass starts
 // and ends is not (retract 0: the link's first posture is the pass's last).

@@ -94,6 +94,9 @@ TEST_F(CpuVsCuda, AnalyticToolsBitIdentical) {
   expectSameBits(g, Tool::ball(2, 8), p, Engine::Fast);
   expectSameBits(g, Tool::torus(3, 1, 12), p, Engine::Fast);
   expectSameBits(g, Tool::flat(1.5, 6), p, Engine::Fast);
+  // Shorter than their end's height: cut at their flat top (tool_entry.h cutAtTop).
+  expectSameBits(g, Tool::ball(2, 2), p, Engine::Fast);
+  expectSameBits(g, Tool::torus(3, 1.5, 2), p, Engine::Fast);
 }
 
 TEST_F(CpuVsCuda, MeshToolBitIdenticalFastAndCoarse) {

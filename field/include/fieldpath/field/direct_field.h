@@ -1,6 +1,8 @@
 #pragma once
 /// Exact evaluation of eq. 1 (law.h): the indexed direct sum and the brute-force reference peer.
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "fieldpath/field/force_field.h"
 #include "fieldpath/field/params.h"
@@ -41,6 +43,7 @@ class BruteForceField final : public ForceField {
  private:
   ObstacleSamples samples_;
   FieldParams params_;
+  std::vector<std::uint8_t> far_face_;  ///< farFaces (law.h's thin-wall rule)
 };
 
 /// Throws common::InputError naming the key (field.r0, field.r_min, ...) if `params` is invalid.

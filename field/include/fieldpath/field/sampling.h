@@ -3,6 +3,7 @@
 /// The guide surface (the one being machined) is never passed here.
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -53,14 +54,20 @@ inline bool isSmallPiece(double area_mm2, double step_mm) {
 /// distance along the first one's normal, where every sample beside the first on its face (three at
 /// least) finds the same within a fifth (a wall, not a crease or a rounded edge, whose depth
 /// changes across a step: a review's 30° wedge, a blade's sharp edge and its nose were called
-/// walls). Such walls, thinner than
-/// about a third of the sample step, let the surface rule (law.h) take the far face's sample for
-/// the nearest beside the near face, and read a point there as inside: the field pulls it in (a
-/// helper's 0.2 mm plate sampled every 1 mm).
+/// walls). The field's samples see such walls (law.h's thin-wall rule); a voxel grid coarser than
+/// twice their thickness interpolates across them between nodes on both faces and pulls a point
+/// beside them in (app/scene_notes.cpp names them).
 struct ThinWall {
   double thickness_mm = HUGE_VAL;  ///< HUGE_VAL: none found
   Vec3 at_mm = Vec3::Zero();       ///< the first sample of the pair
 };
 ThinWall thinnestWall(const ObstacleSamples& samples, double within_mm);
+
+/// The far faces of law.h's thin-wall rule, one flag a sample: sample k is one if a sample j
+/// within `reach_mm` of it faces away from it (n_j·n_k < 0) from behind its face
+/// ((q_j - q_k)·n_k < 0): the far face of a wall thinner than the reach (or of a sharp edge),
+/// whose nearest sample to a point beside the near face may be k's. The rule searches for a
+/// near face only where the nearest sample is flagged: every evaluator reads these flags.
+std::vector<std::uint8_t> farFaces(const ObstacleSamples& samples, double reach_mm);
 
 }  // namespace fieldpath::field

@@ -24,6 +24,8 @@ void validateToolSpec(const ToolSpec& tool);
 /// Throws common::InputError unless there are >= 2 stations, z increases (equal only for a step)
 /// and every radius is finite and > 0.
 void validateHolderProfile(const HolderProfile& holder);
+/// Throws common::InputError unless the holder (if any) starts above the tool's cutting end.
+void validateHolderOnTool(const ToolSpec& tool, const HolderProfile& holder);
 
 /// Closed, outward-oriented mesh of tool body (cutting end + cylindrical shank to L) and holder,
 /// every point within `chord_tol_mm` of the analytic surface. Angular steps come from the sagitta

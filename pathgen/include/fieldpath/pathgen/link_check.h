@@ -47,6 +47,9 @@ struct GrazingChecker {
 GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
                                   const geometry::HolderProfile& holder,
                                   const geometry::TriangleMesh& part);
+/// The grazing checker's holder: `by_mm` thinner (at most half of each radius), its top 2 by_mm
+/// lower (cut on the profile); empty where less than two stations are left.
+geometry::HolderProfile thinnerHolder(const geometry::HolderProfile& holder, double by_mm);
 /// The same against the part prepared once (prepareObstacle).
 GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
                                   const geometry::HolderProfile& holder,

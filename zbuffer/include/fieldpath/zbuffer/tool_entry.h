@@ -86,13 +86,38 @@ FIELDPATH_HD float torusCornerEntry(Vec3f o, Vec3f d, float rho, float r) {
   return t;
 }
 
+/// Whether p lies within r of the disk of radius rho in the plane z = r (the torus corner piece;
+/// rho = 0: the ball of radius r centred at (0, 0, r)).
+FIELDPATH_HD bool inCornerPiece(Vec3f p, float rho, float r) {
+  const float rq = sqrtf(p.x * p.x + p.y * p.y);
+  const float out = maxf(rq - rho, 0.f), dz = p.z - r;
+  return out * out + dz * dz <= r * r;
+}
+
+/// The entry t of the line into the corner piece (convex, entered at t_entry) cut by the tool's
+/// flat top z <= top: where it enters above the top, it enters the cut piece where it crosses
+/// the top plane going down, if that point is in the piece, else never. A ball or torus shorter
+/// than its end's height (L < 2r: a necked tool written with L = R, its neck in the holder) has
+/// no material above L: the whole sphere cut there (322 of 11 092 lines 0.9 mm too low at 25°
+/// of tilt, a helper's).
+FIELDPATH_HD float cutAtTop(float t_entry, Vec3f o, Vec3f d, float top, float rho, float r) {
+  if (t_entry == FLT_MAX || o.z + t_entry * d.z <= top) return t_entry;
+  if (!(d.z < 0.f)) return FLT_MAX;  // level or rising: above the top from the entry on
+  const float t_top = (top - o.z) / d.z;
+  Vec3f p = o + t_top * d;
+  p.z = top;
+  return inCornerPiece(p, rho, r) ? t_top : FLT_MAX;
+}
+
 /// Entry parameter of the line o + t d (tool frame) into an analytic tool, FLT_MAX if it misses.
 FIELDPATH_HD float analyticEntry(const ToolView& tool, Vec3f o, Vec3f d) {
   const float big_r = tool.radius_mm, r = tool.corner_radius_mm;
   float t = cappedCylinderEntry(o, d, big_r, r, tool.length_mm);
   if (r > 0.f) {
     const float rho = big_r - r;
-    t = minf(t, rho > 0.f ? torusCornerEntry(o, d, rho, r) : ballEntry(o, d, r, r));
+    float corner = rho > 0.f ? torusCornerEntry(o, d, rho, r) : ballEntry(o, d, r, r);
+    if (tool.length_mm < 2.f * r) corner = cutAtTop(corner, o, d, tool.length_mm, rho, r);
+    t = minf(t, corner);
   }
   return t;
 }
