@@ -247,10 +247,9 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     }
 
     // (a) exact clearance of postures and motions
-    const geometry::TriangleMesh tool_mesh =
-        geometry::toolMesh(scene.tool, scene.holder, pathgen::kClearanceMeshTolMm);
-    const pathgen::ClearanceChecker checker(tool_mesh, scene.obstacles,
-                                            pathgen::kClearanceMeshTolMm);
+    const double tol_mm = pathgen::clearanceMeshTolMm(scene.tool, scene.holder);
+    const geometry::TriangleMesh tool_mesh = geometry::toolMesh(scene.tool, scene.holder, tol_mm);
+    const pathgen::ClearanceChecker checker(tool_mesh, scene.obstacles, tol_mm);
     surface_request.obstacles = &checker;  // the stock beside them told from the scallop
     const pathgen::ClearanceResult clearance = checker.check(path.postures, {}, progress);
     pathgen::MotionRequest motion_request;
@@ -340,7 +339,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"passes", path.count(geometry::PathBlock::Kind::Pass)},
         {"passes_split_at_gaps", passesSplitAtGaps(path, scene)},
         {"links", path.count(geometry::PathBlock::Kind::Link)},
-        {"clearance", clearanceJson(clearance, scene.clearance_mm, pathgen::kClearanceMeshTolMm)},
+        {"clearance", clearanceJson(clearance, scene.clearance_mm,
+                                    pathgen::clearanceMeshTolMm(scene.tool, scene.holder))},
         {"motions", motionsJson(motions, scene.clearance_mm, motion_request.resolution_mm)},
         {"link_part", linkPartJson(link_part)},
         {"link_part_skipped",

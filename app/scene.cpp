@@ -207,9 +207,11 @@ Scene loadScene(const std::filesystem::path& file, SceneUse use) {
   }
   if (root["holder"]) {
     readHolder(r, root["holder"], scene.holder);
-    // Named here, with the file and line (it was said with neither where the mesh was made).
-    r.check(root["holder"], "holder",
-            [&] { geometry::validateHolderOnTool(scene.tool, scene.holder); });
+    // Named here, with the file and line (it was said with neither where the mesh was made);
+    // against the scene's own tool only (the `field` commands need neither).
+    if (scene.tool_given)
+      r.check(root["holder"], "holder",
+              [&] { geometry::validateHolderOnTool(scene.tool, scene.holder); });
   }
   if (root["clearance"])
     scene.clearance_mm = r.number(

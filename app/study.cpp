@@ -280,7 +280,8 @@ StudyResult runStudy(const StudyRequest& request) {
   auto prepareErrors = [&](const pathgen::GenerateResult& direct_run) {
     const std::vector<geometry::TriangleMesh>& obstacles = job.obstacles;
     const pathgen::ClearanceChecker checker(
-        geometry::toolMesh(job.tool, job.holder, pathgen::kClearanceMeshTolMm), obstacles);
+        geometry::toolMesh(job.tool, job.holder, pathgen::clearanceMeshTolMm(job.tool, job.holder)),
+        obstacles);
     direct = std::make_unique<field::DirectField>(
         field::sampleObstacles(obstacles, job.field.sample_step_mm, job.field.weights), job.field);
 

@@ -418,9 +418,9 @@ ViewData gatherView(const ViewRequest& request) {
       d.missing.push_back("Clearance not shown: " + p.clearance_source);
     } else {
       // As `check` computes it (cmd_check.cpp): the same mesh, tolerance and motion request.
-      const pathgen::ClearanceChecker checker(
-          geometry::toolMesh(scene.tool, scene.holder, pathgen::kClearanceMeshTolMm),
-          scene.obstacles, pathgen::kClearanceMeshTolMm);
+      const double tol_mm = pathgen::clearanceMeshTolMm(scene.tool, scene.holder);
+      const pathgen::ClearanceChecker checker(geometry::toolMesh(scene.tool, scene.holder, tol_mm),
+                                              scene.obstacles, tol_mm);
       const pathgen::ClearanceResult c = checker.check(postures, {}, request.progress);
       pathgen::MotionRequest motion_request;
       motion_request.required_mm = scene.clearance_mm;

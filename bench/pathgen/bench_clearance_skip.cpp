@@ -63,8 +63,8 @@ int main(int argc, char** argv) {
 
   // The balls: every station's centre against the obstacles.
   const pathgen::ClearanceChecker obstacles(
-      geometry::toolMesh(job.tool, job.holder, pathgen::kClearanceMeshTolMm), job.obstacles,
-      pathgen::kClearanceMeshTolMm);
+      geometry::toolMesh(job.tool, job.holder, pathgen::clearanceMeshTolMm(job.tool, job.holder)),
+      job.obstacles, pathgen::clearanceMeshTolMm(job.tool, job.holder));
   std::size_t at_all = 0, at_skip = 0;
   double all = 0, skip = 0;
   const double balls_all_s =
@@ -75,8 +75,8 @@ int main(int argc, char** argv) {
 
   // The holder against the part at every posture.
   const pathgen::ClearanceChecker holder(
-      geometry::holderMesh(job.tool, job.holder, pathgen::kClearanceMeshTolMm),
-      std::span(&*job.part, 1), pathgen::kClearanceMeshTolMm);
+      geometry::holderMesh(job.tool, job.holder, pathgen::clearanceMeshTolMm(job.tool, job.holder)),
+      std::span(&*job.part, 1), pathgen::clearanceMeshTolMm(job.tool, job.holder));
   pathgen::ClearanceRequest only_min;
   only_min.exact_min_only = true;
   pathgen::ClearanceResult every, some;

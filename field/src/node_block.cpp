@@ -108,6 +108,9 @@ struct ReplayHood {
   void nearFace(D3 x, D3 q, D3 n, double eta, Accum& a) const {
     kernel::nearFaceIn(*cells, x, q, n, eta, a);
   }
+  void round(D3 foot, D3 nj, double reach, kernel::Round& r) const {
+    kernel::roundIn(*cells, foot, nj, reach, r);
+  }
   bool pending() const { return missing; }
 };
 

@@ -11,6 +11,8 @@
 ///   bool farFace(const Accum& a);  // whether the nearest sample is a far face (farFaces)
 ///   void nearFace(D3 x, D3 q, D3 n, double eta, Accum& a);  // law.h's thin-wall rule: the
 ///       nearest near face within sqrt(a.best_sq) of x (nearFaceScalar), every sample searched
+///   void round(D3 foot, D3 nj, double reach, Round& r);  // law.h's roundTerm over the samples
+///       within reach of the foot (roundScalar), every sample searched
 ///   bool pending() const;  // a sum it could not answer yet: the value being made is thrown
 ///                          // away, so probe() and nodeValue() stop at once
 /// The GPU passes a cell list (never pending); the CPU block build a node's sums made in lanes
@@ -168,6 +170,26 @@ FP_HD void nearFaceScalar(const SampleSpan& s, D3 x, D3 q, D3 n, double eta, Acc
   }
 }
 
+/// law.h roundTerm and surrounded: the near face's samples round x's foot on its plane.
+struct Round {
+  D3 sum{0, 0, 0};
+  int count = 0;
+  FP_HD bool surrounded() const { return count >= 3 && norm(sum) <= 0.5 * count; }
+};
+FP_HD void roundScalar(const SampleSpan& s, D3 foot, D3 nj, double reach, Round& r) {
+  for (int i = 0; i < s.count; ++i) {
+    if (!(s.nx[i] * nj.x + s.ny[i] * nj.y + s.nz[i] * nj.z >= 0.95)) continue;
+    const D3 d{s.x[i] - foot.x, s.y[i] - foot.y, s.z[i] - foot.z};
+    const double off = dot(d, nj);
+    if (!(fabs(off) <= 0.5 * reach)) continue;
+    const D3 lateral = d - off * nj;
+    const double length = norm(lateral);
+    if (!(length <= reach)) continue;
+    ++r.count;
+    if (length > 0.0) r.sum = r.sum + (1.0 / length) * lateral;
+  }
+}
+
 /// The samples sorted by cell (node_block.h SampleTable) as plain pointers.
 struct CellTable {
   SampleSpan all;  ///< every sample, base 0
@@ -221,6 +243,17 @@ FP_HD void nearFaceIn(const CellTable& T, D3 x, D3 q, D3 n, double eta, Accum& a
   cellSpans(T, x, sqrt(a.best_sq), v);
 }
 
+/// roundScalar over the cells within `reach` of the foot.
+FP_HD void roundIn(const CellTable& T, D3 foot, D3 nj, double reach, Round& r) {
+  struct Visit {
+    D3 foot, nj;
+    double reach;
+    Round* r;
+    FP_HD void operator()(const SampleSpan& s) { roundScalar(s, foot, nj, reach, *r); }
+  } v{foot, nj, reach, &r};
+  cellSpans(T, foot, reach, v);
+}
+
 /// The cell list as a neighbourhood, summing with accumulateScalar (the GPU's).
 struct CellHood {
   const CellTable* table;
@@ -240,6 +273,7 @@ struct CellHood {
   FP_HD void nearFace(D3 x, D3 q, D3 n, double eta, Accum& a) {
     nearFaceIn(*table, x, q, n, eta, a);
   }
+  FP_HD void round(D3 foot, D3 nj, double reach, Round& r) { roundIn(*table, foot, nj, reach, r); }
   FP_HD D3 point(const Accum& a) const {
     return {table->all.x[a.best_at], table->all.y[a.best_at], table->all.z[a.best_at]};
   }
@@ -277,6 +311,12 @@ FP_HD Probe probe(Hood& hood, const Law& L, D3 x, double search_mm) {
     Accum face;
     face.best_sq = (out.nearest_mm + L.face_reach) * (out.nearest_mm + L.face_reach);
     hood.nearFace(x, out.q, out.n, out.height_mm, face);
+    if (face.best_id >= 0) {  // under x's foot (law.h)
+      const D3 qj = hood.point(face), nj = hood.normal(face);
+      Round r;
+      hood.round(x - dot(x - qj, nj) * nj, nj, L.face_reach, r);
+      if (!r.surrounded()) face.best_id = -1;
+    }
     if (face.best_id >= 0) {
       out.q = hood.point(face);
       out.n = hood.normal(face);

@@ -141,10 +141,10 @@ GenerateResult generatePath(const GenerateRequest& request) {
   if (result.passes.empty()) throw InputError("path: no passes to machine");
   const std::vector<geometry::TriangleMesh>& obstacles = request.obstacles;
   if (obstacles.empty()) throw InputError("obstacles: none given (the surfaces that repel)");
-  const geometry::TriangleMesh tool_mesh =
-      geometry::toolMesh(tool, request.holder, kClearanceMeshTolMm);
+  const double tol_mm = clearanceMeshTolMm(tool, request.holder);
+  const geometry::TriangleMesh tool_mesh = geometry::toolMesh(tool, request.holder, tol_mm);
   result.tool_triangles = tool_mesh.triangles.size();
-  const ClearanceChecker checker(tool_mesh, obstacles, kClearanceMeshTolMm);
+  const ClearanceChecker checker(tool_mesh, obstacles, tol_mm);
   checkBallClearance(checker, result.passes, r, request.clearance_mm,
                      scaled(request.progress, 0.0, kBallShare, "balls"),
                      result.balls_under_clearance);
@@ -155,7 +155,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
     if (request.part) top_mm = std::max(top_mm, topOfMeshes(std::span(&*request.part, 1)));
     safe_z_mm = resolveSafeZ(request.links.safe_z_mm, top_mm, request.clearance_mm);
     const double proven_mm =
-        top_mm + request.clearance_mm + kClearanceMeshTolMm + 2.0 * MotionRequest{}.resolution_mm;
+        top_mm + request.clearance_mm + tol_mm + 2.0 * MotionRequest{}.resolution_mm;
     if (request.links.safe_z_mm && safe_z_mm < proven_mm) result.safe_z_proven_mm = proven_mm;
   }
   std::vector<Vec3> nodes;

@@ -96,9 +96,10 @@ GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
   // Its top `by` under the tool's, but never below its own cutting end (a ball as long as
   // its radius, L < R + by, was refused as too short for its end after the job's work).
   shrunk.length_mm = std::max(shrunk.length_mm - 2 * by, geometry::cornerRadius(shrunk));
+  const geometry::HolderProfile thinner = thinnerHolder(holder, by);
+  const double tol_mm = clearanceMeshTolMm(shrunk, thinner);
   return {
-      ClearanceChecker(geometry::toolMesh(shrunk, thinnerHolder(holder, by), kClearanceMeshTolMm),
-                       std::span(&part, 1), kClearanceMeshTolMm),
+      ClearanceChecker(geometry::toolMesh(shrunk, thinner, tol_mm), std::span(&part, 1), tol_mm),
       by};
 }
 
@@ -171,9 +172,10 @@ std::optional<LinkPartResult> checkHolderAgainstPart(
     const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
     const std::shared_ptr<const ObstacleModel>& part, std::span<const geometry::Posture> postures,
     const common::Progress& progress) {
-  const geometry::TriangleMesh holder_mesh = geometry::holderMesh(tool, holder, kClearanceMeshTolMm);
+  const double tol_mm = clearanceMeshTolMm(tool, holder);
+  const geometry::TriangleMesh holder_mesh = geometry::holderMesh(tool, holder, tol_mm);
   if (holder_mesh.triangles.empty() || postures.empty()) return std::nullopt;
-  const ClearanceChecker holder_part(holder_mesh, std::span(&part, 1), kClearanceMeshTolMm);
+  const ClearanceChecker holder_part(holder_mesh, std::span(&part, 1), tol_mm);
   LinkPartResult out;
   ClearanceRequest only_min;  // the holder's minimum and contacts are reported, not each posture's
   only_min.exact_min_only = true;
@@ -212,8 +214,9 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
                               const common::Progress& progress, double ball_exact_below_mm) {
   PartContacts out;  // its progress from 0.2 (0 to 0.2: the model's preparation, above)
   common::report(progress, 0.2, "links vs part");
-  const ClearanceChecker whole(geometry::toolMesh(tool, holder, kClearanceMeshTolMm),
-                               std::span(&model, 1), kClearanceMeshTolMm);
+  const double tol_mm = clearanceMeshTolMm(tool, holder);
+  const ClearanceChecker whole(geometry::toolMesh(tool, holder, tol_mm), std::span(&model, 1),
+                               tol_mm);
   if (path.count(geometry::PathBlock::Kind::Link) > 0)
     out.links = checkLinksAgainstPart(whole, grazingPartChecker(tool, holder, model), path,
                                       common::scaled(progress, 0.2, 0.3, "links vs part"));

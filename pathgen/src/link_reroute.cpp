@@ -51,8 +51,9 @@ class WayChecker {
              const std::shared_ptr<const ObstacleModel>& model, double safe_z_mm)
       : request_(request), obstacles_(obstacles), safe_z_mm_(safe_z_mm) {
     if (model) {
-      whole_.emplace(geometry::toolMesh(request.tool, request.holder, kClearanceMeshTolMm),
-                     std::span(&model, 1), kClearanceMeshTolMm);
+      const double tol_mm = clearanceMeshTolMm(request.tool, request.holder);
+      whole_.emplace(geometry::toolMesh(request.tool, request.holder, tol_mm), std::span(&model, 1),
+                     tol_mm);
       grazing_.emplace(grazingPartChecker(request.tool, request.holder, model));
     }
   }

@@ -215,6 +215,12 @@ TEST(Scene, BadFilesNameTheFileLineAndKey) {
       {"obstacles:\n  - mesh: wall.stl\ndynamics: { damping: 1.0e-300 }\n",
        "dynamics.damping: must be 0, from 1e-12 to 1e12, or `critical`", 3},
       {"obstacles:\n  - mesh: wall.stl\nholder: [[40, 6], [50]]\n", "holder[2]", 3},
+      // A holder under the tool's cutting end, at loading with its line (it was said with neither
+      // file nor key where the tool's mesh was made, a helper's).
+      {"obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, length: 40 }\nholder: "
+       "[[-5, "
+       "6], [20, 6]]\n",
+       "holder: holder starts at z -5 mm, not above the cutting end of the tool (3 mm)", 4},
       {"obstacles:\n  - mesh: wall.stl\nclearance: -0.1\n", "clearance", 3},
       {"obstacles:\n  - mesh: wall.stl\ndynamics:\n  max_tilt_deg: 95\n", "dynamics.max_tilt_deg",
        4},

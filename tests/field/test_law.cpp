@@ -248,6 +248,27 @@ TEST(Field, AThinPlateSampledApartPushesOutOnBothSidesAndFromWithin) {
   EXPECT_NEAR(direct.at(Vec3(10.1, 9.7, 1.2)).z(), both, 0.05 * both);
 }
 
+TEST(Field, InsideABlockBesideAThinFlangeThePushIsOutOfTheBlock) {
+  // A block with a 0.2 mm flange beside it, its top flush with the block's (0.3 mm apart): the
+  // block's top samples have the flange's underside behind them, facing the other way (far
+  // faces), and a plane extended from the underside passes under points inside the block. The
+  // thin-wall rule takes a near face only where its samples round the point's foot: inside the
+  // block, within a step of the flange, the field points up, out of the block's top (the rule
+  // without that test pushed such points down into it: -7.5 at 0.3 mm deep, a review's).
+  const std::vector<TriangleMesh> parts{
+      test::box(Eigen::Vector3d(-10, -10, -10), Eigen::Vector3d(0, 10, 0)),
+      test::box(Eigen::Vector3d(0.3, -10, -0.2), Eigen::Vector3d(10, 10, 0))};
+  FieldParams p;
+  const DirectField direct(sampleObstacles(parts, 1.0, Weights::Area), p);
+  for (double x = -1.5; x <= -0.25; x += 0.25)
+    for (const double z : {-0.3, -0.5, -0.8})
+      for (const double y : {0.1, 0.35, -2.2}) {
+        const Vec3 at(x, y, z);
+        if (-x < -z + 0.2) continue;  // not clearly nearer the top than the side
+        EXPECT_GT(direct.at(at).z(), 0.0) << at.transpose();
+      }
+}
+
 TEST(Sampling, AFineTessellationIsSampledAtTheStepAsked) {
   FieldParams p;
   const TriangleMesh fine = finePlane(8.0, 160, 0.0);  // 51 200 triangles of 0.005 mm²

@@ -5,6 +5,7 @@
 #include "fieldpath/common/errors.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/pathgen/clearance.h"
+#include "fieldpath/pathgen/generate.h"
 #include "fieldpath/pathgen/link_check.h"
 #include "fixtures.h"
 
@@ -134,6 +135,25 @@ TEST(Clearance, BoxToolBesideAWallClosedForm) {
   EXPECT_NEAR(ok.min_clearance_mm, 2.0, 1e-9);
   EXPECT_EQ(ok.min_index, 1u);
   EXPECT_EQ(ok.min_obstacle, 1);
+}
+
+// A micro tool's clearance: the tool mesh within 1/150 of its smallest radius, that chordal
+// error subtracted (at 0.02 mm a 0.1 mm ball read 0.02 mm short: a required 0.02 mm failed at
+// every posture, a helper's). A ball R 0.1 on a neck 0.05 beside a wall 0.03 mm from the ball.
+TEST(Clearance, AMicroToolsClearanceIsWithinAHundredAndFiftiethOfItsRadius) {
+  const geometry::ToolSpec micro{geometry::ToolShape::Ball, 0.1, 0.0, 0.1};
+  const geometry::HolderProfile neck = {{0.2, 0.05}, {5, 0.05}, {5, 0.08}, {30, 0.08}};
+  const double tol_mm = pathgen::clearanceMeshTolMm(micro, neck);
+  EXPECT_DOUBLE_EQ(tol_mm, 0.05 / 150);
+  EXPECT_DOUBLE_EQ(
+      pathgen::clearanceMeshTolMm({geometry::ToolShape::Ball, 3, 0, 40}, {{40, 6}, {90, 12}}),
+      pathgen::kClearanceMeshTolMm);
+  const std::vector<TriangleMesh> obstacles = {wall(0.13)};  // the ball's side at x = 0.1
+  const pathgen::ClearanceChecker checker(geometry::toolMesh(micro, neck, tol_mm), obstacles,
+                                          tol_mm);
+  const double got = checker.clearance(Posture{});
+  EXPECT_LE(got, 0.03);
+  EXPECT_GE(got, 0.03 - 2 * tol_mm);
 }
 
 // A posture whose tool touches or crosses an obstacle (fcl::collide) is reported as colliding

@@ -356,8 +356,9 @@ TEST(Generate, ALinkUpAnAxisIntoAShelfGoesUpAnotherWayTheAxisHeld) {
   ASSERT_EQ(job.passes.size(), 1u);
 
   // The reference: the retract along the axis collides (the checker on its own).
-  const ClearanceChecker checker(geometry::toolMesh(job.tool, job.holder, kClearanceMeshTolMm),
-                                 std::span(job.obstacles), kClearanceMeshTolMm);
+  const double tol_mm = clearanceMeshTolMm(job.tool, job.holder);
+  const ClearanceChecker checker(geometry::toolMesh(job.tool, job.holder, tol_mm),
+                                 std::span(job.obstacles), tol_mm);
   const geometry::Posture start{Vec3(0, 0, 0), axis, 0.0, false};
   const geometry::Posture up_the_axis{Vec3(0, 0, 0) + job.links.retract_mm * axis, axis, 0.0,
                                       false};

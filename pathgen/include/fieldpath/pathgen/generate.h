@@ -249,7 +249,21 @@ GenerateResult generatePath(const GenerateRequest& request);
 /// The impeller's two blades (0 = left, 1 = right).
 std::vector<geometry::TriangleMesh> bladeMeshes(const Impeller& impeller);
 
-/// Chordal tolerance of the tool + holder mesh used for the exact clearance, mm.
+/// Chordal tolerance of the tool + holder mesh used for the exact clearance, mm, at most
+/// (clearanceMeshTolMm).
 inline constexpr double kClearanceMeshTolMm = 0.02;
+
+/// The chordal tolerance of the tool + holder mesh of the exact clearance, mm: kClearanceMeshTolMm,
+/// or 1/150 of the smallest radius of tool and holder where that is less (the same relative
+/// error as a 3 mm ball at 0.02 mm: a 0.1 mm micro ball at 0.02 read every clearance 0.02 mm short,
+/// a required 0.02 mm failed at every posture, a helper's). The checks subtract it.
+inline double clearanceMeshTolMm(const geometry::ToolSpec& tool,
+                                 const geometry::HolderProfile& holder) {
+  double smallest = tool.radius_mm;
+  if (tool.shape == geometry::ToolShape::Torus)
+    smallest = std::min(smallest, tool.corner_radius_mm);
+  for (const geometry::HolderStation& s : holder) smallest = std::min(smallest, s.radius_mm);
+  return smallest > 0.0 ? std::min(kClearanceMeshTolMm, smallest / 150.0) : kClearanceMeshTolMm;
+}
 
 }  // namespace fieldpath::pathgen
