@@ -216,7 +216,9 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     std::vector<std::string> tool_notes = cutterNotes(scene.tool, path);
     if (std::string holder = noHolderNote(scene.tool, scene.holder); !holder.empty())
       tool_notes.push_back(std::move(holder));
-    const std::vector<std::string> obstacle_notes = openObstacleNotes(scene);
+    // The path's voxel size is not known here: the scene's (what `generate` takes by default).
+    const std::vector<std::string> obstacle_notes =
+        openObstacleNotes(scene, scene.field.voxel.voxel_size_mm);
     // What the path file holds that check does not prove: an APT start point (FROM/).
     std::vector<std::string> path_notes;
     if (path.from_line > 0)

@@ -359,7 +359,11 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (scene.nominal) notes.tool = cutterNotes(scene.tool, *scene.nominal);
     if (std::string holder = noHolderNote(scene.tool, scene.holder); !holder.empty())
       notes.tool.push_back(std::move(holder));
-    notes.obstacle = openObstacleNotes(scene);
+    // The voxel size steered with (--voxel or the scene's); --direct and --nominal have none.
+    notes.obstacle =
+        openObstacleNotes(scene, job.mode == pathgen::FieldMode::Voxel && !options->nominal
+                                     ? std::optional<double>(job.field.voxel.voxel_size_mm)
+                                     : std::nullopt);
     if (std::string reach = obstaclesOutOfReachNote(
             scene, obstaclesOutOfReach(scene, result.path, scene.field.r0_mm), scene.field.r0_mm);
         !reach.empty() && !options->nominal)  // (--nominal: nothing steers)

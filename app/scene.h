@@ -109,8 +109,9 @@ inline std::string toolShapeWhere(const Scene& scene) {
 /// facet missing) reads as clear. Empty when every shell is closed; the impeller's blades, sheets
 /// by design, are not files and get none. The part's file gets one too, first (its open shells
 /// have no inside for the cutter test, and their winding says which side is the part's). A part
-/// file named as an obstacle too gets one (it repels the tool from the surface it cuts).
-std::vector<std::string> openObstacleNotes(const Scene& scene);
+/// file named as an obstacle too gets one (it repels the tool from the surface it cuts). Walls
+/// thinner than half of `voxel_mm` (the voxel size the job steers with; none: no voxels) get one.
+std::vector<std::string> openObstacleNotes(const Scene& scene, std::optional<double> voxel_mm);
 /// A mesh file (an obstacle or the part) whose whole extent is under 1 mm beside a mesh, the
 /// nominal path or `path` (check's) 100 times larger: one warning each (a mesh in metres among
 /// millimetres). Said by loadScene on stderr (check says those `path` adds), kept in

@@ -17,7 +17,7 @@
 
 namespace fieldpath::app {
 
-std::vector<std::string> openObstacleNotes(const Scene& scene) {
+std::vector<std::string> openObstacleNotes(const Scene& scene, std::optional<double> voxel) {
   std::vector<std::string> notes;
   if (scene.part && scene.part_file) {
     // An open box wound inward is a pocket by its winding (a tool in it clear); wound outward, a
@@ -54,9 +54,9 @@ std::vector<std::string> openObstacleNotes(const Scene& scene) {
   // Looked for where the samples fit what is left (they are made again here, one obstacle at a
   // time, with a cell map beside them: `check` makes none otherwise).
   const double step_mm = scene.field.sample_step_mm;
-  const double voxel_mm = scene.field.voxel.voxel_size_mm;
+  const double voxel_mm = voxel.value_or(0.0);
   const bool look_for_thin =
-      step_mm > 0.0 &&
+      step_mm > 0.0 && voxel_mm > 0.0 &&
       sampleCount(scene, step_mm) * (kBytesPerSample + 64.0) <= common::memoryLeftBytes();
   for (std::size_t i = 0; i < scene.obstacle_files.size() && i < scene.obstacles.size(); ++i) {
     if (!look_for_thin) break;
@@ -66,8 +66,8 @@ std::vector<std::string> openObstacleNotes(const Scene& scene) {
     if (!(wall.thickness_mm < 0.5 * voxel_mm)) continue;
     char text[400];
     std::snprintf(text, sizeof text,
-                  ": walls down to %.3g mm thick (at %.4g, %.4g, %.4g), under half of "
-                  "field.voxel_size (%g mm): the voxel field interpolates across them and may "
+                  ": walls down to %.3g mm thick (at %.4g, %.4g, %.4g), under half the voxel "
+                  "size steered with (%g mm): the voxel field interpolates across them and may "
                   "pull a point beside them in; a voxel_size of at most %.3g mm (twice their "
                   "thickness) or `generate --direct` keeps it outward",
                   wall.thickness_mm, wall.at_mm.x(), wall.at_mm.y(), wall.at_mm.z(), voxel_mm,

@@ -2,6 +2,7 @@
 /// and bad files rejected with the file, line and key.
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -301,6 +302,28 @@ TEST(Scene, TheSameSurfacesFromTwoFilesAreRefused) {
   }
   const auto two = dir.write("two.yaml", "obstacles:\n  - mesh: wall.stl\n  - mesh: other.stl\n");
   EXPECT_EQ(app::loadScene(two).obstacles.size(), 2u);
+}
+
+// The thin-wall note names walls under half the voxel size the job steers with (`generate
+// --voxel` or the scene's; none for --direct): it quoted the scene's 0.5 mm beside --voxel 1 (a
+// helper's) and spoke of a sample step the samples no longer mind (law.h's thin-wall rule).
+TEST(Scene, TheThinWallNoteIsOnTheVoxelSizeSteeredWith) {
+  TempDir dir;
+  dir.write("plate.stl", app::test::boxStl(0, 0, 0, 10, 10, 0.3));
+  const auto file = dir.write("job.yaml", "obstacles:\n  - mesh: plate.stl\n");
+  const app::Scene scene = app::loadScene(file);
+  auto thin = [&](std::optional<double> voxel_mm) {
+    std::string said;
+    for (const std::string& note : app::openObstacleNotes(scene, voxel_mm))
+      if (note.find("walls down to 0.3 mm") != std::string::npos) said = note;
+    return said;
+  };
+  EXPECT_EQ(thin(0.5), "");  // 0.3 mm is not under half of 0.5
+  const std::string at_one = thin(1.0);
+  EXPECT_NE(at_one.find("under half the voxel size steered with (1 mm)"), std::string::npos)
+      << at_one;
+  EXPECT_NE(at_one.find("at most 0.6 mm"), std::string::npos) << at_one;
+  EXPECT_EQ(thin(std::nullopt), "");  // --direct: the samples see the wall
 }
 
 // A mesh of degenerate triangles only (points on a line) has no surface to repel from: refused,
