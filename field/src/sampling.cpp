@@ -7,6 +7,9 @@
 #include <unordered_map>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "fieldpath/common/errors.h"
 
 namespace fieldpath::field {
@@ -187,14 +190,30 @@ class SampleCells {
   void forNear(std::size_t i, double radius, Fn&& fn) const {
     const double within_sq = radius * radius;
     const Vec3& p = samples_.points_mm[i];
-    const Eigen::Vector3i c = cellOf(p);
+    std::vector<const Members*> near;
+    neighbours(cellOf(p), near);
+    for (const Members* members : near)
+      for (const std::size_t j : *members)
+        if (j != i && (samples_.points_mm[j] - p).squaredNorm() <= within_sq) fn(j);
+  }
+
+  using Members = std::vector<std::size_t>;
+  /// The occupied cells: each one's coordinates and samples.
+  std::vector<std::pair<Eigen::Vector3i, const Members*>> occupied() const {
+    std::vector<std::pair<Eigen::Vector3i, const Members*>> out;
+    out.reserve(cells_.size());
+    for (const auto& [key, members] : cells_)
+      out.emplace_back(cellOf(samples_.points_mm[members.front()]), &members);
+    return out;
+  }
+  /// The samples of the 27 cells round cell c (those occupied).
+  void neighbours(const Eigen::Vector3i& c, std::vector<const Members*>& out) const {
+    out.clear();
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
           const auto it = cells_.find(keyOf(c + Eigen::Vector3i(dx, dy, dz)));
-          if (it == cells_.end()) continue;
-          for (const std::size_t j : it->second)
-            if (j != i && (samples_.points_mm[j] - p).squaredNorm() <= within_sq) fn(j);
+          if (it != cells_.end()) out.push_back(&it->second);
         }
   }
 
@@ -210,7 +229,7 @@ class SampleCells {
   }
   const ObstacleSamples& samples_;
   double cell_mm_;
-  std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells_;
+  std::unordered_map<std::uint64_t, Members> cells_;
 };
 
 }  // namespace
@@ -218,15 +237,34 @@ class SampleCells {
 std::vector<std::uint8_t> farFaces(const ObstacleSamples& samples, double reach_mm) {
   std::vector<std::uint8_t> far(samples.size(), 0);
   if (!(reach_mm > 0.0) || samples.size() < 2) return far;
+  // Cell by cell in parallel (each writes its own samples' flags), its 27 neighbours looked up
+  // once for its samples, each sample's search stopped at its first such neighbour: 500 k
+  // samples (the impeller at 0.1 mm) took 3.4 s one by one.
   const SampleCells cells(samples, reach_mm);
-  for (std::size_t k = 0; k < samples.size(); ++k) {
-    const Vec3& n = samples.normals[k];
-    cells.forNear(k, reach_mm, [&](std::size_t j) {
-      if (samples.normals[j].dot(n) < 0.0 &&
-          (samples.points_mm[j] - samples.points_mm[k]).dot(n) < 0.0)
-        far[k] = 1;
-    });
-  }
+  const auto occupied = cells.occupied();
+  const double reach_sq = reach_mm * reach_mm;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, occupied.size(), 16),
+                    [&](const auto& range) {
+                      std::vector<const SampleCells::Members*> near;
+                      for (std::size_t c = range.begin(); c != range.end(); ++c) {
+                        cells.neighbours(occupied[c].first, near);
+                        for (const std::size_t k : *occupied[c].second) {
+                          const Vec3& q = samples.points_mm[k];
+                          const Vec3& n = samples.normals[k];
+                          auto faces = [&] {
+                            for (const SampleCells::Members* members : near)
+                              for (const std::size_t j : *members) {
+                                const Vec3 d = samples.points_mm[j] - q;
+                                if (j != k && d.squaredNorm() <= reach_sq &&
+                                    samples.normals[j].dot(n) < 0.0 && d.dot(n) < 0.0)
+                                  return true;
+                              }
+                            return false;
+                          };
+                          far[k] = faces() ? 1 : 0;
+                        }
+                      }
+                    });
   return far;
 }
 
