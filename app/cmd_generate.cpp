@@ -503,7 +503,8 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (!result.settle_failures.empty())
       std::fprintf(stderr,
                    "warning: %zu pass%s (first: pass %d) could not start from the axis settled "
-                   "under the field and started from the nominal axis instead: %s "
+                   "under the field and started from the nominal axis (or the clear one nearest "
+                   "it) instead: %s "
                    "(report.json start.settle_failures)\n",
                    result.settle_failures.size(), result.settle_failures.size() == 1 ? "" : "es",
                    result.settle_failures.front().pass + 1,
@@ -534,6 +535,15 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
           result.settled_starts.size(), result.settled_starts.size() == 1 ? "" : "es",
           result.settled_starts.front() + 1, result.settled_starts.size() == 1 ? "its" : "their",
           result.settled_starts.size() == 1 ? "its" : "each one's");
+    if (!result.turned_starts.empty())
+      std::fprintf(stderr,
+                   "note: %zu pass%s (first: pass %d) started from the clear axis nearest the "
+                   "nominal one (%g deg steps within the angle limits): %s start, settled under "
+                   "the field, was still within `clearance` (a holder through a wall thinner "
+                   "than its reach is pushed on, not back) (report.json passes turned_start)\n",
+                   result.turned_starts.size(), result.turned_starts.size() == 1 ? "" : "es",
+                   result.turned_starts.front() + 1, pathgen::kClearStartStepDeg,
+                   result.turned_starts.size() == 1 ? "its" : "each one's");
     if (result.safe_z_proven_mm > 0.0)
       std::fprintf(stderr,
                    "note: links.safe_z %g mm leaves the links within the checks' margin of "

@@ -66,7 +66,9 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
                       {"max_tilt_deg", max_tilt},
                       {"colliding_postures", colliding},
                       {"settled_start", std::find(r.settled_starts.begin(), r.settled_starts.end(),
-                                                  pass.index) != r.settled_starts.end()}});
+                                                  pass.index) != r.settled_starts.end()},
+                      {"turned_start", std::find(r.turned_starts.begin(), r.turned_starts.end(),
+                                                 pass.index) != r.turned_starts.end()}});
     if (std::isnan(pass.v))  // a null beside its reason (DESIGN.md)
       passes.back()["v_skipped"] = "a pass of a nominal path has no channel coordinate v";
   }

@@ -7,13 +7,16 @@
 #include <memory>
 #include <mutex>
 #include <numbers>
+#include <optional>
 #include <sstream>
+#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/phase_trace.h"
+#include "fieldpath/dynamics/frame.h"
 #include "fieldpath/dynamics/steering.h"
 #include "fieldpath/field/direct_field.h"
 #include "fieldpath/field/region_field.h"
@@ -28,6 +31,33 @@
 
 namespace fieldpath::pathgen {
 namespace {
+
+/// The (lead, tilt) nearest (lead0, tilt0) on the grid kClearStartStepDeg apart about it, within
+/// the angle limits, whose clearance(lead, tilt) is at least `required_mm`; nothing if none is.
+/// Nearest first (then lower tilt, then lower lead): the search stops at the first clear one.
+template <class Clearance>
+std::optional<std::pair<double, double>> clearStart(double lead0, double tilt0,
+                                                    const dynamics::DynamicsParams& params,
+                                                    Clearance&& clearance, double required_mm) {
+  const double step = kClearStartStepDeg * std::numbers::pi / 180.0;
+  const double max_lead = params.max_lead_deg * std::numbers::pi / 180.0;
+  const double max_tilt = params.max_tilt_deg * std::numbers::pi / 180.0;
+  std::vector<std::pair<int, int>> grid;
+  const int nl = int(std::floor(2.0 * max_lead / step)) + 1,
+            nt = int(std::floor(2.0 * max_tilt / step)) + 1;
+  for (int i = -nl; i <= nl; ++i)
+    for (int j = -nt; j <= nt; ++j)
+      if (std::abs(lead0 + i * step) <= max_lead && std::abs(tilt0 + j * step) <= max_tilt &&
+          (i != 0 || j != 0))
+        grid.emplace_back(i, j);
+  std::stable_sort(grid.begin(), grid.end(), [](const auto& a, const auto& b) {
+    return a.first * a.first + a.second * a.second < b.first * b.first + b.second * b.second;
+  });
+  for (const auto& [i, j] : grid)
+    if (clearance(lead0 + i * step, tilt0 + j * step) >= required_mm)
+      return std::pair<double, double>{lead0 + i * step, tilt0 + j * step};
+  return std::nullopt;
+}
 
 using common::InputError;
 using Clock = std::chrono::steady_clock;
@@ -202,6 +232,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
                        r)) < request.clearance_mm);
     }
   std::vector<char> started_settled(result.passes.size(), 0);
+  std::vector<char> turned_start(result.passes.size(), 0);
   std::vector<std::string> settle_failed(result.passes.size());  // why, where settling failed
   std::vector<std::string> loosened(result.passes.size());  // why, where the solver was loosened
   struct Steered {
@@ -215,6 +246,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
                          const dynamics::DynamicsParams& params) {
     std::vector<Steered> steered_passes(result.passes.size());
     std::fill(started_settled.begin(), started_settled.end(), 0);  // this steering's own
+    std::fill(turned_start.begin(), turned_start.end(), 0);
     std::fill(settle_failed.begin(), settle_failed.end(), std::string());
     std::fill(loosened.begin(), loosened.end(), std::string());
     int passes_done = 0;
@@ -307,6 +339,25 @@ GenerateResult generatePath(const GenerateRequest& request) {
         } else {
           settle_failed[p] = at_rest.why.empty() ? "the settling failed" : at_rest.why;
         }
+        // Still within `clearance` (a holder upright through a rib thinner than its reach: the
+        // field pushes its nodes on the far side further and the axis settles there, 588
+        // colliding postures on a helper's ribbed pocket): the clear axis nearest the nominal
+        // one within the limits, on a grid kClearStartStepDeg apart, nearest first; the spring
+        // then pulls it back towards the nominal against the near face's field.
+        const dynamics::PassFrame at = dyn_pass.frameAt(0.0);
+        const dynamics::LocalFrame frame = dynamics::localFrame(at);
+        auto clearanceAt = [&](double lead, double tilt) {
+          return checker.clearance(geometry::ballEndPosture(
+              at.centre_mm, dynamics::axisFromAngles(frame, lead, tilt), r));
+        };
+        if (clearanceAt(steer.initial_lead_rad.value_or(at.lead0_rad),
+                        steer.initial_tilt_rad.value_or(at.tilt0_rad)) < request.clearance_mm)
+          if (const auto clear = clearStart(at.lead0_rad, at.tilt0_rad, params, clearanceAt,
+                                            request.clearance_mm)) {
+            steer.initial_lead_rad = clear->first;
+            steer.initial_tilt_rad = clear->second;
+            turned_start[p] = 1;
+          }
       }
       dynamics::SteeringResult steered = dynamics::steerPass(dyn_pass, steer);
       if (steered.status == dynamics::Status::SolverFailed) {
@@ -517,6 +568,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
     if (s.error) std::rethrow_exception(s.error);
   for (std::size_t p = 0; p < result.passes.size(); ++p) {
     if (started_settled[p]) result.settled_starts.push_back(result.passes[p].index);
+    if (turned_start[p]) result.turned_starts.push_back(result.passes[p].index);
     if (!settle_failed[p].empty())
       result.settle_failures.push_back({result.passes[p].index, settle_failed[p]});
     if (!loosened[p].empty()) result.loosened_solver.push_back(loosened[p]);

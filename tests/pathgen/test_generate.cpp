@@ -196,7 +196,9 @@ TEST(Generate, APassStartingInCollisionStartsFromTheSettledAxis) {
   ASSERT_EQ(unsettled.settle_failures.size(), 1u);
   EXPECT_EQ(unsettled.settle_failures.front().pass, 0);
   EXPECT_NE(unsettled.settle_failures.front().why.find("no damping"), std::string::npos);
-  EXPECT_LE(unsettled.postures.front().clearance_mm, 0.0);  // the nominal start, in the wall
+  // The nominal start is in the wall: the pass starts from the clear axis nearest it instead.
+  EXPECT_EQ(unsettled.turned_starts, std::vector<int>{0});
+  EXPECT_GT(unsettled.postures.front().clearance_mm, 0.0);
 
   // With no field (gain 0) `auto` does not settle: the axis at rest is the nominal one, and a
   // note said the pass "started from the axis settled under the field" (a links adversary's).
@@ -205,6 +207,39 @@ TEST(Generate, APassStartingInCollisionStartsFromTheSettledAxis) {
   const GenerateResult still = generatePath(unpushed);
   EXPECT_TRUE(still.settled_starts.empty());
   EXPECT_TRUE(still.settle_failures.empty());
+}
+
+// The same pass beside a rib 0.4 mm thick that the upright holder (r 12 from z 55) passes
+// through: the field pushes its nodes beyond the rib further, the settled axis stays through it
+// (a helper's ribbed pocket: 588 colliding postures). The start is turned to the clear axis
+// nearest the nominal one (kClearStartStepDeg steps), tilted away, and the pass stays clear.
+TEST(Generate, APassStartingThroughAThinRibStartsFromTheNearestClearAxis) {
+  GenerateRequest job;
+  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
+  job.holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
+  job.mode = FieldMode::Direct;
+  job.field.r0_mm = 8.0;
+  job.field.sample_step_mm = 2.0;
+  job.obstacles = {test::boxMesh(20, 20.4, -25, 25, -5, 60)};
+  job.part = test::boxMesh(-30, 20, -25, 25, -5, 0);
+  std::vector<geometry::Posture> nominal;
+  for (int k = 0; k <= 60; ++k)
+    nominal.push_back({Vec3(15, -15 + 0.5 * k, 0), Vec3::UnitZ(), 0.0, false});
+  job.passes = nominalPasses(geometry::singlePass(std::move(nominal)), PathParams{}, 3.0);
+  const GenerateResult r = generatePath(job);
+  EXPECT_EQ(r.turned_starts, std::vector<int>{0});
+  EXPECT_EQ(r.clearance.colliding, 0u);
+  EXPECT_EQ(r.motions.colliding, 0u);
+  EXPECT_GE(r.clearance.min_clearance_mm, job.clearance_mm);
+  EXPECT_LT(r.postures.front().posture.axis.x(), 0.0);  // away from the rib
+  // The first clear axis on the grid: its tilt a multiple of the step (the lead nominal, 0).
+  const double step = kClearStartStepDeg * M_PI / 180.0;
+  const double k = std::abs(r.postures.front().tilt_rad) / step;
+  EXPECT_GE(k, 1.0 - 1e-9);
+  // The wall 2 mm thick of the test above settles clear: no turn there.
+  GenerateRequest thick = job;
+  thick.obstacles = {test::boxMesh(20, 22, -25, 25, -5, 60)};
+  EXPECT_TRUE(generatePath(thick).turned_starts.empty());
 }
 
 // A channel 16 mm wide, walls 20 mm high; the pass runs with the ball 1 mm from one wall, its

@@ -143,8 +143,13 @@ struct GenerateResult {
   /// Passes started from the axis settled at their start (dynamics.start: settled, or auto where
   /// the nominal start posture was within `clearance`), by Pass::index.
   std::vector<int> settled_starts;
+  /// Passes whose start, settled (or nominal), still came within `clearance` and that started
+  /// from the clear axis nearest the nominal one instead (kClearStartStepDeg apart within the
+  /// angle limits), by Pass::index.
+  std::vector<int> turned_starts;
   /// Passes that were to start settled but could not (no damping, the solver failing at rest):
-  /// they start from the nominal axis, which may lie within `clearance`. By Pass::index, why.
+  /// they start from the nominal axis, or where that lies within `clearance` the clear axis
+  /// nearest it (turned_starts). By Pass::index, why.
   struct SettleFailure {
     int pass = 0;
     std::string why;
@@ -248,6 +253,9 @@ GenerateResult generatePath(const GenerateRequest& request);
 
 /// The impeller's two blades (0 = left, 1 = right).
 std::vector<geometry::TriangleMesh> bladeMeshes(const Impeller& impeller);
+
+/// The grid of (lead, tilt) searched for a clear start, degrees (GenerateResult::turned_starts).
+inline constexpr double kClearStartStepDeg = 5.0;
 
 /// Chordal tolerance of the tool + holder mesh used for the exact clearance, mm, at most
 /// (clearanceMeshTolMm).
