@@ -28,6 +28,25 @@ GenerateRequest flatJob() {
   return job;
 }
 
+/// A pass along a wall `thick_mm` thick from x = 20 (its side 2 mm from the ball, 60 mm high),
+/// the ball upright on the floor machined: the holder's r 12 from z 55 reaches x = 27, into the
+/// wall (and through it where it is thinner than 7 mm).
+GenerateRequest passBesideAWall(double thick_mm) {
+  GenerateRequest job;
+  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
+  job.holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
+  job.mode = FieldMode::Direct;
+  job.field.r0_mm = 8.0;
+  job.field.sample_step_mm = 2.0;
+  job.obstacles = {test::boxMesh(20, 20 + thick_mm, -25, 25, -5, 60)};
+  job.part = test::boxMesh(-30, 20, -25, 25, -5, 0);
+  std::vector<geometry::Posture> nominal;
+  for (int k = 0; k <= 60; ++k)
+    nominal.push_back({Vec3(15, -15 + 0.5 * k, 0), Vec3::UnitZ(), 0.0, false});
+  job.passes = nominalPasses(geometry::singlePass(std::move(nominal)), PathParams{}, 3.0);
+  return job;
+}
+
 }  // namespace
 
 // Closed form: walls beyond r0 of every node exert no force, so the steered path is the nominal
@@ -152,18 +171,7 @@ TEST(Generate, RefinementNearThePathGivesThePathOfRefinementEverywhere) {
 // starts from the axis settled under the field there: no collision, no swing. (A pass whose
 // start is clear keeps the nominal start: NoForceGivesTheNominalPath.)
 TEST(Generate, APassStartingInCollisionStartsFromTheSettledAxis) {
-  GenerateRequest job;
-  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
-  job.holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
-  job.mode = FieldMode::Direct;
-  job.field.r0_mm = 8.0;
-  job.field.sample_step_mm = 2.0;
-  job.obstacles = {test::boxMesh(20, 22, -25, 25, -5, 60)};  // the holder's r 12 reaches x = 27
-  job.part = test::boxMesh(-30, 20, -25, 25, -5, 0);         // the floor machined
-  std::vector<geometry::Posture> nominal;
-  for (int k = 0; k <= 60; ++k)  // the ball on the floor 2 mm from the wall, along it
-    nominal.push_back({Vec3(15, -15 + 0.5 * k, 0), Vec3::UnitZ(), 0.0, false});
-  job.passes = nominalPasses(geometry::singlePass(std::move(nominal)), PathParams{}, 3.0);
+  const GenerateRequest job = passBesideAWall(2.0);
   ASSERT_EQ(job.passes.size(), 1u);
 
   GenerateRequest at_nominal = job;
@@ -214,18 +222,7 @@ TEST(Generate, APassStartingInCollisionStartsFromTheSettledAxis) {
 // (a helper's ribbed pocket: 588 colliding postures). The start is turned to the clear axis
 // nearest the nominal one (kClearStartStepDeg steps), tilted away, and the pass stays clear.
 TEST(Generate, APassStartingThroughAThinRibStartsFromTheNearestClearAxis) {
-  GenerateRequest job;
-  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
-  job.holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
-  job.mode = FieldMode::Direct;
-  job.field.r0_mm = 8.0;
-  job.field.sample_step_mm = 2.0;
-  job.obstacles = {test::boxMesh(20, 20.4, -25, 25, -5, 60)};
-  job.part = test::boxMesh(-30, 20, -25, 25, -5, 0);
-  std::vector<geometry::Posture> nominal;
-  for (int k = 0; k <= 60; ++k)
-    nominal.push_back({Vec3(15, -15 + 0.5 * k, 0), Vec3::UnitZ(), 0.0, false});
-  job.passes = nominalPasses(geometry::singlePass(std::move(nominal)), PathParams{}, 3.0);
+  const GenerateRequest job = passBesideAWall(0.4);
   const GenerateResult r = generatePath(job);
   EXPECT_EQ(r.turned_starts, std::vector<int>{0});
   EXPECT_EQ(r.clearance.colliding, 0u);
@@ -237,9 +234,7 @@ TEST(Generate, APassStartingThroughAThinRibStartsFromTheNearestClearAxis) {
   const double k = std::abs(r.postures.front().tilt_rad) / step;
   EXPECT_GE(k, 1.0 - 1e-9);
   // The wall 2 mm thick of the test above settles clear: no turn there.
-  GenerateRequest thick = job;
-  thick.obstacles = {test::boxMesh(20, 22, -25, 25, -5, 60)};
-  EXPECT_TRUE(generatePath(thick).turned_starts.empty());
+  EXPECT_TRUE(generatePath(passBesideAWall(2.0)).turned_starts.empty());
 }
 
 // A channel 16 mm wide, walls 20 mm high; the pass runs with the ball 1 mm from one wall, its
