@@ -14,6 +14,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "clear_start.h"
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/phase_trace.h"
 #include "fieldpath/dynamics/frame.h"
@@ -31,33 +32,6 @@
 
 namespace fieldpath::pathgen {
 namespace {
-
-/// The (lead, tilt) nearest (lead0, tilt0) on the grid kClearStartStepDeg apart about it, within
-/// the angle limits, whose clearance(lead, tilt) is at least `required_mm`; nothing if none is.
-/// Nearest first (then lower tilt, then lower lead): the search stops at the first clear one.
-template <class Clearance>
-std::optional<std::pair<double, double>> clearStart(double lead0, double tilt0,
-                                                    const dynamics::DynamicsParams& params,
-                                                    Clearance&& clearance, double required_mm) {
-  const double step = kClearStartStepDeg * std::numbers::pi / 180.0;
-  const double max_lead = params.max_lead_deg * std::numbers::pi / 180.0;
-  const double max_tilt = params.max_tilt_deg * std::numbers::pi / 180.0;
-  std::vector<std::pair<int, int>> grid;
-  const int nl = int(std::floor(2.0 * max_lead / step)) + 1,
-            nt = int(std::floor(2.0 * max_tilt / step)) + 1;
-  for (int i = -nl; i <= nl; ++i)
-    for (int j = -nt; j <= nt; ++j)
-      if (std::abs(lead0 + i * step) <= max_lead && std::abs(tilt0 + j * step) <= max_tilt &&
-          (i != 0 || j != 0))
-        grid.emplace_back(i, j);
-  std::stable_sort(grid.begin(), grid.end(), [](const auto& a, const auto& b) {
-    return a.first * a.first + a.second * a.second < b.first * b.first + b.second * b.second;
-  });
-  for (const auto& [i, j] : grid)
-    if (clearance(lead0 + i * step, tilt0 + j * step) >= required_mm)
-      return std::pair<double, double>{lead0 + i * step, tilt0 + j * step};
-  return std::nullopt;
-}
 
 using common::InputError;
 using Clock = std::chrono::steady_clock;

@@ -28,25 +28,6 @@ GenerateRequest flatJob() {
   return job;
 }
 
-/// A pass along a wall `thick_mm` thick from x = 20 (its side 2 mm from the ball, 60 mm high),
-/// the ball upright on the floor machined: the holder's r 12 from z 55 reaches x = 27, into the
-/// wall (and through it where it is thinner than 7 mm).
-GenerateRequest passBesideAWall(double thick_mm) {
-  GenerateRequest job;
-  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
-  job.holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
-  job.mode = FieldMode::Direct;
-  job.field.r0_mm = 8.0;
-  job.field.sample_step_mm = 2.0;
-  job.obstacles = {test::boxMesh(20, 20 + thick_mm, -25, 25, -5, 60)};
-  job.part = test::boxMesh(-30, 20, -25, 25, -5, 0);
-  std::vector<geometry::Posture> nominal;
-  for (int k = 0; k <= 60; ++k)
-    nominal.push_back({Vec3(15, -15 + 0.5 * k, 0), Vec3::UnitZ(), 0.0, false});
-  job.passes = nominalPasses(geometry::singlePass(std::move(nominal)), PathParams{}, 3.0);
-  return job;
-}
-
 }  // namespace
 
 // Closed form: walls beyond r0 of every node exert no force, so the steered path is the nominal
@@ -163,78 +144,6 @@ TEST(Generate, RefinementNearThePathGivesThePathOfRefinementEverywhere) {
   EXPECT_LT(near.voxel_outside_points,
             std::size_t(near.rhs_evals) * near.tool_nodes / 2);  // mostly voxels
   EXPECT_EQ(all.voxel_outside_points, 0u);
-}
-
-// A pass along a tall wall whose nominal (upright) axis puts the holder into it. Started at the
-// nominal axis (dynamics.start: nominal, seed 004's), the pass begins colliding and swings to its
-// limits at once; `auto` (the default) sees the nominal start posture within `clearance` and
-// starts from the axis settled under the field there: no collision, no swing. (A pass whose
-// start is clear keeps the nominal start: NoForceGivesTheNominalPath.)
-TEST(Generate, APassStartingInCollisionStartsFromTheSettledAxis) {
-  const GenerateRequest job = passBesideAWall(2.0);
-  ASSERT_EQ(job.passes.size(), 1u);
-
-  GenerateRequest at_nominal = job;
-  at_nominal.dynamics.start = dynamics::StartPolicy::Nominal;
-  const GenerateResult swung = generatePath(at_nominal);
-  EXPECT_TRUE(swung.settled_starts.empty());
-  EXPECT_GT(swung.clearance.colliding, 0u);  // the first posture, holder in the wall
-  EXPECT_LE(swung.postures.front().clearance_mm, 0.0);
-
-  const GenerateResult settled = generatePath(job);
-  EXPECT_EQ(settled.settled_starts, std::vector<int>{0});
-  EXPECT_EQ(settled.clearance.colliding, 0u);
-  EXPECT_EQ(settled.motions.colliding, 0u);
-  EXPECT_GE(settled.clearance.min_clearance_mm, job.clearance_mm);
-  // Tilted away from the wall (+x) from the first posture on, and steady; the nominal start
-  // swings over 10° in its first step.
-  const double first_tilt = settled.postures.front().tilt_rad;
-  EXPECT_GT(std::abs(first_tilt), 20.0 * M_PI / 180.0);
-  EXPECT_LT(settled.postures.front().posture.axis.x(), 0.0);
-  for (const GeneratedPosture& g : settled.postures)
-    EXPECT_NEAR(g.tilt_rad, first_tilt, 0.1 * M_PI / 180.0) << g.s_mm;
-  EXPECT_GT(std::abs(swung.postures[1].tilt_rad - swung.postures[0].tilt_rad), 10.0 * M_PI / 180.0);
-  EXPECT_TRUE(settled.settle_failures.empty());
-
-  // With no damping the axis never comes to rest: the pass starts nominal, and says why.
-  GenerateRequest undamped = job;
-  undamped.dynamics.damping = 0.0;
-  const GenerateResult unsettled = generatePath(undamped);
-  EXPECT_TRUE(unsettled.settled_starts.empty());
-  ASSERT_EQ(unsettled.settle_failures.size(), 1u);
-  EXPECT_EQ(unsettled.settle_failures.front().pass, 0);
-  EXPECT_NE(unsettled.settle_failures.front().why.find("no damping"), std::string::npos);
-  // The nominal start is in the wall: the pass starts from the clear axis nearest it instead.
-  EXPECT_EQ(unsettled.turned_starts, std::vector<int>{0});
-  EXPECT_GT(unsettled.postures.front().clearance_mm, 0.0);
-
-  // With no field (gain 0) `auto` does not settle: the axis at rest is the nominal one, and a
-  // note said the pass "started from the axis settled under the field" (a links adversary's).
-  GenerateRequest unpushed = job;
-  unpushed.field.gain = 0.0;
-  const GenerateResult still = generatePath(unpushed);
-  EXPECT_TRUE(still.settled_starts.empty());
-  EXPECT_TRUE(still.settle_failures.empty());
-}
-
-// The same pass beside a rib 0.4 mm thick that the upright holder (r 12 from z 55) passes
-// through: the field pushes its nodes beyond the rib further, the settled axis stays through it
-// (a helper's ribbed pocket: 588 colliding postures). The start is turned to the clear axis
-// nearest the nominal one (kClearStartStepDeg steps), tilted away, and the pass stays clear.
-TEST(Generate, APassStartingThroughAThinRibStartsFromTheNearestClearAxis) {
-  const GenerateRequest job = passBesideAWall(0.4);
-  const GenerateResult r = generatePath(job);
-  EXPECT_EQ(r.turned_starts, std::vector<int>{0});
-  EXPECT_EQ(r.clearance.colliding, 0u);
-  EXPECT_EQ(r.motions.colliding, 0u);
-  EXPECT_GE(r.clearance.min_clearance_mm, job.clearance_mm);
-  EXPECT_LT(r.postures.front().posture.axis.x(), 0.0);  // away from the rib
-  // The first clear axis on the grid: its tilt a multiple of the step (the lead nominal, 0).
-  const double step = kClearStartStepDeg * M_PI / 180.0;
-  const double k = std::abs(r.postures.front().tilt_rad) / step;
-  EXPECT_GE(k, 1.0 - 1e-9);
-  // The wall 2 mm thick of the test above settles clear: no turn there.
-  EXPECT_TRUE(generatePath(passBesideAWall(2.0)).turned_starts.empty());
 }
 
 // A channel 16 mm wide, walls 20 mm high; the pass runs with the ball 1 mm from one wall, its
