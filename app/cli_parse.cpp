@@ -11,6 +11,7 @@
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/geometry/mesh_io.h"
 #include "fieldpath/geometry/tool_model.h"
+#include "scene_mesh.h"
 #include "to_zbuffer.h"
 
 namespace fieldpath::app {
@@ -45,9 +46,26 @@ zb::Tool parseTool(const std::string& text) {
     }
   }
   geometry::TriangleMesh mesh = geometry::loadMesh(text);
+  mendExportDefects(mesh, text);  // as the scene's solids: slivers, facets wound against the rest
   // The Z-buffer cuts with the tool's downward-facing surface from its tip up: an open mesh
   // (a cylinder without its bottom cap) cut nothing, one below its tip cut 13 mm too deep.
-  const geometry::MeshReport report = geometry::validateMesh(mesh);
+  geometry::MeshReport report = geometry::validateMesh(mesh);
+  if (report.open_edges > 0 || report.non_manifold_edges > 0) {
+    // Triangles of no area cut nothing, but their edges read as non-manifold (a helper's tool
+    // with 286 such edges was refused where the same file as an obstacle was mended): left out
+    // where that closes the tool.
+    geometry::TriangleMesh kept{mesh.vertices, {}};
+    for (const Eigen::Vector3i& t : mesh.triangles)
+      if (!geometry::hasNoArea(mesh.vertices[t[0]], mesh.vertices[t[1]], mesh.vertices[t[2]]))
+        kept.triangles.push_back(t);
+    const geometry::MeshReport without = geometry::validateMesh(kept);
+    if (without.open_edges == 0 && without.non_manifold_edges == 0 && !kept.triangles.empty()) {
+      std::fprintf(stderr, "note: --tool %s: %zu triangles of no area left out\n", text.c_str(),
+                   mesh.triangles.size() - kept.triangles.size());
+      mesh = std::move(kept);
+      report = without;
+    }
+  }
   if (report.open_edges > 0 || report.non_manifold_edges > 0)
     throw InputError("--tool " + text + ": the tool mesh is not closed (" +
                      std::to_string(report.open_edges) + " open, " +

@@ -185,9 +185,10 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     const std::string path_digest = common::fileDigest(options->path);
     // The scene's meshes beside the path checked (loading compared them with each other only: a
     // scene in metres beside the path read ok, a reviewer's): what the path adds, said.
+    const std::vector<MeshScaleWarning> scale_warnings = meshScaleWarnings(scene, &path);
     {
       const std::vector<MeshScaleWarning>& at_load = scene.scale_warnings;  // each mesh once
-      for (const MeshScaleWarning& warning : meshScaleWarnings(scene, &path))
+      for (const MeshScaleWarning& warning : scale_warnings)
         if (std::none_of(at_load.begin(), at_load.end(),
                          [&](const MeshScaleWarning& w) { return w.mesh == warning.mesh; }))
           std::fprintf(stderr, "warning: %s: %s\n", scene.file.string().c_str(),
@@ -318,6 +319,12 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
     const bool part_never_reached = scene.part && !surface && !touches_part && !reaches_part;
     if (part_never_reached)
       not_ok.push_back(std::string("the surface is not checked: ") + surface_skipped);
+    // A part a hundred times smaller than the rest under 1 mm (a part in metres): its surface was
+    // checked at that size, one line of it (a helper's part read `check: ok` beside the warning
+    // that a path read safe beside it is not).
+    for (const MeshScaleWarning& warning : scale_warnings)
+      if (scene.part_file && warning.mesh.rfind("part (", 0) == 0)
+        not_ok.push_back("the surface is checked against a part of another scale: " + warning.text);
     // The finish, where the user gives one (finishReasons).
     for (std::string& reason :
          finishReasons(surface ? &*surface : nullptr, options->max_scallop_um, surface_skipped))

@@ -538,9 +538,10 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
     if (!result.turned_starts.empty())
       std::fprintf(stderr,
                    "note: %zu pass%s (first: pass %d) started from the clear axis nearest the "
-                   "nominal one (%g deg steps within the angle limits): %s start, settled under "
-                   "the field, was still within `clearance` (a holder through a wall thinner "
-                   "than its reach is pushed on, not back) (report.json passes turned_start)\n",
+                   "nominal one (itself where clear; else %g deg steps within the angle limits): "
+                   "%s start, settled under the field (or nominal where settling failed), was "
+                   "within `clearance` (a holder through a wall thinner than its reach is pushed "
+                   "on, not back) (report.json passes turned_start)\n",
                    result.turned_starts.size(), result.turned_starts.size() == 1 ? "" : "es",
                    result.turned_starts.front() + 1, pathgen::kClearStartStepDeg,
                    result.turned_starts.size() == 1 ? "its" : "each one's");

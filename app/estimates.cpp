@@ -165,7 +165,9 @@ void checkSceneSize(const Scene& scene) {
     double reach = scene.tool.length_mm;
     for (const auto& station : scene.holder) reach = std::max(reach, station.z_mm);
     const double limit = box.diagonal() + reach;
-    if (scene.field.r0_mm > limit)
+    // `check` makes no field: a short tool beside a small post was refused for a default r0 it
+    // never uses (a helper's finding).
+    if (scene.field.r0_mm > limit && scene.use != SceneUse::kPathGiven)
       throw InputError(where + "field.r0: " + fmt(scene.field.r0_mm) +
                        " mm exceeds the obstacles' extent plus the tool's reach (" + fmt(limit) +
                        " mm): every sample would act on every node at a cost growing as r0^3" +

@@ -14,6 +14,11 @@ namespace fieldpath::app {
 /// cannot be read or has no surface; the scene reader adds the key and line.
 geometry::TriangleMesh loadSceneMesh(const std::filesystem::path& file);
 
+/// Mends the export defects that leave a solid's shell open or wound both ways (repairShells:
+/// T-junctions, slivers of no area, facets turned against their neighbours) and says what it did
+/// (meshNotes). Used for the scene's meshes and for a `--tool` mesh alike.
+void mendExportDefects(geometry::TriangleMesh& mesh, const std::filesystem::path& file);
+
 /// The notes loadSceneMesh said since the scene's loading began (loadScene clears them): what was
 /// mended or turned, kept for generate's report.json (`mesh_notes`; they were on stderr only).
 std::vector<std::string>& meshNotes();

@@ -260,12 +260,12 @@ LimitCheck checkAngles(const DynamicsParams& p, LimitPolicy policy,
   const struct {
     const char* name;
     const char* key;
-    double max_deg;
+    double max_deg, max_rad;
     int index;
-  } angles[] = {{"lead", "dynamics.max_lead_deg", p.max_lead_deg, 0},
-                {"tilt", "dynamics.max_tilt_deg", p.max_tilt_deg, 1}};
+  } angles[] = {{"lead", "dynamics.max_lead_deg", p.max_lead_deg, p.maxLeadRad(), 0},
+                {"tilt", "dynamics.max_tilt_deg", p.max_tilt_deg, p.maxTiltRad(), 1}};
   for (const auto& a : angles) {
-    const double max_rad = a.max_deg / kDegPerRad;
+    const double max_rad = a.max_rad;
     if (std::abs(y[a.index]) <= max_rad) continue;
     if (policy == LimitPolicy::Clamp) {
       y[a.index] = std::copysign(max_rad, y[a.index]);

@@ -29,6 +29,7 @@
 #include "fieldpath/common/input_file.h"
 #include "fieldpath/common/limits.h"
 #include "ply_check.h"
+#include "polygon_split.h"
 
 namespace fieldpath::geometry {
 namespace {
@@ -435,6 +436,7 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
   // Identical positions are joined across faces and meshes (STL stores every corner per face).
   TriangleMesh mesh;
   std::unordered_map<std::array<ai_real, 3>, int, PositionHash> index_of;
+  std::vector<Eigen::Vector3d> corners;  // a polygon face's, mm
   const auto addMesh = [&](const aiMesh* in, const aiMatrix4x4& transform) {
     std::vector<int> remap(in->mNumVertices);
     for (unsigned i = 0; i < in->mNumVertices; ++i) {
@@ -456,10 +458,26 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
         if (face.mIndices[k] >= in->mNumVertices)
           throw InputError(file.string() + ": face " + std::to_string(f + 1) +
                            " names a vertex that does not exist");
-      // Polygons as fans from their first corner (CAD exports write convex ones).
-      for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)
-        mesh.triangles.emplace_back(remap[face.mIndices[0]], remap[face.mIndices[k]],
-                                    remap[face.mIndices[k + 1]]);
+      if (face.mNumIndices == 3) {
+        mesh.triangles.emplace_back(remap[face.mIndices[0]], remap[face.mIndices[1]],
+                                    remap[face.mIndices[2]]);
+        continue;
+      }
+      // A polygon: a convex one as the fan from its first corner, a concave one ear by ear (an
+      // L-shaped OBJ face fanned covered its notch: 9 colliding postures read where 1.98 mm was).
+      corners.clear();
+      for (unsigned k = 0; k < face.mNumIndices; ++k)
+        corners.push_back(mesh.vertices[std::size_t(remap[face.mIndices[k]])]);
+      const auto split = splitPolygon(corners);
+      if (!split)
+        throw InputError(
+            file.string() + ": face " + std::to_string(f + 1) + ", a polygon of " +
+            std::to_string(face.mNumIndices) + " corners, is concave and " +
+            (face.mNumIndices > kMaxClippedCorners ? "too large to split" : "crosses itself") +
+            ": export the mesh as triangles");
+      for (const Eigen::Vector3i& t : *split)
+        mesh.triangles.emplace_back(remap[face.mIndices[t[0]]], remap[face.mIndices[t[1]]],
+                                    remap[face.mIndices[t[2]]]);
     }
   };
   // Every mesh where the node tree places it (what aiProcess_PreTransformVertices did).

@@ -96,6 +96,39 @@ long long listCount(const unsigned char* bytes, const PlyProperty& property, boo
   return static_cast<long long>(value);
 }
 
+/// The corners of a whole face that the bytes from `at` hold where the body's last element is
+/// `face`: a list of 3 to 64 items that are each an index of the file's vertices (a file whose
+/// header declared one face short: its last face's bytes, indices under 127, passed for padding
+/// and the face was dropped, a tool inside a closed cylinder reading clear). Nothing else.
+std::optional<long long> faceAfterBody(ByteReader& reader, std::uintmax_t size, std::uintmax_t at,
+                                       const std::vector<PlyElement>& elements, bool big_endian) {
+  if (elements.empty() || elements.back().name != "face") return std::nullopt;
+  std::uintmax_t vertices = 0;
+  for (const PlyElement& element : elements)
+    if (element.name == "vertex") vertices = element.count;
+  std::optional<long long> corners;
+  for (const PlyProperty& p : elements.back().properties) {
+    if (p.count_bytes == 0) {
+      if (static_cast<std::uintmax_t>(p.item_bytes) > size - at) return std::nullopt;
+      at += static_cast<std::uintmax_t>(p.item_bytes);
+      continue;
+    }
+    if (static_cast<std::uintmax_t>(p.count_bytes) > size - at) return std::nullopt;
+    const long long n = listCount(reader.at(at, p.count_bytes), p, big_endian);
+    at += static_cast<std::uintmax_t>(p.count_bytes);
+    if (n < 3 || n > 64 || p.item_bytes > 4 ||
+        static_cast<std::uintmax_t>(n * p.item_bytes) > size - at)
+      return std::nullopt;
+    const PlyProperty index{p.item_bytes, false, 0, p.name};  // an item read as a count is
+    for (long long k = 0; k < n; ++k, at += static_cast<std::uintmax_t>(p.item_bytes))
+      if (static_cast<std::uintmax_t>(listCount(reader.at(at, p.item_bytes), index, big_endian)) >=
+          vertices)
+        return std::nullopt;
+    if (p.name == "vertex_indices" || p.name == "vertex_index") corners = n;
+  }
+  return corners;
+}
+
 /// Walks a binary body from `at` element by element as the header declares it: every list count
 /// read (none negative), every byte within the file. Where it does not fit, assimp read past the
 /// file's end (a SEGV found by CI's smoke fuzz) or took counts from float bytes.
@@ -155,6 +188,12 @@ std::uintmax_t walkBinaryBody(const std::filesystem::path& file, std::uintmax_t 
   // Padding is read past (NUL bytes to a block, white space, a DOS end-of-file 0x1A, a line of
   // text: exporters write them, a reviewer's files); bytes of data are not.
   const std::uintmax_t body_end = at;
+  if (const auto extra = faceAfterBody(reader, size, body_end, elements, big_endian))
+    throw InputError(file.string() + ": binary PLY: " + std::to_string(size - body_end) +
+                     " byte(s) after the body its header declares read as another face (" +
+                     std::to_string(*extra) +
+                     " corners, each a vertex of the file): the header's face count is short of "
+                     "the data");
   for (; at < size; ++at) {
     const unsigned char c = *reader.at(at, 1);
     if (!(c == 0 || c == 0x1A || c == '\n' || c == '\r' || c == '\t' || (c >= 0x20 && c < 0x7F)))

@@ -265,8 +265,12 @@ double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double 
   // runs in parallel; the bounds, the minimum and its first index as every station measured.
   constexpr size_t kRun = 64;  // (256 left a pass of fewer stations on one core)
   const bool split = std::isfinite(split_mm) && split_mm > exact_below_mm;
-  const double skip_from_mm = radius_mm + (split ? split_mm : exact_below_mm);
-  const double nearer_from_mm = radius_mm + exact_below_mm, nearer_than_mm = radius_mm + split_mm;
+  // In the result's terms (less the radius and the read margin: a bound skipped at exactly
+  // `exact_below` read under it by the margin far from the origin: a pass 17 mm from a wall at
+  // x = 6e5 was refused as the ball entering it, a helper's).
+  const double from_mm = radius_mm + impl_->read_margin_mm;
+  const double skip_from_mm = from_mm + (split ? split_mm : exact_below_mm);
+  const double nearer_from_mm = from_mm + exact_below_mm, nearer_than_mm = from_mm + split_mm;
   tbb::parallel_for(size_t{0}, (centres_mm.size() + kRun - 1) / kRun, [&](size_t run) {
     const size_t end = std::min(centres_mm.size(), (run + 1) * kRun);
     size_t measured = run * kRun;

@@ -271,7 +271,8 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
                                : std::to_string(end - begin) + " postures at one place")
           << ": a pass needs two distinct postures (passes break at `# pass`, blank lines, "
              "RAPID moves, gaps over path.pass_gap and where the feed turns back: a zig-zag's "
-             "return leg)";
+             "return leg; the feed is the ball centres', tip + R along the axis: axes that "
+             "swing back and forth make it zig-zag)";
       throw InputError(msg.str());
     }
     // An approach down the tool axis at feed before the cut, and a retract up it after (CAM

@@ -212,32 +212,36 @@ TEST(Clearance, BallClearanceIsCentreDistanceLessTheRadius) {
 // Only the clearance under `exact_below_mm` is asked for exactly: a dense path (0.01 mm stations)
 // swinging towards the wall x = 5 from 12 mm off and back gives the every-station minimum, value
 // and index, bit for bit where it is under the threshold, and a lower bound of at least the
-// threshold (at most the true minimum) where it is not.
+// threshold (at most the true minimum) where it is not. So with stations 0.3 mm apart far from
+// the origin (x + 6e5 mm, the meshes read to 0.108 mm there, a margin every figure subtracts): a
+// bound skipped at the threshold read under it by the margin (a pass 17 mm from a wall was
+// refused as the ball entering it, a helper's).
 TEST(Clearance, BallClearanceSkipsStationsThatCannotComeUnderTheThreshold) {
   const TriangleMesh tool = box(Vec3(-1, -1, 0), Vec3(1, 1, 10));
-  const std::vector<TriangleMesh> obstacles = {wall(5.0), wall(-20.0)};
-  const pathgen::ClearanceChecker checker(tool, obstacles);
-  for (const double nearest_x : {-7.0, 2.5, 3.9}) {  // ball clearance 11, 1.5, 0.1 mm at the apex
-    std::vector<Vec3> centres;
-    for (int k = 0; k <= 6000; ++k) {
-      const double t = k / 6000.0;
-      centres.emplace_back(-7.0 + (nearest_x + 7.0) * std::sin(M_PI * t), 60.0 * t, 1.0);
-    }
-    std::size_t at_all = 0, at = 0;
-    int obstacle_all = -1, obstacle = -1;
-    const double all = checker.ballClearance(centres, 1.0, &at_all, &obstacle_all);
-    for (const double threshold : {0.5, 2.0}) {
-      const double skipped = checker.ballClearance(centres, 1.0, &at, &obstacle, threshold);
-      if (all < threshold) {
-        EXPECT_EQ(skipped, all) << nearest_x << ' ' << threshold;
-        EXPECT_EQ(at, at_all);
-        EXPECT_EQ(obstacle, obstacle_all);
-      } else {
-        EXPECT_GE(skipped, threshold) << nearest_x << ' ' << threshold;
-        EXPECT_LE(skipped, all + 1e-12) << nearest_x << ' ' << threshold;
+  for (const auto& [offset, stations] : {std::pair{0.0, 6000}, std::pair{6e5, 200}})
+    for (const double nearest_x : {-7.0, 2.5, 3.9}) {  // ball clearance 11, 1.5, 0.1 mm at the apex
+      const std::vector<TriangleMesh> obstacles = {wall(5.0 + offset), wall(-20.0 + offset)};
+      const pathgen::ClearanceChecker checker(tool, obstacles);
+      std::vector<Vec3> centres;
+      for (int k = 0; k <= stations; ++k) {
+        const double t = double(k) / stations;
+        centres.emplace_back(offset - 7.0 + (nearest_x + 7.0) * std::sin(M_PI * t), 60.0 * t, 1.0);
+      }
+      std::size_t at_all = 0, at = 0;
+      int obstacle_all = -1, obstacle = -1;
+      const double all = checker.ballClearance(centres, 1.0, &at_all, &obstacle_all);
+      for (const double threshold : {0.5, 2.0}) {
+        const double skipped = checker.ballClearance(centres, 1.0, &at, &obstacle, threshold);
+        if (all < threshold) {
+          EXPECT_EQ(skipped, all) << nearest_x << ' ' << threshold;
+          EXPECT_EQ(at, at_all);
+          EXPECT_EQ(obstacle, obstacle_all);
+        } else {
+          EXPECT_GE(skipped, threshold) << nearest_x << ' ' << threshold;
+          EXPECT_LE(skipped, all + 1e-12) << nearest_x << ' ' << threshold;
+        }
       }
     }
-  }
 }
 
 // Split at `split_mm`: every station of the same swinging path told nearer or farther than it

@@ -154,3 +154,36 @@ TEST(GenerateEdges, ObstaclesOutOfTheFieldsReachAreSaid) {
   EXPECT_NE(r.err.find("note: obstacles[2] (beyond.stl, at least"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("it steered nothing"), std::string::npos) << r.err;
 }
+
+// `check` makes no field: a field.r0 beyond the obstacles' extent plus the tool's reach (refused
+// by `generate`, where every sample would act on every node) does not stop it (a reviewer's
+// short tool beside a small post was refused for a default r0 check never uses). A part in
+// metres under a path in millimetres is checked at that size: one Z-buffer line of it read
+// `check: ok` beside the warning that a path read safe beside it is not; now not ok, saying so.
+TEST(GenerateEdges, CheckReadsPastTheFieldsReachAndFailsAPartInMetres) {
+  const TempDir dir;
+  std::string rest = writePlateAndPost(dir);
+  rest.replace(rest.find("r0: 1.0"), 7, "r0: 20");  // the post 4.3 mm across, the tool 10 long
+  dir.write("scene.yaml", "obstacles:\n  - mesh: post.stl\n" + rest);
+  const auto generated = test::runFieldpath(dir, "generate scene.yaml --out g");
+  EXPECT_EQ(generated.exit_code, 1);
+  EXPECT_NE(generated.err.find("field.r0: 20 mm exceeds"), std::string::npos) << generated.err;
+  const auto checked = test::runFieldpath(dir, "check scene.yaml --path p.cl --out c");
+  EXPECT_EQ(checked.err.find("field.r0"), std::string::npos) << checked.err;
+  EXPECT_NE(checked.out.find("check: ok"), std::string::npos) << checked.output();
+
+  geometry::TriangleMesh plate_m;  // the plate in metres, under the passes (y = 1)
+  pathgen::test::addBox(plate_m, -0.002, 0.002, 0.998, 1.002, -0.0005, 0);
+  geometry::saveMesh(plate_m, dir.path() / "plate_m.stl");
+  std::string in_metres = rest;
+  in_metres.replace(in_metres.find("part: plate.stl"), 15, "part: plate_m.stl");
+  dir.write("metres.yaml", "obstacles:\n  - mesh: post.stl\n" + in_metres);
+  const auto metres =
+      test::runFieldpath(dir, "check metres.yaml --path p.cl --spacing 0.001 --out m");
+  EXPECT_EQ(metres.exit_code, 0) << metres.output();
+  EXPECT_EQ(metres.out.find("the surface is not checked"), std::string::npos) << metres.out;
+  EXPECT_NE(metres.out.find("check: NOT OK: the surface is checked against a part of another "
+                            "scale: part (plate_m.stl) spans"),
+            std::string::npos)
+      << metres.output();
+}

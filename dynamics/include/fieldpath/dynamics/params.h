@@ -1,5 +1,6 @@
 #pragma once
 #include <cmath>
+#include <numbers>
 /// Settings of the tool-axis dynamics (scene `dynamics:` block). Defaults documented here, once.
 
 namespace fieldpath::dynamics {
@@ -40,6 +41,11 @@ struct DynamicsParams {
   Integrator integrator = Integrator::Bdf;
   LimitPolicy on_limit = LimitPolicy::Clamp;
   StartPolicy start = StartPolicy::Auto;
+
+  /// The angle limits in radians, as the steering holds them (one conversion for every user: a
+  /// clear start on a grid converted otherwise lay 3e-17 rad over the steering's limit).
+  double maxTiltRad() const { return max_tilt_deg / (180.0 / std::numbers::pi); }
+  double maxLeadRad() const { return max_lead_deg / (180.0 / std::numbers::pi); }
 
   /// c, with the critical default resolved for the spring alone (a field adds its stiffness
   /// during a pass: steering.cpp).

@@ -144,8 +144,8 @@ struct GenerateResult {
   /// the nominal start posture was within `clearance`), by Pass::index.
   std::vector<int> settled_starts;
   /// Passes whose start, settled (or nominal), still came within `clearance` and that started
-  /// from the clear axis nearest the nominal one instead (kClearStartStepDeg apart within the
-  /// angle limits), by Pass::index.
+  /// from the clear axis nearest the nominal one instead (itself where clear, else
+  /// kClearStartStepDeg apart within the angle limits), by Pass::index.
   std::vector<int> turned_starts;
   /// Passes that were to start settled but could not (no damping, the solver failing at rest):
   /// they start from the nominal axis, or where that lies within `clearance` the clear axis
