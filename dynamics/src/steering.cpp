@@ -129,6 +129,13 @@ constexpr double kStiffnessDeltaRad = 5e-3;
 /// stations fall on the grid.
 constexpr double kDampingSpacingMm = 0.5;
 
+/// A corner (steerPass): the feed turning by more than kCornerTurnDeg from a station to the
+/// first station kCornerWindowMm or more on (the next where they lie farther apart): a sharp
+/// corner, or one filleted with a radius under ~5.7 mm. A gentle curve turns less (the
+/// impeller's passes: under 1 deg in 2 mm).
+constexpr double kCornerTurnDeg = 20.0;
+constexpr double kCornerWindowMm = 2.0;
+
 /// J θ'' + c θ' + k (θ - θ0(s)) = τ(θ), first-order form, time in s, s = v t.
 class SteeringSystem final : public detail::OdeSystem {
  public:
@@ -323,7 +330,34 @@ Eigen::Matrix2d fieldStiffness(const field::ForceField& field,
 
 SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
   validate(pass, request);
-  SteeringSystem system(pass, request);
+  // Corners: where the feed turns by more than kCornerTurnDeg within kCornerWindowMm, the feed
+  // (the normal, centre and nominal angles run on) is held from a station to the one that far on
+  // and the angles re-expressed in the frame there, so that the axis does not turn with the
+  // frame about the normal (the stations between are written in the held frame). Held in the
+  // turning frame, a tilt leaning away from a wall leaned at it after a 90 deg turn, the field
+  // kicked and the tilt swung to the opposite limit (holder 2.3 mm into the wall, a helper's pocket
+  // corner). Passes whose feed turns less per station (the impeller's: under 5 deg) run as before,
+  // bit for bit.
+  struct CornerHold {
+    bool on = false;
+    Vec3 feed;
+    double until_mm = 0.0;  // the station where the angles are re-expressed
+  } hold;
+  Pass cornered = pass;
+  cornered.frameAt = [&pass, &hold](double s_mm) {
+    PassFrame f = pass.frameAt(s_mm);
+    if (hold.on) f.feed = hold.feed;  // made square to the normal at s by localFrame
+    return f;
+  };
+  // A corner's frames, a bad one named by its position as the system's are.
+  const auto localAt = [](const PassFrame& frame, double s_mm) {
+    try {
+      return localFrame(frame);
+    } catch (const common::InputError& e) {
+      throw common::InputError(at(s_mm) + e.what());
+    }
+  };
+  SteeringSystem system(cornered, request);
   const double v = system.feedMmPerS();
 
   const PassFrame start = pass.frameAt(0.0);
@@ -397,13 +431,24 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
       }
       if (result.status == Status::SolverFailed || !advanceTo(s_mm)) break;
     }
+    bool corner = false;
+    if (hold.on && s_mm >= hold.until_mm - 1e-9) {  // a corner's end: the axis in the frame at s
+      PassFrame held = pass.frameAt(s_mm);
+      held.feed = hold.feed;
+      const Vec3 axis = axisFromAngles(localAt(held, s_mm), y[0], y[1]);
+      const LocalFrame now = localAt(pass.frameAt(s_mm), s_mm);
+      y[0] = std::asin(std::clamp(axis.dot(now.f), -1.0, 1.0));
+      y[1] = std::atan2(-axis.dot(now.b), axis.dot(now.n));
+      hold.on = false;
+      corner = true;
+    }
     LimitCheck check = checkAngles(request.params, request.params.on_limit, y);
     bool damping_follows = false;
     if (std::abs(gridAt(update) - s_mm) <= 1e-9) {
       damping_follows = s_mm < end_mm && system.updateDamping(s_mm, y);
       ++update;
     }
-    if (check.clamped || damping_follows) integrator->restart(s_mm / v, y.data());
+    if (check.clamped || damping_follows || corner) integrator->restart(s_mm / v, y.data());
     PostureSample sample = system.sample(s_mm, y);
     sample.limited = check.clamped;
     if (!sample.moment.allFinite()) {  // the solver saw it too late (at s = 0) or not at all
@@ -434,6 +479,27 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
       result.status = check.status;
       result.message = at(s_mm) + check.what;
       break;
+    }
+    if (k < intervals && !hold.on) {  // a corner ahead: held from here to its far station
+      // (over kCornerWindowMm at least: a corner sampled finely turns little per station)
+      long end = k + 1;
+      while (end < intervals &&
+             stations[static_cast<std::size_t>(end)] < s_mm + kCornerWindowMm - 1e-9)
+        ++end;
+      const double until_mm = stations[static_cast<std::size_t>(end)];
+      // (a bad frame ahead is the integrator's to name where it first meets it: not held)
+      LocalFrame from, to;
+      bool framed = true;
+      try {
+        from = localFrame(pass.frameAt(s_mm));
+        to = localFrame(pass.frameAt(until_mm));
+      } catch (const common::InputError&) {
+        framed = false;
+      }
+      if (framed && from.f.dot(to.f) < std::cos(kCornerTurnDeg / kDegPerRad)) {
+        hold = {true, from.f, until_mm};
+        integrator->restart(s_mm / v, y.data());
+      }
     }
     if (k % report_every == 0)
       common::report(request.progress, intervals > 0 ? static_cast<double>(k) / intervals : 1.0,
