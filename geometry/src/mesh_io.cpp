@@ -140,10 +140,34 @@ struct StlFeed {
   /// A binary header starting with a UTF-8 byte-order mark's bytes: assimp skips them as text
   /// (and misreads the count, "Failed to determine STL storage"), so the copy has them blank.
   bool blank_mark = false;
+  /// ASCII facets whose normal assimp cannot read (MSVC's `-nan(ind)`, `1.#QNAN`, or no
+  /// `normal` word: it refused the file with a dump of its text): every facet's normal written
+  /// 0 0 0 in the copy (the triangles' normals come from their winding).
+  bool zero_normals = false;
+  /// Bytes of white space before `solid` (a blank first line: "Failed to determine STL storage
+  /// representation"), left out of the copy.
+  std::uintmax_t skip = 0;
   std::uintmax_t length = 0;
   bool ascii = false;
   std::uintmax_t triangles = 0;  ///< its header's count (binary) or its facets (ASCII)
 };
+
+/// `text` (an ASCII STL) with every `facet ...` line written `facet normal 0 0 0`.
+std::string zeroFacetNormals(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t at = 0; at < text.size();) {
+    const std::size_t end = std::min(text.find('\n', at), text.size());
+    const std::size_t word = text.find_first_not_of(" \t\r", at);
+    if (word < end && end - word >= 5 && common::lowerCase(text.substr(word, 5)) == "facet")
+      out += "facet normal 0 0 0";
+    else
+      out.append(text, at, end - at);
+    if (end < text.size()) out += '\n';
+    at = end + 1;
+  }
+  return out;
+}
 
 /// assimp reads an ASCII STL cut after a facet (no `endsolid`) and a facet loop of 4 vertices
 /// (some exporters' quads: half the face lost) without a word: every facet must have 3
@@ -156,7 +180,7 @@ StlFeed checkAsciiStl(const std::filesystem::path& file, std::uintmax_t size) {
   std::ifstream in(file, std::ios::binary);
   std::string line;
   std::size_t number = 0, facet_line = 0, vertices = 0, facets = 0;
-  bool in_facet = false, capitals = false, in_solid = false;
+  bool in_facet = false, capitals = false, in_solid = false, bad_normals = false;
   std::uintmax_t offset = 0, solid_end = 0;  // bytes read; the end of the last `endsolid` line
   std::size_t trailing_line = 0;             // the first line of text after it, if any
   // The first word of each line, lower case (a scan by hand: a million facets are 7 M lines).
@@ -187,6 +211,21 @@ StlFeed checkAsciiStl(const std::filesystem::path& file, std::uintmax_t size) {
       in_solid = true;
       trailing_line = 0;
     } else if (word == "facet") {
+      // `facet normal nx ny nz`, each a number strtod reads (nan and inf too, as assimp does)
+      if (!bad_normals) {
+        std::istringstream rest(line);
+        std::string facet_word, normal_word, token;
+        rest >> facet_word >> normal_word;
+        int numbers = 0;
+        while (rest >> token) {
+          char* stop = nullptr;
+          (void)std::strtod(token.c_str(), &stop);
+          // (strtod reads MSVC's `-nan(ind)` too, assimp does not)
+          const bool plain = token.find('(') == std::string::npos;
+          numbers += stop == token.c_str() + token.size() && plain ? 1 : 100;
+        }
+        bad_normals = common::lowerCase(normal_word) != "normal" || numbers != 3;
+      }
       ++facets;
       in_facet = true;
       facet_line = number;
@@ -232,7 +271,8 @@ StlFeed checkAsciiStl(const std::filesystem::path& file, std::uintmax_t size) {
     throw InputError(file.string() + ": ASCII STL without `endsolid` at its end (truncated?)");
   StlFeed feed;
   feed.lower = capitals;
-  feed.copy = capitals || trailing_line > 0;
+  feed.zero_normals = bad_normals;
+  feed.copy = capitals || trailing_line > 0 || bad_normals;
   feed.length = trailing_line > 0 ? solid_end : size;
   feed.ascii = true;
   feed.triangles = facets;
@@ -287,7 +327,12 @@ StlFeed checkStl(const std::filesystem::path& file, std::uintmax_t size) {
   }
   // Else ASCII, unless it holds a NUL byte: a binary one cut short or padded (it was read as
   // ASCII "without `endsolid`"); its counts are said below.
-  if (word == "solid" && !hasNulByte(file)) return checkAsciiStl(file, size);
+  if (word == "solid" && !hasNulByte(file)) {
+    StlFeed feed = checkAsciiStl(file, size);
+    feed.skip = first;
+    feed.copy = feed.copy || first > 0;
+    return feed;
+  }
   if (got < 84)
     throw InputError(file.string() + ": binary STL of " + std::to_string(size) +
                      " bytes, shorter than its 84-byte header (truncated, or not STL)");
@@ -409,6 +454,8 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
     // polygons are split and node transforms applied below, with every index checked.
     if (stl.copy) {  // its solids or triangles only; lower case where asked (keywords, exponents)
       std::string text = firstBytes(file, stl.length);
+      text.erase(0, static_cast<std::size_t>(stl.skip));
+      if (stl.zero_normals) text = zeroFacetNormals(text);
       if (stl.lower)
         text = common::lowerCase(std::move(text));
       if (stl.blank_mark) text.replace(0, 3, 3, ' ');

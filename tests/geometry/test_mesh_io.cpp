@@ -96,6 +96,30 @@ TEST(MeshIo, AsciiStlInCapitalsIsTheSame) {
   EXPECT_EQ(m_mixed.triangles, lower.triangles);
 }
 
+// Normals as MSVC-built exporters print NaN (`-nan(ind)`, `1.#QNAN`), a `facet` line with no
+// normal, a blank line before `solid`: the same tetrahedron (assimp refused each, dumping the
+// file's text or "Failed to determine STL storage representation"). The normals are not read:
+// a triangle's comes from its winding.
+TEST(MeshIo, AsciiStlWithUnreadableNormalsOrALeadingBlankLineIsTheSame) {
+  const TriangleMesh clean = loadMesh(writeBytes("tetra_clean.stl", kAsciiTetra));
+  std::string first_normal = kAsciiTetra;
+  const std::size_t facet = first_normal.find("facet normal");
+  ASSERT_NE(facet, std::string::npos);
+  const std::size_t line_end = first_normal.find('\n', facet);
+  for (const std::string replacement :
+       {"facet normal -nan(ind) -nan(ind) -nan(ind)", "facet normal 1.#QNAN 0 -1.#IND", "facet"}) {
+    std::string text = first_normal;
+    text.replace(facet, line_end - facet, replacement);
+    const TriangleMesh m = loadMesh(writeBytes("tetra_normals.stl", text));
+    EXPECT_EQ(m.vertices, clean.vertices) << replacement;
+    EXPECT_EQ(m.triangles, clean.triangles) << replacement;
+  }
+  const TriangleMesh blank =
+      loadMesh(writeBytes("tetra_blank.stl", "\n\n" + std::string(kAsciiTetra)));
+  EXPECT_EQ(blank.vertices, clean.vertices);
+  EXPECT_EQ(blank.triangles, clean.triangles);
+}
+
 TEST(MeshIo, AsciiPlyAndObjWithQuadsClosedForm) {
   // Unit cube as six quads: split into 12 triangles, 8 vertices, volume 1.
   const char* quads = "f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
