@@ -545,6 +545,14 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
                    result.turned_starts.size(), result.turned_starts.size() == 1 ? "" : "es",
                    result.turned_starts.front() + 1, pathgen::kClearStartStepDeg,
                    result.turned_starts.size() == 1 ? "its" : "each one's");
+    if (!result.corners_held.empty())
+      std::fprintf(stderr,
+                   "note: %zu pass%s (first: pass %d) steered with the axis held through %s "
+                   "corners: turning with the feed (DESIGN's frame) it came under `clearance` "
+                   "there (report.json passes corners_held)\n",
+                   result.corners_held.size(), result.corners_held.size() == 1 ? "" : "es",
+                   result.corners_held.front() + 1,
+                   result.corners_held.size() == 1 ? "its" : "their");
     if (result.safe_z_proven_mm > 0.0)
       std::fprintf(stderr,
                    "note: links.safe_z %g mm leaves the links within the checks' margin of "

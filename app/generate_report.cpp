@@ -68,7 +68,9 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
                       {"settled_start", std::find(r.settled_starts.begin(), r.settled_starts.end(),
                                                   pass.index) != r.settled_starts.end()},
                       {"turned_start", std::find(r.turned_starts.begin(), r.turned_starts.end(),
-                                                 pass.index) != r.turned_starts.end()}});
+                                                 pass.index) != r.turned_starts.end()},
+                      {"corners_held", std::find(r.corners_held.begin(), r.corners_held.end(),
+                                                 pass.index) != r.corners_held.end()}});
     if (std::isnan(pass.v))  // a null beside its reason (DESIGN.md)
       passes.back()["v_skipped"] = "a pass of a nominal path has no channel coordinate v";
   }

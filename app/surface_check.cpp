@@ -321,11 +321,18 @@ std::optional<SurfaceGrid> surfaceGrid(const SurfaceRequest& request) {
   SurfaceGrid result;
   double spacing = request.spacing_mm;
   if (!(spacing <= region.sizes().maxCoeff())) {
-    char text[160];
+    char text[320];
+    // A part under 1 mm beside passes many times larger is most often one in metres (a helper's
+    // was told only to give a finer spacing).
+    const bool speck = part_box.diagonal().norm() < 1.0 &&
+                       passes_box.diagonal().norm() > 100.0 * part_box.diagonal().norm();
     std::snprintf(text, sizeof text,
                   "--spacing: %g mm is wider than the surface checked (%.3g x %.3g mm in plan): "
-                  "give less (default 0.05 mm)",
-                  spacing, region.sizes().x(), region.sizes().y());
+                  "give less (default 0.05 mm)%s",
+                  spacing, region.sizes().x(), region.sizes().y(),
+                  speck ? "; the part spans under 1 mm in plan beside passes 100 times larger: "
+                          "is it in metres? every length is read in millimetres"
+                        : "");
     throw common::InputError(text);
   }
   const double area = region.sizes().x() * region.sizes().y();

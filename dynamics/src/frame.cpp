@@ -1,7 +1,10 @@
 #include "fieldpath/dynamics/frame.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
+
+#include <Eigen/QR>
 
 #include "fieldpath/common/errors.h"
 
@@ -45,6 +48,34 @@ Vec3 axisFromAngles(const LocalFrame& frame, double lead_rad, double tilt_rad) {
   const double cl = std::cos(lead_rad), sl = std::sin(lead_rad);
   const double ct = std::cos(tilt_rad), st = std::sin(tilt_rad);
   return sl * frame.f + cl * (ct * frame.n - st * frame.b);
+}
+
+namespace {
+
+/// ∂a/∂lead and ∂a/∂tilt of axisFromAngles in `frame`, as columns.
+Eigen::Matrix<double, 3, 2> angleDerivatives(const LocalFrame& frame, double lead, double tilt) {
+  const double cl = std::cos(lead), sl = std::sin(lead), ct = std::cos(tilt), st = std::sin(tilt);
+  Eigen::Matrix<double, 3, 2> d;
+  d.col(0) = cl * frame.f - sl * (ct * frame.n - st * frame.b);
+  d.col(1) = -cl * (st * frame.n + ct * frame.b);
+  return d;
+}
+
+}  // namespace
+
+std::array<double, 4> reexpressState(const LocalFrame& from, const LocalFrame& to,
+                                     const std::array<double, 4>& state) {
+  const Vec3 axis = axisFromAngles(from, state[0], state[1]);
+  const Vec3 rate =
+      angleDerivatives(from, state[0], state[1]) * Eigen::Vector2d(state[2], state[3]);
+  std::array<double, 4> out;
+  out[0] = std::asin(std::clamp(axis.dot(to.f), -1.0, 1.0));
+  out[1] = std::atan2(-axis.dot(to.b), axis.dot(to.n));
+  const Eigen::Vector2d rates =
+      angleDerivatives(to, out[0], out[1]).colPivHouseholderQr().solve(rate);
+  out[2] = rates[0];
+  out[3] = rates[1];
+  return out;
 }
 
 }  // namespace fieldpath::dynamics

@@ -129,10 +129,10 @@ constexpr double kStiffnessDeltaRad = 5e-3;
 /// stations fall on the grid.
 constexpr double kDampingSpacingMm = 0.5;
 
-/// A corner (steerPass): the feed turning by more than kCornerTurnDeg from a station to the
-/// first station kCornerWindowMm or more on (the next where they lie farther apart): a sharp
-/// corner, or one filleted with a radius under ~5.7 mm. A gentle curve turns less (the
-/// impeller's passes: under 1 deg in 2 mm).
+/// A corner (steerPass, SteeringRequest::hold_corners): the feed turning by more than
+/// kCornerTurnDeg from a station to the first station kCornerWindowMm or more on (the next where
+/// they lie farther apart): a sharp corner, or one filleted with a radius under ~5.7 mm (a circle
+/// round a small pin too). The impeller's passes turn under 1 deg in 2 mm.
 constexpr double kCornerTurnDeg = 20.0;
 constexpr double kCornerWindowMm = 2.0;
 
@@ -330,14 +330,15 @@ Eigen::Matrix2d fieldStiffness(const field::ForceField& field,
 
 SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
   validate(pass, request);
-  // Corners: where the feed turns by more than kCornerTurnDeg within kCornerWindowMm, the feed
-  // (the normal, centre and nominal angles run on) is held from a station to the one that far on
-  // and the angles re-expressed in the frame there, so that the axis does not turn with the
-  // frame about the normal (the stations between are written in the held frame). Held in the
-  // turning frame, a tilt leaning away from a wall leaned at it after a 90 deg turn, the field
-  // kicked and the tilt swung to the opposite limit (holder 2.3 mm into the wall, a helper's pocket
-  // corner). Passes whose feed turns less per station (the impeller's: under 5 deg) run as before,
-  // bit for bit.
+  // Corners (request.hold_corners): where the feed turns by more than kCornerTurnDeg within
+  // kCornerWindowMm, the feed (the normal, centre and nominal angles run on) is held from a
+  // station to the one that far on and the angles and their rates re-expressed in the frame
+  // there, so that the axis does not turn with the frame about the normal (the stations between
+  // are written in the held frame, whose limits they keep: within a corner the feed, a central
+  // difference, is no one frame's). Held in the turning frame, a tilt leaning away from a wall
+  // leaned at it after a 90 deg turn, the field kicked and the tilt swung to the opposite limit
+  // (holder 2.3 mm into the wall, a helper's pocket corner); held in the world, a lean away from
+  // a boss the pass turns round is lost (a reviewer's): the caller chooses.
   struct CornerHold {
     bool on = false;
     Vec3 feed;
@@ -435,10 +436,7 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
     if (hold.on && s_mm >= hold.until_mm - 1e-9) {  // a corner's end: the axis in the frame at s
       PassFrame held = pass.frameAt(s_mm);
       held.feed = hold.feed;
-      const Vec3 axis = axisFromAngles(localAt(held, s_mm), y[0], y[1]);
-      const LocalFrame now = localAt(pass.frameAt(s_mm), s_mm);
-      y[0] = std::asin(std::clamp(axis.dot(now.f), -1.0, 1.0));
-      y[1] = std::atan2(-axis.dot(now.b), axis.dot(now.n));
+      y = reexpressState(localAt(held, s_mm), localAt(pass.frameAt(s_mm), s_mm), y);
       hold.on = false;
       corner = true;
     }
@@ -497,8 +495,11 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
         framed = false;
       }
       if (framed && from.f.dot(to.f) < std::cos(kCornerTurnDeg / kDegPerRad)) {
-        hold = {true, from.f, until_mm};
-        integrator->restart(s_mm / v, y.data());
+        ++result.corners;
+        if (request.hold_corners) {
+          hold = {true, from.f, until_mm};
+          integrator->restart(s_mm / v, y.data());
+        }
       }
     }
     if (k % report_every == 0)

@@ -15,6 +15,7 @@
 #include <tbb/parallel_for.h>
 
 #include "clear_start.h"
+#include "corner_steering.h"
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/phase_trace.h"
 #include "fieldpath/dynamics/frame.h"
@@ -207,6 +208,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
     }
   std::vector<char> started_settled(result.passes.size(), 0);
   std::vector<char> turned_start(result.passes.size(), 0);
+  std::vector<char> corners_held(result.passes.size(), 0);
   std::vector<std::string> settle_failed(result.passes.size());  // why, where settling failed
   std::vector<std::string> loosened(result.passes.size());  // why, where the solver was loosened
   struct Steered {
@@ -221,6 +223,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
     std::vector<Steered> steered_passes(result.passes.size());
     std::fill(started_settled.begin(), started_settled.end(), 0);  // this steering's own
     std::fill(turned_start.begin(), turned_start.end(), 0);
+    std::fill(corners_held.begin(), corners_held.end(), 0);
     std::fill(settle_failed.begin(), settle_failed.end(), std::string());
     std::fill(loosened.begin(), loosened.end(), std::string());
     int passes_done = 0;
@@ -342,6 +345,12 @@ GenerateResult generatePath(const GenerateRequest& request) {
           steered = std::move(again);
         }
       }
+      const auto clearanceOf = [&](const geometry::Posture& posture) {
+        return checker.clearance(posture);
+      };
+      if (steerWithCornersHeldIfClearer(dyn_pass, steer, steered, clearanceOf,
+                                        request.clearance_mm))
+        corners_held[p] = 1;
       if (steered.status != dynamics::Status::Ok) {
         std::ostringstream msg;
         msg << pass.label;
@@ -543,6 +552,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
   for (std::size_t p = 0; p < result.passes.size(); ++p) {
     if (started_settled[p]) result.settled_starts.push_back(result.passes[p].index);
     if (turned_start[p]) result.turned_starts.push_back(result.passes[p].index);
+    if (corners_held[p]) result.corners_held.push_back(result.passes[p].index);
     if (!settle_failed[p].empty())
       result.settle_failures.push_back({result.passes[p].index, settle_failed[p]});
     if (!loosened[p].empty()) result.loosened_solver.push_back(loosened[p]);

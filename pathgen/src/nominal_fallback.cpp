@@ -134,6 +134,7 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
     };
     std::erase_if(result.settled_starts, kept);
     std::erase_if(result.turned_starts, kept);
+    std::erase_if(result.corners_held, kept);
     std::erase_if(result.settle_failures, [&](const auto& f) { return kept(f.pass); });
     std::erase_if(result.loosened_solver, [&](const std::string& line) {
       for (const auto& k : result.kept_nominal)

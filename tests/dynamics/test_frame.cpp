@@ -64,3 +64,28 @@ TEST(AxisFromAngles, MatchesRotationsAboutBThenF) {
 
 }  // namespace
 }  // namespace fieldpath::dynamics
+
+namespace fieldpath::dynamics {
+
+// A state re-expressed in a frame turned 90° about the normal (a corner held by the steering):
+// the same axis, and the same velocity of the axis (against a central difference of the axis
+// along the state's rates in the first frame).
+TEST(Frame, AStateReexpressedInATurnedFrameKeepsTheAxisAndItsVelocity) {
+  LocalFrame from, to;
+  from.f = Vec3::UnitX(), from.n = Vec3::UnitZ(), from.b = from.n.cross(from.f);
+  to.f = Vec3::UnitY(), to.n = Vec3::UnitZ(), to.b = to.n.cross(to.f);
+  const std::array<double, 4> state = {0.3, 0.2, 0.1, -0.2};
+  const std::array<double, 4> out = reexpressState(from, to, state);
+  EXPECT_LT((axisFromAngles(to, out[0], out[1]) - axisFromAngles(from, state[0], state[1])).norm(),
+            1e-14);
+  const double h = 1e-6;
+  const auto along = [](const LocalFrame& frame, const std::array<double, 4>& y, double t) {
+    return axisFromAngles(frame, y[0] + t * y[2], y[1] + t * y[3]);
+  };
+  const Vec3 velocity = (along(from, state, h) - along(from, state, -h)) / (2 * h);
+  const Vec3 again = (along(to, out, h) - along(to, out, -h)) / (2 * h);
+  EXPECT_LT((velocity - again).norm(), 1e-8);
+  EXPECT_GT(velocity.norm(), 0.1);
+}
+
+}  // namespace fieldpath::dynamics

@@ -178,6 +178,10 @@ TEST(GenerateEdges, CheckReadsPastTheFieldsReachAndFailsAPartInMetres) {
   std::string in_metres = rest;
   in_metres.replace(in_metres.find("part: plate.stl"), 15, "part: plate_m.stl");
   dir.write("metres.yaml", "obstacles:\n  - mesh: post.stl\n" + in_metres);
+  // At the default spacing the speck holds no line: refused, asking whether it is in metres.
+  const auto coarse = test::runFieldpath(dir, "check metres.yaml --path p.cl --out n");
+  EXPECT_EQ(coarse.exit_code, 1) << coarse.output();
+  EXPECT_NE(coarse.err.find("is it in metres?"), std::string::npos) << coarse.err;
   const auto metres =
       test::runFieldpath(dir, "check metres.yaml --path p.cl --spacing 0.001 --out m");
   EXPECT_EQ(metres.exit_code, 0) << metres.output();

@@ -1,4 +1,5 @@
 #pragma once
+#include <array>
 /// The local frame of a pass and the tool axis as a function of the lead and tilt angles
 /// (DESIGN.md "The dynamics"). Pure geometry; no solver here.
 #include "fieldpath/geometry/posture.h"
@@ -34,5 +35,11 @@ LocalFrame localFrame(const PassFrame& frame, const Vec3& fallback_feed = Vec3::
 /// Tool axis a (unit, tip → spindle): n turned by `lead_rad` about b (towards +f), then by
 /// `tilt_rad` about f (towards -b):  a = sin(L) f + cos(L) (cos(T) n - sin(T) b).
 Vec3 axisFromAngles(const LocalFrame& frame, double lead_rad, double tilt_rad);
+
+/// A steering state (lead, tilt in rad, their rates in rad/s) in `from` expressed in `to`: the
+/// same axis, and the same velocity of the axis where `to`'s angles can give it (least squares).
+/// What a corner held by the steering needs (steerPass, SteeringRequest::hold_corners).
+std::array<double, 4> reexpressState(const LocalFrame& from, const LocalFrame& to,
+                                     const std::array<double, 4>& state);
 
 }  // namespace fieldpath::dynamics

@@ -57,6 +57,13 @@ struct SteeringRequest {
   /// sample (pathgen passes an FCL or point query). NaN in the samples when unset.
   std::function<double(std::span<const Vec3> nodes_world_mm)> clearance;
   common::Progress progress;
+  /// Corners (the feed turning by over 20° within 2 mm: steering.cpp kCornerTurnDeg): false,
+  /// DESIGN's frame, the axis turning with the feed; true, the feed held through each corner and
+  /// the angles re-expressed after it, the axis keeping its direction. Neither is right at every
+  /// corner (a tilt held away from a wall the pass turns from leans at it after the turn; a lean
+  /// away from a boss the pass turns round is lost when held): pathgen steers a pass with corners
+  /// held only where DESIGN's comes under its clearance, and keeps the clearer.
+  bool hold_corners = false;
 };
 
 /// One output sample, every `step_mm` along the pass.
@@ -95,6 +102,7 @@ struct SteeringResult {
   Status status = Status::Ok;
   std::string message;  ///< empty when Ok; otherwise names the arc length (mm) and the cause
   int clamped_samples = 0;
+  int corners = 0;  ///< corners met (kCornerTurnDeg within kCornerWindowMm), held or not
 };
 
 /// Integrates one pass. Throws common::InputError for bad settings (naming the `dynamics.` key) and

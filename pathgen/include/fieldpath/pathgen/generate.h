@@ -147,6 +147,10 @@ struct GenerateResult {
   /// from the clear axis nearest the nominal one instead (itself where clear, else
   /// kClearStartStepDeg apart within the angle limits), by Pass::index.
   std::vector<int> turned_starts;
+  /// Passes steered with their corners held (dynamics::SteeringRequest::hold_corners): the axis
+  /// turning with the feed came under `clearance` there, and holding its direction through the
+  /// corners kept more. By Pass::index.
+  std::vector<int> corners_held;
   /// Passes that were to start settled but could not (no damping, the solver failing at rest):
   /// they start from the nominal axis, or where that lies within `clearance` the clear axis
   /// nearest it (turned_starts). By Pass::index, why.
