@@ -412,6 +412,7 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
     return false;
   };
   const double end_mm = stations.back();
+  long corner_end = 0;  // the station a corner's window from the current one reaches
   for (long k = 0; k <= intervals; ++k) {
     const double s_mm = stations[static_cast<std::size_t>(k)];
     if (k > 0) {
@@ -480,11 +481,11 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
     }
     if (k < intervals && !hold.on) {  // a corner ahead: held from here to its far station
       // (over kCornerWindowMm at least: a corner sampled finely turns little per station)
-      long end = k + 1;
-      while (end < intervals &&
-             stations[static_cast<std::size_t>(end)] < s_mm + kCornerWindowMm - 1e-9)
-        ++end;
-      const double until_mm = stations[static_cast<std::size_t>(end)];
+      corner_end = std::max(corner_end, k + 1);  // (it only moves on: linear in the stations)
+      while (corner_end < intervals &&
+             stations[static_cast<std::size_t>(corner_end)] < s_mm + kCornerWindowMm - 1e-9)
+        ++corner_end;
+      const double until_mm = stations[static_cast<std::size_t>(corner_end)];
       // (a bad frame ahead is the integrator's to name where it first meets it: not held)
       LocalFrame from, to;
       bool framed = true;

@@ -102,7 +102,9 @@ struct SteeringResult {
   Status status = Status::Ok;
   std::string message;  ///< empty when Ok; otherwise names the arc length (mm) and the cause
   int clamped_samples = 0;
-  int corners = 0;  ///< corners met (kCornerTurnDeg within kCornerWindowMm), held or not
+  /// Stations with a corner (kCornerTurnDeg within kCornerWindowMm) ahead, held or not: 0 where
+  /// the pass has none.
+  int corners = 0;
 };
 
 /// Integrates one pass. Throws common::InputError for bad settings (naming the `dynamics.` key) and
