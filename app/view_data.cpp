@@ -18,7 +18,9 @@
 
 #include "cutter_note.h"
 #include "errors.h"
+#include "fieldpath/common/file_digest.h"
 #include "fieldpath/common/limits.h"
+#include "fieldpath/dynamics/frame.h"
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/geometry/units.h"
 #include "fieldpath/pathgen/clearance.h"
@@ -26,7 +28,6 @@
 #include "fieldpath/pathgen/link_check.h"
 #include "job.h"
 #include "scene.h"
-#include "fieldpath/common/file_digest.h"
 #include "surface_check.h"
 #include "to_zbuffer.h"
 
@@ -167,9 +168,10 @@ void computeAngles(const Scene& scene, ViewPath& p) {
     if (!at) continue;
     ++found;
     worst = std::max(worst, d);
-    const geometry::Vec3& a = postures[i].axis;
-    p.lead_deg[i] = std::asin(std::clamp(a.dot(at->feed), -1.0, 1.0)) * geometry::kRadToDeg;
-    p.tilt_deg[i] = std::atan2(-a.dot(at->binormal), a.dot(at->normal)) * geometry::kRadToDeg;
+    const std::array<double, 2> angles =
+        dynamics::anglesOfAxis({at->feed, at->normal, at->binormal}, postures[i].axis);
+    p.lead_deg[i] = angles[0] * geometry::kRadToDeg;
+    p.tilt_deg[i] = angles[1] * geometry::kRadToDeg;
   }
   std::ostringstream s;
   s.precision(3);

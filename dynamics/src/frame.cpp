@@ -63,14 +63,18 @@ Eigen::Matrix<double, 3, 2> angleDerivatives(const LocalFrame& frame, double lea
 
 }  // namespace
 
+std::array<double, 2> anglesOfAxis(const LocalFrame& frame, const Vec3& axis) {
+  return {std::asin(std::clamp(axis.dot(frame.f), -1.0, 1.0)),
+          std::atan2(-axis.dot(frame.b), axis.dot(frame.n))};
+}
+
 std::array<double, 4> reexpressState(const LocalFrame& from, const LocalFrame& to,
                                      const std::array<double, 4>& state) {
   const Vec3 axis = axisFromAngles(from, state[0], state[1]);
   const Vec3 rate =
       angleDerivatives(from, state[0], state[1]) * Eigen::Vector2d(state[2], state[3]);
-  std::array<double, 4> out;
-  out[0] = std::asin(std::clamp(axis.dot(to.f), -1.0, 1.0));
-  out[1] = std::atan2(-axis.dot(to.b), axis.dot(to.n));
+  const std::array<double, 2> angles = anglesOfAxis(to, axis);
+  std::array<double, 4> out = {angles[0], angles[1], 0.0, 0.0};
   const Eigen::Vector2d rates =
       angleDerivatives(to, out[0], out[1]).colPivHouseholderQr().solve(rate);
   out[2] = rates[0];

@@ -136,6 +136,15 @@ constexpr double kDampingSpacingMm = 0.5;
 constexpr double kCornerTurnDeg = 20.0;
 constexpr double kCornerWindowMm = 2.0;
 
+/// localFrame of the pass frame at s; a zero or non-finite normal is bad input naming s.
+LocalFrame localFrameAt(const PassFrame& frame, double s_mm) {
+  try {
+    return localFrame(frame);
+  } catch (const common::InputError& e) {
+    throw common::InputError(at(s_mm) + e.what());
+  }
+}
+
 /// J θ'' + c θ' + k (θ - θ0(s)) = τ(θ), first-order form, time in s, s = v t.
 class SteeringSystem final : public detail::OdeSystem {
  public:
@@ -232,10 +241,10 @@ class SteeringSystem final : public detail::OdeSystem {
       requireThat(f.centre_mm.allFinite(), "pass frame: ball centre", "finite", f.centre_mm.norm());
       requireThat(std::isfinite(f.lead0_rad) && std::isfinite(f.tilt0_rad),
                   "pass frame: nominal angles", "finite", f.lead0_rad + f.tilt0_rad);
-      return {f, localFrame(f)};  // localFrame throws for a zero or non-finite normal
     } catch (const common::InputError& e) {
       throw common::InputError(at(s_mm) + e.what());
     }
+    return {f, localFrameAt(f, s_mm)};
   }
 
   AxisMoment moment(const Frames& frames, double lead_rad, double tilt_rad) {
@@ -350,14 +359,6 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
     if (hold.on) f.feed = hold.feed;  // made square to the normal at s by localFrame
     return f;
   };
-  // A corner's frames, a bad one named by its position as the system's are.
-  const auto localAt = [](const PassFrame& frame, double s_mm) {
-    try {
-      return localFrame(frame);
-    } catch (const common::InputError& e) {
-      throw common::InputError(at(s_mm) + e.what());
-    }
-  };
   SteeringSystem system(cornered, request);
   const double v = system.feedMmPerS();
 
@@ -435,9 +436,8 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
     }
     bool corner = false;
     if (hold.on && s_mm >= hold.until_mm - 1e-9) {  // a corner's end: the axis in the frame at s
-      PassFrame held = pass.frameAt(s_mm);
-      held.feed = hold.feed;
-      y = reexpressState(localAt(held, s_mm), localAt(pass.frameAt(s_mm), s_mm), y);
+      y = reexpressState(localFrameAt(cornered.frameAt(s_mm), s_mm),
+                         localFrameAt(pass.frameAt(s_mm), s_mm), y);
       hold.on = false;
       corner = true;
     }

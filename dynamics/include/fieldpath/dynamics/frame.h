@@ -36,6 +36,10 @@ LocalFrame localFrame(const PassFrame& frame, const Vec3& fallback_feed = Vec3::
 /// `tilt_rad` about f (towards -b):  a = sin(L) f + cos(L) (cos(T) n - sin(T) b).
 Vec3 axisFromAngles(const LocalFrame& frame, double lead_rad, double tilt_rad);
 
+/// The (lead, tilt) of unit `axis` in `frame`, rad: axisFromAngles inverted (lead in
+/// [-90, 90] deg).
+std::array<double, 2> anglesOfAxis(const LocalFrame& frame, const Vec3& axis);
+
 /// A steering state (lead, tilt in rad, their rates in rad/s) in `from` expressed in `to`: the
 /// same axis, and the same velocity of the axis where `to`'s angles can give it (least squares).
 /// What a corner held by the steering needs (steerPass, SteeringRequest::hold_corners).
