@@ -231,6 +231,41 @@ TEST(MeshIo, TextMeshesWithAByteOrderMarkAreTheSame) {
   EXPECT_NEAR(meshArea(loadMesh(writeBytes("bom_binary.stl", binary))), 0.5, 1e-12);
 }
 
+TEST(MeshIo, TextMeshesWithLinesEndedByCrAloneOrCommentsAfterObjDataAreTheSame) {
+  const auto crAlone = [](std::string text) {
+    std::replace(text.begin(), text.end(), '\n', '\r');
+    return text;
+  };
+  // The tetrahedron as an ASCII STL, an OBJ and a PLY, every line ended by CR (the STL and the
+  // PLY were refused as one line: "without `endsolid`", "the first line must be `ply`").
+  const TriangleMesh stl = loadMesh(writeBytes("cr.stl", crAlone(kAsciiTetra)));
+  EXPECT_EQ(stl.triangles.size(), 4u);
+  EXPECT_NEAR(meshVolume(stl), 1.0 / 6.0, 1e-12);
+  const std::string obj =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  const TriangleMesh plain = loadMesh(writeBytes("lf.obj", obj));
+  const TriangleMesh cr = loadMesh(writeBytes("cr.obj", crAlone(obj)));
+  EXPECT_EQ(cr.vertices, plain.vertices);
+  EXPECT_EQ(cr.triangles, plain.triangles);
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  EXPECT_NEAR(meshVolume(loadMesh(writeBytes("cr.ply", crAlone(ply)))), 1.0 / 6.0, 1e-12);
+  // Comments after a line's data (assimp read `#` as a face index: "Invalid face index"), a
+  // `#` inside a group's name, a comment line: the same tetrahedron.
+  const std::string commented =
+      "# made by hand\no tetra#1\nv 0 0 0 # origin\nv 1 0 0\nv 0 1 0\nv 0 0 1\t#apex\n"
+      "f 1 3 2 # base\nf 1 2 4\nf 1 4 3 #side\nf 2 3 4\n";
+  const TriangleMesh cut = loadMesh(writeBytes("comments.obj", commented));
+  EXPECT_EQ(cut.vertices, plain.vertices);
+  EXPECT_EQ(cut.triangles, plain.triangles);
+  // An error in such a file still names the file itself (not the copy read).
+  expectInputErrorNamingFile(
+      writeBytes("cr_bad.stl", crAlone("solid x\nfacet normal 0 0 1\n outer loop\n")));
+  expectInputErrorNamingFile(writeBytes("comments_bad.obj", "v 0 0 0 # a\nf 1 2 3 # b\n"));
+}
+
 TEST(MeshIo, RoundTripsStlObjPly) {
   const TriangleMesh tool =
       toolMesh(parseToolSpec("torus:5:1:20"), parseHolderProfile("20:8,35:8"), 0.01);
