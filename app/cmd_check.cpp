@@ -321,10 +321,13 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
       not_ok.push_back(std::string("the surface is not checked: ") + surface_skipped);
     // A part a hundred times smaller than the rest under 1 mm (a part in metres): its surface was
     // checked at that size, one line of it (a helper's part read `check: ok` beside the warning
-    // that a path read safe beside it is not).
-    for (const MeshScaleWarning& warning : scale_warnings)
-      if (scene.part_file && warning.mesh.rfind("part (", 0) == 0)
-        not_ok.push_back("the surface is checked against a part of another scale: " + warning.text);
+    // that a path read safe beside it is not). Where the passes are at the part's scale too, it
+    // is a micro part among a fixture's jaws: warned of, not failed (a reviewer's 0.6 mm plate).
+    if (scene.part_file && pathExtentMm(path, true) >= 100.0 * meshExtentMm(*scene.part))
+      for (const MeshScaleWarning& warning : scale_warnings)
+        if (warning.mesh.rfind("part (", 0) == 0)
+          not_ok.push_back("the surface is checked against a part of another scale: " +
+                           warning.text);
     // The finish, where the user gives one (finishReasons).
     for (std::string& reason :
          finishReasons(surface ? &*surface : nullptr, options->max_scallop_um, surface_skipped))

@@ -35,6 +35,24 @@ nlohmann::json routedLinkEndsJson(const pathgen::GenerateResult& r) {
 }
 
 void printRepairs(const pathgen::GenerateResult& result, double links_retract_mm) {
+  // Passes steered from their end: the axis turns after the field has pushed, and meets the
+  // side of an obstacle the pass reaches first late.
+  if (const std::size_t n = result.steered_from_end.size(); n > 0)
+    std::fprintf(stderr,
+                 "note: %zu pass%s (first: pass %d) steered from %s end to %s start: steered "
+                 "from the start (the axis turning only after the field has pushed) %s or came "
+                 "under `clearance`, and from the end %s checked better; written in the pass's "
+                 "own order (report.json passes steered_from_end)\n",
+                 n, n == 1 ? "" : "es", result.steered_from_end.front() + 1,
+                 n == 1 ? "its" : "their", n == 1 ? "its" : "their",
+                 n == 1 ? "it collided" : "they collided", n == 1 ? "it" : "they");
+  if (result.steered_from_end_undone > 0)
+    std::fprintf(stderr,
+                 "note: %zu pass%s checked better steered from %s end, but the path linked to "
+                 "them was checked worse: steered from the start is written (report.json "
+                 "steered_from_end_undone)\n",
+                 result.steered_from_end_undone, result.steered_from_end_undone == 1 ? "" : "es",
+                 result.steered_from_end_undone == 1 ? "its" : "their");
   // Passes kept nominal: those that collided steered (a warning), and those that only came
   // under the required clearance steered (a note: the path written keeps it).
   for (const bool collided : {true, false}) {

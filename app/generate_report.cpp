@@ -57,20 +57,23 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       max_tilt = std::max(max_tilt, std::abs(g.tilt_rad) * kRadToDeg);
       colliding += g.clearance_mm <= 0.0;
     }
-    passes.push_back({{"pass", pass.index + 1},
-                      {"source", pass.label},
-                      {"v", jsonNumber(pass.v)},
-                      {"length_mm", pass.length_mm},
-                      {"postures", postures},
-                      {"min_clearance_mm", jsonNumber(min_clearance)},
-                      {"max_tilt_deg", max_tilt},
-                      {"colliding_postures", colliding},
-                      {"settled_start", std::find(r.settled_starts.begin(), r.settled_starts.end(),
-                                                  pass.index) != r.settled_starts.end()},
-                      {"turned_start", std::find(r.turned_starts.begin(), r.turned_starts.end(),
-                                                 pass.index) != r.turned_starts.end()},
-                      {"corners_held", std::find(r.corners_held.begin(), r.corners_held.end(),
-                                                 pass.index) != r.corners_held.end()}});
+    passes.push_back(
+        {{"pass", pass.index + 1},
+         {"source", pass.label},
+         {"v", jsonNumber(pass.v)},
+         {"length_mm", pass.length_mm},
+         {"postures", postures},
+         {"min_clearance_mm", jsonNumber(min_clearance)},
+         {"max_tilt_deg", max_tilt},
+         {"colliding_postures", colliding},
+         {"settled_start", std::find(r.settled_starts.begin(), r.settled_starts.end(),
+                                     pass.index) != r.settled_starts.end()},
+         {"turned_start", std::find(r.turned_starts.begin(), r.turned_starts.end(), pass.index) !=
+                              r.turned_starts.end()},
+         {"corners_held", std::find(r.corners_held.begin(), r.corners_held.end(), pass.index) !=
+                              r.corners_held.end()},
+         {"steered_from_end", std::find(r.steered_from_end.begin(), r.steered_from_end.end(),
+                                        pass.index) != r.steered_from_end.end()}});
     if (std::isnan(pass.v))  // a null beside its reason (DESIGN.md)
       passes.back()["v_skipped"] = "a pass of a nominal path has no channel coordinate v";
   }
@@ -161,6 +164,7 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
       {"balls_under_clearance", balls_under},
       {"kept_nominal", keptNominalJson(r)},
       {"kept_nominal_undone", r.kept_nominal_undone},
+      {"steered_from_end_undone", r.steered_from_end_undone},
       {"axis_turn", axisTurnJson(axis_turn)},
       {"start",
        {{"policy", startPolicyName(job.dynamics.start)},

@@ -112,6 +112,12 @@ inline std::string toolShapeWhere(const Scene& scene) {
 /// file named as an obstacle too gets one (it repels the tool from the surface it cuts). Walls
 /// thinner than half of `voxel_mm` (the voxel size the job steers with; none: no voxels) get one.
 std::vector<std::string> openObstacleNotes(const Scene& scene, std::optional<double> voxel_mm);
+/// The diagonal of a mesh's box (mm; 0 for none).
+double meshExtentMm(const geometry::TriangleMesh& mesh);
+/// The diagonal of the box of a path's tips (mm; 0 for none), of its pass blocks only where
+/// `passes_only` (not the links' climbs to the travel plane).
+double pathExtentMm(const geometry::PathFile& path, bool passes_only);
+
 /// A mesh file (an obstacle or the part) whose whole extent is under 1 mm beside a mesh, the
 /// nominal path or `path` (check's) 100 times larger: one warning each (a mesh in metres among
 /// millimetres). Said by loadScene on stderr (check says those `path` adds), kept in

@@ -88,6 +88,22 @@ std::vector<std::string> openObstacleNotes(const Scene& scene, std::optional<dou
   return notes;
 }
 
+double meshExtentMm(const geometry::TriangleMesh& mesh) {
+  if (mesh.vertices.empty()) return 0.0;
+  Eigen::AlignedBox3d box;
+  for (const geometry::Vec3& v : mesh.vertices) box.extend(v);
+  return box.diagonal().norm();
+}
+
+double pathExtentMm(const geometry::PathFile& path, bool passes_only) {
+  Eigen::AlignedBox3d box;
+  for (const geometry::PathBlock& block : path.blocks)
+    if (!passes_only || block.kind == geometry::PathBlock::Kind::Pass)
+      for (std::size_t i = block.begin; i < block.end && i < path.postures.size(); ++i)
+        box.extend(path.postures[i].tip_mm);
+  return box.isEmpty() ? 0.0 : box.diagonal().norm();
+}
+
 std::vector<MeshScaleWarning> meshScaleWarnings(const Scene& scene,
                                                 const geometry::PathFile* path) {
   // Each mesh file's extent (its box's diagonal, mm), and the largest of them and of the nominal
@@ -96,12 +112,7 @@ std::vector<MeshScaleWarning> meshScaleWarnings(const Scene& scene,
     std::string name;
     double diagonal_mm = 0.0;
   };
-  const auto diagonal = [](const geometry::TriangleMesh& mesh) {
-    if (mesh.vertices.empty()) return 0.0;
-    Eigen::AlignedBox3d box;
-    for (const geometry::Vec3& v : mesh.vertices) box.extend(v);
-    return box.diagonal().norm();
-  };
+  const auto diagonal = meshExtentMm;
   std::vector<Extent> meshes;
   for (std::size_t i = 0; i < scene.obstacle_files.size() && i < scene.obstacles.size(); ++i)
     meshes.push_back({(i < scene.obstacle_keys.size() ? scene.obstacle_keys[i] + " " : "") + "(" +
@@ -124,10 +135,8 @@ std::vector<MeshScaleWarning> meshScaleWarnings(const Scene& scene,
   // The paths the scene's meshes stand beside: its nominal path, and the path `check` reads.
   for (const geometry::PathFile* p : {scene.nominal ? &*scene.nominal : nullptr, path}) {
     if (!p || p->postures.empty()) continue;
-    Eigen::AlignedBox3d box;
-    for (const geometry::Posture& posture : p->postures) box.extend(posture.tip_mm);
-    if (box.diagonal().norm() > largest.diagonal_mm)
-      largest = {"the path (" + p->file.filename().string() + ")", box.diagonal().norm()};
+    if (const double d = pathExtentMm(*p, false); d > largest.diagonal_mm)
+      largest = {"the path (" + p->file.filename().string() + ")", d};
   }
   // A whole mesh under 1 mm beside one at least 100 times larger: a pin exported in metres stood
   // 8 um wide 3 mm from the passes, its field too weak to steer and its solid never met, and the

@@ -11,62 +11,20 @@
 #include <Eigen/Eigenvalues>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/dynamics/reversed_pass.h"
+#include "node_moments.h"
 #include "sundials_support.h"
 
 namespace fieldpath::dynamics {
 namespace {
 
+using detail::centralStiffness;
+using detail::momentOfNodes;
+using detail::offsetsFromCentre;
+using detail::placeNodes;
+
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 constexpr int kStateSize = 4;  ///< lead, tilt (rad), lead rate, tilt rate (rad/s)
-
-/// Places the nodes (offsets from the ball centre, tool frame) at axis a: world frame, mm.
-void placeNodes(std::span<const Vec3> offsets_mm, const Vec3& centre_mm, const Vec3& axis,
-                std::vector<Vec3>& nodes_mm) {
-  const Eigen::Matrix3d rotation = geometry::rotationFromZ(axis);
-  nodes_mm.resize(offsets_mm.size());
-  for (std::size_t i = 0; i < offsets_mm.size(); ++i)
-    nodes_mm[i] = centre_mm + rotation * offsets_mm[i];
-}
-
-/// Places the nodes at the axis of (lead, tilt) and sums their moment about the ball centre.
-AxisMoment momentOfNodes(const field::ForceField& field, std::span<const Vec3> offsets_mm,
-                         const LocalFrame& frame, const Vec3& centre_mm, double lead_rad,
-                         double tilt_rad, std::vector<Vec3>& nodes_mm, std::vector<Vec3>& forces) {
-  placeNodes(offsets_mm, centre_mm, axisFromAngles(frame, lead_rad, tilt_rad), nodes_mm);
-  forces.resize(offsets_mm.size());
-  field.evaluate(nodes_mm, forces);
-  AxisMoment out;
-  for (std::size_t i = 0; i < offsets_mm.size(); ++i)
-    out.moment += (nodes_mm[i] - centre_mm).cross(forces[i]);
-  out.lead_torque = out.moment.dot(frame.b);
-  out.tilt_torque = out.moment.dot(frame.f);
-  return out;
-}
-
-/// The field's stiffness -∂τ/∂θ about (lead, tilt) by central differences of `delta_rad`
-/// (column: the angle moved; row: lead, tilt torque); `moment(lead, tilt)` gives the AxisMoment.
-/// One for fieldStiffness and the critical damping (SteeringSystem::updateDamping).
-template <class Moment>
-Eigen::Matrix2d centralStiffness(Moment&& moment, double lead_rad, double tilt_rad,
-                                 double delta_rad) {
-  Eigen::Matrix2d k;
-  for (int column = 0; column < 2; ++column) {
-    const double dl = column == 0 ? delta_rad : 0.0, dt = column == 1 ? delta_rad : 0.0;
-    const AxisMoment plus = moment(lead_rad + dl, tilt_rad + dt);
-    const AxisMoment minus = moment(lead_rad - dl, tilt_rad - dt);
-    k(0, column) = -(plus.lead_torque - minus.lead_torque) / (2.0 * delta_rad);
-    k(1, column) = -(plus.tilt_torque - minus.tilt_torque) / (2.0 * delta_rad);
-  }
-  return k;
-}
-
-/// Node offsets from the ball centre in the tool frame: x - (0, 0, R).
-std::vector<Vec3> offsetsFromCentre(std::span<const Vec3> nodes_tool_frame_mm,
-                                    double ball_radius_mm) {
-  std::vector<Vec3> out(nodes_tool_frame_mm.begin(), nodes_tool_frame_mm.end());
-  for (Vec3& p : out) p.z() -= ball_radius_mm;
-  return out;
-}
 
 void requireThat(bool ok, const char* key, const char* condition, double value) {
   if (ok) return;
@@ -316,27 +274,6 @@ const char* toString(Status status) {
   return "?";
 }
 
-AxisMoment axisMoment(const field::ForceField& field, std::span<const Vec3> nodes_tool_frame_mm,
-                      double ball_radius_mm, const LocalFrame& frame, const Vec3& centre_mm,
-                      double lead_rad, double tilt_rad) {
-  std::vector<Vec3> nodes_mm, forces;
-  return momentOfNodes(field, offsetsFromCentre(nodes_tool_frame_mm, ball_radius_mm), frame,
-                       centre_mm, lead_rad, tilt_rad, nodes_mm, forces);
-}
-
-Eigen::Matrix2d fieldStiffness(const field::ForceField& field,
-                               std::span<const Vec3> nodes_tool_frame_mm, double ball_radius_mm,
-                               const LocalFrame& frame, const Vec3& centre_mm, double lead_rad,
-                               double tilt_rad, double delta_rad) {
-  const std::vector<Vec3> offsets = offsetsFromCentre(nodes_tool_frame_mm, ball_radius_mm);
-  std::vector<Vec3> nodes_mm, forces;
-  return centralStiffness(
-      [&](double lead, double tilt) {
-        return momentOfNodes(field, offsets, frame, centre_mm, lead, tilt, nodes_mm, forces);
-      },
-      lead_rad, tilt_rad, delta_rad);
-}
-
 SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
   validate(pass, request);
   // Corners (request.hold_corners): where the feed turns by more than kCornerTurnDeg within
@@ -387,12 +324,7 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
           : detail::makeCvodeBdf(system, kStateSize, 0.0, y.data(), settings);
 
   SteeringResult result;
-  std::vector<double> stations = request.output_s_mm;
-  if (stations.empty()) {
-    const auto intervals = static_cast<long>(std::ceil(pass.length_mm / request.step_mm - 1e-9));
-    for (long k = 0; k <= intervals; ++k)
-      stations.push_back(std::min(static_cast<double>(k) * request.step_mm, pass.length_mm));
-  }
+  const std::vector<double> stations = outputStations(pass, request);
   const long intervals = static_cast<long>(stations.size()) - 1;
   result.samples.reserve(stations.size());
   const double max_change_rad_per_mm = request.max_angle_change_deg_per_mm / kDegPerRad;
@@ -441,7 +373,21 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
       hold.on = false;
       corner = true;
     }
-    LimitCheck check = checkAngles(request.params, request.params.on_limit, y);
+    // Within a held corner the limits and the angles written are DESIGN's frame's, as everywhere
+    // (held, a tilt re-expressed as a lead wrote 26 deg where max_lead_deg is 20, and angles.csv
+    // said 18: a reviewer's): the state checked there and put back in the held frame if clamped.
+    std::array<double, kStateSize> written = y;
+    LocalFrame held_frame, design_frame;
+    if (hold.on) {
+      held_frame = localFrameAt(cornered.frameAt(s_mm), s_mm);
+      design_frame = localFrameAt(pass.frameAt(s_mm), s_mm);
+      written = reexpressState(held_frame, design_frame, y);
+    }
+    LimitCheck check = checkAngles(request.params, request.params.on_limit, written);
+    if (!hold.on)
+      y = written;
+    else if (check.clamped)
+      y = reexpressState(design_frame, held_frame, written);
     bool damping_follows = false;
     if (std::abs(gridAt(update) - s_mm) <= 1e-9) {
       damping_follows = s_mm < end_mm && system.updateDamping(s_mm, y);
@@ -449,6 +395,10 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
     }
     if (check.clamped || damping_follows || corner) integrator->restart(s_mm / v, y.data());
     PostureSample sample = system.sample(s_mm, y);
+    sample.lead_rad = written[0];
+    sample.tilt_rad = written[1];
+    sample.lead_rate_rad_per_s = written[2];
+    sample.tilt_rate_rad_per_s = written[3];
     sample.limited = check.clamped;
     if (!sample.moment.allFinite()) {  // the solver saw it too late (at s = 0) or not at all
       result.status = Status::SolverFailed;

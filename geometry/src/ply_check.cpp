@@ -7,6 +7,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fieldpath/common/errors.h"
@@ -97,11 +98,12 @@ long long listCount(const unsigned char* bytes, const PlyProperty& property, boo
 }
 
 /// The corners of a whole face that the bytes from `at` hold where the body's last element is
-/// `face`: a list of 3 to 64 items that are each an index of the file's vertices (a file whose
-/// header declared one face short: its last face's bytes, indices under 127, passed for padding
-/// and the face was dropped, a tool inside a closed cylinder reading clear). Nothing else.
-std::optional<long long> faceAfterBody(ByteReader& reader, std::uintmax_t size, std::uintmax_t at,
-                                       const std::vector<PlyElement>& elements, bool big_endian) {
+/// `face` (a list of 3 to 64 items that are each an index of the file's vertices), and where it
+/// ends. Nothing else.
+std::optional<std::pair<long long, std::uintmax_t>> faceAt(ByteReader& reader, std::uintmax_t size,
+                                                           std::uintmax_t at,
+                                                           const std::vector<PlyElement>& elements,
+                                                           bool big_endian) {
   if (elements.empty() || elements.back().name != "face") return std::nullopt;
   std::uintmax_t vertices = 0;
   for (const PlyElement& element : elements)
@@ -126,7 +128,28 @@ std::optional<long long> faceAfterBody(ByteReader& reader, std::uintmax_t size, 
         return std::nullopt;
     if (p.name == "vertex_indices" || p.name == "vertex_index") corners = n;
   }
-  return corners;
+  if (!corners) return std::nullopt;
+  return std::pair{*corners, at};
+}
+
+/// The corners of the first of the whole faces that the bytes after the body hold, up to the
+/// file's end or to NUL padding (a file whose header declared one face short: its last face's
+/// bytes, indices under 127, passed for padding and the face was dropped, a tool inside a closed
+/// cylinder reading clear). Nothing where they are not faces to the end: a line of text after
+/// the body (`\n# end of mesh data #\n` read as a face of 10 corners with 1-byte indices, the
+/// rest as none: a reviewer's) is padding.
+std::optional<long long> faceAfterBody(ByteReader& reader, std::uintmax_t size, std::uintmax_t at,
+                                       const std::vector<PlyElement>& elements, bool big_endian) {
+  std::optional<long long> first;
+  while (at < size) {
+    const auto face = faceAt(reader, size, at, elements, big_endian);
+    if (!face) break;
+    if (!first) first = face->first;
+    at = face->second;
+  }
+  for (; first && at < size; ++at)
+    if (*reader.at(at, 1) != 0) return std::nullopt;
+  return first;
 }
 
 /// Walks a binary body from `at` element by element as the header declares it: every list count

@@ -2,7 +2,6 @@
 #include "polygon_split.h"
 
 #include <cmath>
-#include <numeric>
 
 #include <Eigen/Geometry>
 
@@ -18,20 +17,31 @@ double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::V
 
 std::optional<std::vector<Eigen::Vector3i>> splitPolygon(
     const std::vector<Eigen::Vector3d>& points) {
-  const std::size_t n = points.size();
   std::vector<Eigen::Vector3i> fan;
-  for (std::size_t k = 1; k + 1 < n; ++k) fan.emplace_back(0, int(k), int(k + 1));
-  if (n <= 3) return fan;
+  for (std::size_t k = 1; k + 1 < points.size(); ++k) fan.emplace_back(0, int(k), int(k + 1));
+  if (points.size() <= 3) return fan;
+  // A corner at the position of the one before it (a vertex listed twice, or two records of one
+  // point) has no edge to it: left out. A zero-length edge at a reflex corner split its turn into
+  // two of none, and an L-shaped face read convex and was fanned over its notch (a reviewer's).
+  std::vector<int> corner;
+  for (std::size_t k = 0; k < points.size(); ++k)
+    if (points[k] != points[(k + points.size() - 1) % points.size()]) corner.push_back(int(k));
+  const std::size_t n = corner.size();
+  if (n < 3) return fan;  // no area
+  fan.clear();
+  for (std::size_t k = 1; k + 1 < n; ++k) fan.emplace_back(corner[0], corner[k], corner[k + 1]);
+  if (n == 3) return fan;
   // The polygon's plane: Newell's normal follows the winding, so the corners run counter-clockwise
   // about it; its length is twice the polygon's area.
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-  for (std::size_t k = 0; k < n; ++k) normal += points[k].cross(points[(k + 1) % n]);
+  for (std::size_t k = 0; k < n; ++k)
+    normal += points[std::size_t(corner[k])].cross(points[std::size_t(corner[(k + 1) % n])]);
   if (!(normal.norm() > 0.0)) return fan;  // no area: the fan's triangles have none either
   normal.normalize();
   const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
-  std::vector<Eigen::Vector2d> flat(n);
+  std::vector<Eigen::Vector2d> flat(points.size());  // by the points' own index
   double size = 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
+  for (std::size_t k = 0; k < points.size(); ++k) {
     const Eigen::Vector3d d = points[k] - points[0];
     flat[k] = {d.dot(u), d.dot(v)};
     size = std::max(size, flat[k].cwiseAbs().maxCoeff());
@@ -40,13 +50,13 @@ std::optional<std::vector<Eigen::Vector3i>> splitPolygon(
   const double tol = 1e-12 * size * size;
   bool convex = true;
   for (std::size_t k = 0; k < n && convex; ++k)
-    convex = cross2(flat[(k + n - 1) % n], flat[k], flat[(k + 1) % n]) >= -tol;
+    convex =
+        cross2(flat[corner[(k + n - 1) % n]], flat[corner[k]], flat[corner[(k + 1) % n]]) >= -tol;
   if (convex) return fan;
   if (n > kMaxClippedCorners) return std::nullopt;
 
   // Ear clipping: a corner turning counter-clockwise whose triangle holds no other corner left.
-  std::vector<int> left(n);
-  std::iota(left.begin(), left.end(), 0);
+  std::vector<int> left = corner;
   std::vector<Eigen::Vector3i> out;
   const auto inside = [&](int p, int a, int b, int c) {  // on or within the triangle (a, b, c)
     const Eigen::Vector2d& q = flat[std::size_t(p)];

@@ -14,8 +14,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "clear_start.h"
-#include "corner_steering.h"
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/phase_trace.h"
 #include "fieldpath/dynamics/frame.h"
@@ -29,6 +27,7 @@
 #include "fieldpath/pathgen/cutter_part.h"
 #include "fieldpath/pathgen/reach_box.h"
 #include "open_sheets.h"
+#include "pass_steering.h"
 #include "path_check.h"
 
 namespace fieldpath::pathgen {
@@ -194,17 +193,22 @@ GenerateResult generatePath(const GenerateRequest& request) {
   // Which passes start from the axis settled at their start (dynamics.start): decided once, on
   // the nominal start posture's exact clearance, so that both steerings (near the path, final)
   // start the same passes settled.
-  std::vector<char> settle(result.passes.size(), 0);
+  // The same at each pass's end, for a pass steered from there (pass_steering.h).
+  std::vector<char> settle(result.passes.size(), 0), settle_end(result.passes.size(), 0);
   if (!request.nominal && request.dynamics.start != dynamics::StartPolicy::Nominal)
     for (std::size_t p = 0; p < result.passes.size(); ++p) {
       const Pass& pass = result.passes[p];
       // `auto` settles only under a field that pushes: with gain 0 the axis at rest is the
       // nominal one, and a note said the pass "started from the axis settled under the field".
-      settle[p] = request.dynamics.start == dynamics::StartPolicy::Settled ||
-                  (request.field.gain > 0.0 && !pass.samples.empty() &&
-                   checker.clearance(geometry::ballEndPosture(
-                       pass.samples.front().centre_mm, nominalAxis(pass.samples.front(), lead_rad),
-                       r)) < request.clearance_mm);
+      const auto settles = [&](const PassSample& at) {
+        return request.dynamics.start == dynamics::StartPolicy::Settled ||
+               (request.field.gain > 0.0 &&
+                checker.clearance(geometry::ballEndPosture(at.centre_mm, nominalAxis(at, lead_rad),
+                                                           r)) < request.clearance_mm);
+      };
+      if (pass.samples.empty()) continue;
+      settle[p] = settles(pass.samples.front());
+      settle_end[p] = settles(pass.samples.back());
     }
   std::vector<char> started_settled(result.passes.size(), 0);
   std::vector<char> turned_start(result.passes.size(), 0);
@@ -217,6 +221,45 @@ GenerateResult generatePath(const GenerateRequest& request) {
     std::exception_ptr error;
   };
   std::mutex progress_mutex;
+  // Pass p steered by `field` (pass_steering.h), from its start or its end.
+  const auto steerPassOf = [&](std::size_t p, const field::ForceField* field,
+                               const dynamics::DynamicsParams& params, bool from_end,
+                               common::Progress progress) {
+    const Pass& pass = result.passes[p];
+    dynamics::Pass dyn_pass;
+    dyn_pass.length_mm = pass.length_mm;
+    dyn_pass.frameAt = [&pass, lead_rad](double s_mm) {
+      const PassSample s = pass.at(s_mm);
+      dynamics::PassFrame frame;
+      frame.centre_mm = s.centre_mm;
+      frame.feed = s.feed;
+      frame.normal = s.normal;
+      frame.lead0_rad = lead_rad;
+      return frame;
+    };
+    dynamics::SteeringRequest steer;
+    steer.field = field;
+    steer.nodes_tool_frame_mm = nodes;
+    steer.ball_radius_mm = r;
+    steer.params = params;
+    // The pass's own stations (even steps, or a nominal path's postures one for one); the solver
+    // never steps over more than the longest gap between them.
+    double gap_mm = 0.0;
+    for (std::size_t i = 0; i < pass.samples.size(); ++i) {
+      steer.output_s_mm.push_back(pass.samples[i].s_mm);
+      if (i > 0) gap_mm = std::max(gap_mm, pass.samples[i].s_mm - pass.samples[i - 1].s_mm);
+    }
+    steer.step_mm = gap_mm > 0.0 ? gap_mm : pass.length_mm;
+    steer.progress = std::move(progress);
+    PassSteeringSetup setup;
+    setup.label = pass.label;
+    setup.checker = &checker;
+    setup.ball_radius_mm = r;
+    setup.required_mm = request.clearance_mm;
+    setup.settle_start = settle[p] != 0;
+    setup.settle_end = settle_end[p] != 0;
+    return steerOnePass(dyn_pass, steer, setup, from_end);
+  };
   // Every pass steered by `field`; `report`: progress and interruption through request.progress.
   auto steerPasses = [&](const field::ForceField* field, bool report,
                          const dynamics::DynamicsParams& params) {
@@ -251,106 +294,20 @@ GenerateResult generatePath(const GenerateRequest& request) {
         }
         return;
       }
-      dynamics::Pass dyn_pass;
-      dyn_pass.length_mm = pass.length_mm;
-      dyn_pass.frameAt = [&pass, lead_rad](double s_mm) {
-        const PassSample s = pass.at(s_mm);
-        dynamics::PassFrame frame;
-        frame.centre_mm = s.centre_mm;
-        frame.feed = s.feed;
-        frame.normal = s.normal;
-        frame.lead0_rad = lead_rad;
-        return frame;
-      };
-      dynamics::SteeringRequest steer;
-      steer.field = field;
-      steer.nodes_tool_frame_mm = nodes;
-      steer.ball_radius_mm = r;
-      steer.params = params;
-      // The pass's own stations (even steps, or a nominal path's postures one for one); the solver
-      // never steps over more than the longest gap between them.
-      double gap_mm = 0.0;
-      for (std::size_t i = 0; i < pass.samples.size(); ++i) {
-        steer.output_s_mm.push_back(pass.samples[i].s_mm);
-        if (i > 0) gap_mm = std::max(gap_mm, pass.samples[i].s_mm - pass.samples[i - 1].s_mm);
-      }
-      steer.step_mm = gap_mm > 0.0 ? gap_mm : pass.length_mm;
+      common::Progress progress;
       if (request.progress && report)
-        steer.progress = [&, p](double fraction, std::string_view) {
+        progress = [&, p](double fraction, std::string_view) {
           std::lock_guard<std::mutex> lock(progress_mutex);
           pass_done[p] = std::clamp(fraction, 0.0, 1.0);
           return request.progress(fractionDone(), "passes");
         };
-      // The integrator stalled (its step to 1e-10 mm where the interpolated field turns sharply:
-      // a start inside a wall on a 1 mm grid, a helper's overhang that --direct and rtol 1e-3
-      // steer clear): once more with the tolerances loosened, said. The path is checked exactly
-      // all the same; a second failure is the job's error.
-      const auto loosen = [&] {  // a copy of the request as it stands, only when needed
-        dynamics::SteeringRequest looser = steer;
-        looser.params.rtol = std::max(params.rtol * 100.0, 1e-3);
-        looser.params.atol = std::max(params.atol * 1000.0, 1e-6);
-        return looser;
-      };
-      const auto sayLoosened = [&](const char* what, const std::string& why,
-                                   const dynamics::SteeringRequest& looser) {
-        std::ostringstream said;
-        said << pass.label << ": the integrator failed" << what << " (" << why << "); "
-             << "done again with dynamics.rtol " << looser.params.rtol << ", atol "
-             << looser.params.atol;
-        loosened[p] += (loosened[p].empty() ? "" : "; ") + said.str();
-      };
-      if (settle[p]) {
-        dynamics::SettledStart at_rest = dynamics::settleAtStart(dyn_pass, steer);
-        if (!at_rest.settled) {  // the same stall at rest
-          const dynamics::SteeringRequest looser = loosen();
-          dynamics::SettledStart again = dynamics::settleAtStart(dyn_pass, looser);
-          if (again.settled) {
-            sayLoosened(" settling at the start", at_rest.why, looser);
-            at_rest = std::move(again);
-          }
-        }
-        if (at_rest.settled) {  // else the nominal start: the pass reports what goes wrong
-          steer.initial_lead_rad = at_rest.lead_rad;
-          steer.initial_tilt_rad = at_rest.tilt_rad;
-          started_settled[p] = 1;
-        } else {
-          settle_failed[p] = at_rest.why.empty() ? "the settling failed" : at_rest.why;
-        }
-        // Still within `clearance` (a holder upright through a rib thinner than its reach: the
-        // field pushes its nodes on the far side further and the axis settles there, 588
-        // colliding postures on a helper's ribbed pocket): the clear axis nearest the nominal
-        // one within the limits, on a grid kClearStartStepDeg apart, nearest first; the spring
-        // then pulls it back towards the nominal against the near face's field.
-        const dynamics::PassFrame at = dyn_pass.frameAt(0.0);
-        const dynamics::LocalFrame frame = dynamics::localFrame(at);
-        auto clearanceAt = [&](double lead, double tilt) {
-          return checker.clearance(geometry::ballEndPosture(
-              at.centre_mm, dynamics::axisFromAngles(frame, lead, tilt), r));
-        };
-        if (clearanceAt(steer.initial_lead_rad.value_or(at.lead0_rad),
-                        steer.initial_tilt_rad.value_or(at.tilt0_rad)) < request.clearance_mm)
-          if (const auto clear = clearStart(at.lead0_rad, at.tilt0_rad, params, clearanceAt,
-                                            request.clearance_mm)) {
-            steer.initial_lead_rad = clear->first;
-            steer.initial_tilt_rad = clear->second;
-            turned_start[p] = 1;
-          }
-      }
-      dynamics::SteeringResult steered = dynamics::steerPass(dyn_pass, steer);
-      if (steered.status == dynamics::Status::SolverFailed) {
-        const dynamics::SteeringRequest looser = loosen();
-        dynamics::SteeringResult again = dynamics::steerPass(dyn_pass, looser);
-        if (again.status == dynamics::Status::Ok) {
-          sayLoosened("", steered.message, looser);
-          steered = std::move(again);
-        }
-      }
-      const auto clearanceOf = [&](const geometry::Posture& posture) {
-        return checker.clearance(posture);
-      };
-      if (steerWithCornersHeldIfClearer(dyn_pass, steer, steered, clearanceOf,
-                                        request.clearance_mm))
-        corners_held[p] = 1;
+      PassSteering done = steerPassOf(p, field, params, false, std::move(progress));
+      started_settled[p] = done.started_settled;
+      turned_start[p] = done.turned_start;
+      corners_held[p] = done.corners_held;
+      settle_failed[p] = std::move(done.settle_failed);
+      loosened[p] = std::move(done.loosened);
+      const dynamics::SteeringResult& steered = done.run;
       if (steered.status != dynamics::Status::Ok) {
         std::ostringstream msg;
         msg << pass.label;
@@ -365,17 +322,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
                  "`generate --nominal` marks where the path collides)";
         throw InputError(msg.str());
       }
-      for (const dynamics::PostureSample& s : steered.samples) {
-        GeneratedPosture g;
-        g.pass = pass.index;
-        g.s_mm = s.s_mm;
-        g.lead_rad = s.lead_rad;
-        g.tilt_rad = s.tilt_rad;
-        g.moment = s.moment.norm();
-        g.limited = s.limited;
-        g.posture = s.posture;
-        out.postures.push_back(g);
-      }
+      out.postures = generatedPostures(pass.index, steered);
       out.stats = steered.stats;
     };
     auto runPass = [&](std::size_t p) {
@@ -576,7 +523,14 @@ GenerateResult generatePath(const GenerateRequest& request) {
 
   // ---- links, then the exact clearance of every posture and motion ----------------------------
   const auto clearance_start = Clock::now();
-  linkCheckAndRepair(request, checker, safe_z_mm, {steer_end, clearance_end, motions_end}, result);
+  // A faulty pass steered again from its end (the repairs judge it): the final field's.
+  const SteerFromEnd steer_from_end = [&](std::size_t p) -> std::optional<PassSteering> {
+    PassSteering done = steerPassOf(p, force, request.dynamics, true, {});
+    if (done.run.status != dynamics::Status::Ok) return std::nullopt;
+    return done;
+  };
+  linkCheckAndRepair(request, checker, safe_z_mm, {steer_end, clearance_end, motions_end},
+                     steer_from_end, result);
   result.times.clearance_s = seconds(clearance_start);
   result.times.total_s = seconds(start);
   if (request.keep_voxels) {

@@ -1,6 +1,7 @@
 #include "nominal_fallback.h"
 
 #include <algorithm>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -72,6 +73,73 @@ bool clearPass(const GenerateRequest& request, const ClearanceChecker& checker,
          !checkCutterAgainstPart(request.tool, part, postures).gouges();
 }
 
+/// How a pass's `postures` check alone, as pathFaults orders a path: its postures and motions
+/// that collide with the obstacles, the holder's and the cutter's with the part (counted as
+/// their checks count them: no fewer than faultsByPass's postures), then its least clearance of
+/// the obstacles at the postures and motions, negated.
+std::pair<std::size_t, double> passFaults(const GenerateRequest& request,
+                                          const ClearanceChecker& checker,
+                                          const std::shared_ptr<const ObstacleModel>& part,
+                                          const std::vector<geometry::Posture>& postures) {
+  const ClearanceResult at = checker.check(postures);
+  MotionRequest motions;
+  motions.required_mm = request.clearance_mm;
+  motions.posture_clearance_mm = at.clearance_mm;
+  const MotionResult moved = checker.checkMotions(postures, motions);
+  std::size_t hits = 0;
+  for (std::size_t k = 0; k < postures.size(); ++k)
+    hits += at.clearance_mm[k] <= 0.0 ||
+            (k < moved.clearance_mm.size() && moved.clearance_mm[k] <= 0.0);
+  if (part) {
+    if (const auto holder = checkHolderAgainstPart(request.tool, request.holder, part, postures))
+      hits += holder->colliding_postures + holder->colliding_motions;
+    if (request.tool.shape != geometry::ToolShape::Flat) {
+      const CutterPartResult cutter = checkCutterAgainstPart(request.tool, part, postures);
+      hits += cutter.gouging_postures + cutter.gouging_motions;
+    }
+  }
+  return {hits, -std::min(at.min_clearance_mm, moved.min_clearance_mm)};
+}
+
+/// Each pass's postures in `result.postures`: [begin, end), in pass order.
+std::vector<std::pair<std::size_t, std::size_t>> postureRanges(const GenerateResult& result) {
+  std::vector<std::pair<std::size_t, std::size_t>> out;
+  std::size_t first = 0;
+  for (const Pass& pass : result.passes) {
+    std::size_t end = first;
+    while (end < result.postures.size() && result.postures[end].pass == pass.index) ++end;
+    out.emplace_back(first, end);
+    first = end;
+  }
+  return out;
+}
+
+/// What the steering said of the passes `gone` (by Pass::index) forgotten: they are written
+/// otherwise (a reviewer: what it said of a pass written nominal was not of the path written).
+void forgetSteeringOf(GenerateResult& result, const std::function<bool(int)>& gone) {
+  std::erase_if(result.settled_starts, gone);
+  std::erase_if(result.turned_starts, gone);
+  std::erase_if(result.corners_held, gone);
+  std::erase_if(result.steered_from_end, gone);
+  std::erase_if(result.settle_failures, [&](const auto& f) { return gone(f.pass); });
+  std::erase_if(result.loosened_solver, [&](const std::string& line) {
+    for (const Pass& pass : result.passes)
+      if (gone(pass.index) && line.rfind(pass.label + ": ", 0) == 0) return true;
+    return false;
+  });
+}
+
+/// The limits held: the written postures' (a pass replaced takes its own).
+void recountLimited(GenerateResult& result) {
+  result.limited_postures = 0;
+  result.first_limited = ClearanceResult::npos;
+  for (std::size_t k = 0; k < result.postures.size(); ++k)
+    if (result.postures[k].limited) {
+      if (result.first_limited == ClearanceResult::npos) result.first_limited = k;
+      ++result.limited_postures;
+    }
+}
+
 }  // namespace
 
 bool hasFaultyPasses(const GenerateRequest& request, const GenerateResult& result,
@@ -97,13 +165,10 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
   const PassFaults faults = faultsByPass(result, request.clearance_mm, part_marks);
   const double lead_rad = request.path.lead_deg * geometry::kDegToRad;
   bool replaced = false;
-  std::size_t first = 0;  // the pass's first posture in result.postures
+  const auto ranges = postureRanges(result);
   for (std::size_t p = 0; p < result.passes.size(); ++p) {
     const Pass& pass = result.passes[p];
-    std::size_t end = first;
-    while (end < result.postures.size() && result.postures[end].pass == pass.index) ++end;
-    const std::size_t begin = first;
-    first = end;
+    const auto [begin, end] = ranges[p];
     const std::size_t colliding = faults.colliding[p], under = faults.under[p];
     if ((colliding == 0 && under == 0) || end - begin != pass.samples.size()) continue;
     const std::vector<geometry::Posture> nominal =
@@ -126,32 +191,61 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
     replaced = true;
   }
   if (replaced) {
-    // What the steering said of a pass written nominal is not of the path written (a reviewer).
-    const auto kept = [&result](int pass) {
+    forgetSteeringOf(result, [&result](int pass) {
       for (const auto& k : result.kept_nominal)
         if (k.pass == pass) return true;
       return false;
-    };
-    std::erase_if(result.settled_starts, kept);
-    std::erase_if(result.turned_starts, kept);
-    std::erase_if(result.corners_held, kept);
-    std::erase_if(result.settle_failures, [&](const auto& f) { return kept(f.pass); });
-    std::erase_if(result.loosened_solver, [&](const std::string& line) {
-      for (const auto& k : result.kept_nominal)
-        if (line.rfind(k.label + ": ", 0) == 0) return true;
-      return false;
     });
-  }
-  if (replaced) {  // the limits held are the steered postures' that remain
-    result.limited_postures = 0;
-    result.first_limited = ClearanceResult::npos;
-    for (std::size_t k = 0; k < result.postures.size(); ++k)
-      if (result.postures[k].limited) {
-        if (result.first_limited == ClearanceResult::npos) result.first_limited = k;
-        ++result.limited_postures;
-      }
+    recountLimited(result);
   }
   return replaced;
+}
+
+bool steerFaultyPassesFromEnd(const GenerateRequest& request, const ClearanceChecker& checker,
+                              const std::shared_ptr<const ObstacleModel>& part,
+                              const SteerFromEnd& steer_from_end, GenerateResult& result,
+                              const std::optional<PartContacts::Marks>& part_marks) {
+  const PassFaults faults = faultsByPass(result, request.clearance_mm, part_marks);
+  std::vector<std::pair<int, PassSteering>> replaced;
+  const auto ranges = postureRanges(result);
+  for (std::size_t p = 0; p < result.passes.size(); ++p) {
+    const Pass& pass = result.passes[p];
+    const auto [begin, end] = ranges[p];
+    if (faults.colliding[p] == 0 && faults.under[p] == 0) continue;
+    std::optional<PassSteering> again = steer_from_end(p);
+    if (!again) continue;
+    std::vector<GeneratedPosture> steered = generatedPostures(pass.index, again->run);
+    if (steered.size() != end - begin) continue;
+    std::vector<geometry::Posture> placed;
+    for (const GeneratedPosture& g : steered) placed.push_back(g.posture);
+    if (!(passFaults(request, checker, part, placed) <
+          std::pair<std::size_t, double>{faults.colliding[p], -faults.min_mm[p]}))
+      continue;
+    for (std::size_t k = begin; k < end; ++k) result.postures[k] = steered[k - begin];
+    again->run = {};
+    replaced.emplace_back(pass.index, std::move(*again));
+  }
+  if (replaced.empty()) return false;
+  forgetSteeringOf(result, [&replaced](int pass) {
+    for (const auto& r : replaced)
+      if (r.first == pass) return true;
+    return false;
+  });
+  for (auto& [pass, said] : replaced) {
+    result.steered_from_end.push_back(pass);
+    if (said.started_settled) result.settled_starts.push_back(pass);
+    if (said.turned_start) result.turned_starts.push_back(pass);
+    if (said.corners_held) result.corners_held.push_back(pass);
+    if (!said.settle_failed.empty())
+      result.settle_failures.push_back({pass, std::move(said.settle_failed)});
+    if (!said.loosened.empty()) result.loosened_solver.push_back(std::move(said.loosened));
+  }
+  for (auto* list : {&result.settled_starts, &result.turned_starts, &result.corners_held})
+    std::sort(list->begin(), list->end());
+  std::stable_sort(result.settle_failures.begin(), result.settle_failures.end(),
+                   [](const auto& a, const auto& b) { return a.pass < b.pass; });
+  recountLimited(result);
+  return true;
 }
 
 }  // namespace fieldpath::pathgen

@@ -1,5 +1,6 @@
 #pragma once
-/// Passes the steering made collide, written with their nominal axes where those are clear.
+/// Passes the steering made collide or come under the clearance: steered again from their end
+/// where that checks better, written with their nominal axes where those are clear.
 #include <memory>
 #include <optional>
 #include <utility>
@@ -7,6 +8,7 @@
 #include "fieldpath/pathgen/clearance.h"
 #include "fieldpath/pathgen/generate.h"
 #include "fieldpath/pathgen/link_check.h"
+#include "pass_steering.h"
 
 namespace fieldpath::pathgen {
 
@@ -24,6 +26,18 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
                             const std::shared_ptr<const ObstacleModel>& part,
                             GenerateResult& result,
                             const std::optional<PartContacts::Marks>& part_marks);
+
+/// The passes of `result` that collide or come under the required clearance (as
+/// keepClearNominalPasses finds them) steered again from their end (`steer_from_end`): their
+/// postures replaced where the pass alone checks better by pathFaults' order (its postures and
+/// motions against the obstacles and the part), listed in `result.steered_from_end`, and what
+/// the steering from the start said of them (settled and turned starts, corners held, solver
+/// loosened) replaced by what this one says. Returns whether any pass was replaced (the caller
+/// links and checks the path again).
+bool steerFaultyPassesFromEnd(const GenerateRequest& request, const ClearanceChecker& checker,
+                              const std::shared_ptr<const ObstacleModel>& part,
+                              const SteerFromEnd& steer_from_end, GenerateResult& result,
+                              const std::optional<PartContacts::Marks>& part_marks);
 
 /// Whether a pass of `result` collides or comes under the required clearance (what
 /// keepClearNominalPasses may mend): the caller keeps a copy of the steered result only then.

@@ -16,7 +16,8 @@ namespace fieldpath::pathgen {
 using common::scaled;
 
 void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& checker,
-                        double safe_z_mm, const CheckStages& stages, GenerateResult& result) {
+                        double safe_z_mm, const CheckStages& stages,
+                        const SteerFromEnd& steer_from_end, GenerateResult& result) {
   std::optional<PartContacts::Marks> part_marks;  // of result.path, where the part is touched
   // The part's model (its tree and shells), prepared once for every check of the path and of the
   // repairs: a 1 M-triangle part takes seconds a preparation.
@@ -97,6 +98,17 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
           part_marks = std::move(before_marks);
         }
       };
+  if (steer_from_end && !request.nominal && !request.passes_only &&
+      hasFaultyPasses(request, result, part_marks)) {
+    // The path as steered from the passes' starts, kept until the one with passes steered from
+    // their ends checks no worse (their links come down other axes).
+    GenerateResult from_starts = result;
+    std::optional<PartContacts::Marks> from_starts_marks = part_marks;
+    if (steerFaultyPassesFromEnd(request, checker, part_model, steer_from_end, result, part_marks))
+      keepIfNoWorse(std::move(from_starts), std::move(from_starts_marks),
+                    result.steered_from_end.size(), &GenerateResult::steered_from_end_undone,
+                    "passes steered from their end: checked again");
+  }
   if (!request.nominal && !request.passes_only && hasFaultyPasses(request, result, part_marks)) {
     // The steered path, kept until the one with nominal passes is checked no worse (its links
     // come down the new axes): a copy only where a pass is faulty.

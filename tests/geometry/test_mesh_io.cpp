@@ -150,14 +150,19 @@ TEST(MeshIo, AsciiPlyAndObjWithQuadsClosedForm) {
 // as OBJ and PLY n-gons) is split ear by ear: its area, 3, every triangle facing the polygon's
 // way (+z), and none over the notch. The fan from the first corner covered the notch (a helper's
 // L-shaped prism read 9 colliding postures where 1.98 mm was clear). A convex one stays the fan.
-TEST(MeshIo, AConcavePolygonFaceIsSplitWithinItself) {
+TEST(MeshIo, AConcavePolygonFaceIsSplitWithinItselfItsCornersListedOnceOrTwice) {
   const char* corners = "v 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nv 0 0 0\nv 2 0 0\n";
   std::string ply =
       "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\n"
       "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
       "2 1 0\n1 1 0\n1 2 0\n0 2 0\n0 0 0\n2 0 0\n6 0 1 2 3 4 5\n";
+  // The reflex corner (1, 1) listed twice, by its index or as a second record of its point: a
+  // zero-length edge there split its turn into two of none, and the face read convex, fanned
+  // over the notch (a reviewer's).
   for (const auto& [name, text] :
-       {std::pair{"l.obj", std::string(corners) + "f 1 2 3 4 5 6\n"}, std::pair{"l.ply", ply}}) {
+       {std::pair{"l.obj", std::string(corners) + "f 1 2 3 4 5 6\n"}, std::pair{"l.ply", ply},
+        std::pair{"l_twice.obj", std::string(corners) + "f 1 2 2 3 4 5 6\n"},
+        std::pair{"l_two_records.obj", std::string(corners) + "v 1 1 0\nf 1 2 7 3 4 5 6\n"}}) {
     const TriangleMesh m = loadMesh(writeBytes(name, text));
     ASSERT_EQ(m.triangles.size(), 4u) << name;
     EXPECT_NEAR(meshArea(m), 3.0, 1e-12) << name;
@@ -420,6 +425,20 @@ TEST(MeshIo, BinaryPlyBodyIsWalkedAgainstItsHeader) {
   expectMessage(circle,
                 "133 byte(s) after the body its header declares read as another face (33 "
                 "corners");
+  // With 1-byte indices and 132 vertices a line of text after the body reads as a face (`\n`: a
+  // count of 10, then printable bytes, each under 132) and the rest as none: padding, as with
+  // wider indices (it was refused, a reviewer's). The header one face short: refused still.
+  std::string small =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 132\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\n"
+      "property list uchar uchar vertex_indices\nend_header\n";
+  for (int k = 0; k < 132; ++k)
+    for (const float c : {float(k % 2), float(k / 2), 0.0f}) small += bytesOf(c, false);
+  small += std::string("\x03\x00\x01\x02", 4);
+  EXPECT_EQ(
+      loadMesh(writeBytes("trailer.ply", small + "\n# end of mesh data #\n")).triangles.size(), 1u);
+  expectMessage(small + std::string("\x03\x01\x03\x02", 4),
+                "4 byte(s) after the body its header declares read as another face (3 corners");
   // Vertices without z (read as flat), triangle strips (dropped): refused.
   std::string flat = square;
   flat.replace(flat.find("property float z\n"), 17, "");

@@ -151,6 +151,14 @@ struct GenerateResult {
   /// turning with the feed came under `clearance` there, and holding its direction through the
   /// corners kept more. By Pass::index.
   std::vector<int> corners_held;
+  /// Passes steered from their end to their start (dynamics/reversed_pass.h): steered from
+  /// their start they collided or came under `clearance` (the causal axis meets the side of an
+  /// obstacle the pass reaches first late: an impeller's passes reversed collided), and steered
+  /// from the end the pass checked better. Written in the pass's order. By Pass::index.
+  std::vector<int> steered_from_end;
+  /// Passes steered from their end that checked better alone, not kept: the path linked to them
+  /// was checked worse (pathFaults).
+  std::size_t steered_from_end_undone = 0;
   /// Passes that were to start settled but could not (no damping, the solver failing at rest):
   /// they start from the nominal axis, or where that lies within `clearance` the clear axis
   /// nearest it (turned_starts). By Pass::index, why.
