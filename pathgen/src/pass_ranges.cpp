@@ -74,9 +74,13 @@ class BlockSplitter {
       if (const double d = (centre(i) - centre(i - 1)).norm(); d > kRepeatMm) steps.push_back(d);
       if (const double d = tipStep(i); d > kRepeatMm) tip_steps.push_back(d);
     }
-    gap_mm_ = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(steps);
+    // A step of the gap itself is no gap, within the rounding of the file's decimals (steps of
+    // exactly 4 x 0.5 mm read 2.000000000000007 at one x and 1.9999999999999964 at another:
+    // some split, some not).
+    constexpr double kRounding = 1.0 + 1e-9;
+    gap_mm_ = kRounding * (pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(steps));
     feed_min_mm_ = centreNoiseMm(median(steps));
-    tip_gap_mm_ = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(tip_steps);
+    tip_gap_mm_ = kRounding * (pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(tip_steps));
   }
 
   void run() {

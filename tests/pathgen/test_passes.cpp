@@ -1,4 +1,6 @@
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -245,4 +247,25 @@ TEST(Passes, AZigZagInOnePassBlockIsOnePassALeg) {
   for (int k = 1; k <= 10; ++k) corner.postures.push_back({Vec3(10, k, 0), Vec3::UnitZ()});
   corner.blocks = {{geometry::PathBlock::Kind::Pass, 0, corner.postures.size()}};
   EXPECT_EQ(passRanges(corner, 0.0, 1.0).size(), 1u);
+}
+
+// Steps of exactly the gap (4 x the median, or path.pass_gap) are no gap wherever they fall: the
+// file's decimals read 2.000000000000007 at one x and 1.9999999999999964 at another, and one
+// split the pass where others did not. A step 1 % over is a gap.
+TEST(Passes, StepsOfExactlyThePassGapSplitNowhere) {
+  for (const double gap_mm : {2.0, 2.02}) {
+    geometry::PathFile file;
+    double x = 0.0;
+    for (int k = 0; k < 120; ++k) {
+      x += k % 10 == 9 ? gap_mm : 0.5;  // a gap every 10 steps, at 12 different x
+      char text[32];
+      std::snprintf(text, sizeof text, "%.6f", 0.1234 + x);  // as a CAM file writes it
+      file.postures.push_back({Vec3(std::stod(text), 0.7, 0.0), Vec3::UnitZ(), 0.0, false});
+    }
+    file.blocks.push_back({geometry::PathBlock::Kind::Pass, 0, file.postures.size()});
+    for (const double pass_gap_mm : {0.0, 2.0}) {
+      const auto ranges = passRanges(file, pass_gap_mm, 3.0);
+      EXPECT_EQ(ranges.size(), gap_mm == 2.0 ? 1u : 13u) << gap_mm << " " << pass_gap_mm;
+    }
+  }
 }
