@@ -76,6 +76,53 @@ INSTANTIATE_TEST_SUITE_P(Dynamics, FreeResponse,
                                            OscillatorCase{"over", 5.0}),
                          [](const auto& info) { return std::string(info.param.name); });
 
+/// A field whose tilt torque on one node L above the ball centre is κ·tilt exactly, pushing the
+/// axis away from the nominal (a field stiffness of -κ about the tilt, none about the lead): at
+/// the node (y = -L sin T relative to the pass at y = 0) F = (0, κ asin(y/L) / sqrt(L² - y²), 0),
+/// whose moment about the centre along f is -L cos T · F_y = κ T.
+struct TiltPushField final : field::ForceField {
+  double kappa = 1.0, length_mm = 30.0;
+  void evaluate(std::span<const Vec3> points, std::span<Vec3> forces) const override {
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const double y = points[i].y();
+      forces[i] = Vec3(
+          0.0, kappa * std::asin(y / length_mm) / std::sqrt(length_mm * length_mm - y * y), 0.0);
+    }
+  }
+};
+
+// `damping: critical` with a field damps each mode as critical for the spring plus the field's
+// stiffness, and never less than for the spring alone: where the field pushes the axis away
+// (κ = 1 against k = 2) the tilt runs J θ'' + 2 sqrt(J k) θ' + (k - κ) θ = 0, overdamped. Damped
+// for the softened stiffness k - κ instead (the floor dropped: a mutation no test caught, and it
+// moved the impeller's axes 0.15 deg) it is critically damped, a trace 7.5e-3 rad away.
+TEST(FreeResponse, CriticalDampingWithAFieldThatPushesAwayKeepsTheSpringsFloor) {
+  const TiltPushField push;
+  const std::vector<Vec3> node = {Vec3(0, 0, kRadius + push.length_mm)};
+  SteeringRequest request = requestFor(&push);
+  request.nodes_tool_frame_mm = node;
+  request.params.inertia = 1.0;
+  request.params.stiffness = 2.0;
+  request.params.damping = -1.0;  // critical
+  request.initial_tilt_rad = 0.05;
+  const Pass pass = straightPass(150.0);
+  const SteeringResult result = runToleranceStable(pass, request);
+  ASSERT_EQ(result.status, Status::Ok) << result.message;
+  const double v = request.params.feed_mm_per_min / 60.0;
+  const double c = 2.0 * std::sqrt(1.0 * 2.0), k_eff = 2.0 - push.kappa;
+  double worst = 0.0, softened = 0.0;
+  for (const PostureSample& s : result.samples) {
+    const double t = s.s_mm / v;
+    worst = std::max(worst, std::abs(s.tilt_rad - analyticAngle(1.0, c, k_eff, 0.05, t)));
+    softened =
+        std::max(softened, std::abs(analyticAngle(1.0, 2.0 * std::sqrt(k_eff), k_eff, 0.05, t) -
+                                    analyticAngle(1.0, c, k_eff, 0.05, t)));
+    EXPECT_NEAR(s.lead_rad, 0.0, 1e-9);
+  }
+  EXPECT_LT(worst, 1e-4 * 0.05);
+  EXPECT_GT(softened, 20.0 * worst);  // the two dampings are told apart
+}
+
 // The spring pulls to the pass's nominal angles θ0(s) (DESIGN: k (θ - θ0(s))), not to 0: with
 // θ0 = (0.05, -0.08) rad the free response is θ0 + (θi - θ0) times the oscillator's from 1, and a
 // pass started without initial angles starts at θ0 and stays there (every test had θ0 = 0: a

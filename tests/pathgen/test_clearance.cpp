@@ -135,6 +135,15 @@ TEST(Clearance, BoxToolBesideAWallClosedForm) {
   EXPECT_NEAR(ok.min_clearance_mm, 2.0, 1e-9);
   EXPECT_EQ(ok.min_index, 1u);
   EXPECT_EQ(ok.min_obstacle, 1);
+
+  // A chordal tolerance is taken off every distance (a faceted tool's vertices on the true
+  // surface lie inside it by that much: never optimistic), and a touch stays 0.
+  const pathgen::ClearanceChecker chorded(tool, obstacles, 0.05);
+  EXPECT_NEAR(chorded.clearance(upright), 4.0 - 0.05, 1e-9);
+  EXPECT_NEAR(chorded.clearance(tilted), 5.0 - (10 * std::sin(theta) + std::cos(theta)) - 0.05,
+              1e-9);
+  EXPECT_NEAR(chorded.check(safe).min_clearance_mm, 2.0 - 0.05, 1e-9);
+  EXPECT_EQ(chorded.clearance(crossing), 0.0);
 }
 
 // A micro tool's clearance: the tool mesh within 1/150 of its smallest radius, that chordal

@@ -23,6 +23,47 @@ using geometry::Posture;
 using pathgen::test::boxMesh;
 using pathgen::test::errorOf;
 
+// Between passes whose axes differ the travel plane's tip height keeps the whole tool above
+// safe_z at every axis on the way: here the lowest point is the holder's rim at the next pass's
+// axis (a wide holder low on the tool, tilted 40 deg), so z = safe_z - lowestPointBelowTip(that
+// axis), not the first's; and the travel ends on that axis right above the next pass, then comes
+// down it. (The last axis of the turn left out, or the point above the next pass dropped, was
+// caught only by the wording of a note: a mutation audit.)
+TEST(Links, TheTravelBetweenTwoAxesClearsSafeZAtTheNextAxisAndEndsAboveIt) {
+  const geometry::ToolSpec tool{geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
+  const geometry::HolderProfile holder = {{10, 20}, {30, 20}};
+  const double t = 40 * M_PI / 180;
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ(), leaning(0, -std::sin(t), std::cos(t));
+  std::vector<std::vector<Posture>> passes(2);
+  for (int i = 0; i <= 4; ++i) {
+    passes[0].push_back({Eigen::Vector3d(i, 0, 0), up, 0.0, false});
+    passes[1].push_back({Eigen::Vector3d(4 - i, 30, 0), leaning, 0.0, false});
+  }
+  LinkRequest request;
+  request.safe_z_mm = 25.0;
+  request.tool = tool;
+  request.holder = holder;
+  const PathFile out = linkPasses(passes, request);
+  ASSERT_EQ(out.blocks.size(), 5u);
+  const PathBlock& middle = out.blocks[2];
+  ASSERT_EQ(middle.kind, PathBlock::Kind::Link);
+  const double lowest = 10 * std::cos(t) - 20 * std::sin(t);  // closed form: the rim, tilted
+  ASSERT_NEAR(lowestPointBelowTip(tool, holder, leaning), lowest, 1e-12);
+  const double z = 25.0 - lowest;
+  std::vector<std::size_t> travel;  // the link's postures in the travel plane
+  for (std::size_t i = middle.begin; i < middle.end; ++i)
+    if (std::abs(out.postures[i].tip_mm.z() - z) < 1e-9) travel.push_back(i);
+  ASSERT_GE(travel.size(), 2u);
+  for (std::size_t i = middle.begin + 1; i + 1 < middle.end; ++i)
+    EXPECT_GE(out.postures[i].tip_mm.z() + lowestPointBelowTip(tool, holder, out.postures[i].axis),
+              25.0 - 1e-9);
+  const Posture& above = out.postures[travel.back()];
+  EXPECT_LT(geometry::axisAngle(above.axis, leaning), 1e-12);
+  const Eigen::Vector3d along = above.tip_mm - passes[1].front().tip_mm;
+  EXPECT_LT(along.cross(leaning).norm(), 1e-9);  // on the next pass's axis
+  EXPECT_GT(along.dot(leaning), 0.0);
+}
+
 TEST(Links, LeaveAlongTheAxisTravelAboveSafeZAndTurnInSmallSteps) {
   geometry::ToolSpec tool{geometry::ToolShape::Ball, 3.0, 0.0, 40.0};
   const geometry::HolderProfile holder = {{40, 6}, {55, 6}, {55, 12}, {90, 12}};
@@ -32,6 +73,12 @@ TEST(Links, LeaveAlongTheAxisTravelAboveSafeZAndTurnInSmallSteps) {
   const Eigen::Vector3d tilted(std::sin(t), 0, std::cos(t));
   EXPECT_NEAR(lowestPointBelowTip(tool, holder, tilted),
               std::min(3 * std::cos(t) - 3, 40 * std::cos(t) - 6 * std::sin(t)), 1e-12);
+  // Where the holder's rim is the lowest (a wide holder low on the tool, tilted 60 deg): its
+  // rim's lowest point, 10 cos t - 20 sin t, below the ball's 3 cos t - 3.
+  const double steep = 60 * M_PI / 180;
+  EXPECT_NEAR(lowestPointBelowTip(tool, {{10, 20}, {30, 20}},
+                                  Eigen::Vector3d(std::sin(steep), 0, std::cos(steep))),
+              10 * std::cos(steep) - 20 * std::sin(steep), 1e-12);
   std::vector<std::vector<Posture>> passes(2);
   for (int i = 0; i <= 4; ++i) {
     passes[0].push_back({Eigen::Vector3d(i, 0, 0), tilted, 0.0, false});

@@ -173,6 +173,16 @@ TEST(Analytic, TorusAndFlatMatchReference) {
     expectMatchesReference(g, tool, postures, runCpu(g, tool, postures).heights_mm);
 }
 
+// Lines apart by other steps in x and y, over a region longer in y (every grid above is square:
+// a line's y taken from the x step was caught only by an app test, a mutation audit).
+TEST(Analytic, NonSquareGridsMatchTheReference) {
+  const Grid g = Grid::fromRegion(-6, -8, 6, 9, 48, 40);  // 0.25 mm in x, 0.425 mm in y
+  ASSERT_NE(g.dx_mm, g.dy_mm);
+  const auto postures = awkwardPostures(8, 5);
+  for (const Tool& tool : {Tool::ball(2, 8), Tool::torus(2, 0.6, 8), Tool::flat(1.5, 6)})
+    expectMatchesReference(g, tool, postures, runCpu(g, tool, postures).heights_mm);
+}
+
 TEST(Analytic, OrderAndBlocksDoNotChangeABit) {
   const Grid g = Grid::fromRegion(-6, -6, 6, 6, 64, 64);
   const Tool tool = Tool::torus(2, 0.5, 8);
