@@ -555,10 +555,11 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
       std::fprintf(stderr,
                    "note: %zu pass%s (first: pass %d) steered with the axis held through %s "
                    "corners: turning with the feed (DESIGN's frame) it came under `clearance` "
-                   "there (report.json passes corners_held)\n",
+                   "there, or swung the axis over %g deg in a step (report.json passes "
+                   "corners_held)\n",
                    result.corners_held.size(), result.corners_held.size() == 1 ? "" : "es",
                    result.corners_held.front() + 1,
-                   result.corners_held.size() == 1 ? "its" : "their");
+                   result.corners_held.size() == 1 ? "its" : "their", pathgen::kNoteAxisTurnDeg);
     if (result.safe_z_proven_mm > 0.0)
       std::fprintf(stderr,
                    "note: links.safe_z %g mm leaves the links within the checks' margin of "

@@ -399,7 +399,11 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
     sample.tilt_rad = written[1];
     sample.lead_rate_rad_per_s = written[2];
     sample.tilt_rate_rad_per_s = written[3];
-    sample.limited = check.clamped;
+    // At a limit without a clamp there too (a start settled or turned onto it: a pass steered
+    // from its end wrote its last posture at lead -20 unmarked, a reviewer's).
+    sample.limited = check.clamped ||
+                     std::abs(written[0]) >= request.params.maxLeadRad() * (1.0 - 1e-12) ||
+                     std::abs(written[1]) >= request.params.maxTiltRad() * (1.0 - 1e-12);
     if (!sample.moment.allFinite()) {  // the solver saw it too late (at s = 0) or not at all
       result.status = Status::SolverFailed;
       result.message = at(s_mm) + "the field gave a non-finite moment";

@@ -4,8 +4,11 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
+
+#include <tbb/parallel_for.h>
 
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/geometry/units.h"
@@ -204,26 +207,52 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
 bool steerFaultyPassesFromEnd(const GenerateRequest& request, const ClearanceChecker& checker,
                               const std::shared_ptr<const ObstacleModel>& part,
                               const SteerFromEnd& steer_from_end, GenerateResult& result,
-                              const std::optional<PartContacts::Marks>& part_marks) {
+                              const std::optional<PartContacts::Marks>& part_marks,
+                              const common::Progress& progress) {
   const PassFaults faults = faultsByPass(result, request.clearance_mm, part_marks);
-  std::vector<std::pair<int, PassSteering>> replaced;
   const auto ranges = postureRanges(result);
+  // The passes to try: those that collide, or come under the clearance where their ball does not
+  // (no axis lifts a ball within the clearance: 50 such passes were steered again for changes of
+  // 0.01 um, generate 2.6 times longer, a reviewer's).
+  std::vector<std::size_t> tried;
   for (std::size_t p = 0; p < result.passes.size(); ++p) {
+    const bool ball_under =
+        std::any_of(result.balls_under_clearance.begin(), result.balls_under_clearance.end(),
+                    [&](const auto& b) { return b.pass == result.passes[p].index; });
+    if (faults.colliding[p] > 0 || (faults.under[p] > 0 && !ball_under)) tried.push_back(p);
+  }
+  // Each steered and judged alone, in parallel (as the passes were steered); kept in pass order.
+  std::vector<std::optional<PassSteering>> again(tried.size());
+  std::vector<std::vector<GeneratedPosture>> steered(tried.size());
+  std::mutex done_mutex;
+  std::size_t done = 0;
+  tbb::parallel_for(std::size_t{0}, tried.size(), [&](std::size_t t) {
+    const std::size_t p = tried[t];
     const Pass& pass = result.passes[p];
-    const auto [begin, end] = ranges[p];
-    if (faults.colliding[p] == 0 && faults.under[p] == 0) continue;
-    std::optional<PassSteering> again = steer_from_end(p);
-    if (!again) continue;
-    std::vector<GeneratedPosture> steered = generatedPostures(pass.index, again->run);
-    if (steered.size() != end - begin) continue;
-    std::vector<geometry::Posture> placed;
-    for (const GeneratedPosture& g : steered) placed.push_back(g.posture);
-    if (!(passFaults(request, checker, part, placed) <
-          std::pair<std::size_t, double>{faults.colliding[p], -faults.min_mm[p]}))
-      continue;
-    for (std::size_t k = begin; k < end; ++k) result.postures[k] = steered[k - begin];
-    again->run = {};
-    replaced.emplace_back(pass.index, std::move(*again));
+    std::optional<PassSteering> run = steer_from_end(p);
+    if (run && run->run.samples.size() == ranges[p].second - ranges[p].first) {
+      std::vector<GeneratedPosture> postures = generatedPostures(pass.index, run->run);
+      std::vector<geometry::Posture> placed;
+      for (const GeneratedPosture& g : postures) placed.push_back(g.posture);
+      const auto [collisions, minus_least] = passFaults(request, checker, part, placed);
+      // Fewer collisions, or as many and more clearance than rounding gives (1 um).
+      if (collisions < faults.colliding[p] ||
+          (collisions == faults.colliding[p] && -minus_least > faults.min_mm[p] + 1e-3)) {
+        run->run = {};
+        again[t] = std::move(run);
+        steered[t] = std::move(postures);
+      }
+    }
+    std::lock_guard<std::mutex> lock(done_mutex);
+    common::report(progress, double(++done) / double(tried.size()), "");
+  });
+  std::vector<std::pair<int, PassSteering>> replaced;
+  for (std::size_t t = 0; t < tried.size(); ++t) {
+    if (!again[t]) continue;
+    const std::size_t p = tried[t];
+    for (std::size_t k = ranges[p].first; k < ranges[p].second; ++k)
+      result.postures[k] = steered[t][k - ranges[p].first];
+    replaced.emplace_back(result.passes[p].index, std::move(*again[t]));
   }
   if (replaced.empty()) return false;
   forgetSteeringOf(result, [&replaced](int pass) {

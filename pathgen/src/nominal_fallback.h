@@ -27,17 +27,19 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
                             GenerateResult& result,
                             const std::optional<PartContacts::Marks>& part_marks);
 
-/// The passes of `result` that collide or come under the required clearance (as
-/// keepClearNominalPasses finds them) steered again from their end (`steer_from_end`): their
-/// postures replaced where the pass alone checks better by pathFaults' order (its postures and
-/// motions against the obstacles and the part), listed in `result.steered_from_end`, and what
-/// the steering from the start said of them (settled and turned starts, corners held, solver
-/// loosened) replaced by what this one says. Returns whether any pass was replaced (the caller
-/// links and checks the path again).
+/// The passes of `result` that collide, or come under the required clearance where their ball
+/// does not (as keepClearNominalPasses finds them), steered again from their end
+/// (`steer_from_end`, in parallel; `progress` per pass done): their postures replaced where the
+/// pass alone checks better (fewer collisions, or as many and over 1 um more clearance; its
+/// postures and motions against the obstacles and the part), listed in `result.steered_from_end`,
+/// and what the steering from the start said of them (settled and turned starts, corners held,
+/// solver loosened) replaced by what this one says. Returns whether any pass was replaced (the
+/// caller links and checks the path again).
 bool steerFaultyPassesFromEnd(const GenerateRequest& request, const ClearanceChecker& checker,
                               const std::shared_ptr<const ObstacleModel>& part,
                               const SteerFromEnd& steer_from_end, GenerateResult& result,
-                              const std::optional<PartContacts::Marks>& part_marks);
+                              const std::optional<PartContacts::Marks>& part_marks,
+                              const common::Progress& progress = {});
 
 /// Whether a pass of `result` collides or comes under the required clearance (what
 /// keepClearNominalPasses may mend): the caller keeps a copy of the steered result only then.

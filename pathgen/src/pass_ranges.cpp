@@ -57,6 +57,11 @@ namespace {
 ///   return leg's start, its frame turned there: 43 deg in one step and 38 postures colliding in
 ///   a helper's pocket). One turn posture is the link's. Any other step ends the turn: its steps
 ///   are the pass's feed (a corner kept, an L).
+/// A step of the gap itself is no gap, within the rounding of the file's decimals (steps of
+/// exactly 4 x 0.5 mm read 2.000000000000007 at one x and 1.9999999999999964 at another: one of
+/// twelve split its pass).
+constexpr double kRounding = 1.0 + 1e-9;
+
 class BlockSplitter {
  public:
   using Ranges = std::vector<std::pair<std::size_t, std::size_t>>;
@@ -74,13 +79,9 @@ class BlockSplitter {
       if (const double d = (centre(i) - centre(i - 1)).norm(); d > kRepeatMm) steps.push_back(d);
       if (const double d = tipStep(i); d > kRepeatMm) tip_steps.push_back(d);
     }
-    // A step of the gap itself is no gap, within the rounding of the file's decimals (steps of
-    // exactly 4 x 0.5 mm read 2.000000000000007 at one x and 1.9999999999999964 at another:
-    // some split, some not).
-    constexpr double kRounding = 1.0 + 1e-9;
-    gap_mm_ = kRounding * (pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(steps));
+    gap_mm_ = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(steps);
     feed_min_mm_ = centreNoiseMm(median(steps));
-    tip_gap_mm_ = kRounding * (pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(tip_steps));
+    tip_gap_mm_ = pass_gap_mm > 0.0 ? pass_gap_mm : 4.0 * median(tip_steps);
   }
 
   void run() {
@@ -89,8 +90,8 @@ class BlockSplitter {
       // DESIGN's gap is the tips'; the centres' too, so that an axis swung about a steady tip
       // (the centre thrown up to 2R) or about a steady centre (the tip thrown) stays in its
       // pass: such a turn is the axis's, counted and named at its line, not a link.
-      if (gap_mm_ > 0.0 && step.norm() > gap_mm_) {
-        if (tipStep(i) > tip_gap_mm_) {  // the link between two passes
+      if (gap_mm_ > 0.0 && step.norm() > kRounding * gap_mm_) {
+        if (tipStep(i) > kRounding * tip_gap_mm_) {  // the link between two passes
           out_.emplace_back(begin_, i);  // (one posture alone: nominalPasses names it)
           if (gaps_) gaps_->push_back({i, tipStep(i), tip_gap_mm_});
           begin_ = i;
@@ -149,7 +150,7 @@ class BlockSplitter {
       if (direction > 0 ? at + 1 >= block_.end : at <= block_.begin) break;
       const std::size_t to = direction > 0 ? at + 1 : at - 1;
       const double step_mm = (centre(to) - centre(at)).norm();
-      if (gap_mm_ > 0.0 && step_mm > gap_mm_) break;
+      if (gap_mm_ > 0.0 && step_mm > kRounding * gap_mm_) break;
       length_mm += step_mm;
       at = to;
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <sstream>
 #include <utility>
 
@@ -10,6 +11,7 @@
 #include "fieldpath/dynamics/frame.h"
 #include "fieldpath/dynamics/reversed_pass.h"
 #include "fieldpath/geometry/posture.h"
+#include "fieldpath/pathgen/passes.h"
 
 namespace fieldpath::pathgen {
 namespace {
@@ -20,6 +22,15 @@ double leastClearance(const dynamics::SteeringResult& run, const PassSteeringSet
   for (const dynamics::PostureSample& sample : run.samples)
     least_mm = std::min(least_mm, setup.checker->clearance(sample.posture));
   return least_mm;
+}
+
+/// The largest turn of the axis between two consecutive postures of a run, deg.
+double largestTurnDeg(const dynamics::SteeringResult& run) {
+  double largest_rad = 0.0;
+  for (std::size_t k = 1; k < run.samples.size(); ++k)
+    largest_rad = std::max(largest_rad, geometry::axisAngle(run.samples[k - 1].posture.axis,
+                                                            run.samples[k].posture.axis));
+  return largest_rad * 180.0 / std::numbers::pi;
 }
 
 /// One way along `pass` (the pass itself, or reversedPass of it): the start settled where
@@ -97,14 +108,23 @@ PassSteering steerOneWay(const dynamics::Pass& pass, dynamics::SteeringRequest s
   // away from, a tilt leaning away from it leans at it after the turn (a helper's pocket
   // corner: 19.5 deg in a step, the holder 2.3 mm into the wall); held in the world the axis
   // keeps its direction, and loses a lean away from a boss the pass turns round (a reviewer's:
-  // 50 colliding postures round a 150 deg turn). The held run only where DESIGN's comes under.
+  // 50 colliding postures round a 150 deg turn). The held run only where DESIGN's comes under,
+  // and kept only if it keeps more.
+  // Clear, but swinging the axis over kNoteAxisTurnDeg in a step (a 0.5 mm jog beside a wall:
+  // 19.5 deg in 0.5 mm, the rotary axes asked for 650 deg/s at 1000 mm/min): the held run where
+  // it keeps the clearance and turns less.
   if (out.run.status != dynamics::Status::Ok || out.run.corners == 0) return out;
   const double turning_mm = leastClearance(out.run, setup);
-  if (turning_mm >= setup.required_mm) return out;
+  const double turning_deg = largestTurnDeg(out.run);
+  const bool under = turning_mm < setup.required_mm;
+  if (!under && turning_deg <= kNoteAxisTurnDeg) return out;
   dynamics::SteeringRequest held = steer;
   held.hold_corners = true;
   dynamics::SteeringResult kept = dynamics::steerPass(pass, held);
-  if (kept.status != dynamics::Status::Ok || !(leastClearance(kept, setup) > turning_mm))
+  if (kept.status != dynamics::Status::Ok) return out;
+  const double held_mm = leastClearance(kept, setup);
+  if (under ? !(held_mm > turning_mm)
+            : !(held_mm >= setup.required_mm && largestTurnDeg(kept) < turning_deg))
     return out;
   out.run = std::move(kept);
   out.corners_held = true;

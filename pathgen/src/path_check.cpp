@@ -22,6 +22,9 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
   // The part's model (its tree and shells), prepared once for every check of the path and of the
   // repairs: a 1 M-triangle part takes seconds a preparation.
   std::shared_ptr<const ObstacleModel> part_model;
+  // The first check reports in the job's bar (steer_end to 1); a repair's check again as a stage
+  // of its own, from 0 % (it ran back from 100 % to the steering's end, unsaid: a reviewer's).
+  common::Progress progress = request.progress;
   const auto linkAndCheck = [&] {
     std::vector<std::vector<geometry::Posture>> pass_postures(result.passes.size());
     for (const GeneratedPosture& g : result.postures) pass_postures[g.pass].push_back(g.posture);
@@ -55,25 +58,25 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
     }
     for (const GeneratedPosture& g : result.postures)
       if (g.limited) result.path.limited.push_back(g.output);
-    result.clearance = checker.check(
-        result.path.postures, {},
-        scaled(request.progress, stages.steer_end, stages.clearance_end, "clearance"));
+    result.clearance =
+        checker.check(result.path.postures, {},
+                      scaled(progress, stages.steer_end, stages.clearance_end, "clearance"));
     if (!request.passes_only) {
       MotionRequest motions;
       motions.required_mm = request.clearance_mm;
       motions.posture_clearance_mm = result.clearance.clearance_mm;
       result.motions = checker.checkMotions(
           result.path.postures, motions,
-          scaled(request.progress, stages.clearance_end, stages.motions_end, "motions"));
+          scaled(progress, stages.clearance_end, stages.motions_end, "motions"));
       if (request.part) {
         // With its own progress: the cutter's stamps along 46 000 postures took 95 s after the
         // motions' 100 %, with no word (a scale sweep's finding).
-        const common::Progress progress = scaled(request.progress, stages.motions_end, 1.0, "part");
-        common::report(progress, 0.0, "part");
+        const common::Progress part = scaled(progress, stages.motions_end, 1.0, "part");
+        common::report(part, 0.0, "part");
         if (!part_model) part_model = prepareObstacle(*request.part, "part");
         PartContacts contacts =
             checkAgainstPart(request.tool, request.holder, part_model, result.path,
-                             kGougeToleranceMm, progress, farFromPartMm(request.tool.radius_mm));
+                             kGougeToleranceMm, part, farFromPartMm(request.tool.radius_mm));
         result.ball_part_mm = contacts.ball_part_mm;
         result.far_from_part = contacts.far;
         part_marks = contacts.marks(result.path.postures.size());
@@ -90,7 +93,11 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
   const auto keepIfNoWorse =
       [&](GenerateResult before, std::optional<PartContacts::Marks> before_marks,
           std::size_t changed, std::size_t GenerateResult::*undone, const char* what) {
-        common::report(request.progress, stages.steer_end, what);
+        if (request.progress)
+          progress = [&request, &stages, what = std::string(what)](double f, std::string_view) {
+            return request.progress((f - stages.steer_end) / (1.0 - stages.steer_end), what);
+          };
+        common::report(progress, stages.steer_end, what);
         linkAndCheck();
         if (pathFaults(result) > pathFaults(before)) {
           before.*undone = changed;
@@ -104,7 +111,9 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
     // their ends checks no worse (their links come down other axes).
     GenerateResult from_starts = result;
     std::optional<PartContacts::Marks> from_starts_marks = part_marks;
-    if (steerFaultyPassesFromEnd(request, checker, part_model, steer_from_end, result, part_marks))
+    if (steerFaultyPassesFromEnd(
+            request, checker, part_model, steer_from_end, result, part_marks,
+            scaled(request.progress, 0.0, 1.0, "faulty passes steered from their end")))
       keepIfNoWorse(std::move(from_starts), std::move(from_starts_marks),
                     result.steered_from_end.size(), &GenerateResult::steered_from_end_undone,
                     "passes steered from their end: checked again");

@@ -183,68 +183,6 @@ TEST(Generate, APassBesideAWallDoesNotRingIntoTheFarWall) {
   EXPECT_GT(largest_turn_deg(ringing), 2.0 * largest_turn_deg(critical));
 }
 
-// A pass along a wall (its side 1.5 mm from the ball, the holder's r 6 over it: the axis leans
-// away) that turns 90 deg away from it at x = 40. Held in the turning frame, the tilt leaning
-// away from the wall leaned the axis along it, the field kicked, and the axis swung 19.5 deg in
-// one 0.5 mm step, the holder 2.3 mm into the wall (a helper's pocket corner, UNSAFE). That
-// coming under the clearance, the pass is steered again with the feed held through its corners
-// and the angles re-expressed after (the clearer kept): clear, the axis turning under 10 deg a
-// posture (a machine's rotary axes follow at feed). So through a corner filleted
-// R 2 (it turns 9 deg a 0.5 mm: 2 colliding postures held in the turning frame).
-TEST(Generate, ACornerAwayFromAWallIsHeldOneRoundABossTurnsWithTheFeed) {
-  GenerateRequest job;
-  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 15.0};
-  job.holder = {{15, 6}, {30, 6}, {30, 12}, {70, 12}};
-  job.mode = FieldMode::Direct;
-  job.field.sample_step_mm = 1.0;
-  job.obstacles = {test::boxMesh(-10, 60, 4.5, 8.5, -1, 30)};
-  job.part = test::boxMesh(-10, 60, -40, 4.5, -5, 0);
-  job.passes_only = true;  // the steered postures, not the nominal ones a colliding pass keeps
-  for (const double fillet_mm : {0.0, 2.0}) {  // sharp, and filleted (R 2, 0.2 mm steps)
-    std::vector<geometry::Posture> nominal;
-    const auto add = [&nominal](double x, double y) {
-      nominal.push_back({Vec3(x, y, 0), Vec3::UnitZ(), 0.0, false});
-    };
-    for (double x = 0.0; x < 40.0 - fillet_mm - 1e-9; x += 0.5) add(x, 0.0);
-    for (int k = 0; k <= 16; ++k) {  // the fillet's arc (one point where sharp)
-      const double a = 0.5 * M_PI * k / 16;
-      add(40.0 - fillet_mm + fillet_mm * std::sin(a), -fillet_mm + fillet_mm * std::cos(a));
-      if (fillet_mm == 0.0) break;
-    }
-    for (double y = fillet_mm + 0.5; y <= 30.0 + 1e-9; y += 0.5) add(40.0, -y);
-    job.passes = nominalPasses(geometry::singlePass(std::move(nominal)), PathParams{}, 3.0);
-    ASSERT_EQ(job.passes.size(), 1u);
-    const GenerateResult r = generatePath(job);
-    EXPECT_EQ(r.clearance.colliding, 0u) << fillet_mm;
-    EXPECT_EQ(r.motions.colliding, 0u) << fillet_mm;
-    EXPECT_GE(r.clearance.min_clearance_mm, job.clearance_mm) << fillet_mm;
-    double largest_deg = 0.0;
-    for (std::size_t i = 1; i < r.postures.size(); ++i)
-      largest_deg =
-          std::max(largest_deg,
-                   std::acos(std::clamp(
-                       r.postures[i].posture.axis.dot(r.postures[i - 1].posture.axis), -1.0, 1.0)) *
-                       180.0 / M_PI);
-    EXPECT_LT(largest_deg, 10.0) << fillet_mm;
-    EXPECT_EQ(r.corners_held, std::vector<int>{0}) << fillet_mm;
-  }
-  // Round a boss's convex corner (the pass turning toward the block it leans from): the axis
-  // turning with the feed keeps the lean away from the block's second face, clear; held, it lost
-  // it (1.48 -> 0.82 mm with every corner held: checked; 50 colliding postures round a 150 deg
-  // turn, a reviewer's). Kept.
-  job.obstacles = {test::boxMesh(-10, 40, 4.5, 34.5, -1, 30)};
-  std::vector<geometry::Posture> round_boss;
-  for (double x = 0.0; x < 44.5 - 1e-9; x += 0.5)
-    round_boss.push_back({Vec3(x, 0, 0), Vec3::UnitZ(), 0.0, false});
-  for (double y = 0.0; y <= 30.0 + 1e-9; y += 0.5)
-    round_boss.push_back({Vec3(44.5, y, 0), Vec3::UnitZ(), 0.0, false});
-  job.passes = nominalPasses(geometry::singlePass(std::move(round_boss)), PathParams{}, 3.0);
-  const GenerateResult boss = generatePath(job);
-  EXPECT_EQ(boss.clearance.colliding, 0u);
-  EXPECT_GE(boss.clearance.min_clearance_mm, 1.4);
-  EXPECT_TRUE(boss.corners_held.empty());
-}
-
 // A pass leaning 30 deg across a channel (walls 10 mm high at |y| >= 14) ends under a roof 92 mm
 // up (x 35-80): every climb toward the vertical runs into the roof, and the first way clear of
 // everything, a 60 deg climb out past the roof's end, passes a wall's top 0.17 mm off. A way
