@@ -35,7 +35,8 @@ double largestTurnDeg(const dynamics::SteeringResult& run) {
 
 /// One way along `pass` (the pass itself, or reversedPass of it): the start settled where
 /// `settle`, turned clear where that is within the clearance, the run, once more loosened where
-/// the integrator stalls, and its corners held where DESIGN's frame comes under the clearance.
+/// the integrator stalls, and its corners held where DESIGN's frame comes under the clearance or
+/// swings the axis over kNoteAxisTurnDeg in a step.
 PassSteering steerOneWay(const dynamics::Pass& pass, dynamics::SteeringRequest steer, bool settle,
                          const PassSteeringSetup& setup) {
   PassSteering out;

@@ -2,7 +2,8 @@
 /// Internal to pathgen/: one pass steered (generate.cpp steers every pass through this, and the
 /// repairs steer a faulty one again from its end). Its start settled and turned clear where
 /// asked, the integrator loosened once where it stalls, and its corners held where DESIGN's frame
-/// comes under the clearance and holding them keeps more (SteeringRequest::hold_corners).
+/// comes under the clearance and holding them keeps more, or swings the axis over 10 deg in a
+/// step and holding them keeps the clearance and turns less (SteeringRequest::hold_corners).
 #include <functional>
 #include <optional>
 #include <string>
@@ -29,7 +30,8 @@ struct PassSteering {
   dynamics::SteeringResult run;  ///< in the pass's order, whichever way it was steered
   bool started_settled = false;
   bool turned_start = false;  ///< the settled start was within clearance: turned to a clear axis
-  bool corners_held = false;  ///< steered with its corners held (DESIGN's frame came under)
+  bool corners_held =
+      false;  ///< steered with its corners held (DESIGN's frame came under or swung)
   bool from_end = false;      ///< steered from its end (dynamics/reversed_pass.h)
   std::string settle_failed;  ///< why, where settling failed
   std::string loosened;       ///< what was said where the integrator was loosened

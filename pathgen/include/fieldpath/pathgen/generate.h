@@ -148,8 +148,9 @@ struct GenerateResult {
   /// kClearStartStepDeg apart within the angle limits), by Pass::index.
   std::vector<int> turned_starts;
   /// Passes steered with their corners held (dynamics::SteeringRequest::hold_corners): the axis
-  /// turning with the feed came under `clearance` there, and holding its direction through the
-  /// corners kept more. By Pass::index.
+  /// turning with the feed came under `clearance` there and holding its direction through the
+  /// corners kept more, or it swung over kNoteAxisTurnDeg in a step and holding it kept the
+  /// clearance and turned less. By Pass::index.
   std::vector<int> corners_held;
   /// Passes steered from their end to their start (dynamics/reversed_pass.h): steered from
   /// their start they collided or came under `clearance` (the causal axis meets the side of an
