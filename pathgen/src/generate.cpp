@@ -192,24 +192,21 @@ GenerateResult generatePath(const GenerateRequest& request) {
   const int pass_count = static_cast<int>(result.passes.size());
   // Which passes start from the axis settled at their start (dynamics.start): decided once, on
   // the nominal start posture's exact clearance, so that both steerings (near the path, final)
-  // start the same passes settled.
-  // The same at each pass's end, for a pass steered from there (pass_steering.h).
-  std::vector<char> settle(result.passes.size(), 0), settle_end(result.passes.size(), 0);
-  if (!request.nominal && request.dynamics.start != dynamics::StartPolicy::Nominal)
-    for (std::size_t p = 0; p < result.passes.size(); ++p) {
-      const Pass& pass = result.passes[p];
-      // `auto` settles only under a field that pushes: with gain 0 the axis at rest is the
-      // nominal one, and a note said the pass "started from the axis settled under the field".
-      const auto settles = [&](const PassSample& at) {
-        return request.dynamics.start == dynamics::StartPolicy::Settled ||
-               (request.field.gain > 0.0 &&
-                checker.clearance(geometry::ballEndPosture(at.centre_mm, nominalAxis(at, lead_rad),
-                                                           r)) < request.clearance_mm);
-      };
-      if (pass.samples.empty()) continue;
-      settle[p] = settles(pass.samples.front());
-      settle_end[p] = settles(pass.samples.back());
-    }
+  // start the same passes settled. `auto` settles only under a field that pushes: with gain 0 the
+  // axis at rest is the nominal one, and a note said the pass "started from the axis settled
+  // under the field". The same at a pass's end for one steered from there (pass_steering.h),
+  // decided only then: a clearance query for every pass's end went to the few that are.
+  const bool may_settle =
+      !request.nominal && request.dynamics.start != dynamics::StartPolicy::Nominal;
+  const auto settles = [&](const PassSample& at) {
+    return may_settle && (request.dynamics.start == dynamics::StartPolicy::Settled ||
+                          (request.field.gain > 0.0 && checker.clearance(geometry::ballEndPosture(
+                                                           at.centre_mm, nominalAxis(at, lead_rad),
+                                                           r)) < request.clearance_mm));
+  };
+  std::vector<char> settle(result.passes.size(), 0);
+  for (std::size_t p = 0; p < result.passes.size(); ++p)
+    if (!result.passes[p].samples.empty()) settle[p] = settles(result.passes[p].samples.front());
   std::vector<char> started_settled(result.passes.size(), 0);
   std::vector<char> turned_start(result.passes.size(), 0);
   std::vector<char> corners_held(result.passes.size(), 0);
@@ -257,7 +254,7 @@ GenerateResult generatePath(const GenerateRequest& request) {
     setup.ball_radius_mm = r;
     setup.required_mm = request.clearance_mm;
     setup.settle_start = settle[p] != 0;
-    setup.settle_end = settle_end[p] != 0;
+    setup.settle_end = from_end && !pass.samples.empty() && settles(pass.samples.back());
     return steerOnePass(dyn_pass, steer, setup, from_end);
   };
   // Every pass steered by `field`; `report`: progress and interruption through request.progress.
