@@ -1,6 +1,7 @@
 #include "nominal_fallback.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -117,13 +118,16 @@ std::vector<std::pair<std::size_t, std::size_t>> postureRanges(const GenerateRes
   return out;
 }
 
-/// What the steering said of the passes `gone` (by Pass::index) forgotten: they are written
-/// otherwise (a reviewer: what it said of a pass written nominal was not of the path written).
+/// What the steering said of the passes `gone` (by Pass::index), and the ways up their links took,
+/// forgotten: they are written otherwise (a reviewer: what it said of a pass written nominal was
+/// not of the path written).
 void forgetSteeringOf(GenerateResult& result, const std::function<bool(int)>& gone) {
   std::erase_if(result.settled_starts, gone);
   std::erase_if(result.turned_starts, gone);
   std::erase_if(result.corners_held, gone);
   std::erase_if(result.steered_from_end, gone);
+  // (a link's way up taken for the axis the pass had)
+  std::erase_if(result.routed_link_ends, [&](const auto& e) { return gone(e.pass); });
   std::erase_if(result.settle_failures, [&](const auto& f) { return gone(f.pass); });
   std::erase_if(result.loosened_solver, [&](const std::string& line) {
     for (const Pass& pass : result.passes)
@@ -204,11 +208,11 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
   return replaced;
 }
 
-bool steerFaultyPassesFromEnd(const GenerateRequest& request, const ClearanceChecker& checker,
-                              const std::shared_ptr<const ObstacleModel>& part,
-                              const SteerFromEnd& steer_from_end, GenerateResult& result,
-                              const std::optional<PartContacts::Marks>& part_marks,
-                              const common::Progress& progress) {
+std::vector<FromEndPass> steerFaultyPassesFromEnd(
+    const GenerateRequest& request, const ClearanceChecker& checker,
+    const std::shared_ptr<const ObstacleModel>& part, const SteerFromEnd& steer_from_end,
+    const GenerateResult& result, const std::optional<PartContacts::Marks>& part_marks,
+    const common::Progress& progress) {
   const PassFaults faults = faultsByPass(result, request.clearance_mm, part_marks);
   const auto ranges = postureRanges(result);
   // The passes to try: those that collide, or come under the clearance where their ball does not
@@ -222,8 +226,7 @@ bool steerFaultyPassesFromEnd(const GenerateRequest& request, const ClearanceChe
     if (faults.colliding[p] > 0 || (faults.under[p] > 0 && !ball_under)) tried.push_back(p);
   }
   // Each steered and judged alone, in parallel (as the passes were steered); kept in pass order.
-  std::vector<std::optional<PassSteering>> again(tried.size());
-  std::vector<std::vector<GeneratedPosture>> steered(tried.size());
+  std::vector<std::optional<FromEndPass>> again(tried.size());
   std::mutex done_mutex;
   std::size_t done = 0;
   tbb::parallel_for(std::size_t{0}, tried.size(), [&](std::size_t t) {
@@ -239,42 +242,75 @@ bool steerFaultyPassesFromEnd(const GenerateRequest& request, const ClearanceChe
       if (collisions < faults.colliding[p] ||
           (collisions == faults.colliding[p] && -minus_least > faults.min_mm[p] + 1e-3)) {
         run->run = {};
-        again[t] = std::move(run);
-        steered[t] = std::move(postures);
+        again[t] = FromEndPass{p, std::move(postures), std::move(*run)};
       }
     }
     std::lock_guard<std::mutex> lock(done_mutex);
     common::report(progress, double(++done) / double(tried.size()), "");
   });
-  std::vector<std::pair<int, PassSteering>> replaced;
-  for (std::size_t t = 0; t < tried.size(); ++t) {
-    if (!again[t]) continue;
-    const std::size_t p = tried[t];
-    for (std::size_t k = ranges[p].first; k < ranges[p].second; ++k)
-      result.postures[k] = steered[t][k - ranges[p].first];
-    replaced.emplace_back(result.passes[p].index, std::move(*again[t]));
-  }
-  if (replaced.empty()) return false;
-  forgetSteeringOf(result, [&replaced](int pass) {
-    for (const auto& r : replaced)
-      if (r.first == pass) return true;
-    return false;
-  });
-  for (auto& [pass, said] : replaced) {
+  std::vector<FromEndPass> out;
+  for (auto& a : again)
+    if (a) out.push_back(std::move(*a));
+  return out;
+}
+
+void useFromEnd(GenerateResult& result, const std::vector<FromEndPass>& passes) {
+  if (passes.empty()) return;
+  const auto ranges = postureRanges(result);
+  for (const FromEndPass& f : passes)
+    for (std::size_t k = ranges[f.pass].first; k < ranges[f.pass].second; ++k)
+      result.postures[k] = f.postures[k - ranges[f.pass].first];
+  const auto replaced = [&](int index) {
+    return std::any_of(passes.begin(), passes.end(),
+                       [&](const FromEndPass& f) { return result.passes[f.pass].index == index; });
+  };
+  forgetSteeringOf(result, replaced);
+  for (const FromEndPass& f : passes) {
+    const int pass = result.passes[f.pass].index;
+    const PassSteering& said = f.said;
     result.steered_from_end.push_back(pass);
     if (said.started_settled) result.settled_starts.push_back(pass);
     if (said.turned_start) result.turned_starts.push_back(pass);
     if (said.corners_held) result.corners_held.push_back(pass);
-    if (!said.settle_failed.empty())
-      result.settle_failures.push_back({pass, std::move(said.settle_failed)});
-    if (!said.loosened.empty()) result.loosened_solver.push_back(std::move(said.loosened));
+    if (!said.settle_failed.empty()) result.settle_failures.push_back({pass, said.settle_failed});
+    if (!said.loosened.empty()) result.loosened_solver.push_back(said.loosened);
   }
-  for (auto* list : {&result.settled_starts, &result.turned_starts, &result.corners_held})
+  for (auto* list : {&result.settled_starts, &result.turned_starts, &result.corners_held,
+                     &result.steered_from_end})
     std::sort(list->begin(), list->end());
   std::stable_sort(result.settle_failures.begin(), result.settle_failures.end(),
                    [](const auto& a, const auto& b) { return a.pass < b.pass; });
   recountLimited(result);
-  return true;
+}
+
+std::pair<std::size_t, double> faultsAround(const GenerateResult& result,
+                                            const std::optional<PartContacts::Marks>& part_marks,
+                                            std::size_t p) {
+  const auto [begin, end] = postureRanges(result)[p];
+  const std::size_t n = result.path.postures.size();
+  // Output postures [lo, hi): the link into the pass, the pass, the link out of it (the passes'
+  // postures lie in pass order).
+  const std::size_t lo = begin > 0 ? result.postures[begin - 1].output + 1 : 0;
+  const std::size_t hi = end < result.postures.size() ? result.postures[end].output : n;
+  const auto& at = result.clearance.clearance_mm;
+  const auto& moving = result.motions.clearance_mm;
+  const auto marked = [](const std::vector<std::uint8_t>* marks, std::size_t i) {
+    return marks && i < marks->size() && (*marks)[i];
+  };
+  std::size_t collisions = 0;
+  double least_mm = std::numeric_limits<double>::infinity();
+  for (std::size_t i = lo; i < hi && i < n; ++i) {
+    if (i < at.size()) least_mm = std::min(least_mm, at[i]);
+    collisions +=
+        (i < at.size() && at[i] <= 0.0) || marked(part_marks ? &part_marks->posture : nullptr, i);
+  }
+  // The motions into the window's first posture and out of its last (to the next pass's first).
+  for (std::size_t i = lo > 0 ? lo - 1 : 0; i < hi && i + 1 < n; ++i) {
+    if (i < moving.size()) least_mm = std::min(least_mm, moving[i]);
+    collisions += (i < moving.size() && moving[i] <= 0.0) ||
+                  marked(part_marks ? &part_marks->motion : nullptr, i);
+  }
+  return {collisions, -least_mm};
 }
 
 }  // namespace fieldpath::pathgen

@@ -4,6 +4,7 @@
 #include <memory>
 #include <optional>
 #include <utility>
+#include <vector>
 
 #include "fieldpath/pathgen/clearance.h"
 #include "fieldpath/pathgen/generate.h"
@@ -27,19 +28,38 @@ bool keepClearNominalPasses(const GenerateRequest& request, const ClearanceCheck
                             GenerateResult& result,
                             const std::optional<PartContacts::Marks>& part_marks);
 
+/// A pass steered again from its end: its index in GenerateResult::passes, its postures, and
+/// what the steering said of it.
+struct FromEndPass {
+  std::size_t pass = 0;
+  std::vector<GeneratedPosture> postures;
+  PassSteering said;  ///< its run emptied (the postures hold it)
+};
+
 /// The passes of `result` that collide, or come under the required clearance where their ball
 /// does not (as keepClearNominalPasses finds them), steered again from their end
-/// (`steer_from_end`, in parallel; `progress` per pass done): their postures replaced where the
-/// pass alone checks better (fewer collisions, or as many and over 1 um more clearance; its
-/// postures and motions against the obstacles and the part), listed in `result.steered_from_end`,
+/// (`steer_from_end`, in parallel; `progress` per pass done): those that check better alone
+/// (fewer collisions, or as many and over 1 um more clearance; their postures and motions
+/// against the obstacles and the part), in pass order. useFromEnd writes them into a result.
+std::vector<FromEndPass> steerFaultyPassesFromEnd(
+    const GenerateRequest& request, const ClearanceChecker& checker,
+    const std::shared_ptr<const ObstacleModel>& part, const SteerFromEnd& steer_from_end,
+    const GenerateResult& result, const std::optional<PartContacts::Marks>& part_marks,
+    const common::Progress& progress = {});
+
+/// `passes` written into `result`: their postures replaced, listed in `result.steered_from_end`,
 /// and what the steering from the start said of them (settled and turned starts, corners held,
-/// solver loosened) replaced by what this one says. Returns whether any pass was replaced (the
-/// caller links and checks the path again).
-bool steerFaultyPassesFromEnd(const GenerateRequest& request, const ClearanceChecker& checker,
-                              const std::shared_ptr<const ObstacleModel>& part,
-                              const SteerFromEnd& steer_from_end, GenerateResult& result,
-                              const std::optional<PartContacts::Marks>& part_marks,
-                              const common::Progress& progress = {});
+/// solver loosened) replaced by what this one says. The caller links and checks the path again.
+void useFromEnd(GenerateResult& result, const std::vector<FromEndPass>& passes);
+
+/// How pass `p` (its index in `result.passes`) checks in the linked path of `result`, with the
+/// link into it and the link out of it, ordered as pathFaults orders a path: its postures and
+/// motions that collide (with the obstacles, or marked in `part_marks`), then its least
+/// clearance of the obstacles, negated. Which of several passes made a path worse: a pass's
+/// links come down its own end axes.
+std::pair<std::size_t, double> faultsAround(const GenerateResult& result,
+                                            const std::optional<PartContacts::Marks>& part_marks,
+                                            std::size_t p);
 
 /// Whether a pass of `result` collides or comes under the required clearance (what
 /// keepClearNominalPasses may mend): the caller keeps a copy of the steered result only then.

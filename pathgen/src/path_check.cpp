@@ -87,18 +87,22 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
     }
   };
   linkAndCheck();
+  // `result` changed by a repair, linked and checked again (`what`: the repair's stage).
+  const auto recheck = [&](const char* what) {
+    if (request.progress)
+      progress = [&request, &stages, what = std::string(what)](double f, std::string_view) {
+        return request.progress((f - stages.steer_end) / (1.0 - stages.steer_end), what);
+      };
+    common::report(progress, stages.steer_end, what);
+    linkAndCheck();
+  };
   // `result` changed by a repair (`changed` things): linked and checked again, and kept only
   // where its path checks no worse than `before`'s (pathFaults), else `before` is restored with
   // its `undone` counting them.
   const auto keepIfNoWorse =
       [&](GenerateResult before, std::optional<PartContacts::Marks> before_marks,
           std::size_t changed, std::size_t GenerateResult::*undone, const char* what) {
-        if (request.progress)
-          progress = [&request, &stages, what = std::string(what)](double f, std::string_view) {
-            return request.progress((f - stages.steer_end) / (1.0 - stages.steer_end), what);
-          };
-        common::report(progress, stages.steer_end, what);
-        linkAndCheck();
+        recheck(what);
         if (pathFaults(result) > pathFaults(before)) {
           before.*undone = changed;
           result = std::move(before);
@@ -107,16 +111,51 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
       };
   if (steer_from_end && !request.nominal && !request.passes_only &&
       hasFaultyPasses(request, result, part_marks)) {
-    // The path as steered from the passes' starts, kept until the one with passes steered from
-    // their ends checks no worse (their links come down other axes).
-    GenerateResult from_starts = result;
-    std::optional<PartContacts::Marks> from_starts_marks = part_marks;
-    if (steerFaultyPassesFromEnd(
-            request, checker, part_model, steer_from_end, result, part_marks,
-            scaled(request.progress, 0.0, 1.0, "faulty passes steered from their end")))
-      keepIfNoWorse(std::move(from_starts), std::move(from_starts_marks),
-                    result.steered_from_end.size(), &GenerateResult::steered_from_end_undone,
-                    "passes steered from their end: checked again");
+    std::vector<FromEndPass> better = steerFaultyPassesFromEnd(
+        request, checker, part_model, steer_from_end, result, part_marks,
+        scaled(request.progress, 0.0, 1.0, "faulty passes steered from their end"));
+    if (!better.empty()) {
+      // The path as steered from the passes' starts, kept until the one with passes steered
+      // from their ends checks no worse (their links come down other axes).
+      const GenerateResult from_starts = result;
+      const std::optional<PartContacts::Marks> from_starts_marks = part_marks;
+      const std::size_t tried = better.size();
+      const char* what = "passes steered from their end: checked again";
+      useFromEnd(result, better);
+      recheck(what);
+      if (pathFaults(result) > pathFaults(from_starts)) {
+        // Worse where a link comes down a new end axis into something: that link taken another
+        // way up first, as the stage below would (a helper's block 78 mm up a pass's first axis,
+        // out of the field's reach, undid two passes' mends for one link it takes elsewhere).
+        auto routed = rerouteLinkEnds(request, checker, part_model, safe_z_mm, result, part_marks);
+        if (!routed.empty()) {
+          result.routed_link_ends = std::move(routed);
+          recheck(what);
+        }
+      }
+      if (pathFaults(result) > pathFaults(from_starts)) {
+        // Worse: kept without the passes whose own links and moves check worse (one pass's
+        // links undid every other pass's mend, all or nothing), where that checks no worse.
+        std::erase_if(better, [&](const FromEndPass& f) {
+          return faultsAround(result, part_marks, f.pass) >
+                 faultsAround(from_starts, from_starts_marks, f.pass);
+        });
+        result = from_starts;
+        part_marks = from_starts_marks;
+        if (!better.empty() && better.size() < tried) {
+          useFromEnd(result, better);
+          recheck(what);
+          if (pathFaults(result) > pathFaults(from_starts)) {
+            result = from_starts;
+            part_marks = from_starts_marks;
+            better.clear();
+          }
+        } else {
+          better.clear();
+        }
+        result.steered_from_end_undone = tried - better.size();
+      }
+    }
   }
   if (!request.nominal && !request.passes_only && hasFaultyPasses(request, result, part_marks)) {
     // The steered path, kept until the one with nominal passes is checked no worse (its links
@@ -136,8 +175,17 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
     if (!routed.empty()) {
       GenerateResult along_axes = result;
       std::optional<PartContacts::Marks> along_marks = part_marks;
-      result.routed_link_ends = std::move(routed);
-      keepIfNoWorse(std::move(along_axes), std::move(along_marks), result.routed_link_ends.size(),
+      // (with those a repair above took: a new way for the same end replaces its old one)
+      for (auto& end : routed) {
+        const auto same =
+            std::find_if(result.routed_link_ends.begin(), result.routed_link_ends.end(),
+                         [&](const auto& e) { return e.pass == end.pass && e.into == end.into; });
+        if (same != result.routed_link_ends.end())
+          *same = std::move(end);
+        else
+          result.routed_link_ends.push_back(std::move(end));
+      }
+      keepIfNoWorse(std::move(along_axes), std::move(along_marks), routed.size(),
                     &GenerateResult::routed_link_ends_undone,
                     "links taken off the axis: checked again");
     }

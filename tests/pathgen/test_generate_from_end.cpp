@@ -9,6 +9,7 @@
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/pathgen/generate.h"
 #include "fieldpath/pathgen/passes.h"
+#include "fixtures.h"
 
 using namespace fieldpath;
 using namespace fieldpath::pathgen;
@@ -79,4 +80,41 @@ TEST(GenerateFromEnd, AnImpellerPassGivenBackwardsIsSteeredFromItsEndAsForwards)
     EXPECT_LT(worst_deg, 1e-6) << pass;
     EXPECT_LT(worst_mm, 1e-9) << pass;
   }
+}
+
+// Two passes along walls they reach late from their start (each coming to 0.43 mm of 0.5),
+// steered from their end clear (1.48 mm), the first one's first axis then leaning 24 deg toward
+// a block 78 mm up it: beyond the field's reach, so no steering sees it, but the link down that
+// axis runs into it. The path linked so checked worse, and both passes' mends were undone, the
+// path written under the clearance (a helper's tower). The link is taken another way up first,
+// as the links' own repair would, and both passes are kept: clear, 1.48 mm.
+TEST(GenerateFromEnd, ALinkIntoSomethingUpAPassesNewAxisIsTakenElsewhereBeforeItsMendIsJudged) {
+  GenerateRequest job;
+  job.tool = {geometry::ToolShape::Ball, 3.0, 0.0, 15.0};
+  job.holder = {{15, 6}, {30, 6}, {30, 12}, {70, 12}};
+  job.field.sample_step_mm = 1.0;
+  job.dynamics.feed_mm_per_min = 2000.0;
+  job.clearance_mm = 0.5;
+  job.obstacles = {test::boxMesh(15, 60, 4.5, 8.5, -1, 30)};
+  test::addBox(job.obstacles[0], 15, 60, 44.5, 48.5, -1, 30);
+  test::addBox(job.obstacles[0], -6, 6, -36.89172, -24.89172, 69.34224, 73.34224);
+  job.part = test::boxMesh(-40, 100, -70, 70, -5, 0);
+  geometry::PathFile file;
+  for (const double y : {0.0, 40.0}) {
+    const std::size_t begin = file.postures.size();
+    for (int k = 0; k <= 80; ++k)
+      file.postures.push_back({Vec3(0.5 * k, y, 0), Vec3::UnitZ(), 0.0, false});
+    file.blocks.push_back({geometry::PathBlock::Kind::Pass, begin, file.postures.size()});
+  }
+  job.passes = nominalPasses(file, PathParams{}, job.tool.radius_mm);
+  ASSERT_EQ(job.passes.size(), 2u);
+
+  const GenerateResult r = generatePath(job);
+  EXPECT_EQ(r.steered_from_end, (std::vector<int>{0, 1}));
+  EXPECT_EQ(r.steered_from_end_undone, 0u);
+  EXPECT_EQ(r.clearance.colliding + r.motions.colliding, 0u);
+  EXPECT_GE(std::min(r.clearance.min_clearance_mm, r.motions.min_clearance_mm), job.clearance_mm);
+  ASSERT_FALSE(r.routed_link_ends.empty());
+  EXPECT_EQ(r.routed_link_ends.front().pass, 0);
+  EXPECT_TRUE(r.routed_link_ends.front().into);
 }

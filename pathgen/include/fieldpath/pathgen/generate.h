@@ -158,7 +158,8 @@ struct GenerateResult {
   /// from the end the pass checked better. Written in the pass's order. By Pass::index.
   std::vector<int> steered_from_end;
   /// Passes steered from their end that checked better alone, not kept: the path linked to them
-  /// was checked worse (pathFaults).
+  /// was checked worse (pathFaults), and their own links and moves into and out of them
+  /// (faultsAround), or the path without the others' that did, still so.
   std::size_t steered_from_end_undone = 0;
   /// Passes that were to start settled but could not (no damping, the solver failing at rest):
   /// they start from the nominal axis, or where that lies within `clearance` the clear axis
