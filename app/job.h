@@ -57,9 +57,9 @@ inline nlohmann::json motionsJson(const pathgen::MotionResult& m, double require
       {"method",
        "tip and axis interpolated linearly; adaptive sampling with a certified lower bound "
        "(tool + holder move at most |dtip| + reach * dangle between samples; the distance "
-       "is 1-Lipschitz in that): halved until the bound reaches max(required_mm, closest "
-       "posture - max(0.01 mm, 1 % of it)), a sample touches, or the sub-motion moves <= 2 "
-       "* resolution_mm"},
+       "is 1-Lipschitz in that): the lowest-bound piece halved first, until the bound reaches "
+       "max(required_mm, closest posture - max(0.01 mm, 1 % of it)), a sample touches, or "
+       "the lowest piece moves <= 2 * resolution_mm (the motion's bound then)"},
       {"resolution_mm", resolution_mm},
       {"min_mm", jsonNumber(m.min_clearance_mm)},
       {"min_is",

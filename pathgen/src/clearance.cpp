@@ -419,6 +419,13 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
     while (!queue.empty()) {
       const Piece p = queue.top();
       queue.pop();
+      // A piece resolved already bounds the motion at `lowest`, and no piece left bounds lower:
+      // they leave lowest first, and a half's bound is no lower than its piece's (the distance
+      // moves by at most half the sweep from either end: dm >= max(d0, d1) - D/2, and a half
+      // sweeps D/2). Refining on changed nothing but the time (a motion under the clearance was
+      // resolved along its whole length: 17 000 queries on a reversed impeller's first check,
+      // a third of its generate, a helper's profile).
+      if (p.certain >= lowest) break;
       const double slack =
           std::max(request.tighten_mm, request.tighten_fraction * std::max(best, 0.0));
       // Every piece left bounds no lower than this one: certified (clear of contact and of the
@@ -471,9 +478,11 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
   // closer, within the slack of the closest posture: the reported minimum is then tight too.
   double closest_mm = std::numeric_limits<double>::infinity();
   for (double d : ends) closest_mm = std::min(closest_mm, d);
-  stop_mm = std::max(request.required_mm,
-                     closest_mm - std::max(request.tighten_mm,
-                                           request.tighten_fraction * std::max(closest_mm, 0.0)));
+  stop_mm =
+      std::max(request.required_mm,
+               std::min(request.enough_mm,
+                        closest_mm - std::max(request.tighten_mm, request.tighten_fraction *
+                                                                      std::max(closest_mm, 0.0))));
   for (size_t begin = 0; begin < result.motions; begin += batch) {
     const size_t end = std::min(result.motions, begin + batch);
     tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {

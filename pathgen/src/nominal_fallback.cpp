@@ -55,6 +55,11 @@ PassFaults faultsByPass(const GenerateResult& result, double required_mm,
   return out;
 }
 
+/// A repair asks a pass's motions whether they keep a clearance (MotionRequest::enough_mm): this
+/// over it, so that a bound reaching it is over it (the pass's own closest posture less 1 % took
+/// a sixth of a reversed impeller's generate, a helper's profile).
+constexpr double kEnoughOverMm = 1e-6;
+
 /// Whether `postures` (one pass) clear the obstacles and the part (`part`: its model, prepared
 /// once for every pass tried: a 1 M-triangle part takes seconds) at every posture and motion,
 /// the obstacles by more than `above_mm` (0: clear; the steered pass's least clearance: nearer
@@ -67,6 +72,7 @@ bool clearPass(const GenerateRequest& request, const ClearanceChecker& checker,
   MotionRequest motions;
   motions.required_mm = request.clearance_mm;
   motions.posture_clearance_mm = at_postures.clearance_mm;
+  motions.enough_mm = above_mm + kEnoughOverMm;
   const MotionResult moved = checker.checkMotions(postures, motions);
   if (moved.colliding > 0 || !(moved.min_clearance_mm > above_mm)) return false;
   if (!part) return true;
@@ -80,15 +86,18 @@ bool clearPass(const GenerateRequest& request, const ClearanceChecker& checker,
 /// How a pass's `postures` check alone, as pathFaults orders a path: its postures and motions
 /// that collide with the obstacles, the holder's and the cutter's with the part (counted as
 /// their checks count them: no fewer than faultsByPass's postures), then its least clearance of
-/// the obstacles at the postures and motions, negated.
+/// the obstacles at the postures and motions, negated (the motions' a bound no tighter than
+/// `enough_mm` where they keep that much).
 std::pair<std::size_t, double> passFaults(const GenerateRequest& request,
                                           const ClearanceChecker& checker,
                                           const std::shared_ptr<const ObstacleModel>& part,
-                                          const std::vector<geometry::Posture>& postures) {
+                                          const std::vector<geometry::Posture>& postures,
+                                          double enough_mm) {
   const ClearanceResult at = checker.check(postures);
   MotionRequest motions;
   motions.required_mm = request.clearance_mm;
   motions.posture_clearance_mm = at.clearance_mm;
+  motions.enough_mm = enough_mm;
   const MotionResult moved = checker.checkMotions(postures, motions);
   std::size_t hits = 0;
   for (std::size_t k = 0; k < postures.size(); ++k)
@@ -237,10 +246,12 @@ std::vector<FromEndPass> steerFaultyPassesFromEnd(
       std::vector<GeneratedPosture> postures = generatedPostures(pass.index, run->run);
       std::vector<geometry::Posture> placed;
       for (const GeneratedPosture& g : postures) placed.push_back(g.posture);
-      const auto [collisions, minus_least] = passFaults(request, checker, part, placed);
       // Fewer collisions, or as many and more clearance than rounding gives (1 um).
+      const double better_mm = faults.min_mm[p] + 1e-3;
+      const auto [collisions, minus_least] =
+          passFaults(request, checker, part, placed, better_mm + kEnoughOverMm);
       if (collisions < faults.colliding[p] ||
-          (collisions == faults.colliding[p] && -minus_least > faults.min_mm[p] + 1e-3)) {
+          (collisions == faults.colliding[p] && -minus_least > better_mm)) {
         run->run = {};
         again[t] = FromEndPass{p, std::move(postures), std::move(*run)};
       }

@@ -36,10 +36,12 @@ struct ClearanceRequest {
 /// D = |Δtip| + ρ_max Δθ (ρ_max: the farthest point from the tip, Δθ: the angle between the
 /// axes), and the distance to the obstacles is 1-Lipschitz in that motion. Over a sub-motion
 /// whose ends are d0 and d1 away the distance is at least (d0 + d1 - D) / 2. Sub-motions are
-/// halved, the lowest bound first, until that bound reaches max(required_mm, closest − slack),
+/// halved, the lowest bound first, until that bound reaches max(required_mm, min(enough_mm,
+/// closest − slack)),
 /// slack = max(tighten_mm, tighten_fraction × closest), closest: the closest posture, or (above
 /// 0 and required_mm) the lowest distance sampled on the motion less its slack; or a sample
-/// touches, or D ≤ 2 `resolution_mm`. The smallest bound is then within `slack` of the true
+/// touches, or D ≤ 2 `resolution_mm` (the lowest piece resolved: no piece left bounds lower,
+/// and the motion's bound is its). The smallest bound is then within `slack` of the true
 /// minimum wherever that is above required_mm. The slack is relative far from the obstacles: a
 /// fixed 0.01 mm refined a job 10× the size (tool, path, clearances) into 27 s of samples, and 100×
 /// into minutes.
@@ -48,6 +50,10 @@ struct MotionRequest {
   double resolution_mm = 0.005;  ///< halve sub-motions no shorter (in D) than 2 × this
   double tighten_mm = 0.01;      ///< see above
   double tighten_fraction = 0.01;  ///< see above
+  /// Where the caller asks only whether the motions keep this much (mm): a motion is certified
+  /// once its bound reaches it, if that comes before the rule above (its bound then may lie
+  /// further under its true minimum). The repairs judging one pass against its steering ask so.
+  double enough_mm = std::numeric_limits<double>::infinity();
   /// Postures per progress report (and per parallel batch).
   std::size_t batch = 256;
   /// The postures' clearances if known (ClearanceResult::clearance_mm), else computed here.
