@@ -16,12 +16,33 @@
 namespace fieldpath::pathgen {
 namespace {
 
-/// The least exact clearance of a run's postures, mm.
-double leastClearance(const dynamics::SteeringResult& run, const PassSteeringSetup& setup) {
-  double least_mm = std::numeric_limits<double>::infinity();
+/// The exact clearance of a run's postures, mm.
+std::vector<double> clearances(const dynamics::SteeringResult& run,
+                               const PassSteeringSetup& setup) {
+  std::vector<double> out;
+  out.reserve(run.samples.size());
   for (const dynamics::PostureSample& sample : run.samples)
-    least_mm = std::min(least_mm, setup.checker->clearance(sample.posture));
-  return least_mm;
+    out.push_back(setup.checker->clearance(sample.posture));
+  return out;
+}
+
+double least(const std::vector<double>& mm) {
+  return mm.empty() ? std::numeric_limits<double>::infinity()
+                    : *std::min_element(mm.begin(), mm.end());
+}
+
+/// Whether a run's motions keep the required clearance (`at_mm`: its postures' clearances),
+/// certified no further than that.
+bool motionsKeepClearance(const dynamics::SteeringResult& run, const PassSteeringSetup& setup,
+                          const std::vector<double>& at_mm) {
+  std::vector<geometry::Posture> postures;
+  postures.reserve(run.samples.size());
+  for (const dynamics::PostureSample& sample : run.samples) postures.push_back(sample.posture);
+  MotionRequest request;
+  request.required_mm = setup.required_mm;
+  request.enough_mm = setup.required_mm;
+  request.posture_clearance_mm = at_mm;
+  return setup.checker->checkMotions(postures, request).under_required == 0;
 }
 
 /// The largest turn of the axis between two consecutive postures of a run, deg.
@@ -115,7 +136,7 @@ PassSteering steerOneWay(const dynamics::Pass& pass, dynamics::SteeringRequest s
   // 19.5 deg in 0.5 mm, the rotary axes asked for 650 deg/s at 1000 mm/min): the held run where
   // it keeps the clearance and turns less.
   if (out.run.status != dynamics::Status::Ok || out.run.corners == 0) return out;
-  const double turning_mm = leastClearance(out.run, setup);
+  const double turning_mm = least(clearances(out.run, setup));
   const double turning_deg = largestTurnDeg(out.run);
   const bool under = turning_mm < setup.required_mm;
   if (!under && turning_deg <= kNoteAxisTurnDeg) return out;
@@ -123,10 +144,15 @@ PassSteering steerOneWay(const dynamics::Pass& pass, dynamics::SteeringRequest s
   held.hold_corners = true;
   dynamics::SteeringResult kept = dynamics::steerPass(pass, held);
   if (kept.status != dynamics::Status::Ok) return out;
-  const double held_mm = leastClearance(kept, setup);
+  const std::vector<double> held_at_mm = clearances(kept, setup);
+  const double held_mm = least(held_at_mm);
   // (Turning less by a degree at least: runs alike to 1e-14 deg were "held", a reviewer's.)
+  // A clear run is given up for its swing only where the held one keeps the clearance along its
+  // motions too (its postures alone were asked: a motion under it would make a clear pass
+  // faulty).
   if (under ? !(held_mm > turning_mm)
-            : !(held_mm >= setup.required_mm && largestTurnDeg(kept) < turning_deg - 1.0))
+            : !(held_mm >= setup.required_mm && largestTurnDeg(kept) < turning_deg - 1.0 &&
+                motionsKeepClearance(kept, setup, held_at_mm)))
     return out;
   out.run = std::move(kept);
   out.corners_held = true;
