@@ -194,9 +194,12 @@ double ClearanceChecker::toolReachMm() const { return impl_->reach_mm; }
 
 namespace {
 
-/// Nearest obstacle to `model` placed at `pose`: 0 if it touches or crosses one (collide()), else
-/// the exact distance. The geometry overloads of FCL avoid CollisionObject, whose constructor
-/// recomputes the model's bounding box on every query.
+/// Nearest obstacle to `model` placed at `pose`: 0 if it touches or crosses one (FCL's triangle
+/// distance of meeting triangles is 0), else the exact distance. A collide() asked first (an
+/// early way out where they meet) cost 13 % of a clear CAM job's check, a helper's profile, and
+/// saved 11 % of a nominal path's that collides at 184 motions: the paths written and checked
+/// are mostly clear (clearance.csv of both the same with and without it). The geometry overloads of
+/// FCL avoid CollisionObject, whose constructor recomputes the model's bounding box on every query.
 double nearestObstacle(const Model& model, const fcl::Transform3d& pose,
                        const std::vector<std::shared_ptr<const ObstacleModel>>& obstacles,
                        int* obstacle) {
@@ -204,18 +207,10 @@ double nearestObstacle(const Model& model, const fcl::Transform3d& pose,
   double best = std::numeric_limits<double>::infinity();
   int best_index = -1;
   for (size_t i = 0; i < obstacles.size(); ++i) {
-    fcl::CollisionRequestd collision_request;
-    fcl::CollisionResultd collision_result;
-    double d;
-    if (fcl::collide(&model, pose, obstacles[i]->tree.get(), identity, collision_request,
-                     collision_result) > 0) {
-      d = 0.0;
-    } else {
-      fcl::DistanceRequestd request;  // rel_err = abs_err = 0: exact triangle distances
-      fcl::DistanceResultd result;
-      d = std::max(
-          0.0, fcl::distance(&model, pose, obstacles[i]->tree.get(), identity, request, result));
-    }
+    fcl::DistanceRequestd request;  // rel_err = abs_err = 0: exact triangle distances
+    fcl::DistanceResultd result;
+    const double d = std::max(
+        0.0, fcl::distance(&model, pose, obstacles[i]->tree.get(), identity, request, result));
     if (d < best) {
       best = d;
       best_index = static_cast<int>(i);
