@@ -90,8 +90,9 @@ TipBounds PostureStream::cutBounds(double length_mm, double top_z) const {
       1, std::min<std::size_t>(std::thread::hardware_concurrency(), chunks_.size()));
   std::vector<std::future<TipBounds>> parts;
   for (std::size_t w = 0; w < workers; ++w)
-    parts.push_back(std::async(std::launch::async, [&, w] {
-      TipBounds b = all;
+    // (each its own copy of the tips' bounds, taken here: `all` is merged into as the first
+    // parts return, while a later worker may not have started: a race, ThreadSanitizer's)
+    parts.push_back(std::async(std::launch::async, [&, w, b = all]() mutable {
       for (std::size_t c = w; c < chunks_.size(); c += workers)
         for (const zbuffer::Posture& p : chunks_[c].postures) {
           double t = length_mm;  // along the axis, from the tip

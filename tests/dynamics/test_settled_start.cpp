@@ -136,5 +136,64 @@ TEST(SettledStart, WithoutDampingThereIsNoRest) {
   EXPECT_NE(settled.why.find("dynamics.damping"), std::string::npos) << settled.why;
 }
 
+/// A vortex about the vertical through the pass's first ball centre: F = κ ẑ × (p - c), which
+/// pushes a node square to its lean, so that the axis circles: J θ'' + c θ' + k θ = q J₉₀ θ with
+/// q = κ L² for a node L above the centre (J₉₀ the quarter turn of (lead, tilt)). Its modes
+/// J s² + c s + k ∓ i q = 0 grow where q > c sqrt(k / J) (c = 2 sqrt(k J): q > 2 k).
+struct VortexField final : field::ForceField {
+  Vec3 centre_mm;
+  double kappa = 0.0;
+  void evaluate(std::span<const Vec3> points, std::span<Vec3> forces) const override {
+    for (std::size_t i = 0; i < points.size(); ++i)
+      forces[i] = kappa * Vec3::UnitZ().cross(points[i] - centre_mm);
+  }
+};
+
+// An axis that never comes to rest: a vortex pumping faster than the damping takes (q = 5 k),
+// the axis circling out to its limits and round them. Each decay then moved as much as the last,
+// and all kSettleDecays ran, each clamped at every station (a helper's pocket corner: 3 M
+// evaluations of the field, 40 s of a 2-pass job). It stops once kSettleCycleDecays decays in a
+// row move no less than the least before, within the limits; a vortex the damping outruns
+// (q = k) still settles, at rest.
+TEST(SettledStart, AnAxisThatCyclesIsNotRunForEveryDecay) {
+  const double node_mm = 30.0;
+  VortexField vortex;
+  // (1 mm aside of the first centre: the nominal axis is then no equilibrium to sit on)
+  vortex.centre_mm = straightPass(1.0).frameAt(0.0).centre_mm + Vec3(0.0, 1.0, 0.0);
+  SteeringRequest request = requestFor(&vortex);
+  const std::vector<Vec3> node = {Vec3(0, 0, kRadius + node_mm)};
+  request.nodes_tool_frame_mm = node;
+  request.params.inertia = 1.0;
+  request.params.stiffness = 1.0;
+  request.params.damping = 2.0;  // critical for the spring
+  request.params.max_lead_deg = 10.0;
+  request.params.max_tilt_deg = 10.0;
+  request.step_mm = 0.5;
+  const Pass pass = dwell(10.0);
+  const double decay_stations = 2.0 * request.params.inertia / request.params.damping *
+                                request.params.feed_mm_per_min / 60.0 / request.step_mm;
+
+  vortex.kappa = 5.0 / (node_mm * node_mm);
+  const SettledStart cycling = settleAtStart(pass, request);
+  ASSERT_TRUE(cycling.settled) << cycling.why;
+  EXPECT_LE(double(cycling.stations), 12.0 * (decay_stations + 2.0));
+  EXPECT_LE(std::abs(cycling.lead_rad), 10.0 * kDeg * (1.0 + 1e-12));
+  EXPECT_LE(std::abs(cycling.tilt_rad), 10.0 * kDeg * (1.0 + 1e-12));
+  // It does cycle: dwelling on from there, the axis still swings.
+  request.initial_lead_rad = cycling.lead_rad;
+  request.initial_tilt_rad = cycling.tilt_rad;
+  EXPECT_GT(largestStep(steerPass(dwell(30.0), request)), 0.1 * kDeg);
+
+  vortex.kappa = 1.0 / (node_mm * node_mm);
+  request.initial_lead_rad.reset();
+  request.initial_tilt_rad.reset();
+  const SettledStart damped = settleAtStart(pass, request);
+  ASSERT_TRUE(damped.settled) << damped.why;
+  request.initial_lead_rad = damped.lead_rad;
+  request.initial_tilt_rad = damped.tilt_rad;
+  EXPECT_GT(std::hypot(damped.lead_rad, damped.tilt_rad), 0.5 * kDeg);  // pushed off the nominal
+  EXPECT_LT(largestStep(steerPass(dwell(30.0), request)), 1e-6);        // and at rest there
+}
+
 }  // namespace
 }  // namespace fieldpath::dynamics

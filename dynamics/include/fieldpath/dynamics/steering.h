@@ -122,7 +122,8 @@ inline constexpr double kMaxSettleMm = 1e5;
 /// the spring-damper runs from the nominal angles at rest, one decay time (the slower of 2J/c and
 /// c/k) after another (c the spring's; `critical` adds the field's stiffness, which only shortens
 /// the decay; with no spring, the field's at the nominal axis), until the axis moves less than
-/// kSettledRad in one, or for kSettleDecays of them (the amplitude down by e^-20); the angles
+/// kSettledRad in one, or for kSettleDecays of them (the amplitude down by e^-20), or until it
+/// cycles (kSettleCycleDecays decays in a row move no less than the least before); the angles
 /// held at their limits on the way (on_limit: clamp whatever the pass's: the settling is not
 /// machined, its swing beyond a limit is no failure; a rest beyond one is held at it, and a pass
 /// with on_limit: fail then stops where the field pushes it further). `settled` false (and
@@ -136,6 +137,8 @@ struct SettledStart {
 };
 constexpr double kSettleDecays = 20.0;
 constexpr double kSettledRad = 1e-7;  ///< 6e-6 deg: far below DESIGN's 0.01 deg
+/// Decays in a row that move no less than the least so far: the axis is cycling (settleAtStart).
+constexpr int kSettleCycleDecays = 3;
 SettledStart settleAtStart(const Pass& pass, const SteeringRequest& request);
 
 /// The moment of the field on the nodes placed at axis angles (lead, tilt) at one pass frame, about
