@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -297,29 +298,33 @@ void useFromEnd(GenerateResult& result, const std::vector<FromEndPass>& passes) 
 std::pair<std::size_t, double> faultsAround(const GenerateResult& result,
                                             const std::optional<PartContacts::Marks>& part_marks,
                                             std::size_t p) {
-  const auto [begin, end] = postureRanges(result)[p];
+  // The pass's postures (they lie in pass order: found by halving, not by a walk of them all,
+  // once a pass judged).
+  const int index = result.passes[p].index;
+  const auto first = std::partition_point(result.postures.begin(), result.postures.end(),
+                                          [&](const GeneratedPosture& g) { return g.pass < index; });
+  const auto last = std::partition_point(first, result.postures.end(),
+                                         [&](const GeneratedPosture& g) { return g.pass == index; });
   const std::size_t n = result.path.postures.size();
-  // Output postures [lo, hi): the link into the pass, the pass, the link out of it (the passes'
-  // postures lie in pass order).
-  const std::size_t lo = begin > 0 ? result.postures[begin - 1].output + 1 : 0;
-  const std::size_t hi = end < result.postures.size() ? result.postures[end].output : n;
+  // Output postures [lo, hi): the link into the pass, the pass, the link out of it.
+  const std::size_t lo = first != result.postures.begin() ? std::prev(first)->output + 1 : 0;
+  const std::size_t hi = last != result.postures.end() ? last->output : n;
   const auto& at = result.clearance.clearance_mm;
   const auto& moving = result.motions.clearance_mm;
-  const auto marked = [](const std::vector<std::uint8_t>* marks, std::size_t i) {
-    return marks && i < marks->size() && (*marks)[i];
+  const auto marked = [&](const std::vector<std::uint8_t> PartContacts::Marks::*which,
+                          std::size_t i) {
+    return part_marks && i < ((*part_marks).*which).size() && ((*part_marks).*which)[i];
   };
   std::size_t collisions = 0;
   double least_mm = std::numeric_limits<double>::infinity();
   for (std::size_t i = lo; i < hi && i < n; ++i) {
     if (i < at.size()) least_mm = std::min(least_mm, at[i]);
-    collisions +=
-        (i < at.size() && at[i] <= 0.0) || marked(part_marks ? &part_marks->posture : nullptr, i);
+    collisions += (i < at.size() && at[i] <= 0.0) || marked(&PartContacts::Marks::posture, i);
   }
   // The motions into the window's first posture and out of its last (to the next pass's first).
   for (std::size_t i = lo > 0 ? lo - 1 : 0; i < hi && i + 1 < n; ++i) {
     if (i < moving.size()) least_mm = std::min(least_mm, moving[i]);
-    collisions += (i < moving.size() && moving[i] <= 0.0) ||
-                  marked(part_marks ? &part_marks->motion : nullptr, i);
+    collisions += (i < moving.size() && moving[i] <= 0.0) || marked(&PartContacts::Marks::motion, i);
   }
   return {collisions, -least_mm};
 }

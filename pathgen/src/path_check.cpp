@@ -119,6 +119,10 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
       // from their ends checks no worse (their links come down other axes).
       const GenerateResult from_starts = result;
       const std::optional<PartContacts::Marks> from_starts_marks = part_marks;
+      const auto restore = [&] {
+        result = from_starts;
+        part_marks = from_starts_marks;
+      };
       const std::size_t tried = better.size();
       const char* what = "passes steered from their end: checked again";
       useFromEnd(result, better);
@@ -140,14 +144,12 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
           return faultsAround(result, part_marks, f.pass) >
                  faultsAround(from_starts, from_starts_marks, f.pass);
         });
-        result = from_starts;
-        part_marks = from_starts_marks;
+        restore();
         if (!better.empty() && better.size() < tried) {
           useFromEnd(result, better);
           recheck(what);
           if (pathFaults(result) > pathFaults(from_starts)) {
-            result = from_starts;
-            part_marks = from_starts_marks;
+            restore();
             better.clear();
           }
         } else {
