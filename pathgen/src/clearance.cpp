@@ -12,6 +12,7 @@
 #include <fcl/geometry/geometric_shape_to_BVH_model.h>
 #include <fcl/geometry/shape/sphere.h>
 #include <fcl/narrowphase/collision.h>
+#include <fcl/narrowphase/detail/primitive_shape_algorithm/triangle_distance.h>
 #include <fcl/narrowphase/distance.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -102,6 +103,15 @@ namespace {
 
 using Model = BvhModel;
 
+/// The closest pair of triangles (tool, obstacle) of a distance query, handed to the next query
+/// of a nearby pose (the next posture of a run, the next sample of a motion): their distance
+/// there bounds the new one from above, and FCL's branch and bound, started under that bound,
+/// skips every pair of boxes farther apart. The value is the same (FCL returns the least
+/// triangle distance under its start); only the boxes visited change.
+struct Witness {
+  int obstacle = -1, tool_triangle = -1, obstacle_triangle = -1;
+};
+
 }  // namespace
 
 struct ClearanceChecker::Impl {
@@ -115,6 +125,8 @@ struct ClearanceChecker::Impl {
   /// times what one coordinate does (half a step each read a face 0.022 mm too far: a later one).
   double read_margin_mm = 0.0;
   double reach_mm = 0.0;
+  /// ClearanceChecker::clearance, `witness` as nearestObstacle's.
+  double clearance(const geometry::Posture& posture, int* obstacle, Witness* witness) const;
   /// The closed shells of the tool (tool frame): an obstacle wholly inside the tool touches no
   /// triangle (FCL: clear). The obstacles' own are in their ObstacleModel.
   std::optional<geometry::ClosedShells> tool_solid;
@@ -194,45 +206,83 @@ double ClearanceChecker::toolReachMm() const { return impl_->reach_mm; }
 
 namespace {
 
+/// The distance between triangle `tool_triangle` of `model` placed at `pose` and triangle
+/// `obstacle_triangle` of `tree`: an upper bound of their meshes' distance.
+double pairDistance(const Model& model, const fcl::Transform3d& pose, const Model& tree,
+                    int tool_triangle, int obstacle_triangle) {
+  fcl::Vector3d a[3], b[3], p, q;
+  const fcl::Triangle& ta = model.tri_indices[tool_triangle];
+  const fcl::Triangle& tb = tree.tri_indices[obstacle_triangle];
+  for (int k = 0; k < 3; ++k) {
+    a[k] = pose * model.vertices[ta[k]];
+    b[k] = tree.vertices[tb[k]];
+  }
+  return fcl::detail::TriangleDistance<double>::triDistance(a, b, p, q);
+}
+
 /// Nearest obstacle to `model` placed at `pose`: 0 if it touches or crosses one (FCL's triangle
 /// distance of meeting triangles is 0), else the exact distance. A collide() asked first (an
 /// early way out where they meet) cost 13 % of a clear CAM job's check, a helper's profile, and
 /// saved 11 % of a nominal path's that collides at 184 motions: the paths written and checked
 /// are mostly clear (clearance.csv of both the same with and without it). The geometry overloads of
 /// FCL avoid CollisionObject, whose constructor recomputes the model's bounding box on every query.
+/// `witness` (optional): in, a nearby pose's closest pair (Witness); out, this pose's.
 double nearestObstacle(const Model& model, const fcl::Transform3d& pose,
                        const std::vector<std::shared_ptr<const ObstacleModel>>& obstacles,
-                       int* obstacle) {
+                       int* obstacle, Witness* witness = nullptr) {
   const fcl::Transform3d identity = fcl::Transform3d::Identity();
+  // Each query starts under the least found so far and under the witness pair's distance here
+  // (a hair above it: that pair is then found again by FCL's own arithmetic). A query that
+  // finds nothing under its start is no nearer than it: not the nearest (ties keep the first,
+  // as the plain loop: a later obstacle at the same distance finds nothing under it).
+  double start = std::numeric_limits<double>::infinity();
+  if (witness && witness->obstacle >= 0 &&
+      static_cast<std::size_t>(witness->obstacle) < obstacles.size()) {
+    const double bound = pairDistance(model, pose, *obstacles[witness->obstacle]->tree,
+                                      witness->tool_triangle, witness->obstacle_triangle);
+    if (std::isfinite(bound)) start = bound + 1e-9 * (1.0 + bound);
+  }
   double best = std::numeric_limits<double>::infinity();
   int best_index = -1;
+  Witness found;
   for (size_t i = 0; i < obstacles.size(); ++i) {
     fcl::DistanceRequestd request;  // rel_err = abs_err = 0: exact triangle distances
     fcl::DistanceResultd result;
-    const double d = std::max(
-        0.0, fcl::distance(&model, pose, obstacles[i]->tree.get(), identity, request, result));
-    if (d < best) {
-      best = d;
+    const double under = std::min(best, start);
+    result.min_distance = under;
+    const double d =
+        fcl::distance(&model, pose, obstacles[i]->tree.get(), identity, request, result);
+    if (d < under) {
+      best = std::max(0.0, d);
       best_index = static_cast<int>(i);
+      found = {best_index, static_cast<int>(result.b1), static_cast<int>(result.b2)};
     }
   }
+  if (best_index < 0 && std::isfinite(start))  // (never: the witness pair lies under its start)
+    return nearestObstacle(model, pose, obstacles, obstacle, nullptr);
   if (obstacle) *obstacle = best_index;
+  if (witness) *witness = found;
   return best;
 }
 
 }  // namespace
 
-double ClearanceChecker::clearance(const geometry::Posture& posture, int* obstacle) const {
+double ClearanceChecker::Impl::clearance(const geometry::Posture& posture, int* obstacle,
+                                         Witness* witness) const {
   const Eigen::Isometry3d placed = geometry::toolToWorld(posture);
-  const double d = nearestObstacle(*impl_->tool, fcl::Transform3d(placed.matrix()),
-                                   impl_->obstacles, obstacle);
+  const double d =
+      nearestObstacle(*tool, fcl::Transform3d(placed.matrix()), obstacles, obstacle, witness);
   if (d > 0.0)  // no surfaces meet: inside one another is the one way left to collide
-    for (std::size_t i = 0; i < impl_->obstacles.size(); ++i)
-      if (impl_->enclosed(placed, i)) {
+    for (std::size_t i = 0; i < obstacles.size(); ++i)
+      if (enclosed(placed, i)) {
         if (obstacle) *obstacle = static_cast<int>(i);
         return 0.0;
       }
-  return std::max(0.0, d - impl_->chord_tol_mm - impl_->read_margin_mm);
+  return std::max(0.0, d - chord_tol_mm - read_margin_mm);
+}
+
+double ClearanceChecker::clearance(const geometry::Posture& posture, int* obstacle) const {
+  return impl_->clearance(posture, obstacle, nullptr);
 }
 
 double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double radius_mm,
@@ -244,10 +294,10 @@ double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double 
   fcl::generateBVHModel(*ball, fcl::Sphered(kPointRadiusMm), fcl::Transform3d::Identity(), 4u, 4u);
   std::vector<double> distance(centres_mm.size());
   std::vector<int> nearest(centres_mm.size());
-  const auto measure = [&](size_t i) {
+  const auto measure = [&](size_t i, Witness& witness) {
     fcl::Transform3d pose = fcl::Transform3d::Identity();
     pose.translation() = centres_mm[i];
-    distance[i] = nearestObstacle(*ball, pose, impl_->obstacles, &nearest[i]);
+    distance[i] = nearestObstacle(*ball, pose, impl_->obstacles, &nearest[i], &witness);
     for (std::size_t k = 0; k < impl_->obstacles.size() && distance[i] > 0.0; ++k)
       if (!impl_->obstacles[k]->solids.empty() &&
           impl_->obstacles[k]->solids.contains(centres_mm[i])) {
@@ -269,7 +319,8 @@ double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double 
   tbb::parallel_for(size_t{0}, (centres_mm.size() + kRun - 1) / kRun, [&](size_t run) {
     const size_t end = std::min(centres_mm.size(), (run + 1) * kRun);
     size_t measured = run * kRun;
-    measure(measured);
+    Witness witness;  // the last measured centre's closest pair
+    measure(measured, witness);
     for (size_t i = measured + 1; i < end; ++i) {
       const double moved = (centres_mm[i] - centres_mm[measured]).norm();
       const double bound = distance[measured] - moved;
@@ -279,7 +330,7 @@ double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double 
         nearest[i] = nearest[measured];
         continue;
       }
-      measure(i);
+      measure(i, witness);
       measured = i;
     }
   });
@@ -337,6 +388,7 @@ ClearanceResult ClearanceChecker::check(std::span<const geometry::Posture> postu
   for (size_t begin = 0; begin < postures.size(); begin += batch) {
     const size_t end = std::min(postures.size(), begin + batch);
     tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
+      Witness witness;  // the previous posture's closest pair (the values do not depend on it)
       for (size_t i = range.begin(); i != range.end(); ++i) {
         if (request.exact_min_only) {
           if (measured(i)) continue;
@@ -351,7 +403,7 @@ ClearanceResult ClearanceChecker::check(std::span<const geometry::Posture> postu
             continue;
           }
         }
-        distance[i] = clearance(postures[i], &nearest[i]);
+        distance[i] = impl_->clearance(postures[i], &nearest[i], &witness);
       }
     });
     common::report(progress, static_cast<double>(end) / postures.size(), "clearance");
@@ -382,6 +434,7 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
   result.motions = postures.empty() ? 0 : postures.size() - 1;
   result.tool_reach_mm = impl_->reach_mm;
   std::vector<double> ends(postures.size());
+  std::vector<Witness> end_pairs(postures.size());  // where the ends are measured here
   std::vector<double> bound(result.motions);
   std::vector<char> touched(result.motions, 0);
   std::vector<std::size_t> samples(result.motions, 0);
@@ -411,6 +464,7 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
     queue.push(piece(0.0, 1.0, ends[i], ends[i + 1], a, b));
     double best = std::min(ends[i], ends[i + 1]);  // the lowest distance sampled on the motion
     double lowest = std::numeric_limits<double>::infinity();
+    Witness witness = end_pairs[i];  // the last sample's closest pair
     while (!queue.empty()) {
       const Piece p = queue.top();
       queue.pop();
@@ -440,9 +494,9 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
       }
       const double tm = 0.5 * (p.t0 + p.t1);
       const geometry::Posture pm = geometry::alongMotion(a, b, tm);
-      const double raw = nearestObstacle(
-          *impl_->tool, fcl::Transform3d(geometry::toolToWorld(pm).matrix()), impl_->obstacles,
-          nullptr);
+      const double raw =
+          nearestObstacle(*impl_->tool, fcl::Transform3d(geometry::toolToWorld(pm).matrix()),
+                          impl_->obstacles, nullptr, &witness);
       ++samples[i];
       if (raw <= 0.0) {  // the meshes touch: so do the true solids (the mesh is inside the tool)
         touched[i] = 1;
@@ -465,7 +519,11 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
   for (size_t begin = 0; begin < postures.size(); begin += batch) {
     const size_t end = std::min(postures.size(), begin + batch);
     tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
-      for (size_t i = range.begin(); i != range.end(); ++i) ends[i] = clearance(postures[i]);
+      Witness witness;
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        ends[i] = impl_->clearance(postures[i], nullptr, &witness);
+        end_pairs[i] = witness;
+      }
     });
     common::report(progress, 0.3 * end / postures.size(), "motions");
   }

@@ -387,3 +387,46 @@ TEST(Links, ABallAsLongAsItsRadiusIsChecked) {
     EXPECT_EQ(links.motion_contacts, std::vector<std::size_t>{3});
   }
 }
+
+// A query starts under the closest pair of the posture before it (FCL's branch and bound skips
+// the boxes farther apart): the values must be a lone query's, bit for bit, wherever the nearest
+// obstacle changes, the tool touches one, or two stand at nearly the same distance. A tool
+// swept over a box, between two walls, and into the box: every posture's clearance, the
+// minimum's obstacle, and the ball's clearance from a run of centres, each against lone queries.
+TEST(Clearance, AQueryAfterItsNeighbourGivesALoneQuerysValues) {
+  const TriangleMesh tool =
+      geometry::toolMesh(geometry::parseToolSpec("ball:3:20"),
+                         geometry::parseHolderProfile("20:6,40:6,40:12,60:12"), 0.02);
+  const std::vector<TriangleMesh> obstacles = {wall(31.0), box(Vec3(-4, 13, -20), Vec3(4, 16, -2)),
+                                               wall(-31.0)};
+  const pathgen::ClearanceChecker checker(tool, obstacles, 0.02);
+  std::vector<Posture> postures;
+  std::vector<Vec3> centres;
+  for (int k = 0; k <= 600; ++k) {
+    const double t = k / 600.0;
+    const double tilt = 0.3 * std::sin(5.0 * M_PI * t);  // rad: towards either wall and back
+    const Vec3 tip(3.0 * std::sin(3.0 * M_PI * t), 30.0 * t, -0.5 + 2.0 * std::cos(2.0 * M_PI * t));
+    postures.push_back({tip, Vec3(std::sin(tilt), 0.0, std::cos(tilt))});
+    centres.push_back(tip + Vec3(0, 0, 3));
+  }
+  pathgen::ClearanceRequest request;
+  request.batch = 1000;  // one batch: the chains run as long as TBB's ranges
+  const pathgen::ClearanceResult all = checker.check(postures, request);
+  std::size_t touching = 0, by_obstacle[3] = {0, 0, 0};
+  for (std::size_t i = 0; i < postures.size(); ++i) {
+    int obstacle = -1;
+    const double alone = checker.clearance(postures[i], &obstacle);
+    EXPECT_EQ(all.clearance_mm[i], alone) << i;
+    touching += alone == 0.0;
+    ++by_obstacle[obstacle];
+    if (i == all.min_index) EXPECT_EQ(all.min_obstacle, obstacle);
+  }
+  EXPECT_GT(touching, 10u);  // (the sweep meets the box, and each obstacle is the nearest)
+  EXPECT_LT(touching, postures.size() / 2);
+  for (const std::size_t n : by_obstacle) EXPECT_GE(n, 10u);
+  std::vector<double> each;
+  checker.ballClearance(centres, 3.0, nullptr, nullptr, std::numeric_limits<double>::infinity(),
+                        &each);
+  for (std::size_t i = 0; i < centres.size(); ++i)
+    EXPECT_EQ(each[i], checker.ballClearance(std::span<const Vec3>(&centres[i], 1), 3.0)) << i;
+}
