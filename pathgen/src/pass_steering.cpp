@@ -16,14 +16,14 @@
 namespace fieldpath::pathgen {
 namespace {
 
-/// The exact clearance of a run's postures, mm.
+/// The exact clearance of a run's postures, mm (as one check: each query starts from the
+/// closest pair of the one before it).
 std::vector<double> clearances(const dynamics::SteeringResult& run,
                                const PassSteeringSetup& setup) {
-  std::vector<double> out;
-  out.reserve(run.samples.size());
-  for (const dynamics::PostureSample& sample : run.samples)
-    out.push_back(setup.checker->clearance(sample.posture));
-  return out;
+  std::vector<geometry::Posture> postures;
+  postures.reserve(run.samples.size());
+  for (const dynamics::PostureSample& sample : run.samples) postures.push_back(sample.posture);
+  return setup.checker->check(postures).clearance_mm;
 }
 
 double least(const std::vector<double>& mm) {
