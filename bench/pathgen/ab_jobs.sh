@@ -3,8 +3,11 @@
 # path, ROUNDS rounds alternating the binaries; prints the median CPU seconds (user + system) of
 # each, the ratio new / old, and whether path.cl and clearance.csv are byte for byte the same.
 # Jobs: both examples, and both with their passes given backwards (each pass's postures in the
-# other order: the from-end repair's jobs, faulty steered from their starts).
-# Usage: bench/pathgen/ab_jobs.sh OLD NEW [ROUNDS] [WORKDIR]
+# other order: the from-end repair's jobs, faulty steered from their starts). AB_JOBS="..." picks
+# them, and offers three more: bodies6 (the mesh example with one STL a blade), bodies96 (each
+# blade in 16 closed pieces, one STL each: blade_bodies.py) and bodies96_one (the same 96 pieces
+# in one STL: bodies96's peer, the same path).
+# Usage: [AB_JOBS="mesh bodies96 bodies96_one"] bench/pathgen/ab_jobs.sh OLD NEW [ROUNDS] [WORKDIR]
 set -euo pipefail
 here=$(cd "$(dirname "$0")/../.." && pwd)
 old=$(realpath "$1"); new=$(realpath "$2")
@@ -55,8 +58,19 @@ cp "$here/examples/mesh_impeller/scene.yaml" "$work/mesh/"
 cp "$work/mesh/"*.stl "$work/mesh/scene.yaml" "$work/mesh_rev/"
 reverse_cl "$work/mesh/nominal.cl" "$work/mesh_rev/nominal.cl"
 
+# The many-bodies jobs (only those asked for).
+jobs=(${AB_JOBS:-impeller impeller_rev mesh mesh_rev})
+for job in "${jobs[@]}"; do
+  case $job in
+    bodies6) pieces=(1) ;; bodies96) pieces=(16) ;; bodies96_one) pieces=(16 --one-file) ;;
+    *) continue ;;
+  esac
+  mkdir -p "$work/$job"
+  cp "$work/mesh/"*.stl "$work/mesh/nominal.cl" "$work/mesh/scene.yaml" "$work/$job/"
+  /usr/bin/python3 "$here/bench/pathgen/blade_bodies.py" "$work/$job" "${pieces[@]}" > /dev/null
+done
+
 median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2 ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2)}'; }
-jobs=(impeller impeller_rev mesh mesh_rev)
 for r in $(seq "$rounds"); do
   for job in "${jobs[@]}"; do
     for b in old new; do

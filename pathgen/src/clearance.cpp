@@ -112,6 +112,15 @@ struct Witness {
   int obstacle = -1, tool_triangle = -1, obstacle_triangle = -1;
 };
 
+/// A lower bound of the distance between a ball (`centre`, `radius_mm`) and anything in `box`,
+/// a micrometre short of it (for the rounding of coordinates far from the origin); 0 or less
+/// where they may meet.
+double boxGapMm(const fcl::Vector3d& centre, double radius_mm, const fcl::AABBd& box) {
+  const fcl::Vector3d outside =
+      (box.min_ - centre).cwiseMax(centre - box.max_).cwiseMax(fcl::Vector3d::Zero());
+  return outside.norm() - radius_mm - 1e-3;
+}
+
 }  // namespace
 
 struct ClearanceChecker::Impl {
@@ -140,6 +149,10 @@ struct ClearanceChecker::Impl {
   /// vertex inside it. (The tip was taken for the point: for the holder alone, a tip resting on
   /// the part's top read as the holder inside the part.)
   bool enclosed(const Eigen::Isometry3d& placed, std::size_t i) const {
+    // Apart from the obstacle's box, neither can hold the other.
+    if (boxGapMm(placed * tool->aabb_center, tool->aabb_radius, obstacles[i]->tree->aabb_local) >
+        0.0)
+      return false;
     const geometry::ClosedShells& solid = obstacles[i]->solids;
     if (!solid.empty() && solid.contains(placed * tool_anchor)) return true;
     if (!tool_solid || tool_solid->empty()) return false;
@@ -245,10 +258,15 @@ double nearestObstacle(const Model& model, const fcl::Transform3d& pose,
   double best = std::numeric_limits<double>::infinity();
   int best_index = -1;
   Witness found;
+  // The model's bounding sphere as placed: an obstacle whose box lies farther from it than the
+  // query's start cannot come nearer (a fixture of 96 bodies took 21x one body's time when each
+  // was asked in full, a helper's scale sweep).
+  const fcl::Vector3d centre = pose * model.aabb_center;
   for (size_t i = 0; i < obstacles.size(); ++i) {
+    const double under = std::min(best, start);
+    if (boxGapMm(centre, model.aabb_radius, obstacles[i]->tree->aabb_local) >= under) continue;
     fcl::DistanceRequestd request;  // rel_err = abs_err = 0: exact triangle distances
     fcl::DistanceResultd result;
-    const double under = std::min(best, start);
     result.min_distance = under;
     const double d =
         fcl::distance(&model, pose, obstacles[i]->tree.get(), identity, request, result);
