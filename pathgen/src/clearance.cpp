@@ -381,8 +381,11 @@ ClearanceResult ClearanceChecker::check(std::span<const geometry::Posture> postu
   double least_measured = std::numeric_limits<double>::infinity();
   if (request.exact_min_only) {
     const size_t firsts = (postures.size() + kEvery - 1) / kEvery;
-    tbb::parallel_for(size_t{0}, firsts, [&](size_t j) {
-      distance[j * kEvery] = clearance(postures[j * kEvery], &nearest[j * kEvery]);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, firsts), [&](const auto& range) {
+      Witness witness;  // the posture measured before's closest pair
+      for (size_t j = range.begin(); j != range.end(); ++j)
+        distance[j * kEvery] =
+            impl_->clearance(postures[j * kEvery], &nearest[j * kEvery], &witness);
     });
     if (!postures.empty()) distance.back() = clearance(postures.back(), &nearest.back());
     for (size_t i = 0; i < postures.size(); i += kEvery)

@@ -421,6 +421,11 @@ TEST(Clearance, AQueryAfterItsNeighbourGivesALoneQuerysValues) {
     ++by_obstacle[obstacle];
     if (i == all.min_index) EXPECT_EQ(all.min_obstacle, obstacle);
   }
+  pathgen::ClearanceRequest only_min;  // every 8th posture measured, in chains of their own
+  only_min.exact_min_only = true;
+  const pathgen::ClearanceResult some = checker.check(postures, only_min);
+  for (std::size_t i = 0; i < postures.size(); i += 8)
+    EXPECT_EQ(some.clearance_mm[i], all.clearance_mm[i]) << i;
   EXPECT_GT(touching, 10u);  // (the sweep meets the box, and each obstacle is the nearest)
   EXPECT_LT(touching, postures.size() / 2);
   for (const std::size_t n : by_obstacle) EXPECT_GE(n, 10u);
