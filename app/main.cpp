@@ -10,11 +10,13 @@
 #include <filesystem>
 #include <iterator>
 #include <new>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <system_error>
 #include <vector>
 
+#include <tbb/global_control.h>
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
@@ -22,6 +24,7 @@
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/limits.h"
 #include "fieldpath/common/output_signals.h"
+#include "fieldpath/zbuffer/simulator.h"
 #include "progress.h"
 #include "scene.h"
 
@@ -101,9 +104,21 @@ int main(int argc, char** argv) {
   app.add_option("--max-memory", max_memory,
                  "Refuse work whose estimated memory exceeds this (e.g. 512M, 4G; default: the "
                  "machine's available memory)");
-  app.parse_complete_callback([&max_memory, &global] {
+  int threads = 0;
+  app.add_option("--threads", threads,
+                 "Use at most N threads (default: one a core; the outputs are the same whatever "
+                 "the number)")
+      ->check(CLI::Range(1, 4096));
+  // Held for the whole run: TBB (the steering, the checks, the field) and OpenMP (the Z-buffer).
+  std::optional<tbb::global_control> thread_limit;
+  app.parse_complete_callback([&max_memory, &global, &threads, &thread_limit] {
     fieldpath::app::progressQuiet() = global.quiet;
     if (!max_memory.empty()) fieldpath::common::limitMemory(max_memory, "--max-memory");
+    if (threads > 0) {
+      thread_limit.emplace(tbb::global_control::max_allowed_parallelism,
+                           static_cast<std::size_t>(threads));
+      fieldpath::zbuffer::limitCpuThreads(threads);
+    }
   });
 
   addToolCommand(app, global);
@@ -162,7 +177,7 @@ int main(int argc, char** argv) {
     std::string chain = "fieldpath";
     for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
-      if (at == &app && arg == "--max-memory") {
+      if (at == &app && (arg == "--max-memory" || arg == "--threads")) {
         ++i;  // its value
         continue;
       }

@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -59,6 +61,55 @@ TEST(Deterministic, GenerateOnOneAndOnAllCores) {
   ASSERT_EQ(run(dir, {"generate", kImpeller.string(), "--out", "all"}), 0);
   // report.json's times_s are the run's own timings: everything else must match.
   expectSameFiles(dir.path() / "one", dir.path() / "all", {"times_s"});
+}
+
+/// The most threads of `pid` seen at once with CPU time of their own (/proc/PID/task/*/stat,
+/// polled every 20 ms until it exits; libraries' idle threads never count), and its exit code.
+std::pair<int, int> busyThreads(pid_t pid) {
+  int most = 0, status = 0;
+  while (waitpid(pid, &status, WNOHANG) == 0) {
+    int busy = 0;
+    std::error_code ec;
+    for (const auto& task : fs::directory_iterator("/proc/" + std::to_string(pid) + "/task", ec)) {
+      std::istringstream stat(slurp(task.path() / "stat"));
+      std::string field;  // pid (comm) state ... utime (14th) stime (15th); comm has no spaces
+      long ticks = 0;
+      for (int k = 1; k <= 15 && stat >> field; ++k)
+        if (k >= 14) ticks += std::atol(field.c_str());
+      busy += ticks > 0;
+    }
+    most = std::max(most, busy);
+    usleep(20000);
+  }
+  return {most, WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status)};
+}
+
+// `--threads N` caps the threads that work (TBB: the steering, the checks, the field; OpenMP: the
+// Z-buffer): on one, no second thread of the run ever has CPU time (uncapped, TBB's workers steer
+// passes and check postures beside the main thread), and its files are those of a run on every
+// core.
+TEST(Deterministic, OneThreadByTheOptionGivesTheSameFiles) {
+  const TempDir dir;
+  const auto [generating, generated] =
+      busyThreads(start(dir, {"--threads", "1", "generate", kImpeller.string(), "--out", "one"}));
+  ASSERT_EQ(generated, 0);
+  EXPECT_EQ(generating, 1) << "generate --threads 1 ran on more threads";
+  const auto [checking, checked] =
+      busyThreads(start(dir, {"--threads", "1", "check", kImpeller.string(), "--path",
+                              "one/path.cl", "--out", "one.check"}));
+  ASSERT_EQ(checked, 0);
+  EXPECT_EQ(checking, 1) << "check --threads 1 ran on more threads";
+  ASSERT_EQ(run(dir, {"generate", kImpeller.string(), "--out", "all"}), 0);
+  ASSERT_EQ(run(dir, {"check", kImpeller.string(), "--path", "all/path.cl", "--out", "all.check"}),
+            0);
+  expectSameFiles(dir.path() / "one", dir.path() / "all", {"times_s"});
+  EXPECT_EQ(slurp(dir.path() / "one.check/clearance.csv"),
+            slurp(dir.path() / "all.check/clearance.csv"));
+  EXPECT_EQ(slurp(dir.path() / "one.check/deviation.npy"),
+            slurp(dir.path() / "all.check/deviation.npy"));
+  // (0 threads is a usage error naming the option)
+  EXPECT_EQ(run(dir, {"--threads", "0", "generate", kImpeller.string(), "--out", "none"}), 1);
+  EXPECT_NE(slurp(dir.path() / "stderr.txt").find("--threads"), std::string::npos);
 }
 
 TEST(Deterministic, SimulateOnOneAndOnAllCores) {

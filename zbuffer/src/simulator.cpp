@@ -95,6 +95,8 @@ Tool Tool::fromMesh(ToolMesh mesh) {
   return tool;
 }
 
+void limitCpuThreads(int threads) { omp_set_num_threads(std::max(1, threads)); }
+
 const char* backendName(Backend backend) {
   switch (backend) {
     case Backend::Auto:

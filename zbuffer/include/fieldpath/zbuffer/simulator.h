@@ -70,6 +70,8 @@ const char* backendName(Backend backend);
 Backend backendFromName(const std::string& name, const std::string& key = "backend");
 /// True if a CUDA device can be used (built with CUDA and cudaGetDeviceCount succeeds with >= 1).
 bool cudaAvailable();
+/// The CPU backend's threads (OpenMP) from now on: at most `threads` (>= 1).
+void limitCpuThreads(int threads);
 
 /// For Backend::Auto, without any CUDA call: whether the CPU engine would finish about `postures`
 /// postures of `tool` on `grid` before the GPU is even ready to cut. Starting the GPU (the driver
