@@ -1,5 +1,7 @@
 #include "posture_stream.h"
 
+#include <tbb/global_control.h>
+
 #include <algorithm>
 #include <cfloat>
 #include <chrono>
@@ -86,8 +88,12 @@ TipBounds PostureStream::bounds_locked() const {
 TipBounds PostureStream::cutBounds(double length_mm, double top_z) const {
   std::lock_guard lock(mutex_);
   TipBounds all = bounds_locked();
+  // (one a core, as TBB's: no more than `--threads`)
   const std::size_t workers = std::max<std::size_t>(
-      1, std::min<std::size_t>(std::thread::hardware_concurrency(), chunks_.size()));
+      1, std::min<std::size_t>(
+             {std::size_t(std::thread::hardware_concurrency()),
+              tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism),
+              chunks_.size()}));
   std::vector<std::future<TipBounds>> parts;
   for (std::size_t w = 0; w < workers; ++w)
     // (each its own copy of the tips' bounds, taken here: `all` is merged into as the first
