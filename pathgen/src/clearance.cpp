@@ -1,12 +1,17 @@
 #include "fieldpath/pathgen/clearance.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <new>
 #include <optional>
 #include <queue>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <unordered_map>
 
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/geometry/geometric_shape_to_BVH_model.h>
@@ -121,7 +126,60 @@ double boxGapMm(const fcl::Vector3d& centre, double radius_mm, const fcl::AABBd&
   return outside.norm() - radius_mm - 1e-3;
 }
 
+/// The bits of doubles, as a key (no two different values alike, -0 and 0 apart).
+template <std::size_t N>
+struct BitsHash {
+  std::size_t operator()(const std::array<std::uint64_t, N>& key) const {
+    std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the words
+    for (const std::uint64_t w : key) h = (h ^ w) * 1099511628211ull;
+    return static_cast<std::size_t>(h);
+  }
+};
+
+void putBits(std::uint64_t* out, const geometry::Posture& p) {
+  for (int k = 0; k < 3; ++k) {
+    out[k] = std::bit_cast<std::uint64_t>(p.tip_mm[k]);
+    out[3 + k] = std::bit_cast<std::uint64_t>(p.axis[k]);
+  }
+}
+
 }  // namespace
+
+struct ClearanceMemo::Impl {
+  using PostureKey = std::array<std::uint64_t, 6>;
+  /// Two postures, their clearances (given, or measured) and the six numbers of the request:
+  /// all that a motion's bound depends on.
+  using MotionKey = std::array<std::uint64_t, 20>;
+  struct Motion {
+    double bound_mm;
+    bool touched;
+    std::size_t samples;
+  };
+  std::unordered_map<PostureKey, std::pair<double, int>, BitsHash<6>> postures;
+  std::unordered_map<MotionKey, Motion, BitsHash<20>> motions;
+  std::size_t reused = 0;
+
+  static PostureKey key(const geometry::Posture& p) {
+    PostureKey k;
+    putBits(k.data(), p);
+    return k;
+  }
+  static MotionKey key(const geometry::Posture& a, const geometry::Posture& b, double a_mm,
+                       double b_mm, const std::array<double, 6>& request) {
+    MotionKey k;
+    putBits(k.data(), a);
+    putBits(k.data() + 6, b);
+    k[12] = std::bit_cast<std::uint64_t>(a_mm);
+    k[13] = std::bit_cast<std::uint64_t>(b_mm);
+    for (std::size_t i = 0; i < request.size(); ++i)
+      k[14 + i] = std::bit_cast<std::uint64_t>(request[i]);
+    return k;
+  }
+};
+
+ClearanceMemo::ClearanceMemo() : impl_(std::make_unique<Impl>()) {}
+ClearanceMemo::~ClearanceMemo() = default;
+std::size_t ClearanceMemo::reused() const { return impl_->reused; }
 
 struct ClearanceChecker::Impl {
   std::shared_ptr<Model> tool;
@@ -406,11 +464,24 @@ ClearanceResult ClearanceChecker::check(std::span<const geometry::Posture> postu
     return distance[k] - (postures[i].tip_mm - postures[k].tip_mm).norm() -
            impl_->reach_mm * (turned + 1e-7);
   };
+  // Postures checked before (the memo): given back, not measured.
+  ClearanceMemo::Impl* const memo =
+      request.memo && !request.exact_min_only ? request.memo->impl_.get() : nullptr;
+  std::vector<char> known(memo ? postures.size() : 0, 0);
+  if (memo)
+    for (size_t i = 0; i < postures.size(); ++i)
+      if (const auto hit = memo->postures.find(ClearanceMemo::Impl::key(postures[i]));
+          hit != memo->postures.end()) {
+        std::tie(distance[i], nearest[i]) = hit->second;
+        known[i] = 1;
+        ++memo->reused;
+      }
   for (size_t begin = 0; begin < postures.size(); begin += batch) {
     const size_t end = std::min(postures.size(), begin + batch);
     tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
       Witness witness;  // the previous posture's closest pair (the values do not depend on it)
       for (size_t i = range.begin(); i != range.end(); ++i) {
+        if (memo && known[i]) continue;
         if (request.exact_min_only) {
           if (measured(i)) continue;
           const size_t before = i - i % kEvery;
@@ -429,6 +500,11 @@ ClearanceResult ClearanceChecker::check(std::span<const geometry::Posture> postu
     });
     common::report(progress, static_cast<double>(end) / postures.size(), "clearance");
   }
+  if (memo)
+    for (size_t i = 0; i < postures.size(); ++i)
+      if (!known[i])
+        memo->postures.emplace(ClearanceMemo::Impl::key(postures[i]),
+                               std::pair(distance[i], nearest[i]));
   for (size_t i = 0; i < postures.size(); ++i) {
     if (distance[i] <= 0.0) {
       ++result.colliding;
@@ -557,13 +633,40 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
                std::min(request.enough_mm,
                         closest_mm - std::max(request.tighten_mm, request.tighten_fraction *
                                                                       std::max(closest_mm, 0.0))));
+  // Motions refined before under the same request (the memo): given back, not refined.
+  ClearanceMemo::Impl* const memo = request.memo ? request.memo->impl_.get() : nullptr;
+  const std::array<double, 6> asked = {stop_mm,
+                                       request.required_mm,
+                                       resolution,
+                                       request.tighten_mm,
+                                       request.tighten_fraction,
+                                       request.enough_mm};
+  std::vector<char> known(memo ? result.motions : 0, 0);
+  if (memo)
+    for (size_t i = 0; i < result.motions; ++i)
+      if (const auto hit = memo->motions.find(
+              ClearanceMemo::Impl::key(postures[i], postures[i + 1], ends[i], ends[i + 1], asked));
+          hit != memo->motions.end()) {
+        bound[i] = hit->second.bound_mm;
+        touched[i] = hit->second.touched;
+        samples[i] = hit->second.samples;
+        known[i] = 1;
+        ++memo->reused;
+      }
   for (size_t begin = 0; begin < result.motions; begin += batch) {
     const size_t end = std::min(result.motions, begin + batch);
     tbb::parallel_for(tbb::blocked_range<size_t>(begin, end), [&](const auto& range) {
-      for (size_t i = range.begin(); i != range.end(); ++i) motion(i);
+      for (size_t i = range.begin(); i != range.end(); ++i)
+        if (!memo || !known[i]) motion(i);
     });
     common::report(progress, 0.3 + 0.7 * end / result.motions, "motions");
   }
+  if (memo)
+    for (size_t i = 0; i < result.motions; ++i)
+      if (!known[i])
+        memo->motions.emplace(
+            ClearanceMemo::Impl::key(postures[i], postures[i + 1], ends[i], ends[i + 1], asked),
+            ClearanceMemo::Impl::Motion{bound[i], touched[i] != 0, samples[i]});
   for (size_t i = 0; i < result.motions; ++i) {
     result.samples += samples[i];
     if (touched[i] || bound[i] <= 0.0) {

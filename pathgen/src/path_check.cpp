@@ -22,6 +22,9 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
   // The part's model (its tree and shells), prepared once for every check of the path and of the
   // repairs: a 1 M-triangle part takes seconds a preparation.
   std::shared_ptr<const ObstacleModel> part_model;
+  // The postures and motions checked: a repair's check of the path it changed measures again
+  // only what changed (a third of a reversed impeller's generate checked the same again).
+  ClearanceMemo checked;
   // The first check reports in the job's bar (steer_end to 1); a repair's check again as a stage
   // of its own, from 0 % (it ran back from 100 % to the steering's end, unsaid: a reviewer's).
   common::Progress progress = request.progress;
@@ -58,11 +61,14 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
     }
     for (const GeneratedPosture& g : result.postures)
       if (g.limited) result.path.limited.push_back(g.output);
+    ClearanceRequest postures;
+    postures.memo = &checked;
     result.clearance =
-        checker.check(result.path.postures, {},
+        checker.check(result.path.postures, postures,
                       scaled(progress, stages.steer_end, stages.clearance_end, "clearance"));
     if (!request.passes_only) {
       MotionRequest motions;
+      motions.memo = &checked;
       motions.required_mm = request.clearance_mm;
       motions.posture_clearance_mm = result.clearance.clearance_mm;
       result.motions = checker.checkMotions(

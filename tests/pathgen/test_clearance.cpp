@@ -435,3 +435,59 @@ TEST(Clearance, AQueryAfterItsNeighbourGivesALoneQuerysValues) {
   for (std::size_t i = 0; i < centres.size(); ++i)
     EXPECT_EQ(each[i], checker.ballClearance(std::span<const Vec3>(&centres[i], 1), 3.0)) << i;
 }
+
+// A repair checks again the path it changed: the memo gives back the postures and motions
+// checked before (the same bits) and measures the rest. The results must be those of a check
+// without it, bit for bit; what it gives back is exactly what did not change.
+TEST(Clearance, AMemoGivesBackWhatWasCheckedAndMeasuresOnlyWhatChanged) {
+  const TriangleMesh tool =
+      geometry::toolMesh(geometry::parseToolSpec("ball:3:20"),
+                         geometry::parseHolderProfile("20:6,40:6,40:12,60:12"), 0.02);
+  const std::vector<TriangleMesh> obstacles = {wall(31.0), box(Vec3(-4, 13, -20), Vec3(4, 16, -2))};
+  const pathgen::ClearanceChecker checker(tool, obstacles, 0.02);
+  std::vector<Posture> before;
+  for (int k = 0; k <= 300; ++k) {
+    const double t = k / 300.0, tilt = 0.3 * std::sin(5.0 * M_PI * t);
+    before.push_back({Vec3(3.0 * std::sin(3.0 * M_PI * t), 30.0 * t, -1.0 + 2.0 * std::cos(2 * t)),
+                      Vec3(std::sin(tilt), 0.0, std::cos(tilt))});
+  }
+  // Postures 100-149 turned, as a repair re-steers a pass (the tips held: the axis is the key
+  // too), and 160-169 moved.
+  std::vector<Posture> after = before;
+  for (int k = 100; k < 150; ++k)
+    after[k].axis = (after[k].axis + Vec3(0.0, 0.05, 0.0)).normalized();
+  for (int k = 160; k < 170; ++k) after[k].tip_mm.x() += 0.7;
+  pathgen::ClearanceMemo memo;
+  pathgen::ClearanceRequest with;
+  with.memo = &memo;
+  pathgen::MotionRequest motions_with;
+  motions_with.required_mm = 0.5;
+  motions_with.memo = &memo;
+  const auto motions = [&](const std::vector<Posture>& path, const pathgen::ClearanceResult& at,
+                           pathgen::MotionRequest request) {
+    request.posture_clearance_mm = at.clearance_mm;
+    return checker.checkMotions(path, request);
+  };
+  motions(before, checker.check(before, with), motions_with);
+  ASSERT_EQ(memo.reused(), 0u);
+  const pathgen::ClearanceResult remembered = checker.check(after, with);
+  EXPECT_EQ(memo.reused(), after.size() - 60);
+  const pathgen::ClearanceResult measured = checker.check(after);
+  EXPECT_EQ(remembered.clearance_mm, measured.clearance_mm);
+  EXPECT_EQ(remembered.min_index, measured.min_index);
+  EXPECT_EQ(remembered.min_obstacle, measured.min_obstacle);
+  EXPECT_EQ(remembered.colliding, measured.colliding);
+  pathgen::MotionRequest motions_without = motions_with;
+  motions_without.memo = nullptr;
+  const std::size_t before_motions = memo.reused();
+  const pathgen::MotionResult moved = motions(after, remembered, motions_with);
+  // (the motions into and out of each changed run changed too; the stop, from the closest
+  // posture, is the same: the box stays the nearest)
+  EXPECT_EQ(memo.reused() - before_motions, after.size() - 1 - 51 - 11);
+  const pathgen::MotionResult fresh = motions(after, measured, motions_without);
+  EXPECT_EQ(moved.clearance_mm, fresh.clearance_mm);
+  EXPECT_EQ(moved.samples, fresh.samples);
+  EXPECT_EQ(moved.colliding, fresh.colliding);
+  EXPECT_EQ(moved.under_required, fresh.under_required);
+  EXPECT_GT(fresh.samples, 0u);
+}

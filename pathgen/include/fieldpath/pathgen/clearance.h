@@ -16,8 +16,30 @@ namespace fieldpath::pathgen {
 
 using geometry::Vec3;
 
+/// Exact results kept from one check for the next (a repair checks again the path it changed:
+/// most of its postures and motions are those checked before, bit for bit). A posture's
+/// clearance is its own, whatever the postures around it, and a motion's bound is its two
+/// postures' under one request: the same key, the same result. One check at a time uses it.
+class ClearanceMemo {
+ public:
+  ClearanceMemo();
+  ~ClearanceMemo();
+  ClearanceMemo(const ClearanceMemo&) = delete;
+  ClearanceMemo& operator=(const ClearanceMemo&) = delete;
+  /// Postures and motions given back from it so far, not measured again.
+  std::size_t reused() const;
+
+ private:
+  friend class ClearanceChecker;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 struct ClearanceRequest {
   bool per_posture = true;  ///< fill ClearanceResult::clearance_mm
+  /// Where set, the postures found in it are not measured again, and those measured are kept in
+  /// it (not with exact_min_only, whose bounds are not the postures' own).
+  ClearanceMemo* memo = nullptr;
   /// Postures per progress report (and per parallel batch).
   std::size_t batch = 256;
   /// Only the minimum (value and posture) and the colliding postures exact: every 8th posture is
@@ -58,6 +80,9 @@ struct MotionRequest {
   std::size_t batch = 256;
   /// The postures' clearances if known (ClearanceResult::clearance_mm), else computed here.
   std::span<const double> posture_clearance_mm;
+  /// Where set, the motions found in it (the same two postures under the same request) are not
+  /// refined again, and those refined are kept in it.
+  ClearanceMemo* memo = nullptr;
 };
 
 struct MotionResult {
