@@ -398,7 +398,10 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
   result.motions = postures.empty() ? 0 : postures.size() - 1;
   result.tool_reach_mm = impl_->reach_mm;
   std::vector<double> ends(postures.size());
-  std::vector<Witness> end_pairs(postures.size());  // where the ends are measured here
+  // The ends' closest pairs, where they are measured here (each motion's first sample starts
+  // from its first end's).
+  const bool ends_given = request.posture_clearance_mm.size() == postures.size();
+  std::vector<Witness> end_pairs(ends_given ? 0 : postures.size());
   std::vector<double> bound(result.motions);
   std::vector<char> touched(result.motions, 0);
   std::vector<std::size_t> samples(result.motions, 0);
@@ -428,7 +431,7 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
     queue.push(piece(0.0, 1.0, ends[i], ends[i + 1], a, b));
     double best = std::min(ends[i], ends[i + 1]);  // the lowest distance sampled on the motion
     double lowest = std::numeric_limits<double>::infinity();
-    Witness witness = end_pairs[i];  // the last sample's closest pair
+    Witness witness = ends_given ? Witness{} : end_pairs[i];  // the last sample's closest pair
     while (!queue.empty()) {
       const Piece p = queue.top();
       queue.pop();
@@ -476,7 +479,7 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
   };
   // The postures' own clearances first (the ends of every motion), unless given.
   const size_t batch = std::max<size_t>(1, request.batch);
-  if (request.posture_clearance_mm.size() == postures.size())
+  if (ends_given)
     std::copy(request.posture_clearance_mm.begin(), request.posture_clearance_mm.end(),
               ends.begin());
   else
