@@ -2,10 +2,13 @@
 #include "fieldpath/pathgen/cutter_part.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <unordered_set>
 
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/geometry/shape/cylinder.h>
@@ -15,6 +18,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "clearance_memo.h"  // memo_detail: keys of bits
 #include "fieldpath/common/limits.h"
 #include "fieldpath/common/short_number.h"
 #include "obstacle_model.h"
@@ -290,7 +294,60 @@ std::vector<Stamp> stampsNearPart(std::span<const Posture> postures, const Part&
   return out;
 }
 
+/// Calls visit(begin, end) for each run of stamps of one posture or of one motion (stampsNearPart
+/// makes them in runs).
+template <class Visit>
+void forEachOwner(const std::vector<Stamp>& stamps, Visit&& visit) {
+  for (std::size_t begin = 0; begin < stamps.size();) {
+    std::size_t end = begin + 1;
+    while (end < stamps.size() && stamps[end].index == stamps[begin].index &&
+           stamps[end].on_motion == stamps[begin].on_motion)
+      ++end;
+    visit(begin, end);
+    begin = end;
+  }
+}
+
 }  // namespace
+
+struct CutterMemo::Impl {
+  using PostureKey = std::array<std::uint64_t, 6>;
+  using MotionKey = std::array<std::uint64_t, 12>;
+  using Context = std::array<std::uint64_t, 5>;
+  std::optional<Context> context;  ///< the tool's shape, R, r and L, and the tolerance
+  std::unordered_set<PostureKey, memo_detail::BitsHash<6>> clear_postures;
+  std::unordered_set<MotionKey, memo_detail::BitsHash<12>> clear_motions;
+  std::size_t reused = 0;
+
+  /// Emptied where the tool or the tolerance is not the one it was filled for.
+  void useFor(const geometry::ToolSpec& tool, double tolerance_mm) {
+    const Context now{
+        static_cast<std::uint64_t>(tool.shape), std::bit_cast<std::uint64_t>(tool.radius_mm),
+        std::bit_cast<std::uint64_t>(tool.corner_radius_mm),
+        std::bit_cast<std::uint64_t>(tool.length_mm), std::bit_cast<std::uint64_t>(tolerance_mm)};
+    if (context == now) return;
+    clear_postures.clear();
+    clear_motions.clear();
+    context = now;
+  }
+  /// Whether the posture or the motion (from posture `index` on) that `stamp` belongs to is held
+  /// clear; with `put`, it is put in instead.
+  bool clear(std::span<const Posture> postures, const Stamp& stamp, bool put) {
+    if (stamp.on_motion) {
+      MotionKey key;
+      memo_detail::putBits(key.data(), postures[stamp.index]);
+      memo_detail::putBits(key.data() + 6, postures[stamp.index + 1]);
+      return put ? clear_motions.insert(key).second : clear_motions.contains(key);
+    }
+    PostureKey key;
+    memo_detail::putBits(key.data(), postures[stamp.index]);
+    return put ? clear_postures.insert(key).second : clear_postures.contains(key);
+  }
+};
+
+CutterMemo::CutterMemo() : impl_(std::make_unique<Impl>()) {}
+CutterMemo::~CutterMemo() = default;
+std::size_t CutterMemo::reused() const { return impl_->reused; }
 
 void requireCutterTestMemory(const geometry::ToolSpec& tool, const Eigen::AlignedBox3d& part_box,
                              std::span<const std::vector<Posture>> passes, double tolerance_mm) {
@@ -326,7 +383,7 @@ CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
 CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
                                         const std::shared_ptr<const ObstacleModel>& part_model,
                                         std::span<const Posture> postures, double tolerance_mm,
-                                        const common::Progress& progress) {
+                                        const common::Progress& progress, CutterMemo* memo) {
   CutterPartResult result;
   result.tolerance_mm = tolerance_mm;
   if (tool.shape == geometry::ToolShape::Flat || !part_model || !(tolerance_mm > 0.0) ||
@@ -340,15 +397,32 @@ CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
   const std::vector<Stamp> stamps = stampsNearPart(postures, part, spacing);
   result.stamps = stamps.size();
   std::vector<char> gouging(stamps.size(), 0);
+  // The stamps of the postures and motions that the memo holds clear: not tested again.
+  CutterMemo::Impl* const kept = memo ? &memo->impl() : nullptr;
+  std::vector<char> known(kept ? stamps.size() : 0, 0);
+  if (kept) {
+    kept->useFor(tool, tolerance_mm);
+    forEachOwner(stamps, [&](std::size_t begin, std::size_t end) {
+      if (!kept->clear(postures, stamps[begin], false)) return;
+      std::fill(known.begin() + begin, known.begin() + end, 1);
+      ++kept->reused;
+    });
+  }
   constexpr std::size_t kBatch = 4096;
   for (std::size_t begin = 0; begin < stamps.size(); begin += kBatch) {
     const std::size_t end = std::min(stamps.size(), begin + kBatch);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end), [&](const auto& range) {
       for (std::size_t i = range.begin(); i != range.end(); ++i)
-        gouging[i] = part.touches(tool, stamps[i].pose, tolerance_mm);
+        if (!kept || !known[i]) gouging[i] = part.touches(tool, stamps[i].pose, tolerance_mm);
     });
     common::report(progress, double(end) / double(stamps.size()), "cutter vs part");
   }
+  if (kept)
+    forEachOwner(stamps, [&](std::size_t begin, std::size_t end) {
+      if (!known[begin] && std::none_of(gouging.begin() + begin, gouging.begin() + end,
+                                        [](char g) { return g != 0; }))
+        kept->clear(postures, stamps[begin], true);
+    });
   // The depth of the deepest: each gouging stamp bisected only where it goes deeper than the
   // deepest so far (few stamps gouge in a path worth running).
   for (std::size_t i = 0; i < stamps.size(); ++i) {

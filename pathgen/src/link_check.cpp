@@ -105,12 +105,16 @@ GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
 
 LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const GrazingChecker& grazing,
                                      const geometry::PathFile& path,
-                                     const common::Progress& progress, bool contacts_only) {
+                                     const common::Progress& progress, bool contacts_only,
+                                     PartMemo* memo) {
   LinkPartResult out;
   // Touching is what counts: required 0. Contacts only: the lowest piece certified above 0 ends
   // a motion (a slack of its whole nearest sample).
   MotionRequest grazing_request;
   if (contacts_only) grazing_request.tighten_fraction = 1.0;
+  if (memo) grazing_request.memo = &memo->grazing;
+  ClearanceRequest posture_request;
+  if (memo) posture_request.memo = &memo->links;
   const auto& all = path.postures;
   // Said link by link (~12 ms each: 1320 passes' links took 16 s without a word, a helper's).
   const double links = static_cast<double>(path.count(geometry::PathBlock::Kind::Link));
@@ -133,7 +137,7 @@ LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const Grazing
       checkGrazingMove(grazing, all[block.end - 1], all[block.end], block.end - 1, out,
                        grazing_request);
     const std::span<const geometry::Posture> postures(all.data() + block.begin, block.size());
-    const ClearanceResult c = part.check(postures);
+    const ClearanceResult c = part.check(postures, posture_request);
     out.postures += c.postures;
     out.min_clearance_mm = std::min(out.min_clearance_mm, c.min_clearance_mm);
     out.colliding_postures += c.colliding;
@@ -143,6 +147,7 @@ LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const Grazing
     if (block.size() < 2) continue;
     MotionRequest request;  // touching is what counts here: required 0
     request.posture_clearance_mm = c.clearance_mm;
+    if (memo) request.memo = &memo->links;
     // Its minimum told to within 10 % (a lower bound), not 1 %: a link 10 mm over a concave part
     // whose axis turns took ~150 distance queries a motion to tell 9.88 mm to 0.1 mm, and a
     // helper's 439 links on a concave cylinder did not finish in 300 s.
@@ -171,7 +176,7 @@ std::optional<LinkPartResult> checkHolderAgainstPart(const geometry::ToolSpec& t
 std::optional<LinkPartResult> checkHolderAgainstPart(
     const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
     const std::shared_ptr<const ObstacleModel>& part, std::span<const geometry::Posture> postures,
-    const common::Progress& progress) {
+    const common::Progress& progress, ClearanceMemo* memo) {
   const double tol_mm = clearanceMeshTolMm(tool, holder);
   const geometry::TriangleMesh holder_mesh = geometry::holderMesh(tool, holder, tol_mm);
   if (holder_mesh.triangles.empty() || postures.empty()) return std::nullopt;
@@ -187,6 +192,7 @@ std::optional<LinkPartResult> checkHolderAgainstPart(
   out.first_colliding_posture = c.first_colliding;
   MotionRequest request;  // touching is what counts: required 0
   request.posture_clearance_mm = c.clearance_mm;
+  request.memo = memo;
   const MotionResult m =
       holder_part.checkMotions(postures, request, common::scaled(progress, 0.3, 1.0, ""));
   out.motions = m.motions;
@@ -211,15 +217,17 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
 PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
                               const std::shared_ptr<const ObstacleModel>& model,
                               const geometry::PathFile& path, double gouge_tolerance_mm,
-                              const common::Progress& progress, double ball_exact_below_mm) {
+                              const common::Progress& progress, double ball_exact_below_mm,
+                              PartMemo* memo) {
   PartContacts out;  // its progress from 0.2 (0 to 0.2: the model's preparation, above)
   common::report(progress, 0.2, "links vs part");
   const double tol_mm = clearanceMeshTolMm(tool, holder);
   const ClearanceChecker whole(geometry::toolMesh(tool, holder, tol_mm), std::span(&model, 1),
                                tol_mm);
   if (path.count(geometry::PathBlock::Kind::Link) > 0)
-    out.links = checkLinksAgainstPart(whole, grazingPartChecker(tool, holder, model), path,
-                                      common::scaled(progress, 0.2, 0.3, "links vs part"));
+    out.links =
+        checkLinksAgainstPart(whole, grazingPartChecker(tool, holder, model), path,
+                              common::scaled(progress, 0.2, 0.3, "links vs part"), false, memo);
   if (tool.shape == geometry::ToolShape::Ball) {
     // Every pass posture's ball told nearer or farther than the far-from-part distance (a pass
     // beside the part is not hidden by one on it), the least exact under the range asked.
@@ -252,10 +260,12 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
     }
   }
   out.holder = checkHolderAgainstPart(tool, holder, model, path.postures,
-                                      common::scaled(progress, 0.3, 0.6, "holder vs part"));
+                                      common::scaled(progress, 0.3, 0.6, "holder vs part"),
+                                      memo ? &memo->holder : nullptr);
   if (tool.shape != geometry::ToolShape::Flat)
     out.cutter = checkCutterAgainstPart(tool, model, path.postures, gouge_tolerance_mm,
-                                        common::scaled(progress, 0.6, 1.0, "cutter vs part"));
+                                        common::scaled(progress, 0.6, 1.0, "cutter vs part"),
+                                        memo ? &memo->cutter : nullptr);
   return out;
 }
 

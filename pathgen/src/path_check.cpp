@@ -25,6 +25,7 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
   // The postures and motions checked: a repair's check of the path it changed measures again
   // only what changed (a third of a reversed impeller's generate checked the same again).
   ClearanceMemo checked;
+  PartMemo part_checked;  // the same for the checks against the part
   // The first check reports in the job's bar (steer_end to 1); a repair's check again as a stage
   // of its own, from 0 % (it ran back from 100 % to the steering's end, unsaid: a reviewer's).
   common::Progress progress = request.progress;
@@ -80,9 +81,9 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
         const common::Progress part = scaled(progress, stages.motions_end, 1.0, "part");
         common::report(part, 0.0, "part");
         if (!part_model) part_model = prepareObstacle(*request.part, "part");
-        PartContacts contacts =
-            checkAgainstPart(request.tool, request.holder, part_model, result.path,
-                             kGougeToleranceMm, part, farFromPartMm(request.tool.radius_mm));
+        PartContacts contacts = checkAgainstPart(
+            request.tool, request.holder, part_model, result.path, kGougeToleranceMm, part,
+            farFromPartMm(request.tool.radius_mm), &part_checked);
         result.ball_part_mm = contacts.ball_part_mm;
         result.far_from_part = contacts.far;
         part_marks = contacts.marks(result.path.postures.size());

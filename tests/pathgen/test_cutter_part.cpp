@@ -3,6 +3,7 @@
 /// towards a wall meets it with its top rim, e/(sin θ + cos θ) in the shrunk-all-round measure;
 /// a rib passed by a motion between two clear postures; a cutter wholly inside a closed part.
 #include <cmath>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -10,6 +11,7 @@
 
 #include "fieldpath/geometry/mesh.h"
 #include "fieldpath/pathgen/cutter_part.h"
+#include "fieldpath/pathgen/link_check.h"
 #include "fixtures.h"
 
 using namespace fieldpath;
@@ -246,4 +248,72 @@ TEST(CutterPart, AFlatEndIsNotTested) {
                                    std::vector<Posture>{upright(0, 0, 0)})
                 .stamps,
             0u);
+}
+
+// generate checks its path against the part again after each repair, with a memo of what it
+// found (PartMemo): the results must be those of a check without it, bit for bit, and the
+// cutter's postures and motions given back exactly those unchanged and clear. A plate with a
+// fin, two passes and a link over the fin; the first pass dips 0.05 mm into the plate at three
+// postures (gouges kept out of the memo); the repair tilts five postures of the second pass by
+// 20 deg, which drives its ball 0.18 mm into the plate (a key blind to the axis gives them back
+// clear).
+TEST(CutterPart, AMemoGivesBackTheChecksOfWhatDidNotChange) {
+  geometry::TriangleMesh part;
+  pathgen::test::addBox(part, -10, 60, -10, 10, -5, 0);
+  pathgen::test::addBox(part, 20, 24, -10, 10, 0, 4);
+  const std::shared_ptr<const ObstacleModel> model = prepareObstacle(part, "part");
+  const geometry::HolderProfile holder = geometry::parseHolderProfile("20:6,40:6,40:12,60:12");
+  geometry::PathFile before;
+  for (int k = 0; k <= 30; ++k)
+    before.postures.push_back(upright(0.5 * k, 0, k >= 10 && k <= 12 ? -0.05 : 0));
+  for (const double z : {2.0, 12.0}) before.postures.push_back(upright(15, 0, z));
+  for (const double z : {12.0, 2.0}) before.postures.push_back(upright(30, 0, z));
+  for (int k = 0; k <= 30; ++k) before.postures.push_back(upright(30.0 + 0.5 * k, 0, 0));
+  using geometry::PathBlock;
+  before.blocks = {{PathBlock::Kind::Pass, 0, 31},
+                   {PathBlock::Kind::Link, 31, 35},
+                   {PathBlock::Kind::Pass, 35, 66}};
+  geometry::PathFile after = before;
+  const double tilt = 20.0 * M_PI / 180.0;
+  for (std::size_t i = 40; i < 45; ++i)
+    after.postures[i].axis = {std::sin(tilt), 0, std::cos(tilt)};
+
+  const auto check = [&](const geometry::PathFile& path, PartMemo* memo) {
+    return checkAgainstPart(ball(), holder, model, path, kGougeToleranceMm, {}, kReachesPartMm,
+                            memo);
+  };
+  PartMemo memo;
+  check(before, &memo);
+  ASSERT_EQ(memo.reused(), 0u);
+  const PartContacts kept = check(after, &memo);
+  const PartContacts fresh = check(after, nullptr);
+  ASSERT_TRUE(kept.cutter && fresh.cutter && kept.links && fresh.links && kept.holder &&
+              fresh.holder);
+  const CutterPartResult &a = *kept.cutter, &b = *fresh.cutter;
+  EXPECT_EQ(a.stamps, b.stamps);
+  EXPECT_EQ(a.posture_contacts, b.posture_contacts);
+  EXPECT_EQ(a.motion_contacts, b.motion_contacts);
+  EXPECT_EQ(a.max_depth_mm, b.max_depth_mm);
+  EXPECT_EQ(a.deepest, b.deepest);
+  EXPECT_EQ(a.deepest_on_motion, b.deepest_on_motion);
+  // (the tilted postures gouge, the dips too)
+  EXPECT_EQ(b.posture_contacts, (std::vector<std::size_t>{10, 11, 12, 40, 41, 42, 43, 44}));
+  EXPECT_NEAR(b.max_depth_mm, 3.0 - 3.0 * std::cos(tilt), 2e-4);
+  for (const auto* r : {&kept.links, &kept.holder}) {
+    const LinkPartResult& x = **r;
+    const LinkPartResult& y = r == &kept.links ? *fresh.links : *fresh.holder;
+    EXPECT_EQ(x.postures, y.postures);
+    EXPECT_EQ(x.motions, y.motions);
+    EXPECT_EQ(x.min_clearance_mm, y.min_clearance_mm);
+    EXPECT_EQ(x.posture_contacts, y.posture_contacts);
+    EXPECT_EQ(x.motion_contacts, y.motion_contacts);
+  }
+  EXPECT_EQ(kept.ball_part_mm, fresh.ball_part_mm);
+  // Given back: the postures but the five turned and the three gouging, and the motions but the
+  // six into, between and out of the turned ones and those gouging.
+  std::size_t motions_gouging_unchanged = 0;
+  for (const std::size_t i : b.motion_contacts) motions_gouging_unchanged += i < 39 || i > 44;
+  const std::size_t n = after.postures.size();
+  EXPECT_EQ(memo.cutter.reused(), (n - 5 - 3) + (n - 1 - 6 - motions_gouging_unchanged));
+  EXPECT_GT(memo.links.reused() + memo.holder.reused(), 0u);
 }

@@ -50,6 +50,27 @@ struct CutterPartResult {
   bool gouges() const { return gouging_postures + gouging_motions > 0; }
 };
 
+/// The postures and motions that a cutter test found clear of the part at every stamp, kept for
+/// the next test of a path changed in places (generate checks its path again after each repair:
+/// the cutter's stamps were a fifth of a reversed job's time, most of them tested before). A
+/// posture's stamp is itself and a motion's are set by its two ends: the same bits, the same
+/// stamps, the same verdicts. Those entering the part are tested again (few, and each then
+/// bisected for its depth). Kept for one tool and tolerance: another empties it.
+class CutterMemo {
+ public:
+  CutterMemo();
+  ~CutterMemo();
+  CutterMemo(const CutterMemo&) = delete;
+  CutterMemo& operator=(const CutterMemo&) = delete;
+  /// Postures and motions given back from it so far, their stamps not tested again.
+  std::size_t reused() const;
+  struct Impl;  ///< (cutter_part.cpp)
+  Impl& impl() { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
 /// Tests the cutter of `tool` (ball or torus; a flat end's sharp rim is not: nothing tested,
 /// stamps 0), shrunk by `tolerance_mm`, against `part` at every posture and along every motion
 /// that comes within the cutter's length of the part, with stamps no farther apart than
@@ -68,11 +89,14 @@ CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
 void requireCutterTestMemory(const geometry::ToolSpec& tool, const Eigen::AlignedBox3d& part_box,
                              std::span<const std::vector<geometry::Posture>> passes,
                              double tolerance_mm = kGougeToleranceMm);
-/// The same against the part prepared once (prepareObstacle), shared with the other checks.
+/// The same against the part prepared once (prepareObstacle), shared with the other checks; with
+/// `memo`, the postures and motions it holds clear are not tested again, and those found clear
+/// are put in it.
 CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
                                         const std::shared_ptr<const ObstacleModel>& part,
                                         std::span<const geometry::Posture> postures,
                                         double tolerance_mm = kGougeToleranceMm,
-                                        const common::Progress& progress = {});
+                                        const common::Progress& progress = {},
+                                        CutterMemo* memo = nullptr);
 
 }  // namespace fieldpath::pathgen

@@ -37,6 +37,18 @@ struct LinkPartResult {
 /// the ball cuts, and slide along a wall the ball finishes (tangent to it all the way up).
 inline constexpr double kPassGrazeMm = 0.1;
 
+/// What the part's checks (checkAgainstPart) keep from one check of a path for the next: generate
+/// checks its path again after each repair, and most of it was checked before, bit for bit. One
+/// memo a checker: the tool + holder at the links, the grazing moves, the holder; and the cutter.
+struct PartMemo {
+  ClearanceMemo links, grazing, holder;
+  CutterMemo cutter;
+  /// Postures and motions given back so far, not measured or tested again.
+  std::size_t reused() const {
+    return links.reused() + grazing.reused() + holder.reused() + cutter.reused();
+  }
+};
+
 /// The checker of the moves out of and into passes (checkLinksAgainstPart): tool and holder
 /// shrunk by `shrink_mm` all round (kPassGrazeMm, or half the corner radius of a smaller tool)
 /// against the part; its poses have the tip `shrink_mm` up the axis (the ball's centre kept).
@@ -64,10 +76,11 @@ GrazingChecker grazingPartChecker(const geometry::ToolSpec& tool,
 /// (a path written with no retract) are that pass's. `progress` after each link.
 /// `contacts_only`: each motion refined only until it is certified clear or touches (its bound
 /// then loose): what a way being chosen needs (rerouteLinkEnds: 53 ms a way told to 10 %).
+/// `memo`: its `links` and `grazing` memos used and filled (the same checkers each time).
 LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const GrazingChecker& grazing,
                                      const geometry::PathFile& path,
                                      const common::Progress& progress = {},
-                                     bool contacts_only = false);
+                                     bool contacts_only = false, PartMemo* memo = nullptr);
 
 /// The holder (geometry::holderMesh) against the part at every posture and every motion of the
 /// path, passes and links. The holder never cuts: touching the part anywhere is a crash, also
@@ -78,11 +91,12 @@ std::optional<LinkPartResult> checkHolderAgainstPart(const geometry::ToolSpec& t
                                                      const geometry::HolderProfile& holder,
                                                      const geometry::TriangleMesh& part,
                                                      std::span<const geometry::Posture> postures);
-/// The same against the part prepared once (prepareObstacle), reporting to `progress`.
+/// The same against the part prepared once (prepareObstacle), reporting to `progress`; `memo`
+/// for its motions (its postures are measured for the minimum only: not kept).
 std::optional<LinkPartResult> checkHolderAgainstPart(
     const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
     const std::shared_ptr<const ObstacleModel>& part, std::span<const geometry::Posture> postures,
-    const common::Progress& progress = {});
+    const common::Progress& progress = {}, ClearanceMemo* memo = nullptr);
 
 /// What a path must not do to the part, as generate, check and view all check it: its links
 /// (checkLinksAgainstPart, when it has link blocks), its holder (checkHolderAgainstPart, when
@@ -124,12 +138,15 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
                               const common::Progress& progress = {});
 /// The same with the part's model already prepared (prepareObstacle): generate checks its path
 /// again after each repair and the repairs check against the part too, one model for them all.
-/// `ball_exact_below_mm`: ball_part_mm exact under it (kReachesPartMm at least).
+/// `ball_exact_below_mm`: ball_part_mm exact under it (kReachesPartMm at least). `memo`: what
+/// the checks before it (of the same tool, holder and part) found, used and filled; the results
+/// are those of a check without it.
 PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder,
                               const std::shared_ptr<const ObstacleModel>& part,
                               const geometry::PathFile& path,
                               double gouge_tolerance_mm = kGougeToleranceMm,
                               const common::Progress& progress = {},
-                              double ball_exact_below_mm = kReachesPartMm);
+                              double ball_exact_below_mm = kReachesPartMm,
+                              PartMemo* memo = nullptr);
 
 }  // namespace fieldpath::pathgen
