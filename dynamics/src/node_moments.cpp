@@ -40,14 +40,6 @@ using detail::centralStiffness;
 using detail::momentOfNodes;
 using detail::offsetsFromCentre;
 
-AxisMoment axisMoment(const field::ForceField& field, std::span<const Vec3> nodes_tool_frame_mm,
-                      double ball_radius_mm, const LocalFrame& frame, const Vec3& centre_mm,
-                      double lead_rad, double tilt_rad) {
-  std::vector<Vec3> nodes_mm, forces;
-  return momentOfNodes(field, offsetsFromCentre(nodes_tool_frame_mm, ball_radius_mm), frame,
-                       centre_mm, lead_rad, tilt_rad, nodes_mm, forces);
-}
-
 Eigen::Matrix2d fieldStiffness(const field::ForceField& field,
                                std::span<const Vec3> nodes_tool_frame_mm, double ball_radius_mm,
                                const LocalFrame& frame, const Vec3& centre_mm, double lead_rad,

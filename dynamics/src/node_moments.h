@@ -1,6 +1,6 @@
 #pragma once
 /// Internal to dynamics/: the field's moment at the tool and holder nodes placed at an axis
-/// (steering.cpp's right-hand side and damping, the public axisMoment and fieldStiffness).
+/// (steering.cpp's right-hand side and damping, the public fieldStiffness).
 #include <span>
 #include <vector>
 

@@ -26,7 +26,7 @@ struct DeviceArray {
     if (n) FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(ptr, host, n * sizeof(T), cudaMemcpyHostToDevice, stream));
   }
   ~DeviceArray() {
-    if (ptr) cudaFree(ptr);
+    if (ptr) FIELDPATH_CUDA_WARN(cudaFree(ptr));
   }
   DeviceArray(const DeviceArray&) = delete;
   DeviceArray& operator=(const DeviceArray&) = delete;
@@ -66,7 +66,7 @@ struct CudaNodeBuild::State {
     cudaStream_t s = nullptr;
     Stream() { FIELDPATH_CUDA_CHECK(cudaStreamCreate(&s)); }
     ~Stream() {
-      if (s) cudaStreamDestroy(s);
+      if (s) FIELDPATH_CUDA_WARN(cudaStreamDestroy(s));
     }
   } stream;
   std::vector<unsigned long long> first;
@@ -122,7 +122,8 @@ CudaNodeBuild::CudaNodeBuild(const CellTable& table, const NodeJob& job,
 }
 
 CudaNodeBuild::~CudaNodeBuild() {
-  if (state_ && state_->stream.s) cudaStreamSynchronize(state_->stream.s);  // before the frees
+  if (state_ && state_->stream.s)  // before the frees
+    FIELDPATH_CUDA_WARN(cudaStreamSynchronize(state_->stream.s));
 }
 
 NodeValues CudaNodeBuild::finish() {

@@ -208,14 +208,6 @@ inline void requireRegularFile(const std::filesystem::path& file) {
   common::requireRegularFile(file, "path file");
 }
 
-/// Opens a path file for reading: "FILE: no such file" / "FILE: cannot open for reading".
-inline std::ifstream openPathFile(const std::filesystem::path& file) {
-  requireRegularFile(file);
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw common::InputError(file.string() + ": cannot open for reading");
-  return in;
-}
-
 /// Appends posture index `i` to the block list: a new block when `kind` differs from the last
 /// block's or `split` is set.
 inline void addToBlocks(std::vector<PathBlock>& blocks, PathBlock::Kind kind, bool split,

@@ -138,10 +138,6 @@ ClearanceChecker::ClearanceChecker(const geometry::TriangleMesh& tool_mesh,
   impl_ = std::move(impl);
 }
 
-std::size_t ClearanceChecker::obstacleCount() const { return impl_->obstacles.size(); }
-double ClearanceChecker::toolChordTolMm() const { return impl_->chord_tol_mm; }
-double ClearanceChecker::toolReachMm() const { return impl_->reach_mm; }
-
 namespace {
 
 /// The distance between triangle `tool_triangle` of `model` placed at `pose` and triangle

@@ -110,7 +110,7 @@ struct DeviceTool {
   DeviceTool(const DeviceTool&) = delete;
   DeviceTool& operator=(const DeviceTool&) = delete;
   ~DeviceTool() {
-    for (void* p : buffers) cudaFree(p);
+    for (void* p : buffers) FIELDPATH_CUDA_WARN(cudaFree(p));
   }
   template <class T>
   const T* copy(const T* host, std::size_t n) {
@@ -205,8 +205,8 @@ struct Engine::Impl {
       FIELDPATH_CUDA_CHECK(cudaEventElapsedTime(&ms, mk.begin, mk.end));
       total[mk.stage].first += ms;
       ++total[mk.stage].second;
-      cudaEventDestroy(mk.begin);
-      cudaEventDestroy(mk.end);
+      FIELDPATH_CUDA_CHECK(cudaEventDestroy(mk.begin));
+      FIELDPATH_CUDA_CHECK(cudaEventDestroy(mk.end));
     }
     marks.clear();
     unsigned long long counts[kStats] = {};
@@ -322,26 +322,29 @@ struct Engine::Impl {
   }
 
   ~Impl() {
-    if (copy_stream) cudaStreamSynchronize(copy_stream);
+    if (copy_stream) FIELDPATH_CUDA_WARN(cudaStreamSynchronize(copy_stream));
     if (!compute_stream) return;
-    cudaStreamSynchronize(compute_stream);
+    FIELDPATH_CUDA_WARN(cudaStreamSynchronize(compute_stream));
     for (void* p :
          {static_cast<void*>(keys), static_cast<void*>(tile_max), static_cast<void*>(tile_live),
           static_cast<void*>(culled), static_cast<void*>(queued), static_cast<void*>(queue),
           sort_temp, static_cast<void*>(stats)})
-      if (p) cudaFreeAsync(p, compute_stream);
+      if (p) FIELDPATH_CUDA_WARN(cudaFreeAsync(p, compute_stream));
     for (int k = 0; k < 2; ++k) {
       for (void* p : {static_cast<void*>(postures[k]), static_cast<void*>(sort_keys[k]),
                       static_cast<void*>(sort_index[k])})
-        if (p) cudaFreeAsync(p, compute_stream);
-      if (copied[k]) cudaEventDestroy(copied[k]);
-      if (computed[k]) cudaEventDestroy(computed[k]);
-      if (staged[k]) cudaEventSynchronize(staged[k]), cudaEventDestroy(staged[k]);
+        if (p) FIELDPATH_CUDA_WARN(cudaFreeAsync(p, compute_stream));
+      if (copied[k]) FIELDPATH_CUDA_WARN(cudaEventDestroy(copied[k]));
+      if (computed[k]) FIELDPATH_CUDA_WARN(cudaEventDestroy(computed[k]));
+      if (staged[k]) {
+        FIELDPATH_CUDA_WARN(cudaEventSynchronize(staged[k]));
+        FIELDPATH_CUDA_WARN(cudaEventDestroy(staged[k]));
+      }
       if (stage[k]) releasePinned(stage[k]);
     }
-    cudaStreamSynchronize(compute_stream);
-    if (copy_stream) cudaStreamDestroy(copy_stream);
-    cudaStreamDestroy(compute_stream);
+    FIELDPATH_CUDA_WARN(cudaStreamSynchronize(compute_stream));
+    if (copy_stream) FIELDPATH_CUDA_WARN(cudaStreamDestroy(copy_stream));
+    FIELDPATH_CUDA_WARN(cudaStreamDestroy(compute_stream));
   }
 
   /// Room for blocks of `count` postures (waits for the queued work before reallocating).
@@ -499,14 +502,23 @@ void Engine::cut(const Posture* block, std::size_t count, bool coarse) {
 void Engine::heights(float* out_mm) const {
   const Impl& m = *impl_;
   cudaStream_t st = m.compute_stream;
-  std::int32_t* bits = nullptr;
-  deviceAlloc(bits, m.lines, st);
-  FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(bits, m.keys, m.lines * 4, cudaMemcpyDeviceToDevice, st));
-  orderBitsKernel<<<unsigned((m.lines + 255) / 256), 256, 0, st>>>(bits, m.lines);
+  // (freed on the stream however this ends: a failed download threw past a bare free)
+  struct Bits {
+    std::int32_t* ptr = nullptr;
+    cudaStream_t stream;
+    ~Bits() {
+      if (ptr) FIELDPATH_CUDA_WARN(cudaFreeAsync(ptr, stream));
+    }
+  } bits{nullptr, st};
+  deviceAlloc(bits.ptr, m.lines, st);
+  FIELDPATH_CUDA_CHECK(
+      cudaMemcpyAsync(bits.ptr, m.keys, m.lines * 4, cudaMemcpyDeviceToDevice, st));
+  orderBitsKernel<<<unsigned((m.lines + 255) / 256), 256, 0, st>>>(bits.ptr, m.lines);
   FIELDPATH_CUDA_CHECK(cudaGetLastError());
   Impl& mm = const_cast<Impl&>(m);
-  mm.timed("download", st, [&] { mm.download(out_mm, bits, m.lines * 4, st); });
-  FIELDPATH_CUDA_CHECK(cudaFreeAsync(bits, st));
+  mm.timed("download", st, [&] { mm.download(out_mm, bits.ptr, m.lines * 4, st); });
+  FIELDPATH_CUDA_CHECK(cudaFreeAsync(bits.ptr, st));
+  bits.ptr = nullptr;
   FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(st));
   mm.printTrace();
 }

@@ -4,6 +4,8 @@
 /// which the command line turns into one line and exit code 1.
 #include <cuda_runtime.h>
 
+#include <atomic>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -15,6 +17,18 @@ inline void checkCuda(cudaError_t status, const char* what, const char* file, in
                              cudaGetErrorString(status));
 }
 
+/// For destructors and other places that must not throw: a failed call said on stderr, once a
+/// process (after a fault CUDA's later calls all fail with the same sticky error: one line, not
+/// one a buffer), and never for a runtime already unloading at the process's exit.
+inline void warnCuda(cudaError_t status, const char* what, const char* file, int line) noexcept {
+  if (status == cudaSuccess || status == cudaErrorCudartUnloading) return;
+  static std::atomic<bool> said{false};
+  if (said.exchange(true)) return;
+  std::fprintf(stderr, "warning: %s:%d: %s: %s\n", file, line, what, cudaGetErrorString(status));
+}
+
 }  // namespace fieldpath::common
 
 #define FIELDPATH_CUDA_CHECK(call) ::fieldpath::common::checkCuda((call), #call, __FILE__, __LINE__)
+/// The same where a throw may not go (destructors): said once on stderr (warnCuda).
+#define FIELDPATH_CUDA_WARN(call) ::fieldpath::common::warnCuda((call), #call, __FILE__, __LINE__)

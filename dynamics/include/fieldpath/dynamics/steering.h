@@ -142,17 +142,14 @@ constexpr int kSettleCycleDecays = 3;
 SettledStart settleAtStart(const Pass& pass, const SteeringRequest& request);
 
 /// The moment of the field on the nodes placed at axis angles (lead, tilt) at one pass frame, about
-/// the ball centre: τ = [M·b, M·f]. Used by steerPass and by callers that want the static moment.
+/// the ball centre: τ = [M·b, M·f] (node_moments.h momentOfNodes).
 struct AxisMoment {
   Vec3 moment = Vec3::Zero();
   double lead_torque = 0.0, tilt_torque = 0.0;
 };
-AxisMoment axisMoment(const field::ForceField& field, std::span<const Vec3> nodes_tool_frame_mm,
-                      double ball_radius_mm, const LocalFrame& frame, const Vec3& centre_mm,
-                      double lead_rad, double tilt_rad);
 
 /// The field's own angular stiffness K = -∂τ/∂θ (2×2, rows/columns lead, tilt; torque per rad) at
-/// one pose, by central differences of axisMoment (step `delta_rad`). Near a wall K adds to the
+/// one pose, by central differences of the moment (step `delta_rad`). Near a wall K adds to the
 /// spring: the default "critical" c = 2·sqrt(k·J) is then underdamped (a step in a wall
 /// overshoots); a damping of 2·sqrt((k + K_tilt,tilt)·J) for the stiffest expected pose keeps the
 /// response critical.

@@ -175,11 +175,6 @@ class ClearanceChecker {
                        std::vector<double>* each = nullptr,
                        double split_mm = std::numeric_limits<double>::quiet_NaN()) const;
 
-  std::size_t obstacleCount() const;
-  double toolChordTolMm() const;
-  /// Farthest point of the tool mesh from its tip (mm): ρ_max of the motion bound.
-  double toolReachMm() const;
-
  private:
   struct Impl;
   std::shared_ptr<const Impl> impl_;
