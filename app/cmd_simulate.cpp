@@ -144,21 +144,7 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
                   "cut while it is read");
   auto* stock =
       cmd->add_option("--stock", o->stock_mm, "Stock top plane z, mm (default: the highest tip)")
-          ->check(CLI::Validator(
-              [](std::string& text) {
-                double v = 0;
-                try {
-                  std::size_t used = 0;
-                  v = std::stod(text, &used);
-                  if (used != text.size()) return std::string("not a number: " + text);
-                } catch (const std::exception&) {
-                  return std::string("not a number: " + text);
-                }
-                if (!std::isfinite(v) || std::abs(v) > 1e6)
-                  return std::string("must be a finite height within +-1e6 mm");
-                return std::string();
-              },
-              "z in mm"));
+          ->check(numberFromTo(-common::kMaxCoordinateMm, common::kMaxCoordinateMm, "mm"));
   cmd->add_option("--part", o->part, "Part mesh whose top is the initial surface")->excludes(stock);
   cmd->add_option("--backend", o->backend,
                   "auto (the CPU where it would finish before the GPU has started, else the "

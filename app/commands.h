@@ -12,9 +12,6 @@
 
 namespace fieldpath::app {
 
-/// CLI11 check for a size option: a finite number > 0 (or >= 0 with `zero_ok`), in `unit`, with
-/// a short message otherwise (CLI::PositiveNumber lets NaN through and prints its range as a
-/// 300-digit number).
 /// A CLI11 check of a number: "'x' is not a number" for no number at all, else `wanted` (the
 /// rule in words) unless `ok(value)`; text after the number, nan and inf fail `ok`'s caller.
 template <class Ok>
@@ -33,6 +30,9 @@ CLI::Validator numberCheck(Ok ok, const std::string& wanted, const std::string& 
       description);
 }
 
+/// CLI11 check for a size option: a finite number > 0 (or >= 0 with `zero_ok`), in `unit`, with
+/// a short message otherwise (CLI::PositiveNumber lets NaN through and prints its range as a
+/// 300-digit number).
 inline CLI::Validator finiteNumber(const std::string& unit, bool zero_ok) {
   const std::string bound = zero_ok ? ">= 0" : "> 0";
   return numberCheck([zero_ok](double v) { return v > 0.0 || (zero_ok && v == 0.0); },

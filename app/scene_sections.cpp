@@ -196,7 +196,8 @@ void readLinks(const Reader& r, const YAML::Node& node, pathgen::LinkParams& lin
       links.safe_z_mm.reset();
     else
       links.safe_z_mm = r.number(
-          node["safe_z"], "links.safe_z", [](double v) { return std::abs(v) <= 1e6; },
+          node["safe_z"], "links.safe_z",
+          [](double v) { return std::abs(v) <= common::kMaxCoordinateMm; },
           "`auto` or a height in mm within 1e6 of 0");
   }
 }

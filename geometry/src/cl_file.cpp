@@ -113,13 +113,7 @@ bool fastLine(std::string_view content, const std::filesystem::path& file, std::
   for (std::size_t c = 0; c < count; ++c)
     if (!std::isfinite(v[c])) return false;
   const auto where = [&] { return file.string() + ":" + std::to_string(line); };
-  Posture posture;
-  posture.tip_mm = Vec3(v[0], v[1], v[2]);
-  checkTip(posture.tip_mm, where);
-  posture.axis = checkedAxis(Vec3(v[3], v[4], v[5]), where);
-  posture.has_spindle = count == 7;
-  posture.spindle_rad = posture.has_spindle ? v[6] : 0.0;
-  out.add(posture, line);
+  out.add(checkedPosture(v, count, where), line);
   if (p < end && isLimitNote(std::string_view(p + 1, std::size_t(end - p - 1)))) out.limit();
   return true;
 }
@@ -180,13 +174,7 @@ void parseClChunk(std::string_view text, std::size_t first_line, const std::file
     double v[7];
     for (std::size_t c = 0; c < count; ++c) v[c] = parseFinite(tokens[c], file, line);
     const auto where = [&] { return file.string() + ":" + std::to_string(line); };
-    Posture p;
-    p.tip_mm = Vec3(v[0], v[1], v[2]);
-    checkTip(p.tip_mm, where);
-    p.axis = checkedAxis(Vec3(v[3], v[4], v[5]), where);
-    p.has_spindle = count == 7;
-    p.spindle_rad = p.has_spindle ? v[6] : 0.0;
-    out.add(p, line);
+    out.add(checkedPosture(v, count, where), line);
     if (has_comment && isLimitNote(comment)) out.limit();
   }
 }

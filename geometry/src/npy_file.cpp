@@ -170,13 +170,7 @@ Posture rowPosture(const std::filesystem::path& file, const NpyRows& a, std::uin
       bad(file, "row " + std::to_string(r) + ", column " + std::to_string(c) + ": not finite");
   }
   const auto where = [&] { return file.string() + ": row " + std::to_string(r); };
-  Posture p;
-  p.tip_mm = Vec3(v[0], v[1], v[2]);
-  checkTip(p.tip_mm, where);
-  p.axis = checkedAxis(Vec3(v[3], v[4], v[5]), where);
-  p.has_spindle = a.columns == 7;
-  p.spindle_rad = p.has_spindle ? v[6] : 0.0;
-  return p;
+  return checkedPosture(v, a.columns, where);
 }
 
 /// Rows per parallel piece: about `chunk_bytes` of the file.

@@ -116,10 +116,11 @@ std::vector<TextChunk> splitAtLines(std::string_view text, std::size_t chunk_byt
 
 void tipTooFar(const Vec3& tip_mm, const std::string& where) {
   for (int k = 0; k < 3; ++k) {
-    if (!(std::abs(tip_mm[k]) <= kMaxCoordinateMm)) {
+    if (!(std::abs(tip_mm[k]) <= common::kMaxCoordinateMm)) {
       std::ostringstream why;
-      why << "tool tip " << "xyz"[k] << " = " << tip_mm[k] << " mm is beyond +-"
-          << kMaxCoordinateMm << " mm (no machine is that large)";
+      why << "tool tip "
+          << "xyz"[k] << " = " << tip_mm[k] << " mm is beyond +-" << common::kMaxCoordinateMm
+          << " mm (no machine is that large)";
       failAt(where, why.str());
     }
   }

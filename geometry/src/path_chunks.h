@@ -10,7 +10,9 @@
 #include <string_view>
 #include <vector>
 
+#include "fieldpath/common/limits.h"
 #include "fieldpath/geometry/cl_file.h"
+#include "path_text.h"  // checkedAxis
 
 namespace fieldpath::geometry::detail {
 
@@ -50,12 +52,26 @@ std::vector<TextChunk> splitAtLines(std::string_view text, std::size_t chunk_byt
 /// error in file order when i orders the chunks of a file.
 void forEachChunk(std::size_t n, unsigned threads, const std::function<void(std::size_t)>& work);
 
-/// Refuses tool tips beyond any machine: |x|, |y|, |z| > kMaxCoordinateMm ("FILE:LINE: ...").
-inline constexpr double kMaxCoordinateMm = 1e6;
+/// Refuses tool tips beyond any machine: |x|, |y|, |z| > common::kMaxCoordinateMm ("FILE:LINE:
+/// ...").
 [[noreturn]] void tipTooFar(const Vec3& tip_mm, const std::string& where);
 template <class Where>
 void checkTip(const Vec3& tip_mm, const Where& where) {
-  if (!(tip_mm.cwiseAbs().maxCoeff() <= kMaxCoordinateMm)) tipTooFar(tip_mm, where());
+  if (!(tip_mm.cwiseAbs().maxCoeff() <= common::kMaxCoordinateMm)) tipTooFar(tip_mm, where());
+}
+
+/// The posture of a record's `count` values, x y z i j k [spindle] (6 or 7, finite), as every
+/// reader takes it: its tip checked (checkTip), its axis unit or refused (checkedAxis), both at
+/// `where()`.
+template <class Where>
+Posture checkedPosture(const double* v, std::size_t count, const Where& where) {
+  Posture p;
+  p.tip_mm = Vec3(v[0], v[1], v[2]);
+  checkTip(p.tip_mm, where);
+  p.axis = checkedAxis(Vec3(v[3], v[4], v[5]), where);
+  p.has_spindle = count == 7;
+  p.spindle_rad = p.has_spindle ? v[6] : 0.0;
+  return p;
 }
 
 /// Where a pass or link block starts: the index of its first posture (which may be the size of

@@ -104,14 +104,6 @@ std::vector<geometry::TriangleMesh> bladeMeshes(const Impeller& impeller) {
   return {impeller.bladeMesh(0), impeller.bladeMesh(1)};
 }
 
-void useImpeller(GenerateRequest& job, const Impeller& impeller) {
-  job.passes = impellerPasses(impeller, job.path, job.tool.radius_mm);
-  std::vector<geometry::TriangleMesh> obstacles = bladeMeshes(impeller);
-  obstacles.insert(obstacles.end(), job.obstacles.begin(), job.obstacles.end());
-  job.obstacles = std::move(obstacles);
-  job.part = impeller.hubMesh();
-}
-
 double defaultNodeSpacingMm(const geometry::ToolSpec& tool, const geometry::HolderProfile& holder) {
   // Area of the revolved profile: ball/torus end ≈ hemisphere, shank, holder bands and end faces.
   const double r = tool.radius_mm;

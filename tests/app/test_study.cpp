@@ -18,6 +18,7 @@
 
 #include "fieldpath/common/errors.h"
 #include "files.h"
+#include "impeller_job.h"
 #include "study.h"
 
 namespace fieldpath::app {
@@ -49,7 +50,7 @@ pathgen::GenerateRequest smallJob() {
   job.dynamics.rtol = 1.0e-4;
   job.dynamics.atol = 1.0e-7;
   job.clearance_mm = 0.5;
-  pathgen::useImpeller(job, pathgen::Impeller(smallImpeller()));
+  pathgen::test::useImpeller(job, pathgen::Impeller(smallImpeller()));
   return job;
 }
 

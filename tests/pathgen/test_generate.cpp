@@ -8,9 +8,11 @@
 #include "fieldpath/geometry/tool_model.h"
 #include "fieldpath/pathgen/generate.h"
 #include "fixtures.h"
+#include "impeller_job.h"
 
 using namespace fieldpath;
 using namespace fieldpath::pathgen;
+using fieldpath::pathgen::test::useImpeller;
 
 namespace {
 

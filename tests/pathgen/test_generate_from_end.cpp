@@ -10,9 +10,11 @@
 #include "fieldpath/pathgen/generate.h"
 #include "fieldpath/pathgen/passes.h"
 #include "fixtures.h"
+#include "impeller_job.h"
 
 using namespace fieldpath;
 using namespace fieldpath::pathgen;
+using fieldpath::pathgen::test::useImpeller;
 
 namespace {
 

@@ -16,18 +16,11 @@
 
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/limits.h"
+#include "fieldpath/common/short_number.h"
 
 namespace fieldpath::zbuffer {
 
 using common::InputError;
-
-namespace {
-std::string shortMm(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", value);
-  return text;
-}
-}  // namespace
 
 Grid Grid::fromRegion(double x0_mm, double y0_mm, double x1_mm, double y1_mm, int nx, int ny) {
   if (!std::isfinite(x0_mm) || !std::isfinite(y0_mm) || !std::isfinite(x1_mm) ||
@@ -35,7 +28,8 @@ Grid Grid::fromRegion(double x0_mm, double y0_mm, double x1_mm, double y1_mm, in
     throw InputError("region: non-finite coordinate");
   for (const double v : {x0_mm, y0_mm, x1_mm, y1_mm})
     if (std::abs(v) > common::kMaxCoordinateMm)
-      throw InputError("region: coordinate " + shortMm(v) + " mm is beyond +-1e6 mm (outside any machine)");
+      throw InputError("region: coordinate " + common::shortNumber(v) +
+                       " mm is beyond +-1e6 mm (outside any machine)");
   if (!(x1_mm > x0_mm) || !(y1_mm > y0_mm))
     throw InputError("region: zero or negative area (need x0 < x1 and y0 < y1)");
   if (nx <= 0 || ny <= 0)
@@ -51,8 +45,8 @@ Grid Grid::fromRegion(double x0_mm, double y0_mm, double x1_mm, double y1_mm, in
   // A spacing that rounds to nothing next to the origin would stack lines on one another.
   const double tiny = 1e-12 * std::max({1.0, std::abs(x0_mm), std::abs(y0_mm), std::abs(x1_mm), std::abs(y1_mm)});
   if (!(g.dx_mm > tiny) || !(g.dy_mm > tiny) || !std::isfinite(g.dx_mm) || !std::isfinite(g.dy_mm))
-    throw InputError("region: degenerate grid spacing " + shortMm(g.dx_mm) + " x " +
-                     shortMm(g.dy_mm) + " mm");
+    throw InputError("region: degenerate grid spacing " + common::shortNumber(g.dx_mm) + " x " +
+                     common::shortNumber(g.dy_mm) + " mm");
   return g;
 }
 

@@ -5,13 +5,14 @@
 
 namespace fieldpath::dynamics {
 
+/// `integrator`: CVODE BDF (default) or ARKODE ERK (explicit reference).
 enum class Integrator { Bdf, Erk };
 
 /// `on_limit`: what to do when an output sample leaves the configured angle limits.
 enum class LimitPolicy {
   Clamp,  ///< `clamp`: hold the angle at the limit (rate zeroed, solver restarted); flagged
   Fail,   ///< `fail`: stop; status TiltLimit / RateLimit and a message naming the arc length
-};  ///< CVODE BDF (default) or ARKODE ERK (explicit reference)
+};
 
 /// `start`: the axis a pass starts from (DESIGN.md leaves it open; seed 004 starts at the
 /// nominal angles). A pass whose nominal start posture already crowds an obstacle would begin

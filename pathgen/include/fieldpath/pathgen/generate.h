@@ -84,10 +84,6 @@ struct GenerateRequest {
   common::Progress progress;  ///< "field", "pass k/n", "clearance", "motions"
 };
 
-/// The parametric impeller as the job's source: its passes (from job.path and the tool radius),
-/// its two blades before job's other obstacles, its hub as job.part.
-void useImpeller(GenerateRequest& job, const Impeller& impeller);
-
 /// One output posture of a pass with what the dynamics and the clearance check say about it.
 struct GeneratedPosture {
   int pass = 0;       ///< 0-based
