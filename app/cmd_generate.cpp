@@ -35,6 +35,7 @@
 #include "job.h"
 #include "json_text.h"
 #include "obstacle_reach.h"
+#include "path_report.h"
 #include "progress.h"
 #include "scene.h"
 

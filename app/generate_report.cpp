@@ -8,8 +8,8 @@
 #include "fieldpath/common/csv.h"
 #include "fieldpath/geometry/units.h"
 #include "generate_repairs.h"
-#include "job.h"
 #include "json_text.h"
+#include "path_report.h"
 
 namespace fieldpath::app {
 namespace {

@@ -27,6 +27,7 @@
 #include "fieldpath/pathgen/generate.h"
 #include "fieldpath/pathgen/link_check.h"
 #include "job.h"
+#include "path_report.h"
 #include "scene.h"
 #include "surface_check.h"
 #include "to_zbuffer.h"

@@ -10,6 +10,7 @@
 #include "fieldpath/common/errors.h"
 #include "files.h"
 #include "job.h"
+#include "path_report.h"
 #include "progress.h"
 #include "scene.h"
 
