@@ -132,6 +132,30 @@ class Part {
                         result) > 0;
   }
 
+  /// Whether a triangle of the part that meets `bound` (placed `at`) passes `exact(a, b, c)`:
+  /// FCL lists the triangles in the bound, each then tested exactly. A list cut short at
+  /// kMaxContacts says yes (not cleared).
+  template <class Exact>
+  bool anyTriangleIn(const fcl::CollisionGeometryd& bound, const fcl::Transform3d& at,
+                     Exact&& exact) const {
+    constexpr std::size_t kMaxContacts = std::size_t{1} << 22;
+    fcl::CollisionRequestd request(kMaxContacts);
+    fcl::CollisionResultd result;
+    if (fcl::collide(&bound, at, model_.tree.get(), fcl::Transform3d::Identity(), request,
+                     result) == 0)
+      return false;
+    if (result.numContacts() >= kMaxContacts) return true;
+    const auto& tree = *model_.tree;
+    for (std::size_t i = 0; i < result.numContacts(); ++i) {
+      // FCL meets a shape with a mesh as the mesh with the shape: the triangle is the side whose
+      // object is the tree (b1 here, not b2).
+      const fcl::Contactd& contact = result.getContact(i);
+      const fcl::Triangle& t = tree.tri_indices[contact.o1 == &tree ? contact.b1 : contact.b2];
+      if (exact(tree.vertices[t[0]], tree.vertices[t[1]], tree.vertices[t[2]])) return true;
+    }
+    return false;
+  }
+
   /// Whether the part meets the ball of radius `reach_mm` about `centre` under the plane `cap_mm`
   /// over it along the axis (turn's third column): the triangles in the ball, each clipped.
   bool cappedBallMeets(const Vec3& centre, const Eigen::Matrix3d& turn, double reach_mm,
@@ -141,23 +165,10 @@ class Part {
     // A point of the cut ball: wholly inside a closed part, it meets it.
     if (model_.solids.contains(centre + 0.5 * (std::min(cap_mm, reach_mm) - reach_mm) * axis))
       return true;
-    constexpr std::size_t kMaxContacts = std::size_t{1} << 22;
-    fcl::CollisionRequestd request(kMaxContacts);
-    fcl::CollisionResultd result;
-    const fcl::Sphered ball(reach_mm);
-    if (fcl::collide(&ball, placed(turn, centre), model_.tree.get(), fcl::Transform3d::Identity(),
-                     request, result) == 0)
-      return false;
-    if (result.numContacts() >= kMaxContacts) return true;  // the list cut short: not cleared
-    const auto& tree = *model_.tree;
-    for (std::size_t i = 0; i < result.numContacts(); ++i) {
-      const fcl::Contactd& contact = result.getContact(i);
-      const fcl::Triangle& t = tree.tri_indices[contact.o1 == &tree ? contact.b1 : contact.b2];
-      if (triangleMeetsCappedBall(tree.vertices[t[0]], tree.vertices[t[1]], tree.vertices[t[2]],
-                                  centre, axis, reach_mm, cap_mm))
-        return true;
-    }
-    return false;
+    return anyTriangleIn(fcl::Sphered(reach_mm), placed(turn, centre),
+                         [&](const Vec3& a, const Vec3& b, const Vec3& c) {
+                           return triangleMeetsCappedBall(a, b, c, centre, axis, reach_mm, cap_mm);
+                         });
   }
 
   /// Whether the part comes within `reach_mm` of the disc of radius `disc_mm` about `centre`,
@@ -171,29 +182,14 @@ class Part {
     if (meets(fcl::Cylinderd(disc_mm, 2.0 * reach_mm), at)) return true;
     // Around it a ring (a torus: no FCL shape). The triangles in the cylinder that bounds it are
     // each measured from the disc (GJK, ~1e-7 mm): within reach, they enter the ring.
-    constexpr std::size_t kMaxContacts = std::size_t{1} << 22;
-    fcl::CollisionRequestd request(kMaxContacts);
-    fcl::CollisionResultd result;
-    const fcl::Cylinderd bound(disc_mm + reach_mm, 2.0 * reach_mm);
-    if (fcl::collide(&bound, at, model_.tree.get(), fcl::Transform3d::Identity(), request,
-                     result) == 0)
-      return false;
-    if (result.numContacts() >= kMaxContacts) return true;  // the list cut short: not cleared
     const fcl::Cylinderd disc(disc_mm, 0.0);
     const fcl::detail::GJKSolver_libccd<double> solver;
-    const auto& tree = *model_.tree;
-    for (std::size_t i = 0; i < result.numContacts(); ++i) {
-      // FCL meets a shape with a mesh as the mesh with the shape: the triangle is the side whose
-      // object is the tree (b1 here, not b2).
-      const fcl::Contactd& contact = result.getContact(i);
-      const fcl::Triangle& t = tree.tri_indices[contact.o1 == &tree ? contact.b1 : contact.b2];
-      double distance = 0.0;
-      if (!solver.shapeTriangleDistance(disc, at, tree.vertices[t[0]], tree.vertices[t[1]],
-                                        tree.vertices[t[2]], &distance) ||
-          distance <= reach_mm)
-        return true;
-    }
-    return false;
+    return anyTriangleIn(fcl::Cylinderd(disc_mm + reach_mm, 2.0 * reach_mm), at,
+                         [&](const Vec3& a, const Vec3& b, const Vec3& c) {
+                           double distance = 0.0;
+                           return !solver.shapeTriangleDistance(disc, at, a, b, c, &distance) ||
+                                  distance <= reach_mm;
+                         });
   }
 
  private:
