@@ -405,8 +405,7 @@ void tellUnreachable(SurfaceResult& result, const pathgen::ClearanceChecker& obs
       centres.push_back(on_part + radius_mm * partNormal(grid, top, at));
     }
     // Exact below -R (none) and split at 0: each centre told touching (0) or clear (> 0).
-    clear_mm.clear();
-    obstacles.ballClearance(centres, ball_mm, nullptr, nullptr, -ball_mm, &clear_mm, 0.0);
+    clear_mm = obstacles.ballClearance(centres, {ball_mm, -ball_mm, 0.0, true}).each_mm;
     for (std::size_t k = begin; k < end; ++k) {
       const std::size_t at =
           std::size_t(std::lower_bound(lines.begin(), lines.end(), order[k]) - lines.begin());

@@ -65,12 +65,11 @@ int main(int argc, char** argv) {
   const pathgen::ClearanceChecker obstacles(
       geometry::toolMesh(job.tool, job.holder, pathgen::clearanceMeshTolMm(job.tool, job.holder)),
       job.obstacles, pathgen::clearanceMeshTolMm(job.tool, job.holder));
-  std::size_t at_all = 0, at_skip = 0;
-  double all = 0, skip = 0;
-  const double balls_all_s =
-      medianSeconds(repeats, [&] { all = obstacles.ballClearance(centres, r, &at_all, nullptr); });
+  pathgen::BallResult all, skip;
+  const double balls_all_s = medianSeconds(
+      repeats, [&] { all = obstacles.ballClearance(centres, pathgen::BallRequest{r}); });
   const double balls_skip_s = medianSeconds(repeats, [&] {
-    skip = obstacles.ballClearance(centres, r, &at_skip, nullptr, job.clearance_mm);
+    skip = obstacles.ballClearance(centres, pathgen::BallRequest{r, job.clearance_mm});
   });
 
   // The holder against the part at every posture.
@@ -96,17 +95,17 @@ int main(int argc, char** argv) {
   // The balls' minimum is exact only under the clearance: above it the skipping run says so.
   std::printf(
       "| balls (exact under %g mm) | %.3f | %.3f | %.1f | %.6f / %.6f%s | %zu / %zu | - |\n",
-      job.clearance_mm, balls_all_s, balls_skip_s, balls_all_s / balls_skip_s, all, skip,
-      all < job.clearance_mm ? "" : " (above: a bound)", at_all, at_skip);
+      job.clearance_mm, balls_all_s, balls_skip_s, balls_all_s / balls_skip_s, all.min_mm,
+      skip.min_mm, all.min_mm < job.clearance_mm ? "" : " (above: a bound)", all.at, skip.at);
   std::printf("| holder vs part | %.3f | %.3f | %.1f | %.6f / %.6f | %zu / %zu | %zu / %zu |\n",
               holder_all_s, holder_skip_s, holder_all_s / holder_skip_s, every.min_clearance_mm,
               some.min_clearance_mm, every.min_index, some.min_index, every.colliding,
               some.colliding);
-  const bool same = (all >= job.clearance_mm ? skip >= job.clearance_mm && skip <= all
-                                             : skip == all && at_skip == at_all) &&
-                    every.min_clearance_mm == some.min_clearance_mm &&
-                    every.min_index == some.min_index && every.colliding == some.colliding &&
-                    every.first_colliding == some.first_colliding;
+  const bool same =
+      (all.min_mm >= job.clearance_mm ? skip.min_mm >= job.clearance_mm && skip.min_mm <= all.min_mm
+                                      : skip.min_mm == all.min_mm && skip.at == all.at) &&
+      every.min_clearance_mm == some.min_clearance_mm && every.min_index == some.min_index &&
+      every.colliding == some.colliding && every.first_colliding == some.first_colliding;
   std::printf("\nsame answers: %s\n", same ? "yes" : "NO");
   return same ? 0 : 2;
 }

@@ -224,9 +224,10 @@ double ClearanceChecker::clearance(const geometry::Posture& posture, int* obstac
   return impl_->clearance(posture, obstacle, nullptr);
 }
 
-double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double radius_mm,
-                                       std::size_t* at, int* obstacle, double exact_below_mm,
-                                       std::vector<double>* each, double split_mm) const {
+BallResult ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm,
+                                           const BallRequest& request) const {
+  const double radius_mm = request.radius_mm, exact_below_mm = request.exact_below_mm,
+               split_mm = request.split_mm;
   // A point-sized sphere model: the distance from the centre to the obstacles, less the radius.
   constexpr double kPointRadiusMm = 1e-4;
   auto ball = std::make_shared<Model>();
@@ -273,20 +274,22 @@ double ClearanceChecker::ballClearance(std::span<const Vec3> centres_mm, double 
       measured = i;
     }
   });
+  BallResult result;
   double best = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < distance.size(); ++i) {
     if (distance[i] < best) {
       best = distance[i];
-      if (at) *at = i;
-      if (obstacle) *obstacle = nearest[i];
+      result.at = i;
+      result.obstacle = nearest[i];
     }
   }
-  if (each) {
-    each->resize(distance.size());
+  if (request.each) {
+    result.each_mm.resize(distance.size());
     for (size_t i = 0; i < distance.size(); ++i)
-      (*each)[i] = std::max(0.0, distance[i] - radius_mm - impl_->read_margin_mm);
+      result.each_mm[i] = std::max(0.0, distance[i] - radius_mm - impl_->read_margin_mm);
   }
-  return std::max(0.0, best - radius_mm - impl_->read_margin_mm);
+  result.min_mm = std::max(0.0, best - radius_mm - impl_->read_margin_mm);
+  return result;
 }
 
 ClearanceResult ClearanceChecker::check(std::span<const geometry::Posture> postures,

@@ -61,21 +61,23 @@ void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>
     common::report(progress, static_cast<double>(k) / passes.size(), "balls");
     std::vector<Vec3> centres;
     for (const PassSample& s : pass.samples) centres.push_back(s.centre_mm);
-    size_t at = 0;
-    int obstacle = -1;
     // Exact under the clearance, and under 1 um at least: a station's 0 is then a touch, never a
     // lower bound.
-    std::vector<double> each;
-    const double d = checker.ballClearance(centres, ball_radius_mm, &at, &obstacle,
-                                           std::max(clearance_mm, 1e-3), &each);
-    if (d <= 0.0) {
+    BallRequest request{ball_radius_mm, std::max(clearance_mm, 1e-3)};
+    request.each = true;
+    const BallResult balls = checker.ballClearance(centres, request);
+    const std::vector<double>& each = balls.each_mm;
+    size_t at = balls.at;
+    int obstacle = balls.obstacle;
+    if (balls.min_mm <= 0.0) {
       // Named where the ball first enters, not where it is deepest (a pass entering a wall at
       // line 37 was named at its line 42): the first station at 0, its obstacle asked again.
       const std::size_t first = static_cast<std::size_t>(
           std::find_if(each.begin(), each.end(), [](double e) { return e <= 0.0; }) - each.begin());
       if (first < at) {
         at = first;
-        checker.ballClearance(std::span(&centres[at], 1), ball_radius_mm, nullptr, &obstacle);
+        obstacle =
+            checker.ballClearance(std::span(&centres[at], 1), BallRequest{ball_radius_mm}).obstacle;
       }
       std::ostringstream msg;
       const double s_mm = pass.samples[at].s_mm;
@@ -93,8 +95,8 @@ void checkBallClearance(const ClearanceChecker& checker, const std::vector<Pass>
         msg << ", or the impeller's passes_v nearer the channel's middle, 0.5)";
       throw InputError(msg.str());
     }
-    if (d < clearance_mm)
-      under.push_back({pass.index, pass.label, pass.samples[at].s_mm, d, obstacle});
+    if (balls.min_mm < clearance_mm)
+      under.push_back({pass.index, pass.label, pass.samples[at].s_mm, balls.min_mm, obstacle});
   }
 }
 

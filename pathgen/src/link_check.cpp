@@ -238,10 +238,12 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
         for (std::size_t i = block.begin; i < block.end; ++i)
           centres.push_back(geometry::ballCentre(path.postures[i], tool.radius_mm));
     std::vector<double> each;
-    if (!centres.empty())
-      out.ball_part_mm =
-          whole.ballClearance(centres, tool.radius_mm, nullptr, nullptr,
-                              std::max(kReachesPartMm, ball_exact_below_mm), &each, far_mm);
+    if (!centres.empty()) {
+      BallResult balls = whole.ballClearance(
+          centres, {tool.radius_mm, std::max(kReachesPartMm, ball_exact_below_mm), far_mm, true});
+      out.ball_part_mm = balls.min_mm;
+      each = std::move(balls.each_mm);
+    }
     out.far.pass_postures = each.size();
     std::size_t k = 0, pass = 0;
     for (const geometry::PathBlock& block : path.blocks) {

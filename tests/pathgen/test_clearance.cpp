@@ -209,11 +209,10 @@ TEST(Clearance, BallClearanceIsCentreDistanceLessTheRadius) {
   const std::vector<TriangleMesh> obstacles = {wall(5.0), wall(-20.0)};
   const pathgen::ClearanceChecker checker(tool, obstacles);
   const std::vector<Vec3> centres = {Vec3(0, 0, 0), Vec3(2.5, 3, -4), Vec3(-10, 0, 0)};
-  std::size_t at = 99;
-  int obstacle = -1;
-  EXPECT_NEAR(checker.ballClearance(centres, 1.0, &at, &obstacle), 1.5, 1e-3);
-  EXPECT_EQ(at, 1u);
-  EXPECT_EQ(obstacle, 0);
+  const pathgen::BallResult balls = checker.ballClearance(centres, pathgen::BallRequest{1.0});
+  EXPECT_NEAR(balls.min_mm, 1.5, 1e-3);
+  EXPECT_EQ(balls.at, 1u);
+  EXPECT_EQ(balls.obstacle, 0);
   const std::vector<Vec3> touching = {Vec3(4.5, 0, 0)};
   EXPECT_EQ(checker.ballClearance(touching, 1.0), 0.0);
 }
@@ -236,18 +235,17 @@ TEST(Clearance, BallClearanceSkipsStationsThatCannotComeUnderTheThreshold) {
         const double t = double(k) / stations;
         centres.emplace_back(offset - 7.0 + (nearest_x + 7.0) * std::sin(M_PI * t), 60.0 * t, 1.0);
       }
-      std::size_t at_all = 0, at = 0;
-      int obstacle_all = -1, obstacle = -1;
-      const double all = checker.ballClearance(centres, 1.0, &at_all, &obstacle_all);
+      const pathgen::BallResult all = checker.ballClearance(centres, pathgen::BallRequest{1.0});
       for (const double threshold : {0.5, 2.0}) {
-        const double skipped = checker.ballClearance(centres, 1.0, &at, &obstacle, threshold);
-        if (all < threshold) {
-          EXPECT_EQ(skipped, all) << nearest_x << ' ' << threshold;
-          EXPECT_EQ(at, at_all);
-          EXPECT_EQ(obstacle, obstacle_all);
+        const pathgen::BallResult skipped =
+            checker.ballClearance(centres, pathgen::BallRequest{1.0, threshold});
+        if (all.min_mm < threshold) {
+          EXPECT_EQ(skipped.min_mm, all.min_mm) << nearest_x << ' ' << threshold;
+          EXPECT_EQ(skipped.at, all.at);
+          EXPECT_EQ(skipped.obstacle, all.obstacle);
         } else {
-          EXPECT_GE(skipped, threshold) << nearest_x << ' ' << threshold;
-          EXPECT_LE(skipped, all + 1e-12) << nearest_x << ' ' << threshold;
+          EXPECT_GE(skipped.min_mm, threshold) << nearest_x << ' ' << threshold;
+          EXPECT_LE(skipped.min_mm, all.min_mm + 1e-12) << nearest_x << ' ' << threshold;
         }
       }
     }
@@ -267,11 +265,11 @@ TEST(Clearance, BallClearanceSplitTellsEachStationNearerOrFartherExactly) {
       const double t = k / 6000.0;
       centres.emplace_back(-7.0 + (nearest_x + 7.0) * std::sin(M_PI * t), 60.0 * t, 1.0);
     }
-    std::vector<double> each;
-    std::size_t at = 0;
     const double split_mm = 6.0, exact_mm = 0.05;
-    const double least =
-        checker.ballClearance(centres, 1.0, &at, nullptr, exact_mm, &each, split_mm);
+    const pathgen::BallResult balls =
+        checker.ballClearance(centres, pathgen::BallRequest{1.0, exact_mm, split_mm, true});
+    const std::vector<double>& each = balls.each_mm;
+    const double least = balls.min_mm;
     ASSERT_EQ(each.size(), centres.size());
     for (std::size_t i = 0; i < centres.size(); ++i) {
       const double exact = 4.0 - centres[i].x();  // the nearer wall, x = 5
@@ -429,9 +427,9 @@ TEST(Clearance, AQueryAfterItsNeighbourGivesALoneQuerysValues) {
   EXPECT_GT(touching, 10u);  // (the sweep meets the box, and each obstacle is the nearest)
   EXPECT_LT(touching, postures.size() / 2);
   for (const std::size_t n : by_obstacle) EXPECT_GE(n, 10u);
-  std::vector<double> each;
-  checker.ballClearance(centres, 3.0, nullptr, nullptr, std::numeric_limits<double>::infinity(),
-                        &each);
+  pathgen::BallRequest every{3.0};
+  every.each = true;
+  const std::vector<double> each = checker.ballClearance(centres, every).each_mm;
   for (std::size_t i = 0; i < centres.size(); ++i)
     EXPECT_EQ(each[i], checker.ballClearance(std::span<const Vec3>(&centres[i], 1), 3.0)) << i;
 }

@@ -123,6 +123,34 @@ struct ObstacleModel;
 std::shared_ptr<const ObstacleModel> prepareObstacle(const geometry::TriangleMesh& mesh,
                                                      const std::string& what);
 
+/// What ClearanceChecker::ballClearance is asked.
+struct BallRequest {
+  double radius_mm = 0.0;
+  /// Finite: only a smallest clearance under it is exact (and its `at`): a centre within
+  /// d - exact_below - R of one measured d from the obstacles is not measured (the distance to a
+  /// surface changes no faster than the point moves, and the point stays on the same side of it),
+  /// so a dense path far from the walls costs a few queries, not one a station (97k stations took
+  /// 17 s); a result of exact_below_mm or more is a lower bound.
+  double exact_below_mm = std::numeric_limits<double>::infinity();
+  /// Finite (over exact_below_mm): each centre told exactly nearer or farther than it, its value
+  /// a lower bound between the two (a centre proven nearer by its walk, d + |c - c_measured| - R
+  /// under split_mm, is not measured: a path hovering 1.5 mm over a part, told against 6 mm,
+  /// checked as fast as one on it). With exact_below_mm = -radius_mm and split_mm = 0 a centre is
+  /// told only touching (0) or clear (> 0), each measured one telling its neighbours within
+  /// min(d, R - d) and beyond d - R (check's stock beside obstacles).
+  double split_mm = std::numeric_limits<double>::quiet_NaN();
+  bool each = false;  ///< fill BallResult::each_mm
+};
+struct BallResult {
+  static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
+  double min_mm = std::numeric_limits<double>::infinity();  ///< the least clearance (none: inf)
+  std::size_t at = npos;                                    ///< its centre (first of equals)
+  int obstacle = -1;                                        ///< its obstacle (0-based)
+  /// With BallRequest::each: every centre's clearance, exact under exact_below_mm (a lower bound
+  /// at or above it).
+  std::vector<double> each_mm;
+};
+
 /// Tool + holder mesh (tool frame: tip at the origin, axis +z) against fixed obstacle meshes.
 /// Copies share the built hierarchies; queries are const and thread-safe.
 class ClearanceChecker {
@@ -153,27 +181,15 @@ class ClearanceChecker {
                             const MotionRequest& request = {},
                             const common::Progress& progress = {}) const;
 
-  /// Smallest distance (mm) from a ball of `radius_mm` at each centre (world frame) to the
-  /// obstacles, 0 if one touches; `at` and `obstacle` receive where. The ball of a ball-end mill
-  /// must clear the obstacles whatever the axis: exact (centre-to-mesh distance less the radius).
-  /// With `exact_below_mm` finite, only a smallest clearance under it is exact (and its `at`):
-  /// a centre within d - exact_below - R of one measured d from the obstacles is not measured
-  /// (the distance to a surface changes no faster than the point moves, and the point stays on
-  /// the same side of it), so a dense path far from the walls costs a few queries, not one a
-  /// station (97k stations took 17 s); a result of exact_below_mm or more is a lower bound.
-  /// `each` (optional) receives every centre's clearance, exact under exact_below_mm (a lower
-  /// bound at or above it). With `split_mm` finite (over exact_below_mm) each centre is told
-  /// exactly nearer or farther than split_mm, its value a lower bound between the two (a centre
-  /// proven nearer by its walk, d + |c - c_measured| - R under split_mm, is not measured: a path
-  /// hovering 1.5 mm over a part, told against 6 mm, checked as fast as one on it). With
-  /// exact_below_mm = -radius_mm and split_mm = 0 a centre is told only touching (0) or clear
-  /// (> 0), each measured one telling its neighbours within min(d, R - d) and beyond d - R
-  /// (check's stock beside obstacles).
-  double ballClearance(std::span<const Vec3> centres_mm, double radius_mm,
-                       std::size_t* at = nullptr, int* obstacle = nullptr,
-                       double exact_below_mm = std::numeric_limits<double>::infinity(),
-                       std::vector<double>* each = nullptr,
-                       double split_mm = std::numeric_limits<double>::quiet_NaN()) const;
+  /// Smallest distance (mm) from balls of `request.radius_mm` at `centres_mm` (world frame) to
+  /// the obstacles, 0 if one touches, where and from which obstacle (BallRequest: how exact).
+  /// The ball of a ball-end mill must clear the obstacles whatever the axis: exact (centre-to-mesh
+  /// distance less the radius).
+  BallResult ballClearance(std::span<const Vec3> centres_mm, const BallRequest& request) const;
+  /// The smallest alone, exact.
+  double ballClearance(std::span<const Vec3> centres_mm, double radius_mm) const {
+    return ballClearance(centres_mm, BallRequest{radius_mm}).min_mm;
+  }
 
  private:
   struct Impl;
