@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <numbers>
@@ -120,6 +121,98 @@ double defaultNodeSpacingMm(const geometry::ToolSpec& tool, const geometry::Hold
   area += std::numbers::pi * prev_r * prev_r;  // top face
   return std::sqrt(area / kTargetNodes);
 }
+
+namespace {
+
+/// A job's field and what it is made of (the voxels answer within the reach box, the exact sum
+/// beyond it).
+struct PathField {
+  std::unique_ptr<field::DirectField> direct;
+  std::shared_ptr<field::VoxelField> voxels;
+  std::unique_ptr<field::BruteForceField> brute;
+  std::unique_ptr<field::RegionField> voxels_in_reach;
+  std::shared_ptr<const field::CellMask> refine_mask;  ///< refinement near the path
+  const field::ForceField* force = nullptr;            ///< the one the passes are steered by
+};
+using NearPathMask = std::function<std::shared_ptr<const field::CellMask>(
+    const field::DirectField& exact, const field::VoxelRequest& refined,
+    const Eigen::AlignedBox3d& valid, std::optional<field::VoxelField>& level0)>;
+/// The field the passes are steered by (request.mode: the exact sum, the brute force, or the
+/// voxels), from the obstacles' samples (their open sheets turned to face the passes first);
+/// none for a nominal job. `near_path`: the mask of the cells the path's nodes pass through, for
+/// a refinement near the path (it steers the passes on the uniform grid it leaves in `level0`).
+/// Fills the result's reach box, turned sheets, samples and voxel figures.
+PathField buildPathField(const GenerateRequest& request, const std::vector<Vec3>& nodes,
+                         const NearPathMask& near_path, GenerateResult& result) {
+  PathField f;
+  const std::vector<geometry::TriangleMesh>& obstacles = request.obstacles;
+  const double h = request.field.voxel.voxel_size_mm;
+  result.reach_box_mm = reachBox(result.passes, nodes, request.tool.radius_mm, request.dynamics,
+                                 request.path.lead_deg * kDegToRad,
+                                 request.mode == FieldMode::Voxel ? voxelRegionPadMm(h) : 0.0);
+  if (!request.nominal) {
+    // Open sheets turned to face the passes before they are sampled (their normals are the
+    // field's direction): points along the nominal axis of every 4th station vote. The meshes
+    // are copied only when a sheet is turned.
+    std::vector<Vec3> points;
+    {
+      double reach_mm = request.tool.length_mm;
+      for (const auto& station : request.holder) reach_mm = std::max(reach_mm, station.z_mm);
+      for (const Pass& pass : result.passes)
+        for (std::size_t i = 0; i < pass.samples.size(); i += 4)
+          for (double t = 0.0; t <= reach_mm; t += std::max(request.tool.radius_mm, 1.0))
+            points.push_back(pass.samples[i].centre_mm + t * pass.samples[i].normal);
+    }
+    const std::vector<OpenSheet> away =
+        sheetsFacingAway(obstacles, points, request.field.r0_mm + request.tool.radius_mm);
+    result.turned_sheets = away.size();
+    std::vector<geometry::TriangleMesh> faced;
+    if (!away.empty()) {
+      faced = obstacles;
+      turnSheets(faced, away);
+    }
+    field::ObstacleSamples samples = field::sampleObstacles(
+        away.empty() ? obstacles : faced, request.field.sample_step_mm, request.field.weights);
+    result.obstacle_points = samples.size();
+    f.direct = std::make_unique<field::DirectField>(std::move(samples), request.field);
+    f.force = f.direct.get();
+    if (request.mode == FieldMode::BruteForce) {
+      f.brute = std::make_unique<field::BruteForceField>(f.direct->samples(), request.field);
+      f.force = f.brute.get();
+    }
+    if (request.mode == FieldMode::Voxel) {
+      field::VoxelRequest voxel_request(request.field.voxel);
+      voxel_request.region_mm = result.reach_box_mm;
+      // The voxels hold values where every node of a point's stencil lies in the box (2 h in
+      // from its faces); beyond, the exact sum answers (a voxel field is zero where it has no
+      // nodes: a point the box missed would feel no wall).
+      const Eigen::AlignedBox3d valid = field::RegionField::stencilBox(result.reach_box_mm, h);
+      double built_share = kBallShare;
+      std::optional<field::VoxelField> level0;
+      if (voxel_request.refine_tolerance > 0.0 && voxel_request.refine_levels > 0 &&
+          voxel_request.refine_region == field::RefineRegion::Path) {
+        const auto near_start = Clock::now();
+        f.refine_mask = near_path(*f.direct, voxel_request, valid, level0);
+        result.times.near_path_s = seconds(near_start);
+        voxel_request.refine_mask = f.refine_mask;
+        built_share = 0.05;
+      }
+      voxel_request.progress = scaled(request.progress, built_share, 0.3, "field");
+      f.voxels = f.refine_mask ? std::make_shared<field::VoxelField>(*f.direct, voxel_request,
+                                                                     std::move(*level0))
+                               : std::make_shared<field::VoxelField>(*f.direct, voxel_request);
+      level0.reset();
+      result.voxel_nodes = f.voxels->stats().active_nodes;
+      result.voxel_memory_bytes = f.voxels->stats().memory_bytes;
+      f.voxels_in_reach = std::make_unique<field::RegionField>(*f.voxels, *f.direct, valid,
+                                                               voxel_request.refine_mask);
+      f.force = f.voxels_in_reach.get();
+    }
+  }
+  return f;
+}
+
+}  // namespace
 
 GenerateResult generatePath(const GenerateRequest& request) {
   const auto start = Clock::now();
@@ -397,74 +490,8 @@ GenerateResult generatePath(const GenerateRequest& request) {
 
   // ---- field -----------------------------------------------------------------------------------
   const auto field_start = Clock::now();
-  std::unique_ptr<field::DirectField> direct;
-  std::shared_ptr<field::VoxelField> voxels;
-  std::unique_ptr<field::BruteForceField> brute;
-  std::unique_ptr<field::RegionField> voxels_in_reach;
-  std::shared_ptr<const field::CellMask> refine_mask;  // refinement near the path
-  const field::ForceField* force = nullptr;
-  const double h = request.field.voxel.voxel_size_mm;
-  result.reach_box_mm = reachBox(result.passes, nodes, r, request.dynamics, lead_rad,
-                                 request.mode == FieldMode::Voxel ? voxelRegionPadMm(h) : 0.0);
-  if (!request.nominal) {
-    // Open sheets turned to face the passes before they are sampled (their normals are the
-    // field's direction): points along the nominal axis of every 4th station vote. The meshes
-    // are copied only when a sheet is turned.
-    std::vector<Vec3> points;
-    {
-      double reach_mm = tool.length_mm;
-      for (const auto& station : request.holder) reach_mm = std::max(reach_mm, station.z_mm);
-      for (const Pass& pass : result.passes)
-        for (std::size_t i = 0; i < pass.samples.size(); i += 4)
-          for (double t = 0.0; t <= reach_mm; t += std::max(r, 1.0))
-            points.push_back(pass.samples[i].centre_mm + t * pass.samples[i].normal);
-    }
-    const std::vector<OpenSheet> away = sheetsFacingAway(obstacles, points, request.field.r0_mm + r);
-    result.turned_sheets = away.size();
-    std::vector<geometry::TriangleMesh> faced;
-    if (!away.empty()) {
-      faced = obstacles;
-      turnSheets(faced, away);
-    }
-    field::ObstacleSamples samples =
-        field::sampleObstacles(away.empty() ? obstacles : faced, request.field.sample_step_mm,
-                               request.field.weights);
-    result.obstacle_points = samples.size();
-    direct = std::make_unique<field::DirectField>(std::move(samples), request.field);
-    force = direct.get();
-    if (request.mode == FieldMode::BruteForce) {
-      brute = std::make_unique<field::BruteForceField>(direct->samples(), request.field);
-      force = brute.get();
-    }
-    if (request.mode == FieldMode::Voxel) {
-      field::VoxelRequest voxel_request(request.field.voxel);
-      voxel_request.region_mm = result.reach_box_mm;
-      // The voxels hold values where every node of a point's stencil lies in the box (2 h in
-      // from its faces); beyond, the exact sum answers (a voxel field is zero where it has no
-      // nodes: a point the box missed would feel no wall).
-      const Eigen::AlignedBox3d valid = field::RegionField::stencilBox(result.reach_box_mm, h);
-      double built_share = kBallShare;
-      std::optional<field::VoxelField> level0;
-      if (voxel_request.refine_tolerance > 0.0 && voxel_request.refine_levels > 0 &&
-          voxel_request.refine_region == field::RefineRegion::Path) {
-        const auto near_start = Clock::now();
-        refine_mask = nodesNearPath(*direct, voxel_request, valid, level0);
-        result.times.near_path_s = seconds(near_start);
-        voxel_request.refine_mask = refine_mask;
-        built_share = 0.05;
-      }
-      voxel_request.progress = scaled(request.progress, built_share, 0.3, "field");
-      voxels = refine_mask
-                   ? std::make_shared<field::VoxelField>(*direct, voxel_request, std::move(*level0))
-                   : std::make_shared<field::VoxelField>(*direct, voxel_request);
-      level0.reset();
-      result.voxel_nodes = voxels->stats().active_nodes;
-      result.voxel_memory_bytes = voxels->stats().memory_bytes;
-      voxels_in_reach =
-          std::make_unique<field::RegionField>(*voxels, *direct, valid, voxel_request.refine_mask);
-      force = voxels_in_reach.get();
-    }
-  }
+  PathField path_field = buildPathField(request, nodes, nodesNearPath, result);
+  const field::ForceField* force = path_field.force;
   result.times.field_s = seconds(field_start);
 
   // The cutter's test against the part runs last: its stamps are asked for now, so that a run
@@ -510,7 +537,8 @@ GenerateResult generatePath(const GenerateRequest& request) {
     result.convergence_failures += st.convergence_failures;
   }
   result.times.steering_s = seconds(steer_start);
-  if (voxels_in_reach) result.voxel_outside_points = voxels_in_reach->outsidePoints();
+  if (path_field.voxels_in_reach)
+    result.voxel_outside_points = path_field.voxels_in_reach->outsidePoints();
 
   // ---- links, then the exact clearance of every posture and motion ----------------------------
   const auto clearance_start = Clock::now();
@@ -525,8 +553,8 @@ GenerateResult generatePath(const GenerateRequest& request) {
   result.times.clearance_s = seconds(clearance_start);
   result.times.total_s = seconds(start);
   if (request.keep_voxels) {
-    result.voxels = std::move(voxels);
-    if (result.voxels) result.refine_mask = refine_mask;
+    result.voxels = std::move(path_field.voxels);
+    if (result.voxels) result.refine_mask = path_field.refine_mask;
   }
   return result;
 }
