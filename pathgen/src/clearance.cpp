@@ -338,7 +338,9 @@ ClearanceResult ClearanceChecker::check(std::span<const geometry::Posture> postu
     for (size_t i = 0; i < postures.size(); ++i)
       if (const auto hit = memo->postures.find(ClearanceMemo::Impl::key(postures[i]));
           hit != memo->postures.end()) {
-        std::tie(distance[i], nearest[i]) = hit->second;
+        distance[i] = hit->second.distance_mm;
+        nearest[i] = hit->second.obstacle;
+        hit->second.used = memo->generation;
         known[i] = 1;
         ++memo->reused;
       }
@@ -369,8 +371,9 @@ ClearanceResult ClearanceChecker::check(std::span<const geometry::Posture> postu
   if (memo)
     for (size_t i = 0; i < postures.size(); ++i)
       if (!known[i])
-        memo->postures.emplace(ClearanceMemo::Impl::key(postures[i]),
-                               std::pair(distance[i], nearest[i]));
+        memo->postures.emplace(
+            ClearanceMemo::Impl::key(postures[i]),
+            ClearanceMemo::Impl::Posture{distance[i], nearest[i], memo->generation});
   for (size_t i = 0; i < postures.size(); ++i) {
     if (distance[i] <= 0.0) {
       ++result.colliding;
@@ -519,6 +522,7 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
         bound[i] = hit->second.bound_mm;
         touched[i] = hit->second.touched;
         samples[i] = hit->second.samples;
+        hit->second.used = memo->generation;
         known[i] = 1;
         ++memo->reused;
       }
@@ -535,7 +539,7 @@ MotionResult ClearanceChecker::checkMotions(std::span<const geometry::Posture> p
       if (!known[i])
         memo->motions.emplace(
             ClearanceMemo::Impl::key(postures[i], postures[i + 1], ends[i], ends[i + 1], asked),
-            ClearanceMemo::Impl::Motion{bound[i], touched[i] != 0, samples[i]});
+            ClearanceMemo::Impl::Motion{bound[i], touched[i] != 0, samples[i], memo->generation});
   for (size_t i = 0; i < result.motions; ++i) {
     result.samples += samples[i];
     if (touched[i] || bound[i] <= 0.0) {

@@ -39,14 +39,21 @@ struct ClearanceMemo::Impl {
   /// Two postures, their clearances (given, or measured) and the six numbers of the request:
   /// all that a motion's bound depends on.
   using MotionKey = std::array<std::uint64_t, 20>;
+  struct Posture {
+    double distance_mm;
+    int obstacle;
+    std::uint32_t used;  ///< the generation that last put or gave it back
+  };
   struct Motion {
     double bound_mm;
     bool touched;
     std::size_t samples;
+    std::uint32_t used;
   };
-  std::unordered_map<PostureKey, std::pair<double, int>, memo_detail::BitsHash<6>> postures;
+  std::unordered_map<PostureKey, Posture, memo_detail::BitsHash<6>> postures;
   std::unordered_map<MotionKey, Motion, memo_detail::BitsHash<20>> motions;
   std::size_t reused = 0;
+  std::uint32_t generation = 0;  ///< forgetUnused's count
 
   static PostureKey key(const geometry::Posture& p) {
     PostureKey k;

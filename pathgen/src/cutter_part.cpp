@@ -8,7 +8,8 @@
 #include <cmath>
 #include <memory>
 #include <optional>
-#include <unordered_set>
+#include <span>
+#include <unordered_map>
 
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/geometry/shape/cylinder.h>
@@ -309,41 +310,61 @@ void forEachOwner(const std::vector<Stamp>& stamps, Visit&& visit) {
 struct CutterMemo::Impl {
   using PostureKey = std::array<std::uint64_t, 6>;
   using MotionKey = std::array<std::uint64_t, 12>;
+  /// The tool's shape, R, r and L, and the tolerance.
   using Context = std::array<std::uint64_t, 5>;
-  std::optional<Context> context;  ///< the tool's shape, R, r and L, and the tolerance
-  std::unordered_set<PostureKey, memo_detail::BitsHash<6>> clear_postures;
-  std::unordered_set<MotionKey, memo_detail::BitsHash<12>> clear_motions;
+  std::optional<Context> context;
+  std::shared_ptr<const ObstacleModel> part;  ///< held: another model at its address is another
+  /// The owners clear at every stamp, each with the generation that last put or gave it back.
+  std::unordered_map<PostureKey, std::uint32_t, memo_detail::BitsHash<6>> clear_postures;
+  std::unordered_map<MotionKey, std::uint32_t, memo_detail::BitsHash<12>> clear_motions;
   std::size_t reused = 0;
+  std::uint32_t generation = 0;
 
-  /// Emptied where the tool or the tolerance is not the one it was filled for.
-  void useFor(const geometry::ToolSpec& tool, double tolerance_mm) {
+  /// Emptied where the part, the tool or the tolerance is not the one it was filled for.
+  void useFor(const std::shared_ptr<const ObstacleModel>& model, const geometry::ToolSpec& tool,
+              double tolerance_mm) {
     const Context now{
         static_cast<std::uint64_t>(tool.shape), std::bit_cast<std::uint64_t>(tool.radius_mm),
         std::bit_cast<std::uint64_t>(tool.corner_radius_mm),
         std::bit_cast<std::uint64_t>(tool.length_mm), std::bit_cast<std::uint64_t>(tolerance_mm)};
-    if (context == now) return;
+    if (context == now && part == model) return;
     clear_postures.clear();
     clear_motions.clear();
     context = now;
+    part = model;
   }
   /// Whether the posture or the motion (from posture `index` on) that `stamp` belongs to is held
-  /// clear; with `put`, it is put in instead.
+  /// clear (and marked used); with `put`, it is put in instead.
   bool clear(std::span<const Posture> postures, const Stamp& stamp, bool put) {
+    const auto ask = [&](auto& owners, const auto& key) {
+      if (put) return owners.insert_or_assign(key, generation).second;
+      const auto hit = owners.find(key);
+      if (hit == owners.end()) return false;
+      hit->second = generation;
+      return true;
+    };
     if (stamp.on_motion) {
       MotionKey key;
       memo_detail::putBits(key.data(), postures[stamp.index]);
       memo_detail::putBits(key.data() + 6, postures[stamp.index + 1]);
-      return put ? clear_motions.insert(key).second : clear_motions.contains(key);
+      return ask(clear_motions, key);
     }
     PostureKey key;
     memo_detail::putBits(key.data(), postures[stamp.index]);
-    return put ? clear_postures.insert(key).second : clear_postures.contains(key);
+    return ask(clear_postures, key);
   }
 };
 
 CutterMemo::CutterMemo() : impl_(std::make_unique<Impl>()) {}
 CutterMemo::~CutterMemo() = default;
 std::size_t CutterMemo::reused() const { return impl_->reused; }
+
+void CutterMemo::forgetUnused() {
+  const std::uint32_t now = impl_->generation;
+  std::erase_if(impl_->clear_postures, [now](const auto& entry) { return entry.second != now; });
+  std::erase_if(impl_->clear_motions, [now](const auto& entry) { return entry.second != now; });
+  ++impl_->generation;
+}
 
 void requireCutterTestMemory(const geometry::ToolSpec& tool, const Eigen::AlignedBox3d& part_box,
                              std::span<const std::vector<Posture>> passes, double tolerance_mm) {
@@ -397,7 +418,7 @@ CutterPartResult checkCutterAgainstPart(const geometry::ToolSpec& tool,
   CutterMemo::Impl* const kept = memo ? &memo->impl() : nullptr;
   std::vector<char> known(kept ? stamps.size() : 0, 0);
   if (kept) {
-    kept->useFor(tool, tolerance_mm);
+    kept->useFor(part_model, tool, tolerance_mm);
     forEachOwner(stamps, [&](std::size_t begin, std::size_t end) {
       if (!kept->clear(postures, stamps[begin], false)) return;
       std::fill(known.begin() + begin, known.begin() + end, 1);

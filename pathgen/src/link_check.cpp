@@ -220,6 +220,7 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
                               const common::Progress& progress, double ball_exact_below_mm,
                               PartMemo* memo) {
   PartContacts out;  // its progress from 0.2 (0 to 0.2: the model's preparation, above)
+  if (memo) memo->useFor(model, tool, holder, gouge_tolerance_mm);
   common::report(progress, 0.2, "links vs part");
   const double tol_mm = clearanceMeshTolMm(tool, holder);
   const ClearanceChecker whole(geometry::toolMesh(tool, holder, tol_mm), std::span(&model, 1),
@@ -269,6 +270,33 @@ PartContacts checkAgainstPart(const geometry::ToolSpec& tool, const geometry::Ho
                                         common::scaled(progress, 0.6, 1.0, "cutter vs part"),
                                         memo ? &memo->cutter : nullptr);
   return out;
+}
+
+void PartMemo::forgetUnused() {
+  links.forgetUnused();
+  grazing.forgetUnused();
+  holder.forgetUnused();
+  cutter.forgetUnused();
+}
+
+void PartMemo::useFor(const std::shared_ptr<const ObstacleModel>& part,
+                      const geometry::ToolSpec& tool, const geometry::HolderProfile& profile,
+                      double tolerance_mm) {
+  const auto same_station = [](const geometry::HolderStation& a, const geometry::HolderStation& b) {
+    return a.z_mm == b.z_mm && a.radius_mm == b.radius_mm;
+  };
+  if (part == part_ && tool.shape == tool_.shape && tool.radius_mm == tool_.radius_mm &&
+      tool.corner_radius_mm == tool_.corner_radius_mm && tool.length_mm == tool_.length_mm &&
+      std::equal(profile.begin(), profile.end(), holder_.begin(), holder_.end(), same_station) &&
+      tolerance_mm == tolerance_mm_)
+    return;
+  links.clear();
+  grazing.clear();
+  holder.clear();  // (the cutter's memo checks its own: part, tool and tolerance)
+  part_ = part;
+  tool_ = tool;
+  holder_ = profile;
+  tolerance_mm_ = tolerance_mm;
 }
 
 PartContacts::Marks PartContacts::marks(std::size_t n) const {

@@ -62,6 +62,9 @@ void linkCheckAndRepair(const GenerateRequest& request, const ClearanceChecker& 
     }
     for (const GeneratedPosture& g : result.postures)
       if (g.limited) result.path.limited.push_back(g.output);
+    // (each memo keeps what this check uses: at most two checks' worth)
+    checked.forgetUnused();
+    part_checked.forgetUnused();
     ClearanceRequest postures;
     postures.memo = &checked;
     result.clearance =

@@ -250,13 +250,40 @@ TEST(CutterPart, AFlatEndIsNotTested) {
             0u);
 }
 
+/// Every result of two part checks alike, bit for bit (a memo's and a fresh check's).
+void expectSameContacts(const PartContacts& kept, const PartContacts& fresh) {
+  ASSERT_TRUE(kept.cutter && fresh.cutter && kept.links && fresh.links && kept.holder &&
+              fresh.holder);
+  const CutterPartResult &a = *kept.cutter, &b = *fresh.cutter;
+  EXPECT_EQ(a.stamps, b.stamps);
+  EXPECT_EQ(a.posture_contacts, b.posture_contacts);
+  EXPECT_EQ(a.motion_contacts, b.motion_contacts);
+  EXPECT_EQ(a.max_depth_mm, b.max_depth_mm);
+  EXPECT_EQ(a.deepest, b.deepest);
+  EXPECT_EQ(a.deepest_on_motion, b.deepest_on_motion);
+  for (const auto* r : {&kept.links, &kept.holder}) {
+    const LinkPartResult& x = **r;
+    const LinkPartResult& y = r == &kept.links ? *fresh.links : *fresh.holder;
+    EXPECT_EQ(x.postures, y.postures);
+    EXPECT_EQ(x.motions, y.motions);
+    EXPECT_EQ(x.colliding_postures, y.colliding_postures);
+    EXPECT_EQ(x.colliding_motions, y.colliding_motions);
+    EXPECT_EQ(x.min_clearance_mm, y.min_clearance_mm);
+    EXPECT_EQ(x.posture_contacts, y.posture_contacts);
+    EXPECT_EQ(x.motion_contacts, y.motion_contacts);
+  }
+  EXPECT_EQ(kept.ball_part_mm, fresh.ball_part_mm);
+}
+
 // generate checks its path against the part again after each repair, with a memo of what it
-// found (PartMemo): the results must be those of a check without it, bit for bit, and the
-// cutter's postures and motions given back exactly those unchanged and clear. A plate with a
-// fin, two passes and a link over the fin; the first pass dips 0.05 mm into the plate at three
-// postures (gouges kept out of the memo); the repair tilts five postures of the second pass by
-// 20 deg, which drives its ball 0.18 mm into the plate (a key blind to the axis gives them back
-// clear).
+// found (PartMemo, forgetting before each check what the check before did not use): the results
+// must be those of a check without it, bit for bit, and the cutter's postures and motions given
+// back exactly those unchanged and clear. A plate with a fin, two passes and a link over the
+// fin; the first pass dips 0.05 mm into the plate at three postures (gouges kept out of the
+// memo); the repair tilts five postures of the second pass by 20 deg, which drives its ball
+// 0.18 mm into the plate (a key blind to the axis gives them back clear). The path before the
+// repair checked again gives back the same count: its upright five, unused by the check between,
+// were forgotten. Another tolerance, or another part, is not given back at all.
 TEST(CutterPart, AMemoGivesBackTheChecksOfWhatDidNotChange) {
   geometry::TriangleMesh part;
   pathgen::test::addBox(part, -10, 60, -10, 10, -5, 0);
@@ -278,42 +305,49 @@ TEST(CutterPart, AMemoGivesBackTheChecksOfWhatDidNotChange) {
   for (std::size_t i = 40; i < 45; ++i)
     after.postures[i].axis = {std::sin(tilt), 0, std::cos(tilt)};
 
-  const auto check = [&](const geometry::PathFile& path, PartMemo* memo) {
-    return checkAgainstPart(ball(), holder, model, path, kGougeToleranceMm, {}, kReachesPartMm,
-                            memo);
+  const auto check = [&](const geometry::PathFile& path, PartMemo* memo,
+                         double tolerance_mm = kGougeToleranceMm,
+                         const std::shared_ptr<const ObstacleModel>& against = nullptr) {
+    if (memo) memo->forgetUnused();
+    return checkAgainstPart(ball(), holder, against ? against : model, path, tolerance_mm, {},
+                            kReachesPartMm, memo);
   };
   PartMemo memo;
   check(before, &memo);
   ASSERT_EQ(memo.reused(), 0u);
   const PartContacts kept = check(after, &memo);
   const PartContacts fresh = check(after, nullptr);
-  ASSERT_TRUE(kept.cutter && fresh.cutter && kept.links && fresh.links && kept.holder &&
-              fresh.holder);
-  const CutterPartResult &a = *kept.cutter, &b = *fresh.cutter;
-  EXPECT_EQ(a.stamps, b.stamps);
-  EXPECT_EQ(a.posture_contacts, b.posture_contacts);
-  EXPECT_EQ(a.motion_contacts, b.motion_contacts);
-  EXPECT_EQ(a.max_depth_mm, b.max_depth_mm);
-  EXPECT_EQ(a.deepest, b.deepest);
-  EXPECT_EQ(a.deepest_on_motion, b.deepest_on_motion);
+  expectSameContacts(kept, fresh);
   // (the tilted postures gouge, the dips too)
+  ASSERT_TRUE(fresh.cutter);
+  const CutterPartResult& b = *fresh.cutter;
   EXPECT_EQ(b.posture_contacts, (std::vector<std::size_t>{10, 11, 12, 40, 41, 42, 43, 44}));
   EXPECT_NEAR(b.max_depth_mm, 3.0 - 3.0 * std::cos(tilt), 2e-4);
-  for (const auto* r : {&kept.links, &kept.holder}) {
-    const LinkPartResult& x = **r;
-    const LinkPartResult& y = r == &kept.links ? *fresh.links : *fresh.holder;
-    EXPECT_EQ(x.postures, y.postures);
-    EXPECT_EQ(x.motions, y.motions);
-    EXPECT_EQ(x.min_clearance_mm, y.min_clearance_mm);
-    EXPECT_EQ(x.posture_contacts, y.posture_contacts);
-    EXPECT_EQ(x.motion_contacts, y.motion_contacts);
-  }
-  EXPECT_EQ(kept.ball_part_mm, fresh.ball_part_mm);
   // Given back: the postures but the five turned and the three gouging, and the motions but the
   // six into, between and out of the turned ones and those gouging.
   std::size_t motions_gouging_unchanged = 0;
   for (const std::size_t i : b.motion_contacts) motions_gouging_unchanged += i < 39 || i > 44;
   const std::size_t n = after.postures.size();
-  EXPECT_EQ(memo.cutter.reused(), (n - 5 - 3) + (n - 1 - 6 - motions_gouging_unchanged));
-  EXPECT_GT(memo.links.reused() + memo.holder.reused(), 0u);
+  const std::size_t unchanged = (n - 5 - 3) + (n - 1 - 6 - motions_gouging_unchanged);
+  EXPECT_EQ(memo.cutter.reused(), unchanged);
+  EXPECT_GT(memo.links.reused(), 0u);    // the link's postures
+  EXPECT_GT(memo.holder.reused(), 0u);   // the holder's motions far from the turned ones
+  EXPECT_GT(memo.grazing.reused(), 0u);  // the moves into and out of the passes
+  // The path before again: its upright five were forgotten (not used by the check of `after`).
+  const PartContacts again = check(before, &memo);
+  expectSameContacts(again, check(before, nullptr));
+  EXPECT_EQ(memo.cutter.reused(), 2 * unchanged);
+  // Another part, then another tolerance: nothing given back, the results a fresh check's.
+  const std::size_t so_far = memo.reused();
+  geometry::TriangleMesh higher;  // the plate 0.02 mm higher
+  pathgen::test::addBox(higher, -10, 60, -10, 10, -5, 0.02);
+  pathgen::test::addBox(higher, 20, 24, -10, 10, 0.02, 4);
+  const std::shared_ptr<const ObstacleModel> other = prepareObstacle(higher, "part");
+  const PartContacts on_other = check(after, &memo, kGougeToleranceMm, other);
+  expectSameContacts(on_other, check(after, nullptr, kGougeToleranceMm, other));
+  EXPECT_EQ(memo.reused(), so_far);
+  ASSERT_TRUE(on_other.cutter);
+  EXPECT_GT(on_other.cutter->posture_contacts.size(), b.posture_contacts.size());
+  expectSameContacts(check(after, &memo, 0.01, other), check(after, nullptr, 0.01, other));
+  EXPECT_EQ(memo.reused(), so_far);
 }

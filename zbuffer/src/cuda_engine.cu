@@ -21,6 +21,7 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cuda_engine.h"
@@ -517,8 +518,7 @@ void Engine::heights(float* out_mm) const {
   FIELDPATH_CUDA_CHECK(cudaGetLastError());
   Impl& mm = const_cast<Impl&>(m);
   mm.timed("download", st, [&] { mm.download(out_mm, bits.ptr, m.lines * 4, st); });
-  FIELDPATH_CUDA_CHECK(cudaFreeAsync(bits.ptr, st));
-  bits.ptr = nullptr;
+  FIELDPATH_CUDA_CHECK(cudaFreeAsync(std::exchange(bits.ptr, nullptr), st));  // (freed once)
   FIELDPATH_CUDA_CHECK(cudaStreamSynchronize(st));
   mm.printTrace();
 }

@@ -19,7 +19,8 @@ using geometry::Vec3;
 /// Exact results kept from one check for the next (a repair checks again the path it changed:
 /// most of its postures and motions are those checked before, bit for bit). A posture's
 /// clearance is its own, whatever the postures around it, and a motion's bound is its two
-/// postures' under one request: the same key, the same result. One check at a time uses it.
+/// postures' under one request: the same key, the same result. One check at a time uses it, and
+/// one checker (its keys do not name the tool or the obstacles).
 class ClearanceMemo {
  public:
   ClearanceMemo();
@@ -28,6 +29,13 @@ class ClearanceMemo {
   ClearanceMemo& operator=(const ClearanceMemo&) = delete;
   /// Postures and motions given back from it so far, not measured again.
   std::size_t reused() const;
+  /// Drops what the checks since the last call did not use: called before each check of a whole
+  /// path, the memo holds at most two checks' postures and motions (a repair job's checks grew it
+  /// by the path's changes each, for nothing: a motion keyed by bounds that a shifted posture
+  /// changed is never asked again).
+  void forgetUnused();
+  /// Drops everything (another checker's results are not these).
+  void clear();
 
  private:
   friend class ClearanceChecker;

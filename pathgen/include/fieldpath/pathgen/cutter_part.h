@@ -55,7 +55,7 @@ struct CutterPartResult {
 /// the cutter's stamps were a fifth of a reversed job's time, most of them tested before). A
 /// posture's stamp is itself and a motion's are set by its two ends: the same bits, the same
 /// stamps, the same verdicts. Those entering the part are tested again (few, and each then
-/// bisected for its depth). Kept for one tool and tolerance: another empties it.
+/// bisected for its depth). Kept for one part, tool and tolerance: another empties it.
 class CutterMemo {
  public:
   CutterMemo();
@@ -64,6 +64,8 @@ class CutterMemo {
   CutterMemo& operator=(const CutterMemo&) = delete;
   /// Postures and motions given back from it so far, their stamps not tested again.
   std::size_t reused() const;
+  /// Drops what the tests since the last call did not use (ClearanceMemo::forgetUnused).
+  void forgetUnused();
   struct Impl;  ///< (cutter_part.cpp)
   Impl& impl() { return *impl_; }
 

@@ -40,13 +40,27 @@ inline constexpr double kPassGrazeMm = 0.1;
 /// What the part's checks (checkAgainstPart) keep from one check of a path for the next: generate
 /// checks its path again after each repair, and most of it was checked before, bit for bit. One
 /// memo a checker: the tool + holder at the links, the grazing moves, the holder; and the cutter.
-struct PartMemo {
+/// Kept for one part, tool, holder and gouge tolerance: checkAgainstPart empties it for another.
+class PartMemo {
+ public:
   ClearanceMemo links, grazing, holder;
   CutterMemo cutter;
   /// Postures and motions given back so far, not measured or tested again.
   std::size_t reused() const {
     return links.reused() + grazing.reused() + holder.reused() + cutter.reused();
   }
+  /// Drops what the checks since the last call did not use (ClearanceMemo::forgetUnused).
+  void forgetUnused();
+  /// Empties the memos where the part, tool, holder or tolerance is not the one they were filled
+  /// for.
+  void useFor(const std::shared_ptr<const ObstacleModel>& part, const geometry::ToolSpec& tool,
+              const geometry::HolderProfile& profile, double tolerance_mm);
+
+ private:
+  std::shared_ptr<const ObstacleModel> part_;  // held: another model at its address is another
+  geometry::ToolSpec tool_;
+  geometry::HolderProfile holder_;
+  double tolerance_mm_ = -1.0;
 };
 
 /// The checker of the moves out of and into passes (checkLinksAgainstPart): tool and holder
