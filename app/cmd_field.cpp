@@ -169,7 +169,8 @@ void build(const FieldOptions& o, const GlobalOptions& global) {
   const field::VoxelRequest request = voxelRequest(o, obstacles.scene, global.quiet);
   // CUDA's start-up (the device's context, once per process) before the timed build.
   double cuda_start_s = 0.0;
-  if (request.backend == field::FieldBackend::Auto || request.backend == field::FieldBackend::Cuda) {
+  if (request.backend == field::FieldBackend::Auto ||
+      request.backend == field::FieldBackend::Cuda) {
     const auto start = std::chrono::steady_clock::now();
     field::cudaFieldBackendAvailable();
     cuda_start_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -96,7 +96,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("fieldpath ") + FIELDPATH_VERSION);
   app.require_subcommand(1);
   GlobalOptions global;
-  app.add_flag("--quiet", global.quiet, "No progress lines on stderr (before or after the command)");
+  app.add_flag("--quiet", global.quiet,
+               "No progress lines on stderr (before or after the command)");
   // Options a sub-command does not know fall through to this level, so `fieldpath simulate ...
   // --quiet` works as well as `fieldpath --quiet simulate ...`. Sub-commands inherit the setting.
   app.fallthrough();

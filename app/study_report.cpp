@@ -183,7 +183,8 @@ std::string buildsSideBySide(const StudyResult& r) {
     << " 15; `cpu`: the block build; `cuda`: the GPU's), in this run; × is the first build's time"
     << " over this one's (> 1: faster). Same node values to float rounding: the errors agree.\n\n"
     << "| variant | build | active nodes | field s | path s | total s | field × | total × |"
-       " max force error % | tilt diff max ° |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+       " max force error % | tilt diff max ° "
+       "|\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const std::string& group : groups) {
     const StudyRow* first = nullptr;
     for (const StudyRow& row : r.rows) {

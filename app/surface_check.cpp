@@ -429,11 +429,12 @@ std::optional<SurfaceResult> checkSurface(const SurfaceRequest& request, const S
   const double spacing = plan.spacing_mm;
   zbuffer::SimulationRequest sim;
   sim.grid = plan.grid;
-  sim.tool = request.tool.shape == geometry::ToolShape::Ball
-                 ? zbuffer::Tool::ball(radius, request.tool.length_mm)
-             : request.tool.shape == geometry::ToolShape::Torus
-                 ? zbuffer::Tool::torus(radius, request.tool.corner_radius_mm, request.tool.length_mm)
-                 : zbuffer::Tool::flat(radius, request.tool.length_mm);
+  sim.tool =
+      request.tool.shape == geometry::ToolShape::Ball
+          ? zbuffer::Tool::ball(radius, request.tool.length_mm)
+      : request.tool.shape == geometry::ToolShape::Torus
+          ? zbuffer::Tool::torus(radius, request.tool.corner_radius_mm, request.tool.length_mm)
+          : zbuffer::Tool::flat(radius, request.tool.length_mm);
   sim.backend = request.backend;
   // The Z-buffer in a frame at the grid's corner and the part's lowest point: its coordinates
   // are floats, which 1e5 mm from the origin hold to 8 µm only (a clean job read 7.8 µm of

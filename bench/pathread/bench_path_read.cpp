@@ -118,9 +118,11 @@ int main(int argc, char** argv) {
   }
   std::printf("%u hardware threads, median of %d runs (page cache warm)\n\n",
               std::thread::hardware_concurrency(), reps);
-  std::printf("| file | MB | postures | serial getline ms (peer) | readPathFile 1 thread ms | "
-              "readPathFile all ms | scanPathFile 1 thread ms | scanPathFile all ms | MB/s (scan all) | "
-              "speed-up scan all / peer | same postures |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| file | MB | postures | serial getline ms (peer) | readPathFile 1 thread ms | "
+      "readPathFile all ms | scanPathFile 1 thread ms | scanPathFile all ms | MB/s (scan all) | "
+      "speed-up scan all / peer | same postures "
+      "|\n|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const fs::path& file : files) {
     const double mb = double(fs::file_size(file)) / 1e6;
     const bool cl = pathFormatOf(file) == PathFormat::Cl;

@@ -52,7 +52,8 @@ void validate(const Pass& pass, const SteeringRequest& request) {
               request.step_mm);
   const auto& stations = request.output_s_mm;
   for (std::size_t i = 0; i < stations.size(); ++i)
-    requireThat(std::isfinite(stations[i]) && (i == 0 ? stations[i] == 0.0 : stations[i] > stations[i - 1]) &&
+    requireThat(std::isfinite(stations[i]) &&
+                    (i == 0 ? stations[i] == 0.0 : stations[i] > stations[i - 1]) &&
                     stations[i] <= pass.length_mm,
                 "output station (mm)", "0 first, increasing, within the pass", stations[i]);
   requireThat(std::isfinite(request.ball_radius_mm) && request.ball_radius_mm > 0.0, "tool.radius",

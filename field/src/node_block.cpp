@@ -39,14 +39,16 @@ SampleTable::SampleTable(const ObstacleSamples& samples, const std::vector<std::
   for (int a = 0; a < 3; ++a) extent = std::max(extent, hi[a] - lo[a]);
   cell_mm = std::max(0.5 * r0_mm, extent / (kMaxCellsPerAxis - 1));
   for (int a = 0; a < 3; ++a)
-    dim[a] = std::max(1, std::min(kMaxCellsPerAxis, int(std::floor((hi[a] - lo[a]) / cell_mm)) + 1));
+    dim[a] =
+        std::max(1, std::min(kMaxCellsPerAxis, int(std::floor((hi[a] - lo[a]) / cell_mm)) + 1));
   const std::size_t cells = std::size_t(dim[0]) * dim[1] * dim[2];
   std::vector<std::int32_t> cell_of(n);
   cell_start.assign(cells + 1, 0);
   for (std::size_t j = 0; j < n; ++j) {
     int c[3];
     for (int a = 0; a < 3; ++a)
-      c[a] = std::clamp(int(std::floor((samples.points_mm[j][a] - lo[a]) / cell_mm)), 0, dim[a] - 1);
+      c[a] =
+          std::clamp(int(std::floor((samples.points_mm[j][a] - lo[a]) / cell_mm)), 0, dim[a] - 1);
     cell_of[j] = (c[0] * dim[1] + c[1]) * dim[2] + c[2];
     ++cell_start[cell_of[j] + 1];
   }

@@ -96,8 +96,8 @@ struct BlockScratch {
 
 /// The values of a leaf's masked nodes (out[offset], 512 of them; unmasked ones untouched):
 /// the samples within reach of the leaf gathered once; a 2 x 2 x 2 brick's first sums together,
-/// the nodes in the vector lanes, over the samples near the brick; then, in rounds, every node's value
-/// made from the sums it has, the sums still asked for (the points the surface rule and the
+/// the nodes in the vector lanes, over the samples near the brick; then, in rounds, every node's
+/// value made from the sums it has, the sums still asked for (the points the surface rule and the
 /// plane ratio lift a node to) answered 8 points at a time over the samples near them. Same
 /// values as the per-node reference build up to the order of the sums.
 void buildLeafNodes(const SampleTable& table, const ObstacleSamples& samples, const NodeJob& job,

@@ -23,7 +23,9 @@ struct DeviceArray {
     if (n) FIELDPATH_CUDA_CHECK(cudaMalloc(&ptr, n * sizeof(T)));
   }
   DeviceArray(const T* host, std::size_t n, cudaStream_t stream) : DeviceArray(n) {
-    if (n) FIELDPATH_CUDA_CHECK(cudaMemcpyAsync(ptr, host, n * sizeof(T), cudaMemcpyHostToDevice, stream));
+    if (n)
+      FIELDPATH_CUDA_CHECK(
+          cudaMemcpyAsync(ptr, host, n * sizeof(T), cudaMemcpyHostToDevice, stream));
   }
   ~DeviceArray() {
     if (ptr) FIELDPATH_CUDA_WARN(cudaFree(ptr));
@@ -56,7 +58,8 @@ bool cudaNodeBuildAvailable() {
   // process, here rather than inside the first build that asks for the device.
   static const bool available = [] {
     int count = 0;
-    return cudaGetDeviceCount(&count) == cudaSuccess && count > 0 && cudaFree(nullptr) == cudaSuccess;
+    return cudaGetDeviceCount(&count) == cudaSuccess && count > 0 &&
+           cudaFree(nullptr) == cudaSuccess;
   }();
   return available;
 }
@@ -96,7 +99,9 @@ CudaNodeBuild::CudaNodeBuild(const CellTable& table, const NodeJob& job,
   const std::size_t n = std::size_t(table.all.count);
   const std::size_t cells = std::size_t(table.dim[0]) * table.dim[1] * table.dim[2] + 1;
   // Host-to-device copies from pageable memory return once staged: the sources may go.
-  auto up = [&](const double* host) { return std::make_unique<DeviceArray<double>>(host, n, stream); };
+  auto up = [&](const double* host) {
+    return std::make_unique<DeviceArray<double>>(host, n, stream);
+  };
   st.x = up(table.all.x);
   st.y = up(table.all.y);
   st.z = up(table.all.z);

@@ -80,7 +80,8 @@ struct Law {
   FP_HD double planeHeight(double magnitude) const {
     if (!(magnitude > 0.0) || !(plane_scale > 0.0)) return r0;
     const double b = 2.0 * plane_scale * r0 + magnitude;
-    return 2.0 * plane_scale * r0 * r0 / (b + sqrt(magnitude * (4.0 * plane_scale * r0 + magnitude)));
+    return 2.0 * plane_scale * r0 * r0 /
+           (b + sqrt(magnitude * (4.0 * plane_scale * r0 + magnitude)));
   }
 };
 

@@ -151,9 +151,11 @@ static __attribute__((target("avx512f"))) void gather512(const SampleSpan& f, co
     // max(0, lo - p, p - hi): gapTo's value (one of the two differences is <= 0)
     __m512d d[3];
     for (int a = 0; a < 3; ++a)
-      d[a] = _mm512_max_pd(zero, _mm512_max_pd(_mm512_sub_pd(blo[a], p[a]), _mm512_sub_pd(p[a], bhi[a])));
-    const __m512d d2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(d[0], d[0]), _mm512_mul_pd(d[1], d[1])),
-                                     _mm512_mul_pd(d[2], d[2]));
+      d[a] = _mm512_max_pd(zero,
+                           _mm512_max_pd(_mm512_sub_pd(blo[a], p[a]), _mm512_sub_pd(p[a], bhi[a])));
+    const __m512d d2 =
+        _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(d[0], d[0]), _mm512_mul_pd(d[1], d[1])),
+                      _mm512_mul_pd(d[2], d[2]));
     // Stored whether any lane passes or not: which do is data, not a branch to mispredict.
     const __mmask8 in_near = _mm512_mask_cmp_pd_mask(valid, d2, vnear, _CMP_LE_OQ);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(near_at + n_near),

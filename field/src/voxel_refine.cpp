@@ -46,8 +46,9 @@ class NodeCurvature {
       constexpr double kStepMm = 1e-4;
       plane = law_->at(here.s);
       force = plane * here.v.norm();
-      slope = std::abs(law_->at(std::abs(here.s) + kStepMm) - law_->at(std::abs(here.s) - kStepMm)) /
-              (2 * kStepMm);
+      slope =
+          std::abs(law_->at(std::abs(here.s) + kStepMm) - law_->at(std::abs(here.s) - kStepMm)) /
+          (2 * kStepMm);
     } else {
       force = here.v.norm();
     }

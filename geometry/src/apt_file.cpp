@@ -310,16 +310,18 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
       continue;
     }
     if (major == "UNITS") {
-      const std::string_view value =
-          slash == std::string::npos ? std::string_view() : trimmed(std::string_view(statement).substr(slash + 1));
+      const std::string_view value = slash == std::string::npos
+                                         ? std::string_view()
+                                         : trimmed(std::string_view(statement).substr(slash + 1));
       const double scale = unitScale(value);
       if (scale == 0.0)
         fail(file, record_line, "UNITS/" + std::string(value) + ": unknown unit (MM or INCHES)");
       out.units.emplace_back(chunk.postures.size(), scale);
       continue;
     }
-    const std::string_view values =
-        slash == std::string::npos ? std::string_view() : std::string_view(statement).substr(slash + 1);
+    const std::string_view values = slash == std::string::npos
+                                        ? std::string_view()
+                                        : std::string_view(statement).substr(slash + 1);
     if (major == "TLAXIS") {
       // TLAXIS/i, j, k[, ...]: the axis of the 3-number GOTOs that follow (APT's modal axis).
       // Other forms (TLAXIS/NORMPS, ...) leave them the last axis, as before: read past.

@@ -50,13 +50,14 @@ std::size_t PathFile::count(PathBlock::Kind kind) const {
 }
 
 void requireSteadyAxis(const PathFile& path, std::size_t before, std::size_t i) {
-  const double turn_deg = axisAngle(path.postures[before].axis, path.postures[i].axis) * 180.0 / M_PI;
+  const double turn_deg =
+      axisAngle(path.postures[before].axis, path.postures[i].axis) * 180.0 / M_PI;
   if (turn_deg <= kMaxPassAxisTurnDeg) return;
   char turn[64], limit[64];
   std::snprintf(turn, sizeof turn, "%.4g", turn_deg);
   std::snprintf(limit, sizeof limit, "%g", kMaxPassAxisTurnDeg);
-  throw InputError(path.where(i) + ": the tool axis turns " + turn + " deg from the posture before (" +
-                   path.where(before) + "): more than " + limit +
+  throw InputError(path.where(i) + ": the tool axis turns " + turn +
+                   " deg from the posture before (" + path.where(before) + "): more than " + limit +
                    " deg between two postures of a pass (a flipped axis?)");
 }
 
@@ -260,7 +261,8 @@ std::size_t handOver(const PathFile& path, const PathReadOptions& options,
   const std::size_t n = (path.postures.size() + per_chunk - 1) / per_chunk;
   if (sink.begin) sink.begin(n);
   forEachChunk(n, options.threads, [&](std::size_t i) {
-    const std::size_t begin = i * per_chunk, end = std::min(path.postures.size(), begin + per_chunk);
+    const std::size_t begin = i * per_chunk,
+                      end = std::min(path.postures.size(), begin + per_chunk);
     std::vector<CompactPosture> out(end - begin);
     for (std::size_t k = begin; k < end; ++k) out[k - begin] = compact(path.postures[k]);
     sink.chunk(i, out);

@@ -135,7 +135,8 @@ std::vector<Shell> shellsOf(const TriangleMesh& mesh) {
   std::sort(cycles.begin(), cycles.end());
   std::vector<char> repeat(mesh.triangles.size(), 0);
   for (std::size_t i = 1; i < cycles.size(); ++i)
-    if (cycles[i].first == cycles[i - 1].first) repeat[static_cast<std::size_t>(cycles[i].second)] = 1;
+    if (cycles[i].first == cycles[i - 1].first)
+      repeat[static_cast<std::size_t>(cycles[i].second)] = 1;
   // Closed: every edge used as many times each way (once each way on a manifold; bodies that
   // share a face or an edge, as a multi-body export writes them, use it twice each way: the
   // vertical-ray parity of ClosedShells still tells inside from outside). The directed edges as

@@ -29,7 +29,8 @@ MappedFile::MappedFile(const std::filesystem::path& file) {
   if (fd < 0) throw common::InputError(file.string() + ": cannot open for reading");
   struct stat st {};
   if (::fstat(fd, &st) == 0 && st.st_size > 0) {
-    void* map = ::mmap(nullptr, static_cast<std::size_t>(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0);
+    void* map =
+        ::mmap(nullptr, static_cast<std::size_t>(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0);
     if (map != MAP_FAILED) {
       map_ = map;
       mapped_bytes_ = static_cast<std::size_t>(st.st_size);

@@ -196,7 +196,8 @@ inline std::string_view readableText(std::string_view text, const std::filesyste
     throw common::InputError(file.string() + ": UTF-16 text: save it as UTF-8 or ASCII");
   // The first line tells (not a scan of the whole text: paths run to gigabytes).
   const std::string_view first = text.substr(0, text.find('\n'));
-  if (const std::size_t cr = first.find('\r'); cr != std::string_view::npos && cr + 1 < first.size())
+  if (const std::size_t cr = first.find('\r');
+      cr != std::string_view::npos && cr + 1 < first.size())
     throw common::InputError(file.string() +
                              ":1: the line ends in a CR alone (classic Mac OS line ends): save "
                              "the file with LF or CRLF line ends");

@@ -125,8 +125,10 @@ LinkPartResult checkLinksAgainstPart(const ClearanceChecker& part, const Grazing
     common::report(progress, links_done++ / std::max(1.0, links), "links vs part");
     // A link posture where the pass beside it starts or ends (a path written with no retract) is
     // that pass's: the ball cuts there.
-    if (block.begin > 0 && block.begin < block.end && same(block.begin, block.begin - 1)) ++block.begin;
-    if (block.end < all.size() && block.begin < block.end && same(block.end - 1, block.end)) --block.end;
+    if (block.begin > 0 && block.begin < block.end && same(block.begin, block.begin - 1))
+      ++block.begin;
+    if (block.end < all.size() && block.begin < block.end && same(block.end - 1, block.end))
+      --block.end;
     if (block.size() == 0) continue;
     // The moves out of the pass before and into the pass after (a retract along a tool axis
     // leaning over a fin of the part drove the ball into it): they may graze what the ball cuts.

@@ -301,10 +301,11 @@ std::pair<std::size_t, double> faultsAround(const GenerateResult& result,
   // The pass's postures (they lie in pass order: found by halving, not by a walk of them all,
   // once a pass judged).
   const int index = result.passes[p].index;
-  const auto first = std::partition_point(result.postures.begin(), result.postures.end(),
-                                          [&](const GeneratedPosture& g) { return g.pass < index; });
-  const auto last = std::partition_point(first, result.postures.end(),
-                                         [&](const GeneratedPosture& g) { return g.pass == index; });
+  const auto first =
+      std::partition_point(result.postures.begin(), result.postures.end(),
+                           [&](const GeneratedPosture& g) { return g.pass < index; });
+  const auto last = std::partition_point(
+      first, result.postures.end(), [&](const GeneratedPosture& g) { return g.pass == index; });
   const std::size_t n = result.path.postures.size();
   // Output postures [lo, hi): the link into the pass, the pass, the link out of it.
   const std::size_t lo = first != result.postures.begin() ? std::prev(first)->output + 1 : 0;
@@ -324,7 +325,8 @@ std::pair<std::size_t, double> faultsAround(const GenerateResult& result,
   // The motions into the window's first posture and out of its last (to the next pass's first).
   for (std::size_t i = lo > 0 ? lo - 1 : 0; i < hi && i + 1 < n; ++i) {
     if (i < moving.size()) least_mm = std::min(least_mm, moving[i]);
-    collisions += (i < moving.size() && moving[i] <= 0.0) || marked(&PartContacts::Marks::motion, i);
+    collisions +=
+        (i < moving.size() && moving[i] <= 0.0) || marked(&PartContacts::Marks::motion, i);
   }
   return {collisions, -least_mm};
 }

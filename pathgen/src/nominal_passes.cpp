@@ -143,7 +143,8 @@ PassSample polylineSample(const Polyline& line, double s_mm) {
   sample.feed = feed.normalized();
   Vec3 normal = (1 - w) * line.normal[i] + w * line.normal[j];
   normal -= normal.dot(sample.feed) * sample.feed;
-  if (normal.norm() < kMinAxisToFeedSin) normal = line.normal[i] - line.normal[i].dot(sample.feed) * sample.feed;
+  if (normal.norm() < kMinAxisToFeedSin)
+    normal = line.normal[i] - line.normal[i].dot(sample.feed) * sample.feed;
   sample.normal = normal.normalized();
   sample.binormal = sample.normal.cross(sample.feed);
   return sample;
@@ -172,7 +173,8 @@ AxisTurn largestAxisTurn(const PathFile& path, double ball_radius_mm) {
       out.deg = deg;
       out.at = i - 1;
       out.step_mm =
-          (geometry::ballCentre(b, ball_radius_mm) - geometry::ballCentre(a, ball_radius_mm)).norm();
+          (geometry::ballCentre(b, ball_radius_mm) - geometry::ballCentre(a, ball_radius_mm))
+              .norm();
     }
   return out;
 }
@@ -300,7 +302,8 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
       kept = std::vector<std::size_t>(kept.begin() + head, kept.begin() + tail);
     }
     // A cutting move does not turn the axis over (repeats dropped: between the kept postures).
-    for (std::size_t k = 1; k < kept.size(); ++k) geometry::requireSteadyAxis(path, kept[k - 1], kept[k]);
+    for (std::size_t k = 1; k < kept.size(); ++k)
+      geometry::requireSteadyAxis(path, kept[k - 1], kept[k]);
     auto line = std::make_shared<Polyline>();
     const std::size_t n = kept.size();
     for (std::size_t k = 0; k < n; ++k) {

@@ -415,8 +415,9 @@ TEST(Convert, RoundTripsKeepThePosturesBitForBit) {
       << to_apt.err;
   EXPECT_EQ(to_apt.err.find("no link between"), std::string::npos) << to_apt.err;
 
-  for (const std::string args : {"convert marked.cl e.txt", "convert marked.cl e.apt",
-                                 "convert missing.cl e.cl", "convert marked.cl e.apt --tool cone"}) {
+  for (const std::string args :
+       {"convert marked.cl e.txt", "convert marked.cl e.apt", "convert missing.cl e.cl",
+        "convert marked.cl e.apt --tool cone"}) {
     const Outcome run = runFieldpath(f.dir, args);
     EXPECT_EQ(run.exit_code, 1) << args << ": " << run.err;
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << args << ": " << run.err;

@@ -125,7 +125,8 @@ TEST(AtomicOutput, SignalDuringAWriteLeavesNothing) {
     }
     EXPECT_EQ(finish(pid), 128 + sig);
     EXPECT_TRUE(filesUnder(dir.path() / "out").empty())
-        << "left: " << (filesUnder(dir.path() / "out").empty() ? "" : filesUnder(dir.path() / "out")[0]);
+        << "left: "
+        << (filesUnder(dir.path() / "out").empty() ? "" : filesUnder(dir.path() / "out")[0]);
   }
   // And without a signal the file is there, whole, with no temporary beside it.
   common::writeTextAtomically(target, "whole");
@@ -375,7 +376,8 @@ TEST(AtomicOutput, DevicesAndFifosAreWrittenIntoAndLinksFollowed) {
   common::removeWrittenOutputs();
 }
 
-// ---- the commands, interrupted midway ------------------------------------------------------------
+// ---- the commands, interrupted midway
+// ------------------------------------------------------------
 
 /// Starts the command, signals it after `after`, and checks what is left in `out`: no temporary,
 /// and every JSON output that is there parses. A machine fast enough to finish the command first

@@ -292,7 +292,8 @@ TEST(Scene, TheSameSurfacesFromTwoFilesAreRefused) {
   dir.write("wall.stl", app::test::squareStl(5));
   dir.write("copy.stl", app::test::squareStl(5));
   dir.write("other.stl", app::test::squareStl(6));
-  const auto twice = dir.write("twice.yaml", "obstacles:\n  - mesh: wall.stl\n  - mesh: copy.stl\n");
+  const auto twice =
+      dir.write("twice.yaml", "obstacles:\n  - mesh: wall.stl\n  - mesh: copy.stl\n");
   try {
     (void)app::loadScene(twice);
     ADD_FAILURE() << "a copy of an obstacle was read as a second obstacle";
@@ -352,9 +353,10 @@ TEST(Scene, KeysThatDoNotApplyAreRefused) {
   TempDir dir;
   dir.write("wall.stl", app::test::squareStl(5));
   dir.write("nominal.cl", "0 0 1 0 0 1\n1 0 1 0 0 1\n");
-  const auto file = dir.write("job.yaml",
-                              "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, "
-                              "corner_radius: 3, length: 40 }\npath: { nominal: nominal.cl, passes: 3 }\n");
+  const auto file =
+      dir.write("job.yaml",
+                "obstacles:\n  - mesh: wall.stl\ntool: { shape: ball, radius: 3, "
+                "corner_radius: 3, length: 40 }\npath: { nominal: nominal.cl, passes: 3 }\n");
   const app::Scene scene = app::loadScene(file);
   EXPECT_EQ(scene.tool.radius_mm, 3.0);
   try {

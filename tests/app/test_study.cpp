@@ -240,7 +240,8 @@ TEST(Study, SmallJobExactMethodsAgreeCsvIsFiniteErrorsShrink) {
 
 /// The small job's study of trilinear plane-ratio grids of `voxels` (mm), each refined to its
 /// tolerance (a fraction; 0: none) one level down, no brute force.
-static StudyRequest planeRatioStudy(std::vector<double> voxels, std::vector<double> tolerances = {}) {
+static StudyRequest planeRatioStudy(std::vector<double> voxels,
+                                    std::vector<double> tolerances = {}) {
   StudyRequest request;
   request.job = smallJob();
   request.impeller = smallImpeller();
@@ -261,7 +262,8 @@ TEST(StudyRefinement, RefinedVariantBeatsItsUniformGridAndIsCountedApart) {
   const StudyRow& uniform = result.rows[1];
   const StudyRow& refined = result.rows[2];
   EXPECT_EQ(uniform.variant.name(), "voxel 2 mm trilinear plane_ratio");
-  EXPECT_EQ(refined.variant.name(), "voxel 2 mm trilinear plane_ratio refined 5 % to 1 mm near its path");
+  EXPECT_EQ(refined.variant.name(),
+            "voxel 2 mm trilinear plane_ratio refined 5 % to 1 mm near its path");
   EXPECT_EQ(refined.failure, "");
   EXPECT_EQ(uniform.levels, 1);
   EXPECT_EQ(refined.levels, 2);
@@ -297,7 +299,8 @@ TEST(StudyBackends, OldAndNewBuildsSideBySideGiveTheSameErrorsAndPaths) {
   request.backends = {field::FieldBackend::Reference, field::FieldBackend::Cpu};
   const StudyResult result = runStudy(request);
   ASSERT_EQ(result.rows.size(), 3u);  // direct, reference build, cpu build
-  const StudyRow& old_build = rowNamed(result, "voxel 1 mm trilinear plane_ratio [reference build]");
+  const StudyRow& old_build =
+      rowNamed(result, "voxel 1 mm trilinear plane_ratio [reference build]");
   const StudyRow& new_build = rowNamed(result, "voxel 1 mm trilinear plane_ratio [cpu build]");
   EXPECT_EQ(old_build.variant.nameWithoutBackend(), new_build.variant.nameWithoutBackend());
   EXPECT_EQ(old_build.active_nodes, new_build.active_nodes);

@@ -111,8 +111,8 @@ inline double tiltTorque(const field::ForceField& field, double tilt_rad) {
 }
 
 /// Angle about e where k θ = τ(θ) (θ0 = 0), by bisection in [lo, hi] (a sign change required).
-inline double staticAngle(const field::ForceField& field, const Vec3& e, double stiffness, double lo_rad,
-                   double hi_rad) {
+inline double staticAngle(const field::ForceField& field, const Vec3& e, double stiffness,
+                          double lo_rad, double hi_rad) {
   auto residual = [&](double angle) { return stiffness * angle - torqueAbout(field, e, angle); };
   const bool rising = residual(lo_rad) < 0.0;
   EXPECT_NE(rising, residual(hi_rad) < 0.0)
@@ -124,14 +124,16 @@ inline double staticAngle(const field::ForceField& field, const Vec3& e, double 
   return 0.5 * (lo_rad + hi_rad);
 }
 
-inline double staticTilt(const field::ForceField& field, double stiffness, double lo_rad, double hi_rad) {
+inline double staticTilt(const field::ForceField& field, double stiffness, double lo_rad,
+                         double hi_rad) {
   return staticAngle(field, Vec3::UnitX(), stiffness, lo_rad, hi_rad);
 }
 
 /// Undamped swing from rest at tilt 0: the turning point θmax > 0 where the work of the field
 /// equals the spring energy, ∫0^θmax (τ(φ) - k φ) dφ = 0 (trapezoids, linear interpolation of the
 /// crossing).
-inline double undampedTurningPoint(const field::ForceField& field, double stiffness, double hi_rad) {
+inline double undampedTurningPoint(const field::ForceField& field, double stiffness,
+                                   double hi_rad) {
   const int n = 5000;
   const double dphi = hi_rad / n;
   double energy = 0.0, prev = tiltTorque(field, 0.0);

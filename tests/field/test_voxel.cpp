@@ -123,7 +123,8 @@ TEST(Voxel, EstimateIsTheSameOnTheDenseBitmapAndTheSparseMask) {
   // boxes, one turned, at several voxel sizes, and a cube with a copy 380 mm away.
   const TriangleMesh a = test::box(Vec3(-5, -5, -5), Vec3(5, 5, 5));
   TriangleMesh b = test::box(Vec3(-3, -4, -2), Vec3(9, 2, 3));
-  for (auto& v : b.vertices) v = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()) * v + Vec3(7, 1, -2);
+  for (auto& v : b.vertices)
+    v = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()) * v + Vec3(7, 1, -2);
   TriangleMesh far = a;
   for (auto& v : far.vertices) v += Vec3(300, -200, 100);
   const TriangleMesh two[] = {a, b}, spread[] = {a, far};

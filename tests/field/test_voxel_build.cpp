@@ -60,7 +60,8 @@ void expectSameNodes(const VoxelField& expected, const VoxelField& actual, std::
   EXPECT_LE(differ, ties) << "of " << compared << " nodes; worst relative error " << worst;
 }
 
-VoxelRequest requestOn(double h, FieldBackend backend, StoredQuantity stored, double tolerance = 0) {
+VoxelRequest requestOn(double h, FieldBackend backend, StoredQuantity stored,
+                       double tolerance = 0) {
   VoxelRequest r;
   r.voxel_size_mm = h;
   r.stored = stored;
@@ -145,7 +146,8 @@ TEST(VoxelBuild, BlockBuildEqualsTheReferenceOnRandomScenes) {
     fieldpath::geometry::TriangleMesh loose;  // open triangles, either way round
     for (int t = 0; t < 3; ++t) {
       const int first = static_cast<int>(loose.vertices.size());
-      for (int v = 0; v < 3; ++v) loose.vertices.emplace_back(uniform(-8, 8), uniform(-8, 8), uniform(-8, 8));
+      for (int v = 0; v < 3; ++v)
+        loose.vertices.emplace_back(uniform(-8, 8), uniform(-8, 8), uniform(-8, 8));
       loose.triangles.emplace_back(first, first + 1, first + 2);
     }
     meshes.push_back(loose);

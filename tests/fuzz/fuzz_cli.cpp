@@ -36,7 +36,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (double v : r)
       if (!std::isfinite(v)) std::abort();
     if (lines.first > 0) {
-      const zbuffer::Grid g = zbuffer::Grid::fromRegion(r[0], r[1], r[2], r[3], lines.first, lines.second);
+      const zbuffer::Grid g =
+          zbuffer::Grid::fromRegion(r[0], r[1], r[2], r[3], lines.first, lines.second);
       if (!(g.dx_mm > 0) || !(g.dy_mm > 0) || !std::isfinite(g.dx_mm) || !std::isfinite(g.dy_mm))
         std::abort();  // a degenerate grid got through
       zbuffer::checkGridFits(g);

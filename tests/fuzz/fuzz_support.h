@@ -25,8 +25,9 @@ inline const std::filesystem::path& scratchDir() {
   // later, and a static path would be one of them (the directories were left behind).
   static const std::filesystem::path* const dir = [] {
     std::error_code ec;
-    const std::filesystem::path base =
-        std::filesystem::is_directory("/dev/shm", ec) ? "/dev/shm" : std::filesystem::temp_directory_path();
+    const std::filesystem::path base = std::filesystem::is_directory("/dev/shm", ec)
+                                           ? "/dev/shm"
+                                           : std::filesystem::temp_directory_path();
     auto* d = new std::filesystem::path(base / ("fieldpath-fuzz-" + std::to_string(::getpid())));
     std::filesystem::create_directories(*d);
     std::atexit([] {  // libFuzzer ends by exit(): leave no scratch directory behind

@@ -38,7 +38,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view text = fuzz::view(data, size);
   const auto cut = text.find('\n');
   const std::string_view spec = text.substr(0, cut);
-  const std::string_view holder = cut == std::string_view::npos ? std::string_view{} : text.substr(cut + 1);
+  const std::string_view holder =
+      cut == std::string_view::npos ? std::string_view{} : text.substr(cut + 1);
   try {
     const geometry::ToolSpec tool = geometry::parseToolSpec(spec);
     const geometry::HolderProfile profile = geometry::parseHolderProfile(holder);

@@ -471,7 +471,8 @@ TEST(AptFile, TlaxisSetsTheAxisOfThreeValueGotos) {
   EXPECT_EQ(p[3].axis, Vec3::UnitZ());
   // Other forms (TLAXIS/NORMPS) are read past, as are a fourth value's words.
   const auto n = readAptFile(writeBytes(
-      "n.apt", "GOTO/0,0,0,0.6,0,0.8\nTLAXIS/NORMPS\nGOTO/1,0,0\nTLAXIS/0,0.6,0.8,0\nGOTO/2,0,0\n"));
+      "n.apt",
+      "GOTO/0,0,0,0.6,0,0.8\nTLAXIS/NORMPS\nGOTO/1,0,0\nTLAXIS/0,0.6,0.8,0\nGOTO/2,0,0\n"));
   ASSERT_EQ(n.size(), 3u);
   EXPECT_EQ(n[1].axis, Vec3(0.6, 0, 0.8));
   EXPECT_EQ(n[2].axis, Vec3(0, 0.6, 0.8));

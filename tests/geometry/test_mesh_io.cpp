@@ -333,12 +333,15 @@ TEST(MeshIo, BrokenFilesAreInputErrors) {
     loadMesh(tempPath("truncated.stl"));
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("header says 1000 triangles (50084 bytes), the file has 234"),
-              std::string::npos) << e.what();
+    EXPECT_NE(
+        std::string(e.what()).find("header says 1000 triangles (50084 bytes), the file has 234"),
+        std::string::npos)
+        << e.what();
   }
   // A directory or a device is said to be one, not "no such file".
-  for (const auto& [path, what] : {std::pair<fs::path, std::string>{fs::temp_directory_path(), "is a directory"},
-                                   {"/dev/null", "not a regular file"}}) {
+  for (const auto& [path, what] :
+       {std::pair<fs::path, std::string>{fs::temp_directory_path(), "is a directory"},
+        {"/dev/null", "not a regular file"}}) {
     try {
       loadMesh(path);
       FAIL();
@@ -364,7 +367,8 @@ TEST(MeshIo, BrokenFilesAreInputErrors) {
                 "without `endsolid`");
   std::string quad = tetra;
   quad.insert(quad.find("  vertex 1 0 0\n endloop"), "  vertex 1 1 0\n");
-  expectMessage(writeBytes("quad_facet.stl", quad), "quad_facet.stl:2: ASCII STL facet with 4 vertices");
+  expectMessage(writeBytes("quad_facet.stl", quad),
+                "quad_facet.stl:2: ASCII STL facet with 4 vertices");
   const std::string ply_header =
       "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
       "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"

@@ -162,7 +162,8 @@ TEST(PathRead, AptPprintLineEndsARecordWhateverTheChunks) {
   const fs::path file =
       writeBytes("pprint_inside.apt", "GOTO/1.5,2.5,$\n PPRINT/3.5,1 $\n 3,0,0,1\nGOTO/4,5,6\n");
   const std::string whole = errorOf(file, std::size_t{1} << 30, 1);
-  EXPECT_NE(whole.find("pprint_inside.apt:1: 'PPRINT/3.5' is not a number"), std::string::npos) << whole;
+  EXPECT_NE(whole.find("pprint_inside.apt:1: 'PPRINT/3.5' is not a number"), std::string::npos)
+      << whole;
   for (std::size_t bytes : kChunkBytes)
     for (unsigned threads : {1u, 0u}) EXPECT_EQ(errorOf(file, bytes, threads), whole) << bytes;
 }

@@ -46,7 +46,8 @@ class MeshJob : public ::testing::Test {
     const geometry::TriangleMesh right = impeller.bladeMesh(1);
     const int offset = static_cast<int>(blades.vertices.size());
     blades.vertices.insert(blades.vertices.end(), right.vertices.begin(), right.vertices.end());
-    for (auto t : right.triangles) blades.triangles.push_back(t + Eigen::Vector3i::Constant(offset));
+    for (auto t : right.triangles)
+      blades.triangles.push_back(t + Eigen::Vector3i::Constant(offset));
     geometry::saveMesh(blades, dir_->path() / "blades.stl");
     geometry::saveMesh(impeller.hubMesh(), dir_->path() / "hub.stl");
     const auto r = test::runFieldpath(*dir_, "generate '" + kImpellerScene.string() +
@@ -104,7 +105,8 @@ TEST_F(MeshJob, ClAptAndNpyNominalPathsGiveTheSamePathBitForBit) {
 TEST_F(MeshJob, ASafeZAtTheLeastAcceptedIsSaid) {
   double top = -HUGE_VAL;
   for (const char* mesh : {"blades.stl", "hub.stl"})
-    for (const auto& v : geometry::loadMesh(dir_->path() / mesh).vertices) top = std::max(top, v.z());
+    for (const auto& v : geometry::loadMesh(dir_->path() / mesh).vertices)
+      top = std::max(top, v.z());
   const double least = top + 0.5;  // the scene's clearance
   for (const double above : {0.0, 0.05}) {
     std::ostringstream extra;
@@ -133,8 +135,9 @@ TEST_F(MeshJob, LinkBlocksOfTheNominalPathAreSaidNotCut) {
   dir_->write("linked.yaml", sceneText("nominal.cl"));
   const auto r = test::runFieldpath(*dir_, "generate linked.yaml --out out_linked");
   ASSERT_EQ(r.exit_code, 0) << r.output();
-  const std::string said = fs::path(nominal.where(first)).filename().string() + ": " + std::to_string(postures) +
-                           " postures in " + std::to_string(blocks) + " `# link` blocks";
+  const std::string said = fs::path(nominal.where(first)).filename().string() + ": " +
+                           std::to_string(postures) + " postures in " + std::to_string(blocks) +
+                           " `# link` blocks";
   EXPECT_NE(r.err.find(said), std::string::npos) << said << "\n" << r.err;
 }
 
@@ -227,7 +230,8 @@ TEST_F(MeshJob, CheckComparesWithThePartMesh) {
 
 TEST_F(MeshJob, BadNominalPathsAndMeshesAreOneLineErrorsWithNoOutputs) {
   dir_->write("one.cl", "0 0 0 0 0 1\n");
-  dir_->write("twice.cl", "0 -8 0 0 0 1\n1 -8 0 0 0 1\n2 -8 0 0 0 1\n# pass\n5 0 1 0 0 1\n5 0 1 0 0 1\n");
+  dir_->write("twice.cl",
+              "0 -8 0 0 0 1\n1 -8 0 0 0 1\n2 -8 0 0 0 1\n# pass\n5 0 1 0 0 1\n5 0 1 0 0 1\n");
   dir_->write("plunge.cl", "0 -8 0 1 0 0\n1 -8 0 1 0 0\n2 -8 0 1 0 0\n");
   dir_->write("empty.stl", "solid empty\nendsolid empty\n");
   struct Case {
@@ -287,7 +291,8 @@ TEST(StiffScene, ClampGivesAPathAndACountFailStops) {
   EXPECT_LE(report["max_tilt_deg"].get<double>(), 35.0 + 1e-9);
   EXPECT_NE(test::slurp(dir.path() / "clamp/path.cl").find("# limit"), std::string::npos);
   // check reads the marks and says whether those postures collide.
-  const auto checked = test::runFieldpath(dir, "check stiff.yaml --path clamp/path.cl --spacing 0.3");
+  const auto checked =
+      test::runFieldpath(dir, "check stiff.yaml --path clamp/path.cl --spacing 0.3");
   ASSERT_EQ(checked.exit_code, 0) << checked.output();
   EXPECT_NE(checked.out.find("held at an angle limit"), std::string::npos) << checked.out;
 

@@ -56,7 +56,8 @@ TEST(NominalPasses, TheAxesLeanAlongTheFeedIsMeasured) {
             "\n";
   text += "# pass 2\n" + straightLines(0, 10, 1, 10);
   TempDir dir;
-  const auto passes = nominalPasses(geometry::readPathFile(dir.write("lean.cl", text)), PathParams{}, kR);
+  const auto passes =
+      nominalPasses(geometry::readPathFile(dir.write("lean.cl", text)), PathParams{}, kR);
   ASSERT_EQ(passes.size(), 2u);
   EXPECT_NEAR(passes[0].nominal_lean_deg, 20.0, 1e-4);
   EXPECT_NE(passes[0].nominal_lean_at.find("lean.cl:5"), std::string::npos)
@@ -205,7 +206,8 @@ TEST(NominalPasses, FramesFollowThePolylineAndKeepPosturesOneForOne) {
   std::string text;
   for (int k = 0; k <= 40; ++k) {
     const double t = k * 0.05;
-    text += std::to_string(20 * std::cos(t)) + " " + std::to_string(20 * std::sin(t)) + " 0 0 0 1\n";
+    text +=
+        std::to_string(20 * std::cos(t)) + " " + std::to_string(20 * std::sin(t)) + " 0 0 0 1\n";
   }
   TempDir dir;
   const PathFile path = geometry::readPathFile(dir.write("c.cl", text));
@@ -215,7 +217,8 @@ TEST(NominalPasses, FramesFollowThePolylineAndKeepPosturesOneForOne) {
   for (std::size_t k = 0; k < 41; ++k) {
     const PassSample& s = passes[0].samples[k];
     const double t = k * 0.05;
-    EXPECT_NEAR((s.centre_mm - (path.postures[k].tip_mm + kR * Eigen::Vector3d::UnitZ())).norm(), 0, 1e-12);
+    EXPECT_NEAR((s.centre_mm - (path.postures[k].tip_mm + kR * Eigen::Vector3d::UnitZ())).norm(), 0,
+                1e-12);
     EXPECT_NEAR((s.normal - Eigen::Vector3d::UnitZ()).norm(), 0, 1e-12);
     // Central differences of a circle: the tangent exactly, away from the ends.
     if (k > 0 && k < 40)
@@ -286,7 +289,8 @@ TEST(NominalPasses, DegeneratePosturesAreClearErrorsNamingTheLine) {
   EXPECT_NE(m1.find("plunge.cl:1:"), std::string::npos) << m1;
   EXPECT_NE(m1.find("along the tool axis"), std::string::npos) << m1;
   // A pass of two identical postures.
-  const auto twice = dir.write("twice.cl", straightLines(0, 3, 1, 0) + "# pass\n5 5 0 0 0 1\n5 5 0 0 0 1\n");
+  const auto twice =
+      dir.write("twice.cl", straightLines(0, 3, 1, 0) + "# pass\n5 5 0 0 0 1\n5 5 0 0 0 1\n");
   const std::string m2 = errorOf([&] { nominalPasses(geometry::readPathFile(twice), {}, kR); });
   EXPECT_NE(m2.find("twice.cl:6:"), std::string::npos) << m2;
   EXPECT_NE(m2.find("pass 2"), std::string::npos) << m2;
@@ -303,7 +307,8 @@ TEST(NominalPasses, DegeneratePosturesAreClearErrorsNamingTheLine) {
   ASSERT_EQ(passes[0].samples.size(), 3u);
   for (const auto& s : passes[0].samples) EXPECT_TRUE(s.feed.allFinite() && s.normal.allFinite());
   // An axis flipped on line 3 (0 0 -1 among 0 0 1): named with the turn; 60 deg is a path.
-  const auto flipped = dir.write("flip.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n2 0 0 0 0 -1\n3 0 0 0 0 1\n");
+  const auto flipped =
+      dir.write("flip.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n2 0 0 0 0 -1\n3 0 0 0 0 1\n");
   const std::string m4 = errorOf([&] { nominalPasses(geometry::readPathFile(flipped), {}, kR); });
   EXPECT_NE(m4.find("flip.cl:3: the tool axis turns 180 deg"), std::string::npos) << m4;
   const auto turned = dir.write("turn.cl", "0 0 0 0 0 1\n1 0 0 0 0 1\n2 0 0 0 0.866 0.5\n");
@@ -386,7 +391,8 @@ TEST(NominalPasses, LargestAxisTurnIsOfThePassesAndItsClosedForm) {
   // axis swings 80 deg is not a pass (rapid moves turn as they like); pass 2 turns 20 deg.
   auto at = [](double x, double deg) {
     const double r = deg * M_PI / 180.0;
-    return Posture{Eigen::Vector3d(x, 0, 0), Eigen::Vector3d(std::sin(r), 0, std::cos(r)), 0.0, false};
+    return Posture{Eigen::Vector3d(x, 0, 0), Eigen::Vector3d(std::sin(r), 0, std::cos(r)), 0.0,
+                   false};
   };
   PathFile path;
   path.postures = {at(0, 0), at(1, 12), at(2, 42), at(2, 42), at(3, -38), at(4, 0), at(5, 20)};

@@ -59,7 +59,8 @@ TEST(ReachBox, HoldsTheNodesWithLeadAndTiltBothAtTheirLimits) {
           const dynamics::LocalFrame frame{s.feed, s.normal, s.binormal, false};
           const Eigen::Isometry3d placed = geometry::toolToWorld(geometry::ballEndPosture(
               s.centre_mm, dynamics::axisFromAngles(frame, l, t), 3.0));
-          for (const Vec3& n : nodes) worst_mm = std::max(worst_mm, box.exteriorDistance(placed * n));
+          for (const Vec3& n : nodes)
+            worst_mm = std::max(worst_mm, box.exteriorDistance(placed * n));
         }
     EXPECT_LE(worst_mm, 1e-9) << "heading " << heading_deg << "°";
   }

@@ -1,5 +1,5 @@
-/// Z-buffer culling: every floor (capsule, radial, float offsets, groups, tiles) is below the cut it
-/// stands for and tight where it can be; the cut does not depend on the height it is given.
+/// Z-buffer culling: every floor (capsule, radial, float offsets, groups, tiles) is below the cut
+/// it stands for and tight where it can be; the cut does not depend on the height it is given.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,5 +1,6 @@
 #pragma once
-/// Postures and a tool shared by the Z-buffer CPU tests (test_zbuffer.cpp, test_zbuffer_culling.cpp).
+/// Postures and a tool shared by the Z-buffer CPU tests (test_zbuffer.cpp,
+/// test_zbuffer_culling.cpp).
 #include <cmath>
 #include <cstdint>
 

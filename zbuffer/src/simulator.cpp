@@ -43,7 +43,8 @@ Grid Grid::fromRegion(double x0_mm, double y0_mm, double x1_mm, double y1_mm, in
   g.dx_mm = (x1_mm - x0_mm) / nx;
   g.dy_mm = (y1_mm - y0_mm) / ny;
   // A spacing that rounds to nothing next to the origin would stack lines on one another.
-  const double tiny = 1e-12 * std::max({1.0, std::abs(x0_mm), std::abs(y0_mm), std::abs(x1_mm), std::abs(y1_mm)});
+  const double tiny =
+      1e-12 * std::max({1.0, std::abs(x0_mm), std::abs(y0_mm), std::abs(x1_mm), std::abs(y1_mm)});
   if (!(g.dx_mm > tiny) || !(g.dy_mm > tiny) || !std::isfinite(g.dx_mm) || !std::isfinite(g.dy_mm))
     throw InputError("region: degenerate grid spacing " + common::shortNumber(g.dx_mm) + " x " +
                      common::shortNumber(g.dy_mm) + " mm");

@@ -101,7 +101,9 @@ struct TemporaryListing {
 };
 
 /// "what FILE: strerror(errno)" for a failed system call on a user's output path.
-inline std::string systemReason(int error) { return error != 0 ? std::strerror(error) : "unknown error"; }
+inline std::string systemReason(int error) {
+  return error != 0 ? std::strerror(error) : "unknown error";
+}
 
 /// Why a write into `dir` failed: errno's text, or a full device when errno was lost on the way
 /// (std::ofstream does not keep it).
@@ -266,7 +268,8 @@ inline void writeFileAtomically(const std::filesystem::path& given,
   for (int hops = 0; fs::is_symlink(path, status_ec); ++hops) {
     if (hops == 40) throw InputError(given.string() + ": too many levels of symbolic links");
     const fs::path target = fs::read_symlink(path, status_ec);
-    if (status_ec) throw InputError(given.string() + ": cannot read the link: " + status_ec.message());
+    if (status_ec)
+      throw InputError(given.string() + ": cannot read the link: " + status_ec.message());
     path = target.is_absolute() ? target : path.parent_path() / target;
   }
   const fs::file_status status = fs::status(path, status_ec);
@@ -280,7 +283,8 @@ inline void writeFileAtomically(const std::filesystem::path& given,
     errno = 0;
     std::ofstream out(path, mode);
     if (!out)
-      throw InputError(given.string() + ": cannot open for writing: " + detail::systemReason(errno));
+      throw InputError(given.string() +
+                       ": cannot open for writing: " + detail::systemReason(errno));
     write(out);
     out.flush();
     if (!out) throw InputError(given.string() + ": cannot write: " + detail::systemReason(errno));

@@ -66,7 +66,8 @@ inline std::filesystem::path inputAt(const std::filesystem::path& file) {
 
 /// Throws InputError "FILE: no such WHAT" / "FILE: is a directory, expected a WHAT" / "FILE: not
 /// a regular file (a FIFO, socket or device), expected a WHAT" unless `file` is a regular file.
-inline void requireRegularFile(const std::filesystem::path& file, const std::string& what = "file") {
+inline void requireRegularFile(const std::filesystem::path& file,
+                               const std::string& what = "file") {
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(file, ec);
   if (std::filesystem::is_regular_file(status)) {
@@ -91,8 +92,8 @@ inline void requireRegularFile(const std::filesystem::path& file, const std::str
   if (std::filesystem::is_directory(status))
     throw InputError(file.string() + ": is a directory, expected a " + what);
   if (std::filesystem::exists(status))
-    throw InputError(file.string() + ": not a regular file (a FIFO, socket or device), expected a " +
-                     what);
+    throw InputError(file.string() +
+                     ": not a regular file (a FIFO, socket or device), expected a " + what);
   throw InputError(file.string() + ": no such " + what);
 }
 

@@ -75,7 +75,7 @@ struct PostureSample {
   Vec3 moment = Vec3::Zero();                   ///< M about the ball centre, world frame
   double clearance_mm = 0.0;                    ///< from SteeringRequest::clearance, else NaN
   geometry::Posture posture;                    ///< tip = C - R a, axis a
-  bool limited = false;                         ///< clamped (params.on_limit Clamp) or rate over limit
+  bool limited = false;  ///< clamped (params.on_limit Clamp) or rate over limit
 };
 
 /// Solver counters, summed over restarts (clamps).

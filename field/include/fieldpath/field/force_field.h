@@ -1,6 +1,7 @@
 #pragma once
 /// The one interface through which later stages (dynamics, pathgen, study) read a repulsive field,
-/// whether direct (exact sum) or voxel (sampled). A runtime choice, hence a small virtual interface.
+/// whether direct (exact sum) or voxel (sampled). A runtime choice, hence a small virtual
+/// interface.
 #include <span>
 
 #include "fieldpath/geometry/posture.h"

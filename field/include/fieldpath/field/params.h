@@ -39,8 +39,8 @@ inline std::optional<RefineRegion> refineRegionNamed(std::string_view name) {
 }
 
 /// How the field is sampled on voxels (scene `field.voxel_size`, `interpolation`, `stored`,
-/// `refine_tolerance`, `refine_levels`, `refine_region`), written once: FieldParams holds the scene's, a
-/// VoxelRequest (voxel_field.h) starts from them and adds how to build.
+/// `refine_tolerance`, `refine_levels`, `refine_region`), written once: FieldParams holds the
+/// scene's, a VoxelRequest (voxel_field.h) starts from them and adds how to build.
 struct VoxelSettings {
   double voxel_size_mm = 0.5;  ///< h of the sparse grid
   Interpolation interpolation = Interpolation::Trilinear;

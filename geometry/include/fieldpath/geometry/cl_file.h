@@ -105,8 +105,9 @@ PathFormat pathFormatOf(const std::filesystem::path& file);
 /// Throws common::InputError naming the file and the line (or row) for every defect: non-finite
 /// numbers, short/long lines, zero or non-unit axes (axes off unit length by < 1e-3 are
 /// normalised; by <= 1e-6, float rounding, kept as written), a tip coordinate beyond +-1e6 mm,
-/// garbage, a missing file, a file without postures; `.npy`: a dtype other than float32/float64, a shape other than N×6 / N×7, Fortran
-/// order, a truncated or padded file. Where a file has several defects, the first in file order.
+/// garbage, a missing file, a file without postures; `.npy`: a dtype other than float32/float64, a
+/// shape other than N×6 / N×7, Fortran order, a truncated or padded file. Where a file has several
+/// defects, the first in file order.
 PathFile readPathFile(const std::filesystem::path& file, const PathReadOptions& options = {});
 
 /// The readers behind readPathFile, by format whatever the extension.

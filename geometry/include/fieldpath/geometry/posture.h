@@ -53,7 +53,9 @@ Posture postureFromTransform(const Eigen::Isometry3d& tool_to_world);
 Posture alongMotion(const Posture& a, const Posture& b, double t);
 
 /// The angle between two axes (rad), exact for small and near-opposite ones.
-inline double axisAngle(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
+inline double axisAngle(const Vec3& a, const Vec3& b) {
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
 
 /// How far (mm) any point within `reach_mm` of the tip moves at most along the motion a → b:
 /// |Δtip| + reach · Δθ.
