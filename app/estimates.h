@@ -23,9 +23,11 @@ inline constexpr double kBytesPerSample = 128.0;
 /// Bytes an output posture costs through generate: the steered posture with its angles, the path
 /// and its APT / CSV text, the clearance and motion results, the cutter's stamps along the
 /// motions. Measured: the mesh example's nominal path repeated 10 times (20 118 postures) peaked
-/// 49.7 MB over the example's own (2 012): 2.7 KB a posture, rounded up (512 was assumed: a 1 M
-/// posture path ran past an accepted --max-memory by 10 times, a memory sweep's).
-inline constexpr double kBytesPerPosture = 3072.0;
+/// 49.7 MB over the example's own (2 012): 2.7 KB a posture (512 was assumed: a 1 M posture path
+/// ran past an accepted --max-memory by 10 times, a memory sweep's). With the repairs' memos the
+/// same passes reversed (each steered again from its end) 55.2 MB over 18 090: 3.05 KB, within 1 %
+/// of 3 KB; 3.5 KB leaves the estimate ~7 % over that job's peak (reliability.md 41).
+inline constexpr double kBytesPerPosture = 3584.0;
 
 /// The parametric impeller's meshes (driven by `chord_tol` and the dimensions), before they are
 /// made. `where` is "SCENE:LINE: ".

@@ -335,7 +335,7 @@ TEST(InputSizes, FilesReadWholeAreSizedBeforeTheRead) {
   std::string many;  // 3.5 M postures by its lines' length and its 40 MiB (the rest sparse)
   for (int i = 0; i < 60000; ++i) many += "1 2 3 0 0 1\n";
   fs::resize_file(dir.write("many.cl", many), 40 << 20);
-  // 60000 postures a generate steers one for one: ~3 KB each (a 1 M posture path ran past an
+  // 60000 postures a generate steers one for one: ~3.5 KB each (a 1 M posture path ran past an
   // accepted --max-memory 78M to 0.8 GB: a memory sweep's), refused before the work.
   std::string steered;
   for (int i = 0; i < 60000; ++i) steered += std::to_string(0.01 * i) + " 2 3 0 0 1\n";
@@ -345,7 +345,7 @@ TEST(InputSizes, FilesReadWholeAreSizedBeforeTheRead) {
             "path: { nominal: steered.cl }\n");
   const Case cases[] = {
       {"--max-memory 100M generate steered.yaml --out g",
-       "steered.yaml: path.nominal: needs about 176 MiB of memory (6e+04 postures: the nominal "
+       "steered.yaml: path.nominal: needs about 205 MiB of memory (6e+04 postures: the nominal "
        "path's, one for one)"},
       {"generate s.yaml --out g", "s.yaml:4: path.nominal: huge.cl: NUL bytes near its start"},
       {"check s.yaml --path huge.cl", "huge.cl: NUL bytes near its start"},
