@@ -237,7 +237,9 @@ function setPosture(j, quiet) {
   placeTool(current);
   var o = postureInfo(current);
   tool.material.emissive.setHex(o.colliding || o.part_contact ? 0xaa1100 : 0x000000);
-  posLabel.textContent = (o.index + 1) + ' / ' + path.counts.postures;
+  // Numbered from 0 as in the panel, the files and #posture= (README): "2 / 2346" beside
+  // "posture 1" read as two postures.
+  posLabel.textContent = 'posture ' + o.index + ' (0\u2013' + (path.counts.postures - 1) + ')';
   var rows = [
     ['posture', o.index + ' (' + (path.rows ? 'row ' : 'line ') + o.line + ')'],
     ['block', o.block === 'link' ? 'link' : 'pass ' + o.pass],
