@@ -15,29 +15,9 @@ rounds=${3:-3}
 work=${4:-$(mktemp -d)}
 mkdir -p "$work"
 
-# Each pass block of a .cl (`# pass` lines start them; `# link` blocks dropped) in reverse order.
-reverse_cl() {
-  /usr/bin/python3 - "$1" "$2" <<'EOF'
-import sys
-head, blocks, cur = [], [], None
-for line in open(sys.argv[1]):
-    s = line.strip()
-    if s.startswith('# pass'):
-        cur = [line, []]; blocks.append(cur)
-    elif s.startswith('# link'):
-        cur = None
-    elif cur is None:
-        # (the header's comments, less its count of postures: the links are dropped)
-        if not blocks and s.startswith('#') and not s.startswith('# postures'):
-            head.append(line)
-    elif s and not s.startswith('#'):
-        cur[1].append(line)
-with open(sys.argv[2], 'w') as out:
-    out.writelines(head)
-    for title, postures in blocks:
-        out.write(title); out.writelines(reversed(postures))
-EOF
-}
+# Each pass block of a .cl (`# pass` lines start them; `# link` blocks dropped) in reverse order
+# (the corpus's helper, bench/reliability/corpus_scenes.py, makes the same reversed jobs).
+reverse_cl() { /usr/bin/python3 "$here/bench/reliability/corpus_scenes.py" --reverse "$1" "$2"; }
 
 # The jobs: impeller, impeller_rev, mesh, mesh_rev (each a scene.yaml in its folder).
 mkdir -p "$work/impeller" "$work/impeller_rev" "$work/mesh" "$work/mesh_rev"
