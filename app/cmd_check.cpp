@@ -27,6 +27,7 @@
 #include "fieldpath/common/short_number.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/tool_model.h"
+#include "fieldpath/geometry/units.h"
 #include "fieldpath/pathgen/clearance.h"
 #include "fieldpath/pathgen/generate.h"
 #include "fieldpath/pathgen/link_check.h"
@@ -71,7 +72,7 @@ std::pair<std::size_t, std::size_t> rapidsOntoPasses(const geometry::PathFile& p
     if (next < pass.end) {
       const geometry::Vec3 step = path.postures[next].tip_mm - path.postures[pass.begin].tip_mm;
       if (path.postures[pass.begin].axis.dot(step) <=
-          -std::cos(pathgen::kApproachDeg * M_PI / 180.0) * step.norm())
+          -std::cos(pathgen::kApproachDeg * geometry::kDegToRad) * step.norm())
         continue;
     }
     if (count++ == 0) first = end;

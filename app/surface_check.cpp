@@ -14,6 +14,7 @@
 #include "fieldpath/common/errors.h"
 #include "fieldpath/common/memory.h"
 #include "fieldpath/common/short_number.h"
+#include "fieldpath/geometry/units.h"
 #include "fieldpath/pathgen/clearance.h"
 #include "fieldpath/pathgen/passes.h"
 #include "fieldpath/zbuffer/outputs.h"
@@ -45,7 +46,7 @@ double scallopGridErrorUm(double scallop_um, double spacing_mm, double edge_mm, 
   if (!(scallop_um > 0.0) || !(edge_mm > 0.0)) return 0.0;
   const double reach_mm = spacing_mm / std::sqrt(2.0);
   const double theta = std::acos(std::clamp(n.z(), 0.0, 1.0));
-  const double steepest = 85.0 * M_PI / 180.0;
+  const double steepest = 85.0 * geometry::kDegToRad;
   double error_mm = 0.0;
   for (int round = 0; round < 4; ++round) {
     const double h = std::min(edge_mm, (1e-3 * scallop_um + error_mm) * std::cos(theta));

@@ -8,6 +8,7 @@
 
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/file_names.h"
+#include "fieldpath/geometry/units.h"
 
 #include "path_chunks.h"
 #include "path_text.h"
@@ -50,8 +51,7 @@ std::size_t PathFile::count(PathBlock::Kind kind) const {
 }
 
 void requireSteadyAxis(const PathFile& path, std::size_t before, std::size_t i) {
-  const double turn_deg =
-      axisAngle(path.postures[before].axis, path.postures[i].axis) * 180.0 / M_PI;
+  const double turn_deg = axisAngle(path.postures[before].axis, path.postures[i].axis) * kRadToDeg;
   if (turn_deg <= kMaxPassAxisTurnDeg) return;
   char turn[64], limit[64];
   std::snprintf(turn, sizeof turn, "%.4g", turn_deg);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "fieldpath/dynamics/params.h"
+#include "fieldpath/geometry/units.h"
 #include "fieldpath/pathgen/generate.h"  // kClearStartStepDeg
 
 namespace fieldpath::pathgen {
@@ -24,7 +25,7 @@ template <class Clearance>
 std::optional<std::pair<double, double>> clearStart(double lead0, double tilt0,
                                                     const dynamics::DynamicsParams& params,
                                                     Clearance&& clearance, double required_mm) {
-  const double step = kClearStartStepDeg * std::numbers::pi / 180.0;
+  const double step = kClearStartStepDeg * geometry::kDegToRad;
   const double max_lead = params.maxLeadRad(), max_tilt = params.maxTiltRad();
   std::vector<std::pair<int, int>> grid;
   const int nl = int(std::floor(2.0 * max_lead / step)) + 1,

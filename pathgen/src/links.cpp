@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/geometry/units.h"
 
 namespace fieldpath::pathgen {
 namespace {
@@ -38,7 +39,7 @@ class AxisTurn {
     first_rad_ = via_up_ ? angle(a, Vec3::UnitZ()) : angle(a, b);
     total_rad_ = first_rad_ + (via_up_ ? angle(Vec3::UnitZ(), b) : 0.0);
   }
-  double degrees() const { return total_rad_ * 180.0 / M_PI; }
+  double degrees() const { return total_rad_ * geometry::kRadToDeg; }
   /// The axis at fraction t of the turn (by angle).
   Vec3 at(double t) const {
     if (!via_up_) return slerp(a_, b_, t);
@@ -80,7 +81,7 @@ Vec3 travelPoint(const Posture& p, double z_mm, double retract_mm, const char* w
     std::ostringstream msg;
     msg.precision(3);
     msg << "links: " << pass << " " << which << " with the tool axis "
-        << std::acos(std::clamp(p.axis.z(), -1.0, 1.0)) * 180.0 / M_PI
+        << std::acos(std::clamp(p.axis.z(), -1.0, 1.0)) * geometry::kRadToDeg
         << " deg from vertical, pointing down: no link from the travel plane above reaches it "
            "(write its links in the nominal path and run `check` on it)";
     throw InputError(msg.str());

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fieldpath/geometry/units.h"
+
 namespace fieldpath::pathgen {
 namespace {
 
@@ -85,8 +87,8 @@ RotaryStray rotaryStray(std::span<const geometry::Posture> postures, const Motio
   const std::size_t said = out.first_beyond != RotaryStray::npos ? out.first_beyond : out.max_at;
   if (said != RotaryStray::npos) {
     const Vec3 &a = postures[said].axis, &b = postures[said + 1].axis;
-    out.c_deg = cTurn(anglesOf(a.normalized()), anglesOf(b.normalized())) * 180.0 / M_PI;
-    out.turn_deg = geometry::axisAngle(a, b) * 180.0 / M_PI;
+    out.c_deg = cTurn(anglesOf(a.normalized()), anglesOf(b.normalized())) * geometry::kRadToDeg;
+    out.turn_deg = geometry::axisAngle(a, b) * geometry::kRadToDeg;
   }
   return out;
 }

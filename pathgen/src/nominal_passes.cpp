@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/geometry/units.h"
 #include "fieldpath/pathgen/passes.h"
 
 namespace fieldpath::pathgen {
@@ -168,7 +169,7 @@ AxisTurn largestAxisTurn(const PathFile& path, double ball_radius_mm) {
   for (const auto& [begin, end] : ranges)
     for (std::size_t i = begin + 1; i < end; ++i) {
       const Posture &a = path.postures[i - 1], &b = path.postures[i];
-      const double deg = geometry::axisAngle(a.axis, b.axis) * 180.0 / M_PI;
+      const double deg = geometry::axisAngle(a.axis, b.axis) * geometry::kRadToDeg;
       if (out.at != AxisTurn{}.at && !(deg > out.deg)) continue;  // (the first pair counts)
       out.deg = deg;
       out.at = i - 1;
@@ -255,7 +256,7 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
       const Vec3 step = geometry::ballCentre(path.postures[neighbour], r) -
                         geometry::ballCentre(path.postures[begin], r);
       return std::abs(path.postures[begin].axis.dot(step)) >=
-             std::cos(kApproachDeg * M_PI / 180.0) * step.norm();
+             std::cos(kApproachDeg * geometry::kDegToRad) * step.norm();
     };
     const bool lone_approach =
         kept.size() < 2 && block != path.blocks.end() &&
@@ -326,7 +327,7 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
         std::ostringstream msg;
         msg.precision(3);
         msg << path.where(kept[k]) << ": the feed direction runs along the tool axis (angle "
-            << std::acos(std::min(1.0, std::abs(axis.dot(tangent)))) * 180.0 / M_PI
+            << std::acos(std::min(1.0, std::abs(axis.dot(tangent)))) * geometry::kRadToDeg
             << " deg): no frame for the dynamics (a plunge belongs in a link, after RAPID or "
                "`# link`)";
         throw InputError(msg.str());
@@ -334,7 +335,7 @@ std::vector<Pass> nominalPasses(const PathFile& path, const PathParams& params,
       line->tangent.push_back(tangent);
       line->normal.push_back(normal.normalized());
       const double lean_deg =
-          std::asin(std::min(1.0, std::abs(axis.normalized().dot(tangent)))) * 180.0 / M_PI;
+          std::asin(std::min(1.0, std::abs(axis.normalized().dot(tangent)))) * geometry::kRadToDeg;
       if (lean_deg > lean_max_deg) {
         lean_max_deg = lean_deg;
         lean_at = kept[k];

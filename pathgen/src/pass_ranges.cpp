@@ -6,6 +6,7 @@
 #include <cmath>
 #include <optional>
 
+#include "fieldpath/geometry/units.h"
 #include "fieldpath/pathgen/passes.h"
 
 namespace fieldpath::pathgen {
@@ -24,9 +25,9 @@ constexpr double kTurnBackCos = -0.5;
 /// How many feed directions the turn-back test remembers (repeats skipped).
 constexpr std::size_t kRecentSteps = 3;
 /// A step-over step runs within 60 deg of square to the leg: |cos| under cos 30 deg.
-const double kSquareToLegCos = std::cos(30.0 * M_PI / 180.0);
+const double kSquareToLegCos = std::cos(30.0 * geometry::kDegToRad);
 /// The return leg runs within 30 deg of the leg reversed: cos under -cos 30 deg.
-const double kReverseOfLegCos = std::cos(30.0 * M_PI / 180.0);
+const double kReverseOfLegCos = std::cos(30.0 * geometry::kDegToRad);
 /// A run of ball centres is straight where its chord is at least this fraction of its path.
 constexpr double kStraightChord = 0.9;
 

@@ -11,6 +11,7 @@
 #include "fieldpath/dynamics/frame.h"
 #include "fieldpath/dynamics/reversed_pass.h"
 #include "fieldpath/geometry/posture.h"
+#include "fieldpath/geometry/units.h"
 #include "fieldpath/pathgen/passes.h"
 
 namespace fieldpath::pathgen {
@@ -51,7 +52,7 @@ double largestTurnDeg(const dynamics::SteeringResult& run) {
   for (std::size_t k = 1; k < run.samples.size(); ++k)
     largest_rad = std::max(largest_rad, geometry::axisAngle(run.samples[k - 1].posture.axis,
                                                             run.samples[k].posture.axis));
-  return largest_rad * 180.0 / std::numbers::pi;
+  return largest_rad * geometry::kRadToDeg;
 }
 
 /// One way along `pass` (the pass itself, or reversedPass of it): the start settled where

@@ -9,6 +9,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "fieldpath/geometry/units.h"
+
 namespace fieldpath::geometry {
 
 using Vec3 = Eigen::Vector3d;
@@ -70,7 +72,7 @@ inline double motionSweepMm(const Posture& a, const Posture& b, double reach_mm)
 /// steps apart, a reviewer's finding). Turns past 179 deg count as 179 (an axis turned over is
 /// refused or marked by its own check; tan would ask for millions of stamps).
 inline double motionSteps(const Posture& a, const Posture& b, double reach_mm, double step_mm) {
-  const double turn_rad = std::min(axisAngle(a.axis, b.axis), 179.0 * std::numbers::pi / 180.0);
+  const double turn_rad = std::min(axisAngle(a.axis, b.axis), 179.0 * kDegToRad);
   return std::ceil(((b.tip_mm - a.tip_mm).norm() + reach_mm * 2.0 * std::tan(0.5 * turn_rad)) /
                    step_mm);
 }
