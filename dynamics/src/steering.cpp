@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <numbers>
 #include <sstream>
 
 #include <Eigen/Eigenvalues>
@@ -23,7 +22,8 @@ using detail::momentOfNodes;
 using detail::offsetsFromCentre;
 using detail::placeNodes;
 
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+using geometry::kDegToRad;
+using geometry::kRadToDeg;
 constexpr int kStateSize = 4;  ///< lead, tilt (rad), lead rate, tilt rate (rad/s)
 
 void requireThat(bool ok, const char* key, const char* condition, double value) {
@@ -250,7 +250,7 @@ LimitCheck checkAngles(const DynamicsParams& p, LimitPolicy policy,
     }
     std::ostringstream msg;
     msg.precision(4);
-    msg << a.name << " " << y[a.index] * kDegPerRad << "° exceeds " << a.key << " = " << a.max_deg
+    msg << a.name << " " << y[a.index] * kRadToDeg << "° exceeds " << a.key << " = " << a.max_deg
         << "°";
     out.status = Status::TiltLimit;
     out.what = msg.str();
@@ -328,7 +328,7 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
   const std::vector<double> stations = outputStations(pass, request);
   const long intervals = static_cast<long>(stations.size()) - 1;
   result.samples.reserve(stations.size());
-  const double max_change_rad_per_mm = request.max_angle_change_deg_per_mm / kDegPerRad;
+  const double max_change_rad_per_mm = request.max_angle_change_deg_per_mm * kDegToRad;
   const long report_every = std::max(1L, intervals / 100);
 
   // The damping's grid (kDampingSpacingMm): point `update` is the next it takes; a point within
@@ -420,7 +420,7 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
         if (request.params.on_limit == LimitPolicy::Fail) {
           std::ostringstream msg;
           msg.precision(4);
-          msg << "axis turned " << change / ds_mm * kDegPerRad << "°/mm, over the limit of "
+          msg << "axis turned " << change / ds_mm * kRadToDeg << "°/mm, over the limit of "
               << request.max_angle_change_deg_per_mm << "°/mm";
           check.status = Status::RateLimit;
           check.what = msg.str();
@@ -450,7 +450,7 @@ SteeringResult steerPass(const Pass& pass, const SteeringRequest& request) {
       } catch (const common::InputError&) {
         framed = false;
       }
-      if (framed && from.f.dot(to.f) < std::cos(kCornerTurnDeg / kDegPerRad)) {
+      if (framed && from.f.dot(to.f) < std::cos(kCornerTurnDeg * kDegToRad)) {
         ++result.corners;
         if (request.hold_corners) {
           hold = {true, from.f, until_mm};

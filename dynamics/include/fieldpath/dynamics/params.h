@@ -1,6 +1,8 @@
 #pragma once
 #include <cmath>
-#include <numbers>
+
+#include "fieldpath/geometry/units.h"
+
 /// Settings of the tool-axis dynamics (scene `dynamics:` block). Defaults documented here, once.
 
 namespace fieldpath::dynamics {
@@ -45,8 +47,8 @@ struct DynamicsParams {
 
   /// The angle limits in radians, as the steering holds them (one conversion for every user: a
   /// clear start on a grid converted otherwise lay 3e-17 rad over the steering's limit).
-  double maxTiltRad() const { return max_tilt_deg / (180.0 / std::numbers::pi); }
-  double maxLeadRad() const { return max_lead_deg / (180.0 / std::numbers::pi); }
+  double maxTiltRad() const { return max_tilt_deg * geometry::kDegToRad; }
+  double maxLeadRad() const { return max_lead_deg * geometry::kDegToRad; }
 
   /// c, with the critical default resolved for the spring alone (a field adds its stiffness
   /// during a pass: steering.cpp).
