@@ -11,6 +11,18 @@ Usage: corpus_scenes.py OUT_DIR            writes OUT_DIR/JOB/ for every job, an
                                           blocks dropped (ab_jobs.sh's reverse_cl)
        corpus_scenes.py --unguide IN OUT   the impeller scene IN with its passes read from rev.cl
                                           (no `guide`, the `path` block replaced)
+       corpus_scenes.py --apt IN OUT       IN's passes as APT CLDATA the way a CAM system writes it
+                                          (OUT .apt or .cls; see write_apt)
+       corpus_scenes.py --npy IN OUT f4|f8 6|7
+                                          IN's postures as .npy, float32 or float64, N x 6 or N x 7
+                                          (a 7th column: a spindle angle); no pass markers
+       corpus_scenes.py --shift IN OUT X0 X1 DY
+                                          IN with the tips of x in [X0, X1] moved DY along y: a
+                                          deliberate collision for `check` of a path fieldpath did
+                                          not write
+       corpus_scenes.py --small-impeller IN OUT
+                                          the impeller scene IN cut to 3 passes over u 0..0.4: a
+                                          `study` that takes seconds, not minutes
 
 Jobs (units mm, degrees; the floor, the `part`, is z <= 0 unless said):
   corner_away_T_rR    a pass along x at y = 0, 4.5 mm from a straight wall (y 4.5..8.5, 31 high)
@@ -651,11 +663,134 @@ def unguide(src, dst):
     open(dst, "w").write(text)
 
 
+# ---- the same paths in the other formats (DESIGN.md: path.nominal reads .cl, APT and .npy) ---------
+def read_cl(src):
+    """The passes of a .cl: lists of the 6 numbers of each posture, as written (strings: the APT
+    copy then carries the very digits of the .cl); `# pass` or a blank line starts a pass, `# link`
+    blocks are dropped."""
+    passes, cur = [], []
+    in_link = False
+    for line in open(src):
+        s = line.split("#", 1)[0].split()
+        c = line.strip()
+        if c.startswith("# pass") or not c:
+            in_link = False
+            if cur:
+                passes.append(cur)
+            cur = []
+        elif c.startswith("# link"):
+            in_link = True
+            if cur:
+                passes.append(cur)
+            cur = []
+        elif s and not in_link:
+            cur.append(s[:6])
+    if cur:
+        passes.append(cur)
+    return passes
+
+
+def apt_num(t):
+    """Fixed 6 decimals as posts print them (30 -> 30.000000): the corpus' .cl values exactly (it
+    writes 6 decimals at most), so the APT job reads the .cl job's postures; make_part.py's to 1e-6 mm."""
+    out = f"{float(t):.6f}"
+    return "0.000000" if out == "-0.000000" else out
+
+
+def write_apt(dst, passes, source):
+    """APT CLDATA as CAM systems write it (DESIGN.md "Passes from a nominal path"): `GOTO / x, y, z,
+    i, j, k` with spaces, 6-value GOTOs split over two lines by a `$` continuation, a GOTO with 3
+    values where the axis is the last one's (kept by the reader), `$$` comments and records the
+    reader reads past (TLDATA, LOAD/TOOL, SPINDL, COOLNT, PAINT, MSYS, TOOL PATH, END-OF-PATH); each
+    pass: RAPID to 10 mm above its first posture along the axis, FEDRAT, the feed moves, RAPID up
+    10 mm again (the rapids are links: the reader drops them, so the passes are exactly IN's)."""
+    lines = [f"$$ corpus_scenes.py --apt {source}: the passes of {source} as a CAM system posts them",
+             "PARTNO/CORPUS", "UNITS/MM", "MULTAX/ON", "MSYS/0.0,0.0,0.0,1.0,0.0,0.0,0.0,1.0,0.0",
+             "TOOL PATH/FINISH,TOOL,BALL6", "TLDATA/MILL,6.0000,3.0000,35.0000,0.0000,0.0000",
+             "LOAD/TOOL,1,ADJUST,1", "CUTTER/6.000000,3.000000,0.000000,3.000000,0.000000,0.000000,35.000000",
+             "SPINDL/RPM,12000,CLW", "COOLNT/ON", "PAINT/COLOR,186"]
+    last_axis = None
+
+    def goto(xyz, axis):
+        nonlocal last_axis
+        if axis == last_axis:
+            return [f"GOTO / {xyz[0]}, {xyz[1]}, {xyz[2]}"]
+        last_axis = axis
+        return [f"GOTO / {xyz[0]}, {xyz[1]}, {xyz[2]}, $", f"       {axis[0]}, {axis[1]}, {axis[2]}"]
+
+    def lifted(q):
+        v = [float(t) for t in q]
+        return tuple(apt_num(str(v[i] + 10.0 * v[i + 3])) for i in range(3))
+
+    for k, p in enumerate(passes, 1):
+        first, last = p[0], p[-1]
+        lines += [f"$$ pass {k}: {len(p)} postures", "PAINT/COLOR,37", "RAPID"]
+        lines += goto(lifted(first), tuple(apt_num(t) for t in first[3:6]))
+        lines += ["PAINT/COLOR,186", "FEDRAT/MMPM,1000.0000"]
+        for q in p:
+            lines += goto(tuple(apt_num(t) for t in q[:3]), tuple(apt_num(t) for t in q[3:6]))
+        lines += ["RAPID"]
+        lines += goto(lifted(last), tuple(apt_num(t) for t in last[3:6]))
+    lines += ["COOLNT/OFF", "SPINDL/OFF", "END-OF-PATH", "FINI"]
+    with open(dst, "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def write_npy(dst, passes, dtype, cols):
+    """NumPy format 1.0 by hand (stdlib only): '<f4' or '<f8', shape (N, cols), C order; the 7th
+    column a spindle angle (0.1 rad a posture, mod 2 pi: the reader keeps or ignores it, never
+    reads it as a pass break). No pass markers: the reader splits the passes where two tips lie
+    farther apart than path.pass_gap (the corpus' passes lie 2.5 mm apart, steps 0.5 mm)."""
+    rows = [[float(t) for t in q] for p in passes for q in p]
+    if cols == 7:
+        rows = [r + [math.fmod(0.1 * n, 2 * math.pi)] for n, r in enumerate(rows)]
+    header = f"{{'descr': '<{dtype}', 'fortran_order': False, 'shape': ({len(rows)}, {cols}), }}"
+    header += " " * ((64 - (10 + len(header) + 1) % 64) % 64) + "\n"
+    code = "<" + ("f" if dtype == "f4" else "d") * cols
+    with open(dst, "wb") as f:
+        f.write(b"\x93NUMPY\x01\x00" + struct.pack("<H", len(header)) + header.encode("latin1"))
+        for r in rows:
+            f.write(struct.pack(code, *r))
+
+
+def shift_cl(src, dst, x0, x1, dy):
+    """The .cl with the tips of x0 <= x <= x1 moved dy along y (comments kept)."""
+    out = []
+    for line in open(src):
+        s = line.split()
+        if s and not line.lstrip().startswith("#") and x0 <= float(s[0]) <= x1:
+            s[1] = fmt(float(s[1]) + dy)
+            line = " ".join(s) + "\n"
+        out.append(line)
+    open(dst, "w").writelines(out)
+
+
+def small_impeller(src, dst):
+    """The impeller scene with 3 passes over the first 40 % of the channel (study's lines and its
+    middle pass stay in it)."""
+    import re
+    text = open(src).read()
+    text, n1 = re.subn(r"^(\s+u_range:\s*)\[0, 1\]", r"\g<1>[0, 0.4]", text, flags=re.M)
+    text, n2 = re.subn(r"^(\s+passes:\s*)7\b", r"\g<1>3", text, flags=re.M)
+    if n1 != 1 or n2 != 1:
+        sys.exit(f"small_impeller: {src}: no `u_range: [0, 1]` or `passes: 7` to change")
+    open(dst, "w").write(text)
+
+
 if __name__ == "__main__":
     if len(sys.argv) == 4 and sys.argv[1] == "--reverse":
         reverse_cl(sys.argv[2], sys.argv[3])
     elif len(sys.argv) == 4 and sys.argv[1] == "--unguide":
         unguide(sys.argv[2], sys.argv[3])
+    elif len(sys.argv) == 4 and sys.argv[1] == "--apt":
+        write_apt(sys.argv[3], read_cl(sys.argv[2]), os.path.basename(sys.argv[2]))
+    elif len(sys.argv) == 6 and sys.argv[1] == "--npy" and sys.argv[4] in ("f4", "f8") \
+            and sys.argv[5] in ("6", "7"):
+        write_npy(sys.argv[3], read_cl(sys.argv[2]), sys.argv[4], int(sys.argv[5]))
+    elif len(sys.argv) == 7 and sys.argv[1] == "--shift":
+        shift_cl(sys.argv[2], sys.argv[3], *map(float, sys.argv[4:]))
+    elif len(sys.argv) == 4 and sys.argv[1] == "--small-impeller":
+        small_impeller(sys.argv[2], sys.argv[3])
     elif len(sys.argv) == 2 and not sys.argv[1].startswith("-"):
         jobs = make_all(sys.argv[1])
         print(f"corpus_scenes: {len(jobs)} jobs in {sys.argv[1]}")
