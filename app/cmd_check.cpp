@@ -352,8 +352,10 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
         {"passes", path.count(geometry::PathBlock::Kind::Pass)},
         {"passes_split_at_gaps", passesSplitAtGaps(path, scene)},
         {"links", path.count(geometry::PathBlock::Kind::Link)},
-        {"clearance", clearanceJson(clearance, scene.clearance_mm,
-                                    pathgen::clearanceMeshTolMm(scene.tool, scene.holder))},
+        {"clearance",
+         clearanceJson(
+             clearance, scene.clearance_mm, pathgen::clearanceMeshTolMm(scene.tool, scene.holder),
+             clearance.min_obstacle < 0 ? "" : obstacleName(scene, clearance.min_obstacle))},
         {"motions", motionsJson(motions, scene.clearance_mm, motion_request.resolution_mm)},
         {"link_part", linkPartJson(link_part)},
         {"link_part_skipped",

@@ -499,11 +499,11 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
       const auto& b = result.balls_under_clearance.front();
       std::fprintf(stderr,
                    "warning: %zu pass%s the ball itself within `clearance` of an obstacle "
-                   "(first: %s at s = %.3f mm, %.6g mm from obstacle %d): its centre is held, no "
+                   "(first: %s at s = %.3f mm, %.6g mm from %s): its centre is held, no "
                    "axis clears it (report.json balls_under_clearance)\n",
                    result.balls_under_clearance.size(),
                    result.balls_under_clearance.size() == 1 ? " runs" : "es run", b.label.c_str(),
-                   b.s_mm, b.clearance_mm, b.obstacle + 1);
+                   b.s_mm, b.clearance_mm, obstacleName(scene, b.obstacle).c_str());
     }
     for (const std::string& why : result.loosened_solver)
       std::fprintf(stderr, "warning: %s (report.json solver.loosened)\n", why.c_str());

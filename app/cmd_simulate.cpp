@@ -443,7 +443,11 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
                    part                       ? "the top of --part"
                    : !std::isnan(o->stock_mm) ? "--stock"
                                               : "the stock at the highest tip, the default",
-                   part ? " instead of --part" : "");
+                   // A user read "nothing cut" on the part as "no gouge": the moves between
+                   // postures are not stamped (a chord over a convex part gouged 141 um).
+                   part ? " instead of --part (simulate stamps the postures, not the moves "
+                          "between them: `fieldpath check` finds a move's gouge)"
+                        : "");
     // From the part's top a finishing path lowers only the lines where it enters the part: a
     // CAM engineer's raster changed 0.2 % of them and read as the path's surface, scallops and
     // all (they stand above the part, where the stock already is).

@@ -43,7 +43,8 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
                            {"at", b.label},
                            {"s_mm", b.s_mm},
                            {"ball_clearance_mm", b.clearance_mm},
-                           {"obstacle", b.obstacle + 1}});
+                           {"obstacle", b.obstacle + 1},
+                           {"obstacle_name", obstacleName(scene, b.obstacle)}});
   json settle_failures = json::array();
   for (const auto& f : r.settle_failures)
     settle_failures.push_back({{"pass", f.pass + 1}, {"why", f.why}});
@@ -110,8 +111,10 @@ nlohmann::json reportJson(const Scene& scene, const pathgen::GenerateRequest& jo
        {{"min", {box.min().x(), box.min().y(), box.min().z()}},
         {"max", {box.max().x(), box.max().y(), box.max().z()}},
         {"volume_cm3", box.volume() / 1000.0}}},
-      {"clearance", clearanceJson(r.clearance, job.clearance_mm,
-                                  pathgen::clearanceMeshTolMm(job.tool, job.holder))},
+      {"clearance",
+       clearanceJson(
+           r.clearance, job.clearance_mm, pathgen::clearanceMeshTolMm(job.tool, job.holder),
+           r.clearance.min_obstacle < 0 ? "" : obstacleName(scene, r.clearance.min_obstacle))},
       {"motions", motionsJson(r.motions, job.clearance_mm, pathgen::MotionRequest{}.resolution_mm)},
       {"link_part", linkPartJson(r.link_part)},
       {"holder_part", holderPartJson(r.holder_part)},

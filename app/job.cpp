@@ -73,8 +73,8 @@ pathgen::GenerateRequest sceneJob(const Scene& scene) {
     const pathgen::GapSplit& g = dropped.gaps.front();
     std::fprintf(stderr,
                  "note: %zu move%s farther than path.pass_gap (%s: %s mm) made into link%s "
-                 "between passes, not cut (first: %s to %s, %s mm): set path.pass_gap above a "
-                 "cutting move that long\n",
+                 "between passes, not cut (first: %s to %s, %s mm): where such a move is meant "
+                 "to cut, set path.pass_gap above its length\n",
                  dropped.gaps.size(), dropped.gaps.size() == 1 ? "" : "s",
                  job.path.pass_gap_mm > 0.0 ? "given" : "4 x the pass's median step",
                  common::shortNumber(g.gap_mm).c_str(), dropped.gaps.size() == 1 ? "" : "s",

@@ -17,11 +17,13 @@ nlohmann::json jsonNumber(double value) {
 }
 
 nlohmann::json clearanceJson(const pathgen::ClearanceResult& c, double required_mm,
-                             double chord_tol_mm) {
+                             double chord_tol_mm, const std::string& min_obstacle_name) {
   return {{"required_mm", required_mm},
           {"min_mm", jsonNumber(c.min_clearance_mm)},
           {"min_posture", jsonIndex(c.min_index)},
           {"min_obstacle", c.min_obstacle + 1},
+          {"min_obstacle_name",
+           min_obstacle_name.empty() ? nlohmann::json(nullptr) : nlohmann::json(min_obstacle_name)},
           {"colliding_postures", c.colliding},
           {"first_colliding_posture", jsonIndex(c.first_colliding)},
           {"tool_mesh_chord_tol_mm", chord_tol_mm},
@@ -219,6 +221,13 @@ std::string collidingPasses(const geometry::PathFile& path, const std::vector<do
   return " in " + text;
 }
 
+/// "1 posture touches", "2 postures touch": a count, its noun and verb agreed ("1 postures
+/// touch" read as a typo to a user).
+std::string counted(std::size_t n, const std::string& noun, const std::string& verb) {
+  return std::to_string(n) + " " + noun +
+         (n == 1 ? " " + verb + (verb == "touch" ? "es" : "s") : "s " + verb);
+}
+
 std::vector<std::string> unsafeReasons(const geometry::PathFile& path,
                                        const pathgen::ClearanceResult& c,
                                        const pathgen::MotionResult& m,
@@ -243,26 +252,24 @@ std::vector<std::string> unsafeReasons(const geometry::PathFile& path,
   };
   if (c.colliding) {
     const std::string in = collidingPasses(path, c.clearance_mm);
-    out.push_back(std::to_string(c.colliding) + " postures touch an obstacle (first: " +
+    out.push_back(counted(c.colliding, "posture", "touch") + " an obstacle (first: " +
                   posture(c.first_colliding) + (in.empty() ? "" : ";" + in) + ")");
   }
   if (m.colliding)
-    out.push_back(std::to_string(m.colliding) +
-                  " motions touch an obstacle (first: " + motion(m.first_colliding) + ")");
+    out.push_back(counted(m.colliding, "motion", "touch") +
+                  " an obstacle (first: " + motion(m.first_colliding) + ")");
   if (l && l->colliding_postures)
-    out.push_back(std::to_string(l->colliding_postures) + " link postures touch the part (first: " +
-                  posture(l->first_colliding_posture) + ")");
+    out.push_back(counted(l->colliding_postures, "link posture", "touch") +
+                  " the part (first: " + posture(l->first_colliding_posture) + ")");
   if (l && l->colliding_motions)
-    out.push_back(std::to_string(l->colliding_motions) + " link motions touch the part (first: " +
-                  motion(l->first_colliding_motion) + ")");
+    out.push_back(counted(l->colliding_motions, "link motion", "touch") +
+                  " the part (first: " + motion(l->first_colliding_motion) + ")");
   if (h && h->colliding_postures)
-    out.push_back(std::to_string(h->colliding_postures) +
-                  " postures put the holder into the part (first: " +
-                  posture(h->first_colliding_posture) + ")");
+    out.push_back(counted(h->colliding_postures, "posture", "put") +
+                  " the holder into the part (first: " + posture(h->first_colliding_posture) + ")");
   if (h && h->colliding_motions)
-    out.push_back(
-        std::to_string(h->colliding_motions) +
-        " motions put the holder into the part (first: " + motion(h->first_colliding_motion) + ")");
+    out.push_back(counted(h->colliding_motions, "motion", "put") +
+                  " the holder into the part (first: " + motion(h->first_colliding_motion) + ")");
   return out;
 }
 

@@ -23,9 +23,10 @@ nlohmann::json jsonIndex(std::size_t i);
 nlohmann::json jsonNumber(double value);
 
 /// The `clearance` block of report.json and check.json (posture and obstacle indices 0- and
-/// 1-based as printed; null when there is none).
+/// 1-based as printed; null when there is none); `min_obstacle_name` names the nearest obstacle
+/// as the scene gives it (app/scene.h obstacleName; empty: null).
 nlohmann::json clearanceJson(const pathgen::ClearanceResult& c, double required_mm,
-                             double chord_tol_mm);
+                             double chord_tol_mm, const std::string& min_obstacle_name);
 
 /// The `motions` block of report.json and check.json (motion i: posture i → i + 1).
 nlohmann::json motionsJson(const pathgen::MotionResult& m, double required_mm,

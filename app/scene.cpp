@@ -100,6 +100,13 @@ YAML::Node valueNamedIn(const YAML::Node& map, const std::string& message) {
   return best;
 }
 
+std::string obstacleName(const Scene& scene, std::size_t index) {
+  if (index < scene.obstacle_files.size() && index < scene.obstacle_keys.size())
+    return scene.obstacle_keys[index] + " (" + scene.obstacle_files[index].filename().string() +
+           ")";
+  return "the impeller's blade " + std::to_string(index + 1 - scene.obstacle_files.size());
+}
+
 std::string sceneWhere(const Scene& scene, const std::string& key) {
   const SceneKeyLines& keys = sceneKeyLines();
   const auto at = keys.lines.find(key);

@@ -89,6 +89,11 @@ std::filesystem::path nominalPathOf(const std::filesystem::path& file);
 /// line put in front, as the scene's own checks write them. Any other message as it is.
 std::string placeSceneKey(const std::string& message);
 
+/// Obstacle `index` (0-based, in scene.obstacles' order) as a user finds it in the scene:
+/// "obstacles[2] (pin.stl)" (the list's 1-based key and the file), or "the impeller's blade 3".
+/// Reports and messages name the file, not only a number ("obstacle 8" sent a user counting).
+std::string obstacleName(const Scene& scene, std::size_t index);
+
 /// "FILE:LINE: key" (LINE where the scene gives the key): the start of a refusal of one setting.
 std::string sceneWhere(const Scene& scene, const std::string& key);
 

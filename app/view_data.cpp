@@ -242,7 +242,23 @@ geometry::TriangleMesh decimateMesh(const geometry::TriangleMesh& mesh, std::siz
 
 ViewData gatherView(const ViewRequest& request) {
   ViewData d;
-  const Scene scene = loadScene(request.scene);
+  // Given its own path, view reads it beside a scene whose path.nominal is stale or gone, as
+  // check does (a helper's: view refused what check and simulate read); the passes' frames, and
+  // so the lead and tilt, are then not known, and a note says why.
+  std::string nominal_unread;
+  const Scene scene = [&] {
+    if (request.path.empty()) return loadScene(request.scene);
+    try {
+      return loadScene(request.scene);
+    } catch (const InputError& e) {
+      Scene given = loadScene(request.scene, SceneUse::kPathGiven);  // throws if not the nominal
+      nominal_unread = e.what();
+      return given;
+    }
+  }();
+  if (!nominal_unread.empty())
+    d.notes.push_back("the scene's path.nominal is not read (" + nominal_unread +
+                      "): --path is shown without the passes' lead and tilt");
   d.scene_file = scene.file;
   for (std::size_t i = 0; i < scene.obstacles.size(); ++i) {
     ViewMesh m;
@@ -320,10 +336,23 @@ ViewData gatherView(const ViewRequest& request) {
     Eigen::AlignedBox3d near = d.box;
     near.min().array() -= margin;
     near.max().array() += margin;
-    for (std::size_t i = 0; i < n; ++i)
-      if (!near.contains(postures[i].tip_mm)) {
-        if (p.outside++ == 0) p.first_outside = i;
+    // Link postures are told apart: generate's links climb the last posture's axis to safe_z,
+    // which on a steep axis ends far aside (a blisk's links 150 mm out, in the red banner as if
+    // the path were another scene's); said in a note, the banner kept for the cutting postures.
+    std::vector<bool> link(n, false);
+    for (const geometry::PathBlock& block : p.file.blocks)
+      if (block.kind == geometry::PathBlock::Kind::Link)
+        for (std::size_t i = block.begin; i < block.end && i < n; ++i) link[i] = true;
+    const std::size_t links = std::size_t(std::count(link.begin(), link.end(), true));
+    std::size_t links_outside = 0, first_link_outside = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (near.contains(postures[i].tip_mm)) continue;
+      if (link[i]) {
+        if (links_outside++ == 0) first_link_outside = i;
+      } else if (p.outside++ == 0) {
+        p.first_outside = i;
       }
+    }
     auto boxText = [&] {
       std::ostringstream s;
       s.precision(4);
@@ -334,12 +363,22 @@ ViewData gatherView(const ViewRequest& request) {
     if (p.outside > 0) {
       std::ostringstream s;
       s.precision(4);
-      s << p.outside << " of " << n << " postures lie more than " << margin
-        << " mm outside the scene's meshes (" << boxText() << "), the first at posture "
-        << p.first_outside << " (" << p.file.where(p.first_outside) << ")";
-      if (2 * p.outside > n)
+      s << p.outside << " of " << n - links << (links ? " cutting" : "")
+        << " postures lie more than " << margin << " mm outside the scene's meshes (" << boxText()
+        << "), the first at posture " << p.first_outside << " (" << p.file.where(p.first_outside)
+        << ")";
+      if (2 * p.outside > n - links)
         throw InputError(p.file.file.string() + ": " + s.str() + ": a path for another scene?");
       d.warnings.push_back(s.str());
+    }
+    if (links_outside > 0) {
+      std::ostringstream s;
+      s.precision(4);
+      s << links_outside << " of " << links << " link postures lie more than " << margin
+        << " mm outside the scene's meshes, the first at posture " << first_link_outside << " ("
+        << p.file.where(first_link_outside)
+        << "): a link climbs the tool axis to links.safe_z, far aside where the axis is steep";
+      d.notes.push_back(s.str());
     }
     // With a part, the passes' tips lie on it: the margin above (the holder's reach) let an inch
     // file over a part 5 mm wide pass (its postures 41 mm outside, a helper's). A pass posture

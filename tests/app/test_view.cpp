@@ -117,15 +117,44 @@ TEST(View, AFewPosturesOutsideTheSceneAreShownWithAWarning) {
   // path for it all the same.
   dir.write("runoff.cl", pathCl(25));
   EXPECT_EQ(runFieldpath(dir, "view scene.yaml --path runoff.cl --out r.html").exit_code, 0);
-  dir.write("home.cl", pathCl() + "# link\n0 0 10000 0 0 1\n");
-  const Outcome r = runFieldpath(dir, "view scene.yaml --path home.cl --out v.html");
+  // A cutting posture far out is warned of in the banner; a link posture far out (a home
+  // position, or generate's link climbing a steep axis to safe_z) is a note beside the page.
+  for (const bool in_link : {false, true}) {
+    dir.write("home.cl", pathCl() + (in_link ? "# link\n" : "") + "0 0 10000 0 0 1\n");
+    const Outcome r = runFieldpath(dir, "view scene.yaml --path home.cl --out v.html");
+    ASSERT_EQ(r.exit_code, 0) << r.output();
+    const json meta = pageMeta(slurp(dir.path() / "v.html"));
+    EXPECT_EQ(meta["path"]["counts"]["postures"], 83);
+    const auto says = [&meta](const char* list, const std::string& text) {
+      bool said = false;
+      for (const auto& w : meta[list])
+        said = said || w.get<std::string>().find(text) != std::string::npos;
+      return said;
+    };
+    EXPECT_EQ(says("warnings", "postures lie more than"), !in_link) << meta["warnings"];
+    EXPECT_EQ(says("notes", "link postures lie more than"), in_link) << meta["notes"];
+    if (!in_link)
+      EXPECT_TRUE(says("warnings", "1 of 81 cutting postures lie more than")) << meta["warnings"];
+  }
+}
+
+// Given --path, view shows it beside a scene whose own path.nominal is gone, as check reads it
+// (a helper's: view alone refused); the note says the passes' angles are not known. Without
+// --path, the scene's nominal path is the one shown: its absence is still exit 1.
+TEST(View, ShowsItsPathBesideASceneWhoseNominalIsGone) {
+  const TempDir dir;
+  writeBlockScene(dir);  // path: { nominal: path.cl }
+  std::filesystem::rename(dir.path() / "path.cl", dir.path() / "other.cl");
+  const Outcome r = runFieldpath(dir, "view scene.yaml --path other.cl --out v.html");
   ASSERT_EQ(r.exit_code, 0) << r.output();
   const json meta = pageMeta(slurp(dir.path() / "v.html"));
-  EXPECT_EQ(meta["path"]["counts"]["postures"], 83);
-  bool said = false;
-  for (const auto& w : meta["warnings"])
-    said = said || w.get<std::string>().find("1 of 83 postures lie more than") != std::string::npos;
-  EXPECT_TRUE(said) << meta["warnings"];
+  EXPECT_EQ(meta["path"]["counts"]["postures"], 82);
+  ASSERT_FALSE(meta["notes"].empty());
+  EXPECT_NE(meta["notes"][0].get<std::string>().find("path.nominal is not read"), std::string::npos)
+      << meta["notes"];
+  const Outcome none = runFieldpath(dir, "view scene.yaml --out w.html");
+  EXPECT_EQ(none.exit_code, 1) << none.output();
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "w.html"));
 }
 
 TEST(View, BadInputIsExitOneWithOneLineOrAPageThatSaysWhatIsMissing) {

@@ -319,10 +319,12 @@ TEST(CheckClearance, AMoveBetweenTwoPassesIsNamedWithThePassItLeaves) {
   ASSERT_EQ(c.exit_code, 0) << c.output();
   const auto checked = nlohmann::json::parse(test::slurp(dir.path() / "chk" / "check.json"));
   EXPECT_EQ(checked["clearance"]["colliding_postures"].get<int>(), 0) << checked["clearance"];
+  // The nearest obstacle named as the scene gives it, not only numbered (a user counted files).
+  EXPECT_EQ(checked["clearance"]["min_obstacle_name"], "obstacles[1] (post.stl)");
   ASSERT_EQ(checked["unsafe"].size(), 1u) << checked["unsafe"];
   // Posture 10, the last of pass 1, on line 12 of the file.
   EXPECT_NE(checked["unsafe"][0].get<std::string>().find(
-                "motions touch an obstacle (first: posture 10 to the next (pass 1, two.cl:12))"),
+                "1 motion touches an obstacle (first: posture 10 to the next (pass 1, two.cl:12))"),
             std::string::npos)
       << checked["unsafe"];
   EXPECT_EQ(checked["passes"].get<int>(), 2);
