@@ -12,9 +12,14 @@
 
 namespace fieldpath::dynamics::detail {
 
-/// Places the nodes (offsets from the ball centre, tool frame) at axis a: world frame, mm.
+/// Places the nodes (offsets from the ball centre, tool frame) at axis a: world frame, mm. The
+/// tool frame's x goes to the feed `f` made square to a, y to a × that, z to a (the minimal
+/// rotation from e_z where a ∥ f): the nodes then mirror with the axis across the plane normal
+/// to the feed, so that a wall symmetric about that plane gives no lead torque at lead 0 (placed by
+/// the minimal rotation from e_z, the rings' stagger turned with the pass's heading and a lone
+/// node nearest the wall pushed the lead 2-3° beside a straight wall: dynamics.md 2026-12-01).
 void placeNodes(std::span<const Vec3> offsets_mm, const Vec3& centre_mm, const Vec3& axis,
-                std::vector<Vec3>& nodes_mm);
+                const Vec3& feed, std::vector<Vec3>& nodes_mm);
 
 /// Places the nodes at the axis of (lead, tilt) and sums their moment about the ball centre.
 AxisMoment momentOfNodes(const field::ForceField& field, std::span<const Vec3> offsets_mm,

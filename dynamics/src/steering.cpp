@@ -180,7 +180,8 @@ class SteeringSystem final : public detail::OdeSystem {
     out.posture = geometry::ballEndPosture(frames.pass.centre_mm, axis, request_.ball_radius_mm);
     out.clearance_mm = std::numeric_limits<double>::quiet_NaN();
     if (request_.clearance) {
-      if (!request_.field) placeNodes(offsets_mm_, frames.pass.centre_mm, axis, nodes_mm_);
+      if (!request_.field)
+        placeNodes(offsets_mm_, frames.pass.centre_mm, axis, frames.local.f, nodes_mm_);
       out.clearance_mm = request_.clearance(nodes_mm_);
     }
     return out;

@@ -457,7 +457,7 @@ std::vector<SurfaceNode> surfaceNodes(const ToolSpec& tool, const HolderProfile&
   double nodes_estimate = 0;
   for (const auto& s : profile)
     nodes_estimate +=
-        (s.length() / spacing_mm + 2) * (2 * kPi * std::max(s.from.x(), s.to.x()) / spacing_mm + 1);
+        (s.length() / spacing_mm + 2) * (2 * kPi * std::max(s.from.x(), s.to.x()) / spacing_mm + 2);
   if (nodes_estimate > kMaxNodes)
     throw InputError("node spacing " + std::to_string(spacing_mm) + " mm is too fine: about " +
                      std::to_string(static_cast<long long>(nodes_estimate)) + " nodes");
@@ -469,7 +469,9 @@ std::vector<SurfaceNode> surfaceNodes(const ToolSpec& tool, const HolderProfile&
       nodes.push_back({Vec3(0.0, 0.0, q.y()), Vec3(0.0, 0.0, n.y()), s.part});
       return;
     }
-    const int count = std::max(1, static_cast<int>(std::ceil(2 * kPi * q.x() / spacing_mm)));
+    // An even count: with either stagger the ring is its own mirror across x = 0 and y = 0 (the
+    // dynamics place x along the feed: a ring of 25 held a lone node nearest a wall on one side).
+    const int count = 2 * std::max(1, static_cast<int>(std::ceil(kPi * q.x() / spacing_mm)));
     const double phase = 0.5 * (ring_index % 2);  // staggered rings cover the surface more evenly
     for (int j = 0; j < count; ++j) {
       const double a = 2 * kPi * (j + phase) / count;

@@ -254,7 +254,7 @@ TEST(MemoryLimit, AStudyIsSizedBeforeItsVariantsRun) {
     if (mib == 95) {
       EXPECT_EQ(run.exit_code, 1) << err;
       EXPECT_NE(err.find("study: needs about"), std::string::npos) << err;
-      EXPECT_NE(err.find("1035 postures x 559 tool nodes"), std::string::npos) << err;
+      EXPECT_NE(err.find("1035 postures x 596 tool nodes"), std::string::npos) << err;
       EXPECT_LT(run.peak_kib, 95 * 1024L);
     } else {
       EXPECT_EQ(run.exit_code, 0) << err;

@@ -5,12 +5,16 @@
 /// angles:
 ///
 ///   J θ'' + c θ' + k (θ - θ0(s)) = τ(θ),   θ = (lead, tilt),   s = v t,
-///   τ = [ M·b, M·f ],   M = Σ (x_i - C) × F(x_i)   (world frame, about the ball centre C).
+///   τ = [ M·e, M·f ],   M = Σ (x_i - C) × F(x_i)   (world frame, about the ball centre C),
+///   e = cos(tilt) b + sin(tilt) n   (b turned by the tilt about f).
 ///
 /// Integrated in time with CVODE (BDF, dense Newton, difference-quotient Jacobian) or, for
 /// comparison, ARKODE's explicit ERK, which reports SolverFailed when stiffness outruns its budget.
-/// τ_lead = M·b is DESIGN.md's; the exact generalised force of the lead (turned about b, then
-/// tilted about f) is M·R_f(tilt) b, which differs by O(tilt · M·n). Each steerPass call has its
+/// DESIGN.md writes τ_lead = M·b (seed 004's small angles); the axis being n turned about b by
+/// the lead, then about f by the tilt, the lead's generalised force is M·e (τ = -∂U/∂θ where the
+/// field is a potential's gradient), which differs by sin(tilt) M·n. That share, which no lead
+/// relieves, held the lead at its limit beside a wall on a slope, the holder nearer it
+/// (dynamics.md, 2026-12-01). Each steerPass call has its
 /// own SUNDIALS context: calls for different passes may run in parallel (if the field is
 /// thread-safe, as ForceField requires).
 #include <functional>
@@ -71,7 +75,7 @@ struct PostureSample {
   double s_mm = 0.0;
   double lead_rad = 0.0, tilt_rad = 0.0;
   double lead_rate_rad_per_s = 0.0, tilt_rate_rad_per_s = 0.0;
-  double lead_torque = 0.0, tilt_torque = 0.0;  ///< τ = [M·b, M·f]
+  double lead_torque = 0.0, tilt_torque = 0.0;  ///< τ = [M·e, M·f] (above)
   Vec3 moment = Vec3::Zero();                   ///< M about the ball centre, world frame
   double clearance_mm = 0.0;                    ///< from SteeringRequest::clearance, else NaN
   geometry::Posture posture;                    ///< tip = C - R a, axis a
@@ -142,7 +146,7 @@ constexpr int kSettleCycleDecays = 3;
 SettledStart settleAtStart(const Pass& pass, const SteeringRequest& request);
 
 /// The moment of the field on the nodes placed at axis angles (lead, tilt) at one pass frame, about
-/// the ball centre: τ = [M·b, M·f] (node_moments.h momentOfNodes).
+/// the ball centre: τ = [M·e, M·f] (node_moments.h momentOfNodes).
 struct AxisMoment {
   Vec3 moment = Vec3::Zero();
   double lead_torque = 0.0, tilt_torque = 0.0;

@@ -50,7 +50,8 @@ struct SurfaceNode {
 };
 
 /// Nodes spread over the revolved surface about `spacing_mm` apart (along the profile and around
-/// the axis), including the tip, and the flat top (tool only) or the holder's end faces.
+/// the axis), including the tip, and the flat top (tool only) or the holder's end faces. Each ring
+/// has an even count: the set is its own mirror across the planes x = 0 and y = 0.
 std::vector<SurfaceNode> surfaceNodes(const ToolSpec& tool, const HolderProfile& holder,
                                       double spacing_mm);
 
