@@ -24,6 +24,7 @@
 #include "fieldpath/common/atomic_file.h"
 #include "fieldpath/common/csv.h"
 #include "fieldpath/common/file_digest.h"
+#include "fieldpath/common/input_file.h"
 #include "fieldpath/common/short_number.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "fieldpath/geometry/tool_model.h"
@@ -179,6 +180,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global) {
           {options->scene, options->path});
       common::removeEarlierOutputs();
     }
+    // A missing path is said before the scene's meshes are read (and their notes printed).
+    common::requireRegularFile(options->path, "path file");
     const Scene scene = loadScene(options->scene, SceneUse::kPathGiven);
     checkPathFileSize(options->path, "--path " + options->path);
     const common::FileStamp path_stamp = common::fileStamp(options->path);

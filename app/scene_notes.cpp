@@ -115,9 +115,7 @@ std::vector<MeshScaleWarning> meshScaleWarnings(const Scene& scene,
   const auto diagonal = meshExtentMm;
   std::vector<Extent> meshes;
   for (std::size_t i = 0; i < scene.obstacle_files.size() && i < scene.obstacles.size(); ++i)
-    meshes.push_back({(i < scene.obstacle_keys.size() ? scene.obstacle_keys[i] + " " : "") + "(" +
-                          scene.obstacle_files[i].filename().string() + ")",
-                      diagonal(scene.obstacles[i])});
+    meshes.push_back({obstacleName(scene, i), diagonal(scene.obstacles[i])});
   if (scene.part && scene.part_file)
     meshes.push_back(
         {"part (" + scene.part_file->filename().string() + ")", diagonal(*scene.part)});

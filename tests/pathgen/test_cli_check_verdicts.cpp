@@ -342,3 +342,16 @@ TEST(CheckClearance, AMoveBetweenTwoPassesIsNamedWithThePassItLeaves) {
             std::string::npos)
       << unmarked["unsafe"];
 }
+
+// A missing --path is said first, before the scene's meshes are read (a user's large meshes were
+// loaded, and their notes printed, before the missing path was named): here the scene's own
+// mesh is missing too, and the one line names the path.
+TEST(CheckClearance, AMissingPathIsNamedBeforeTheScenesMeshesAreRead) {
+  const TempDir dir;
+  dir.write("scene.yaml",
+            "obstacles:\n  - mesh: gone.stl\ntool: { shape: ball, radius: 3, length: 40 }\n");
+  const auto c = test::runFieldpath(dir, "check scene.yaml --path nothere.cl");
+  EXPECT_EQ(c.exit_code, 1) << c.output();
+  EXPECT_NE(c.err.find("nothere.cl: no such path file"), std::string::npos) << c.err;
+  EXPECT_EQ(c.err.find("gone.stl"), std::string::npos) << c.err;
+}
