@@ -417,6 +417,10 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
         job.clearance_mm, c.colliding, m.colliding, m.motions, m.min_clearance_mm,
         read_s + result.times.total_s, read_s, out.string().c_str());
     if (!unsafe.empty()) std::fprintf(stderr, "warning: %s\n", unsafe_text.c_str());
+    if (const std::string limits =
+            limitsAtCollisionsNote(result, job.dynamics.max_lead_deg, job.dynamics.max_tilt_deg);
+        !limits.empty())
+      std::fprintf(stderr, "note: %s\n", limits.c_str());
     if (options->fail_unsafe && !unsafe.empty()) verdictExitCode() = kVerdictExitCode;
     if (const std::string gouge = cutterGougeReason(result.path, result.cutter_part);
         !gouge.empty())
@@ -573,12 +577,23 @@ void addGenerateCommand(CLI::App& app, const GlobalOptions& global) {
           "note: %zu open obstacle surface%s faced away from the passes: turned to face them "
           "(the field pushes along the normals)\n",
           result.turned_sheets, result.turned_sheets == 1 ? "" : "s");
-    if (result.voxel_outside_points > 0)
+    if (result.voxel_outside_points > 0) {
+      // What to do about it (a blisk helper read the note as a fault): nothing for accuracy, the
+      // exact field is the voxels' reference; only the time, and which key widens the voxels.
+      const bool near_path = job.field.voxel.refine_tolerance > 0.0 &&
+                             job.field.voxel.refine_region == field::RefineRegion::Path;
       std::fprintf(stderr,
-                   "note: %zu node positions fell outside where the voxels answer (the reach box; "
-                   "with field.refine_region: path, near the first path) and were given the exact "
-                   "field\n",
-                   result.voxel_outside_points);
+                   "note: %zu node positions fell outside where the voxels answer (%s) and were "
+                   "given the exact field: as accurate there, only slower to evaluate%s\n",
+                   result.voxel_outside_points,
+                   near_path ? "the refined cells lie near the path steered on the uniform grid "
+                               "first; the steered path went farther"
+                             : "the reach box, taken at stations of each pass: a pass turned "
+                               "sharply between them",
+                   near_path ? "; field.refine_region: reach refines everywhere the tool "
+                               "reaches (a longer build)"
+                             : "");
+    }
   });
 }
 

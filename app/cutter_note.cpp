@@ -39,15 +39,34 @@ std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool,
     // CUTTER/d alone is, in APT, a flat end mill (corner radius 0): compared as one.
     const double file_corner_mm = c.corner_mm < 0.0 ? 0.0 : c.corner_mm;
     const bool same_corner = std::abs(file_corner_mm - corner_mm) <= kCutterTolMm;
-    if (same_diameter && same_corner) continue;
+    const bool same_length =
+        c.length_mm < 0.0 || std::abs(c.length_mm - tool.length_mm) <= kCutterTolMm;
+    if (same_diameter && same_corner && same_length) continue;
+    const std::string where = path.file.string() + ":" + std::to_string(c.line) + ": ";
+    if (same_diameter && same_corner) {
+      // The length alone: the holder sits at it, so a shorter tool in the machine than in the
+      // scene brings the holder nearer the part than the proof put it.
+      const double lower_mm = tool.length_mm - c.length_mm;
+      notes.push_back(
+          where + c.record + " says the tool is " + mm(c.length_mm) +
+          " mm long (tip to holder); the scene's tool.length_mm is " + mm(tool.length_mm) +
+          (lower_mm > 0.0 ? ": with the file's tool the holder sits " + mm(lower_mm) +
+                                " mm lower, nearer the part, than the scene proves it; give "
+                                "tool.length_mm the length the machine runs"
+                          : ": with the file's tool the holder sits " + mm(-lower_mm) +
+                                " mm higher than the scene proves it (the proof is the stricter)"));
+      continue;
+    }
     std::string file_tool = "a " + mm(c.diameter_mm) + " mm cutter";
     if (c.corner_mm >= 0.0)
       file_tool += " with a " + mm(c.corner_mm) + " mm corner";
     else
       file_tool += " with no corner radius given (in APT, a flat end mill)";
-    notes.push_back(path.file.string() + ":" + std::to_string(c.line) + ": " + c.record +
-                    " says the path was written for " + file_tool + "; the scene's tool is " +
-                    toolWords(tool) + ": what follows is for the scene's tool, not the file's");
+    if (!same_length) file_tool += ", " + mm(c.length_mm) + " mm long";
+    notes.push_back(where + c.record + " says the path was written for " + file_tool +
+                    "; the scene's tool is " + toolWords(tool) +
+                    (same_length ? "" : ", " + mm(tool.length_mm) + " mm long") +
+                    ": what follows is for the scene's tool, not the file's");
   }
   // A file that changes tools: each is proven as the scene's one (the cutters of the loads are
   // compared above where CUTTER or TLDATA records give them).

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "fieldpath/common/file_digest.h"
+#include "fieldpath/geometry/units.h"
 
 namespace fieldpath::app {
 nlohmann::json jsonIndex(std::size_t i) {
@@ -184,6 +185,14 @@ bool inLink(const geometry::PathFile& path, std::size_t i) {
   return false;
 }
 
+std::vector<bool> linkMask(const geometry::PathFile& path) {
+  std::vector<bool> link(path.postures.size(), false);
+  for (const geometry::PathBlock& b : path.blocks)
+    if (b.kind == geometry::PathBlock::Kind::Link)
+      for (std::size_t i = b.begin; i < b.end && i < link.size(); ++i) link[i] = true;
+  return link;
+}
+
 std::string motionWhere(const geometry::PathFile& path, std::size_t i) {
   const bool into_link = !inLink(path, i) && i + 1 < path.postures.size() && inLink(path, i + 1);
   const std::string where = postureWhere(path, i, into_link ? i + 1 : i);
@@ -222,10 +231,10 @@ std::string collidingPasses(const geometry::PathFile& path, const std::vector<do
 }
 
 /// "1 posture touches", "2 postures touch": a count, its noun and verb agreed ("1 postures
-/// touch" read as a typo to a user).
-std::string counted(std::size_t n, const std::string& noun, const std::string& verb) {
-  return std::to_string(n) + " " + noun +
-         (n == 1 ? " " + verb + (verb == "touch" ? "es" : "s") : "s " + verb);
+/// touch" read as a typo to a user); the verb given in both forms, so no verb is special-cased.
+std::string counted(std::size_t n, const std::string& noun, const std::string& verb_one,
+                    const std::string& verb_many) {
+  return std::to_string(n) + " " + noun + (n == 1 ? " " + verb_one : "s " + verb_many);
 }
 
 std::vector<std::string> unsafeReasons(const geometry::PathFile& path,
@@ -252,23 +261,23 @@ std::vector<std::string> unsafeReasons(const geometry::PathFile& path,
   };
   if (c.colliding) {
     const std::string in = collidingPasses(path, c.clearance_mm);
-    out.push_back(counted(c.colliding, "posture", "touch") + " an obstacle (first: " +
+    out.push_back(counted(c.colliding, "posture", "touches", "touch") + " an obstacle (first: " +
                   posture(c.first_colliding) + (in.empty() ? "" : ";" + in) + ")");
   }
   if (m.colliding)
-    out.push_back(counted(m.colliding, "motion", "touch") +
+    out.push_back(counted(m.colliding, "motion", "touches", "touch") +
                   " an obstacle (first: " + motion(m.first_colliding) + ")");
   if (l && l->colliding_postures)
-    out.push_back(counted(l->colliding_postures, "link posture", "touch") +
+    out.push_back(counted(l->colliding_postures, "link posture", "touches", "touch") +
                   " the part (first: " + posture(l->first_colliding_posture) + ")");
   if (l && l->colliding_motions)
-    out.push_back(counted(l->colliding_motions, "link motion", "touch") +
+    out.push_back(counted(l->colliding_motions, "link motion", "touches", "touch") +
                   " the part (first: " + motion(l->first_colliding_motion) + ")");
   if (h && h->colliding_postures)
-    out.push_back(counted(h->colliding_postures, "posture", "put") +
+    out.push_back(counted(h->colliding_postures, "posture", "puts", "put") +
                   " the holder into the part (first: " + posture(h->first_colliding_posture) + ")");
   if (h && h->colliding_motions)
-    out.push_back(counted(h->colliding_motions, "motion", "put") +
+    out.push_back(counted(h->colliding_motions, "motion", "puts", "put") +
                   " the holder into the part (first: " + motion(h->first_colliding_motion) + ")");
   return out;
 }
@@ -380,6 +389,41 @@ std::string dogLegNote(const geometry::PathFile& path, const pathgen::DogLegRapi
                 "the part is not in that proof: a retract out of a pass run axis by axis "
                 "can cut into the finished surface");
   return note + ": run rapids as linear moves, or post them as feed moves";
+}
+
+std::string limitsAtCollisionsNote(const pathgen::GenerateResult& r, double max_lead_deg,
+                                   double max_tilt_deg) {
+  // At a limit: within a thousandth of a degree (the clamp holds the angle on it).
+  constexpr double kAtLimitDeg = 1e-3;
+  std::size_t colliding = 0, limited = 0, at_lead = 0, at_tilt = 0;
+  const pathgen::GeneratedPosture* first = nullptr;
+  for (const pathgen::GeneratedPosture& g : r.postures) {
+    if (!(g.clearance_mm <= 0.0)) continue;
+    ++colliding;
+    const bool lead = std::abs(g.lead_rad) * geometry::kRadToDeg >= max_lead_deg - kAtLimitDeg;
+    const bool tilt = std::abs(g.tilt_rad) * geometry::kRadToDeg >= max_tilt_deg - kAtLimitDeg;
+    if (!g.limited && !lead && !tilt) continue;
+    ++limited;
+    at_lead += lead;
+    at_tilt += tilt;
+    if (!first) first = &g;
+  }
+  if (limited == 0) return {};
+  char text[160];
+  std::snprintf(text, sizeof text,
+                "lead at %g deg (dynamics.max_lead_deg): %zu; tilt at %g deg "
+                "(dynamics.max_tilt_deg): %zu",
+                max_lead_deg, at_lead, max_tilt_deg, at_tilt);
+  const std::string which =
+      limited < colliding ? std::to_string(limited) + " of the " + std::to_string(colliding) +
+                                " colliding postures have"
+      : colliding == 1 ? std::string("the colliding posture has")
+      : colliding == 2 ? std::string("both colliding postures have")
+                       : "all " + std::to_string(colliding) + " colliding postures have";
+  return which + " an angle held at its limit (" + text +
+         "; first: " + postureWhere(r.path, first->output) +
+         "): the field pushes the axis past the limits there; wider limits where the machine "
+         "and the holder allow, or a nominal path with more room there";
 }
 
 }  // namespace fieldpath::app

@@ -77,6 +77,9 @@ std::string postureWhere(const geometry::PathFile& path, std::size_t i);
 /// Whether posture i lies in a link block.
 bool inLink(const geometry::PathFile& path, std::size_t i);
 
+/// inLink for every posture at once (one pass over the blocks, where inLink scans them per call).
+std::vector<bool> linkMask(const geometry::PathFile& path);
+
 /// "posture i to the next (BLOCK, FILE:LINE)": motion i, from posture i to i + 1, in the block of
 /// the end that makes it a link's (the retract and the plunge are), else i's own: a move from one
 /// pass straight into the next is named with the pass it leaves, at the line it leaves from (a
@@ -139,5 +142,14 @@ std::string farPassesWarning(const geometry::PathFile& path, const pathgen::FarF
 /// sloped plate cut 1.17 mm into the part).
 std::string dogLegNote(const geometry::PathFile& path, const pathgen::DogLegRapids& d,
                        const pathgen::MotionResult& m, bool has_part);
+
+/// The note where colliding postures of a steered path have an angle held at its limit (empty
+/// otherwise): how many, which angle at which limit (`max_lead_deg`, `max_tilt_deg` of
+/// dynamics), the first. The UNSAFE line named only the collisions, and the summary's count of
+/// limited postures did not say they were the same ones (an oracle found that at the corpus's
+/// UNSAFE corners the limits, not the steering, leave the holder in the wall; in three of seven
+/// the lead's).
+std::string limitsAtCollisionsNote(const pathgen::GenerateResult& r, double max_lead_deg,
+                                   double max_tilt_deg);
 
 }  // namespace fieldpath::app

@@ -339,15 +339,12 @@ ViewData gatherView(const ViewRequest& request) {
     // Link postures are told apart: generate's links climb the last posture's axis to safe_z,
     // which on a steep axis ends far aside (a blisk's links 150 mm out, in the red banner as if
     // the path were another scene's); said in a note, the banner kept for the cutting postures.
-    std::vector<bool> link(n, false);
-    for (const geometry::PathBlock& block : p.file.blocks)
-      if (block.kind == geometry::PathBlock::Kind::Link)
-        for (std::size_t i = block.begin; i < block.end && i < n; ++i) link[i] = true;
+    const std::vector<bool> link = linkMask(p.file);
     const std::size_t links = std::size_t(std::count(link.begin(), link.end(), true));
     std::size_t links_outside = 0, first_link_outside = 0;
     for (std::size_t i = 0; i < n; ++i) {
       if (near.contains(postures[i].tip_mm)) continue;
-      if (link[i]) {
+      if (i < link.size() && link[i]) {
         if (links_outside++ == 0) first_link_outside = i;
       } else if (p.outside++ == 0) {
         p.first_outside = i;

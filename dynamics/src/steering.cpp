@@ -526,7 +526,13 @@ SettledStart settleAtStart(const Pass& pass, const SteeringRequest& request) {
   run.max_angle_change_deg_per_mm = 0.0;     // the settling is not machined: its swing on the
   run.params.on_limit = LimitPolicy::Clamp;  // way to rest is held at the limits, never failed
   run.clearance = nullptr;
-  run.progress = nullptr;
+  // The settling is before the pass: reported as none of it done, but reported (and interruptible)
+  // all the same: a pass's settling over a dense direct field ran a minute with no progress line
+  // (a blisk helper's ~60 s silence).
+  if (request.progress)
+    run.progress = [progress = request.progress](double, std::string_view what) {
+      return progress(0.0, what);
+    };
   // A decaying axis moves less every decay (by about e: its envelope); one that sets no new
   // least move in kSettleCycleDecays decays is cycling, not coming to rest (held at a limit
   // against a field that pushes on: a helper's pocket corner ran all 20 decays, each clamped at

@@ -132,13 +132,17 @@ std::size_t leadingNumbers(std::string_view values, double* v, std::size_t max) 
   return count;
 }
 
-/// CUTTER/d[, r, ...]: diameter and corner radius in file units, or nothing when the first value
-/// is not a number (a CAM's `CUTTER/TOOL1`: read past, as DESIGN.md says of CUTTER).
-std::optional<PathFile::Cutter> cutterOf(std::string_view values, std::size_t line) {
-  double v[2] = {0.0, -1.0};
-  const std::size_t count = leadingNumbers(values, v, 2);
+/// CUTTER/d[, r, ...]: diameter, corner radius and length (the value at `length_at`, 0-based:
+/// 6 for CUTTER's h, 2 for TLDATA/MILL's l) in file units, or nothing when the first value is
+/// not a number (a CAM's `CUTTER/TOOL1`: read past, as DESIGN.md says of CUTTER).
+std::optional<PathFile::Cutter> cutterOf(std::string_view values, std::size_t line,
+                                         std::size_t length_at) {
+  double v[7] = {0.0, -1.0};
+  const std::size_t count = leadingNumbers(values, v, length_at + 1);
   if (count == 0 || !(v[0] > 0.0)) return std::nullopt;
-  return PathFile::Cutter{v[0], count == 2 && v[1] >= 0.0 ? v[1] : -1.0, line};
+  PathFile::Cutter cutter{v[0], count >= 2 && v[1] >= 0.0 ? v[1] : -1.0, line};
+  if (count > length_at && v[length_at] > 0.0) cutter.length_mm = v[length_at];
+  return cutter;
 }
 
 /// A FEDRAT record's feed: its number in `feed.mm_per_min` and, in `unit`, mm per unit of it:
@@ -283,7 +287,7 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
     }
     if (major == "CUTTER") {
       if (slash != std::string::npos)
-        if (auto cutter = cutterOf(std::string_view(statement).substr(slash + 1), record_line))
+        if (auto cutter = cutterOf(std::string_view(statement).substr(slash + 1), record_line, 6))
           out.cutters.emplace_back(out.units.size(), *cutter);
       continue;
     }
@@ -303,7 +307,7 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
       const std::string_view values = trimmed(std::string_view(statement).substr(slash + 1));
       const auto comma = values.find(',');
       if (trimmed(values.substr(0, comma)) == "MILL" && comma != std::string_view::npos)
-        if (auto cutter = cutterOf(values.substr(comma + 1), record_line)) {
+        if (auto cutter = cutterOf(values.substr(comma + 1), record_line, 2)) {
           cutter->record = "TLDATA";
           out.cutters.emplace_back(out.units.size(), *cutter);
         }
@@ -518,6 +522,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
       const double unit = units_before ? c.units[units_before - 1].second : scale;
       cutter.diameter_mm *= unit;
       if (cutter.corner_mm > 0.0) cutter.corner_mm *= unit;
+      if (cutter.length_mm > 0.0) cutter.length_mm *= unit;
       cutters.push_back(cutter);
     }
     for (const AptChunk::Feed& f : c.feeds) {  // in the unit in force at the record

@@ -29,6 +29,7 @@
 #include "fieldpath/common/file_names.h"
 #include "fieldpath/common/input_file.h"
 #include "fieldpath/common/limits.h"
+#include "obj_check.h"
 #include "ply_check.h"
 #include "polygon_split.h"
 #include "stl_check.h"
@@ -244,6 +245,13 @@ std::optional<std::string> objWithoutTrailingComments(const std::filesystem::pat
   return text;
 }
 
+/// An OBJ that assimp refused, or whose face came out naming no vertex: the line of its first
+/// bad face index where one is found (assimp's message has none), thrown; nothing else.
+void throwObjFaceFault(const std::filesystem::path& file) {
+  if (lowerExtension(file) != ".obj") return;
+  if (std::string fault = detail::objFaceFault(file); !fault.empty()) throw InputError(fault);
+}
+
 }  // namespace
 
 TriangleMesh loadMesh(const std::filesystem::path& file) {
@@ -322,10 +330,12 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
       scene = importer.ReadFile(file.string(), aiProcess_ValidateDataStructure);
     }
   } catch (const std::exception& e) {
+    throwObjFaceFault(file);
     throw InputError(file.string() + ": cannot read mesh: " + readableAssimpError(e.what()));
   }
   if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 ||
       scene->mRootNode == nullptr) {
+    throwObjFaceFault(file);
     const std::string why = importer.GetErrorString();
     throw InputError(file.string() + ": cannot read mesh" +
                      (why.empty() ? std::string() : ": " + readableAssimpError(why)));
@@ -353,9 +363,11 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
       const aiFace& face = in->mFaces[f];
       if (face.mNumIndices < 3 || face.mIndices == nullptr) continue;  // points and lines
       for (unsigned k = 0; k < face.mNumIndices; ++k)
-        if (face.mIndices[k] >= in->mNumVertices)
+        if (face.mIndices[k] >= in->mNumVertices) {
+          throwObjFaceFault(file);
           throw InputError(file.string() + ": face " + std::to_string(f + 1) +
                            " names a vertex that does not exist");
+        }
       if (face.mNumIndices == 3) {
         mesh.triangles.emplace_back(remap[face.mIndices[0]], remap[face.mIndices[1]],
                                     remap[face.mIndices[2]]);

@@ -382,7 +382,8 @@ GenerateResult generatePath(const GenerateRequest& request) {
       if (request.progress && report)
         progress = [&, p](double fraction, std::string_view) {
           std::lock_guard<std::mutex> lock(progress_mutex);
-          pass_done[p] = std::clamp(fraction, 0.0, 1.0);
+          // Never back: a pass run again (loosened, or its corners held) reports from 0 anew.
+          pass_done[p] = std::max(pass_done[p], std::clamp(fraction, 0.0, 1.0));
           return request.progress(fractionDone(), "passes");
         };
       PassSteering done = steerPassOf(p, field, params, false, std::move(progress));

@@ -185,6 +185,7 @@ TEST(ConvertFeeds, TldataMillIsTheFilesCutter) {
   EXPECT_EQ(read.cutters[0].record, "TLDATA");
   EXPECT_EQ(read.cutters[0].diameter_mm, 16.0);
   EXPECT_EQ(read.cutters[0].corner_mm, 0.0);
+  EXPECT_EQ(read.cutters[0].length_mm, 50.0);  // TLDATA/MILL, d, r, l
   writeWallScene(dir);
   const Outcome check = runFieldpath(dir, "check scene.yaml --path nx.cls --out out");
   EXPECT_NE(check.err.find("nx.cls:1: TLDATA says the path was written for a 16 mm cutter"),

@@ -50,5 +50,35 @@ TEST(CutterNotes, SaidWhenTheFileWasWrittenForAnotherTool) {
   EXPECT_EQ(many[2], "job.apt: 3 more CUTTER / TLDATA records differ from the scene's tool");
 }
 
+TEST(CutterNotes, SaidWhenTheFilesToolIsAnotherLength) {
+  // CUTTER's h and TLDATA's l are the tool's length: the holder sits there (a blisk helper's file
+  // said 40 mm against the scene's 60 and went unsaid).
+  geometry::ToolSpec ball;
+  ball.radius_mm = 3.0;
+  ball.length_mm = 60.0;
+  // The one note for a record of diameter d, corner r and length at `line` ("" where none).
+  const auto noteFor = [&](double d, double r, double length_mm, std::size_t line,
+                           const char* record = "CUTTER") {
+    geometry::PathFile::Cutter cutter{d, r, line, record};
+    cutter.length_mm = length_mm;
+    const std::vector<std::string> notes = cutterNotes(ball, withCutters({cutter}));
+    EXPECT_LE(notes.size(), 1u);
+    return notes.empty() ? std::string() : notes[0];
+  };
+  EXPECT_EQ(noteFor(6.0, 3.0, 60.0 + 5e-4, 4), "");  // within 1 um
+  EXPECT_EQ(noteFor(6.0, 3.0, 40.0, 5),
+            "job.apt:5: CUTTER says the tool is 40 mm long (tip to holder); the scene's "
+            "tool.length_mm is 60: with the file's tool the holder sits 20 mm lower, nearer the "
+            "part, than the scene proves it; give tool.length_mm the length the machine runs");
+  const std::string high = noteFor(6.0, 3.0, 75.0, 6, "TLDATA");
+  EXPECT_NE(high.find("job.apt:6: TLDATA says the tool is 75 mm long"), std::string::npos);
+  EXPECT_NE(high.find("sits 15 mm higher"), std::string::npos);
+  // with another diameter too: one line naming both tools' lengths
+  EXPECT_EQ(noteFor(10.0, 5.0, 40.0, 7),
+            "job.apt:7: CUTTER says the path was written for a 10 mm cutter with a 5 mm corner, "
+            "40 mm long; the scene's tool is a ball of radius 3 mm (6 mm), 60 mm long: what "
+            "follows is for the scene's tool, not the file's");
+}
+
 }  // namespace
 }  // namespace fieldpath::app::test

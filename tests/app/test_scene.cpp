@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "fieldpath/common/errors.h"
+#include "fieldpath/geometry/units.h"
 #include "files.h"
 #include "job.h"
 #include "path_report.h"
@@ -493,4 +494,38 @@ TEST(JobText, APlungeIntoATouchingPassBlamesThePass) {
   ASSERT_EQ(reasons.size(), 2u);
   EXPECT_EQ(reasons[1].find(hint), std::string::npos) << reasons[1];
   EXPECT_NE(reasons[1].find("its end in the pass touches too"), std::string::npos) << reasons[1];
+}
+
+// Colliding postures with an angle at its limit are counted, by angle, in a note (the UNSAFE line
+// named the collisions only, and the summary's "N postures held at a limit" did not say they were
+// the same ones: an oracle found the limits binding at the corpus's UNSAFE corners, the lead's in
+// three of seven). Postures clear, or colliding within the limits, are not counted.
+TEST(JobText, CollisionsAtTheAngleLimitsAreCounted) {
+  using geometry::PathBlock;
+  pathgen::GenerateResult r;
+  r.path.postures.resize(5);
+  r.path.blocks = {{PathBlock::Kind::Pass, 0, 5}};
+  const double deg = geometry::kDegToRad;
+  // (lead, tilt, clearance): clear at both limits; colliding at the lead's; at both; within them.
+  const double rows[][3] = {
+      {20, 35, 1.0}, {0, 10, 0.3}, {-20, 5, 0.0}, {20, -35, 0.0}, {5, 30, 0.0}};
+  for (std::size_t i = 0; i < 5; ++i) {
+    pathgen::GeneratedPosture g;
+    g.lead_rad = rows[i][0] * deg;
+    g.tilt_rad = rows[i][1] * deg;
+    g.clearance_mm = rows[i][2];
+    g.output = i;
+    r.postures.push_back(g);
+  }
+  EXPECT_EQ(app::limitsAtCollisionsNote(r, 20.0, 35.0),
+            "2 of the 3 colliding postures have an angle held at its limit (lead at 20 deg "
+            "(dynamics.max_lead_deg): 2; tilt at 35 deg (dynamics.max_tilt_deg): 1; first: "
+            "posture 2 (pass 1)): the field pushes the axis past the limits there; wider limits "
+            "where the machine and the holder allow, or a nominal path with more room there");
+  EXPECT_EQ(app::limitsAtCollisionsNote(r, 25.0, 40.0), "");  // none at these limits
+  r.postures[4].limited = true;                               // the clamp's own flag counts too
+  EXPECT_NE(app::limitsAtCollisionsNote(r, 25.0, 40.0).find("1 of the 3"), std::string::npos);
+  r.postures.resize(4);
+  EXPECT_EQ(app::limitsAtCollisionsNote(r, 20.0, 35.0).rfind("both colliding postures have", 0),
+            0u);
 }

@@ -48,6 +48,26 @@ TEST(SettledStart, IsTheStaticEquilibriumAndThePassStartsAtRestThere) {
   EXPECT_NEAR(from_nominal.samples.back().tilt_rad, from_rest.samples.back().tilt_rad, 1e-6);
 }
 
+TEST(SettledStart, ReportsProgressAsNoneOfThePassAndCanBeInterrupted) {
+  // The settling ran with no progress hook: over a dense direct field a minute of silence (a
+  // blisk helper's). It reports now, as 0 of the pass (it comes before it), and stops when asked.
+  const auto wall = wallAt(3.1);
+  SteeringRequest request = requestFor(wall.get());
+  std::size_t calls = 0;
+  double largest = -1.0;
+  request.progress = [&](double fraction, std::string_view) {
+    ++calls;
+    largest = std::max(largest, fraction);
+    return true;
+  };
+  const SettledStart settled = settleAtStart(straightPass(300.0), request);
+  ASSERT_TRUE(settled.settled) << settled.why;
+  EXPECT_GT(calls, 0u);
+  EXPECT_EQ(largest, 0.0);
+  request.progress = [](double, std::string_view) { return false; };
+  EXPECT_THROW((void)settleAtStart(straightPass(300.0), request), common::Interrupted);
+}
+
 TEST(SettledStart, NoFieldNoDeflection) {
   SteeringRequest request = requestFor(nullptr);
   const SettledStart settled = settleAtStart(straightPass(10.0), request);

@@ -412,6 +412,15 @@ TEST(MeshIo, BrokenFilesAreInputErrors) {
                                             "vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n"
                                             "0 1 0\n3 0 1 7\n"),
                 "a face names a vertex the file does not have");
+  // An OBJ's bad face index is named with its line (assimp's "Invalid face index" has none: a
+  // blisk helper's typo in 90 000 lines); vt/vn parts and a negative index as OBJ reads them.
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n# a comment\nf 1/1/1 2//2 -1\n";
+  expectMessage(writeBytes("past.obj", tri + "f 1 2 9\n"),
+                "past.obj:6: face index '9': past the last vertex (the file has 3 vertices)");
+  expectMessage(writeBytes("zero.obj", tri + "f 1 0 3\n"),
+                "zero.obj:6: face index '0': 0 (OBJ counts vertices from 1)");
+  expectMessage(writeBytes("back.obj", "v 0 0 0\nf 1 -2 -1\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+                "back.obj:2: face index '-2': counts back past the first vertex (1 read so far)");
 }
 
 TEST(MeshIo, DefectiveMeshesLoadAndAreReported) {

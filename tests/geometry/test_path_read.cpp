@@ -291,6 +291,8 @@ TEST(PathRead, AptCutterRecordsInMmWhateverTheChunks) {
       EXPECT_EQ(p.cutters[0].diameter_mm, 6.0);
       EXPECT_EQ(p.cutters[0].corner_mm, 3.0);
       EXPECT_EQ(p.cutters[0].line, 3u);
+      EXPECT_EQ(p.cutters[0].length_mm, 40.0);  // h, the seventh value
+      EXPECT_EQ(p.cutters[1].length_mm, -1.0);  // not given
       EXPECT_DOUBLE_EQ(p.cutters[1].diameter_mm, 6.35) << bytes;
       EXPECT_DOUBLE_EQ(p.cutters[1].corner_mm, 3.175) << bytes;
       EXPECT_EQ(p.cutters[1].line, 6u) << bytes;
@@ -305,4 +307,5 @@ TEST(PathRead, AptCutterRecordsInMmWhateverTheChunks) {
   ASSERT_EQ(back.cutters.size(), 1u);
   EXPECT_EQ(back.cutters[0].diameter_mm, 5.0);
   EXPECT_EQ(back.cutters[0].corner_mm, 2.5);
+  EXPECT_EQ(back.cutters[0].length_mm, header.tool.length_mm);
 }

@@ -40,8 +40,8 @@ struct PathFile {
   /// Postures whose `.cl` line carries the comment `# limit ...` (generate marks the postures where
   /// an angle limit held), sorted.
   std::vector<std::size_t> limited;
-  /// APT: the `CUTTER/d[, r, ...]` records (diameter d, corner radius r), in mm, in file order;
-  /// those whose first values are not numbers are read past. Not compared here: the commands
+  /// APT: the `CUTTER/d[, r, ...]` records (diameter d, corner radius r, length), in mm, in file
+  /// order; those whose first values are not numbers are read past. Not compared here: the commands
   /// that take a tool say when the file was written for another one (app/cutter_note.h).
   struct Cutter {
     double diameter_mm = 0.0;
@@ -50,6 +50,11 @@ struct PathFile {
     /// The record: CUTTER, or TLDATA (`TLDATA/MILL,d,r,...`, as NX writes the tool: a 16 mm flat
     /// end mill there against a 6 mm ball in the scene went unsaid).
     std::string record = "CUTTER";
+    /// The tool's length from its tip (-1: not given): CUTTER's seventh value (h, the height of
+    /// `CUTTER/d, r, e, f, a, b, h`, as the APT writer writes tool.length_mm) or TLDATA/MILL's
+    /// third (`TLDATA/MILL, d, r, l, ...`). The holder sits there: a file's tool shorter than
+    /// the scene's puts the holder nearer the part than the scene proves (a blisk helper's).
+    double length_mm = -1.0;
   };
   std::vector<Cutter> cutters;
   /// APT tool loads (`LOAD/TOOL,n`, `LOADTL/n`): the tool's number as written and the line. More
