@@ -21,6 +21,7 @@
 
 #include "cli_parse.h"
 #include "commands.h"
+#include "cutter_note.h"
 #include "errors.h"
 #include "estimates.h"
 #include "fieldpath/common/atomic_file.h"
@@ -308,6 +309,21 @@ void addSimulateCommand(CLI::App& app, const GlobalOptions& global) {
     const zb::SimulationResult res = zb::simulateBlocks(req, [&stream] { return stream.next(); });
     stream.waitAll();  // an error after the last chunk (e.g. no postures at all)
     if (res.postures == 0) throw InputError(o->path + ": no postures");
+    // An APT file's CUTTER / TLDATA against --tool, as generate and check say it of the scene's
+    // (an adversary's 8 mm cutter was cut as a 6 mm ball in silence). Not a mesh tool's.
+    if (req.tool.kind != zb::ToolKind::Mesh) {
+      geometry::ToolSpec spec;
+      spec.shape = req.tool.kind == zb::ToolKind::Ball    ? geometry::ToolShape::Ball
+                   : req.tool.kind == zb::ToolKind::Torus ? geometry::ToolShape::Torus
+                                                          : geometry::ToolShape::Flat;
+      spec.radius_mm = req.tool.radius_mm;
+      spec.corner_radius_mm = req.tool.corner_radius_mm;
+      spec.length_mm = req.tool.length_mm;
+      const std::vector<std::string> notes =
+          cutterNotes(spec, stream.toolRecords(), "--tool", /*compare_length=*/false);
+      if (!notes.empty()) endProgressLine();
+      for (const std::string& note : notes) std::fprintf(stderr, "note: %s\n", note.c_str());
+    }
     // Heights from the bytes read: a path rewritten in place meanwhile (not cut short: that is
     // SIGBUS's) mixed both files' postures, exit 0 (a helper's).
     common::requireUnchanged(o->path, path_stamp, "simulated");

@@ -131,6 +131,9 @@ void addViewCommand(CLI::App& app, const GlobalOptions& global) {
     if (data.surface) std::printf("surface: %s\n", data.surface->source.c_str());
     for (const std::string& line : data.missing) std::printf("missing: %s\n", line.c_str());
     for (const std::string& line : data.warnings) std::printf("warning: %s\n", line.c_str());
+    // The side panel's notes on the terminal too (an APT file's CUTTER against the scene's tool
+    // was on the page only: an adversary read view as saying nothing of it).
+    for (const std::string& line : data.notes) std::printf("note: %s\n", line.c_str());
   });
 }
 

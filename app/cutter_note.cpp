@@ -29,8 +29,8 @@ std::string toolWords(const geometry::ToolSpec& tool) {
 
 }  // namespace
 
-std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool,
-                                     const geometry::PathFile& path) {
+std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool, const geometry::PathFile& path,
+                                     const std::string& tool_name, bool compare_length) {
   constexpr std::size_t kMaxLines = 3;
   const double corner_mm = geometry::cornerRadius(tool);
   std::vector<std::string> notes;
@@ -39,8 +39,8 @@ std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool,
     // CUTTER/d alone is, in APT, a flat end mill (corner radius 0): compared as one.
     const double file_corner_mm = c.corner_mm < 0.0 ? 0.0 : c.corner_mm;
     const bool same_corner = std::abs(file_corner_mm - corner_mm) <= kCutterTolMm;
-    const bool same_length =
-        c.length_mm < 0.0 || std::abs(c.length_mm - tool.length_mm) <= kCutterTolMm;
+    const bool same_length = !compare_length || c.length_mm < 0.0 ||
+                             std::abs(c.length_mm - tool.length_mm) <= kCutterTolMm;
     if (same_diameter && same_corner && same_length) continue;
     const std::string where = path.file.string() + ":" + std::to_string(c.line) + ": ";
     if (same_diameter && same_corner) {
@@ -57,16 +57,20 @@ std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool,
                                 " mm higher than the scene proves it (the proof is the stricter)"));
       continue;
     }
-    std::string file_tool = "a " + mm(c.diameter_mm) + " mm cutter";
+    // "an 8 mm", "an 11 mm", "an 18 mm" (as they are said), else "a"
+    const std::string d = mm(c.diameter_mm);
+    const bool an = d[0] == '8' || ((d.rfind("11", 0) == 0 || d.rfind("18", 0) == 0) &&
+                                    (d.size() == 2 || d[2] == '.'));
+    std::string file_tool = (an ? "an " : "a ") + d + " mm cutter";
     if (c.corner_mm >= 0.0)
       file_tool += " with a " + mm(c.corner_mm) + " mm corner";
     else
       file_tool += " with no corner radius given (in APT, a flat end mill)";
     if (!same_length) file_tool += ", " + mm(c.length_mm) + " mm long";
-    notes.push_back(where + c.record + " says the path was written for " + file_tool +
-                    "; the scene's tool is " + toolWords(tool) +
+    notes.push_back(where + c.record + " says the path was written for " + file_tool + "; " +
+                    tool_name + " is " + toolWords(tool) +
                     (same_length ? "" : ", " + mm(tool.length_mm) + " mm long") +
-                    ": what follows is for the scene's tool, not the file's");
+                    ": what follows is for " + tool_name + ", not the file's");
   }
   // A file that changes tools: each is proven as the scene's one (the cutters of the loads are
   // compared above where CUTTER or TLDATA records give them).
@@ -82,8 +86,12 @@ std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool,
     notes.insert(notes.begin(),
                  path.file.string() + ":" + std::to_string(loads[1]->line) +
                      ": the file changes tools (" + std::to_string(loads.size()) +
-                     " loads: " + which + "): every motion is proven with the scene's one tool, " +
-                     toolWords(tool) + "; split the file by tool and give each its scene");
+                     " loads: " + which + "): " +
+                     (compare_length
+                          ? "every motion is proven with the scene's one tool, " + toolWords(tool) +
+                                "; split the file by tool and give each its scene"
+                          : "every posture is cut with " + tool_name + ", " + toolWords(tool) +
+                                "; split the file by tool"));
   }
   if (notes.size() > kMaxLines) {
     const std::size_t more = notes.size() - (kMaxLines - 1);

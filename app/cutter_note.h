@@ -11,11 +11,14 @@
 
 namespace fieldpath::app {
 
-/// One line per CUTTER record that differs from `tool` (diameter, or corner radius where the
-/// record gives one, by more than 1 um), "FILE:LINE: ..."; empty when they agree or there are
-/// none. At most 3 lines, the last saying how many more.
-std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool,
-                                     const geometry::PathFile& path);
+/// One line per CUTTER record that differs from `tool` (diameter, corner radius where the
+/// record gives one, or length where it gives one and `compare_length`, by more than 1 um),
+/// "FILE:LINE: ..."; empty when they agree or there are none. At most 3 lines, the last saying
+/// how many more. `tool_name` says whose tool it is ("the scene's tool", "--tool"); the length
+/// is where the holder sits, which `simulate` does not model (it compares none).
+std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool, const geometry::PathFile& path,
+                                     const std::string& tool_name = "the scene's tool",
+                                     bool compare_length = true);
 
 /// The line said when a scene has no `holder`: what is then proven clear is the tool up to its
 /// length, not what holds it (a newcomer's job read safe with no word of it). Empty with a holder.

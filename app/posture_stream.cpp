@@ -20,6 +20,10 @@ void PostureStream::read(const std::filesystem::path& file,
                          const geometry::PathReadOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   geometry::PostureChunkSink sink;
+  sink.tool_records = [this](const geometry::PathFile& records) {
+    std::lock_guard lock(mutex_);
+    tool_records_ = records;
+  };
   sink.begin = [this](std::size_t n) {
     std::lock_guard lock(mutex_);
     chunks_.resize(n);

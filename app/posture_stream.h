@@ -39,6 +39,9 @@ class PostureStream {
   /// tips, and each posture's axis from its tip up to where it leaves the stock's top `top_z`
   /// (at most `length_mm` along it: a tilted shank cuts beside the tip), on all cores.
   TipBounds cutBounds(double length_mm, double top_z) const;
+  /// After waitAll: an APT file's tool records (file, cutters, tool_loads; app/cutter_note.h),
+  /// none for other formats.
+  const geometry::PathFile& toolRecords() const { return tool_records_; }
   /// Seconds from the start to the last chunk parsed (after waitAll).
   double readSeconds() const { return read_seconds_; }
 
@@ -63,6 +66,7 @@ class PostureStream {
   std::vector<Chunk> chunks_;
   std::size_t next_ = 0;  ///< next chunk handed out
   double read_seconds_ = 0;
+  geometry::PathFile tool_records_;  ///< set by the reading thread before its first chunk
   std::thread thread_;
 };
 

@@ -220,6 +220,10 @@ void parseAptChunk(std::string_view text, std::size_t first_line,
       record += content.substr(0, content.size() - 1);
       continue;
     }
+    // A comment line (or a blank one) inside a continued record: read past, the record goes on
+    // (`GOTO/1,2,0,$` then `$$ note` then `0,0,1`, as CATIA writes: refused as a GOTO of 3 values
+    // and a comma, an adversary's).
+    if (!record.empty() && content.empty()) continue;
     record += content;
     const std::string statement = upperCase(record);
     const auto slash = statement.find('/');
@@ -473,7 +477,11 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
   const std::string_view text = readableText(mapped.text(), file);
   const std::vector<TextChunk> pieces =
       splitAtLines(text, options.chunk_bytes, options.threads,
-                   [](std::string_view line) { return continuesRecord(aptContent(line)); });
+                   // (never after a comment line either: it may lie inside a continued record)
+                   [](std::string_view line) {
+                     const std::string_view content = aptContent(line);
+                     return content.empty() || continuesRecord(content);
+                   });
   std::vector<AptChunk> chunks(pieces.size());
   // A chunk's error counts only if no FINI comes before it: kept, and thrown in file order below.
   std::vector<std::exception_ptr> errors(pieces.size());

@@ -280,8 +280,17 @@ std::size_t scanPathFile(const std::filesystem::path& file, const PathReadOption
   switch (pathFormatOf(file)) {
     case PathFormat::Npy:
       return scanNpy(file, options, sink);
-    case PathFormat::Apt:
-      return handOver(readAptPath(file, options), options, sink);
+    case PathFormat::Apt: {
+      const PathFile path = readAptPath(file, options);
+      if (sink.tool_records) {
+        PathFile records;
+        records.file = path.file;
+        records.cutters = path.cutters;
+        records.tool_loads = path.tool_loads;
+        sink.tool_records(records);
+      }
+      return handOver(path, options, sink);
+    }
     case PathFormat::Cl:
       break;
   }

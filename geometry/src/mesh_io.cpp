@@ -133,8 +133,13 @@ std::string readableAssimpError(const std::string& why) {
     return "a face with fewer than 3 vertices (a line or a point; a mesh needs triangles or "
            "polygons) [" +
            why + "]";
-  if (why.find("mIndices[") != std::string::npos && why.find("out of range") != std::string::npos)
-    return "a face names a vertex the file does not have (index out of range) [" + why + "]";
+  if (why.find("mIndices[") != std::string::npos && why.find("out of range") != std::string::npos) {
+    // "aiMesh::mFaces[3]::mIndices[2] is out of range": face 4 as read, its third corner.
+    const std::size_t at = why.find("mFaces[");
+    const long face = at == std::string::npos ? -1 : std::atol(why.c_str() + at + 7);
+    return (face >= 0 ? "face " + std::to_string(face + 1) + " (as read)" : std::string("a face")) +
+           " names a vertex the file does not have (index out of range) [" + why + "]";
+  }
   return why;
 }
 
@@ -221,35 +226,45 @@ bool isRewrittenCopy(const std::filesystem::path& file) {
 }
 
 /// An OBJ's text with comments after a line's data cut off (`f 1 2 3  # cap`: assimp read
-/// `#` as a face index, "OBJ: Invalid face index"); none where no line has one. A line that is
-/// a comment from its start is assimp's to skip.
-std::optional<std::string> objWithoutTrailingComments(const std::filesystem::path& file) {
+/// `#` as a face index, "OBJ: Invalid face index") and the blanks before a line's key taken away
+/// (assimp 5.2 reads keys at a line's start only: indented `v` lines were no vertices, "vertex
+/// index out of range", an adversary's file); none where no line needs either. A line that is a
+/// comment from its start is assimp's to skip.
+std::optional<std::string> objTidied(const std::filesystem::path& file) {
   if (lowerExtension(file) != ".obj") return std::nullopt;
+  // A line's data start, and where a comment after it starts (npos: none).
+  const auto cuts = [](const std::string& line) {
+    const std::size_t data = line.find_first_not_of(" \t");
+    const std::size_t hash = line.find('#');
+    return std::pair{data, hash != std::string::npos && data < hash ? hash : std::string::npos};
+  };
   std::ifstream in(file, std::ios::binary);
   std::string line;
   bool found = false;
   while (!found && std::getline(in, line)) {
-    const std::size_t hash = line.find('#');
-    found = hash != std::string::npos && line.find_first_not_of(" \t") < hash;
+    const auto [data, comment] = cuts(line);
+    found = comment != std::string::npos ||
+            (data != 0 && data != std::string::npos && line[data] != '#' && line[data] != '\r');
   }
   if (!found) return std::nullopt;
   in.clear();
   in.seekg(0);
   std::string text;
   while (std::getline(in, line)) {
-    const std::size_t hash = line.find('#');
-    if (hash != std::string::npos && line.find_first_not_of(" \t") < hash) line.erase(hash);
+    const auto [data, comment] = cuts(line);
+    if (comment != std::string::npos) line.erase(comment);
+    if (data != std::string::npos) line.erase(0, data);
     text += line;
     text += '\n';
   }
   return text;
 }
 
-/// An OBJ that assimp refused, or whose face came out naming no vertex: the line of its first
-/// bad face index where one is found (assimp's message has none), thrown; nothing else.
-void throwObjFaceFault(const std::filesystem::path& file) {
+/// An OBJ that assimp refused, or whose vertex or face came out wrong: the line of its first bad
+/// vertex or face index where one is found (assimp's message has none), thrown; nothing else.
+void throwObjFault(const std::filesystem::path& file) {
   if (lowerExtension(file) != ".obj") return;
-  if (std::string fault = detail::objFaceFault(file); !fault.empty()) throw InputError(fault);
+  if (std::string fault = detail::objFault(file); !fault.empty()) throw InputError(fault);
 }
 
 }  // namespace
@@ -259,6 +274,12 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
   common::requireRegularFile(file, "mesh file");
   const std::uintmax_t size = std::filesystem::file_size(file, ec);
   if (ec || size == 0) throw InputError(file.string() + ": empty file");
+  // A CAD model where a mesh was meant (a common slip: the part's STEP beside its STL): assimp
+  // said "IFC: Unrecognized file schema" (an adversary's).
+  if (firstBytes(file, 64).find("ISO-10303-21") <= 4)  // (after a byte-order mark, blanks)
+    throw InputError(file.string() +
+                     ": a STEP CAD model (ISO-10303-21), not a mesh: export it as STL, OBJ or PLY "
+                     "(a chordal tolerance of a few micrometres)");
   if (startsWithByteOrderMark(file, size)) {
     if (isRewrittenCopy(file))
       throw InputError(file.string() + ": starts with two UTF-8 byte-order marks");
@@ -323,19 +344,19 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
         if (text[i] == '\n' && (i == 0 || text[i - 1] != '\r')) text.insert(i, 1, '\r');
       scene = importer.ReadFileFromMemory(text.data(), text.size(), aiProcess_ValidateDataStructure,
                                           "ply");
-    } else if (const auto obj = objWithoutTrailingComments(file)) {
+    } else if (const auto obj = objTidied(file)) {
       scene = importer.ReadFileFromMemory(obj->data(), obj->size(), aiProcess_ValidateDataStructure,
                                           "obj");
     } else {
       scene = importer.ReadFile(file.string(), aiProcess_ValidateDataStructure);
     }
   } catch (const std::exception& e) {
-    throwObjFaceFault(file);
+    throwObjFault(file);
     throw InputError(file.string() + ": cannot read mesh: " + readableAssimpError(e.what()));
   }
   if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 ||
       scene->mRootNode == nullptr) {
-    throwObjFaceFault(file);
+    throwObjFault(file);
     const std::string why = importer.GetErrorString();
     throw InputError(file.string() + ": cannot read mesh" +
                      (why.empty() ? std::string() : ": " + readableAssimpError(why)));
@@ -351,9 +372,11 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
       const aiVector3D v = transform * in->mVertices[i];
       if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z) ||
           std::abs(v.x) > common::kMaxCoordinateMm || std::abs(v.y) > common::kMaxCoordinateMm ||
-          std::abs(v.z) > common::kMaxCoordinateMm)
-        throw InputError(file.string() + ": vertex " + std::to_string(i + 1) +
-                         " is not finite or beyond +-1e6 mm");
+          std::abs(v.z) > common::kMaxCoordinateMm) {
+        throwObjFault(file);
+        // (assimp's count of vertices, not the file's: an OBJ's fourth read "vertex 6")
+        throw InputError(file.string() + ": a vertex is not finite or lies beyond +-1e6 mm");
+      }
       const auto [it, added] =
           index_of.try_emplace({v.x, v.y, v.z}, static_cast<int>(mesh.vertices.size()));
       if (added) mesh.vertices.emplace_back(v.x, v.y, v.z);
@@ -364,7 +387,7 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
       if (face.mNumIndices < 3 || face.mIndices == nullptr) continue;  // points and lines
       for (unsigned k = 0; k < face.mNumIndices; ++k)
         if (face.mIndices[k] >= in->mNumVertices) {
-          throwObjFaceFault(file);
+          throwObjFault(file);
           throw InputError(file.string() + ": face " + std::to_string(f + 1) +
                            " names a vertex that does not exist");
         }

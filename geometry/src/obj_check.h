@@ -1,17 +1,20 @@
 #pragma once
-/// An OBJ's faces checked for the line a bad vertex index is on. assimp 5.2 says only "OBJ:
-/// Invalid face index." or, after validation, "mIndices[..] out of range", with no line (a blisk
-/// helper's file: one typo in 90 000 lines). Run where assimp refused the file or a face came
-/// out naming no vertex: a diagnosis, not a second reader.
+/// An OBJ's vertex and face lines checked for the line a fault is on. assimp 5.2 says only "OBJ:
+/// Invalid face index.", "vertex index out of range" or, after validation, "mIndices[..] out of
+/// range", with no line (a blisk helper's file: one typo in 90 000 lines), and numbers vertices
+/// as it expands them (a NaN on line 4 read "vertex 6"). Run where assimp refused the file or a
+/// vertex or face came out wrong: a diagnosis, not a second reader.
 #include <filesystem>
 #include <string>
 
 namespace fieldpath::geometry::detail {
 
-/// "FILE:LINE: face index K: WHY (the file has V vertices)" for the first face (`f` line) whose
-/// vertex index is not an integer, is 0, or names a vertex the file does not have (1-based; a
-/// negative index counts back from the vertices read so far, as OBJ says); empty where every
-/// index is good.
-std::string objFaceFault(const std::filesystem::path& file);
+/// "FILE:LINE: ..." for the first statement (lines joined where one ends in `\`, as OBJ
+/// continues them; keys after leading blanks) that is a vertex (`v`) without three finite
+/// coordinates, or a face (`f`) whose vertex index is not an integer, is 0, or names a vertex the
+/// file does not have (1-based; a negative index counts back from the vertices read so far, as
+/// OBJ says); ": no vertex ..." for a file of none (comments only, or another format saved as
+/// .obj); empty where none of these is.
+std::string objFault(const std::filesystem::path& file);
 
 }  // namespace fieldpath::geometry::detail

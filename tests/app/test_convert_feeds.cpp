@@ -191,6 +191,23 @@ TEST(ConvertFeeds, TldataMillIsTheFilesCutter) {
   EXPECT_NE(check.err.find("nx.cls:1: TLDATA says the path was written for a 16 mm cutter"),
             std::string::npos)
       << check.err;
+  // simulate against its --tool (its length not compared: no holder there), view on the
+  // terminal as on its page (both were silent: an adversary's)
+  const Outcome sim =
+      runFieldpath(dir, "simulate --tool ball:3 --path nx.cls --stock 1 --grid 64x64 --out sim");
+  EXPECT_EQ(sim.exit_code, 0) << sim.err;
+  EXPECT_NE(sim.err.find("note: nx.cls:1: TLDATA says the path was written for a 16 mm cutter "
+                         "with a 0 mm corner; --tool is a ball of radius 3 mm (6 mm): what "
+                         "follows is for --tool, not the file's"),
+            std::string::npos)
+      << sim.err;
+  const Outcome flat =
+      runFieldpath(dir, "simulate --tool flat:8:20 --path nx.cls --stock 1 --grid 64x64 --out sim");
+  EXPECT_EQ(flat.err.find("TLDATA says"), std::string::npos) << flat.err;  // 16 mm flat: the same
+  const Outcome view = runFieldpath(dir, "view scene.yaml --path nx.cls --out view.html");
+  EXPECT_NE(view.out.find("note: nx.cls:1: TLDATA says the path was written for a 16 mm cutter"),
+            std::string::npos)
+      << view.out;
 }
 
 // A file that loads a second tool (`LOAD/TOOL,n`, `LOADTL/n`) is said: every motion is proven

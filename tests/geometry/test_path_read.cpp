@@ -277,6 +277,24 @@ TEST(PathRead, AptAfterFiniIsNotReadWhateverTheChunks) {
   fs::remove(file);
 }
 
+TEST(PathRead, AptCommentLinesInsideAContinuedRecordAreReadPast) {
+  // `$$` lines (and blank ones) between the cards of a `$`-continued record, as CATIA writes
+  // them: read past, the record goes on (refused as "GOTO: expected comma-separated numbers", an
+  // adversary's); every chunking the same postures, the next record's line kept.
+  const std::string text =
+      "PARTNO/X\nMULTAX/ON\nGOTO/1,2,0,$\n$$ the axis\n\n   $$ more\n0,0,1\nGOTO/4,5,6\n";
+  const fs::path file = writeBytes("comment_cont.apt", text);
+  for (std::size_t bytes : kChunkBytes)
+    for (unsigned threads : {1u, 0u}) {
+      const PathFile p = read(file, bytes, threads);
+      ASSERT_EQ(p.postures.size(), 2u) << bytes;
+      EXPECT_EQ(p.postures[0].tip_mm, Vec3(1, 2, 0)) << bytes;
+      EXPECT_EQ(p.postures[1].tip_mm, Vec3(4, 5, 6)) << bytes;
+      EXPECT_EQ(p.postures[1].axis, Vec3(0, 0, 1)) << bytes;
+      EXPECT_EQ(p.where(1), file.string() + ":8") << bytes;
+    }
+}
+
 TEST(PathRead, AptCutterRecordsInMmWhateverTheChunks) {
   // CUTTER/d, r, ... in the unit of the UNITS record before it (inches x 25.4), a continued one
   // joined, one with words read past; every chunking the same records.

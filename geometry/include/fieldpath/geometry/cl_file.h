@@ -142,6 +142,10 @@ struct PostureChunkSink {
   /// Called once per chunk from worker threads, in any order (chunk indices follow the file,
   /// from 0), with the chunk's postures in file order.
   std::function<void(std::size_t chunk, std::span<const CompactPosture> postures)> chunk;
+  /// Optional: an APT file's tool records (its PathFile without postures: file, cutters,
+  /// tool_loads), once, before `begin` (APT is read whole: scanPathFile's chunks are handed on
+  /// after). Not called for .cl and .npy, which have none.
+  std::function<void(const PathFile& records)> tool_records;
 };
 
 /// The postures of a path file, compact, without keeping the whole PathFile: for big files.
