@@ -306,9 +306,18 @@ void walkAsciiValues(const std::filesystem::path& file, std::ifstream& in,
         const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
         return ec == std::errc() && end == text.data() + text.size();
       };
+      // The values the properties take here (a list's by its count), counted as they are read:
+      // unknown (`counted` false) where a list's count lies past the line's end.
+      std::size_t taken = 0;
+      bool counted = true;
       for (const PlyProperty& p : element.properties) {
         double value = 0.0;
-        if (at >= values.size()) break;  // short: said below with the count
+        ++taken;
+        if (at >= values.size()) {  // short: said below with the count
+          counted = p.count_bytes == 0 && counted;
+          if (!counted) break;
+          continue;
+        }
         if (!number_at(at, value))
           throw InputError(where + ": '" + std::string(values[at].substr(0, 20)) +
                            "' is not a number (" + p.name + ")");
@@ -324,6 +333,7 @@ void walkAsciiValues(const std::filesystem::path& file, std::ifstream& in,
                            std::string(values[at - 1].substr(0, 20)) + " (the line holds " +
                            std::to_string(values.size()) + " values)");
         const auto n = static_cast<std::size_t>(value);
+        taken += n;
         const bool corners = is_face && (p.name == "vertex_indices" || p.name == "vertex_index");
         for (std::size_t k = 0; k < n && at < values.size(); ++k, ++at) {
           if (!number_at(at, value))
@@ -333,23 +343,6 @@ void walkAsciiValues(const std::filesystem::path& file, std::ifstream& in,
             throw InputError(where + " names vertex " + std::string(values[at].substr(0, 20)) +
                              ", the file has " + std::to_string(vertices) + " (numbered from 0)");
         }
-      }
-      // The values the properties take here (a list's by its count, as read above).
-      std::size_t taken = 0;
-      bool counted = true;
-      for (std::size_t k = 0, p = 0; p < element.properties.size(); ++p) {
-        ++taken;
-        if (element.properties[p].count_bytes == 0) {
-          ++k;
-          continue;
-        }
-        double n = 0.0;
-        if (k >= values.size() || !number_at(k, n)) {
-          counted = false;
-          break;
-        }
-        taken += static_cast<std::size_t>(n);
-        k += 1 + static_cast<std::size_t>(n);
       }
       if (!counted || taken != values.size())
         throw InputError(where + " has " + std::to_string(values.size()) + " values" +
