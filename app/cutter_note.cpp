@@ -35,6 +35,13 @@ std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool, const geome
   const double corner_mm = geometry::cornerRadius(tool);
   std::vector<std::string> notes;
   for (const geometry::PathFile::Cutter& c : path.cutters) {
+    const std::string where = path.file.string() + ":" + std::to_string(c.line) + ": ";
+    if (!(c.diameter_mm > 0.0)) {  // `CUTTER/-6`: a typo or a placeholder, no tool to compare
+      notes.push_back(where + c.record + " gives a diameter of " + mm(c.diameter_mm) +
+                      " mm, no tool: the file does not say which cutter it was written for; " +
+                      "what follows is for " + tool_name + ", " + toolWords(tool));
+      continue;
+    }
     const bool same_diameter = std::abs(c.diameter_mm - 2 * tool.radius_mm) <= kCutterTolMm;
     // CUTTER/d alone is, in APT, a flat end mill (corner radius 0): compared as one.
     const double file_corner_mm = c.corner_mm < 0.0 ? 0.0 : c.corner_mm;
@@ -42,7 +49,6 @@ std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool, const geome
     const bool same_length = !compare_length || c.length_mm < 0.0 ||
                              std::abs(c.length_mm - tool.length_mm) <= kCutterTolMm;
     if (same_diameter && same_corner && same_length) continue;
-    const std::string where = path.file.string() + ":" + std::to_string(c.line) + ": ";
     if (same_diameter && same_corner) {
       // The length alone: the holder sits at it, so a shorter tool in the machine than in the
       // scene brings the holder nearer the part than the proof put it.

@@ -15,7 +15,8 @@ namespace fieldpath::app {
 /// record gives one, or length where it gives one and `compare_length`, by more than 1 um),
 /// "FILE:LINE: ..."; empty when they agree or there are none. At most 3 lines, the last saying
 /// how many more. `tool_name` says whose tool it is ("the scene's tool", "--tool"); the length
-/// is where the holder sits, which `simulate` does not model (it compares none).
+/// is where the holder sits, which `simulate` does not model (it compares none). A record whose
+/// diameter is not > 0 gives no tool: said so.
 std::vector<std::string> cutterNotes(const geometry::ToolSpec& tool, const geometry::PathFile& path,
                                      const std::string& tool_name = "the scene's tool",
                                      bool compare_length = true);

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
+#include <utility>
 
 #include "fieldpath/common/file_digest.h"
 #include "fieldpath/geometry/units.h"
@@ -237,6 +239,30 @@ std::string counted(std::size_t n, const std::string& noun, const std::string& v
   return std::to_string(n) + " " + noun + (n == 1 ? " " + verb_one : "s " + verb_many);
 }
 
+namespace {
+
+/// Where link posture i lies on the axis line of the pass posture its link block joins (the next
+/// pass's first, or the last pass's last), above it: that posture and how far up (mm); none
+/// where it lies elsewhere (the travel plane, a way off the axis).
+std::optional<std::pair<std::size_t, double>> onPassAxis(const geometry::PathFile& path,
+                                                         std::size_t i) {
+  for (const geometry::PathBlock& b : path.blocks) {
+    if (i < b.begin || i >= b.end || b.kind != geometry::PathBlock::Kind::Link) continue;
+    for (const std::size_t j : {b.end, b.begin - 1}) {  // (b.begin 0: j wraps past the end)
+      if (j >= path.postures.size() || inLink(path, j)) continue;
+      const geometry::Posture &p = path.postures[i], &end = path.postures[j];
+      const geometry::Vec3 up = p.tip_mm - end.tip_mm;
+      const double along_mm = up.dot(end.axis);
+      if (geometry::axisAngle(p.axis, end.axis) < 1e-6 && along_mm > 1e-6 &&
+          (up - along_mm * end.axis).norm() <= 1e-6 * std::max(1.0, along_mm))
+        return std::pair(j, along_mm);
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 std::vector<std::string> unsafeReasons(const geometry::PathFile& path,
                                        const pathgen::ClearanceResult& c,
                                        const pathgen::MotionResult& m,
@@ -244,14 +270,33 @@ std::vector<std::string> unsafeReasons(const geometry::PathFile& path,
                                        const std::optional<pathgen::LinkPartResult>& h,
                                        const std::string& link_hint) {
   std::vector<std::string> out;
-  auto posture = [&](std::size_t i) {
-    return postureWhere(path, i) + (inLink(path, i) && !link_hint.empty() ? ": " + link_hint : "");
-  };
   // A pass posture that touches itself: a link's plunge into it (or retract out of it) touches
   // because the pass does, and the link's keys are not the cure (a CAM engineer's mould: the
   // holder met a pin at pass 1's start, and the hint named links.retract and links.safe_z).
   auto passTouches = [&](std::size_t k) {
     return k < c.clearance_mm.size() && !inLink(path, k) && c.clearance_mm[k] <= 0.0;
+  };
+  auto posture = [&](std::size_t i) {
+    if (!inLink(path, i)) return postureWhere(path, i);
+    // A link posture up a pass end's axis: the axis meets the obstacle there, which the travel
+    // plane's keys do not move (an oracle's mould: a link coming down pass 12's start axis into
+    // a rib was hinted with links.retract and links.safe_z).
+    if (const auto on = onPassAxis(path, i)) {
+      const auto [j, along_mm] = *on;
+      char up[32];
+      std::snprintf(up, sizeof up, "%.3g", along_mm);
+      const bool start = j > i;
+      return postureWhere(path, i) + ": " + up + " mm up the axis of the " +
+             (start ? "first" : "last") + " posture of its pass (" + postureWhere(path, j) +
+             "), which meets the obstacle there" +
+             (passTouches(j) ? "; that posture touches too (the pass collides there)"
+              : link_hint.empty()
+                  ? ""
+                  : " (generate's links run along a pass end's axis: not "
+                    "moved by the links' keys; a pass " +
+                        std::string(start ? "starting" : "ending") + " on another axis avoids it)");
+    }
+    return postureWhere(path, i) + (link_hint.empty() ? "" : ": " + link_hint);
   };
   auto motion = [&](std::size_t i) {
     const bool link = inLink(path, i) || inLink(path, i + 1);

@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "apt_records.h"
 #include "fieldpath/geometry/cl_file.h"
 #include "path_chunks.h"
 #include "path_text.h"
@@ -29,48 +30,6 @@ namespace {
 
 using namespace detail;
 using common::InputError;
-
-/// PPRINT, PARTNO, INSERT and REMARK carry text: a `$` in it is the text's (at its end it
-/// swallowed the next GOTO; a Siemens post's `INSERT/R1=$P_TOOLNO` names a variable).
-bool isTextRecord(std::string_view content) {
-  const std::string head = upperCase(std::string(trimmed(content).substr(0, 6)));
-  return head == "PPRINT" || head == "PARTNO" || head == "INSERT" || head == "REMARK";
-}
-
-/// A line without the sequence field of an 80-column card: up to 8 letters or digits in columns
-/// 73-80 after a blank column 72 (classic CLDATA decks number their cards so; such a deck's GOTOs
-/// were refused as bad numbers). Not where the text before ends in a separator (`,` `/` `=`): a
-/// free-format record's last number may stand past column 72.
-std::string_view withoutCardSequence(std::string_view line) {
-  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-  if (line.size() <= kAptColumns || line.size() > 80 || line[kAptColumns - 1] != ' ') return line;
-  const std::string_view field = trimmed(line.substr(kAptColumns));
-  const bool sequence = !field.empty() && std::all_of(field.begin(), field.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) != 0;
-  });
-  const std::string_view card = trimmed(line.substr(0, kAptColumns));
-  if (!sequence || card.empty() || card.back() == ',' || card.back() == '/' || card.back() == '=')
-    return line;
-  return line.substr(0, kAptColumns);
-}
-
-/// A line's content without its `$$` comment and surrounding blanks. A single `$` followed by a
-/// blank continues the statement on the next line and what follows it is a remark
-/// (`GOTO/0,0,-0.5,$ first part` was refused as a bad number); the content then ends at that
-/// `$`. Not in text records, whose text may hold a `$`.
-std::string_view aptContent(std::string_view line) {
-  line = withoutCardSequence(line);
-  if (const auto comment = line.find("$$"); comment != std::string_view::npos)
-    line = line.substr(0, comment);
-  line = trimmed(line);
-  if (!isTextRecord(line))
-    if (const auto dollar = line.find("$ "); dollar != std::string_view::npos)
-      line = line.substr(0, dollar + 1);
-  if (!isTextRecord(line))
-    if (const auto dollar = line.find("$\t"); dollar != std::string_view::npos)
-      line = line.substr(0, dollar + 1);
-  return line;
-}
 
 /// What one chunk of an APT file leaves to the chunks around it.
 struct AptChunk {
@@ -88,15 +47,7 @@ struct AptChunk {
   /// CUTTER records in file units, each with the count of this chunk's UNITS records before it.
   std::vector<std::pair<std::size_t, PathFile::Cutter>> cutters;
   std::vector<PathFile::ToolLoad> tool_loads;  ///< in the file's order
-  /// FEDRAT records: the feed (`from`: this chunk's posture after it) as written, in mm per
-  /// minute times `unit` (0: the file's unit in force, the count of this chunk's UNITS records
-  /// before it in `units_before`).
-  struct Feed {
-    PathFile::Feed feed;
-    double unit = 1.0;
-    std::size_t units_before = 0;
-  };
-  std::vector<Feed> feeds;
+  std::vector<AptFeed> feeds;                  ///< FEDRAT records, in the file's order
   std::size_t from_line = 0;  ///< its first FROM record's line (0: none)
   /// FROM/x, y, z[, ...] records (the start and home point), in file units: `posture` is the
   /// chunk's posture after it, `units_before` the count of its UNITS records before it.
@@ -117,85 +68,6 @@ struct AptChunk {
   std::size_t msys_line = 0;  ///< its first MSYS record that is not the identity (0: none)
   std::size_t cutcom_line = 0;  ///< its first CUTCOM record that is not CUTCOM/OFF (0: none)
 };
-
-/// The leading finite numbers of comma-separated `values` (at most `max`, into v): how many.
-std::size_t leadingNumbers(std::string_view values, double* v, std::size_t max) {
-  std::size_t count = 0;
-  for (std::size_t start = 0; start <= values.size() && count < max;) {
-    const auto comma = std::min(values.find(',', start), values.size());
-    const std::string_view token = trimmed(values.substr(start, comma - start));
-    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), v[count]);
-    if (ec != std::errc() || end != token.data() + token.size() || !std::isfinite(v[count])) break;
-    ++count;
-    start = comma + 1;
-  }
-  return count;
-}
-
-/// CUTTER/d[, r, ...]: diameter, corner radius and length (the value at `length_at`, 0-based:
-/// 6 for CUTTER's h, 2 for TLDATA/MILL's l) in file units, or nothing when the first value is
-/// not a number (a CAM's `CUTTER/TOOL1`: read past, as DESIGN.md says of CUTTER).
-std::optional<PathFile::Cutter> cutterOf(std::string_view values, std::size_t line,
-                                         std::size_t length_at) {
-  double v[7] = {0.0, -1.0};
-  const std::size_t count = leadingNumbers(values, v, length_at + 1);
-  if (count == 0 || !(v[0] > 0.0)) return std::nullopt;
-  PathFile::Cutter cutter{v[0], count >= 2 && v[1] >= 0.0 ? v[1] : -1.0, line};
-  if (count > length_at && v[length_at] > 0.0) cutter.length_mm = v[length_at];
-  return cutter;
-}
-
-/// A FEDRAT record's feed: its number in `feed.mm_per_min` and, in `unit`, mm per unit of it:
-/// 1 with MMPM, 25.4 with IPM, 0 (the file's unit) with none or PERMIN. NaN, with the record's
-/// text in `feed.text`, where it is per revolution (IPR, MMPR, PERREV, REV), inverse time
-/// (INVERS), or not read whole: no number or one <= 0, a second number, a word of no feed
-/// (`FEDRAT/IMP,10`, a typo, was read as 10 mm/min) or two units.
-AptChunk::Feed feedOf(std::string_view values, std::size_t line, std::size_t posture) {
-  AptChunk::Feed out;
-  out.feed = {posture, std::numeric_limits<double>::quiet_NaN(), line, {}};
-  out.unit = 0.0;
-  int numbers = 0, units = 0;
-  bool understood = true;
-  double value = 0.0;
-  for (std::size_t start = 0; start <= values.size();) {
-    const auto comma = std::min(values.find(',', start), values.size());
-    std::string_view token = trimmed(values.substr(start, comma - start));
-    start = comma + 1;
-    if (!token.empty() && token.front() == '+') token.remove_prefix(1);  // as GOTO reads `+1`
-    double v = 0.0;
-    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), v);
-    if (!token.empty() && ec == std::errc() && end == token.data() + token.size()) {
-      value = v;
-      understood = understood && ++numbers == 1 && std::isfinite(v) && v > 0.0;
-    } else if (token == "MMPM" || token == "IPM" || token == "PERMIN") {
-      out.unit = token == "MMPM" ? 1.0 : token == "IPM" ? 25.4 : 0.0;
-      understood = understood && ++units == 1;
-    } else {  // per revolution, inverse time, or a word of no feed
-      understood = false;
-    }
-  }
-  if (understood && numbers == 1) {
-    out.feed.mm_per_min = value;
-  } else {
-    out.feed.text =
-        std::string(trimmed(values.substr(0, std::min<std::size_t>(values.size(), 60))));
-  }
-  return out;
-}
-
-/// mm per unit of a UNITS record's value (MM, INCHES), 0 if unknown.
-double unitScale(std::string_view value) {
-  if (value == "MM" || value == "MILLIMETERS" || value == "MILLIMETRES") return 1.0;
-  if (value == "INCHES" || value == "INCH" || value == "IN") return 25.4;
-  return 0.0;
-}
-
-/// Whether a line's content goes on in the next line (`$` at its end, not a text record's).
-/// Decided by the line alone, so that the chunk splitter and the parser agree: a PPRINT line
-/// inside a continued record ends it too (the fuzzer found them disagreeing there).
-bool continuesRecord(std::string_view content) {
-  return !content.empty() && content.back() == '$' && !isTextRecord(content);
-}
 
 void parseAptChunk(std::string_view text, std::size_t first_line,
                    const std::filesystem::path& file, AptChunk& out) {
@@ -438,7 +310,8 @@ void resolveRelativeMoves(AptChunk& c, double chunk_scale, const std::filesystem
   const auto takeFromsUpTo = [&](std::size_t k) {
     for (; next_from < c.froms.size() && c.froms[next_from].posture <= k; ++next_from) {
       AptChunk::From from = c.froms[next_from];
-      from.tip *= from.units_before ? c.units[from.units_before - 1].second : chunk_scale;
+      from.tip =
+          inMm(from.tip, from.units_before ? c.units[from.units_before - 1].second : chunk_scale);
       home = from;
     }
   };
@@ -454,7 +327,7 @@ void resolveRelativeMoves(AptChunk& c, double chunk_scale, const std::filesystem
       if (!before)
         fail(file, line, "GODLTA/: no position before it to move from (a GOTO or a FROM/)");
       const Vec3 move = along_axis ? postures[k].tip_mm.x() * postures[k].axis : postures[k].tip_mm;
-      postures[k].tip_mm = *before + move;
+      postures[k].tip_mm = onPicometres(*before + move);
     } else if (next_home < c.home.size() && c.home[next_home] == k) {
       ++next_home;
       if (!home) fail(file, line, "GOHOME: no FROM/x, y, z before it (the home point it goes to)");
@@ -528,12 +401,12 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
     tool_loads.insert(tool_loads.end(), c.tool_loads.begin(), c.tool_loads.end());
     for (auto& [units_before, cutter] : c.cutters) {  // in the unit of the record before it
       const double unit = units_before ? c.units[units_before - 1].second : scale;
-      cutter.diameter_mm *= unit;
-      if (cutter.corner_mm > 0.0) cutter.corner_mm *= unit;
-      if (cutter.length_mm > 0.0) cutter.length_mm *= unit;
+      cutter.diameter_mm = inMm(cutter.diameter_mm, unit);
+      if (cutter.corner_mm > 0.0) cutter.corner_mm = inMm(cutter.corner_mm, unit);
+      if (cutter.length_mm > 0.0) cutter.length_mm = inMm(cutter.length_mm, unit);
       cutters.push_back(cutter);
     }
-    for (const AptChunk::Feed& f : c.feeds) {  // in the unit in force at the record
+    for (const AptFeed& f : c.feeds) {  // in the unit in force at the record
       PathFile::Feed feed = f.feed;
       const double unit = f.unit > 0.0     ? f.unit
                           : f.units_before ? c.units[f.units_before - 1].second
@@ -548,7 +421,7 @@ PathFile readAptPath(const std::filesystem::path& file, const PathReadOptions& o
     for (std::size_t k = 0; k < postures.size(); ++k) {
       while (next_unit < c.units.size() && c.units[next_unit].first <= k)
         scale = c.units[next_unit++].second;
-      postures[k].tip_mm *= scale;
+      postures[k].tip_mm = inMm(postures[k].tip_mm, scale);
       // Checked in mm: 50000 inches passed the readers' +-1e6 as read, then `convert` refused
       // its own 1.27e6 mm output (a helper's finding).
       if (scale != 1.0 && !too_far) {

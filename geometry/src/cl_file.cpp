@@ -40,7 +40,8 @@ bool isLimitNote(std::string_view comment) {
 
 std::string PathFile::where(std::size_t i) const {
   if (i >= lines.size()) return file.string();
-  return rows ? file.string() + ": row " + std::to_string(lines[i])
+  // Rows as numpy counts them, from 0, which is said (a user counting from 1 read one off).
+  return rows ? file.string() + ": row " + std::to_string(lines[i]) + " (from 0)"
               : file.string() + ":" + std::to_string(lines[i]);
 }
 

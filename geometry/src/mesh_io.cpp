@@ -323,6 +323,9 @@ TriangleMesh loadMesh(const std::filesystem::path& file) {
                                           : "mesh file of " + common::formatBytes(bytes),
                         common::MemoryUse::kPassing);
 
+  if (lowerExtension(file) == ".obj")
+    if (std::string fault = detail::objStatementFault(file); !fault.empty())
+      throw InputError(fault);
   Assimp::Importer importer;
   const aiScene* scene = nullptr;
   try {

@@ -167,9 +167,10 @@ Posture rowPosture(const std::filesystem::path& file, const NpyRows& a, std::uin
   for (std::size_t c = 0; c < a.columns; ++c) {
     v[c] = a.at(r, c);
     if (!std::isfinite(v[c]))
-      bad(file, "row " + std::to_string(r) + ", column " + std::to_string(c) + ": not finite");
+      bad(file, "row " + std::to_string(r) + ", column " + std::to_string(c) +
+                    " (both counted from 0, as numpy does): not finite");
   }
-  const auto where = [&] { return file.string() + ": row " + std::to_string(r); };
+  const auto where = [&] { return file.string() + ": row " + std::to_string(r) + " (from 0)"; };
   return checkedPosture(v, a.columns, where);
 }
 

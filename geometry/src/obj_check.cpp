@@ -1,9 +1,11 @@
 #include "obj_check.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <iterator>
 #include <string_view>
 #include <system_error>
 
@@ -111,6 +113,38 @@ std::string objFault(const std::filesystem::path& file) {
       return where + "face index '" + std::string(index_text.substr(0, 20)) + "': " + why +
              " (the file has " + std::to_string(total) + " vertices)";
     }
+  }
+  return {};
+}
+
+std::string objStatementFault(const std::filesystem::path& file) {
+  // The OBJ specification's statements of polygonal geometry, grouping, display and rendering
+  // (`fo`: an old face; `csh`: a shell command, read past as assimp does).
+  static constexpr std::string_view kPolygonal[] = {
+      "v",   "vt",    "vn",       "vp",       "f",          "fo",        "l",      "p",
+      "g",   "o",     "s",        "mg",       "usemtl",     "mtllib",    "usemap", "maplib",
+      "lod", "bevel", "c_interp", "d_interp", "shadow_obj", "trace_obj", "csh"};
+  static constexpr std::string_view kFreeForm[] = {
+      "cstype", "deg",  "bmat", "step", "curv", "curv2", "surf",  "parm",
+      "trim",   "hole", "scrv", "sp",   "end",  "con",   "ctech", "stech"};
+  Statements statements(file);
+  std::string text;
+  std::size_t line = 0;
+  while (statements.next(text, line)) {
+    std::size_t at = 0;
+    const std::string_view key = nextWord(text, at);
+    if (key.empty() ||
+        std::find(std::begin(kPolygonal), std::end(kPolygonal), key) != std::end(kPolygonal))
+      continue;
+    const std::string where =
+        file.string() + ":" + std::to_string(line) + ": `" + std::string(key.substr(0, 20)) + "`";
+    if (std::find(std::begin(kFreeForm), std::end(kFreeForm), key) != std::end(kFreeForm))
+      return where +
+             ": free-form geometry (curves and surfaces) is not read: export the part as a "
+             "polygon mesh (triangles)";
+    if (key == "call")
+      return where + ": another file's statements are not read: export the part as one mesh";
+    return where + ": not an OBJ statement (v, vt, vn, f, l, g, o, s, usemtl, ...)";
   }
   return {};
 }

@@ -17,4 +17,12 @@ namespace fieldpath::geometry::detail {
 /// .obj); empty where none of these is.
 std::string objFault(const std::filesystem::path& file);
 
+/// "FILE:LINE: ..." for the first statement whose key is no OBJ polygon statement: free-form
+/// geometry (`cstype`, `curv`, `surf`, ...: a part given so would lose those surfaces; assimp
+/// then dropped the faces after them, "Mesh contains no faces"), `call` (another file's
+/// statements), or a key OBJ does not have (`foo 1 2 3` was read by assimp as a face, its first
+/// letter's: a triangle more, without a word, an adversary's). Empty where every key is one.
+/// Run before assimp reads the file.
+std::string objStatementFault(const std::filesystem::path& file);
+
 }  // namespace fieldpath::geometry::detail

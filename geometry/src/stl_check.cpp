@@ -186,13 +186,14 @@ StlFeed checkStl(const std::filesystem::path& file, std::uintmax_t size) {
     feed.triangles = (needed - 84) / 50;
     return feed;
   };
-  if (word == "solid" && got == 84) {
-    // A binary STL whose header starts so (CAD exports): its size matches its count.
-    const std::uint32_t count = std::uint32_t(header[80]) | std::uint32_t(header[81]) << 8 |
-                                std::uint32_t(header[82]) << 16 | std::uint32_t(header[83]) << 24;
-    if (binaryFits(84 + 50 * std::uintmax_t(count)))
-      return binaryFeed(84 + 50 * std::uintmax_t(count));
-  }
+  // A binary header's triangle count, and the size it gives (0 and 84 where there is none).
+  const std::uint32_t count =
+      got < 84 ? 0
+               : std::uint32_t(header[80]) | std::uint32_t(header[81]) << 8 |
+                     std::uint32_t(header[82]) << 16 | std::uint32_t(header[83]) << 24;
+  const std::uintmax_t needed = 84 + 50 * std::uintmax_t(count);
+  // A binary STL whose header starts so (CAD exports): its size matches its count.
+  if (word == "solid" && got == 84 && binaryFits(needed)) return binaryFeed(needed);
   // Else ASCII, unless it holds a NUL byte: a binary one cut short or padded (it was read as
   // ASCII "without `endsolid`"); its counts are said below.
   if (word == "solid" && !hasNulByte(file)) {
@@ -201,12 +202,20 @@ StlFeed checkStl(const std::filesystem::path& file, std::uintmax_t size) {
     feed.copy = feed.copy || first > 0;
     return feed;
   }
+  // Text, not `solid ...`, that no binary STL's size fits: another format named .stl (an OBJ's
+  // `v 0 0 0` read as a binary header said "811479840 triangles", an adversary's).
+  if (!binaryFits(needed) && !hasNulByte(file)) {
+    std::string start;
+    for (std::size_t k = first; k < got && header[k] != '\n' && header[k] != '\r' && k < first + 40;
+         ++k)
+      start += std::isprint(header[k]) ? static_cast<char>(header[k]) : '?';
+    throw InputError(file.string() + ": text that does not start with `solid`, as an ASCII STL " +
+                     "does (it starts \"" + start +
+                     "\"): not STL; another format named .stl? (OBJ starts `v`, PLY `ply`)");
+  }
   if (got < 84)
     throw InputError(file.string() + ": binary STL of " + std::to_string(size) +
                      " bytes, shorter than its 84-byte header (truncated, or not STL)");
-  const std::uint32_t count = std::uint32_t(header[80]) | std::uint32_t(header[81]) << 8 |
-                              std::uint32_t(header[82]) << 16 | std::uint32_t(header[83]) << 24;
-  const std::uintmax_t needed = 84 + 50 * std::uintmax_t(count);
   if (!binaryFits(needed))
     throw InputError(file.string() + ": binary STL: its header says " + std::to_string(count) +
                      " triangles (" + std::to_string(needed) + " bytes), the file has " +

@@ -36,6 +36,13 @@ TEST(CutterNotes, SaidWhenTheFileWasWrittenForAnotherTool) {
             "job.apt:4: CUTTER says the path was written for a 10 mm cutter with a 5 mm corner; "
             "the scene's tool is a ball of radius 3 mm (6 mm): what follows is for the scene's "
             "tool, not the file's");
+  // a diameter not > 0 (`CUTTER/-6`, a typo or a placeholder) gives no tool: said so
+  const auto none = cutterNotes(ball, withCutters({{-6.0, 3.0, 5}}));
+  ASSERT_EQ(none.size(), 1u);
+  EXPECT_EQ(none[0],
+            "job.apt:5: CUTTER gives a diameter of -6 mm, no tool: the file does not say which "
+            "cutter it was written for; what follows is for the scene's tool, a ball of radius "
+            "3 mm (6 mm)");
   // a flat end mill of the same diameter differs by its corner
   EXPECT_EQ(cutterNotes(ball, withCutters({{6.0, 0.0, 7}})).size(), 1u);
   geometry::ToolSpec torus;

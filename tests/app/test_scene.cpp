@@ -496,6 +496,48 @@ TEST(JobText, APlungeIntoATouchingPassBlamesThePass) {
   EXPECT_NE(reasons[1].find("its end in the pass touches too"), std::string::npos) << reasons[1];
 }
 
+// A link posture up a pass's first axis meets the obstacle because that axis does: said so, not
+// hinted with the links' keys, which do not move it (an oracle's mould: a link coming down pass
+// 12's start axis into a rib). One elsewhere (the travel plane) keeps the hint.
+TEST(JobText, ALinkUpAPassAxisBlamesTheAxis) {
+  using geometry::PathBlock;
+  geometry::PathFile path;
+  const geometry::Vec3 axis = geometry::Vec3(1, 0, 1).normalized();
+  const geometry::Vec3 start(10, 0, 0);
+  path.postures.resize(5);
+  path.postures[0].tip_mm = start + geometry::Vec3(-30, 0, 40);  // in the travel plane
+  path.postures[0].axis = axis;
+  path.postures[1].tip_mm = start + 7.5 * axis;  // retract above the start, on its axis
+  path.postures[1].axis = axis;
+  for (std::size_t k = 2; k < 5; ++k) {
+    path.postures[k].tip_mm = start + geometry::Vec3(double(k - 2), 0, 0);
+    path.postures[k].axis = axis;
+  }
+  path.blocks = {{PathBlock::Kind::Link, 0, 2}, {PathBlock::Kind::Pass, 2, 5}};
+  pathgen::ClearanceResult c;
+  c.clearance_mm = {5, 0, 1, 1, 1};
+  c.colliding = 1;
+  c.first_colliding = 1;
+  const std::string hint = "THE LINK'S KEYS";
+  std::vector<std::string> reasons = app::unsafeReasons(path, c, {}, {}, {}, hint);
+  ASSERT_EQ(reasons.size(), 1u);
+  EXPECT_EQ(reasons[0].find(hint), std::string::npos) << reasons[0];
+  EXPECT_NE(reasons[0].find("7.5 mm up the axis of the first posture of its pass (posture 2"),
+            std::string::npos)
+      << reasons[0];
+  // Its pass's start touching too: the pass is the cause.
+  c.clearance_mm[2] = 0.0;
+  c.colliding = 2;
+  reasons = app::unsafeReasons(path, c, {}, {}, {}, hint);
+  EXPECT_NE(reasons[0].find("that posture touches too"), std::string::npos) << reasons[0];
+  // Off the axis (turned 1 deg): the links' keys place it.
+  c.clearance_mm[2] = 1.0;
+  c.colliding = 1;
+  path.postures[1].axis = geometry::Vec3(1.02, 0, 1).normalized();
+  reasons = app::unsafeReasons(path, c, {}, {}, {}, hint);
+  EXPECT_NE(reasons[0].find(hint), std::string::npos) << reasons[0];
+}
+
 // Colliding postures with an angle at its limit are counted, by angle, in a note (the UNSAFE line
 // named the collisions only, and the summary's "N postures held at a limit" did not say they were
 // the same ones: an oracle found the limits binding at the corpus's UNSAFE corners, the lead's in

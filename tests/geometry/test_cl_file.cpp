@@ -1,3 +1,4 @@
+#include <charconv>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -345,6 +346,33 @@ TEST(ClFile, ByteOrderMarkIsReadPast) {
   EXPECT_EQ(readAptFile(writeBytes("bom.apt", "\xEF\xBB\xBFGOTO/1,2,3\n")).size(), 1u);
 }
 
+// Inches in mm are the decimals they are (the nearest double to them), as a CAM engineer reads
+// them and `convert` writes them: 0.7874 in was written 19.999959999999998 (an adversary's). A
+// relative move's sum too: 0.1 + 0.2 mm is 0.3, and a CUTTER in inches is its mm.
+TEST(AptFile, InchesAndRelativeMovesAreTheirDecimalsInMm) {
+  const PathFile p = readPathFile(
+      writeBytes("inch_decimals.apt",
+                 "UNITS/INCHES\nCUTTER/0.23622, 0.11811\nGOTO/0.7874, -1.1811, 0.0001, "
+                 "0, 0, 1\nUNITS/MM\nGOTO/0.1, 0, 0\nGODLTA/0.2, 0, 0\n"));
+  ASSERT_EQ(p.postures.size(), 3u);
+  EXPECT_EQ(p.postures[0].tip_mm, Vec3(19.99996, -29.99994, 0.00254));
+  EXPECT_EQ(p.postures[2].tip_mm, Vec3(0.3, 0, 0));
+  ASSERT_EQ(p.cutters.size(), 1u);
+  EXPECT_EQ(p.cutters[0].diameter_mm, 5.999988);
+  EXPECT_EQ(p.cutters[0].corner_mm, 2.999994);
+  // What the writers write of them: the decimals (shortest round trip of the double).
+  char text[64];
+  const auto end = std::to_chars(text, text + sizeof text, p.postures[0].tip_mm.x()).ptr;
+  EXPECT_EQ(std::string(text, end), "19.99996");
+  // A CUTTER whose diameter is not > 0 is kept as written (the notes say it gives no tool; it was
+  // read past without a word), one of words read past.
+  const PathFile q = readPathFile(
+      writeBytes("cutter_negative.apt", "CUTTER/-6, 3\nCUTTER/TOOL1\nGOTO/0,0,0,0,0,1\n"));
+  ASSERT_EQ(q.cutters.size(), 1u);
+  EXPECT_EQ(q.cutters[0].diameter_mm, -6.0);
+  EXPECT_EQ(q.cutters[0].line, 1u);
+}
+
 // UNITS scales what follows to mm (inches: 25.4), an unknown unit is refused with its line, FINI
 // ends the program (a post-processor reads nothing after it), PPRINT remarks are read past.
 TEST(AptFile, UnitsFiniAndRemarks) {
@@ -354,7 +382,8 @@ TEST(AptFile, UnitsFiniAndRemarks) {
       "GOTO/1,2,3\nUNITS/MM\nGOTO/4,5,6\nFINI\nGOTO/7,8,9,0,0,1\n"));
   ASSERT_EQ(p.size(), 3u);
   EXPECT_EQ(p[0].tip_mm, Vec3(1, 2, 3));
-  EXPECT_EQ(p[1].tip_mm, 25.4 * Vec3(1, 2, 3));
+  // On the picometre grid: 3 in is 76.2 mm (the product is 76.19999999999999).
+  EXPECT_EQ(p[1].tip_mm, Vec3(25.4, 50.8, 76.2));
   EXPECT_EQ(p[1].axis, Vec3::UnitZ());
   EXPECT_EQ(p[2].tip_mm, Vec3(4, 5, 6));
   try {

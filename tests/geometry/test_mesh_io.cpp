@@ -430,6 +430,14 @@ TEST(MeshIo, BrokenFilesAreInputErrors) {
                 "binary STL: its header says 2 triangles (184 bytes), the file has 164");
   expectMessage(writeBytes("solid_binary_long.stl", solid_header + facet + facet + facet),
                 "binary STL: its header says 2 triangles (184 bytes), the file has 234");
+  // Text of another format named .stl, short or long: said as text, not as a binary header's
+  // count ("811479840 triangles" of an OBJ's `v 0 0 0`, an adversary's).
+  std::string obj_text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  expectMessage(writeBytes("short_obj.stl", obj_text),
+                "short_obj.stl: text that does not start with `solid`, as an ASCII STL does (it "
+                "starts \"v 0 0 0\"): not STL");
+  for (int k = 0; k < 10; ++k) obj_text += "v 1 1 " + std::to_string(k) + "\n";
+  expectMessage(writeBytes("long_obj.stl", obj_text), "(it starts \"v 0 0 0\"): not STL");
   expectMessage(writeBytes("line.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n"),
                 "a face with fewer than 3 vertices");
   expectMessage(writeBytes("index.ply", ply_header.substr(0, ply_header.find("element face 2")) +
@@ -464,6 +472,22 @@ TEST(MeshIo, BrokenFilesAreInputErrors) {
   expectMessage(writeBytes("only_comments.obj", "# nothing\n# here\n"),
                 "only_comments.obj: no vertex (`v x y z` lines): not an OBJ mesh");
   EXPECT_EQ(loadMesh(writeBytes("indented.obj", "  v 0 0 0\n\tv 1 0 1\n  v 1 1 1\nf 1 2 3\n"))
+                .triangles.size(),
+            1u);
+  // A key OBJ does not have is named with its line (assimp read `foo 1 2 3` as a face: a
+  // triangle more, without a word); free-form geometry is said not read (assimp dropped the
+  // faces after `cstype`: "Mesh contains no faces"); the grouping, material and other polygon
+  // statements are read past.
+  const std::string three = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  expectMessage(writeBytes("unknown_key.obj", three + "foo 1 2 3\nf 1 2 3\n"),
+                "unknown_key.obj:4: `foo`: not an OBJ statement");
+  expectMessage(writeBytes("free_form.obj", three + "cstype bspline\nf 1 2 3\n"),
+                "free_form.obj:4: `cstype`: free-form geometry (curves and surfaces) is not read");
+  expectMessage(writeBytes("call.obj", three + "f 1 2 3\ncall other.obj\n"),
+                "call.obj:5: `call`: another file's statements are not read");
+  EXPECT_EQ(loadMesh(writeBytes("statements.obj",
+                                "mtllib a.mtl\no part\ng walls\n" + three +
+                                    "vt 0 0\nvn 0 0 1\nvp 0.5\nusemtl steel\ns off\nf 1 2 3\n"))
                 .triangles.size(),
             1u);
 }

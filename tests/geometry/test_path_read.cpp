@@ -224,7 +224,8 @@ TEST(PathRead, RefusesTipsBeyondAnyMachine) {
   postures[2].tip_mm.z() = 1e308;
   const fs::path npy = tempPath("far.npy");
   writeNpyFile(npy, postures);
-  EXPECT_NE(errorOf(npy, 4096, 0).find(npy.string() + ": row 2: tool tip z"), std::string::npos)
+  EXPECT_NE(errorOf(npy, 4096, 0).find(npy.string() + ": row 2 (from 0): tool tip z"),
+            std::string::npos)
       << errorOf(npy, 4096, 0);
   // In mm after UNITS/INCHES: 50000 in is 1.27e6 mm (it passed as read, a helper's finding).
   const fs::path inches =
